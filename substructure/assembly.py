@@ -1,0 +1,360 @@
+"""The assembly graph: components connected by joints, with sensors and supports.
+
+Nodes are components, edges are joints; sensors and supports hang on points.
+The assembly owns its bookkeeping (which DOF is where), so one component can
+sit in many assemblies and sweeps at once.  It is immutable: ``add``,
+``connect``, ``attach``, ``support`` and friends return new assemblies.
+
+The coupled receptance between any points is computed by the one generic
+engine of :mod:`substructure.coupling`: the free-free receptances of the
+components at the points that matter (outputs, joint ends, sensor and
+support points) are stacked block-diagonally, and every joint, support and
+sensor is applied as a connection.  Any number of components and any
+topology (chain, branch, loop) work the same way.
+
+An assembly is itself a component: it can be added to a larger assembly,
+which is how a spindle-holder subassembly (modelled or measured) is coupled
+to a tool (thesis eq. 2.2).
+
+Examples
+--------
+>>> from substructure import Assembly, Holder, Tool, Segment
+>>> holder = Holder("holder", [Segment("60 mm", "40 mm")])
+>>> tool = Tool("tool", [Segment("50 mm", "12 mm", material="carbide")])
+>>> asm = (Assembly("demo").add(holder, tool)
+...        .connect("holder.tip", "tool.base", k={"yf": "4e7 N/m", "tm": "6e4 N*m/rad"}))
+>>> frf = asm.receptance("tool.tip", frequency=[1000.0, 2000.0])
+>>> frf.outputs
+('tool.tip:y', 'tool.tip:theta')
+"""
+
+from __future__ import annotations
+
+from typing import Any, Iterable, Sequence
+
+import attrs
+import numpy as np
+
+from .components import as_frequency, dof_labels
+from .coupling import Link, couple_substructures
+from .errors import AssemblyError, InvalidValueError, UnknownPointError
+from .frf import FRF, Frequency
+from .joints import Joint, Sensor, Support
+from .materials import Material
+from .points import DOFS, PointRef, check_name, parse_point
+
+__all__ = ["Assembly"]
+
+
+def _tuple(kind: type | None = None):
+    def convert(value) -> tuple:
+        if value is None:
+            return ()
+        items = tuple(value)
+        if kind is not None:
+            for i, item in enumerate(items):
+                if not isinstance(item, kind):
+                    raise InvalidValueError(f"got {item!r} at position {i}; expected a {kind.__name__}")
+        return items
+
+    return convert
+
+
+def _component_check(items) -> tuple:
+    items = _tuple()(items)
+    for c in items:
+        for attr in ("name", "component_names", "node_key", "receptance_matrix"):
+            if not hasattr(c, attr):
+                raise InvalidValueError(
+                    f"components: {c!r} is not a component (it has no {attr!r}); see "
+                    "substructure.components for the protocol"
+                )
+    return items
+
+
+@attrs.frozen
+class Assembly:
+    """Components connected by joints, with sensors and supports on points.
+
+    Parameters
+    ----------
+    name : str
+    components : sequence
+        Beams, measured components or subassemblies.
+    joints : sequence of Joint
+    supports : sequence of Support
+    sensors : sequence of Sensor
+        Bodies on the structure (they are part of the model: their mass acts).
+    frequency : Frequency, optional
+        Default frequency grid of the computations and commands.
+    materials : sequence of Material
+        Custom materials this assembly was defined with (kept for saving).
+    """
+
+    name: str = attrs.field(default="assembly")
+    components: tuple = attrs.field(default=(), converter=_component_check)
+    joints: tuple[Joint, ...] = attrs.field(default=(), converter=_tuple(Joint))
+    supports: tuple[Support, ...] = attrs.field(default=(), converter=_tuple(Support))
+    sensors: tuple[Sensor, ...] = attrs.field(default=(), converter=_tuple(Sensor))
+    frequency: Frequency | None = attrs.field(default=None)
+    materials: tuple[Material, ...] = attrs.field(default=(), converter=_tuple(Material))
+
+    def __attrs_post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name.strip():
+            raise InvalidValueError(f"name: got {self.name!r}; expected a non-empty string")
+        if self.frequency is not None and not isinstance(self.frequency, Frequency):
+            raise InvalidValueError(f"frequency: got {self.frequency!r}; expected a Frequency")
+        seen: dict[str, str] = {}
+        for comp in self.components:
+            for n in comp.component_names:
+                if n in seen:
+                    raise AssemblyError(
+                        f"component name {n!r} is used twice (in {seen[n]!r} and {comp.name!r}); "
+                        "names must be unique in an assembly"
+                    )
+                seen[n] = comp.name
+        for kind, items in (("joint", self.joints), ("sensor", self.sensors)):
+            names = [i.name for i in items]
+            dup = {n for n in names if names.count(n) > 1}
+            if dup:
+                raise AssemblyError(f"{kind} names used twice: {', '.join(sorted(dup))}")
+        for j in self.joints:
+            for p in j.between:
+                self._resolve(p, f"joint {j.name!r}")
+        for s in self.sensors:
+            self._resolve(s.at, f"sensor {s.name!r}")
+        for s in self.supports:
+            self._resolve(s.at, "support")
+
+    # -- lookup -----------------------------------------------------------
+
+    @property
+    def component_names(self) -> frozenset[str]:
+        """Every component name whose points this assembly answers for."""
+        return frozenset(n for c in self.components for n in c.component_names)
+
+    def _owner(self, ref: PointRef, context: str = ""):
+        for comp in self.components:
+            if ref.component in comp.component_names:
+                return comp
+        where = f"{context}: " if context else ""
+        known = ", ".join(sorted(self.component_names)) or "none"
+        raise UnknownPointError(
+            f"{where}point {ref}: there is no component {ref.component!r} in assembly "
+            f"{self.name!r} (components: {known})"
+        )
+
+    def _resolve(self, point: str | PointRef, context: str = ""):
+        ref = parse_point(point)
+        owner = self._owner(ref, context)
+        try:
+            key = owner.node_key(ref.point)
+        except UnknownPointError as exc:
+            raise UnknownPointError(f"{context}: {exc}" if context else str(exc)) from None
+        return ref, owner, key
+
+    def component(self, name: str):
+        """The component (or the subassembly holding it) called ``name``."""
+        for comp in self.components:
+            if comp.name == name:
+                return comp
+        for comp in self.components:
+            if name in comp.component_names and isinstance(comp, Assembly):
+                return comp.component(name)
+        raise UnknownPointError(f"no component {name!r} in assembly {self.name!r}")
+
+    def joint(self, name: str) -> Joint:
+        for j in self.joints:
+            if j.name == name:
+                return j
+        known = ", ".join(j.name for j in self.joints) or "none"
+        raise UnknownPointError(f"no joint {name!r} in assembly {self.name!r} (joints: {known})")
+
+    def sensor(self, name: str) -> Sensor:
+        for s in self.sensors:
+            if s.name == name:
+                return s
+        known = ", ".join(s.name for s in self.sensors) or "none"
+        raise UnknownPointError(f"no sensor {name!r} in assembly {self.name!r} (sensors: {known})")
+
+    # -- building (each returns a new assembly) ---------------------------
+
+    def add(self, *components) -> "Assembly":
+        """Add components (beams, measured components, subassemblies)."""
+        return attrs.evolve(self, components=self.components + components)
+
+    def connect(self, a: str | Joint, b: str | None = None, *, name: str | None = None,
+                k=None, c=None, rigid: bool = False) -> "Assembly":
+        """Connect two points by a joint: ``connect(joint)`` or ``connect(a, b, k=..., c=...)``.
+
+        Without ``k`` the connection is rigid.
+        """
+        if isinstance(a, Joint):
+            joint = a
+        else:
+            if b is None:
+                raise InvalidValueError("connect: expected two points, or a Joint")
+            rigid = rigid or k is None
+            joint = Joint(name or f"joint-{len(self.joints) + 1}", (a, b), k=None if rigid else k,
+                          c=None if rigid else c, rigid=rigid)
+        return attrs.evolve(self, joints=self.joints + (joint,))
+
+    def attach(self, *sensors: Sensor) -> "Assembly":
+        """Put sensors on the structure."""
+        return attrs.evolve(self, sensors=self.sensors + sensors)
+
+    def support(self, at: str | Support, k=None, c=None) -> "Assembly":
+        """Add springs/dampers to the ground at a point: ``support(Support(...))`` or ``support(at, k, c)``."""
+        sup = at if isinstance(at, Support) else Support(at, k=k, c=c)
+        return attrs.evolve(self, supports=self.supports + (sup,))
+
+    def with_joint(self, joint: Joint) -> "Assembly":
+        """Replace the joint of the same name."""
+        self.joint(joint.name)
+        return attrs.evolve(self, joints=tuple(joint if j.name == joint.name else j for j in self.joints))
+
+    def with_component(self, component) -> "Assembly":
+        """Replace the component of the same name."""
+        if not any(c.name == component.name for c in self.components):
+            raise UnknownPointError(f"no component {component.name!r} in assembly {self.name!r}")
+        return attrs.evolve(
+            self, components=tuple(component if c.name == component.name else c for c in self.components)
+        )
+
+    def without_sensors(self, *names: str) -> "Assembly":
+        """The assembly without the named sensors (all when none is named)."""
+        for n in names:
+            self.sensor(n)
+        keep = tuple(s for s in self.sensors if names and s.name not in names)
+        return attrs.evolve(self, sensors=keep)
+
+    def without(self, *names: str) -> "Assembly":
+        """The assembly without the named components and what hangs on them."""
+        for n in names:
+            if not any(c.name == n for c in self.components):
+                raise UnknownPointError(f"no component {n!r} in assembly {self.name!r}")
+        removed = {m for c in self.components if c.name in names for m in c.component_names}
+
+        def on_removed(point: str) -> bool:
+            return parse_point(point).component in removed
+
+        return attrs.evolve(
+            self,
+            components=tuple(c for c in self.components if c.name not in names),
+            joints=tuple(j for j in self.joints if not any(on_removed(p) for p in j.between)),
+            sensors=tuple(s for s in self.sensors if not on_removed(s.at)),
+            supports=tuple(s for s in self.supports if not on_removed(s.at)),
+        )
+
+    # -- computing ---------------------------------------------------------
+
+    def _frequency(self, frequency) -> Frequency:
+        if frequency is None:
+            if self.frequency is None:
+                raise InvalidValueError(
+                    f"frequency: assembly {self.name!r} has no default grid; pass frequency="
+                )
+            return self.frequency
+        return as_frequency(frequency)
+
+    def receptance_matrix(self, refs: Sequence[PointRef], frequency_hz: np.ndarray) -> np.ndarray:
+        """Coupled receptances between points, ``(2p, 2p, n)`` frequency-last (component protocol)."""
+        f = np.asarray(frequency_hz, dtype=float)
+        # Every point that takes part, deduplicated by physical node.
+        nodes: dict[Any, tuple[Any, PointRef]] = {}
+
+        def node(point) -> Any:
+            ref, owner, key = self._resolve(point)
+            nodes.setdefault(key, (owner, ref.point))
+            return key
+
+        out_keys = [node(r) for r in refs]
+        links = []  # (key_a, key_b or None, object, label)
+        for s in self.sensors:
+            if s.mass_kg > 0 or s.inertia_si > 0:
+                links.append((node(s.at), None, s, f"sensor {s.name!r}"))
+        for i, s in enumerate(self.supports):
+            links.append((node(s.at), None, s, s.name or f"support at {s.at}"))
+        for j in self.joints:
+            ka, kb = node(j.between[0]), node(j.between[1])
+            if ka == kb:
+                raise AssemblyError(f"joint {j.name!r} connects a point to itself")
+            links.append((ka, kb, j, f"joint {j.name!r}"))
+
+        # Free-free receptances of each component at its points, then the engine.
+        by_owner: dict[int, list] = {}
+        for k, (owner, ref) in nodes.items():
+            by_owner.setdefault(id(owner), [owner, []])[1].append((k, ref))
+        blocks = []
+        for owner, items in by_owner.values():
+            blocks.append(([k for k, _ in items], owner.receptance_matrix([ref for _, ref in items], f)))
+        coupling_links = [
+            Link(ka, kb, None if getattr(obj, "rigid", False) else obj.dynamic_stiffness(f), label)
+            for ka, kb, obj, label in links
+        ]
+        return couple_substructures(blocks, coupling_links, out_keys)
+
+    def node_key(self, ref: PointRef):
+        return self._resolve(ref)[2]
+
+    def frf(self, outputs: Sequence[str] | str, inputs: Sequence[str] | str | None = None,
+            frequency=None) -> FRF:
+        """Coupled receptances from ``inputs`` to ``outputs``.
+
+        Parameters
+        ----------
+        outputs, inputs : str or sequence of str
+            Point names; a point without a DOF suffix stands for both its
+            DOFs ``(y, theta)``.  ``inputs`` defaults to ``outputs``.
+        frequency : Frequency or array of Hz, optional
+            Defaults to the assembly's grid.
+        """
+        freq = self._frequency(frequency)
+        outputs = [outputs] if isinstance(outputs, str) else list(outputs)
+        inputs = outputs if inputs is None else ([inputs] if isinstance(inputs, str) else list(inputs))
+        if not outputs or not inputs:
+            raise InvalidValueError("frf: expected at least one output and one input point")
+
+        def expand(points):
+            labels, dof_index, refs = [], [], []
+            for p in points:
+                ref = parse_point(p)
+                refs.append(ref.point)
+                base = str(ref.point)
+                for d, name in enumerate(DOFS):
+                    if ref.dof is None or ref.dof == name:
+                        labels.append(f"{base}:{name}")
+                        dof_index.append((len(refs) - 1, d))
+            return labels, dof_index, refs
+
+        out_labels, out_idx, out_refs = expand(outputs)
+        in_labels, in_idx, in_refs = expand(inputs)
+        refs = out_refs + in_refs
+        y = self.receptance_matrix(refs, freq.hz)
+        rows = [2 * i + d for i, d in out_idx]
+        cols = [2 * (len(out_refs) + i) + d for i, d in in_idx]
+        data = np.moveaxis(y[np.ix_(rows, cols)], -1, 0)
+        return FRF(freq, data, tuple(out_labels), tuple(in_labels))
+
+    def receptance(self, at: str, to: str | None = None, frequency=None) -> FRF:
+        """Receptance at ``at`` due to a load at ``to`` (default: the point receptance).
+
+        Without DOF suffixes this is the 2x2 matrix ``[[H, L], [N, P]]``
+        (conventions.md); ``"tool.tip:y"`` picks one DOF.
+        """
+        return self.frf([at], [to if to is not None else at], frequency)
+
+    def describe(self) -> str:
+        """A few lines describing the assembly, for summaries and teaching."""
+        from .components import component_info
+
+        lines = [f"{self.name}:"]
+        lines += [f"  component {component_info(c)}" for c in self.components]
+        for j in self.joints:
+            what = "rigid" if j.rigid else ", ".join(f"k_{k}={v}" for k, v in j.k.as_dict().items())
+            lines.append(f"  joint {j.name}: {j.between[0]} -- {j.between[1]} ({what})")
+        for s in self.supports:
+            lines.append(f"  support at {s.at}: " + ", ".join(f"k_{k}={v}" for k, v in s.k.as_dict().items()))
+        for s in self.sensors:
+            lines.append(f"  sensor {s.name} at {s.at}: {s.mass:~P}")
+        return "\n".join(lines)

@@ -1,0 +1,370 @@
+"""Components: the substructures an assembly is made of.
+
+A component knows its points and produces its free-free receptances between
+them; it knows nothing of assemblies.  Three kinds ship with the package:
+
+* :class:`Beam` and its kinds :class:`Spindle`, :class:`Holder`,
+  :class:`Tool`: stepped Timoshenko beams from :mod:`substructure.beams`;
+* :class:`MeasuredComponent`: receptances given as data (a tap test, or a
+  computed subassembly), at the points its FRF names;
+* :class:`substructure.assembly.Assembly` itself, so that a subassembly can be
+  coupled like any other component (thesis eq. 2.2).
+
+The protocol a component satisfies (duck-typed, nothing to inherit):
+
+``name``
+    Its name.
+``component_names``
+    The component names whose points it answers for (its own name; all
+    inner names for a subassembly).
+``node_key(ref) -> hashable``
+    A key identifying the physical point of a :class:`~substructure.points.PointRef`
+    (two names of the same place give the same key); raises
+    :class:`~substructure.errors.UnknownPointError` for a point it lacks.
+``receptance_matrix(refs, frequency_hz) -> ndarray``
+    The receptances between the points, shape ``(2p, 2p, n_freq)``
+    (frequency last), DOFs ``(y, theta)`` per point.
+
+New component types are registered with :func:`register_component` so that
+assembly files can name them by their ``type``.
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar, Iterable, Sequence
+
+import attrs
+import numpy as np
+import pint
+
+from .beams import Flutes, Segment, stepped_beam_receptance
+from .errors import FrequencyAxisMismatchError, InvalidValueError, UnknownPointError
+from .frf import FRF, Frequency
+from .points import DOFS, PointRef, check_name, parse_point
+
+__all__ = [
+    "Beam",
+    "Spindle",
+    "Holder",
+    "Tool",
+    "MeasuredComponent",
+    "COMPONENT_TYPES",
+    "register_component",
+    "as_frequency",
+    "dof_labels",
+]
+
+COMPONENT_TYPES: dict[str, type] = {}
+"""Registered component types by their ``type`` name in assembly files."""
+
+
+def register_component(kind: str):
+    """Class decorator registering a component type under ``kind``.
+
+    Examples
+    --------
+    >>> @register_component("shrink-fit-holder")          # doctest: +SKIP
+    ... @attrs.frozen
+    ... class ShrinkFitHolder(Holder): ...
+    """
+
+    def decorate(cls):
+        if kind in COMPONENT_TYPES and COMPONENT_TYPES[kind] is not cls:
+            raise InvalidValueError(f"component type {kind!r} is already registered")
+        cls.kind = kind
+        COMPONENT_TYPES[kind] = cls
+        return cls
+
+    return decorate
+
+
+def as_frequency(frequency) -> Frequency:
+    """A :class:`Frequency` from a Frequency, an FRF, or an array of frequencies in Hz."""
+    if isinstance(frequency, Frequency):
+        return frequency
+    if isinstance(frequency, FRF):
+        return frequency.frequency
+    if isinstance(frequency, pint.Quantity):
+        return Frequency.from_hz(np.atleast_1d(frequency.m_as("Hz")))
+    if isinstance(frequency, str):
+        raise InvalidValueError(
+            f"frequency: got {frequency!r}; expected a Frequency (e.g. Frequency.from_range('20 Hz', "
+            "'5000 Hz', '2 Hz')) or an array of frequencies in Hz"
+        )
+    return Frequency.from_hz(np.atleast_1d(np.asarray(frequency, dtype=float)))
+
+
+def dof_labels(points: Iterable[str]) -> tuple[str, ...]:
+    """DOF labels ``("p:y", "p:theta", ...)`` of point names."""
+    return tuple(f"{p}:{d}" for p in points for d in DOFS)
+
+
+def _positive_frequencies(f: np.ndarray, who: str) -> None:
+    if np.any(f <= 0):
+        raise InvalidValueError(
+            f"frequency: {who} is free-free and has no static receptance; "
+            f"expected frequencies > 0 Hz, got {float(f.min())} Hz"
+        )
+
+
+def _segments(value) -> tuple[Segment, ...]:
+    if isinstance(value, Segment):
+        value = (value,)
+    try:
+        segs = tuple(value)
+    except TypeError:
+        raise InvalidValueError(f"segments: got {value!r}; expected a sequence of Segment") from None
+    if not segs:
+        raise InvalidValueError("segments: got none; expected at least one Segment (base to tip)")
+    for i, s in enumerate(segs):
+        if not isinstance(s, Segment):
+            raise InvalidValueError(f"segments[{i}]: got {s!r}; expected a Segment")
+    return segs
+
+
+@register_component("beam")
+@attrs.frozen
+class Beam:
+    """A free-free stepped Timoshenko beam (the base class of spindles, holders and tools).
+
+    Parameters
+    ----------
+    name : str
+        Name used in point names (``"tool"`` gives ``"tool.tip"``).
+    segments : sequence of Segment
+        Base to tip.
+
+    Examples
+    --------
+    >>> from substructure import Tool, Segment
+    >>> tool = Tool("tool", [Segment("60 mm", "12 mm", material="carbide")])
+    >>> frf = tool.receptance([500.0, 1000.0], points=["tip"])
+    >>> frf.outputs
+    ('tool.tip:y', 'tool.tip:theta')
+    """
+
+    kind: ClassVar[str] = "beam"
+
+    name: str = attrs.field(converter=check_name)
+    segments: tuple[Segment, ...] = attrs.field(converter=_segments)
+
+    @property
+    def component_names(self) -> frozenset[str]:
+        return frozenset({self.name})
+
+    @property
+    def length(self) -> pint.Quantity:
+        """Total length."""
+        total = self.segments[0].length
+        for s in self.segments[1:]:
+            total = total + s.length
+        return total.to(self.segments[0].length.units)
+
+    @property
+    def length_m(self) -> float:
+        return float(sum(s.length_m for s in self.segments))
+
+    def mass(self) -> float:
+        """Total mass in kg (inserts included)."""
+        return float(sum(s.mass() for s in self.segments))
+
+    def position(self, ref: PointRef | str) -> float:
+        """Distance of a point from the base, in metres."""
+        if isinstance(ref, str):
+            ref = self._ref(ref)
+        if ref.component != self.name:
+            raise UnknownPointError(f"point {ref}: not on component {self.name!r}")
+        total = self.length_m
+        if ref.where == "base":
+            x = 0.0
+        elif ref.where == "tip":
+            x = total
+        elif ref.where == "at":
+            x = float(ref.distance.m_as("m"))
+        elif ref.where == "from_tip":
+            x = total - float(ref.distance.m_as("m"))
+        else:
+            raise UnknownPointError(
+                f"point {ref}: {self.name!r} has points base, tip, @X and tip-X, not {ref.where!r}"
+            )
+        tol = 1e-12 * total
+        if x < -tol or x > total + tol:
+            raise UnknownPointError(
+                f"point {ref}: lies outside {self.name!r}, whose length is {self.length:~P}"
+            )
+        return min(max(x, 0.0), total)
+
+    def node_key(self, ref: PointRef):
+        return (self.name, round(self.position(ref), 12))
+
+    def receptance_matrix(self, refs: Sequence[PointRef], frequency_hz: np.ndarray) -> np.ndarray:
+        f = np.asarray(frequency_hz, dtype=float)
+        _positive_frequencies(f, f"component {self.name!r}")
+        return stepped_beam_receptance(self.segments, [self.position(r) for r in refs], f)
+
+    def _ref(self, point: str) -> PointRef:
+        text = point if point.startswith(self.name + ".") or point.startswith(self.name + "@") else (
+            f"{self.name}{point}" if point.startswith("@") else f"{self.name}.{point}"
+        )
+        return parse_point(text, allow_dof=False)
+
+    def receptance(self, frequency, points: Sequence[str] = ("tip",)) -> FRF:
+        """Free-free receptance matrix between points of this beam.
+
+        Parameters
+        ----------
+        frequency : Frequency or array of Hz
+        points : sequence of str
+            Point names, full (``"tool.tip"``) or local (``"tip"``, ``"base"``,
+            ``"@30 mm"``, ``"tip-15 mm"``).
+
+        Returns
+        -------
+        FRF
+            Outputs and inputs ``(p:y, p:theta)`` per point.
+        """
+        freq = as_frequency(frequency)
+        refs = [self._ref(p) for p in points]
+        data = np.moveaxis(self.receptance_matrix(refs, freq.hz), -1, 0)
+        labels = dof_labels(str(r) for r in refs)
+        return FRF(freq, data, labels, labels)
+
+
+@register_component("spindle")
+@attrs.frozen
+class Spindle(Beam):
+    """A spindle: base at its rear end, tip at its nose."""
+
+
+@register_component("holder")
+@attrs.frozen
+class Holder(Beam):
+    """A tool holder: base at the taper end, tip at its face.
+
+    The part of the tool inside the holder is usually modelled as an
+    :class:`~substructure.beams.Insert` of the holder's bore segment
+    (thesis section 2.1).
+    """
+
+
+@register_component("tool")
+@attrs.frozen
+class Tool(Beam):
+    """A cutting tool: base at the shank end, tip at the cutting end."""
+
+    @classmethod
+    def end_mill(
+        cls,
+        diameter,
+        overhang,
+        flute_length=None,
+        *,
+        material="carbide",
+        diameter_ratio: float = 0.8,
+        name: str = "tool",
+    ) -> "Tool":
+        """An end mill sticking out of its holder by ``overhang``.
+
+        The shank inside the holder belongs to the holder (as an insert); this
+        tool is the overhang: a solid shank, then ``flute_length`` of flutes
+        modelled by the equivalent diameter ``diameter_ratio * diameter``.
+        """
+        from .units import quantity
+
+        d = quantity(diameter, "diameter", "[length]")
+        total = quantity(overhang, "overhang", "[length]")
+        flutes = None if flute_length is None else quantity(flute_length, "flute_length", "[length]")
+        if flutes is None or flutes.magnitude == 0:
+            return cls(name, [Segment(total, d, material=material)])
+        if flutes > total:
+            raise InvalidValueError(
+                f"flute_length: got {flutes:~P}, longer than the overhang {total:~P}"
+            )
+        shank = total - flutes
+        segs = [Segment(flutes, d, material=material, flutes=Flutes(diameter_ratio))]
+        if shank.magnitude > 0:
+            segs.insert(0, Segment(shank, d, material=material))
+        return cls(name, segs)
+
+
+def _measured_frf(value) -> FRF:
+    if not isinstance(value, FRF):
+        raise InvalidValueError(f"frf: got {value!r}; expected an FRF")
+    if value.outputs != value.inputs:
+        raise InvalidValueError(
+            "frf: a measured component needs a square receptance matrix with the same "
+            f"outputs and inputs; got outputs {value.outputs} and inputs {value.inputs}"
+        )
+    return value.to_receptance()
+
+
+@register_component("measured")
+@attrs.frozen
+class MeasuredComponent:
+    """A substructure known by its receptances (measured, or computed elsewhere).
+
+    Parameters
+    ----------
+    name : str
+        Name of the component in messages.
+    frf : FRF
+        Square receptance matrix whose labels are point names with DOFs,
+        e.g. ``"holder.tip:y"``, ``"holder.tip:theta"``.  Both DOFs of a point
+        are needed for coupling at that point (estimate rotational FRFs by
+        finite differences when only ``y`` was measured).
+
+    Notes
+    -----
+    The points answer to the component names in the labels, so that a
+    measured spindle-holder subassembly keeps the point names of the model
+    (``"holder.tip"``) and couples to a tool like the modelled one.
+    """
+
+    name: str = attrs.field(converter=check_name)
+    frf: FRF = attrs.field(converter=_measured_frf)
+
+    @property
+    def component_names(self) -> frozenset[str]:
+        return frozenset(parse_point(lbl).component for lbl in self.frf.outputs)
+
+    @property
+    def points(self) -> tuple[str, ...]:
+        seen: dict[str, None] = {}
+        for lbl in self.frf.outputs:
+            seen[str(parse_point(lbl).point)] = None
+        return tuple(seen)
+
+    def node_key(self, ref: PointRef):
+        point = str(ref.point)
+        missing = [f"{point}:{d}" for d in DOFS if f"{point}:{d}" not in self.frf.outputs]
+        if len(missing) == 2:
+            raise UnknownPointError(
+                f"point {point}: not in measured component {self.name!r}, which has {', '.join(self.points)}"
+            )
+        if missing:
+            raise UnknownPointError(
+                f"point {point}: measured component {self.name!r} lacks {', '.join(missing)}; "
+                "coupling needs both y and theta (estimate rotational FRFs by finite differences)"
+            )
+        return (self.name, point)
+
+    def receptance_matrix(self, refs: Sequence[PointRef], frequency_hz: np.ndarray) -> np.ndarray:
+        f = np.asarray(frequency_hz, dtype=float)
+        if f.shape != self.frf.frequency.hz.shape or not np.array_equal(f, self.frf.frequency.hz):
+            raise FrequencyAxisMismatchError(
+                f"measured component {self.name!r} is known on {self.frf.frequency!r}; the request "
+                "uses another grid: interpolate the FRF or compute on its grid"
+            )
+        for r in refs:
+            self.node_key(r)
+        labels = [f"{r.point}:{d}" for r in refs for d in DOFS]
+        index = [self.frf.outputs.index(lbl) for lbl in labels]
+        return np.moveaxis(self.frf.data[:, index][:, :, index], 0, -1)
+
+
+def component_info(component: Any) -> str:
+    """One line describing a component, for summaries."""
+    kind = getattr(component, "kind", type(component).__name__)
+    if isinstance(component, Beam):
+        return f"{component.name} ({kind}, {len(component.segments)} segments, {component.length:~P}, {component.mass():.3g} kg)"
+    return f"{component.name} ({kind})"

@@ -1,0 +1,284 @@
+"""Joints, sensors and supports: what connects components and what hangs on points.
+
+* :class:`Joint` connects two points, rigidly or through the complex stiffness
+  ``K = [[k_yf, k_ym], [k_tf, k_tm]] + i omega [[c_yf, c_ym], [c_tf, c_tm]]``
+  acting on ``[y_a - y_b, theta_a - theta_b]`` (thesis eq. 2.5).
+* :class:`Support` is the same matrix between a point and the ground
+  (bearings, suspension bands).
+* :class:`Sensor` is a rigid body on a point: mass and rotary inertia, i.e.
+  the dynamic stiffness ``-omega^2 diag(m, J)`` (thesis eq. 5.2); a massless
+  sensor stands for a laser vibrometer.
+
+All three give their dynamic stiffness as an array ``(2, 2, n_freq)``, which is
+all the coupling engine asks of them: a new joint model is a class with
+``name``, ``between``, ``rigid`` and ``dynamic_stiffness(frequency_hz)``.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Mapping
+
+import attrs
+import numpy as np
+import pint
+
+from .errors import InvalidValueError, NonPassiveJointWarning, NonReciprocalWarning
+from .points import check_name, parse_point
+from .units import format_quantity, quantity
+
+__all__ = ["JointMatrix", "Joint", "Support", "Sensor", "STIFFNESS_UNITS", "DAMPING_UNITS"]
+
+ENTRIES = ("yf", "ym", "tf", "tm")
+STIFFNESS_UNITS = {"yf": "N/m", "ym": "N", "tf": "N/rad", "tm": "N*m/rad"}
+DAMPING_UNITS = {"yf": "N*s/m", "ym": "N*s", "tf": "N*s/rad", "tm": "N*m*s/rad"}
+_DIMENSIONS = {
+    "stiffness": {"yf": "[mass] / [time] ** 2", "ym": "[length] * [mass] / [time] ** 2",
+                  "tf": "[length] * [mass] / [time] ** 2", "tm": "[length] ** 2 * [mass] / [time] ** 2"},
+    "damping": {"yf": "[mass] / [time]", "ym": "[length] * [mass] / [time]",
+                "tf": "[length] * [mass] / [time]", "tm": "[length] ** 2 * [mass] / [time]"},
+}
+
+
+@attrs.frozen
+class JointMatrix:
+    """A 2x2 joint stiffness or damping matrix with units per entry.
+
+    Build it with :meth:`from_mapping` from ``{"yf": "4.19e7 N/m", "tm": ...}``
+    (missing entries are 0).  ``values`` holds SI floats ``[[yf, ym], [tf, tm]]``.
+    """
+
+    kind: str
+    entries: tuple[tuple[str, pint.Quantity], ...]
+
+    @classmethod
+    def from_mapping(cls, mapping, kind: str, field: str) -> "JointMatrix":
+        if isinstance(mapping, JointMatrix):
+            return mapping
+        if mapping is None:
+            mapping = {}
+        if not isinstance(mapping, Mapping):
+            raise InvalidValueError(
+                f"{field}: got {mapping!r}; expected a table of entries yf, ym, tf, tm with units"
+            )
+        unknown = sorted(set(mapping) - set(ENTRIES))
+        if unknown:
+            raise InvalidValueError(
+                f"{field}: unknown entries {unknown}; expected some of yf, ym, tf, tm"
+            )
+        dims = _DIMENSIONS[kind]
+        items = []
+        for key in ENTRIES:
+            if key in mapping:
+                items.append((key, quantity(mapping[key], f"{field}.{key}", dims[key])))
+        return cls(kind, tuple(items))
+
+    def get(self, key: str) -> float:
+        """Entry ``key`` in SI units (0 when not given)."""
+        units = STIFFNESS_UNITS if self.kind == "stiffness" else DAMPING_UNITS
+        for k, q in self.entries:
+            if k == key:
+                return float(q.m_as(units[key]))
+        return 0.0
+
+    @property
+    def values(self) -> np.ndarray:
+        """``[[yf, ym], [tf, tm]]`` in SI units."""
+        return np.array([[self.get("yf"), self.get("ym")], [self.get("tf"), self.get("tm")]])
+
+    def as_dict(self) -> dict[str, str]:
+        """Entries as strings that read back to the same quantities."""
+        return {k: format_quantity(q) for k, q in self.entries}
+
+    def __bool__(self) -> bool:
+        return bool(self.entries)
+
+
+def _check_matrix(m: np.ndarray, what: str, owner: str) -> None:
+    """Warn when a matrix is not symmetric or not positive semi-definite."""
+    scale = np.abs(m).max()
+    if scale == 0:
+        return
+    if abs(m[0, 1] - m[1, 0]) > 1e-9 * max(abs(m[0, 1]), abs(m[1, 0])):
+        warnings.warn(
+            f"{owner}: {what} matrix is not symmetric ({what[0]}_ym = {m[0, 1]:.6g} != "
+            f"{what[0]}_tf = {m[1, 0]:.6g}): the coupled receptances will not be reciprocal",
+            NonReciprocalWarning,
+            stacklevel=4,
+        )
+    sym = 0.5 * (m + m.T)
+    det = sym[0, 0] * sym[1, 1] - sym[0, 1] ** 2
+    if sym[0, 0] < 0 or sym[1, 1] < 0 or det < -1e-12 * (abs(sym[0, 0] * sym[1, 1]) + sym[0, 1] ** 2):
+        c = what[0]
+        warnings.warn(
+            f"{owner}: {what} matrix is not positive semi-definite (non-passive): "
+            f"{c}_ym*{c}_tf = {sym[0, 1] ** 2:.4g} > {c}_yf*{c}_tm = {sym[0, 0] * sym[1, 1]:.4g}"
+            if sym[0, 0] >= 0 and sym[1, 1] >= 0
+            else f"{owner}: {what} matrix has a negative diagonal entry (non-passive)",
+            NonPassiveJointWarning,
+            stacklevel=4,
+        )
+
+
+def _point(value) -> str:
+    return str(parse_point(value, allow_dof=False))
+
+
+def _between(value) -> tuple[str, str]:
+    if isinstance(value, str) or len(value) != 2:
+        raise InvalidValueError(f"between: got {value!r}; expected two point names")
+    a, b = (_point(v) for v in value)
+    if a == b:
+        raise InvalidValueError(f"between: got the same point twice ({a})")
+    return a, b
+
+
+@attrs.frozen
+class Joint:
+    """A connection between two points: rigid, or elastic with stiffness and damping.
+
+    Parameters
+    ----------
+    name : str
+    between : (str, str)
+        The two points, e.g. ``("holder.tip", "tool.base")``.
+    k, c : mapping, optional
+        Stiffness and damping entries ``yf, ym, tf, tm`` with units
+        (conventions.md, Joints); missing entries are 0.
+    rigid : bool
+        Equal displacement and rotation of the two points (no ``k``/``c``).
+
+    Warns
+    -----
+    NonReciprocalWarning
+        When ``ym != tf``.
+    NonPassiveJointWarning
+        When ``k`` or ``c`` is not positive semi-definite (as the thesis's
+        Tables 2.1 and 2.2 are not: ``k_ym^2 > k_yf k_tm``); still accepted.
+    """
+
+    name: str = attrs.field(converter=check_name)
+    between: tuple[str, str] = attrs.field(converter=_between)
+    k: JointMatrix = attrs.field(default=None, converter=lambda v: JointMatrix.from_mapping(v, "stiffness", "k"))
+    c: JointMatrix = attrs.field(default=None, converter=lambda v: JointMatrix.from_mapping(v, "damping", "c"))
+    rigid: bool = attrs.field(default=False)
+
+    def __attrs_post_init__(self) -> None:
+        if not isinstance(self.rigid, bool):
+            raise InvalidValueError(f"rigid: got {self.rigid!r}; expected true or false")
+        if self.rigid and (self.k or self.c):
+            raise InvalidValueError(f"joint {self.name!r}: a rigid joint takes no k or c")
+        if not self.rigid:
+            if not self.k:
+                raise InvalidValueError(
+                    f"joint {self.name!r}: an elastic joint needs stiffness entries k "
+                    "(or rigid = true)"
+                )
+            _check_matrix(self.k.values, "stiffness", f"joint {self.name!r}")
+            _check_matrix(self.c.values, "damping", f"joint {self.name!r}")
+
+    @classmethod
+    def rigid_between(cls, name: str, a: str, b: str) -> "Joint":
+        """A rigid joint."""
+        return cls(name, (a, b), rigid=True)
+
+    def dynamic_stiffness(self, frequency_hz: np.ndarray) -> np.ndarray:
+        """``K + i omega C`` as an array ``(2, 2, n_freq)``; rigid joints have none."""
+        if self.rigid:
+            raise InvalidValueError(f"joint {self.name!r} is rigid: it has no finite stiffness")
+        omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
+        return self.k.values[:, :, None] + 1j * omega * self.c.values[:, :, None]
+
+    def with_parameters(self, k=None, c=None) -> "Joint":
+        """A copy with some entries of ``k`` and ``c`` replaced (others kept)."""
+        new_k = {**self.k.as_dict(), **(k or {})}
+        new_c = {**self.c.as_dict(), **(c or {})}
+        return attrs.evolve(self, k=new_k, c=new_c, rigid=False)
+
+
+@attrs.frozen
+class Support:
+    """Springs and dampers from a point to the ground (bearings, suspension bands).
+
+    Parameters
+    ----------
+    at : str
+        The point, e.g. ``"spindle@310 mm"``.
+    k, c : mapping
+        Entries ``yf, ym, tf, tm`` with units, as for :class:`Joint`.
+    name : str, optional
+        Defaults to ``"support-N"`` in an assembly.
+    """
+
+    at: str = attrs.field(converter=_point)
+    k: JointMatrix = attrs.field(default=None, converter=lambda v: JointMatrix.from_mapping(v, "stiffness", "k"))
+    c: JointMatrix = attrs.field(default=None, converter=lambda v: JointMatrix.from_mapping(v, "damping", "c"))
+    name: str | None = attrs.field(default=None)
+
+    def __attrs_post_init__(self) -> None:
+        if self.name is not None:
+            check_name(self.name)
+        if not self.k and not self.c:
+            raise InvalidValueError(f"support at {self.at}: needs stiffness k or damping c entries")
+        _check_matrix(self.k.values, "stiffness", f"support at {self.at}")
+        _check_matrix(self.c.values, "damping", f"support at {self.at}")
+
+    def dynamic_stiffness(self, frequency_hz: np.ndarray) -> np.ndarray:
+        omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
+        return self.k.values[:, :, None] + 1j * omega * self.c.values[:, :, None]
+
+
+def _mass(value) -> pint.Quantity:
+    q = quantity(value, "mass", "[mass]")
+    if q.magnitude < 0:
+        raise InvalidValueError(f"mass: got {value!r}; expected a mass >= 0")
+    return q
+
+
+def _inertia(value) -> pint.Quantity:
+    q = quantity(value, "inertia", "[mass] * [length] ** 2")
+    if q.magnitude < 0:
+        raise InvalidValueError(f"inertia: got {value!r}; expected a rotary inertia >= 0")
+    return q
+
+
+@attrs.frozen
+class Sensor:
+    """A body on the structure during a test: an accelerometer, a magnet, a laser target.
+
+    Parameters
+    ----------
+    name : str
+    at : str
+        The point, e.g. ``"tool.tip"``.
+    mass : quantity or str
+        ``"0 g"`` for a non-contact sensor (laser vibrometer).
+    inertia : quantity or str, default "0 kg*m^2"
+        Rotary inertia about the bending axis.
+    """
+
+    name: str = attrs.field(converter=check_name)
+    at: str = attrs.field(converter=_point)
+    mass: pint.Quantity = attrs.field(converter=_mass)
+    inertia: pint.Quantity = attrs.field(default="0 kg*m^2", converter=_inertia)
+
+    @classmethod
+    def laser(cls, name: str, at: str) -> "Sensor":
+        """A non-contact sensor: no mass."""
+        return cls(name, at, "0 g")
+
+    @property
+    def mass_kg(self) -> float:
+        return float(self.mass.m_as("kg"))
+
+    @property
+    def inertia_si(self) -> float:
+        return float(self.inertia.m_as("kg*m^2"))
+
+    def dynamic_stiffness(self, frequency_hz: np.ndarray) -> np.ndarray:
+        """``-omega^2 diag(m, J)``, shape ``(2, 2, n_freq)``."""
+        w2 = (2.0 * np.pi * np.asarray(frequency_hz, dtype=float)) ** 2
+        out = np.zeros((2, 2, w2.size), dtype=complex)
+        out[0, 0] = -w2 * self.mass_kg
+        out[1, 1] = -w2 * self.inertia_si
+        return out

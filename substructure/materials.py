@@ -1,0 +1,126 @@
+"""Materials: elastic constants, density and loss factor, with a catalogue.
+
+A :class:`Material` is a frozen value object; the catalogue holds typical
+values for the materials of spindles, holders and tools.  Files and users may
+define their own (``Material("bronze", E="110 GPa", nu=0.34, rho="8800 kg/m^3")``).
+
+The loss factor ``eta`` makes both moduli complex, ``E(1 + i*eta)`` and
+``G(1 + i*eta)`` (conventions.md, time-harmonic convention).
+"""
+
+from __future__ import annotations
+
+import attrs
+import pint
+
+from .errors import InvalidValueError
+from .units import dimensionless, quantity
+
+__all__ = ["Material", "CATALOG", "get_material", "steel", "carbide", "aluminium"]
+
+
+def _modulus(value) -> pint.Quantity:
+    q = quantity(value, "E", "[mass] / [length] / [time] ** 2")
+    if q.magnitude <= 0:
+        raise InvalidValueError(f"E: got {value!r}; expected a positive Young's modulus")
+    return q
+
+
+def _density(value) -> pint.Quantity:
+    q = quantity(value, "rho", "[mass] / [length] ** 3")
+    if q.magnitude <= 0:
+        raise InvalidValueError(f"rho: got {value!r}; expected a positive density")
+    return q
+
+
+def _poisson(value) -> float:
+    nu = dimensionless(value, "nu")
+    if not -1.0 < nu < 0.5:
+        raise InvalidValueError(f"nu: got {value!r}; expected a Poisson ratio in (-1, 0.5)")
+    return nu
+
+
+def _loss(value) -> float:
+    eta = dimensionless(value, "loss_factor")
+    if eta < 0:
+        raise InvalidValueError(
+            f"loss_factor: got {value!r}; expected a loss factor >= 0 (a negative one adds energy)"
+        )
+    return eta
+
+
+def _name(value) -> str:
+    if not isinstance(value, str) or not value.strip():
+        raise InvalidValueError(f"name: got {value!r}; expected a non-empty string")
+    return value
+
+
+@attrs.frozen
+class Material:
+    """An isotropic, linear viscoelastic material.
+
+    Parameters
+    ----------
+    name : str
+        Name used in files and messages.
+    E : quantity or str
+        Young's modulus, e.g. ``"210 GPa"``.
+    nu : float
+        Poisson ratio, in (-1, 0.5).
+    rho : quantity or str
+        Density, e.g. ``"7850 kg/m^3"``.
+    loss_factor : float, default 0
+        Structural (hysteretic) loss factor ``eta >= 0``.
+    """
+
+    name: str = attrs.field(converter=_name)
+    E: pint.Quantity = attrs.field(converter=_modulus)
+    nu: float = attrs.field(converter=_poisson)
+    rho: pint.Quantity = attrs.field(converter=_density)
+    loss_factor: float = attrs.field(default=0.0, converter=_loss)
+
+    @property
+    def G(self) -> pint.Quantity:
+        """Shear modulus ``E / (2 (1 + nu))``."""
+        return self.E / (2.0 * (1.0 + self.nu))
+
+    @property
+    def E_si(self) -> complex:
+        """Complex Young's modulus ``E (1 + i eta)`` in Pa."""
+        return self.E.m_as("Pa") * (1.0 + 1j * self.loss_factor)
+
+    @property
+    def G_si(self) -> complex:
+        """Complex shear modulus ``G (1 + i eta)`` in Pa."""
+        return self.G.m_as("Pa") * (1.0 + 1j * self.loss_factor)
+
+    @property
+    def rho_si(self) -> float:
+        """Density in kg/m^3."""
+        return self.rho.m_as("kg/m^3")
+
+    @classmethod
+    def from_catalog(cls, name: str) -> "Material":
+        """The catalogue material called ``name`` (see :data:`CATALOG`)."""
+        return get_material(name)
+
+
+steel = Material("steel", E="210 GPa", nu=0.29, rho="7850 kg/m^3", loss_factor=0.002)
+"""Tool and spindle steel."""
+carbide = Material("carbide", E="580 GPa", nu=0.22, rho="14500 kg/m^3", loss_factor=0.002)
+"""Cemented tungsten carbide (end mills)."""
+aluminium = Material("aluminium", E="70 GPa", nu=0.33, rho="2700 kg/m^3", loss_factor=0.001)
+"""Aluminium alloy."""
+
+CATALOG: dict[str, Material] = {m.name: m for m in (steel, carbide, aluminium)}
+"""Built-in materials by name.  Read-only by convention: pass custom ones explicitly."""
+
+
+def get_material(name: str, extra: dict[str, Material] | None = None) -> Material:
+    """Look a material up by name, first in ``extra`` then in the catalogue."""
+    if extra and name in extra:
+        return extra[name]
+    if name in CATALOG:
+        return CATALOG[name]
+    known = sorted(set(CATALOG) | set(extra or {}))
+    raise InvalidValueError(f"material: unknown material {name!r}; known: {', '.join(known)}")

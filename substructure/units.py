@@ -1,0 +1,179 @@
+"""The one pint unit registry of `substructure`, and the checks at the boundary.
+
+Public constructors take pint quantities or strings that pint parses
+(``"60 mm"``, ``"4.19e7 N/m"``).  A bare number where a dimension is expected
+is rejected, as is a quantity of the wrong dimension; inside the numerical
+core everything is SI floats, converted once here.
+
+Examples
+--------
+>>> from substructure.units import quantity, to_si
+>>> quantity("60 mm", "od", "[length]")
+<Quantity(60, 'millimeter')>
+>>> to_si("60 mm", "od", "m")
+0.06
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from typing import Any
+
+import numpy as np
+import pint
+
+from .errors import InvalidValueError, UnitError
+
+__all__ = [
+    "ureg",
+    "Q_",
+    "quantity",
+    "to_si",
+    "dimensionless",
+    "format_quantity",
+    "rpm_to_hz",
+    "hz_to_rpm",
+]
+
+ureg = pint.UnitRegistry()
+"""The registry every quantity of the package belongs to."""
+Q_ = ureg.Quantity
+
+# Human names of the dimensions the package uses, for error messages.
+_DIMENSION_NAMES = {
+    "[length]": "a length (e.g. '60 mm')",
+    "[mass]": "a mass (e.g. '2 g')",
+    "[mass] / [length] ** 3": "a density (e.g. '7850 kg/m^3')",
+    "[mass] / [length] / [time] ** 2": "a pressure or modulus (e.g. '210 GPa')",
+    "[mass] * [length] ** 2": "a rotary inertia (e.g. '5e-8 kg*m^2')",
+    "[mass] / [time] ** 2": "a stiffness in N/m (e.g. '4e7 N/m')",
+    "[length] * [mass] / [time] ** 2": "a force or N*m/m (e.g. '2e6 N')",
+    "[length] ** 2 * [mass] / [time] ** 2": "a moment or N*m/rad (e.g. '6.5e4 N*m/rad')",
+    "[mass] / [time]": "a damping in N*s/m (e.g. '54 N*s/m')",
+    "[length] * [mass] / [time]": "a damping in N*s (e.g. '22 N*s')",
+    "[length] ** 2 * [mass] / [time]": "a damping in N*m*s/rad (e.g. '1 N*m*s/rad')",
+    "1 / [time]": "a frequency (e.g. '20 Hz')",
+}
+
+
+def _describe(dimension: str) -> str:
+    return _DIMENSION_NAMES.get(dimension, f"a quantity of dimension {dimension}")
+
+
+def quantity(value: Any, field: str, dimension: str) -> pint.Quantity:
+    """Return ``value`` as a scalar quantity of this registry with ``dimension``.
+
+    Parameters
+    ----------
+    value : pint.Quantity or str
+        The value as given by the user, e.g. ``"60 mm"`` or ``Q_(60, "mm")``.
+        Quantities of another registry are converted through their string form.
+    field : str
+        Name of the field, used in error messages.
+    dimension : str
+        Expected pint dimensionality, e.g. ``"[length]"``.
+
+    Raises
+    ------
+    UnitError
+        For a bare number, an unparsable string or a wrong dimension.
+    InvalidValueError
+        For a non-finite magnitude.
+    """
+    expected = _describe(dimension)
+    if isinstance(value, bool) or isinstance(value, numbers.Number) or isinstance(value, np.ndarray):
+        raise UnitError(
+            f"{field}: got the bare number {value!r}; expected {expected}, with its unit"
+        )
+    if isinstance(value, str):
+        try:
+            q = ureg.Quantity(value)
+        except Exception as exc:  # pint raises several types for bad strings
+            raise UnitError(
+                f"{field}: cannot read {value!r} as a quantity ({exc}); expected {expected}"
+            ) from None
+        if not isinstance(q, pint.Quantity) or q.dimensionless and dimension != "":
+            raise UnitError(
+                f"{field}: got {value!r} without a unit; expected {expected}, with its unit"
+            )
+    elif isinstance(value, pint.Quantity):
+        q = value if value._REGISTRY is ureg else ureg.Quantity(str(value))
+    else:
+        raise UnitError(
+            f"{field}: got {value!r} of type {type(value).__name__}; expected {expected}"
+        )
+    if np.ndim(q.magnitude) != 0:
+        raise UnitError(f"{field}: got an array {value!r}; expected a single value")
+    if not q.check(dimension):
+        raise UnitError(
+            f"{field}: got {value!r} with dimension {q.dimensionality}; expected {expected}"
+        )
+    if not math.isfinite(float(q.magnitude)):
+        raise InvalidValueError(f"{field}: got {value!r}; expected a finite value")
+    return q
+
+
+def to_si(value: Any, field: str, unit: str) -> float:
+    """Check ``value`` and return its magnitude in ``unit`` (an SI unit) as float.
+
+    The dimension expected is that of ``unit``.
+    """
+    dimension = str(ureg.Quantity(1.0, unit).dimensionality)
+    return float(quantity(value, field, dimension).m_as(unit))
+
+
+def dimensionless(value: Any, field: str) -> float:
+    """Check a dimensionless value (a plain number or a dimensionless quantity)."""
+    if isinstance(value, bool):
+        raise InvalidValueError(f"{field}: got {value!r}; expected a number")
+    if isinstance(value, pint.Quantity):
+        if not value.dimensionless:
+            raise UnitError(
+                f"{field}: got {value!r} with dimension {value.dimensionality}; "
+                "expected a dimensionless number"
+            )
+        value = value.m_as("dimensionless")
+    elif isinstance(value, str):
+        try:
+            q = ureg.Quantity(value)
+        except Exception:
+            raise InvalidValueError(f"{field}: cannot read {value!r}; expected a number") from None
+        return dimensionless(q, field)
+    if not isinstance(value, numbers.Real):
+        raise InvalidValueError(
+            f"{field}: got {value!r} of type {type(value).__name__}; expected a number"
+        )
+    value = float(value)
+    if not math.isfinite(value):
+        raise InvalidValueError(f"{field}: got {value!r}; expected a finite number")
+    return value
+
+
+def format_quantity(q: pint.Quantity) -> str:
+    """Format a scalar quantity as a string pint reads back to the same value.
+
+    ``repr`` of the float keeps every digit, so that save/load round-trips
+    without loss; integral values are written without a trailing ``.0``.
+    """
+    m = q.magnitude
+    if isinstance(m, float) and m.is_integer() and abs(m) < 1e15:
+        text = str(int(m))
+    else:
+        text = repr(float(m)) if not isinstance(m, int) else str(m)
+    units = f"{q.units:~C}"
+    return f"{text} {units}" if units else text
+
+
+def rpm_to_hz(speed_rpm: float | np.ndarray) -> float | np.ndarray:
+    """Revolutions per minute to revolutions per second (Hz): divide by 60.
+
+    An explicit helper on purpose: pint converts ``rpm`` to ``Hz`` as angular
+    velocity to frequency, which is off by ``2*pi``.
+    """
+    return np.asarray(speed_rpm, dtype=float) / 60.0
+
+
+def hz_to_rpm(frequency_hz: float | np.ndarray) -> float | np.ndarray:
+    """Revolutions per second (Hz) to revolutions per minute: multiply by 60."""
+    return np.asarray(frequency_hz, dtype=float) * 60.0
