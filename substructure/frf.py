@@ -1,0 +1,611 @@
+"""Frequency response functions: the value object every other layer exchanges.
+
+A :class:`Frequency` is an immutable, strictly increasing axis in Hz (``omega``
+derived); an :class:`FRF` holds complex data ``(n_freq, n_out, n_in)`` on it, with
+DOF labels (``"tool.tip:y"``, ``"tool.tip:theta"``) and its quantity (receptance,
+mobility, accelerance).  Both are frozen: band selection, interpolation, label
+selection and arithmetic return new objects, and FRFs on different axes are never
+reconciled silently.  Plots and files are delegated to :mod:`substructure.plot`
+and :mod:`substructure.io.frf_files`, imported on use.
+"""
+
+from __future__ import annotations
+
+import numbers
+import warnings
+from collections.abc import Sequence
+from typing import Any
+
+import attrs
+import numpy as np
+
+from .errors import FrequencyAxisMismatchError, InvalidValueError, NonReciprocalWarning, UnknownPointError
+from .units import to_si
+
+__all__ = ["Frequency", "FRF", "QUANTITIES"]
+
+QUANTITIES = ("receptance", "mobility", "accelerance")
+"""The quantities an FRF may hold: displacement, velocity or acceleration per load."""
+
+# Relative tolerance (of the largest frequency) with which band limits and
+# interpolation ranges are compared, so that a grid built as start + step*k
+# and one read from a file as decimals are not told apart by rounding.
+_GRID_RTOL = 1e-12
+
+
+def _hz(value: Any, field: str) -> float:
+    """A frequency in Hz from a plain number (taken as Hz), a quantity or a string."""
+    if isinstance(value, numbers.Real) and not isinstance(value, bool):
+        return float(value)
+    return to_si(value, field, "Hz")
+
+
+def _readonly(array: np.ndarray) -> np.ndarray:
+    array.flags.writeable = False
+    return array
+
+
+def _hz_array(value: Any) -> np.ndarray:
+    if np.iscomplexobj(value):
+        raise InvalidValueError("hz: got complex values; expected real frequencies in Hz")
+    try:
+        return _readonly(np.array(value, dtype=np.float64, copy=True))
+    except (TypeError, ValueError):
+        raise InvalidValueError(
+            f"hz: cannot read {value!r} as numbers; expected a 1-D array of frequencies in Hz"
+        ) from None
+
+
+def _check_hz(instance: Any, attribute: Any, hz: np.ndarray) -> None:
+    if hz.ndim != 1 or hz.size == 0:
+        raise InvalidValueError(f"hz: got an array of shape {hz.shape}; expected a non-empty 1-D array")
+    if not np.isfinite(hz).all():
+        i = int(np.argmax(~np.isfinite(hz)))
+        raise InvalidValueError(f"hz: got {hz[i]} at index {i}; expected finite frequencies")
+    if hz[0] < 0:
+        raise InvalidValueError(f"hz: got {hz[0]} Hz at index 0; expected frequencies >= 0")
+    if (np.diff(hz) <= 0).any():
+        i = int(np.argmax(np.diff(hz) <= 0))
+        raise InvalidValueError(
+            f"hz: got {hz[i + 1]} Hz at index {i + 1} after {hz[i]} Hz; "
+            "expected strictly increasing frequencies"
+        )
+
+
+@attrs.frozen(repr=False)
+class Frequency:
+    """A strictly increasing axis of frequencies, stored in Hz.
+
+    Parameters
+    ----------
+    hz : array_like
+        Frequencies in Hz, 1-D, non-empty, finite, >= 0 and strictly
+        increasing.  Stored as a read-only float64 copy.  Prefer the named
+        constructors :meth:`from_range` and :meth:`from_hz`.
+
+    Examples
+    --------
+    >>> f = Frequency.from_range("20 Hz", "5000 Hz", "2 Hz")
+    >>> len(f), f.start, f.stop
+    (2491, 20.0, 5000.0)
+    """
+
+    hz: np.ndarray = attrs.field(converter=_hz_array, validator=_check_hz, eq=attrs.cmp_using(eq=np.array_equal))
+
+    @classmethod
+    def from_range(cls, start: Any, stop: Any, step: Any) -> Frequency:
+        """Grid ``start + step*k``, ``k = 0, 1, ...``, up to ``stop`` (included when on the grid).
+
+        Parameters
+        ----------
+        start, stop, step : pint.Quantity or str
+            Frequencies with their unit, e.g. ``"20 Hz"``, ``"5 kHz"``.  Bare
+            numbers are rejected.  ``stop`` counts as on the grid when it is
+            within 1e-9 steps of a grid point.
+
+        Raises
+        ------
+        UnitError
+            For a bare number or a value that is not a frequency.
+        InvalidValueError
+            For ``start < 0``, ``step <= 0`` or ``stop < start``.
+        """
+        f0, f1, df = to_si(start, "start", "Hz"), to_si(stop, "stop", "Hz"), to_si(step, "step", "Hz")
+        if f0 < 0:
+            raise InvalidValueError(f"start: got {start!r}; expected a frequency >= 0 Hz")
+        if df <= 0:
+            raise InvalidValueError(f"step: got {step!r}; expected a positive frequency step")
+        if f1 < f0:
+            raise InvalidValueError(f"stop: got {stop!r} below start {start!r}; expected stop >= start")
+        count = (f1 - f0) / df
+        nearest = round(count)
+        k = nearest if abs(count - nearest) <= 1e-9 * max(1.0, nearest) else int(np.floor(count))
+        return cls(f0 + df * np.arange(k + 1))
+
+    @classmethod
+    def from_hz(cls, values: Any) -> Frequency:
+        """Axis from an array of plain numbers in Hz (not rad/s).
+
+        Pint quantities are refused, to rule out a silent ``2*pi`` between
+        rad/s and Hz: convert them explicitly with ``q.m_as("Hz")``.
+        """
+        if hasattr(values, "units") and hasattr(values, "magnitude"):
+            raise InvalidValueError(
+                f"hz: got the quantity {values!r}; from_hz takes plain numbers in Hz, "
+                "convert with q.m_as('Hz') (mind rad/s versus Hz)"
+            )
+        return cls(values)
+
+    @property
+    def omega(self) -> np.ndarray:
+        """Angular frequencies ``2*pi*hz`` in rad/s (read-only)."""
+        return _readonly(2.0 * np.pi * self.hz)
+
+    @property
+    def n(self) -> int:
+        """Number of frequency lines."""
+        return int(self.hz.size)
+
+    def __len__(self) -> int:
+        return self.n
+
+    @property
+    def start(self) -> float:
+        """First frequency in Hz."""
+        return float(self.hz[0])
+
+    @property
+    def stop(self) -> float:
+        """Last frequency in Hz."""
+        return float(self.hz[-1])
+
+    def band_mask(self, lo: Any = None, hi: Any = None) -> np.ndarray:
+        """Boolean mask of the lines with ``lo <= f <= hi``.
+
+        Parameters
+        ----------
+        lo, hi : float, pint.Quantity, str or None
+            Band limits; plain numbers are in Hz; ``None`` leaves that side open.
+            Limits are compared with a relative tolerance of 1e-12 of the
+            largest frequency, so that rounding of the grid does not drop a
+            line that is meant to be on the limit.
+        """
+        f_lo = -np.inf if lo is None else _hz(lo, "lo")
+        f_hi = np.inf if hi is None else _hz(hi, "hi")
+        if f_lo > f_hi:
+            raise InvalidValueError(f"lo, hi: got lo={lo!r} > hi={hi!r}; expected lo <= hi")
+        tol = _GRID_RTOL * max(abs(self.stop), 1.0)
+        return (self.hz >= f_lo - tol) & (self.hz <= f_hi + tol)
+
+    def crop(self, lo: Any = None, hi: Any = None) -> Frequency:
+        """New axis with the lines of :meth:`band_mask`; an empty band is an error."""
+        mask = self.band_mask(lo, hi)
+        if not mask.any():
+            raise InvalidValueError(
+                f"lo, hi: the band [{lo!r}, {hi!r}] holds no line of the grid "
+                f"{self.start:g}..{self.stop:g} Hz"
+            )
+        return Frequency(self.hz[mask])
+
+    def __hash__(self) -> int:
+        return hash(self.hz.tobytes())
+
+    def __repr__(self) -> str:
+        if self.n == 1:
+            return f"Frequency({self.start:g} Hz)"
+        steps = np.diff(self.hz)
+        uniform = np.ptp(steps) <= 1e-9 * steps.max()
+        spacing = f"step {steps[0]:.6g} Hz" if uniform else "non-uniform"
+        return f"Frequency({self.start:g}..{self.stop:g} Hz, n={self.n}, {spacing})"
+
+
+def _labels(field: str):
+    def convert(value: Any) -> tuple[str, ...]:
+        if isinstance(value, str):
+            value = (value,)
+        try:
+            labels = tuple(value)
+        except TypeError:
+            raise InvalidValueError(f"{field}: got {value!r}; expected a sequence of DOF labels") from None
+        for label in labels:
+            if not isinstance(label, str) or not label.strip() or label != label.strip():
+                raise InvalidValueError(
+                    f"{field}: got the label {label!r}; expected a non-empty string "
+                    "without surrounding spaces, e.g. 'tool.tip:y'"
+                )
+        if len(set(labels)) != len(labels):
+            twice = sorted({x for x in labels if labels.count(x) > 1})
+            raise InvalidValueError(f"{field}: the labels {twice} appear more than once")
+        if not labels:
+            raise InvalidValueError(f"{field}: got no labels; expected at least one")
+        return labels
+
+    return convert
+
+
+def _complex_array(value: Any) -> np.ndarray:
+    try:
+        return _readonly(np.array(value, dtype=np.complex128, copy=True))
+    except (TypeError, ValueError):
+        raise InvalidValueError(
+            f"data: cannot read {type(value).__name__} as complex numbers; "
+            "expected an array of shape (n_freq, n_out, n_in)"
+        ) from None
+
+
+def _check_quantity(instance: Any, attribute: Any, value: Any) -> None:
+    if value not in QUANTITIES:
+        raise InvalidValueError(f"quantity: got {value!r}; expected one of {', '.join(QUANTITIES)}")
+
+
+def _check_frequency(instance: Any, attribute: Any, value: Any) -> None:
+    if not isinstance(value, Frequency):
+        raise InvalidValueError(
+            f"frequency: got {type(value).__name__}; expected a Frequency, "
+            "e.g. Frequency.from_hz(values) or Frequency.from_range('20 Hz', '5000 Hz', '2 Hz')"
+        )
+
+
+def _scalar(value: Any) -> complex | None:
+    if isinstance(value, numbers.Number) and not isinstance(value, bool):
+        value = complex(value)
+        if not np.isfinite(value):
+            raise InvalidValueError(f"factor: got {value!r}; expected a finite number")
+        return value
+    return None
+
+
+@attrs.frozen(repr=False)
+class FRF:
+    """Frequency response functions between labelled DOFs on one frequency axis.
+
+    Parameters
+    ----------
+    frequency : Frequency
+        The axis, in Hz.
+    data : array_like
+        Complex values of shape ``(n_freq, n_out, n_in)``, finite, in SI units
+        (receptance in m/N, 1/N or 1/(N m) depending on the DOFs).  Stored as
+        a read-only complex128 copy.  A 1-D array is not reshaped: use
+        :meth:`FRF.single` for one FRF.
+    outputs, inputs : sequence of str
+        Unique labels of the response and excitation DOFs, ``"POINT:y"`` or
+        ``"POINT:theta"`` (conventions.md).
+    quantity : {"receptance", "mobility", "accelerance"}
+        What the data are; :meth:`to_receptance` converts.
+
+    Examples
+    --------
+    >>> f = Frequency.from_range("100 Hz", "110 Hz", "5 Hz")
+    >>> frf = FRF.single(f, [1e-7, 2e-7, 1e-7], output="tool.tip:y", input="tool.tip:y")
+    >>> frf.entry("tool.tip:y", "tool.tip:y").real
+    array([1.e-07, 2.e-07, 1.e-07])
+    """
+
+    __array_ufunc__ = None  # numpy scalars defer to FRF.__rmul__ instead of broadcasting
+
+    frequency: Frequency = attrs.field(validator=_check_frequency)
+    data: np.ndarray = attrs.field(converter=_complex_array, eq=attrs.cmp_using(eq=np.array_equal))
+    outputs: tuple[str, ...] = attrs.field(converter=_labels("outputs"))
+    inputs: tuple[str, ...] = attrs.field(converter=_labels("inputs"))
+    quantity: str = attrs.field(default="receptance", validator=_check_quantity)
+
+    def __attrs_post_init__(self) -> None:
+        expected = (self.frequency.n, len(self.outputs), len(self.inputs))
+        if self.data.shape != expected:
+            hint = " (for one FRF use FRF.single)" if self.data.ndim == 1 else ""
+            raise InvalidValueError(
+                f"data: got shape {self.data.shape}; expected (n_freq, n_out, n_in) = {expected} "
+                f"for {expected[0]} frequency lines, {expected[1]} output label(s) and "
+                f"{expected[2]} input label(s){hint}"
+            )
+        bad = ~np.isfinite(self.data)
+        if bad.any():
+            k, i, j = np.argwhere(bad)[0]
+            raise InvalidValueError(
+                f"data: got {self.data[k, i, j]} at {self.frequency.hz[k]:g} Hz, entry "
+                f"({self.outputs[i]!r}, {self.inputs[j]!r}); expected finite values"
+            )
+
+    @classmethod
+    def single(
+        cls, frequency: Frequency, values: Any, output: str = "response", input: str = "excitation",
+        quantity: str = "receptance",
+    ) -> FRF:
+        """One FRF, shape ``(n_freq, 1, 1)``, from a 1-D array of ``n_freq`` complex values."""
+        values = np.asarray(values)
+        if values.ndim != 1:
+            raise InvalidValueError(f"values: got shape {values.shape}; expected a 1-D array of n_freq values")
+        return cls(frequency, values[:, None, None], (output,), (input,), quantity)
+
+    # -- labels ---------------------------------------------------------------
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        """``(n_freq, n_out, n_in)``."""
+        return self.data.shape
+
+    def _index(self, labels: Any, which: str) -> list[int]:
+        have = self.outputs if which == "output" else self.inputs
+        if isinstance(labels, slice) and labels == slice(None):
+            return list(range(len(have)))
+        wanted = list(labels) if isinstance(labels, (list, tuple, np.ndarray)) else [labels]
+        for label in wanted:
+            if label not in have:
+                available = ", ".join(repr(x) for x in have)
+                raise UnknownPointError(f"{which} {label!r} is not in this FRF; {which}s available: {available}")
+        return [have.index(x) for x in wanted]
+
+    def entry(self, output: str, input: str) -> np.ndarray:
+        """The 1-D complex FRF from ``input`` to ``output`` (read-only view)."""
+        if not isinstance(output, str) or not isinstance(input, str):
+            raise InvalidValueError(
+                f"output, input: got {output!r}, {input!r}; expected one label each (use select for more)"
+            )
+        (i,), (j,) = self._index(output, "output"), self._index(input, "input")
+        return self.data[:, i, j]
+
+    def select(self, outputs: Any = None, inputs: Any = None) -> FRF:
+        """Sub-FRF with these outputs and inputs (a label or a list; ``None`` keeps all)."""
+        rows = self._index(slice(None) if outputs is None else outputs, "output")
+        cols = self._index(slice(None) if inputs is None else inputs, "input")
+        outputs, inputs = [self.outputs[i] for i in rows], [self.inputs[j] for j in cols]
+        return attrs.evolve(self, data=self.data[:, rows][:, :, cols], outputs=outputs, inputs=inputs)
+
+    def __getitem__(self, key: Any) -> FRF:
+        """``frf[outputs, inputs]``: labels, lists of labels or ``:``; always an FRF."""
+        if not isinstance(key, tuple) or len(key) != 2:
+            raise InvalidValueError(
+                f"index: got {key!r}; expected a pair frf[outputs, inputs] of labels, "
+                "lists of labels or ':'"
+            )
+        return self.select(*key)
+
+    def with_labels(self, outputs: Sequence[str], inputs: Sequence[str]) -> FRF:
+        """Same data under new output and input labels."""
+        return attrs.evolve(self, outputs=outputs, inputs=inputs)
+
+    def unit(self, output: str, input: str) -> str:
+        """SI unit of one entry, from the DOF kinds and the quantity (e.g. ``"m/N"``)."""
+        self._index(output, "output"), self._index(input, "input")
+        rotation, moment = output.endswith(":theta"), input.endswith(":theta")  # else y (default)
+        # y/f in m/N; y/m = m/(N m) and theta/f = rad/N in 1/N; theta/m in 1/(N m)
+        numerator = "1" if rotation or moment else "m"
+        factors = ["N"] + (["m"] if rotation and moment else [])
+        factors += {"receptance": [], "mobility": ["s"], "accelerance": ["s^2"]}[self.quantity]
+        denominator = " ".join(factors)
+        return f"{numerator}/({denominator})" if len(factors) > 1 else f"{numerator}/{denominator}"
+
+    # -- views of the data ----------------------------------------------------
+    @property
+    def omega(self) -> np.ndarray:
+        """Angular frequencies in rad/s."""
+        return self.frequency.omega
+
+    @property
+    def magnitude(self) -> np.ndarray:
+        """``|data|``, same shape as the data."""
+        return np.abs(self.data)
+
+    def phase(self, deg: bool = False) -> np.ndarray:
+        """Phase angle of the data in rad (or degrees), in (-pi, pi]."""
+        return np.angle(self.data, deg=deg)
+
+    @property
+    def real(self) -> np.ndarray:
+        """Real part of the data."""
+        return self.data.real
+
+    @property
+    def imag(self) -> np.ndarray:
+        """Imaginary part of the data."""
+        return self.data.imag
+
+    # -- frequency axis -------------------------------------------------------
+    def crop(self, lo: Any = None, hi: Any = None) -> FRF:
+        """FRF restricted to ``lo <= f <= hi`` (floats in Hz, quantities or strings)."""
+        mask = self.frequency.band_mask(lo, hi)
+        return attrs.evolve(self, frequency=self.frequency.crop(lo, hi), data=self.data[mask])
+
+    def interpolate(self, frequency: Frequency, kind: str = "linear") -> FRF:
+        """FRF on another grid, real and imaginary parts interpolated separately.
+
+        Parameters
+        ----------
+        frequency : Frequency
+            The new grid; it must lie within this FRF's range (no extrapolation,
+            up to a rounding tolerance of 1e-12 of the largest frequency).
+        kind : {"linear", "cubic"}
+            Piecewise linear, or a not-a-knot cubic spline (needs 4 lines).
+        """
+        if not isinstance(frequency, Frequency):
+            raise InvalidValueError(
+                f"frequency: got {type(frequency).__name__}; expected a Frequency "
+                "(e.g. Frequency.from_range('20 Hz', '5000 Hz', '2 Hz'))"
+            )
+        if kind not in ("linear", "cubic"):
+            raise InvalidValueError(f"kind: got {kind!r}; expected 'linear' or 'cubic'")
+        old, new = self.frequency.hz, frequency.hz
+        if np.array_equal(old, new):
+            return self
+        tol = _GRID_RTOL * max(abs(old[-1]), 1.0)
+        if new[0] < old[0] - tol or new[-1] > old[-1] + tol:
+            raise InvalidValueError(
+                f"frequency: the new grid {new[0]:g}..{new[-1]:g} Hz leaves this FRF's range "
+                f"{old[0]:g}..{old[-1]:g} Hz; extrapolation is not done, crop the new grid"
+            )
+        minimum = 2 if kind == "linear" else 4
+        if old.size < minimum:
+            raise InvalidValueError(
+                f"kind: {kind} interpolation needs at least {minimum} lines; this FRF has {old.size}"
+            )
+        x = np.clip(new, old[0], old[-1])
+        if kind == "linear":
+            k = np.clip(np.searchsorted(old, x, side="right") - 1, 0, old.size - 2)
+            t = ((x - old[k]) / (old[k + 1] - old[k]))[:, None, None]
+            data = self.data[k] * (1.0 - t) + self.data[k + 1] * t
+        else:
+            from scipy.interpolate import CubicSpline
+
+            real, imag = (CubicSpline(old, part, axis=0)(x) for part in (self.data.real, self.data.imag))
+            data = real + 1j * imag
+        return attrs.evolve(self, frequency=frequency, data=data)
+
+    # -- arithmetic -----------------------------------------------------------
+    def _check_compatible(self, other: FRF, operation: str) -> None:
+        if self.frequency != other.frequency:
+            raise FrequencyAxisMismatchError(
+                f"cannot {operation} FRFs on different frequency axes ({self.frequency!r} and "
+                f"{other.frequency!r}); call .interpolate(frequency) or .crop(lo, hi) first"
+            )
+        if (self.outputs, self.inputs) != (other.outputs, other.inputs):
+            raise InvalidValueError(
+                f"cannot {operation} FRFs with different labels: outputs {self.outputs} / "
+                f"{other.outputs}, inputs {self.inputs} / {other.inputs}; use .select or .with_labels"
+            )
+        if self.quantity != other.quantity:
+            raise InvalidValueError(
+                f"cannot {operation} a {self.quantity} and a {other.quantity}; "
+                "convert with .to_receptance() first"
+            )
+
+    def __add__(self, other: Any) -> FRF:
+        if not isinstance(other, FRF):
+            return NotImplemented
+        self._check_compatible(other, "combine")
+        return attrs.evolve(self, data=self.data + other.data)
+
+    def __sub__(self, other: Any) -> FRF:
+        return self + (-other) if isinstance(other, FRF) else NotImplemented
+
+    def __neg__(self) -> FRF:
+        return attrs.evolve(self, data=-self.data)
+
+    def __mul__(self, other: Any) -> FRF:
+        factor = _scalar(other)
+        if factor is None:
+            return NotImplemented
+        return attrs.evolve(self, data=self.data * factor)
+
+    __rmul__ = __mul__
+
+    # -- analysis -------------------------------------------------------------
+    def peaks(
+        self, output: str | None = None, input: str | None = None, prominence: float | None = None
+    ) -> np.ndarray:
+        """Frequencies in Hz (ascending) of the local maxima of ``|FRF|`` of one entry.
+
+        Parameters
+        ----------
+        output, input : str, optional
+            The entry; may be left out along a side with a single label.
+        prominence : float, optional
+            Keep only peaks whose prominence is at least this fraction of the
+            largest ``|FRF|`` of the entry (``scipy.signal.find_peaks``).
+
+        Notes
+        -----
+        A maximum at the first or last line is not a peak (it may be outside
+        the band).  The resolution is the grid's: no sub-line refinement.
+        """
+        from scipy.signal import find_peaks
+
+        chosen = []
+        for label, have, which in ((output, self.outputs, "output"), (input, self.inputs, "input")):
+            if label is None and len(have) != 1:
+                raise InvalidValueError(
+                    f"{which}: this FRF has {len(have)} {which}s ({', '.join(have)}); name one"
+                )
+            chosen.append(have[0] if label is None else label)
+        magnitude = np.abs(self.entry(*chosen))
+        if prominence is not None:
+            if not isinstance(prominence, numbers.Real) or not 0.0 <= prominence <= 1.0:
+                raise InvalidValueError(
+                    f"prominence: got {prominence!r}; expected a fraction of the largest |FRF| in [0, 1]"
+                )
+            prominence = prominence * magnitude.max()
+        index, _ = find_peaks(magnitude, prominence=prominence)
+        return self.frequency.hz[index].copy()
+
+    def reciprocity_error(self) -> float:
+        """Largest relative asymmetry ``|Y_pq - Y_qp| / max(|Y_pq|, |Y_qp|)``.
+
+        Taken over the frequency lines and every pair of labels ``p, q`` that
+        are both outputs and inputs (``H_ij = H_ji``, ``L_ij = N_ji``); 0.0 when
+        there is no such pair.
+        """
+        common = [x for x in self.outputs if x in self.inputs]
+        if len(common) < 2:
+            return 0.0
+        rows = [self.outputs.index(x) for x in common]
+        cols = [self.inputs.index(x) for x in common]
+        block = self.data[:, rows][:, :, cols]
+        transposed = np.swapaxes(block, 1, 2)
+        scale = np.maximum(np.maximum(np.abs(block), np.abs(transposed)), np.finfo(float).tiny)
+        return float((np.abs(block - transposed) / scale).max())
+
+    def check_reciprocity(self, rtol: float = 1e-6) -> float:
+        """:meth:`reciprocity_error`, warning with NonReciprocalWarning above ``rtol``."""
+        error = self.reciprocity_error()
+        if error > rtol:
+            message = f"FRF is not reciprocal: relative asymmetry {error:.3g} exceeds rtol={rtol:g}"
+            warnings.warn(message, NonReciprocalWarning, stacklevel=2)
+        return error
+
+    def to_receptance(self) -> FRF:
+        """Receptance from mobility (``/ (i omega)``) or accelerance (``/ -omega**2``)."""
+        if self.quantity == "receptance":
+            return self
+        omega = self.frequency.omega
+        if omega[0] == 0.0:
+            raise InvalidValueError(
+                f"frequency: the grid starts at 0 Hz, where a {self.quantity} has no "
+                "receptance; crop it first, e.g. frf.crop(lo='1 Hz')"
+            )
+        factor = 1j * omega if self.quantity == "mobility" else -(omega**2)
+        return attrs.evolve(self, data=self.data / factor[:, None, None], quantity="receptance")
+
+    # -- edges: plots and files -----------------------------------------------
+    def plot(self, ax: Any = None, **kw: Any):
+        """Plot with :func:`substructure.plot.plot_frf`; returns the Figure."""
+        from .plot import plot_frf
+
+        return plot_frf(self, ax=ax, **kw)
+
+    def to_csv(self, path: Any) -> None:
+        """Write a 1x1 FRF to a CSV file (:func:`substructure.io.frf_files.write_csv`)."""
+        from .io.frf_files import write_csv
+
+        write_csv(self, path)
+
+    @classmethod
+    def from_csv(cls, path: Any, output: str = "response", input: str = "excitation",
+                 quantity: str = "receptance") -> FRF:
+        """Read a CSV file (:func:`substructure.io.frf_files.read_csv`)."""
+        from .io.frf_files import read_csv
+
+        return read_csv(path, output=output, input=input, quantity=quantity)
+
+    def to_uff(self, path: Any) -> None:
+        """Write type-58 records, one per entry (:func:`substructure.io.frf_files.write_uff`)."""
+        from .io.frf_files import write_uff
+
+        write_uff(self, path)
+
+    @classmethod
+    def from_uff(cls, path: Any, record: int | None = None, quantity: str | None = None) -> FRF:
+        """Read type-58 records (:func:`substructure.io.frf_files.read_uff`)."""
+        from .io.frf_files import read_uff
+
+        return read_uff(path, record=record, quantity=quantity)
+
+    def __hash__(self) -> int:
+        return hash((self.frequency, self.data.tobytes(), self.outputs, self.inputs, self.quantity))
+
+    def __repr__(self) -> str:
+        def short(labels: tuple[str, ...]) -> str:
+            return ", ".join(labels) if len(labels) <= 4 else f"{', '.join(labels[:3])}, ... ({len(labels)})"
+
+        return (
+            f"FRF({self.quantity}, {self.frequency!r}, {len(self.outputs)}x{len(self.inputs)}, "
+            f"outputs=[{short(self.outputs)}], inputs=[{short(self.inputs)}])"
+        )
