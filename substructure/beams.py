@@ -15,12 +15,14 @@ equations, with no discretisation and no modal truncation:
   with the divided difference ``g[s1, s2]``, evaluated by its power series
   where ``s L^2`` is small (low frequency, and exactly at ``omega = 0``).
 
-The dynamic stiffness follows from the blocks of ``T``.  Segments are
-split, without approximation, into pieces no longer than 1.5 radians of the
-largest wavenumber, which keeps every piece below its own first
-clamped-end resonance (1.875 rad) and the arithmetic well conditioned.  Receptances
-between any points are obtained by condensing the chain onto those points
-and inverting the small remaining system, all vectorised over frequency.
+Receptances between any points of a free-free stepped beam follow from the
+transfer matrices between the points and the free-end conditions (see
+:func:`_chain_receptance`): one 2x2 inversion per frequency line, singular
+only at the beam's own natural frequencies, with the rigid-body ``omega^2``
+factor carried exactly, so that the lowest lines are as accurate as the
+rest.  The segment dynamic stiffness (for joints of beam pieces and for
+teaching) follows from the blocks of ``T``.  Everything is vectorised over
+frequency (and over configurations in sweeps).
 
 Shear coefficient: Cowper (1966) for a hollow circular section,
 ``kappa = 6(1+nu)(1+m^2)^2 / ((7+6nu)(1+m^2)^2 + (20+12nu)m^2)``, ``m = id/od``
@@ -52,9 +54,9 @@ __all__ = [
     "shear_coefficient",
     "segment_dynamic_stiffness",
     "stepped_beam_receptance",
+    "stepped_beam_receptance_batch",
 ]
 
-_MAX_PIECE_PHASE = 1.5  # largest |wavenumber| * length of one piece [rad], below a cantilever's 1.875
 
 
 def _length(field: str, *, allow_zero: bool = False):
@@ -252,8 +254,9 @@ def _squared_wavenumbers(sec: Section, w2: np.ndarray) -> tuple[np.ndarray, np.n
     return a, e, mean + root, mean - root
 
 
-def _functions(s1: np.ndarray, s2: np.ndarray, length: float):
-    """``C(s2), C[s1,s2], S(s2), S[s1,s2]`` for one length, vectorised."""
+def _functions(s1: np.ndarray, s2: np.ndarray, length):
+    """``C(s2), C[s1,s2], S(s2), S[s1,s2]``, vectorised (``length`` scalar or per element)."""
+    length = np.broadcast_to(np.asarray(length, dtype=float), s1.shape)
     z1, z2 = s1 * length**2, s2 * length**2
     c0 = np.empty_like(z2)
     c1 = np.empty_like(z2)
@@ -286,16 +289,18 @@ def _functions(s1: np.ndarray, s2: np.ndarray, length: float):
             sc += pow2 / fact_c
             ss += pow2 / fact_s
             h = a1 * h + pow2  # h_n = a1 h_{n-1} + a2^n
+        ls = length[small]
         c0[small] = sc
-        g0[small] = length * ss
-        c1[small] = length**2 * dc
-        g1[small] = length**3 * ds
+        g0[small] = ls * ss
+        c1[small] = ls**2 * dc
+        g1[small] = ls**3 * ds
     big = ~small
     if np.any(big):
         # cosh and sinh from one exponential each (the principal square root
         # has Re >= 0, so exp(-r L) <= 1 and nothing overflows before exp(r L)).
         r1, r2 = np.sqrt(s1[big]), np.sqrt(s2[big])
-        e1, e2 = np.exp(r1 * length), np.exp(r2 * length)
+        lb = length[big]
+        e1, e2 = np.exp(r1 * lb), np.exp(r2 * lb)
         i1, i2 = 1.0 / e1, 1.0 / e2
         ch1, ch2 = 0.5 * (e1 + i1), 0.5 * (e2 + i2)
         sh1, sh2 = 0.5 * (e1 - i1) / r1, 0.5 * (e2 - i2) / r2
@@ -356,42 +361,82 @@ def segment_dynamic_stiffness(sec: Section, length: float, omega: np.ndarray):
 
 
 # ---------------------------------------------------------------------------
-# Chains of segments
+# Chains of segments: free-free receptances by transfer matrices
 
 
-def _pieces(segments: Sequence[Segment], positions: np.ndarray, omega_max: float):
-    """Split the beam at segment ends, requested positions and for conditioning.
+def _mul4(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Product of 4x4 stacks ``(4, 4, n)`` by 2x2 blocks."""
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape), dtype=complex)
+    a11, a12, a21, a22 = a[:2, :2], a[:2, 2:], a[2:, :2], a[2:, 2:]
+    b11, b12, b21, b22 = b[:2, :2], b[:2, 2:], b[2:, :2], b[2:, 2:]
+    out[:2, :2] = bk.mul2(a11, b11) + bk.mul2(a12, b21)
+    out[:2, 2:] = bk.mul2(a11, b12) + bk.mul2(a12, b22)
+    out[2:, :2] = bk.mul2(a21, b11) + bk.mul2(a22, b21)
+    out[2:, 2:] = bk.mul2(a21, b12) + bk.mul2(a22, b22)
+    return out
 
-    Returns the node positions and, per piece, its section and length.
+
+def _product(mats: list[np.ndarray], n: int) -> np.ndarray | None:
+    """``mats[-1] @ ... @ mats[0]`` (transfer in the +x direction); None when empty."""
+    acc = None
+    for t in mats:
+        acc = t if acc is None else _mul4(t, acc)
+    return acc
+
+
+def _chain_receptance(intervals: list[tuple[Section, object]], nodes: list[int], omega: np.ndarray) -> np.ndarray:
+    """Free-free receptances of a chain of uniform intervals at some of its nodes.
+
+    ``intervals[k]`` spans node ``k`` to node ``k + 1``; ``nodes`` are sorted,
+    distinct node indices.  With the state ``z = [u; F]`` (``u = [w, psi]``,
+    ``F = [V, M]``) a load ``g`` at node ``j`` makes ``F`` jump by ``-g``; the
+    free ends give ``F = 0`` before the base and after the tip, so
+
+    ``Y_ij = P_i,uu M_Fu^-1 S_j,FF - [x_i > x_j] T_(j->i),uF``
+
+    with ``P_i = T(0 -> x_i)``, ``S_j = T(x_j -> L)`` and ``M = T(0 -> L)``.
+    ``M_Fu`` is singular only at the free-free natural frequencies, and its
+    ``omega^2`` factor carries the rigid-body modes exactly, so the result is
+    well conditioned down to the lowest frequency line.
     """
-    sections = [s.section() for s in segments]
-    ends = np.concatenate([[0.0], np.cumsum([s.length_m for s in segments])])
-    cuts = np.unique(np.concatenate([ends, positions]))
-    nodes, pieces = [cuts[0]], []
-    for x0, x1 in zip(cuts[:-1], cuts[1:]):
-        mid = 0.5 * (x0 + x1)
-        k = int(np.clip(np.searchsorted(ends, mid) - 1, 0, len(segments) - 1))
-        sec = sections[k]
-        _, _, s1, s2 = _squared_wavenumbers(sec, np.array([omega_max**2]))
-        wavenumber = float(np.sqrt(max(abs(s1[0]), abs(s2[0]))))
-        n_sub = max(1, math.ceil(wavenumber * (x1 - x0) / _MAX_PIECE_PHASE))
-        for j in range(1, n_sub + 1):
-            nodes.append(x0 + (x1 - x0) * j / n_sub if j < n_sub else x1)
-            pieces.append((sec, (x1 - x0) / n_sub))
-    return np.asarray(nodes), pieces
-
-
-def _series(a, b):
-    """Two-ports ``a`` (nodes i, j) and ``b`` (nodes j, k) joined at j, j condensed."""
-    a11, a12, a21, a22 = a
-    b11, b12, b21, b22 = b
-    si = bk.inv2(a22 + b11)
-    return (
-        a11 - bk.mul2(a12, bk.mul2(si, a21)),
-        -bk.mul2(a12, bk.mul2(si, b12)),
-        -bk.mul2(bk.mul2(b21, si), a21),
-        b22 - bk.mul2(b21, bk.mul2(si, b12)),
-    )
+    n = omega.size
+    cache: dict[tuple, np.ndarray] = {}
+    mats = []
+    for sec, length in intervals:
+        key = (id(sec), id(length) if isinstance(length, np.ndarray) else length)
+        if key not in cache:
+            cache[key] = segment_transfer_matrix(sec, length, omega)
+        mats.append(cache[key])
+    m = len(nodes)
+    # Transfer matrices between consecutive requested nodes, and the overhangs.
+    head = _product(mats[: nodes[0]], n)
+    tail = _product(mats[nodes[-1] :], n)
+    gaps = [_product(mats[nodes[k] : nodes[k + 1]], n) for k in range(m - 1)]
+    eye = np.zeros((4, 4, n), dtype=complex)
+    for i in range(4):
+        eye[i, i] = 1.0
+    prefix = [head if head is not None else eye]
+    for g in gaps:
+        prefix.append(_mul4(g, prefix[-1]))
+    total = prefix[-1] if tail is None else _mul4(tail, prefix[-1])
+    suffix = [None] * m
+    suffix[-1] = tail if tail is not None else eye
+    for k in range(m - 2, -1, -1):
+        suffix[k] = _mul4(suffix[k + 1], gaps[k])
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        mfu_inv = bk.inv2(total[2:, :2])
+        left = [bk.mul2(prefix[i][:2, :2], mfu_inv) for i in range(m)]
+        y = np.empty((2 * m, 2 * m, n), dtype=complex)
+        for j in range(m):
+            s_ff = suffix[j][2:, 2:]
+            between = None
+            for i in range(m):
+                blk = bk.mul2(left[i], s_ff)
+                if i > j:
+                    between = gaps[i - 1] if between is None else _mul4(gaps[i - 1], between)
+                    blk = blk - between[:2, 2:]
+                y[2 * i : 2 * i + 2, 2 * j : 2 * j + 2] = blk
+    return y
 
 
 def stepped_beam_receptance(
@@ -419,51 +464,78 @@ def stepped_beam_receptance(
     pos = np.asarray(positions, dtype=float)
     order = np.argsort(pos)
     sorted_pos = pos[order]
-    nodes, pieces = _pieces(segments, sorted_pos, float(omega.max()))
-    node_of = np.searchsorted(nodes, sorted_pos)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        cache: dict[tuple, tuple] = {}
-        blocks = []
-        for sec, length in pieces:
-            key = (id(sec), length)
-            if key not in cache:
-                cache[key] = segment_dynamic_stiffness(sec, length, omega)
-            blocks.append(cache[key])
-
-        # Condense the chain onto the requested nodes: super-elements between
-        # consecutive requested nodes, and end stiffnesses of the free overhangs.
-        def chain(i0: int, i1: int):
-            acc = blocks[i0]
-            for k in range(i0 + 1, i1):
-                acc = _series(acc, blocks[k])
-            return acc
-
-        m = len(sorted_pos)
-        n = omega.size
-        diag = [np.zeros((2, 2, n), dtype=complex) for _ in range(m)]
-        off = []
-        if node_of[0] > 0:
-            p11, p12, p21, p22 = chain(0, node_of[0])
-            diag[0] += p22 - bk.mul2(p21, bk.mul2(bk.inv2(p11), p12))
-        if node_of[-1] < len(nodes) - 1:
-            p11, p12, p21, p22 = chain(node_of[-1], len(pieces))
-            diag[-1] += p11 - bk.mul2(p12, bk.mul2(bk.inv2(p22), p21))
-        for j in range(m - 1):
-            p11, p12, p21, p22 = chain(node_of[j], node_of[j + 1])
-            diag[j] += p11
-            diag[j + 1] += p22
-            off.append((p12, p21))
-        g = np.zeros((2 * m, 2 * m, n), dtype=complex)
-        for j in range(m):
-            g[2 * j : 2 * j + 2, 2 * j : 2 * j + 2] = diag[j]
-        for j, (p12, p21) in enumerate(off):
-            g[2 * j : 2 * j + 2, 2 * j + 2 : 2 * j + 4] = p12
-            g[2 * j + 2 : 2 * j + 4, 2 * j : 2 * j + 2] = p21
-        y_sorted = bk.inv(g)
-    # Back to the caller's order of positions.
-    dof = np.empty(2 * m, dtype=int)
+    if np.any(np.diff(sorted_pos) <= 0):
+        raise InvalidValueError("positions: expected distinct positions")
+    sections = [s.section() for s in segments]
+    ends = np.concatenate([[0.0], np.cumsum([s.length_m for s in segments])])
+    cuts = np.unique(np.concatenate([ends, sorted_pos]))
+    intervals = []
+    for x0, x1 in zip(cuts[:-1], cuts[1:]):
+        k = int(np.clip(np.searchsorted(ends, 0.5 * (x0 + x1)) - 1, 0, len(segments) - 1))
+        intervals.append((sections[k], float(x1 - x0)))
+    nodes = [int(i) for i in np.searchsorted(cuts, sorted_pos)]
+    y_sorted = _chain_receptance(intervals, nodes, omega)
+    m = len(sorted_pos)
     inverse = np.empty(m, dtype=int)
     inverse[order] = np.arange(m)
+    dof = np.empty(2 * m, dtype=int)
     dof[0::2] = 2 * inverse
     dof[1::2] = 2 * inverse + 1
     return y_sorted[np.ix_(dof, dof)]
+
+
+def _stack_sections(sections: Sequence[Section], repeat: int) -> Section:
+    """One Section whose fields are arrays over configurations (each repeated)."""
+    return Section(
+        EI=np.repeat(np.array([s.EI for s in sections], dtype=complex), repeat),
+        kGA=np.repeat(np.array([s.kGA for s in sections], dtype=complex), repeat),
+        rhoA=np.repeat(np.array([s.rhoA for s in sections], dtype=float), repeat),
+        rhoI=np.repeat(np.array([s.rhoI for s in sections], dtype=float), repeat),
+    )
+
+
+def stepped_beam_receptance_batch(
+    configurations: Sequence[Sequence[Segment]], ends: Sequence[str], frequency_hz: np.ndarray
+) -> np.ndarray:
+    """End receptances of many stepped beams of the same layout, in one pass.
+
+    Parameters
+    ----------
+    configurations : sequence of sequences of Segment
+        One beam per configuration, all with the same number of segments
+        (lengths, diameters and materials may differ).
+    ends : sequence of {"base", "tip"}
+        The points wanted (one or both ends), in this order.
+    frequency_hz : ndarray
+        Frequency lines, > 0.
+
+    Returns
+    -------
+    ndarray, shape (2p, 2p, n_config * n_freq)
+        Frequency-last receptances; the last axis runs over configurations
+        first (``index = config * n_freq + line``).
+
+    Notes
+    -----
+    The same closed form as :func:`stepped_beam_receptance`, evaluated on one
+    long axis that holds every configuration's frequency lines, so that a
+    sweep over tool overhangs costs a few numpy operations per segment.
+    """
+    n_seg = len(configurations[0])
+    if any(len(c) != n_seg for c in configurations):
+        raise InvalidValueError("configurations: every beam of a batch needs the same number of segments")
+    if not ends or any(e not in ("base", "tip") for e in ends) or len(set(ends)) != len(ends):
+        raise InvalidValueError(f"ends: got {ends!r}; expected 'base' and/or 'tip'")
+    f = np.asarray(frequency_hz, dtype=float)
+    n_f = f.size
+    omega = np.tile(2.0 * np.pi * f, len(configurations))
+    intervals = []
+    for j in range(n_seg):
+        sec = _stack_sections([cfg[j].section() for cfg in configurations], n_f)
+        lengths = np.repeat(np.array([cfg[j].length_m for cfg in configurations]), n_f)
+        intervals.append((sec, lengths))
+    nodes = sorted({"base": 0, "tip": n_seg}[e] for e in ends)
+    y = _chain_receptance(intervals, nodes, omega)
+    if len(ends) == 2 and ends[0] == "tip":
+        y = y[np.ix_([2, 3, 0, 1], [2, 3, 0, 1])]
+    return y

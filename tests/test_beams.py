@@ -1,0 +1,197 @@
+"""Exact Timoshenko beams against closed forms and invariants."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.optimize import brentq
+
+from substructure import Flutes, Insert, InvalidValueError, Material, Segment, Tool, shear_coefficient
+from substructure.beams import (
+    Section,
+    segment_dynamic_stiffness,
+    segment_transfer_matrix,
+    stepped_beam_receptance,
+    stepped_beam_receptance_batch,
+)
+
+STEEL_NO_LOSS = Material("steel0", E="210 GPa", nu=0.29, rho="7850 kg/m^3")
+
+
+def natural_frequencies(segments, n_modes, f_max, lines=20000):
+    """Free-free natural frequencies: the poles of the (undamped) tip point receptance.
+
+    At a pole the real receptance jumps from +inf to -inf; 1/H is continuous
+    there and crosses zero, which brentq pins down to ~1e-12.
+    """
+    length = sum(s.length_m for s in segments)
+
+    def inv_h(f):
+        with np.errstate(all="ignore"):
+            h = stepped_beam_receptance(segments, [length], np.array([f]))[0, 0, 0].real
+        return 0.0 if not np.isfinite(h) else 1.0 / h  # exactly on the pole
+
+    f = np.linspace(f_max / lines, f_max, lines)
+    h = stepped_beam_receptance(segments, [length], f)[0, 0].real
+    found = []
+    for i in np.nonzero(np.sign(h[:-1]) != np.sign(h[1:]))[0]:
+        if h[i] > 0 > h[i + 1]:  # through a pole (an antiresonance goes - to +)
+            found.append(brentq(inv_h, f[i], f[i + 1], xtol=1e-12, rtol=1e-14))
+    return np.array(found[:n_modes])
+
+
+def test_cowper_shear_coefficient():
+    assert shear_coefficient(0.29, 0.0) == pytest.approx(6 * 1.29 / (7 + 6 * 0.29))
+    assert shear_coefficient(0.29) == pytest.approx(0.886, abs=5e-4)  # conventions.md
+    # A thin ring tends to Cowper's thin-walled value 2(1+nu)/(4+3nu).
+    assert shear_coefficient(0.3, 0.9999) == pytest.approx(2 * 1.3 / (4 + 0.9), rel=1e-6)
+
+
+def test_free_free_slender_beam_matches_euler_bernoulli():
+    """beta*L = 4.7300, 7.8532, 10.9956 for a free-free uniform beam (< 0.1 %)."""
+    d, length = 0.005, 1.0  # L/d = 200: shear and rotary inertia negligible
+    seg = [Segment(f"{length} m", f"{d} m", material=STEEL_NO_LOSS)]
+    sec = seg[0].section()
+    beta_l = np.array([4.730040745, 7.853204624, 10.99560784])
+    expected = beta_l**2 / (2 * np.pi * length**2) * math.sqrt(sec.EI.real / sec.rhoA)
+    found = natural_frequencies(seg, 3, 1.2 * expected[-1])
+    np.testing.assert_allclose(found, expected, rtol=1e-3)
+    # and Timoshenko lowers them, by less than 0.1 % here
+    assert np.all(found < expected)
+
+
+def test_cantilever_static_tip_compliance():
+    """Clamped base, load at the tip: L^3/(3EI) + L/(kappa G A), from the exact stiffness at omega = 0."""
+    for od, idd, length in [(0.012, 0.0, 0.06), (0.04, 0.02, 0.03), (0.1, 0.0, 0.05)]:
+        seg = Segment(f"{length} m", f"{od} m", f"{idd} m", material=STEEL_NO_LOSS)
+        sec = seg.section()
+        _, _, _, d22 = segment_dynamic_stiffness(sec, length, np.array([0.0]))
+        compliance = np.linalg.inv(d22[..., 0])
+        expected = length**3 / (3 * sec.EI.real) + length / sec.kGA.real
+        assert compliance[0, 0].real == pytest.approx(expected, rel=1e-12)
+        assert compliance[1, 1].real == pytest.approx(length / sec.EI.real, rel=1e-12)
+
+
+def test_rigid_body_limit_of_free_free_receptance():
+    """At low frequency a free-free uniform beam is a rigid body (thesis eq. 2.8-2.11)."""
+    length = 0.08
+    seg = [Segment(f"{length} m", "0.012 m", material=STEEL_NO_LOSS)]
+    sec = seg[0].section()
+    mass = sec.rhoA * length
+    f = np.array([1e-3])
+    w2 = (2 * np.pi * f[0]) ** 2
+    y = stepped_beam_receptance(seg, [length], f)[..., 0]
+    rot = 1 + 12 * sec.rhoI / (sec.rhoA * length**2)  # rotary inertia adds to the body's inertia
+    # End receptances of a rigid bar with mass m and inertia J = m L^2/12 + rhoI L about its centre
+    j_c = mass * length**2 / 12 * rot
+    h = -(1 / mass + (length / 2) ** 2 / j_c) / w2
+    n = -(length / 2) / j_c / w2
+    p = -1 / j_c / w2
+    np.testing.assert_allclose(y.real, [[h, n], [n, p]], rtol=1e-6)
+
+
+def test_transfer_matrix_is_exact_against_matrix_exponential():
+    """T = exp(A L) from the closed form equals scipy's expm of the first-order system."""
+    from scipy.linalg import expm
+
+    mat = Material("m", E="200 GPa", nu=0.3, rho="7800 kg/m^3", loss_factor=0.01)
+    sec = Segment("50 mm", "30 mm", "10 mm", material=mat).section()
+    for f in [0.0, 1e-3, 50.0, 3000.0, 40000.0]:
+        w2 = (2 * np.pi * f) ** 2
+        a = np.array(
+            [
+                [0, 1, 1 / sec.kGA, 0],
+                [0, 0, 0, 1 / sec.EI],
+                [-w2 * sec.rhoA, 0, 0, 0],
+                [0, -w2 * sec.rhoI, -1, 0],
+            ],
+            dtype=complex,
+        )
+        for length in [0.001, 0.05, 0.3]:
+            t = segment_transfer_matrix(sec, length, np.array([2 * np.pi * f]))[..., 0]
+            ref = expm(a * length)
+            np.testing.assert_allclose(t, ref, rtol=1e-10, atol=1e-13 * np.abs(ref).max())
+
+
+def test_segment_dynamic_stiffness_is_symmetric():
+    sec = Segment("40 mm", "20 mm", material="carbide").section()
+    d11, d12, d21, d22 = segment_dynamic_stiffness(sec, 0.04, 2 * np.pi * np.linspace(10, 8000, 50))
+    scale = np.abs(d11).max()
+    assert np.abs(d12 - d21.transpose(1, 0, 2)).max() < 1e-13 * scale
+    assert np.abs(d11 - d11.transpose(1, 0, 2)).max() < 1e-13 * scale
+
+
+segment_strategy = st.builds(
+    lambda length, od, ratio, mat: Segment(f"{length} mm", f"{od} mm", f"{od * ratio} mm", material=mat),
+    st.floats(5, 80),
+    st.floats(20, 120),
+    st.sampled_from([0.0, 0.3, 0.6]),
+    st.sampled_from(["steel", "carbide", "aluminium"]),
+)
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.lists(segment_strategy, min_size=1, max_size=4), st.floats(0.05, 0.95))
+def test_reciprocity_and_splitting_invariants(segments, frac):
+    """Y is symmetric to machine precision; an extra point does not change the others.
+
+    Machine-tool proportions (k L < 12 at 6 kHz): the transfer-matrix rounding
+    grows like eps * exp(k L), see docs/beams.md.
+    """
+    length = sum(s.length_m for s in segments)
+    f = np.linspace(10, 6000, 97)
+    y3 = stepped_beam_receptance(segments, [length, 0.0, frac * length], f)
+    # rounding grows like eps * exp(k L) with the evanescent wavenumber k (k L up to ~10 here)
+    assert np.abs(y3 - y3.transpose(1, 0, 2)).max() <= 1e-10 * np.abs(y3).max()
+    y2 = stepped_beam_receptance(segments, [length, 0.0], f)
+    assert np.abs(y3[:4, :4] - y2).max() <= 1e-10 * np.abs(y2).max()
+
+
+def test_batch_equals_single_configurations():
+    f = np.linspace(20, 5000, 300)
+    configs = [
+        [Segment("20 mm", "12 mm", material="carbide"), Segment(f"{L} mm", "12 mm", material="carbide", flutes=Flutes(0.8))]
+        for L in (10, 33, 70)
+    ]
+    batch = stepped_beam_receptance_batch(configs, ["tip", "base"], f)
+    for i, c in enumerate(configs):
+        single = stepped_beam_receptance(c, [sum(s.length_m for s in c), 0.0], f)
+        np.testing.assert_allclose(batch[..., i * 300 : (i + 1) * 300], single, rtol=1e-12, atol=0)
+
+
+def test_composite_and_fluted_sections():
+    steel, carbide = Material.from_catalog("steel"), Material.from_catalog("carbide")
+    seg = Segment("40 mm", "40 mm", "12 mm", insert=Insert("12 mm", "carbide"))
+    sec = seg.section()
+    ring = Section.ring(0.04, 0.012, steel)
+    core = Section.ring(0.012, 0.0, carbide)
+    assert sec.EI == pytest.approx(ring.EI + core.EI)
+    assert sec.kGA == pytest.approx(ring.kGA + core.kGA)
+    assert sec.rhoA == pytest.approx(math.pi / 4 * ((0.04**2 - 0.012**2) * 7850 + 0.012**2 * 14500))
+    fl = Segment("30 mm", "12 mm", material="carbide", flutes=Flutes(0.8)).section()
+    assert fl.EI == pytest.approx(Section.ring(0.0096, 0.0, carbide).EI)
+    assert fl.rhoA == pytest.approx(Section.ring(0.0096, 0.0, carbide).rhoA)
+
+
+def test_segment_validation_errors():
+    with pytest.raises(InvalidValueError, match="insert: the segment is solid"):
+        Segment("10 mm", "40 mm", insert=Insert("12 mm", "carbide"))
+    with pytest.raises(InvalidValueError, match="insert.od: got 14 mm, larger than the bore id 12 mm"):
+        Segment("10 mm", "40 mm", "12 mm", insert=Insert("14 mm", "carbide"))
+    with pytest.raises(InvalidValueError, match=r"flutes.diameter_ratio: got 1.2; expected a ratio in \(0, 1\]"):
+        Flutes(1.2)
+    with pytest.raises(InvalidValueError, match="material"):
+        Segment("10 mm", "12 mm", material=3)
+    with pytest.raises(InvalidValueError, match="segments"):
+        Tool("tool", [])
+
+
+def test_end_mill_constructor():
+    tool = Tool.end_mill("12 mm", "60 mm", "30 mm")
+    assert [s.length.m_as("mm") for s in tool.segments] == [30, 30]
+    assert tool.segments[1].flutes == Flutes(0.8)
+    assert tool.length.m_as("mm") == pytest.approx(60)
+    with pytest.raises(InvalidValueError, match="flute_length"):
+        Tool.end_mill("12 mm", "60 mm", "70 mm")

@@ -1,0 +1,100 @@
+"""Unit checks at the boundary: one registry, bare numbers and wrong dimensions rejected."""
+
+import math
+
+import numpy as np
+import pint
+import pytest
+
+from substructure import InvalidValueError, Material, Segment, UnitError
+from substructure.units import Q_, dimensionless, format_quantity, hz_to_rpm, quantity, rpm_to_hz, to_si, ureg
+
+
+def test_strings_and_quantities_are_accepted():
+    assert quantity("60 mm", "od", "[length]") == Q_(0.06, "m")
+    assert to_si(Q_(60, "mm"), "od", "m") == pytest.approx(0.06)
+    assert to_si("4.19e7 N/m", "k", "N/m") == 4.19e7
+
+
+def test_quantity_of_another_registry_is_converted():
+    other = pint.UnitRegistry()
+    q = quantity(other.Quantity(12, "mm"), "od", "[length]")
+    assert q._REGISTRY is ureg
+    assert q.m_as("m") == pytest.approx(0.012)
+
+
+@pytest.mark.parametrize("value", [60, 60.0, np.float64(60.0)])
+def test_bare_number_is_rejected_with_field_and_expectation(value):
+    with pytest.raises(UnitError, match=r"od: got the bare number .*expected a length"):
+        quantity(value, "od", "[length]")
+
+
+def test_wrong_dimension_names_field_value_and_expectation():
+    with pytest.raises(UnitError, match=r"od: got '60 kg' with dimension \[mass\]; expected a length"):
+        quantity("60 kg", "od", "[length]")
+
+
+def test_unitless_string_and_garbage_are_rejected():
+    with pytest.raises(UnitError, match="without a unit"):
+        quantity("60", "od", "[length]")
+    with pytest.raises(UnitError, match="cannot read"):
+        quantity("sixty mm", "od", "[length]")
+
+
+@pytest.mark.parametrize("text", ["nan mm", "inf mm"])
+def test_non_finite_values_are_rejected(text):
+    with pytest.raises(InvalidValueError, match="finite"):
+        quantity(text, "od", "[length]")
+
+
+def test_dimensionless_rejects_units_and_non_numbers():
+    assert dimensionless(0.3, "nu") == 0.3
+    with pytest.raises(UnitError):
+        dimensionless(Q_(3, "mm"), "nu")
+    with pytest.raises(InvalidValueError):
+        dimensionless(float("nan"), "nu")
+    with pytest.raises(InvalidValueError):
+        dimensionless(True, "nu")
+
+
+def test_format_quantity_round_trips_exactly():
+    for q in (Q_(60, "mm"), Q_(0.1 + 0.2, "m"), Q_(4.19e7, "N/m"), Q_(1e-8, "kg*m**2")):
+        back = ureg.Quantity(format_quantity(q))
+        assert back == q and back.magnitude == q.magnitude
+
+
+def test_rpm_helpers_are_explicit_and_exact():
+    assert rpm_to_hz(6000) == 100.0
+    assert hz_to_rpm(100.0) == 6000.0
+    # The trap the helper avoids: pint treats rpm as an angular velocity.
+    assert ureg.Quantity(6000, "rpm").m_as("Hz") == pytest.approx(100 * 2 * math.pi)
+
+
+def test_negative_length_and_id_ge_od_are_errors():
+    with pytest.raises(InvalidValueError, match="length: got '-5 mm'; expected a positive length"):
+        Segment("-5 mm", "12 mm")
+    with pytest.raises(InvalidValueError, match="id: got 12 mm with od 12 mm; expected id < od"):
+        Segment("5 mm", "12 mm", "12 mm")
+
+
+def test_material_checks():
+    with pytest.raises(InvalidValueError, match=r"nu: got 0.5; expected a Poisson ratio in \(-1, 0.5\)"):
+        Material("x", E="200 GPa", nu=0.5, rho="7800 kg/m^3")
+    with pytest.raises(InvalidValueError, match="loss_factor: got -0.1"):
+        Material("x", E="200 GPa", nu=0.3, rho="7800 kg/m^3", loss_factor=-0.1)
+    with pytest.raises(UnitError, match="E: got the bare number 200000000000.0"):
+        Material("x", E=200e9, nu=0.3, rho="7800 kg/m^3")
+    with pytest.raises(UnitError, match="rho"):
+        Material("x", E="200 GPa", nu=0.3, rho="7800 kg")
+    m = Material("x", E="260 GPa", nu=0.3, rho="7800 kg/m^3", loss_factor=0.01)
+    assert m.G.m_as("GPa") == pytest.approx(100.0)
+    assert m.E_si == pytest.approx(260e9 * (1 + 0.01j))
+
+
+def test_catalogue():
+    from substructure import CATALOG, get_material
+
+    assert set(CATALOG) == {"steel", "carbide", "aluminium"}
+    assert Material.from_catalog("steel") is CATALOG["steel"]
+    with pytest.raises(InvalidValueError, match="unknown material 'unobtainium'; known: aluminium, carbide, steel"):
+        get_material("unobtainium")
