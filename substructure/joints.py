@@ -94,27 +94,34 @@ class JointMatrix:
         return bool(self.entries)
 
 
-def _check_matrix(m: np.ndarray, what: str, owner: str) -> None:
-    """Warn when a matrix is not symmetric or not positive semi-definite."""
-    scale = np.abs(m).max()
-    if scale == 0:
-        return
-    if abs(m[0, 1] - m[1, 0]) > 1e-9 * max(abs(m[0, 1]), abs(m[1, 0])):
+def _check_matrices(k: np.ndarray, c: np.ndarray, owner: str) -> None:
+    """Warn (once per kind of problem) when k or c is not symmetric or not passive."""
+    asym, nonpassive = [], []
+    for sym_name, m in (("k", k), ("c", c)):
+        if np.abs(m).max() == 0:
+            continue
+        if abs(m[0, 1] - m[1, 0]) > 1e-9 * max(abs(m[0, 1]), abs(m[1, 0])):
+            asym.append(f"{sym_name}_ym = {m[0, 1]:.6g} != {sym_name}_tf = {m[1, 0]:.6g}")
+        sym = 0.5 * (m + m.T)
+        det = sym[0, 0] * sym[1, 1] - sym[0, 1] ** 2
+        if sym[0, 0] < 0 or sym[1, 1] < 0:
+            nonpassive.append(f"{sym_name} has a negative diagonal entry")
+        elif det < -1e-12 * (abs(sym[0, 0] * sym[1, 1]) + sym[0, 1] ** 2):
+            nonpassive.append(
+                f"{sym_name}_ym*{sym_name}_tf = {sym[0, 1] ** 2:.4g} > "
+                f"{sym_name}_yf*{sym_name}_tm = {sym[0, 0] * sym[1, 1]:.4g}"
+            )
+    if asym:
         warnings.warn(
-            f"{owner}: {what} matrix is not symmetric ({what[0]}_ym = {m[0, 1]:.6g} != "
-            f"{what[0]}_tf = {m[1, 0]:.6g}): the coupled receptances will not be reciprocal",
+            f"{owner}: the joint matrix is not symmetric ({'; '.join(asym)}): the coupled "
+            "receptances will not be reciprocal",
             NonReciprocalWarning,
             stacklevel=4,
         )
-    sym = 0.5 * (m + m.T)
-    det = sym[0, 0] * sym[1, 1] - sym[0, 1] ** 2
-    if sym[0, 0] < 0 or sym[1, 1] < 0 or det < -1e-12 * (abs(sym[0, 0] * sym[1, 1]) + sym[0, 1] ** 2):
-        c = what[0]
+    if nonpassive:
         warnings.warn(
-            f"{owner}: {what} matrix is not positive semi-definite (non-passive): "
-            f"{c}_ym*{c}_tf = {sym[0, 1] ** 2:.4g} > {c}_yf*{c}_tm = {sym[0, 0] * sym[1, 1]:.4g}"
-            if sym[0, 0] >= 0 and sym[1, 1] >= 0
-            else f"{owner}: {what} matrix has a negative diagonal entry (non-passive)",
+            f"{owner}: not positive semi-definite (non-passive): {'; '.join(nonpassive)}; accepted, "
+            "but such a joint can generate energy at some frequencies",
             NonPassiveJointWarning,
             stacklevel=4,
         )
@@ -174,8 +181,7 @@ class Joint:
                     f"joint {self.name!r}: an elastic joint needs stiffness entries k "
                     "(or rigid = true)"
                 )
-            _check_matrix(self.k.values, "stiffness", f"joint {self.name!r}")
-            _check_matrix(self.c.values, "damping", f"joint {self.name!r}")
+            _check_matrices(self.k.values, self.c.values, f"joint {self.name!r}")
 
     @classmethod
     def rigid_between(cls, name: str, a: str, b: str) -> "Joint":
@@ -220,8 +226,7 @@ class Support:
             check_name(self.name)
         if not self.k and not self.c:
             raise InvalidValueError(f"support at {self.at}: needs stiffness k or damping c entries")
-        _check_matrix(self.k.values, "stiffness", f"support at {self.at}")
-        _check_matrix(self.c.values, "damping", f"support at {self.at}")
+        _check_matrices(self.k.values, self.c.values, f"support at {self.at}")
 
     def dynamic_stiffness(self, frequency_hz: np.ndarray) -> np.ndarray:
         omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)

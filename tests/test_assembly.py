@@ -1,0 +1,142 @@
+"""Assembly graph: building, lookups, joints' checks and bad input."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+from conftest import make_assembly, make_holder, make_spindle, make_tool
+from substructure import (
+    Assembly,
+    AssemblyError,
+    Frequency,
+    InvalidValueError,
+    Joint,
+    NonPassiveJointWarning,
+    NonReciprocalWarning,
+    Segment,
+    Sensor,
+    Support,
+    Tool,
+    UnitError,
+    UnknownPointError,
+)
+from substructure.datasets import thesis_joint
+from substructure.points import parse_point
+
+
+def test_thesis_tables_are_accepted_with_a_non_passive_warning():
+    for table in ("2.1", "2.2"):
+        k, c = thesis_joint(table)
+        with pytest.warns(NonPassiveJointWarning, match=r"non-passive.*k_ym\*k_tf = .* > k_yf\*k_tm"):
+            joint = Joint("j", ("a.tip", "b.base"), k=k, c=c)
+        assert joint.k.get("ym") == joint.k.get("tf")
+
+
+def test_asymmetric_joint_warns():
+    with pytest.warns(NonReciprocalWarning, match="not symmetric"):
+        Joint("j", ("a.tip", "b.base"), k={"yf": "1e7 N/m", "ym": "1e3 N", "tf": "2e3 N/rad", "tm": "1e4 N*m/rad"})
+
+
+def test_joint_errors():
+    with pytest.raises(UnitError, match="k.yf: got the bare number"):
+        Joint("j", ("a.tip", "b.base"), k={"yf": 1e7})
+    with pytest.raises(UnitError, match=r"k.tm: got '1e4 N/m' with dimension"):
+        Joint("j", ("a.tip", "b.base"), k={"yf": "1e7 N/m", "tm": "1e4 N/m"})
+    with pytest.raises(InvalidValueError, match=r"unknown entries \['xy'\]"):
+        Joint("j", ("a.tip", "b.base"), k={"xy": "1 N/m"})
+    with pytest.raises(InvalidValueError, match="a rigid joint takes no k or c"):
+        Joint("j", ("a.tip", "b.base"), k={"yf": "1 N/m"}, rigid=True)
+    with pytest.raises(InvalidValueError, match="needs stiffness entries"):
+        Joint("j", ("a.tip", "b.base"))
+    with pytest.raises(InvalidValueError, match="between"):
+        Joint("j", ("a.tip", "a.tip"), rigid=True)
+    with pytest.raises(InvalidValueError, match="name"):
+        Joint("bad.name", ("a.tip", "b.base"), rigid=True)
+
+
+def test_sensor_and_support_errors():
+    with pytest.raises(InvalidValueError, match="mass: got '-2 g'"):
+        Sensor("acc", "tool.tip", "-2 g")
+    with pytest.raises(UnitError, match="inertia"):
+        Sensor("acc", "tool.tip", "2 g", "5 kg")
+    with pytest.raises(InvalidValueError, match="needs stiffness k or damping c"):
+        Support("spindle@10 mm")
+    assert Sensor.laser("ldv", "tool.tip").mass_kg == 0.0
+
+
+def test_point_names():
+    assert str(parse_point("tool.tip")) == "tool.tip"
+    ref = parse_point("spindle@310 mm:theta")
+    assert (ref.component, ref.where, ref.distance.m_as("mm"), ref.dof) == ("spindle", "at", 310, "theta")
+    assert parse_point("tool.tip-15 mm").where == "from_tip"
+    for bad in ["tool", "tool.tip:z", "tool@ten", "tool@-3 mm", ""]:
+        with pytest.raises(UnknownPointError):
+            parse_point(bad)
+
+
+def test_unknown_points_and_names_are_errors():
+    with pytest.raises(UnknownPointError, match="no component 'tol'.*components: holder, spindle, tool"):
+        make_assembly().connect("tol.tip", "holder.tip", rigid=True)
+    with pytest.raises(UnknownPointError, match="lies outside 'tool'"):
+        make_assembly().attach(Sensor("acc", "tool@80 mm", "2 g"))
+    with pytest.raises(UnknownPointError, match="'tool' has points base, tip"):
+        make_assembly().attach(Sensor("acc", "tool.middle", "2 g"))
+    with pytest.raises(AssemblyError, match="component name 'tool' is used twice"):
+        Assembly("dup", components=(make_tool(), make_tool()))
+    with pytest.raises(AssemblyError, match="sensor names used twice"):
+        make_assembly().attach(Sensor("a", "tool.tip", "1 g"), Sensor("a", "tool.base", "1 g"))
+    with pytest.raises(InvalidValueError, match="is not a component"):
+        Assembly("x", components=("tool",))
+    with pytest.raises(InvalidValueError, match="no default grid"):
+        make_assembly().receptance("tool.tip")
+
+
+def test_receptance_labels_and_dofs(assembly, grid):
+    full = assembly.receptance("tool.tip", frequency=grid)
+    h = assembly.receptance("tool.tip:y", frequency=grid)
+    assert h.outputs == ("tool.tip:y",) and h.data.shape == (len(grid), 1, 1)
+    np.testing.assert_array_equal(h.data[:, 0, 0], full.data[:, 0, 0])
+    cross = assembly.receptance("tool.tip:theta", "holder.tip:y", frequency=grid)
+    assert cross.outputs == ("tool.tip:theta",) and cross.inputs == ("holder.tip:y",)
+    # the same physical point under two names
+    same = assembly.receptance("tool@60 mm:y", frequency=grid)
+    np.testing.assert_allclose(same.data, h.data, rtol=1e-12)
+
+
+def test_building_returns_new_assemblies(assembly, grid):
+    s = Sensor("acc", "tool.tip", "2 g")
+    with_s = assembly.attach(s)
+    assert assembly.sensors == () and with_s.sensors == (s,)
+    assert with_s.without_sensors().sensors == ()
+    assert with_s.sensor("acc") is s
+    with pytest.warns(NonPassiveJointWarning):  # the thesis's Table 2.2 joint stays non-passive
+        stiffer = assembly.with_joint(assembly.joint("holder-tool").with_parameters(k={"yf": "1e8 N/m"}))
+    assert stiffer.joint("holder-tool").k.get("yf") == 1e8
+    assert stiffer.joint("holder-tool").k.get("tm") == assembly.joint("holder-tool").k.get("tm")
+    # With a passive (diagonal) joint, a stiffer joint raises the tool mode.
+    diagonal = {"ym": "0 N", "tf": "0 N/rad"}
+    soft = assembly.with_joint(assembly.joint("holder-tool").with_parameters(k={"yf": "1e7 N/m", **diagonal}, c={"ym": "0 N*s", "tf": "0 N*s/rad"}))
+    hard = soft.with_joint(soft.joint("holder-tool").with_parameters(k={"yf": "1e8 N/m"}))
+    f_soft = soft.receptance("tool.tip:y", frequency=grid).peaks()
+    f_hard = hard.receptance("tool.tip:y", frequency=grid).peaks()
+    assert f_hard[1] > f_soft[1]
+    shorter = assembly.with_component(make_tool(40.0))
+    assert shorter.component("tool").length.m_as("mm") == pytest.approx(40)
+    assert "joint holder-tool: holder.tip -- tool.base" in assembly.describe()
+
+
+def test_support_to_ground_shifts_rigid_modes(grid):
+    """A free-free tool on a soft spring gets a bounce mode at sqrt(k/m)/(2 pi)."""
+    tool = Tool("tool", [Segment("100 mm", "20 mm")])
+    m = tool.mass()
+    k = 1e4
+    asm = Assembly("bounce", components=(tool,)).support("tool@50 mm", k={"yf": f"{k} N/m"})
+    grid = Frequency.from_range("1 Hz", "200 Hz", "0.05 Hz")
+    peaks = asm.receptance("tool@50 mm:y", frequency=grid).peaks()
+    assert peaks[0] == pytest.approx(np.sqrt(k / m) / (2 * np.pi), abs=0.05)
+
+
+def test_frequencies_must_be_positive_for_free_free_components(assembly):
+    with pytest.raises(InvalidValueError, match="no static receptance"):
+        assembly.receptance("tool.tip", frequency=Frequency.from_hz([0.0, 10.0]))
