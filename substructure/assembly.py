@@ -43,7 +43,27 @@ from .joints import Joint, Sensor, Support
 from .materials import Material
 from .points import DOFS, PointRef, check_name, parse_point
 
-__all__ = ["Assembly"]
+__all__ = ["Assembly", "expand_points"]
+
+
+def expand_points(points: Sequence[str] | str):
+    """DOF labels of point names, and where they sit: ``(labels, [(point, dof)], refs)``.
+
+    A point without a DOF suffix stands for both of its DOFs ``(y, theta)``.
+    """
+    points = [points] if isinstance(points, str) else list(points)
+    if not points:
+        raise InvalidValueError("expected at least one point")
+    labels, dof_index, refs = [], [], []
+    for p in points:
+        ref = parse_point(p)
+        refs.append(ref.point)
+        base = str(ref.point)
+        for d, name in enumerate(DOFS):
+            if ref.dof is None or ref.dof == name:
+                labels.append(f"{base}:{name}")
+                dof_index.append((len(refs) - 1, d))
+    return labels, dof_index, refs
 
 
 def _tuple(kind: type | None = None):
@@ -257,10 +277,15 @@ class Assembly:
             return self.frequency
         return as_frequency(frequency)
 
-    def receptance_matrix(self, refs: Sequence[PointRef], frequency_hz: np.ndarray) -> np.ndarray:
-        """Coupled receptances between points, ``(2p, 2p, n)`` frequency-last (component protocol)."""
-        f = np.asarray(frequency_hz, dtype=float)
-        # Every point that takes part, deduplicated by physical node.
+    def _plan(self, refs: Sequence[PointRef]):
+        """What a computation needs: the nodes per component and the links, in order.
+
+        Returns ``(groups, out_keys, links)``: ``groups`` is a list of
+        ``(owner, [(key, ref), ...])`` (every point that takes part, deduplicated
+        by physical node), ``links`` a list of ``(key_a, key_b or None, object,
+        label)`` for sensors, supports and joints.  Assemblies of the same
+        structure give plans that match item by item (used by sweeps).
+        """
         nodes: dict[Any, tuple[Any, PointRef]] = {}
 
         def node(point) -> Any:
@@ -269,25 +294,29 @@ class Assembly:
             return key
 
         out_keys = [node(r) for r in refs]
-        links = []  # (key_a, key_b or None, object, label)
+        links = []
         for s in self.sensors:
-            if s.mass_kg > 0 or s.inertia_si > 0:
-                links.append((node(s.at), None, s, f"sensor {s.name!r}"))
-        for i, s in enumerate(self.supports):
+            links.append((node(s.at), None, s, f"sensor {s.name!r}"))
+        for s in self.supports:
             links.append((node(s.at), None, s, s.name or f"support at {s.at}"))
         for j in self.joints:
             ka, kb = node(j.between[0]), node(j.between[1])
             if ka == kb:
                 raise AssemblyError(f"joint {j.name!r} connects a point to itself")
             links.append((ka, kb, j, f"joint {j.name!r}"))
-
-        # Free-free receptances of each component at its points, then the engine.
-        by_owner: dict[int, list] = {}
+        groups: dict[int, list] = {}
         for k, (owner, ref) in nodes.items():
-            by_owner.setdefault(id(owner), [owner, []])[1].append((k, ref))
-        blocks = []
-        for owner, items in by_owner.values():
-            blocks.append(([k for k, _ in items], owner.receptance_matrix([ref for _, ref in items], f)))
+            groups.setdefault(id(owner), [owner, []])[1].append((k, ref))
+        return [tuple(g) for g in groups.values()], out_keys, links
+
+    def receptance_matrix(self, refs: Sequence[PointRef], frequency_hz: np.ndarray) -> np.ndarray:
+        """Coupled receptances between points, ``(2p, 2p, n)`` frequency-last (component protocol)."""
+        f = np.asarray(frequency_hz, dtype=float)
+        groups, out_keys, links = self._plan(refs)
+        blocks = [
+            ([k for k, _ in items], owner.receptance_matrix([ref for _, ref in items], f))
+            for owner, items in groups
+        ]
         coupling_links = [
             Link(ka, kb, None if getattr(obj, "rigid", False) else obj.dynamic_stiffness(f), label)
             for ka, kb, obj, label in links
@@ -315,20 +344,8 @@ class Assembly:
         if not outputs or not inputs:
             raise InvalidValueError("frf: expected at least one output and one input point")
 
-        def expand(points):
-            labels, dof_index, refs = [], [], []
-            for p in points:
-                ref = parse_point(p)
-                refs.append(ref.point)
-                base = str(ref.point)
-                for d, name in enumerate(DOFS):
-                    if ref.dof is None or ref.dof == name:
-                        labels.append(f"{base}:{name}")
-                        dof_index.append((len(refs) - 1, d))
-            return labels, dof_index, refs
-
-        out_labels, out_idx, out_refs = expand(outputs)
-        in_labels, in_idx, in_refs = expand(inputs)
+        out_labels, out_idx, out_refs = expand_points(outputs)
+        in_labels, in_idx, in_refs = expand_points(inputs)
         refs = out_refs + in_refs
         y = self.receptance_matrix(refs, freq.hz)
         rows = [2 * i + d for i, d in out_idx]

@@ -408,30 +408,35 @@ def _chain_receptance(intervals: list[tuple[Section, object]], nodes: list[int],
             cache[key] = segment_transfer_matrix(sec, length, omega)
         mats.append(cache[key])
     m = len(nodes)
-    # Transfer matrices between consecutive requested nodes, and the overhangs.
+    # Transfer matrices between consecutive requested nodes, and the overhangs
+    # (None stands for the identity: an end that is itself a requested node).
     head = _product(mats[: nodes[0]], n)
     tail = _product(mats[nodes[-1] :], n)
     gaps = [_product(mats[nodes[k] : nodes[k + 1]], n) for k in range(m - 1)]
-    eye = np.zeros((4, 4, n), dtype=complex)
-    for i in range(4):
-        eye[i, i] = 1.0
-    prefix = [head if head is not None else eye]
+
+    def then(first, second):  # transfer through `first`, then `second`
+        if first is None:
+            return second
+        if second is None:
+            return first
+        return _mul4(second, first)
+
+    prefix = [head]
     for g in gaps:
-        prefix.append(_mul4(g, prefix[-1]))
-    total = prefix[-1] if tail is None else _mul4(tail, prefix[-1])
+        prefix.append(then(prefix[-1], g))
+    total = then(prefix[-1], tail)
     suffix = [None] * m
-    suffix[-1] = tail if tail is not None else eye
+    suffix[-1] = tail
     for k in range(m - 2, -1, -1):
-        suffix[k] = _mul4(suffix[k + 1], gaps[k])
+        suffix[k] = then(gaps[k], suffix[k + 1])
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         mfu_inv = bk.inv2(total[2:, :2])
-        left = [bk.mul2(prefix[i][:2, :2], mfu_inv) for i in range(m)]
+        left = [mfu_inv if prefix[i] is None else bk.mul2(prefix[i][:2, :2], mfu_inv) for i in range(m)]
         y = np.empty((2 * m, 2 * m, n), dtype=complex)
         for j in range(m):
-            s_ff = suffix[j][2:, 2:]
             between = None
             for i in range(m):
-                blk = bk.mul2(left[i], s_ff)
+                blk = left[i] if suffix[j] is None else bk.mul2(left[i], suffix[j][2:, 2:])
                 if i > j:
                     between = gaps[i - 1] if between is None else _mul4(gaps[i - 1], between)
                     blk = blk - between[:2, 2:]

@@ -1,0 +1,311 @@
+"""The ``substructure`` command: the library's workflows without writing code.
+
+Subcommands (formats.md, "The `substructure` command"):
+
+``substructure frf ASSEMBLY.toml --at POINT[:dof] [--to POINT[:dof]] [--grid START:STOP:STEP]
+[--out FILE.csv|.uff] [--plot FILE.png] [--json]``
+    A receptance of an assembly file, with its peaks; written to a CSV or UFF
+    file and plotted on request.
+``substructure demo [--out DIR]``
+    The workflow on the built-in assembly, as a list of steps (:data:`DEMO_STEPS`).
+
+Every subcommand prints a human summary, or with ``--json`` exactly one JSON
+object (SI units, Hz) and nothing else on standard output.  A user's mistake
+prints ``substructure: error: ...`` on standard error and returns 1 (2 for
+misuse of the options), never a traceback; warnings print once each as
+``substructure: warning: ...`` on standard error.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import warnings
+from pathlib import Path
+from typing import Any, Callable
+
+import attrs
+import numpy as np
+
+from .errors import SubstructureError
+from .frf import FRF, Frequency
+from .io.assembly_toml import default_assembly, load_assembly
+from .points import parse_point
+from .units import Q_
+
+__all__ = ["main", "DEMO_STEPS", "DemoState"]
+
+PROG = "substructure"
+TOOL_POINT = "tool.tip:y"
+"""The tool point of the built-in assembly."""
+
+
+class _UsageError(Exception):
+    """Misuse of the command line (exit status 2)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser that raises instead of printing usage and exiting."""
+
+    def error(self, message: str):
+        raise _UsageError(message)
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+def _grid(text: str) -> Frequency:
+    """``START:STOP:STEP`` in Hz, or with units (``"20 Hz:5 kHz:2 Hz"``)."""
+    parts = text.split(":")
+    if len(parts) != 3:
+        raise argparse.ArgumentTypeError(
+            f"got {text!r}; expected START:STOP:STEP, e.g. 20:5000:2 (Hz) or '20 Hz:5 kHz:2 Hz'"
+        )
+    values: list[Any] = []
+    for part in parts:
+        try:
+            values.append(Q_(float(part), "Hz"))  # plain numbers are Hz
+        except ValueError:
+            values.append(part.strip())
+    try:
+        return Frequency.from_range(*values)
+    except SubstructureError as exc:
+        raise argparse.ArgumentTypeError(f"{text!r}: {exc}") from None
+
+
+def _point(text: str) -> str:
+    """A point name with its DOF, ``y`` when none is given."""
+    ref = parse_point(text)
+    return str(attrs.evolve(ref, dof=ref.dof or "y"))
+
+
+def _peak_table(frf: FRF) -> list[tuple[float, float]]:
+    """``(frequency in Hz, |FRF|)`` of the peaks of a one-entry FRF, ascending."""
+    peaks = frf.peaks()
+    magnitude = np.abs(frf.data[:, 0, 0])
+    index = np.searchsorted(frf.frequency.hz, peaks)
+    return [(float(f), float(magnitude[i])) for f, i in zip(peaks, index)]
+
+
+def _grid_text(frequency: Frequency) -> str:
+    return f"{frequency.start:g} Hz to {frequency.stop:g} Hz, {frequency.n} lines"
+
+
+def _save_plot(frf: FRF, path: str | os.PathLike, title: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")  # files only: no window, works without a display
+    import matplotlib.pyplot as plt
+
+    fig = frf.plot()
+    fig.suptitle(title)
+    try:
+        fig.savefig(path, dpi=120)
+    finally:
+        plt.close(fig)
+
+
+def _write_frf(frf: FRF, path: str) -> None:
+    suffix = Path(path).suffix.lower()
+    if suffix == ".csv":
+        frf.to_csv(path)
+    elif suffix in (".uff", ".unv"):
+        frf.to_uff(path)
+    else:  # checked before computing; kept for callers of this helper
+        raise _UsageError(f"argument --out: {path!r}: expected a .csv or .uff file")
+
+
+# -- frf ------------------------------------------------------------------------------
+
+
+def _run_frf(args: argparse.Namespace) -> int:
+    if args.out and Path(args.out).suffix.lower() not in (".csv", ".uff", ".unv"):
+        raise _UsageError(f"argument --out: {args.out!r}: expected a .csv or .uff file")
+    assembly = load_assembly(args.assembly)
+    at = _point(args.at)
+    to = _point(args.to) if args.to else at
+    frequency = args.grid or assembly.frequency
+    if frequency is None:
+        raise _UsageError(
+            f"{args.assembly} has no [frequency] table; give the grid with --grid START:STOP:STEP"
+        )
+    frf = assembly.receptance(at, to, frequency)
+    peaks = _peak_table(frf)
+    written = []
+    if args.out:
+        _write_frf(frf, args.out)
+        written.append(args.out)
+    if args.plot:
+        _save_plot(frf, args.plot, f"{assembly.name}: {at} / {to}")
+        written.append(args.plot)
+    if args.json:
+        values = frf.data[:, 0, 0]
+        print(json.dumps({
+            "frequency_hz": frf.frequency.hz.tolist(),
+            "real": values.real.tolist(),
+            "imag": values.imag.tolist(),
+            "peaks_hz": [f for f, _ in peaks],
+        }))
+        return 0
+    unit = frf.unit(frf.outputs[0], frf.inputs[0])
+    print(f"assembly: {assembly.name}")
+    print(f"receptance: response {at}, excitation {to} [{unit}]")
+    print(f"grid: {_grid_text(frf.frequency)}")
+    print("peaks:" if peaks else "peaks: none inside the grid")
+    for f, m in peaks:
+        print(f"  {f:10.6g} Hz   |FRF| = {m:.4g} {unit}")
+    for path in written:
+        print(f"wrote {path}")
+    return 0
+
+
+# -- demo -----------------------------------------------------------------------------
+
+
+@attrs.define
+class DemoState:
+    """What the demo steps share: the output directory, results so far, files written."""
+
+    out: Path
+    assembly: Any = None
+    frf: FRF | None = None
+    results: dict = attrs.field(factory=dict)
+    files: list = attrs.field(factory=list)
+    lines: list = attrs.field(factory=list)
+
+
+def _demo_load(state: DemoState) -> None:
+    state.assembly = default_assembly()
+    state.lines.append(state.assembly.describe())
+    state.results["components"] = [c.name for c in state.assembly.components]
+    state.results["joints"] = [j.name for j in state.assembly.joints]
+
+
+def _demo_frf(state: DemoState) -> None:
+    state.frf = state.assembly.receptance(TOOL_POINT)
+    peaks = _peak_table(state.frf)
+    tool_mode = max(peaks, key=lambda p: p[1])[0] if peaks else None
+    state.results["peaks_hz"] = [f for f, _ in peaks]
+    state.results["tool_mode_hz"] = tool_mode
+    state.lines.append(f"tool point FRF ({TOOL_POINT}) on {_grid_text(state.frf.frequency)}")
+    state.lines.append("peaks: " + ", ".join(f"{f:g} Hz" for f, _ in peaks))
+    if tool_mode is not None:
+        state.lines.append(f"tool mode (highest peak): {tool_mode:g} Hz")
+    path = state.out / "tool_point_frf.csv"
+    state.frf.to_csv(path)
+    state.files.append(str(path))
+
+
+def _demo_plot(state: DemoState) -> None:
+    path = state.out / "tool_point_frf.png"
+    _save_plot(state.frf, path, f"{state.assembly.name}: tool point FRF")
+    state.files.append(str(path))
+
+
+def _demo_assembly_file(state: DemoState) -> None:
+    import importlib.resources
+
+    path = state.out / "default_assembly.toml"
+    text = (importlib.resources.files("substructure") / "data" / "default_assembly.toml").read_text("utf-8")
+    path.write_text(text, encoding="utf-8")  # the packaged file, with its comments
+    state.files.append(str(path))
+
+
+DEMO_STEPS: list[tuple[str, Callable[[DemoState], None]]] = [
+    ("load the built-in assembly", _demo_load),
+    ("compute the tool point FRF", _demo_frf),
+    ("plot the tool point FRF", _demo_plot),
+    ("write the assembly file to start from", _demo_assembly_file),
+]
+"""The demo's steps, in order: ``(title, function(state))``; append to add steps."""
+
+
+def _run_demo(args: argparse.Namespace) -> int:
+    state = DemoState(out=Path(args.out))
+    state.out.mkdir(parents=True, exist_ok=True)
+    for _title, step in DEMO_STEPS:
+        step(state)
+    if args.json:
+        print(json.dumps({**state.results, "files": state.files}))
+        return 0
+    print("\n".join(state.lines))
+    for path in state.files:
+        print(f"wrote {path}")
+    return 0
+
+
+# -- entry point ----------------------------------------------------------------------
+
+
+def _parser() -> _Parser:
+    parser = _Parser(prog=PROG, description="Receptance coupling of spindle-holder-tool assemblies.")
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND")
+    frf = commands.add_parser("frf", help="receptance of an assembly file between two points")
+    frf.add_argument("assembly", metavar="ASSEMBLY.toml", help="assembly file (formats.md)")
+    frf.add_argument("--at", required=True, metavar="POINT[:dof]",
+                     help="response point, e.g. tool.tip (DOF y by default)")
+    frf.add_argument("--to", metavar="POINT[:dof]", help="excitation point (default: --at)")
+    frf.add_argument("--grid", type=_grid, metavar="START:STOP:STEP",
+                     help="frequency grid in Hz or with units (default: the file's [frequency])")
+    frf.add_argument("--out", metavar="FILE.csv|FILE.uff", help="write the FRF to a CSV or UFF file")
+    frf.add_argument("--plot", metavar="FILE.png", help="plot the FRF to an image file")
+    frf.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
+    frf.set_defaults(run=_run_frf)
+    demo = commands.add_parser("demo", help="the workflow on the built-in assembly, with plots")
+    demo.add_argument("--out", default="out/demo", metavar="DIR", help="output directory (default out/demo)")
+    demo.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
+    demo.set_defaults(run=_run_demo)
+    return parser
+
+
+def _error(exc: BaseException) -> str:
+    if isinstance(exc, OSError) and exc.filename is not None and exc.strerror:
+        return f"{exc.filename}: {exc.strerror}"
+    return _one_line(str(exc))
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit status (0 ok, 1 error, 2 usage).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments without the program name (default ``sys.argv[1:]``).
+    """
+    reported: set[str] = set()
+
+    def show(message, category, filename, lineno, file=None, line=None) -> None:
+        text = _one_line(str(message))
+        if text not in reported:
+            reported.add(text)
+            print(f"{PROG}: warning: {text}", file=sys.stderr)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        warnings.showwarning = show
+        try:
+            args = _parser().parse_args(argv)
+            if args.command is None:
+                raise _UsageError("choose a command: frf, demo (see substructure --help)")
+            return args.run(args)
+        except _UsageError as exc:
+            print(f"{PROG}: error: {_one_line(str(exc))}", file=sys.stderr)
+            return 2
+        except BrokenPipeError:  # e.g. piped into `head`: stop quietly
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            return 1
+        except (SubstructureError, OSError) as exc:
+            print(f"{PROG}: error: {_error(exc)}", file=sys.stderr)
+            return 1
+        except SystemExit as exc:  # --help and --version print and exit
+            return exc.code if isinstance(exc.code, int) else 0
+        except KeyboardInterrupt:
+            print(f"{PROG}: interrupted", file=sys.stderr)
+            return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

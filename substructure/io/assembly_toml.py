@@ -1,0 +1,547 @@
+"""Assembly files (TOML): read and write assemblies in the format of formats.md.
+
+:func:`load_assembly` and :func:`loads_assembly` read a file or a string into
+an :class:`~substructure.assembly.Assembly`; :func:`save_assembly` and
+:func:`dumps_assembly` write one back, quantities with every digit
+(:func:`~substructure.units.format_quantity`), so that
+``loads_assembly(dumps_assembly(a)) == a``.  Every problem of a file raises
+:class:`~substructure.errors.FileFormatError` whose message starts with the
+file name (and the line, where it can be found) and names the key path, e.g.
+``components[2].segments[1].od``, what was given and what was expected.
+
+Component types are looked up in :data:`substructure.components.COMPONENT_TYPES`,
+so registered user types work: a class with a classmethod
+``from_toml(table, materials, key)`` and a method ``to_toml()`` reads and
+writes its own table; any other :class:`~substructure.components.Beam`
+subclass uses the generic ``name``/``type``/``material``/``segments`` table.
+"""
+
+from __future__ import annotations
+
+import importlib.resources
+import os
+import re
+import tomllib
+from typing import Any
+
+import tomli_w
+
+from ..assembly import Assembly
+from ..beams import Flutes, Insert, Segment
+from ..components import COMPONENT_TYPES, Beam
+from ..errors import FileFormatError, InvalidValueError, SubstructureError
+from ..frf import Frequency
+from ..joints import Joint, Sensor, Support
+from ..materials import CATALOG, Material
+from ..points import parse_point
+from ..units import Q_, format_quantity
+
+__all__ = ["load_assembly", "loads_assembly", "save_assembly", "dumps_assembly", "default_assembly"]
+
+_TOP_KEYS = ("name", "frequency", "materials", "components", "joints", "supports", "sensors")
+_FREQUENCY_KEYS = ("start", "stop", "step")
+_MATERIAL_KEYS = ("E", "nu", "rho", "loss_factor")
+_COMPONENT_KEYS = ("name", "type", "material", "segments")
+_SEGMENT_KEYS = ("length", "od", "id", "material", "insert", "flutes")
+_INSERT_KEYS = ("od", "material", "id")
+_FLUTES_KEYS = ("diameter_ratio",)
+_JOINT_KEYS = ("name", "between", "k", "c", "rigid")
+_SUPPORT_KEYS = ("name", "at", "k", "c")
+_SENSOR_KEYS = ("name", "at", "mass", "inertia")
+_MATRIX_KEYS = ("yf", "ym", "tf", "tm")
+_MISSING = object()
+_FIELD = re.compile(r"^([A-Za-z_][A-Za-z0-9_.\[\]]*): (.*)$", re.DOTALL)
+_HEADER = re.compile(r"^\s*(\[\[?)\s*([^\[\]#]+?)\s*\]\]?\s*(?:#.*)?$")
+_HEADER_COMMENT = "# substructure assembly file (formats.md): units on every dimensional value\n"
+
+
+def _path(parts) -> str:
+    text = ""
+    for p in parts:
+        text += f"[{p}]" if isinstance(p, int) else (f".{p}" if text else str(p))
+    return text
+
+
+class _Locator:
+    """Best-effort line numbers of keys in TOML text, for error messages."""
+
+    def __init__(self, text: str):
+        self.lines = text.splitlines()
+        self.headers = []  # (line index, dotted name, is an array of tables)
+        for n, line in enumerate(self.lines):
+            m = _HEADER.match(line)
+            if m:
+                self.headers.append((n, re.sub(r"[\s\"']", "", m.group(2)), m.group(1) == "[["))
+
+    def _section(self, parts):
+        start, rest = None, list(parts)
+        if len(parts) >= 2 and isinstance(parts[0], str) and isinstance(parts[1], int):
+            heads = [n for n, name, array in self.headers if array and name == parts[0]]
+            if parts[1] < len(heads):
+                start, rest = heads[parts[1]], list(parts[2:])
+        else:
+            for size in range(len(parts), 0, -1):
+                if all(isinstance(p, str) for p in parts[:size]):
+                    name = ".".join(parts[:size])
+                    found = [n for n, h, array in self.headers if h == name and not array]
+                    if found:
+                        start, rest = found[0], list(parts[size:])
+                        break
+        following = [n for n, _, _ in self.headers if start is None or n > start]
+        end = following[0] if following else len(self.lines)
+        return start, end, rest
+
+    def _find_key(self, key: str, start: int, end: int, value: Any = _MISSING) -> int | None:
+        pattern = re.compile(r"(?:^|[\s{,.])" + re.escape(key) + r"\s*=")
+        hits = [n for n in range(start, end) if pattern.search(self.lines[n])]
+        if isinstance(value, str):
+            exact = [n for n in hits if f'"{value}"' in self.lines[n] or f"'{value}'" in self.lines[n]]
+            hits = exact or hits
+        return hits[0] if hits else None
+
+    def line(self, parts, value: Any = _MISSING) -> int | None:
+        """1-based line of the key at ``parts`` (a list of names and indices), or None."""
+        header, end, rest = self._section(parts)
+        start = 0 if header is None else header
+        i = 0
+        while i < len(rest):
+            if isinstance(rest[i], str) and i + 1 < len(rest) and isinstance(rest[i + 1], int):
+                key_line = self._find_key(rest[i], start, end)
+                if key_line is None:
+                    break
+                elements = [n for n in range(key_line, end) if "{" in self.lines[n]]
+                if rest[i + 1] >= len(elements):
+                    return key_line + 1
+                start = elements[rest[i + 1]]
+                end = start + 1
+                i += 2
+            else:
+                i += 1
+        keys = [p for p in rest if isinstance(p, str)]
+        found = self._find_key(keys[-1], start, end, value) if keys else None
+        if found is not None:
+            return found + 1
+        return None if header is None and start == 0 else start + 1
+
+
+class _Reader:
+    """Builds an assembly from parsed TOML, naming the key path in every error."""
+
+    def __init__(self, source: str, text: str, data: dict):
+        self.source, self.data, self.locator = source, data, _Locator(text)
+        self.materials: dict[str, Material] = dict(CATALOG)
+
+    def _value(self, parts) -> Any:
+        value = self.data
+        for p in parts:
+            try:
+                value = value[p]
+            except (KeyError, IndexError, TypeError):
+                return _MISSING
+        return value
+
+    def error(self, parts, message: str) -> FileFormatError:
+        line = self.locator.line(parts, self._value(parts))
+        where = f"{self.source}, line {line}" if line else self.source
+        key = _path(parts)
+        return FileFormatError(f"{where}: {key}: {message}" if key else f"{where}: {message}")
+
+    def wrap(self, parts, exc: SubstructureError) -> FileFormatError:
+        """A constructor's error with the container's key path merged into its field."""
+        message = str(exc)
+        if message.startswith(self.source):
+            return FileFormatError(message)
+        m = _FIELD.match(message)
+        if not m:
+            return self.error(parts, message)
+        field = [int(i) if i else k for k, i in re.findall(r"([^.\[\]]+)|\[(\d+)\]", m.group(1))]
+        full = m.group(1).startswith(_path(parts) + ".") or m.group(1) == _path(parts)  # a hook's own path
+        return self.error(field if full and parts else list(parts) + field, m.group(2))
+
+    def call(self, parts, factory, *args, **kwargs):
+        try:
+            return factory(*args, **kwargs)
+        except SubstructureError as exc:
+            raise self.wrap(parts, exc) from None
+
+    def table(self, value, parts, allowed, required=(), what="a table") -> dict:
+        if not isinstance(value, dict):
+            raise self.error(parts, f"got {value!r}; expected {what}")
+        for key in value:
+            if key not in allowed:
+                raise self.error(list(parts) + [key], f"unknown key; allowed keys: {', '.join(allowed)}")
+        for key in required:
+            if key not in value:
+                raise self.error(list(parts) + [key], "missing; this value is required")
+        return value
+
+    def array(self, value, parts, what: str) -> list:
+        if not isinstance(value, list):
+            raise self.error(parts, f"got {value!r}; expected {what}")
+        return value
+
+    def material(self, name, parts) -> Material:
+        if not isinstance(name, str) or name not in self.materials:
+            known = ", ".join(self.materials)
+            raise self.error(parts, f"unknown material {name!r}; known: {known} (add a [materials.NAME] table)")
+        return self.materials[name]
+
+    # -- the file, top down -------------------------------------------------------------
+    def assembly(self) -> Assembly:
+        data = self.table(self.data, [], _TOP_KEYS, required=("name",))
+        frequency = None
+        if "frequency" in data:
+            grid = self.table(data["frequency"], ["frequency"], _FREQUENCY_KEYS, _FREQUENCY_KEYS)
+            frequency = self.call(["frequency"], Frequency.from_range, grid["start"], grid["stop"], grid["step"])
+        custom = []
+        materials = data.get("materials", {})
+        if not isinstance(materials, dict):
+            raise self.error(["materials"], f"got {materials!r}; expected [materials.NAME] tables")
+        for name, table in materials.items():
+            parts = ["materials", name]
+            table = self.table(table, parts, _MATERIAL_KEYS, ("E", "nu", "rho"))
+            custom.append(self.call(parts, Material, name, **table))
+            self.materials[name] = custom[-1]
+        items = {key: self.array(data.get(key, []), [key], f"[[{key}]] tables")
+                 for key in ("components", "joints", "supports", "sensors")}
+        components = self.unique([self.component(c, ["components", i]) for i, c in enumerate(items["components"])],
+                                 "components")
+        base = self.call([], Assembly, data["name"], components, frequency=frequency, materials=custom)
+        joints = self.unique([self.joint(j, ["joints", i], base) for i, j in enumerate(items["joints"])], "joints")
+        supports = [self.support(s, ["supports", i], base) for i, s in enumerate(items["supports"])]
+        sensors = self.unique([self.sensor(s, ["sensors", i], base) for i, s in enumerate(items["sensors"])],
+                              "sensors")
+        return self.call([], Assembly, data["name"], components, joints, supports, sensors, frequency, custom)
+
+    def unique(self, items: list, section: str) -> list:
+        seen: dict[str, int] = {}
+        for i, item in enumerate(items):
+            if item.name in seen:
+                raise self.error([section, i, "name"], f"{item.name!r} is already the name of "
+                                 f"{section}[{seen[item.name]}]; names must be unique")
+            seen[item.name] = i
+        return items
+
+    def component(self, table, parts):
+        if not isinstance(table, dict):
+            raise self.error(parts, f"got {table!r}; expected a table")
+        if "type" not in table:
+            raise self.error(parts + ["type"], f"missing; expected one of {', '.join(COMPONENT_TYPES)}")
+        kind = table["type"]
+        cls = COMPONENT_TYPES.get(kind) if isinstance(kind, str) else None
+        if cls is None:
+            raise self.error(parts + ["type"], f"unknown component type {kind!r}; known: {', '.join(COMPONENT_TYPES)}")
+        if hasattr(cls, "from_toml"):
+            return self.call(parts, cls.from_toml, table, dict(self.materials), _path(parts))
+        if not (isinstance(cls, type) and issubclass(cls, Beam)):
+            raise self.error(parts + ["type"], f"components of type {kind!r} cannot be described in an assembly file")
+        self.table(table, parts, _COMPONENT_KEYS, ("name", "type", "segments"))
+        material = self.material(table["material"], parts + ["material"]) if "material" in table else None
+        segments = self.array(table["segments"], parts + ["segments"], "an array of segment tables, base to tip")
+        segs = [self.segment(s, parts + ["segments", j], material) for j, s in enumerate(segments)]
+        return self.call(parts, cls, table["name"], segs)
+
+    def segment(self, table, parts, material):
+        table = self.table(table, parts, _SEGMENT_KEYS, ("length", "od"), "a segment table {length, od, ...}")
+        kw = {k: table[k] for k in ("length", "od", "id") if k in table}
+        if "material" in table:
+            kw["material"] = self.material(table["material"], parts + ["material"])
+        elif material is not None:
+            kw["material"] = material
+        if "insert" in table:
+            ins = self.table(table["insert"], parts + ["insert"], _INSERT_KEYS, ("od", "material"))
+            mat = self.material(ins["material"], parts + ["insert", "material"])
+            extra = {"id": ins["id"]} if "id" in ins else {}
+            kw["insert"] = self.call(parts, Insert, ins["od"], mat, **extra)
+        if "flutes" in table:
+            flutes = self.table(table["flutes"], parts + ["flutes"], _FLUTES_KEYS, _FLUTES_KEYS)
+            kw["flutes"] = self.call(parts, Flutes, flutes["diameter_ratio"])
+        return self.call(parts, Segment, **kw)
+
+    def point(self, value, parts, base: Assembly) -> str:
+        if not isinstance(value, str):
+            raise self.error(parts, f"got {value!r}; expected a point name such as 'tool.tip'")
+        ref = self.call(parts, parse_point, value, allow_dof=False)
+        self.call(parts, base.node_key, ref)
+        return str(ref)
+
+    def matrices(self, table, parts) -> dict:
+        return {key: self.table(table[key], parts + [key], _MATRIX_KEYS)
+                for key in ("k", "c") if key in table}
+
+    def joint(self, table, parts, base: Assembly) -> Joint:
+        table = self.table(table, parts, _JOINT_KEYS, ("name", "between"))
+        between = table["between"]
+        if not isinstance(between, list) or len(between) != 2:
+            raise self.error(parts + ["between"], f"got {between!r}; expected two point names")
+        points = [self.point(p, parts + ["between", m], base) for m, p in enumerate(between)]
+        return self.call(parts, Joint, table["name"], points, rigid=table.get("rigid", False),
+                         **self.matrices(table, parts))
+
+    def support(self, table, parts, base: Assembly) -> Support:
+        table = self.table(table, parts, _SUPPORT_KEYS, ("at",))
+        at = self.point(table["at"], parts + ["at"], base)
+        return self.call(parts, Support, at, name=table.get("name"), **self.matrices(table, parts))
+
+    def sensor(self, table, parts, base: Assembly) -> Sensor:
+        table = self.table(table, parts, _SENSOR_KEYS, ("name", "at", "mass"))
+        at = self.point(table["at"], parts + ["at"], base)
+        extra = {"inertia": table["inertia"]} if "inertia" in table else {}
+        return self.call(parts, Sensor, table["name"], at, table["mass"], **extra)
+
+
+def loads_assembly(text: str, source: str = "<string>") -> Assembly:
+    """Read an assembly from TOML text.
+
+    Parameters
+    ----------
+    text : str
+        The TOML document (formats.md, "Assembly file").
+    source : str
+        Name of the text in error messages, e.g. the file name.
+
+    Raises
+    ------
+    FileFormatError
+        For TOML syntax (with line and column), unknown keys, missing values,
+        wrong units, non-physical values, unknown materials or component
+        types and points that do not exist; the message starts with
+        ``source`` and names the key path.
+    """
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise FileFormatError(f"{source}: invalid TOML: {exc}") from None
+    return _Reader(source, text, data).assembly()
+
+
+def load_assembly(path: str | os.PathLike) -> Assembly:
+    """Read an assembly file (TOML); see :func:`loads_assembly`."""
+    name = os.fspath(path)
+    try:
+        with open(path, "rb") as fh:
+            text = fh.read().decode("utf-8")
+    except FileNotFoundError:
+        raise FileFormatError(f"{name}: no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise FileFormatError(f"{name}: cannot read the file ({exc})") from None
+    return loads_assembly(text, source=name)
+
+
+def default_assembly() -> Assembly:
+    """The built-in assembly: BT40-like holder and 12 mm carbide end mill on a free-free spindle.
+
+    Read from ``substructure/data/default_assembly.toml``, which documents
+    where its numbers come from.
+    """
+    resource = importlib.resources.files("substructure") / "data" / "default_assembly.toml"
+    return loads_assembly(resource.read_text(encoding="utf-8"), source="default_assembly.toml")
+
+
+# -- writing ---------------------------------------------------------------------------
+
+
+def _hz(value: float) -> str:
+    return format_quantity(Q_(value, "Hz"))
+
+
+def _frequency_table(frequency: Frequency) -> dict:
+    hz = frequency.hz
+    if hz.size == 1:
+        return {"start": _hz(hz[0]), "stop": _hz(hz[0]), "step": "1 Hz"}
+    raw = [hz[1] - hz[0], (hz[-1] - hz[0]) / (hz.size - 1)]
+    for step in raw + [float(f"{d:.{digits}g}") for d in raw for digits in (15, 12)]:
+        table = {"start": _hz(hz[0]), "stop": _hz(hz[-1]), "step": _hz(float(step))}
+        try:
+            if Frequency.from_range(table["start"], table["stop"], table["step"]) == frequency:
+                return table
+        except SubstructureError:
+            continue
+    raise InvalidValueError(
+        f"frequency: the grid {frequency!r} is not start + step*k; an assembly file holds only "
+        "start, stop and step: save the assembly with a uniform grid (Frequency.from_range)"
+    )
+
+
+def _material_table(material: Material) -> dict:
+    return {"E": format_quantity(material.E), "nu": material.nu,
+            "rho": format_quantity(material.rho), "loss_factor": material.loss_factor}
+
+
+def _collect_materials(assembly: Assembly) -> dict[str, Material]:
+    """The materials the file must define: the assembly's own, then custom ones in use."""
+    found: dict[str, Material] = {}
+    seen: dict[str, Material] = {}
+
+    def add(material: Material, declared: bool) -> None:
+        name = material.name
+        if seen.setdefault(name, material) != material:
+            raise InvalidValueError(
+                f"materials: two different materials are called {name!r}; a file names them "
+                "once: rename one (attrs.evolve(material, name=...))"
+            )
+        if declared or CATALOG.get(name) != material:
+            found.setdefault(name, material)
+
+    for m in assembly.materials:
+        add(m, True)
+    for comp in assembly.components:
+        for seg in getattr(comp, "segments", ()):
+            if isinstance(seg, Segment):
+                add(seg.material, False)
+                if seg.insert is not None:
+                    add(seg.insert.material, False)
+    return found
+
+
+def _kind(component) -> str:
+    for kind, cls in COMPONENT_TYPES.items():
+        if cls is type(component):
+            return kind
+    raise InvalidValueError(
+        f"components: {component.name!r} is a {type(component).__name__}, which is not a registered "
+        "component type; register it with substructure.components.register_component"
+    )
+
+
+def _segment_table(seg: Segment, with_material: bool) -> dict:
+    table = {"length": format_quantity(seg.length), "od": format_quantity(seg.od)}
+    if seg.id.magnitude != 0:
+        table["id"] = format_quantity(seg.id)
+    if with_material:
+        table["material"] = seg.material.name
+    if seg.insert is not None:
+        ins = seg.insert
+        table["insert"] = {"od": format_quantity(ins.od), "material": ins.material.name}
+        if ins.id.magnitude != 0:
+            table["insert"]["id"] = format_quantity(ins.id)
+    if seg.flutes is not None:
+        table["flutes"] = {"diameter_ratio": seg.flutes.diameter_ratio}
+    return table
+
+
+def _component_table(component) -> dict:
+    kind = _kind(component)
+    if hasattr(component, "to_toml"):
+        return {"name": component.name, "type": kind, **component.to_toml()}
+    if not isinstance(component, Beam):
+        raise InvalidValueError(
+            f"components: {component.name!r} ({kind}) cannot be written to an assembly file; "
+            "give its class a to_toml method"
+        )
+    table = {"name": component.name, "type": kind}
+    shared = all(s.material == component.segments[0].material for s in component.segments)
+    if shared:
+        table["material"] = component.segments[0].material.name
+    table["segments"] = [_segment_table(s, not shared) for s in component.segments]
+    return table
+
+
+def _matrices(item) -> dict:
+    return {key: m.as_dict() for key, m in (("k", item.k), ("c", item.c)) if m}
+
+
+def _key(key: str) -> str:
+    return key if re.fullmatch(r"[A-Za-z0-9_-]+", key) else _inline(key)
+
+
+def _inline(value) -> str:
+    """One TOML value on one line (scalars formatted by tomli_w)."""
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{_key(k)} = {_inline(v)}" for k, v in value.items()) + " }"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_inline(v) for v in value) + "]"
+    return tomli_w.dumps({"v": value})[len("v = "):].rstrip("\n")
+
+
+def _body(table: dict) -> list[str]:
+    lines = []
+    for key, value in table.items():
+        if isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+            lines += [f"{_key(key)} = ["] + [f"  {_inline(v)}," for v in value] + ["]"]
+        else:
+            lines.append(f"{_key(key)} = {_inline(value)}")
+    return lines
+
+
+def _emit(doc: dict) -> str:
+    """The document laid out as formats.md shows it: tables per section, segments one per line."""
+    out = [f"{_key(k)} = {_inline(v)}" for k, v in doc.items() if not isinstance(v, (dict, list))]
+    for key, value in doc.items():
+        if isinstance(value, dict) and value and all(isinstance(v, dict) for v in value.values()):
+            for name, table in value.items():
+                out += ["", f"[{key}.{_key(name)}]", *_body(table)]
+        elif isinstance(value, dict):
+            out += ["", f"[{key}]", *_body(value)]
+        elif isinstance(value, list):
+            for table in value:
+                out += ["", f"[[{key}]]", *_body(table)]
+    return "\n".join(out) + "\n"
+
+
+def dumps_assembly(assembly: Assembly) -> str:
+    """Write an assembly as TOML text that :func:`loads_assembly` reads back equal.
+
+    Custom materials (the assembly's ``materials`` and any non-catalogue
+    material its segments use) are written to ``[materials.NAME]`` tables; a
+    component's material is written once when all its segments share it.
+
+    Raises
+    ------
+    InvalidValueError
+        For what a file cannot hold: a non-uniform frequency grid, two
+        different materials of the same name, components of an unregistered
+        type or without a file form (measured components, subassemblies).
+    """
+    if not isinstance(assembly, Assembly):
+        raise InvalidValueError(f"assembly: got {type(assembly).__name__}; expected an Assembly")
+    doc: dict[str, Any] = {"name": assembly.name}
+    if assembly.frequency is not None:
+        doc["frequency"] = _frequency_table(assembly.frequency)
+    materials = _collect_materials(assembly)
+    if materials:
+        doc["materials"] = {name: _material_table(m) for name, m in materials.items()}
+    doc["components"] = [_component_table(c) for c in assembly.components]
+    if assembly.joints:
+        doc["joints"] = [
+            {"name": j.name, "between": list(j.between), **({"rigid": True} if j.rigid else _matrices(j))}
+            for j in assembly.joints
+        ]
+    if assembly.supports:
+        doc["supports"] = [
+            {**({"name": s.name} if s.name is not None else {}), "at": s.at, **_matrices(s)}
+            for s in assembly.supports
+        ]
+    if assembly.sensors:
+        doc["sensors"] = [
+            {"name": s.name, "at": s.at, "mass": format_quantity(s.mass),
+             **({"inertia": format_quantity(s.inertia)} if s.inertia.magnitude != 0 else {})}
+            for s in assembly.sensors
+        ]
+    return _HEADER_COMMENT + _emit(doc)
+
+
+def save_assembly(assembly: Assembly, path: str | os.PathLike, overwrite: bool = False) -> None:
+    """Write an assembly file (TOML); see :func:`dumps_assembly`.
+
+    Parameters
+    ----------
+    assembly : Assembly
+    path : str or path-like
+    overwrite : bool, default False
+        Replace an existing file; without it an existing file is an error,
+        so that a user's input is never overwritten silently.
+
+    Raises
+    ------
+    FileExistsError
+        When ``path`` exists and ``overwrite`` is False.
+    """
+    text = dumps_assembly(assembly)
+    try:
+        with open(path, "w" if overwrite else "x", encoding="utf-8", newline="\n") as fh:
+            fh.write(text)
+    except FileExistsError:
+        raise FileExistsError(
+            f"{os.fspath(path)}: the file exists; pass overwrite=True to replace it"
+        ) from None

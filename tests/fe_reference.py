@@ -1,0 +1,340 @@
+"""Independent finite-element reference for Timoshenko beam assemblies (test helper).
+
+This module is the *second method* used by the test-suite to check the
+library's closed-form Timoshenko receptances and its receptance-coupling
+engine.  It deliberately imports nothing from ``substructure``; all inputs are
+SI floats.  Conventions follow ``/work/shared/conventions.md``: DOFs per node
+``(y, theta)``, loads ``(f, m)``, ``x(t) = X exp(i omega t)``, loss factor as a
+complex modulus on both E and G, Cowper (1966) shear coefficient.
+
+Element
+-------
+Two-node Timoshenko "interdependent interpolation element" (IIE) of
+Friedman & Kosmatka, *An improved two-node Timoshenko beam finite element*,
+Computers & Structures 47(3), 1993, 473-481.  Nodal DOFs ``(y1, psi1, y2,
+psi2)`` with ``psi`` the bending rotation of Timoshenko theory (the library's
+``theta``).  The cubic ``y`` and quadratic ``psi`` shape functions satisfy the
+homogeneous static Timoshenko equations, so the stiffness is exact for nodal
+loads (e.g. one element gives the exact cantilever compliance
+``L^3/(3EI) + L/(kappa G A)``).  The consistent mass (translational ``rho*A``
+and rotary ``rho*I`` terms, both functions of ``Phi = 12 EI/(kappa G A L^2)``)
+is obtained here by 4-point Gauss quadrature of the shape functions, which
+is exact (integrands are polynomials of degree <= 6) and reproduces the
+published closed-form matrices (checked in ``test_fe_reference.py``).
+Eigenvalue errors fall as h^4 (frequencies converge from above).  ``Phi`` of
+the interpolation uses the storage (real) moduli; the stiffness integrand uses
+the complex ``EI`` and ``kappa*G*A``, so a uniform loss factor simply gives
+``K*(1+i*eta)``.
+
+Default mesh (measured, see ``test_fe_reference.py``): element length about
+``L_beam/ELEMENTS_PER_BEAM`` (40) with at least ``MIN_PER_SEGMENT`` (2) per
+segment.  Free-free uniform / stepped beams and cantilevers (slender and
+stubby): first five frequencies within 2e-5 of the converged values, and
+changing < 1e-5 when the mesh is doubled.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+import scipy.linalg
+import scipy.sparse
+import scipy.sparse.linalg
+
+ELEMENTS_PER_BEAM = 40
+MIN_PER_SEGMENT = 2
+_DOF = {"y": 0, "theta": 1}
+
+
+# --------------------------------------------------------------------------- sections
+class Material(NamedTuple):
+    E: float          # Young's modulus [Pa]
+    nu: float         # Poisson ratio
+    rho: float        # density [kg/m^3]
+    eta: float = 0.0  # loss factor
+
+
+STEEL = Material(210e9, 0.29, 7850.0)
+CARBIDE = Material(580e9, 0.22, 14500.0)
+
+
+def cowper_kappa(nu: float, m: float = 0.0) -> float:
+    """Cowper (1966) shear coefficient of a hollow circle, ``m = id/od``."""
+    a = (1.0 + m * m) ** 2
+    return 6.0 * (1.0 + nu) * a / ((7.0 + 6.0 * nu) * a + (20.0 + 12.0 * nu) * m * m)
+
+
+@dataclass(frozen=True)
+class Section:
+    """Section properties of one beam slice; ``+`` stacks layers (composite)."""
+    EI: complex
+    kGA: complex
+    rhoA: float
+    rhoI: float
+    A: float = 0.0
+    I: float = 0.0
+
+    def __add__(self, other: "Section") -> "Section":
+        return Section(self.EI + other.EI, self.kGA + other.kGA, self.rhoA + other.rhoA,
+                       self.rhoI + other.rhoI, self.A + other.A, self.I + other.I)
+
+
+def ring(od: float, id: float, mat: Material) -> Section:
+    """Circular ring (``id = 0``: solid) of one material."""
+    A = math.pi / 4.0 * (od**2 - id**2)
+    I = math.pi / 64.0 * (od**4 - id**4)
+    c = 1.0 + 1j * mat.eta
+    G = mat.E / (2.0 * (1.0 + mat.nu))
+    kappa = cowper_kappa(mat.nu, id / od)
+    return Section(mat.E * c * I, kappa * G * c * A, mat.rho * A, mat.rho * I, A, I)
+
+
+def section(od: float, id: float, mat: Material, insert: Material | None = None,
+            insert_id: float = 0.0) -> Section:
+    """Ring ``od``/``id`` plus, optionally, an insert of ``insert`` filling the bore
+    (itself a ring ``id``/``insert_id``, solid by default)."""
+    s = ring(od, id, mat)
+    if insert is not None and id > 0.0:
+        s = s + ring(id, insert_id, insert)
+    return s
+
+
+def fluted(od: float, ratio: float, mat: Material) -> Section:
+    """Fluted tool part: solid circle of equivalent diameter ``ratio*od``."""
+    return ring(ratio * od, 0.0, mat)
+
+
+# --------------------------------------------------------------------------- element
+_GX, _GW = np.polynomial.legendre.leggauss(4)
+_XI, _W = (_GX + 1.0) / 2.0, _GW / 2.0
+
+
+def _shapes(L: float, phi: float):
+    """IIE shape functions at the Gauss points: y, dy/dx, psi, dpsi/dx, each (4, 4)."""
+    x, p = _XI, 1.0 / (1.0 + phi)
+    x2, x3 = x * x, x**3
+    Nv = p * np.stack([2*x3 - 3*x2 - phi*x + 1 + phi,
+                       L * (x3 - (2 + phi/2)*x2 + (1 + phi/2)*x),
+                       -2*x3 + 3*x2 + phi*x,
+                       L * (x3 - (1 - phi/2)*x2 - phi/2*x)], -1)
+    dNv = p * np.stack([(6*x2 - 6*x - phi) / L,
+                        3*x2 - (4 + phi)*x + 1 + phi/2,
+                        (-6*x2 + 6*x + phi) / L,
+                        3*x2 - (2 - phi)*x - phi/2], -1)
+    Np = p * np.stack([6/L * (x2 - x), 3*x2 - (4 + phi)*x + 1 + phi,
+                       -6/L * (x2 - x), 3*x2 - (2 - phi)*x], -1)
+    dNp = p / L * np.stack([6/L * (2*x - 1), 6*x - (4 + phi),
+                            -6/L * (2*x - 1), 6*x - (2 - phi)], -1)
+    return Nv, dNv, Np, dNp
+
+
+def element(L: float, s: Section):
+    """IIE element matrices ``(K (complex 4x4), M (real 4x4))`` for DOFs (y1, th1, y2, th2)."""
+    phi = 12.0 * s.EI.real / (s.kGA.real * L * L)
+    Nv, dNv, Np, dNp = _shapes(L, phi)
+    g = -phi / (1.0 + phi) * np.array([1.0 / L, 0.5, -1.0 / L, 0.5])[None, :]  # = dNv - Np
+    wl = _W * L
+    K = s.EI * np.einsum("g,gi,gj->ij", wl, dNp, dNp) + s.kGA * np.einsum("g,gi,gj->ij", wl, g, g)
+    M = s.rhoA * np.einsum("g,gi,gj->ij", wl, Nv, Nv) + s.rhoI * np.einsum("g,gi,gj->ij", wl, Np, Np)
+    return K.astype(complex), M
+
+
+def _mat2(v) -> np.ndarray:
+    """2x2 from a 2x2, a 2-vector (diagonal per DOF) or a scalar (y only)."""
+    a = np.asarray(v, dtype=complex)
+    if a.ndim == 0:
+        return np.array([[a, 0], [0, 0]], dtype=complex)
+    if a.shape == (2,):
+        return np.diag(a)
+    if a.shape == (2, 2):
+        return a
+    raise ValueError(f"expected a scalar, 2-vector or 2x2, got shape {a.shape}")
+
+
+# --------------------------------------------------------------------------- model
+class Model:
+    """FE assembly of beams plus point masses, ground springs, joints and constraints.
+
+    A point is ``(beam, x)`` or ``(beam, x, "y"|"theta")`` (default ``"y"``), or
+    a global DOF index ``int``.  Positions ``x`` must be nodes: pass them in
+    ``add_beam(points=...)`` (segment ends are always nodes).
+    """
+
+    def __init__(self):
+        self.x: list[np.ndarray] = []        # node positions per beam
+        self._off: list[int] = []            # first global DOF per beam
+        self.ndof = 0
+        self._blocks = []                    # (dofs, K0, C, M) dense blocks to scatter
+        self._clamped: set[int] = set()
+        self._merge: list[tuple[int, int]] = []
+
+    # ---- building
+    def add_beam(self, segments, n_elem: int | None = None, points=()) -> int:
+        """Add a beam from ``segments = [(length, Section), ...]`` (base to tip).
+
+        ``n_elem``: elements per segment (default: element length about
+        ``L_beam/ELEMENTS_PER_BEAM``, >= ``MIN_PER_SEGMENT`` per segment).
+        ``points``: extra positions that become nodes (sub-intervals keep the
+        segment's element density).  Returns the beam index.
+        """
+        ends = np.concatenate([[0.0], np.cumsum([float(L) for L, _ in segments])])
+        total, off = ends[-1], self.ndof
+        pts = np.asarray(sorted(float(p) for p in points))
+        xs, e = [0.0], 0
+        for i, (L, sec) in enumerate(segments):
+            n_seg = n_elem or max(MIN_PER_SEGMENT, math.ceil(L / total * ELEMENTS_PER_BEAM - 1e-9))
+            tol = 1e-9 * total
+            inner = pts[(pts > ends[i] + tol) & (pts < ends[i + 1] - tol)]
+            cuts = np.concatenate([[ends[i]], inner, [ends[i + 1]]])
+            for a, b in zip(cuts[:-1], cuts[1:]):
+                n = max(1, math.ceil(n_seg * (b - a) / L - 1e-9))
+                Ke, Me = element((b - a) / n, sec)
+                for _ in range(n):
+                    d = list(range(off + 2 * e, off + 2 * e + 4))
+                    self._blocks.append((d, Ke, np.zeros((4, 4)), Me))
+                    e += 1
+                xs.extend(a + (b - a) * np.arange(1, n + 1) / n)
+        self.x.append(np.array(xs))
+        self._off.append(off)
+        self.ndof += 2 * len(xs)
+        return len(self.x) - 1
+
+    def node(self, beam: int, x: float) -> int:
+        """Index of the node exactly at ``x`` (ValueError if none)."""
+        i, xn = self.nearest_node(beam, x)
+        if abs(xn - x) > 1e-9 * max(1.0, self.length(beam)):
+            raise ValueError(f"beam {beam}: no node at x={x} (nearest {xn}); add it to points=")
+        return i
+
+    def nearest_node(self, beam: int, x: float) -> tuple[int, float]:
+        """``(index, position)`` of the node nearest to ``x``."""
+        i = int(np.argmin(np.abs(self.x[beam] - x)))
+        return i, float(self.x[beam][i])
+
+    def length(self, beam: int) -> float:
+        return float(self.x[beam][-1])
+
+    def dof(self, point) -> int:
+        """Global (unreduced) DOF index of ``(beam, x[, 'y'|'theta'])`` or an int."""
+        if isinstance(point, (int, np.integer)):
+            return int(point)
+        beam, x, *d = point
+        return self._off[beam] + 2 * self.node(beam, x) + _DOF[d[0] if d else "y"]
+
+    def _dofs2(self, point) -> list[int]:
+        d = self._off[point[0]] + 2 * self.node(point[0], point[1])
+        return [d, d + 1]
+
+    def add_mass(self, point, m: float, J: float = 0.0):
+        """Point mass ``m`` [kg] with rotary inertia ``J`` [kg m^2] at ``(beam, x)``."""
+        z = np.zeros((2, 2))
+        self._blocks.append((self._dofs2(point), z, z, np.diag([m, J])))
+
+    def add_support(self, point, k, c=0.0):
+        """Spring/damper to ground at ``(beam, x)``: dynamic stiffness ``k + i w c``
+        (each a 2x2, a per-DOF 2-vector ``(k_y, k_theta)``, or a scalar = y only)."""
+        self._blocks.append((self._dofs2(point), _mat2(k), _mat2(c), np.zeros((2, 2))))
+
+    def add_joint(self, point_a, point_b, k, c=0.0):
+        """Joint: ``[f, m] = (k + i w c) [y_a - y_b, th_a - th_b]``, ``k`` and ``c`` as
+        ``[[kyf, kym], [ktf, ktm]]`` (or per-DOF 2-vectors / scalar, see add_support)."""
+        blk = lambda A: np.block([[A, -A], [-A, A]])
+        dofs = self._dofs2(point_a) + self._dofs2(point_b)
+        self._blocks.append((dofs, blk(_mat2(k)), blk(_mat2(c)), np.zeros((4, 4))))
+
+    def add_rigid(self, point_a, point_b, dofs=("y", "theta")):
+        """Rigid connection: the listed DOFs of the two points become one DOF."""
+        a, b = self._dofs2(point_a), self._dofs2(point_b)
+        self._merge += [(a[_DOF[d]], b[_DOF[d]]) for d in dofs]
+
+    def clamp(self, point, dofs=("y", "theta")):
+        """Fix the listed DOFs of ``(beam, x)`` to ground."""
+        a = self._dofs2(point)
+        self._clamped.update(a[_DOF[d]] for d in dofs)
+
+    # ---- assembly
+    def reduction(self) -> np.ndarray:
+        """``red[full_dof]`` = reduced DOF after merges and clamps (-1 = clamped)."""
+        parent = list(range(self.ndof))
+
+        def root(i):
+            while parent[i] != i:
+                parent[i] = parent[parent[i]] = parent[parent[i]]
+                i = parent[i]
+            return i
+
+        for a, b in self._merge:
+            parent[root(a)] = root(b)
+        fixed = {root(i) for i in self._clamped}
+        ids: dict[int, int] = {}
+        red = np.full(self.ndof, -1)
+        for i in range(self.ndof):
+            if (r := root(i)) not in fixed:
+                red[i] = ids.setdefault(r, len(ids))
+        return red
+
+    def matrices(self):
+        """Reduced sparse (CSC) ``K0, C, M`` and the map ``red``; the dynamic
+        stiffness is ``K0 + i w C - w^2 M`` (K0 complex: loss factor, joints)."""
+        red = self.reduction()
+        n = int(red.max()) + 1
+        rows, cols, vals = [], [], [[], [], []]
+        for d, *mats in self._blocks:
+            r = red[np.asarray(d)]
+            ii, jj = np.meshgrid(r, r, indexing="ij")
+            keep = (ii >= 0) & (jj >= 0)
+            rows.append(ii[keep])
+            cols.append(jj[keep])
+            for v, A in zip(vals, mats):
+                v.append(np.asarray(A, complex)[keep])
+        rc = (np.concatenate(rows), np.concatenate(cols))
+        K0, C, M = (scipy.sparse.csc_matrix((np.concatenate(v), rc), shape=(n, n)) for v in vals)
+        return K0, C, M.real, red
+
+    # ---- results
+    def natural_frequencies(self, n: int | None = None, skip_rigid=True,
+                            rigid_hz: float = 1.0) -> np.ndarray:
+        """Undamped natural frequencies [Hz] from ``eigh(Re K0, M)`` (dampers
+        ignored; ``eig`` if ``K0`` is not symmetric).  ``skip_rigid``: True drops
+        |f| < ``rigid_hz`` (rigid-body zeros come out as ~0.01 Hz round-off);
+        an int drops that many lowest ones; False keeps all (signed sqrt)."""
+        K0, _, M, _ = self.matrices()
+        K, M = K0.real.toarray(), M.toarray()
+        if np.allclose(K, K.T, rtol=0, atol=1e-12 * np.abs(K).max()):
+            lam = scipy.linalg.eigh((K + K.T) / 2, M, eigvals_only=True)
+        else:
+            lam = np.sort(scipy.linalg.eigvals(K, M).real)
+        f = np.sign(lam) * np.sqrt(np.abs(lam)) / (2 * math.pi)
+        if skip_rigid is True:
+            f = f[np.abs(f) >= rigid_hz]
+        elif skip_rigid:
+            f = f[int(skip_rigid):]
+        return f if n is None else f[:n]
+
+    def receptance(self, f_hz, outputs, inputs=None) -> np.ndarray:
+        """Receptances ``(n_freq, n_out, n_in)`` between points (outputs: y or theta;
+        inputs: force on y, moment on theta).  Clamped DOFs give 0.  ``f_hz = 0``
+        is the static compliance of a constrained structure.  One sparse LU per
+        frequency (fast for the banded beam matrices)."""
+        inputs = outputs if inputs is None else inputs
+        w = 2 * math.pi * np.atleast_1d(np.asarray(f_hz, float))
+        K0, C, M, red = self.matrices()
+        oi = np.array([red[self.dof(p)] for p in outputs])
+        ii = np.array([red[self.dof(p)] for p in inputs])
+        B = np.zeros((M.shape[0], len(ii)), complex)
+        B[ii[ii >= 0], np.flatnonzero(ii >= 0)] = 1.0
+        H = np.zeros((len(w), len(oi), len(ii)), complex)
+        for k, wk in enumerate(w):
+            X = scipy.sparse.linalg.splu((K0 + 1j * wk * C - wk**2 * M).tocsc()).solve(B)
+            H[k, oi >= 0] = X[oi[oi >= 0]]
+        return H
+
+    def point_receptance(self, f_hz, point_out, point_in=None) -> np.ndarray:
+        """``[[H, L], [N, P]]`` (n_freq, 2, 2) from ``(beam, x)`` (input) to
+        ``(beam, x)`` (output); default input = output point."""
+        point_in = point_out if point_in is None else point_in
+        o = [(*point_out[:2], d) for d in _DOF]
+        return self.receptance(f_hz, o, [(*point_in[:2], d) for d in _DOF])
