@@ -254,61 +254,67 @@ def _squared_wavenumbers(sec: Section, w2: np.ndarray) -> tuple[np.ndarray, np.n
     return a, e, mean + root, mean - root
 
 
+def _series(z1: np.ndarray, z2: np.ndarray, length: np.ndarray):
+    """``C(s2), C[s1,s2], S(s2), S[s1,s2]`` by power series, for ``|s L^2| < 0.5``.
+
+    ``z = s L^2``; ``h_n`` is the complete homogeneous symmetric polynomial of
+    degree n in ``z1, z2`` (the divided difference of ``z^(n+1)``); terms are
+    summed until they fall below double precision, ``|z|^n / (2n)! < 1e-18``.
+    """
+    bound = float(np.max(np.maximum(np.abs(z1), np.abs(z2)))) if z1.size else 0.0
+    n_terms = 2
+    while bound**n_terms / math.factorial(2 * n_terms) > 1e-18:
+        n_terms += 1
+    sc = np.ones_like(z2)
+    ss = np.ones_like(z2)
+    dc = np.zeros_like(z2)
+    ds = np.zeros_like(z2)
+    h = np.ones_like(z2)  # h_0
+    pow2 = np.ones_like(z2)
+    fact_c, fact_s = 1.0, 1.0  # (2n)!, (2n+1)!
+    for n in range(1, n_terms + 1):
+        fact_c *= (2 * n - 1) * (2 * n)
+        fact_s *= (2 * n) * (2 * n + 1)
+        dc += h / fact_c
+        ds += h / fact_s
+        pow2 = pow2 * z2
+        sc += pow2 / fact_c
+        ss += pow2 / fact_s
+        h = z1 * h + pow2  # h_n = z1 h_{n-1} + z2^n
+    return sc, length**2 * dc, length * ss, length**3 * ds
+
+
+def _direct(s1: np.ndarray, s2: np.ndarray, length: np.ndarray):
+    """``C(s2), C[s1,s2], S(s2), S[s1,s2]`` from exponentials, for ``|s L^2| >= 0.5``.
+
+    cosh and sinh from one exponential each: the principal square root has
+    ``Re >= 0``, so ``exp(-r L) <= 1`` and nothing overflows before ``exp(r L)``.
+    """
+    r1, r2 = np.sqrt(s1), np.sqrt(s2)
+    e1, e2 = np.exp(r1 * length), np.exp(r2 * length)
+    i1, i2 = 1.0 / e1, 1.0 / e2
+    ch1, ch2 = 0.5 * (e1 + i1), 0.5 * (e2 + i2)
+    sh1, sh2 = 0.5 * (e1 - i1) / r1, 0.5 * (e2 - i2) / r2
+    ds12 = s1 - s2
+    return ch2, (ch1 - ch2) / ds12, sh2, (sh1 - sh2) / ds12
+
+
 def _functions(s1: np.ndarray, s2: np.ndarray, length):
     """``C(s2), C[s1,s2], S(s2), S[s1,s2]``, vectorised (``length`` scalar or per element)."""
     length = np.broadcast_to(np.asarray(length, dtype=float), s1.shape)
     z1, z2 = s1 * length**2, s2 * length**2
-    c0 = np.empty_like(z2)
-    c1 = np.empty_like(z2)
-    g0 = np.empty_like(z2)
-    g1 = np.empty_like(z2)
-    zmax = np.maximum(np.abs(z1), np.abs(z2))
-    small = zmax < 0.5
-    if np.any(small):
-        a1, a2 = z1[small], z2[small]
-        # Power series of C, S and of their divided differences (h_n: complete
-        # homogeneous symmetric polynomial of degree n in a1, a2), summed until
-        # the terms fall below double precision: |z|^n / (2n)! < 1e-18.
-        bound = float(zmax[small].max())
-        n_terms = 2
-        while bound ** n_terms / math.factorial(2 * n_terms) > 1e-18:
-            n_terms += 1
-        sc = np.ones_like(a2)
-        ss = np.ones_like(a2)
-        dc = np.zeros_like(a2)
-        ds = np.zeros_like(a2)
-        h = np.ones_like(a2)  # h_0
-        pow2 = np.ones_like(a2)
-        fact_c, fact_s = 1.0, 1.0  # (2n)!, (2n+1)!
-        for n in range(1, n_terms + 1):
-            fact_c *= (2 * n - 1) * (2 * n)
-            fact_s *= (2 * n) * (2 * n + 1)
-            dc += h / fact_c
-            ds += h / fact_s
-            pow2 = pow2 * a2
-            sc += pow2 / fact_c
-            ss += pow2 / fact_s
-            h = a1 * h + pow2  # h_n = a1 h_{n-1} + a2^n
-        ls = length[small]
-        c0[small] = sc
-        g0[small] = ls * ss
-        c1[small] = ls**2 * dc
-        g1[small] = ls**3 * ds
+    small = np.maximum(np.abs(z1), np.abs(z2)) < 0.5
+    if small.all():
+        return _series(z1, z2, length)
+    if not small.any():
+        return _direct(s1, s2, length)
+    out = tuple(np.empty_like(z2) for _ in range(4))
     big = ~small
-    if np.any(big):
-        # cosh and sinh from one exponential each (the principal square root
-        # has Re >= 0, so exp(-r L) <= 1 and nothing overflows before exp(r L)).
-        r1, r2 = np.sqrt(s1[big]), np.sqrt(s2[big])
-        lb = length[big]
-        e1, e2 = np.exp(r1 * lb), np.exp(r2 * lb)
-        i1, i2 = 1.0 / e1, 1.0 / e2
-        ch1, ch2 = 0.5 * (e1 + i1), 0.5 * (e2 + i2)
-        sh1, sh2 = 0.5 * (e1 - i1) / r1, 0.5 * (e2 - i2) / r2
-        ds12 = s1[big] - s2[big]
-        c0[big], g0[big] = ch2, sh2
-        c1[big] = (ch1 - ch2) / ds12
-        g1[big] = (sh1 - sh2) / ds12
-    return c0, c1, g0, g1
+    for o, v in zip(out, _series(z1[small], z2[small], length[small])):
+        o[small] = v
+    for o, v in zip(out, _direct(s1[big], s2[big], length[big])):
+        o[big] = v
+    return out
 
 
 def segment_transfer_matrix(sec: Section, length: float, omega: np.ndarray) -> np.ndarray:
