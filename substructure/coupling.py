@@ -86,6 +86,20 @@ def _mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.einsum("ikn,kjn->ijn", a, b)
 
 
+def interface_update(s: np.ndarray, stiffness: np.ndarray | None) -> np.ndarray:
+    """``W`` of the update ``Y_c = Y - (Y B^T) W (B Y)`` for ``S = B Y B^T``.
+
+    ``W = S^-1`` for a rigid connection (``stiffness`` None), else
+    ``W = K (I + S K)^-1``, which equals ``(S + K^-1)^-1`` without inverting a
+    possibly singular ``K``.  Shapes ``(r, r, n)``, frequency last.
+    """
+    r, n = s.shape[0], s.shape[-1]
+    if stiffness is None:
+        return bk.inv(s)
+    k = stiffness if stiffness.shape[-1] == n else np.broadcast_to(stiffness, stiffness.shape[:2] + (n,))
+    return _mul(k, bk.inv(_identity(r, n) + _mul(s, k)))
+
+
 def apply_connection(y: np.ndarray, conn: Connection) -> np.ndarray:
     """One coupling step on a frequency-last receptance matrix ``(M, M, n)``."""
     a = list(conn.a)
@@ -99,13 +113,7 @@ def apply_connection(y: np.ndarray, conn: Connection) -> np.ndarray:
         v = y[a, :] - y[b, :]
     s = v[:, a] if conn.b is None else v[:, a] - v[:, list(conn.b)]  # B Y B^T
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        if conn.stiffness is None:
-            w = bk.inv(s)
-        else:
-            k = conn.stiffness
-            if k.shape[-1] != n:
-                k = np.broadcast_to(k, k.shape[:2] + (n,))
-            w = _mul(k, bk.inv(_identity(len(a), n) + _mul(s, k)))
+        w = interface_update(s, conn.stiffness)
         uw = _mul(u, w) if u.shape[0] == 2 else np.einsum("mkn,kjn->mjn", u, w)
         out = y.copy()
         for j in range(len(a)):
@@ -216,13 +224,7 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
             base += [[zero] * len(kept_a) + [_blk(yb, i, j) for j in kept_b] for i in kept_b]
             new_keys = [ka[i] for i in kept_a] + [kb[i] for i in kept_b]
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            if link.stiffness is None:
-                w = bk.inv2(s)
-            else:
-                k = link.stiffness
-                if k.shape[-1] != n:
-                    k = np.broadcast_to(k, (2, 2, n))
-                w = bk.mul2(k, bk.inv2(_identity(2, n) + bk.mul2(s, k)))
+            w = interface_update(s, link.stiffness)
             uw = [bk.mul2(u, w) for u in us]
             m = len(new_keys)
             out = np.empty((2 * m, 2 * m, n), dtype=complex)
@@ -332,7 +334,7 @@ def modify(frf: FRF, at: str, delta_stiffness) -> FRF:
     n = f.size
     dz = np.broadcast_to(dz, dz.shape[:2] + (n,)) if dz.shape[-1] != n else dz
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        w = _mul(dz, bk.inv(_identity(len(dofs), n) + _mul(s, dz)))
+        w = interface_update(s, dz)
         uw = np.einsum("mkn,kjn->mjn", u, w)
         out = y - np.einsum("mkn,kjn->mjn", uw, v)
     if not np.all(np.isfinite(out)):
