@@ -330,22 +330,25 @@ def segment_transfer_matrix(sec: Section, length: float, omega: np.ndarray) -> n
     gamma, delta = c1, g1
     EI, kGA, mA, mI = sec.EI, sec.kGA, w2 * sec.rhoA, w2 * sec.rhoI
     t = np.empty((4, 4, w2.size), dtype=complex)
-    t[0, 0] = alpha + gamma * a
+    # T = alpha I + beta A + gamma A^2 + delta A^3, written entry by entry
+    # (A, A^2, A^3 are sparse), sharing the repeated entries.
+    t[0, 0] = t[2, 2] = alpha + gamma * a
+    t[1, 1] = t[3, 3] = alpha + gamma * e
     t[0, 1] = beta + delta * (a + e)
     t[0, 2] = beta / kGA + delta * (a / kGA - 1.0 / EI)
-    t[0, 3] = gamma / EI
-    t[1, 0] = delta * mA / EI
-    t[1, 1] = alpha + gamma * e
-    t[1, 2] = -gamma / EI
+    g_ei = gamma / EI
+    t[0, 3] = g_ei
+    t[1, 2] = -g_ei
+    d_ma_ei = delta * mA / EI
+    t[1, 0] = d_ma_ei
+    t[2, 3] = -d_ma_ei
     t[1, 3] = (beta + delta * e) / EI
     t[2, 0] = -(beta + delta * a) * mA
-    t[2, 1] = -gamma * mA
-    t[2, 2] = alpha + gamma * a
-    t[2, 3] = -delta * mA / EI
-    t[3, 0] = gamma * mA
+    g_ma = gamma * mA
+    t[3, 0] = g_ma
+    t[2, 1] = -g_ma
     t[3, 1] = -beta * mI + delta * (mA - mI * e)
     t[3, 2] = -beta + delta * (mI / EI - a)
-    t[3, 3] = alpha + gamma * e
     return t
 
 
