@@ -25,7 +25,7 @@ bench: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python benchmarks/run.py
 
 examples: $(STAMP)
-	cd examples && for f in [0-9]*.py; do MPLBACKEND=Agg ../$(BIN)/python $$f || exit 1; done
+	for f in examples/[0-9]*.py; do MPLBACKEND=Agg SUBSTRUCTURE_EXAMPLES_OUT=out/examples $(BIN)/python $$f || exit 1; done
 
 clean:
 	rm -rf $(VENV) out .pytest_cache

@@ -40,6 +40,8 @@ from .frf import FRF, Frequency
 from .joints import Joint, Sensor, Support
 from .materials import CATALOG, Material, get_material
 from .units import Q_, ureg
+from .io.assembly_toml import default_assembly, dumps_assembly, load_assembly, loads_assembly, save_assembly
+from .sweep import SweepResult, sweep
 
 __version__ = "0.1.0"
 
@@ -50,5 +52,6 @@ __all__ = [
     "remove_mass", "modify", "decouple", "ureg", "Q_", "SubstructureError", "UnitError",
     "InvalidValueError", "FrequencyAxisMismatchError", "UnknownPointError", "AssemblyError",
     "FileFormatError", "SubstructureWarning", "NonPassiveJointWarning", "NonReciprocalWarning",
-    "IllConditionedWarning",
+    "IllConditionedWarning", "load_assembly", "loads_assembly", "save_assembly", "dumps_assembly",
+    "default_assembly", "sweep", "SweepResult",
 ]

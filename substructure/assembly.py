@@ -30,18 +30,18 @@ Examples
 
 from __future__ import annotations
 
-from typing import Any, Iterable, Sequence
+from typing import Any, Sequence
 
 import attrs
 import numpy as np
 
-from .components import as_frequency, dof_labels
+from .components import as_frequency
 from .coupling import Link, couple_substructures
 from .errors import AssemblyError, InvalidValueError, UnknownPointError
 from .frf import FRF, Frequency
 from .joints import Joint, Sensor, Support
 from .materials import Material
-from .points import DOFS, PointRef, check_name, parse_point
+from .points import DOFS, PointRef, parse_point
 
 __all__ = ["Assembly", "expand_points"]
 
@@ -80,6 +80,18 @@ def _tuple(kind: type | None = None):
     return convert
 
 
+def _joint_check(items) -> tuple:
+    items = _tuple()(items)
+    for i, j in enumerate(items):
+        missing = [a for a in ("name", "between", "rigid", "dynamic_stiffness") if not hasattr(j, a)]
+        if missing:
+            raise InvalidValueError(
+                f"joints[{i}]: {j!r} is not a joint (it has no {', '.join(missing)}); expected a Joint "
+                "or an object with name, between, rigid and dynamic_stiffness(frequency_hz)"
+            )
+    return items
+
+
 def _component_check(items) -> tuple:
     items = _tuple()(items)
     for c in items:
@@ -113,7 +125,7 @@ class Assembly:
 
     name: str = attrs.field(default="assembly")
     components: tuple = attrs.field(default=(), converter=_component_check)
-    joints: tuple[Joint, ...] = attrs.field(default=(), converter=_tuple(Joint))
+    joints: tuple = attrs.field(default=(), converter=_joint_check)
     supports: tuple[Support, ...] = attrs.field(default=(), converter=_tuple(Support))
     sensors: tuple[Sensor, ...] = attrs.field(default=(), converter=_tuple(Sensor))
     frequency: Frequency | None = attrs.field(default=None)
@@ -133,7 +145,8 @@ class Assembly:
                         "names must be unique in an assembly"
                     )
                 seen[n] = comp.name
-        for kind, items in (("joint", self.joints), ("sensor", self.sensors)):
+        named_supports = tuple(s for s in self.supports if s.name is not None)
+        for kind, items in (("joint", self.joints), ("sensor", self.sensors), ("support", named_supports)):
             names = [i.name for i in items]
             dup = {n for n in names if names.count(n) > 1}
             if dup:
@@ -203,14 +216,14 @@ class Assembly:
         """Add components (beams, measured components, subassemblies)."""
         return attrs.evolve(self, components=self.components + components)
 
-    def connect(self, a: str | Joint, b: str | None = None, *, name: str | None = None,
+    def connect(self, a, b: str | None = None, *, name: str | None = None,
                 k=None, c=None, rigid: bool = False) -> "Assembly":
         """Connect two points by a joint: ``connect(joint)`` or ``connect(a, b, k=..., c=...)``.
 
         Without ``k`` the connection is rigid.
         """
-        if isinstance(a, Joint):
-            joint = a
+        if not isinstance(a, str):
+            joint = a  # a Joint, or any object of the joint protocol
         else:
             if b is None:
                 raise InvalidValueError("connect: expected two points, or a Joint")

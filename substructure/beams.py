@@ -42,6 +42,7 @@ import numpy as np
 import pint
 
 from . import _blocks as bk
+from ._engine import Link, couple_substructures
 from .errors import InvalidValueError
 from .materials import Material, get_material
 from .units import dimensionless, quantity
@@ -393,7 +394,7 @@ def _product(mats: list[np.ndarray], n: int) -> np.ndarray | None:
     return acc
 
 
-def _chain_receptance(intervals: list[tuple[Section, object]], nodes: list[int], omega: np.ndarray) -> np.ndarray:
+def _chain_single(intervals: list[tuple[Section, object]], nodes: list[int], omega: np.ndarray) -> np.ndarray:
     """Free-free receptances of a chain of uniform intervals at some of its nodes.
 
     ``intervals[k]`` spans node ``k`` to node ``k + 1``; ``nodes`` are sorted,
@@ -451,6 +452,65 @@ def _chain_receptance(intervals: list[tuple[Section, object]], nodes: list[int],
                     blk = blk - between[:2, 2:]
                 y[2 * i : 2 * i + 2, 2 * j : 2 * j + 2] = blk
     return y
+
+
+_CHUNK_KL = 8.0  # largest k L of one transfer-matrix chain: rounding ~ 1e-16 exp(8) ~ 3e-13
+
+
+def _phase(sec: Section, length, omega_max: float) -> float:
+    """Largest ``k L`` of an interval at ``omega_max`` (over a batch: the maximum)."""
+    fields = [np.atleast_1d(getattr(sec, f)) for f in ("EI", "kGA", "rhoA", "rhoI")]
+    _, _, s1, s2 = _squared_wavenumbers(Section(*fields), np.array(omega_max**2))
+    k = np.sqrt(np.maximum(np.abs(s1), np.abs(s2)))
+    return float(np.max(k * np.asarray(length, dtype=float)))
+
+
+def _chain_receptance(intervals: list[tuple[Section, object]], nodes: list[int], omega: np.ndarray) -> np.ndarray:
+    """Free-free receptances of a chain at some of its nodes, for any length and frequency.
+
+    The transfer-matrix rounding grows like ``exp(k L)`` (``k`` the evanescent
+    bending wavenumber), so a chain with ``k L`` above 8 at the highest line is
+    cut into pieces of ``k L <= 8``: each piece's receptances come from
+    :func:`_chain_single` and the pieces are joined by rigid connections with
+    the coupling engine, which is exact and well conditioned.  Short chains
+    (the usual case) are one piece.
+    """
+    omega_max = float(np.max(omega))
+    refined, node_map, phases = [], [0], []
+    for sec, length in intervals:
+        kl = _phase(sec, length, omega_max)
+        n_sub = max(1, math.ceil(kl / _CHUNK_KL))
+        piece = (sec, length / n_sub if n_sub > 1 else length)
+        refined.extend([piece] * n_sub)
+        phases.extend([kl / n_sub] * n_sub)
+        node_map.append(node_map[-1] + n_sub)
+    nodes = [node_map[i] for i in nodes]
+    bounds, acc = [0], 0.0
+    for i, kl in enumerate(phases):
+        if acc + kl > _CHUNK_KL and i > bounds[-1]:
+            bounds.append(i)
+            acc = 0.0
+        acc += kl
+    bounds.append(len(refined))
+    if len(bounds) == 2:
+        return _chain_single(refined, nodes, omega)
+    blocks, links = [], []
+    last = len(bounds) - 2
+    for c, (n0, n1) in enumerate(zip(bounds[:-1], bounds[1:])):
+        local = {nd for nd in nodes if n0 <= nd <= n1}
+        if c > 0:
+            local.add(n0)
+            links.append(Link((c - 1, n0), (c, n0), None, "a beam's own cross-section"))
+        if c < last:
+            local.add(n1)
+        local = sorted(local)
+        y = _chain_single(refined[n0:n1], [nd - n0 for nd in local], omega)
+        blocks.append(([(c, nd) for nd in local], y))
+    outputs = []
+    for nd in nodes:
+        c = next(c for c, (n0, n1) in enumerate(zip(bounds[:-1], bounds[1:])) if n0 <= nd <= n1)
+        outputs.append((c, nd))
+    return couple_substructures(blocks, links, outputs)
 
 
 def stepped_beam_receptance(

@@ -267,6 +267,25 @@ def _error(exc: BaseException) -> str:
     return _one_line(str(exc))
 
 
+PLUGIN_GROUP = "substructure.plugins"
+"""Entry-point group whose modules are imported before a command runs.
+
+A package that registers its own component types (``register_component``)
+declares ``[project.entry-points."substructure.plugins"] name = "module"``
+so that assembly files using its types work from the command line too.
+"""
+
+
+def _load_plugins() -> None:
+    from importlib.metadata import entry_points
+
+    for ep in entry_points(group=PLUGIN_GROUP):
+        try:
+            ep.load()
+        except Exception as exc:  # a broken plugin must not break the command
+            warnings.warn(f"plugin {ep.name!r} ({ep.value}) failed to load: {exc}", stacklevel=2)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status (0 ok, 1 error, 2 usage).
 
@@ -287,6 +306,7 @@ def main(argv: list[str] | None = None) -> int:
         warnings.simplefilter("always")
         warnings.showwarning = show
         try:
+            _load_plugins()
             args = _parser().parse_args(argv)
             if args.command is None:
                 raise _UsageError("choose a command: frf, demo (see substructure --help)")

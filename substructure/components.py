@@ -85,6 +85,13 @@ def as_frequency(frequency) -> Frequency:
     if isinstance(frequency, FRF):
         return frequency.frequency
     if isinstance(frequency, pint.Quantity):
+        units = str(frequency.units)
+        if not frequency.check("1 / [time]") or any(w in units for w in ("radian", "revolution", "turn", "degree")):
+            raise InvalidValueError(
+                f"frequency: got a quantity in {units}; expected frequencies in Hz (cycles per second). "
+                "An angular frequency in rad/s or a speed in rpm is not converted silently: divide "
+                "rad/s by 2*pi, or use substructure.units.rpm_to_hz"
+            )
         return Frequency.from_hz(np.atleast_1d(frequency.m_as("Hz")))
     if isinstance(frequency, str):
         raise InvalidValueError(

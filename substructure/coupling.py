@@ -33,8 +33,15 @@ from typing import Sequence
 import attrs
 import numpy as np
 
-from . import _blocks as bk
-from .errors import AssemblyError, FrequencyAxisMismatchError, InvalidValueError, UnknownPointError
+from ._engine import (
+    Connection,
+    Link,
+    apply_connection,
+    couple,
+    couple_substructures,
+    interface_update,
+)
+from .errors import FrequencyAxisMismatchError, InvalidValueError, UnknownPointError
 from .frf import FRF
 
 __all__ = [
@@ -50,210 +57,6 @@ __all__ = [
 ]
 
 
-@attrs.frozen
-class Connection:
-    """A connection between DOF groups of a receptance matrix.
-
-    Attributes
-    ----------
-    a : tuple of int
-        DOF indices on one side.
-    b : tuple of int or None
-        DOF indices on the other side (same length), or ``None`` for the ground.
-    stiffness : ndarray or None
-        Dynamic stiffness ``(r, r, n_freq)`` acting on ``u_a - u_b``;
-        ``None`` for a rigid connection.
-    label : str
-        For messages.
-    """
-
-    a: tuple[int, ...]
-    b: tuple[int, ...] | None
-    stiffness: np.ndarray | None = attrs.field(eq=False)
-    label: str = ""
-
-
-def _identity(r: int, n: int) -> np.ndarray:
-    eye = np.zeros((r, r, n), dtype=complex)
-    for i in range(r):
-        eye[i, i] = 1.0
-    return eye
-
-
-def _mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    if a.shape[0] == a.shape[1] == b.shape[0] == b.shape[1] == 2:
-        return bk.mul2(a, b)
-    return np.einsum("ikn,kjn->ijn", a, b)
-
-
-def interface_update(s: np.ndarray, stiffness: np.ndarray | None) -> np.ndarray:
-    """``W`` of the update ``Y_c = Y - (Y B^T) W (B Y)`` for ``S = B Y B^T``.
-
-    ``W = S^-1`` for a rigid connection (``stiffness`` None), else
-    ``W = K (I + S K)^-1``, which equals ``(S + K^-1)^-1`` without inverting a
-    possibly singular ``K``.  Shapes ``(r, r, n)``, frequency last.
-    """
-    r, n = s.shape[0], s.shape[-1]
-    if stiffness is None:
-        return bk.inv(s)
-    k = stiffness if stiffness.shape[-1] == n else np.broadcast_to(stiffness, stiffness.shape[:2] + (n,))
-    return _mul(k, bk.inv(_identity(r, n) + _mul(s, k)))
-
-
-def apply_connection(y: np.ndarray, conn: Connection) -> np.ndarray:
-    """One coupling step on a frequency-last receptance matrix ``(M, M, n)``."""
-    a = list(conn.a)
-    n = y.shape[-1]
-    if conn.b is None:
-        u = y[:, a]  # Y B^T
-        v = y[a, :]  # B Y
-    else:
-        b = list(conn.b)
-        u = y[:, a] - y[:, b]
-        v = y[a, :] - y[b, :]
-    s = v[:, a] if conn.b is None else v[:, a] - v[:, list(conn.b)]  # B Y B^T
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        w = interface_update(s, conn.stiffness)
-        uw = _mul(u, w) if u.shape[0] == 2 else np.einsum("mkn,kjn->mjn", u, w)
-        out = y.copy()
-        for j in range(len(a)):
-            out -= uw[:, j][:, None, :] * v[j][None, :, :]
-    if not np.all(np.isfinite(out)):
-        raise AssemblyError(
-            f"coupling through {conn.label or 'a connection'} is singular: a rigid joint that closes a "
-            "loop of rigid joints (redundant), a zero frequency, or a connection to a point with no "
-            "flexibility"
-        )
-    return out
-
-
-def couple(y: np.ndarray, connections: Sequence[Connection]) -> np.ndarray:
-    """Apply connections one after the other; returns the coupled ``(M, M, n)`` matrix."""
-    for conn in connections:
-        y = apply_connection(y, conn)
-    return y
-
-
-@attrs.frozen
-class Link:
-    """A connection between two points (2 DOFs each) of substructures, or to the ground.
-
-    ``stiffness`` is ``(2, 2, n_freq)`` acting on ``u_a - u_b`` (or ``u_a``), or
-    ``None`` for a rigid connection.
-    """
-
-    a: object
-    b: object | None
-    stiffness: np.ndarray | None = attrs.field(eq=False)
-    label: str = ""
-
-
-def _blk(y: np.ndarray, i: int, j: int) -> np.ndarray:
-    return y[2 * i : 2 * i + 2, 2 * j : 2 * j + 2]
-
-
-def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object]) -> np.ndarray:
-    """Couple substructures through links and return the receptances at ``outputs``.
-
-    Parameters
-    ----------
-    blocks : sequence of (keys, y)
-        Each substructure's point keys and its receptance matrix
-        ``(2m, 2m, n)`` (frequency last), DOFs ``(y, theta)`` per point.
-    links : sequence of Link
-        Joints, supports and modifications, applied in order.
-    outputs : sequence of keys
-        Points whose receptances are wanted (in this order).
-
-    Returns
-    -------
-    ndarray ``(2p, 2p, n)``
-        Zero between points of substructures that end up unconnected.
-
-    Notes
-    -----
-    Substructures are merged cluster by cluster, and after each link only the
-    points that the outputs or later links need are kept, so the working
-    matrices stay as small as the interfaces.  Each step is the update of
-    :func:`apply_connection`, with the zero off-diagonal blocks of two
-    uncoupled clusters skipped.
-    """
-    n = blocks[0][1].shape[-1]
-    clusters: dict[int, tuple[list, np.ndarray]] = {}
-    where: dict[object, int] = {}
-    for cid, (keys, y) in enumerate(blocks):
-        clusters[cid] = (list(keys), y)
-        for k in keys:
-            where[k] = cid
-    for step, link in enumerate(links):
-        needed = set(outputs)
-        for later in links[step + 1 :]:
-            needed.add(later.a)
-            if later.b is not None:
-                needed.add(later.b)
-        ca = where[link.a]
-        cb = None if link.b is None else where[link.b]
-        if cb is None or cb == ca:
-            keys, y = clusters.pop(ca)
-            ia = keys.index(link.a)
-            ib = None if link.b is None else keys.index(link.b)
-
-            def u_of(i, keys=keys, y=y, ia=ia, ib=ib):
-                return _blk(y, i, ia) if ib is None else _blk(y, i, ia) - _blk(y, i, ib)
-
-            def v_of(j, keys=keys, y=y, ia=ia, ib=ib):
-                return _blk(y, ia, j) if ib is None else _blk(y, ia, j) - _blk(y, ib, j)
-
-            s = u_of(ia) if ib is None else u_of(ia) - u_of(ib)
-            kept = [i for i, k in enumerate(keys) if k in needed]
-            us = [u_of(i) for i in kept]
-            vs = [v_of(j) for j in kept]
-            base = [[_blk(y, i, j) for j in kept] for i in kept]
-            new_keys = [keys[i] for i in kept]
-        else:
-            ka, ya = clusters.pop(ca)
-            kb, yb = clusters.pop(cb)
-            ia, ib = ka.index(link.a), kb.index(link.b)
-            s = _blk(ya, ia, ia) + _blk(yb, ib, ib)
-            kept_a = [i for i, k in enumerate(ka) if k in needed]
-            kept_b = [i for i, k in enumerate(kb) if k in needed]
-            us = [_blk(ya, i, ia) for i in kept_a] + [-_blk(yb, i, ib) for i in kept_b]
-            vs = [_blk(ya, ia, j) for j in kept_a] + [-_blk(yb, ib, j) for j in kept_b]
-            zero = None
-            base = [[_blk(ya, i, j) for j in kept_a] + [zero] * len(kept_b) for i in kept_a]
-            base += [[zero] * len(kept_a) + [_blk(yb, i, j) for j in kept_b] for i in kept_b]
-            new_keys = [ka[i] for i in kept_a] + [kb[i] for i in kept_b]
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            w = interface_update(s, link.stiffness)
-            uw = [bk.mul2(u, w) for u in us]
-            m = len(new_keys)
-            out = np.empty((2 * m, 2 * m, n), dtype=complex)
-            for i in range(m):
-                for j in range(m):
-                    blk = -bk.mul2(uw[i], vs[j])
-                    if base[i][j] is not None:
-                        blk += base[i][j]
-                    out[2 * i : 2 * i + 2, 2 * j : 2 * j + 2] = blk
-        if not np.all(np.isfinite(out)):
-            raise AssemblyError(
-                f"coupling through {link.label or 'a connection'} is singular: a rigid joint that "
-                "closes a loop of rigid joints (redundant), or a connection to a point with no "
-                "flexibility"
-            )
-        cid = min(ca, cb if cb is not None else ca)
-        clusters[cid] = (new_keys, out)
-        for k in new_keys:
-            where[k] = cid
-    result = np.zeros((2 * len(outputs), 2 * len(outputs), n), dtype=complex)
-    for i, ki in enumerate(outputs):
-        ci = where[ki]
-        keys_i, y_i = clusters[ci]
-        for j, kj in enumerate(outputs):
-            if where[kj] == ci:
-                result[2 * i : 2 * i + 2, 2 * j : 2 * j + 2] = _blk(y_i, keys_i.index(ki), keys_i.index(kj))
-    return result
-
-
 # ---------------------------------------------------------------------------
 # FRF-level operations
 
@@ -267,21 +70,6 @@ def _point_dofs(frf: FRF, at: str) -> list[str]:
             f"point {at}: not among the FRF's DOFs; outputs are {', '.join(frf.outputs)}"
         )
     return present
-
-
-def _square_view(frf: FRF) -> tuple[list[str], np.ndarray]:
-    """The FRF as a square matrix over the union of its labels, frequency-last.
-
-    Entries that are not in the FRF are unknown; they are filled with NaN and
-    must not be needed by the operation (checked by the caller).
-    """
-    labels = list(dict.fromkeys(frf.outputs + frf.inputs))
-    n = len(frf.frequency)
-    y = np.full((len(labels), len(labels), n), np.nan, dtype=complex)
-    oi = [labels.index(lbl) for lbl in frf.outputs]
-    ii = [labels.index(lbl) for lbl in frf.inputs]
-    y[np.ix_(oi, ii)] = np.moveaxis(frf.data, 0, -1)
-    return labels, y
 
 
 def modify(frf: FRF, at: str, delta_stiffness) -> FRF:

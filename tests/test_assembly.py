@@ -140,3 +140,47 @@ def test_support_to_ground_shifts_rigid_modes(grid):
 def test_frequencies_must_be_positive_for_free_free_components(assembly):
     with pytest.raises(InvalidValueError, match="no static receptance"):
         assembly.receptance("tool.tip", frequency=Frequency.from_hz([0.0, 10.0]))
+
+
+def test_angular_frequency_quantities_are_not_taken_as_hz(assembly):
+    from substructure import Q_
+
+    with pytest.raises(InvalidValueError, match="rad/s|radian"):
+        assembly.receptance("tool.tip", frequency=Q_(np.array([628.3]), "rad/s"))
+    with pytest.raises(InvalidValueError, match="rpm_to_hz"):
+        assembly.receptance("tool.tip", frequency=Q_(np.array([6000.0]), "rpm"))
+    ok = assembly.receptance("tool.tip:y", frequency=Q_(np.array([0.1, 0.2]), "kHz"))
+    np.testing.assert_array_equal(ok.frequency.hz, [100.0, 200.0])
+
+
+def test_a_joint_model_by_protocol_is_accepted(grid):
+    """Any object with name, between, rigid and dynamic_stiffness is a joint."""
+    holder, tool = make_holder(), make_tool()
+
+    class Hysteretic:
+        name, between, rigid = "ht", ("holder.tip", "tool.base"), False
+
+        def dynamic_stiffness(self, f):
+            k = np.diag([1.4e7, 8e4]) * (1 + 0.05j)
+            return np.repeat(k[:, :, None], np.size(f), axis=2)
+
+    asm = Assembly("h", components=(holder, tool), joints=(Hysteretic(),))
+    same = Assembly("h", components=(holder, tool)).connect(
+        "holder.tip", "tool.base", name="ht", k={"yf": "1.4e7 N/m", "tm": "8e4 N*m/rad"}
+    )
+    a = asm.receptance("tool.tip:y", frequency=grid).data
+    b = same.receptance("tool.tip:y", frequency=grid).data
+    assert not np.allclose(a, b)  # the loss factor acts
+    with pytest.raises(InvalidValueError, match=r"joints\[0\].*not a joint"):
+        Assembly("bad", components=(holder, tool), joints=("holder.tip",))
+    from substructure import dumps_assembly
+
+    with pytest.raises(InvalidValueError, match="cannot hold"):
+        dumps_assembly(asm)
+
+
+def test_duplicate_support_names_are_errors():
+    with pytest.raises(AssemblyError, match="support names used twice"):
+        make_assembly().support(Support("tool@10 mm", k={"yf": "1e5 N/m"}, name="band")).support(
+            Support("tool@20 mm", k={"yf": "1e5 N/m"}, name="band")
+        )

@@ -358,3 +358,21 @@ def test_two_different_materials_of_one_name_are_refused_on_writing():
     tool = Tool("tool", [Segment("20 mm", "10 mm", material="carbide"), Segment("20 mm", "10 mm", material=fake)])
     with pytest.raises(InvalidValueError, match="two different materials are called 'carbide'"):
         dumps_assembly(Assembly("two carbides", [tool]))
+
+
+def test_missing_material_and_zero_start_are_errors():
+    text = """
+name = "x"
+[frequency]
+start = "0 Hz"
+stop = "100 Hz"
+step = "10 Hz"
+[[components]]
+name = "tool"
+type = "tool"
+segments = [{ length = "30 mm", od = "12 mm" }]
+"""
+    with pytest.raises(FileFormatError, match=r"frequency.start: got '0 Hz'; expected a frequency > 0 Hz"):
+        loads_assembly(text, "x.toml")
+    with pytest.raises(FileFormatError, match=r"components\[0\].segments\[0\].material: missing"):
+        loads_assembly(text.replace('"0 Hz"', '"10 Hz"'), "x.toml")

@@ -125,8 +125,8 @@ def test_segment_dynamic_stiffness_is_symmetric():
 
 segment_strategy = st.builds(
     lambda length, od, ratio, mat: Segment(f"{length} mm", f"{od} mm", f"{od * ratio} mm", material=mat),
-    st.floats(5, 80),
-    st.floats(20, 120),
+    st.floats(5, 150),
+    st.floats(6, 120),
     st.sampled_from([0.0, 0.3, 0.6]),
     st.sampled_from(["steel", "carbide", "aluminium"]),
 )
@@ -137,13 +137,12 @@ segment_strategy = st.builds(
 def test_reciprocity_and_splitting_invariants(segments, frac):
     """Y is symmetric to machine precision; an extra point does not change the others.
 
-    Machine-tool proportions (k L < 12 at 6 kHz): the transfer-matrix rounding
-    grows like eps * exp(k L), see docs/beams.md.
+    Slender pieces too (k L up to ~40 at 6 kHz): long chains are evaluated in
+    rigidly joined pieces of k L <= 8, see docs/beams.md.
     """
     length = sum(s.length_m for s in segments)
     f = np.linspace(10, 6000, 97)
     y3 = stepped_beam_receptance(segments, [length, 0.0, frac * length], f)
-    # rounding grows like eps * exp(k L) with the evanescent wavenumber k (k L up to ~10 here)
     assert np.abs(y3 - y3.transpose(1, 0, 2)).max() <= 1e-10 * np.abs(y3).max()
     y2 = stepped_beam_receptance(segments, [length, 0.0], f)
     assert np.abs(y3[:4, :4] - y2).max() <= 1e-10 * np.abs(y2).max()

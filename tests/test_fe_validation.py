@@ -76,7 +76,7 @@ def poles(h, f_max, n_modes, lines=6000):
 def test_free_free_natural_frequencies_match_fe(segments, fe_segments):
     beam = Tool("b", segments)
     model = fe.Model()
-    model.add_beam(fe_segments, n_elem=128)  # converged: mode 5 moves < 1e-4 when doubled
+    model.add_beam(fe_segments)  # default mesh: first five within 2.5e-6 of converged
     expected = model.natural_frequencies(5)
     length = beam.length_m
 
@@ -84,7 +84,7 @@ def test_free_free_natural_frequencies_match_fe(segments, fe_segments):
         return beam.receptance(f, ["tip"]).data[:, 0, 0].real
 
     found = poles(h, 1.1 * expected[-1], 5)
-    np.testing.assert_allclose(found, expected, rtol=2e-3)
+    np.testing.assert_allclose(found, expected, rtol=2e-4)  # issue asks 0.2 %; we see < 1e-5
 
 
 def _library_assembly(loss: bool):
@@ -135,7 +135,7 @@ def test_assembly_natural_frequencies_match_fe():
         return asm.receptance("tool.tip:y", frequency=f).data[:, 0, 0].real
 
     found = poles(h, 1.1 * expected[-1], 5, lines=20000)
-    np.testing.assert_allclose(found, expected, rtol=2e-3)
+    np.testing.assert_allclose(found, expected, rtol=2e-4)  # issue asks 0.2 %; we see < 1e-5
 
 
 def test_assembly_receptances_match_fe_with_damping():
@@ -147,4 +147,24 @@ def test_assembly_receptances_match_fe_with_damping():
     theirs = model.receptance(grid.hz, points)
     # Relative to each entry's largest value over the band (the FE mesh error)
     err = np.abs(ours - theirs).max(axis=0) / np.abs(theirs).max(axis=0)
-    assert err.max() < 5e-3
+    assert err.max() < 1e-6  # measured 1e-9 with the converged FE mesh
+
+
+def test_slender_beam_at_high_frequency_matches_fe():
+    """k L up to ~40: the beam is evaluated in rigidly joined pieces of k L <= 8."""
+    rod = Tool("rod", [Segment("0.5 m", "6 mm", material=STEEL0)])
+    model = fe.Model()
+    model.add_beam([(0.5, fe.section(0.006, 0, FE_STEEL))], n_elem=200, points=[0.2])
+    f = np.linspace(100.0, 9000.0, 60)
+    ours = rod.receptance(f, ["tip", "@200 mm"]).data
+    theirs = model.receptance(f, [(0, 0.5, "y"), (0, 0.5, "theta"), (0, 0.2, "y"), (0, 0.2, "theta")])
+    # relative to each entry's largest value (poles excluded by the grid)
+    err = np.abs(ours - theirs).max(axis=0) / np.abs(theirs).max(axis=0)
+    assert err.max() < 1e-3
+    expected = model.natural_frequencies(40)
+    expected = expected[expected < 9000.0]
+
+    def h(freq):
+        return rod.receptance(freq, ["tip"]).data[:, 0, 0].real
+
+    np.testing.assert_allclose(poles(h, 9000.0, len(expected), lines=40000), expected, rtol=1e-4)

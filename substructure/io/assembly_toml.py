@@ -109,6 +109,8 @@ class _Locator:
                 key_line = self._find_key(rest[i], start, end)
                 if key_line is None:
                     break
+                if i + 2 == len(rest):  # an element of an array of values: the key's line
+                    return key_line + 1
                 elements = [n for n in range(key_line, end) if "{" in self.lines[n]]
                 if rest[i + 1] >= len(elements):
                     return key_line + 1
@@ -193,6 +195,9 @@ class _Reader:
         if "frequency" in data:
             grid = self.table(data["frequency"], ["frequency"], _FREQUENCY_KEYS, _FREQUENCY_KEYS)
             frequency = self.call(["frequency"], Frequency.from_range, grid["start"], grid["stop"], grid["step"])
+            if frequency.hz[0] <= 0:
+                raise self.error(["frequency", "start"], f"got {grid['start']!r}; expected a frequency > 0 Hz "
+                                 "(a free-free assembly has no static receptance)")
         custom = []
         materials = data.get("materials", {})
         if not isinstance(materials, dict):
@@ -209,6 +214,7 @@ class _Reader:
         base = self.call([], Assembly, data["name"], components, frequency=frequency, materials=custom)
         joints = self.unique([self.joint(j, ["joints", i], base) for i, j in enumerate(items["joints"])], "joints")
         supports = [self.support(s, ["supports", i], base) for i, s in enumerate(items["supports"])]
+        self.unique([s for s in supports if s.name is not None], "supports")
         sensors = self.unique([self.sensor(s, ["sensors", i], base) for i, s in enumerate(items["sensors"])],
                               "sensors")
         return self.call([], Assembly, data["name"], components, joints, supports, sensors, frequency, custom)
@@ -230,7 +236,8 @@ class _Reader:
         kind = table["type"]
         cls = COMPONENT_TYPES.get(kind) if isinstance(kind, str) else None
         if cls is None:
-            raise self.error(parts + ["type"], f"unknown component type {kind!r}; known: {', '.join(COMPONENT_TYPES)}")
+            known = ", ".join(k for k, c in COMPONENT_TYPES.items() if hasattr(c, "from_toml") or issubclass(c, Beam))
+            raise self.error(parts + ["type"], f"unknown component type {kind!r}; known: {known}")
         if hasattr(cls, "from_toml"):
             return self.call(parts, cls.from_toml, table, dict(self.materials), _path(parts))
         if not (isinstance(cls, type) and issubclass(cls, Beam)):
@@ -248,6 +255,9 @@ class _Reader:
             kw["material"] = self.material(table["material"], parts + ["material"])
         elif material is not None:
             kw["material"] = material
+        else:
+            raise self.error(parts + ["material"], "missing; give the segment's material, or the "
+                             "component's `material` (steel, carbide, aluminium or a [materials.NAME])")
         if "insert" in table:
             ins = self.table(table["insert"], parts + ["insert"], _INSERT_KEYS, ("od", "material"))
             mat = self.material(ins["material"], parts + ["insert", "material"])
@@ -491,7 +501,8 @@ def dumps_assembly(assembly: Assembly) -> str:
     InvalidValueError
         For what a file cannot hold: a non-uniform frequency grid, two
         different materials of the same name, components of an unregistered
-        type or without a file form (measured components, subassemblies).
+        type or without a file form (measured components, subassemblies),
+        joint models other than :class:`Joint`.
     """
     if not isinstance(assembly, Assembly):
         raise InvalidValueError(f"assembly: got {type(assembly).__name__}; expected an Assembly")
@@ -502,6 +513,12 @@ def dumps_assembly(assembly: Assembly) -> str:
     if materials:
         doc["materials"] = {name: _material_table(m) for name, m in materials.items()}
     doc["components"] = [_component_table(c) for c in assembly.components]
+    for j in assembly.joints:
+        if type(j) is not Joint:
+            raise InvalidValueError(
+                f"joints: {j.name!r} is a {type(j).__name__}, which an assembly file cannot hold "
+                "(only Joint's k, c and rigid); save it another way rather than lose its parameters"
+            )
     if assembly.joints:
         doc["joints"] = [
             {"name": j.name, "between": list(j.between), **({"rigid": True} if j.rigid else _matrices(j))}
