@@ -6,6 +6,12 @@ import warnings
 
 import numpy as np
 import pytest
+from hypothesis import settings
+
+# Property-based tests are deterministic (a fixed seed) and keep no example
+# database, so that every run, here and in CI, tests the same cases.
+settings.register_profile("substructure", derandomize=True, database=None, deadline=None)
+settings.load_profile("substructure")
 
 from substructure import (
     Assembly,
