@@ -36,6 +36,7 @@ import attrs
 import numpy as np
 
 from .components import as_frequency
+from ._blocks import by_chunks
 from .coupling import Link, couple_substructures
 from .errors import AssemblyError, InvalidValueError, UnknownPointError
 from .frf import FRF, Frequency
@@ -324,8 +325,11 @@ class Assembly:
 
     def receptance_matrix(self, refs: Sequence[PointRef], frequency_hz: np.ndarray) -> np.ndarray:
         """Coupled receptances between points, ``(2p, 2p, n)`` frequency-last (component protocol)."""
-        f = np.asarray(frequency_hz, dtype=float)
         groups, out_keys, links = self._plan(refs)
+        return by_chunks(lambda f: self._compute(groups, out_keys, links, f), frequency_hz)
+
+    @staticmethod
+    def _compute(groups, out_keys, links, f: np.ndarray) -> np.ndarray:
         blocks = [
             ([k for k, _ in items], owner.receptance_matrix([ref for _, ref in items], f))
             for owner, items in groups

@@ -200,6 +200,8 @@ class Segment:
     material: Material = attrs.field(default="steel", converter=_material)
     insert: Insert | None = attrs.field(default=None)
     flutes: Flutes | None = attrs.field(default=None)
+    # SI values, derived once (the kernels need them at every call)
+    _si: tuple = attrs.field(init=False, eq=False, repr=False)
 
     def __attrs_post_init__(self) -> None:
         if self.id >= self.od:
@@ -221,20 +223,21 @@ class Segment:
                     "flutes.diameter_ratio: the equivalent diameter "
                     f"{self.flutes.diameter_ratio} * {self.od:~P} is not larger than the bore {self.id:~P}"
                 )
-
-    @property
-    def length_m(self) -> float:
-        return float(self.length.m_as("m"))
-
-    def section(self) -> Section:
-        """Section properties in SI units (layers summed)."""
         od = self.od.m_as("m")
         if self.flutes is not None:
             od = od * self.flutes.diameter_ratio
         sec = Section.ring(od, self.id.m_as("m"), self.material)
         if self.insert is not None:
             sec = sec + Section.ring(self.insert.od.m_as("m"), self.insert.id.m_as("m"), self.insert.material)
-        return sec
+        object.__setattr__(self, "_si", (float(self.length.m_as("m")), sec))
+
+    @property
+    def length_m(self) -> float:
+        return self._si[0]
+
+    def section(self) -> Section:
+        """Section properties in SI units (layers summed)."""
+        return self._si[1]
 
     def mass(self) -> float:
         """Mass of the segment (with its insert) in kg."""
@@ -247,10 +250,10 @@ class Segment:
 
 def _squared_wavenumbers(sec: Section, w2: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """``a, e`` (diagonal of A^2) and the eigenvalues ``s1, s2`` of ``A^2``."""
-    a = -w2 * sec.rhoA / sec.kGA
-    e = -w2 * sec.rhoI / sec.EI
+    a = w2 * (-sec.rhoA / sec.kGA)
+    e = w2 * (-sec.rhoI / sec.EI)
     half = 0.5 * (a - e)
-    root = np.sqrt(half * half + w2 * sec.rhoA / sec.EI + 0j)
+    root = np.sqrt(half * half + w2 * (sec.rhoA / sec.EI) + 0j)
     mean = 0.5 * (a + e)
     return a, e, mean + root, mean - root
 
@@ -272,15 +275,13 @@ def _series(z1: np.ndarray, z2: np.ndarray, length: np.ndarray):
     ds = np.zeros_like(z2)
     h = np.ones_like(z2)  # h_0
     pow2 = np.ones_like(z2)
-    fact_c, fact_s = 1.0, 1.0  # (2n)!, (2n+1)!
     for n in range(1, n_terms + 1):
-        fact_c *= (2 * n - 1) * (2 * n)
-        fact_s *= (2 * n) * (2 * n + 1)
-        dc += h / fact_c
-        ds += h / fact_s
+        rc, rs = 1.0 / math.factorial(2 * n), 1.0 / math.factorial(2 * n + 1)
+        dc += rc * h
+        ds += rs * h
         pow2 = pow2 * z2
-        sc += pow2 / fact_c
-        ss += pow2 / fact_s
+        sc += rc * pow2
+        ss += rs * pow2
         h = z1 * h + pow2  # h_n = z1 h_{n-1} + z2^n
     return sc, length**2 * dc, length * ss, length**3 * ds
 
@@ -329,27 +330,28 @@ def segment_transfer_matrix(sec: Section, length: float, omega: np.ndarray) -> n
     alpha = c0 - c1 * s2
     beta = g0 - g1 * s2
     gamma, delta = c1, g1
-    EI, kGA, mA, mI = sec.EI, sec.kGA, w2 * sec.rhoA, w2 * sec.rhoI
+    inv_ei, inv_kga = 1.0 / sec.EI, 1.0 / sec.kGA
+    mA, mI = w2 * sec.rhoA, w2 * sec.rhoI
     t = np.empty((4, 4, w2.size), dtype=complex)
     # T = alpha I + beta A + gamma A^2 + delta A^3, written entry by entry
     # (A, A^2, A^3 are sparse), sharing the repeated entries.
     t[0, 0] = t[2, 2] = alpha + gamma * a
     t[1, 1] = t[3, 3] = alpha + gamma * e
     t[0, 1] = beta + delta * (a + e)
-    t[0, 2] = beta / kGA + delta * (a / kGA - 1.0 / EI)
-    g_ei = gamma / EI
+    t[0, 2] = beta * inv_kga + delta * (a * inv_kga - inv_ei)
+    g_ei = gamma * inv_ei
     t[0, 3] = g_ei
     t[1, 2] = -g_ei
-    d_ma_ei = delta * mA / EI
+    d_ma_ei = delta * mA * inv_ei
     t[1, 0] = d_ma_ei
     t[2, 3] = -d_ma_ei
-    t[1, 3] = (beta + delta * e) / EI
+    t[1, 3] = (beta + delta * e) * inv_ei
     t[2, 0] = -(beta + delta * a) * mA
     g_ma = gamma * mA
     t[3, 0] = g_ma
     t[2, 1] = -g_ma
     t[3, 1] = -beta * mI + delta * (mA - mI * e)
-    t[3, 2] = -beta + delta * (mI / EI - a)
+    t[3, 2] = -beta + delta * (mI * inv_ei - a)
     return t
 
 
@@ -412,10 +414,14 @@ def _chain_single(intervals: list[tuple[Section, object]], nodes: list[int], ome
     n = omega.size
     cache: dict[tuple, np.ndarray] = {}
     mats = []
-    for sec, length in intervals:
+    for sec, length, *tile in intervals:
         key = (id(sec), id(length) if isinstance(length, np.ndarray) else length)
         if key not in cache:
-            cache[key] = segment_transfer_matrix(sec, length, omega)
+            if tile:  # the same in every configuration of a batch: once, then repeated
+                n_f, reps = tile[0]
+                cache[key] = np.tile(segment_transfer_matrix(sec, length, omega[:n_f]), (1, 1, reps))
+            else:
+                cache[key] = segment_transfer_matrix(sec, length, omega)
         mats.append(cache[key])
     m = len(nodes)
     # Transfer matrices between consecutive requested nodes, and the overhangs
@@ -465,7 +471,9 @@ def _phase(sec: Section, length, omega_max: float) -> float:
     return float(np.max(k * np.asarray(length, dtype=float)))
 
 
-def _chain_receptance(intervals: list[tuple[Section, object]], nodes: list[int], omega: np.ndarray) -> np.ndarray:
+def _chain_receptance(
+    intervals: list[tuple], nodes: list[int], omega: np.ndarray, phases: list[float] | None = None
+) -> np.ndarray:
     """Free-free receptances of a chain at some of its nodes, for any length and frequency.
 
     The transfer-matrix rounding grows like ``exp(k L)`` (``k`` the evanescent
@@ -476,14 +484,16 @@ def _chain_receptance(intervals: list[tuple[Section, object]], nodes: list[int],
     (the usual case) are one piece.
     """
     omega_max = float(np.max(omega))
-    refined, node_map, phases = [], [0], []
-    for sec, length in intervals:
-        kl = _phase(sec, length, omega_max)
+    if phases is None:
+        phases = [_phase(item[0], item[1], omega_max) for item in intervals]
+    refined, node_map, piece_phases = [], [0], []
+    for item, kl in zip(intervals, phases):
         n_sub = max(1, math.ceil(kl / _CHUNK_KL))
-        piece = (sec, length / n_sub if n_sub > 1 else length)
+        piece = item if n_sub == 1 else (item[0], item[1] / n_sub, *item[2:])
         refined.extend([piece] * n_sub)
-        phases.extend([kl / n_sub] * n_sub)
+        piece_phases.extend([kl / n_sub] * n_sub)
         node_map.append(node_map[-1] + n_sub)
+    phases = piece_phases
     nodes = [node_map[i] for i in nodes]
     bounds, acc = [0], 0.0
     for i, kl in enumerate(phases):
@@ -533,8 +543,6 @@ def stepped_beam_receptance(
         Frequency-last receptances; DOFs ordered ``(y, theta)`` per position in
         the order given.
     """
-    f = np.asarray(frequency_hz, dtype=float)
-    omega = 2.0 * np.pi * f
     pos = np.asarray(positions, dtype=float)
     order = np.argsort(pos)
     sorted_pos = pos[order]
@@ -548,7 +556,7 @@ def stepped_beam_receptance(
         k = int(np.clip(np.searchsorted(ends, 0.5 * (x0 + x1)) - 1, 0, len(segments) - 1))
         intervals.append((sections[k], float(x1 - x0)))
     nodes = [int(i) for i in np.searchsorted(cuts, sorted_pos)]
-    y_sorted = _chain_receptance(intervals, nodes, omega)
+    y_sorted = bk.by_chunks(lambda f: _chain_receptance(intervals, nodes, 2.0 * np.pi * f), frequency_hz)
     m = len(sorted_pos)
     inverse = np.empty(m, dtype=int)
     inverse[order] = np.arange(m)
@@ -603,13 +611,20 @@ def stepped_beam_receptance_batch(
     f = np.asarray(frequency_hz, dtype=float)
     n_f = f.size
     omega = np.tile(2.0 * np.pi * f, len(configurations))
-    intervals = []
+    omega_max = 2.0 * np.pi * float(f.max())
+    intervals, phases = [], []
     for j in range(n_seg):
-        sec = _stack_sections([cfg[j].section() for cfg in configurations], n_f)
-        lengths = np.repeat(np.array([cfg[j].length_m for cfg in configurations]), n_f)
-        intervals.append((sec, lengths))
+        column = [cfg[j] for cfg in configurations]
+        secs = [seg.section() for seg in column]
+        lengths = np.array([seg.length_m for seg in column])
+        if all(seg == column[0] for seg in column[1:]):
+            intervals.append((secs[0], lengths[0], (n_f, len(column))))
+            phases.append(_phase(secs[0], lengths[0], omega_max))
+        else:
+            intervals.append((_stack_sections(secs, n_f), np.repeat(lengths, n_f)))
+            phases.append(_phase(_stack_sections(secs, 1), lengths, omega_max))
     nodes = sorted({"base": 0, "tip": n_seg}[e] for e in ends)
-    y = _chain_receptance(intervals, nodes, omega)
+    y = _chain_receptance(intervals, nodes, omega, phases)
     if len(ends) == 2 and ends[0] == "tip":
         y = y[np.ix_([2, 3, 0, 1], [2, 3, 0, 1])]
     return y

@@ -357,7 +357,9 @@ class MeasuredComponent:
 
     def receptance_matrix(self, refs: Sequence[PointRef], frequency_hz: np.ndarray) -> np.ndarray:
         f = np.asarray(frequency_hz, dtype=float)
-        if f.shape != self.frf.frequency.hz.shape or not np.array_equal(f, self.frf.frequency.hz):
+        hz = self.frf.frequency.hz
+        start = int(np.searchsorted(hz, f[0])) if f.size else 0
+        if f.size == 0 or not np.array_equal(hz[start : start + f.size], f):
             raise FrequencyAxisMismatchError(
                 f"measured component {self.name!r} is known on {self.frf.frequency!r}; the request "
                 "uses another grid: interpolate the FRF or compute on its grid"
@@ -366,7 +368,8 @@ class MeasuredComponent:
             self.node_key(r)
         labels = [f"{r.point}:{d}" for r in refs for d in DOFS]
         index = [self.frf.outputs.index(lbl) for lbl in labels]
-        return np.moveaxis(self.frf.data[:, index][:, :, index], 0, -1)
+        data = self.frf.data[start : start + f.size]
+        return np.moveaxis(data[:, index][:, :, index], 0, -1)
 
 
 def component_info(component: Any) -> str:
