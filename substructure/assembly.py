@@ -36,7 +36,7 @@ import attrs
 import numpy as np
 
 from .components import as_frequency
-from ._blocks import by_chunks
+from ._blocks import CHUNK_LINES, by_chunks
 from .coupling import Link, couple_substructures
 from .errors import AssemblyError, InvalidValueError, UnknownPointError
 from .frf import FRF, Frequency
@@ -44,7 +44,7 @@ from .joints import Joint, Sensor, Support
 from .materials import Material
 from .points import DOFS, PointRef, parse_point
 
-__all__ = ["Assembly", "expand_points"]
+__all__ = ["Assembly", "PreparedFRF", "expand_points"]
 
 
 def expand_points(points: Sequence[str] | str):
@@ -340,6 +340,15 @@ class Assembly:
         ]
         return couple_substructures(blocks, coupling_links, out_keys)
 
+    def prepare(self, outputs, inputs=None, frequency=None) -> "PreparedFRF":
+        """The FRF from ``inputs`` to ``outputs``, ready to be re-evaluated fast.
+
+        The components' receptances are computed once; :meth:`PreparedFRF.evaluate`
+        then only re-couples, with some joints, sensors or supports replaced.
+        Identification and diagnosis fits evaluate the model this way.
+        """
+        return PreparedFRF(self, outputs, inputs, frequency)
+
     def node_key(self, ref: PointRef):
         return self._resolve(ref)[2]
 
@@ -392,3 +401,68 @@ class Assembly:
         for s in self.sensors:
             lines.append(f"  sensor {s.name} at {s.at}: {s.mass:~P}")
         return "\n".join(lines)
+
+
+class PreparedFRF:
+    """An assembly's FRF at fixed points and frequency lines, for fast re-evaluation.
+
+    Built by :meth:`Assembly.prepare`.  :meth:`evaluate` accepts replacements
+    for joints (by name), sensors (by name) and supports (by name or label),
+    which must act on the same points as the ones they replace; everything
+    else (the components' free-free receptances) is reused.
+    """
+
+    def __init__(self, assembly: Assembly, outputs, inputs=None, frequency=None):
+        self.assembly = assembly
+        self.frequency = assembly._frequency(frequency)
+        outputs = [outputs] if isinstance(outputs, str) else list(outputs)
+        inputs = outputs if inputs is None else ([inputs] if isinstance(inputs, str) else list(inputs))
+        self.outputs, out_idx, out_refs = expand_points(outputs)
+        self.inputs, in_idx, in_refs = expand_points(inputs)
+        groups, self._out_keys, self._links = assembly._plan(out_refs + in_refs)
+        f = self.frequency.hz
+        self._blocks = [
+            ([k for k, _ in items], by_chunks(lambda ff, o=owner, r=[ref for _, ref in items]: o.receptance_matrix(r, ff), f))
+            for owner, items in groups
+        ]
+        self._rows = [2 * i + d for i, d in out_idx]
+        self._cols = [2 * (len(out_refs) + i) + d for i, d in in_idx]
+
+    def _replacement(self, obj, joints, sensors, supports):
+        if isinstance(obj, Sensor):
+            new = sensors.get(obj.name, obj)
+            where = (obj.at, new.at)
+        elif isinstance(obj, Support):
+            new = supports.get(obj.name or f"support at {obj.at}", obj)
+            where = (obj.at, new.at)
+        else:
+            new = joints.get(obj.name, obj)
+            where = (tuple(obj.between), tuple(new.between))
+        if where[0] != where[1]:
+            raise InvalidValueError(
+                f"prepared FRF: a replacement must act on the same points ({where[0]}), got {where[1]}"
+            )
+        return new
+
+    def evaluate(self, joints=None, sensors=None, supports=None) -> FRF:
+        """The FRF with some joints, sensors or supports replaced (mappings by name)."""
+        joints, sensors, supports = dict(joints or {}), dict(sensors or {}), dict(supports or {})
+        known = {o.name for _, _, o, _ in self._links if not isinstance(o, (Sensor, Support))}
+        unknown = set(joints) - known
+        if unknown:
+            raise UnknownPointError(f"prepared FRF: no joint {sorted(unknown)} (joints: {sorted(known)})")
+        objs = [self._replacement(obj, joints, sensors, supports) for _, _, obj, _ in self._links]
+        f = self.frequency.hz
+        n = f.size
+        parts = []
+        for start in range(0, n, CHUNK_LINES):
+            sl = slice(start, min(n, start + CHUNK_LINES))
+            blocks = [(keys, y[..., sl]) for keys, y in self._blocks]
+            links = [
+                Link(ka, kb, None if getattr(o, "rigid", False) else o.dynamic_stiffness(f[sl]), label)
+                for (ka, kb, _, label), o in zip(self._links, objs)
+            ]
+            parts.append(couple_substructures(blocks, links, self._out_keys))
+        y = np.concatenate(parts, axis=-1) if len(parts) > 1 else parts[0]
+        data = np.moveaxis(y[np.ix_(self._rows, self._cols)], -1, 0)
+        return FRF(self.frequency, data, tuple(self.outputs), tuple(self.inputs))

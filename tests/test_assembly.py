@@ -184,3 +184,18 @@ def test_duplicate_support_names_are_errors():
         make_assembly().support(Support("tool@10 mm", k={"yf": "1e5 N/m"}, name="band")).support(
             Support("tool@20 mm", k={"yf": "1e5 N/m"}, name="band")
         )
+
+
+def test_prepared_frf_equals_full_computation(assembly, grid):
+    prepared = assembly.attach(Sensor("acc", "tool.tip", "2 g")).prepare("tool.tip", frequency=grid)
+    joint = Joint("holder-tool", ("holder.tip", "tool.base"), k={"yf": "3e7 N/m", "tm": "5e4 N*m/rad"},
+                  c={"yf": "60 N*s/m"})
+    sensor = Sensor("acc", "tool.tip", "5 g")
+    got = prepared.evaluate(joints={"holder-tool": joint}, sensors={"acc": sensor})
+    expected = assembly.with_joint(joint).attach(sensor).receptance("tool.tip", frequency=grid)
+    np.testing.assert_allclose(got.data, expected.data, rtol=1e-12)
+    assert got.outputs == expected.outputs
+    with pytest.raises(UnknownPointError, match="no joint"):
+        prepared.evaluate(joints={"nope": joint})
+    with pytest.raises(InvalidValueError, match="same points"):
+        prepared.evaluate(sensors={"acc": Sensor("acc", "tool.base", "1 g")})
