@@ -1,0 +1,543 @@
+"""Inverse identification of a joint's stiffness and damping from FRFs, for any joint.
+
+Two methods, meant to be used together:
+
+* :func:`closed_form` is thesis eq. 2.3 generalised to any joint of any
+  assembly: with the receptances of the two sides of the joint (measured,
+  modelled or mixed) and the coupled receptance measured at a point of one
+  side, the joint's complex stiffness matrix at every frequency line,
+  ``K = [ [T12^-1 (T11 - Y_c) T21^-1]^-1 - T22 - Y_A ]^-1``.  Exact on exact
+  data; very sensitive to noise, because of its four 2x2 inversions, whose
+  condition numbers it reports.
+* :class:`JointIdentifier` is the robust method the thesis asks for as
+  future work: constant ``k`` and ``c`` fitted by least squares to the
+  measured translational FRFs directly, over the band where the joint is
+  observable (the mode it dominates, found from the model's sensitivity to
+  the joint), with standard deviations from the fit's Jacobian (and
+  optionally a bootstrap over the residuals).  No noisy matrix inversion
+  drives the result.
+
+Both take an :class:`~substructure.assembly.Assembly` in which the joint is
+named, and so work for the holder-tool joint, the spindle-holder joint or any
+joint of any topology that separates the assembly in two (a bridge).
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Mapping, Sequence
+
+import attrs
+import numpy as np
+from scipy.optimize import least_squares
+
+from . import _blocks as bk
+from .assembly import Assembly
+from .errors import AssemblyError, IllConditionedWarning, InvalidValueError, NonPassiveJointWarning
+from .frf import FRF, Frequency
+from .joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint
+from .points import DOFS, parse_point
+
+__all__ = ["ClosedFormResult", "closed_form", "joint_sides", "JointIdentifier", "PARAMETERS"]
+
+PARAMETERS = ("k_yf", "k_ym", "k_tm", "c_yf", "c_ym", "c_tm")
+"""Names of the joint parameters (``k_ym`` stands for ``k_ym = k_tf``)."""
+
+_ENTRY = {"yf": (0, 0), "ym": (0, 1), "tf": (1, 0), "tm": (1, 1)}
+COND_WARN = 1e8
+"""Condition numbers above this make the closed-form result meaningless at that line."""
+
+
+def _cond2(a: np.ndarray) -> np.ndarray:
+    """2-norm condition numbers of 2x2 stacks ``(2, 2, n)``."""
+    fro2 = (np.abs(a) ** 2).sum(axis=(0, 1))
+    det = np.abs(a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        root = np.sqrt(np.maximum(fro2**2 - 4 * det**2, 0.0))
+        return np.where(det > 0, (fro2 + root) / (2 * det), np.inf)
+
+
+@attrs.frozen
+class ClosedFormResult:
+    """The joint's complex stiffness at every frequency line (thesis eq. 2.3).
+
+    Attributes
+    ----------
+    frequency : Frequency
+    stiffness : ndarray, shape (n_freq, 2, 2)
+        ``K = k + i omega c``, entries ``[[yf, ym], [tf, tm]]``.
+    condition : dict of str to ndarray
+        2-norm condition numbers of the inverted matrices per line: ``"T12"``,
+        ``"T21"``, ``"W"`` (``T12^-1 (T11 - Y_c) T21^-1``) and ``"K_inv"``.
+    """
+
+    frequency: Frequency
+    stiffness: np.ndarray = attrs.field(eq=attrs.cmp_using(eq=np.array_equal))
+    condition: dict = attrs.field(eq=False)
+
+    def parameter(self, name: str) -> np.ndarray:
+        """``k_yf``, ``k_ym``, ``k_tf``, ``k_tm``, ``c_...`` at every line (SI)."""
+        kind, entry = name.split("_", 1)
+        if kind not in ("k", "c") or entry not in _ENTRY:
+            raise InvalidValueError(f"parameter: got {name!r}; expected k_/c_ with yf, ym, tf or tm")
+        i, j = _ENTRY[entry]
+        k = self.stiffness[:, i, j]
+        return k.real if kind == "k" else k.imag / self.frequency.omega
+
+    def ill_conditioned(self, limit: float = COND_WARN) -> np.ndarray:
+        """Lines where an inversion's condition number exceeds ``limit``."""
+        worst = np.max(np.vstack(list(self.condition.values())), axis=0)
+        return ~(worst <= limit)
+
+    def band_mean(self, name: str, band) -> float:
+        """Mean of a parameter over a band ``(lo, hi)`` in Hz (the thesis's reading of its plots)."""
+        mask = self.frequency.band_mask(*band)
+        return float(np.mean(self.parameter(name)[mask]))
+
+    def plot(self, names=("k_yf", "c_yf"), band=None, fitted=None, ax=None):
+        """The frequency-dependent parameters, the chosen band and fitted constants."""
+        from .plot import plot_identification
+
+        return plot_identification(self, names=names, band=band, fitted=fitted, ax=ax)
+
+
+def closed_form(coupled: FRF, side_a: FRF, side_b: FRF, *, at: str, at_a: str, at_b: str,
+                warn: bool = True) -> ClosedFormResult:
+    """Joint stiffness from the coupled and the two sides' receptances (thesis eq. 2.3).
+
+    Parameters
+    ----------
+    coupled : FRF
+        Receptances of the coupled assembly containing the 2x2 point matrix at
+        ``at`` (a point of side B), e.g. ``[[H, L], [N, P]]`` at the tool tip.
+    side_a : FRF
+        Receptances of side A alone containing the 2x2 point matrix at its
+        joint point ``at_a`` (e.g. the spindle-holder at the holder tip).
+    side_b : FRF
+        Receptances of side B alone containing the points ``at`` and ``at_b``
+        (e.g. the free-free tool at its tip and base); ``at`` may equal ``at_b``.
+    at, at_a, at_b : str
+        Point names (without DOF suffix).
+    warn : bool
+        Warn where an inversion is so ill-conditioned that the result is
+        meaningless (condition number above :data:`COND_WARN`).
+
+    Returns
+    -------
+    ClosedFormResult
+    """
+    freq = coupled.frequency
+    for name, frf in (("side_a", side_a), ("side_b", side_b)):
+        if frf.frequency != freq:
+            raise InvalidValueError(
+                f"{name}: on another frequency axis than the coupled receptances; interpolate first"
+            )
+
+    def block(frf: FRF, row: str, col: str, what: str) -> np.ndarray:
+        outs = [f"{row}:{d}" for d in DOFS]
+        ins = [f"{col}:{d}" for d in DOFS]
+        missing = [lbl for lbl in outs if lbl not in frf.outputs] + [lbl for lbl in ins if lbl not in frf.inputs]
+        if missing:
+            raise InvalidValueError(
+                f"closed_form: {what} lacks {', '.join(dict.fromkeys(missing))}; the closed form needs "
+                "y and theta at the points (estimate rotations by finite differences: substructure.rdof)"
+            )
+        return np.moveaxis(frf.select(outs, ins).data, 0, -1)
+
+    t11 = block(side_b, at, at, "side_b")
+    t12 = block(side_b, at, at_b, "side_b")
+    t21 = block(side_b, at_b, at, "side_b")
+    t22 = block(side_b, at_b, at_b, "side_b")
+    ya = block(side_a, at_a, at_a, "side_a")
+    yc = block(coupled, at, at, "coupled")
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        w = bk.mul2(bk.inv2(t12), bk.mul2(t11 - yc, bk.inv2(t21)))
+        k_inv = bk.inv2(w) - t22 - ya
+        k = bk.inv2(k_inv)
+        condition = {"T12": _cond2(t12), "T21": _cond2(t21), "W": _cond2(w), "K_inv": _cond2(k_inv)}
+    result = ClosedFormResult(freq, np.moveaxis(k, -1, 0), condition)
+    bad = result.ill_conditioned()
+    if warn and np.any(bad):
+        f = freq.hz[bad]
+        warnings.warn(
+            f"closed form: {bad.sum()} of {bad.size} lines ({f.min():.0f}-{f.max():.0f} Hz) have an "
+            f"inversion with condition number above {COND_WARN:.0e}; the joint values there are meaningless",
+            IllConditionedWarning,
+            stacklevel=2,
+        )
+    return result
+
+
+def joint_sides(assembly: Assembly, joint: str) -> tuple[Assembly, Assembly, str, str]:
+    """The two sides of an assembly cut at a joint: ``(side_a, side_b, at_a, at_b)``.
+
+    ``side_a`` holds the joint's first point (``between[0]``), ``side_b`` the
+    second.  The joint must separate the assembly in two (a bridge of the
+    graph); the joints, sensors and supports of each side stay with it.
+    """
+    j = assembly.joint(joint)
+    rest = [x for x in assembly.joints if x.name != joint]
+    owner = {}
+    for comp in assembly.components:
+        for name in comp.component_names:
+            owner[name] = comp.name
+    adjacency: dict[str, set] = {c.name: set() for c in assembly.components}
+    for x in rest:
+        a, b = (owner[parse_point(p).component] for p in x.between)
+        adjacency[a].add(b)
+        adjacency[b].add(a)
+    start = owner[parse_point(j.between[0]).component]
+    seen, stack = {start}, [start]
+    while stack:
+        for nxt in adjacency[stack.pop()]:
+            if nxt not in seen:
+                seen.add(nxt)
+                stack.append(nxt)
+    other = owner[parse_point(j.between[1]).component]
+    if other in seen:
+        raise AssemblyError(
+            f"joint {joint!r} does not separate the assembly in two (the components stay connected "
+            "through other joints), so the closed form of thesis eq. 2.3 does not apply; use the band fit"
+        )
+    base = attrs.evolve(assembly, joints=tuple(rest))
+    a_side = base.without(*[c.name for c in assembly.components if c.name not in seen])
+    b_side = base.without(*[c.name for c in assembly.components if c.name in seen])
+    return a_side, b_side, j.between[0], j.between[1]
+
+
+# ---------------------------------------------------------------------------
+# Robust band identification
+
+
+def _configuration(assembly: Assembly, measurement) -> Assembly:
+    """The model of the structure as it was measured: removed components, sensors on."""
+    removed = tuple(getattr(measurement, "removed", ()) or ())
+    sensors = tuple(getattr(measurement, "sensors", ()) or ())
+    model = assembly.without(*removed) if removed else assembly
+    on = [assembly.sensor(name) for name in sensors]
+    return model.without_sensors().attach(*on)
+
+
+def _frf_of(measurement) -> FRF:
+    frf = measurement if isinstance(measurement, FRF) else measurement.frf
+    if not isinstance(frf, FRF):
+        raise InvalidValueError(f"measurements: got {measurement!r}; expected FRFs or measurements with .frf")
+    return frf.to_receptance()
+
+
+def _set_parameter(k: dict, c: dict, name: str, value: float) -> None:
+    kind, entry = name.split("_", 1)
+    target, units = (k, STIFFNESS_UNITS) if kind == "k" else (c, DAMPING_UNITS)
+    entries = ("ym", "tf") if entry == "ym" else (entry,)
+    for e in entries:
+        target[e] = f"{float(value)!r} {units[e]}"
+
+
+@attrs.frozen
+class _MatrixJoint:
+    """A joint given by SI matrices, for fast model evaluations inside fits."""
+
+    name: str
+    between: tuple[str, str]
+    k: np.ndarray
+    c: np.ndarray
+    rigid: bool = False
+
+    @classmethod
+    def from_values(cls, template, values: Mapping[str, float]) -> "_MatrixJoint":
+        k = np.array([[values["k_yf"], values["k_ym"]], [values["k_ym"], values["k_tm"]]], dtype=float)
+        c = np.array([[values["c_yf"], values["c_ym"]], [values["c_ym"], values["c_tm"]]], dtype=float)
+        return cls(template.name, tuple(template.between), k, c)
+
+    def dynamic_stiffness(self, frequency_hz: np.ndarray) -> np.ndarray:
+        omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
+        return self.k[:, :, None] + 1j * omega * self.c[:, :, None]
+
+
+def _joint_values(joint: Joint) -> dict[str, float]:
+    return {
+        name: (joint.k if name[0] == "k" else joint.c).get(name.split("_", 1)[1])
+        for name in PARAMETERS
+    }
+
+
+def auto_band(prepared, joint: Joint, parameter: str = "k_yf", factor: float = 1.2) -> tuple[float, float]:
+    """The band of the mode the joint dominates, from the model's sensitivity to it.
+
+    The model FRF is computed with the joint's ``parameter`` as given and
+    multiplied by ``factor``; the resonance whose frequency moves most
+    (relatively) is the joint's mode, and the band runs between the minima
+    of ``|H|`` on either side of it, within 0.7 to 1.3 times its frequency.
+    """
+    base = prepared.evaluate()
+    values = _joint_values(joint)
+    k, c = joint.k.as_dict(), joint.c.as_dict()
+    _set_parameter(k, c, parameter, values[parameter] * factor)
+    stiffer = prepared.evaluate(joints={joint.name: attrs.evolve(joint, k=k, c=c)})
+    f = base.frequency.hz
+    h0 = np.abs(base.data[:, 0, 0])
+    h1 = np.abs(stiffer.data[:, 0, 0])
+    peaks = base.peaks(base.outputs[0], base.inputs[0])
+    if peaks.size == 0:
+        raise InvalidValueError("band: the model FRF has no resonance on the grid; give the band explicitly")
+    shifts = []
+    for p in peaks:
+        window = (f > 0.8 * p) & (f < 1.25 * p)
+        f1 = f[window][np.argmax(h1[window])]
+        shifts.append(abs(f1 - p) / p)
+    peak = peaks[int(np.argmax(shifts))]
+    i = int(np.searchsorted(f, peak))
+    lo = i
+    while lo > 0 and h0[lo - 1] <= h0[lo] and f[lo - 1] > 0.7 * peak:
+        lo -= 1
+    hi = i
+    while hi < f.size - 1 and h0[hi + 1] <= h0[hi] and f[hi + 1] < 1.3 * peak:
+        hi += 1
+    return float(f[lo]), float(f[hi])
+
+
+class JointIdentifier:
+    """Constant joint stiffness and damping fitted to measured FRFs over a band.
+
+    Parameters
+    ----------
+    joint : str
+        Name of the joint in the assembly.
+    parameters : sequence of str
+        Which of :data:`PARAMETERS` to fit; the others keep the assembly's
+        values.  Default: ``k_yf``, ``k_tm``, ``c_yf``, ``c_tm`` (the diagonal
+        joint of thesis eq. 2.4); add ``k_ym`` (= ``k_tf``) and ``c_ym`` for the
+        fully populated joint of eq. 2.5.
+    band : "auto" or (lo, hi)
+        Frequency band in Hz; ``"auto"``: the mode the joint dominates
+        (:func:`auto_band`).
+    bootstrap : int
+        Number of bootstrap refits over the residuals (0: standard
+        deviations from the Jacobian only).
+    random_state : int
+        Seed of the bootstrap.
+    initial : mapping, optional
+        Starting values (SI) for parameters the assembly gives as 0 or rigid.
+
+    Attributes
+    ----------
+    joint_ : Joint
+        The fitted joint.
+    values_, std_ : dict of str to float
+        Fitted parameters and their standard deviations (SI units).
+    band_ : (float, float)
+    cost_ : float
+        Final sum of squared relative residuals.
+    residual_rms_ : float
+        RMS of the relative complex residual over the band.
+    warnings_ : list of str
+        Passivity and reciprocity findings on the fitted joint.
+
+    Notes
+    -----
+    Residuals are ``(H_model - H_measured) / |H_measured|`` (real and
+    imaginary parts) at every line of the band for every measured FRF of a
+    configuration in which the joint exists, so that multiplicative noise is
+    weighted evenly.  Positive parameters are fitted as logarithms; the
+    standard deviations come from ``s^2 (J^T J)^-1`` with ``s^2`` the residual
+    variance, mapped back by the delta method.
+    """
+
+    def __init__(self, joint: str, parameters: Sequence[str] = ("k_yf", "k_tm", "c_yf", "c_tm"),
+                 band="auto", bootstrap: int = 0, random_state: int = 0, initial: Mapping | None = None):
+        self.joint = joint
+        self.parameters = tuple(parameters)
+        self.band = band
+        self.bootstrap = bootstrap
+        self.random_state = random_state
+        self.initial = dict(initial or {})
+
+    # -- helpers -----------------------------------------------------------------
+
+    def _check(self) -> None:
+        unknown = [p for p in self.parameters if p not in PARAMETERS]
+        if unknown or not self.parameters:
+            raise InvalidValueError(
+                f"parameters: got {list(self.parameters)}; expected some of {', '.join(PARAMETERS)}"
+            )
+        if not (isinstance(self.bootstrap, int) and self.bootstrap >= 0):
+            raise InvalidValueError(f"bootstrap: got {self.bootstrap!r}; expected an integer >= 0")
+
+    def _joint(self, template: Joint, values: Mapping[str, float]) -> Joint:
+        k, c = template.k.as_dict() if not template.rigid else {}, template.c.as_dict() if not template.rigid else {}
+        for name, value in values.items():
+            _set_parameter(k, c, name, value)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", (NonPassiveJointWarning,))
+            return Joint(template.name, template.between, k=k, c=c)
+
+    def fit(self, assembly: Assembly, measurements: Sequence) -> "JointIdentifier":
+        """Fit the joint to the measurements; returns ``self``.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model, with the joint to identify (its values are the start).
+        measurements : sequence of FRF or measurement objects
+            Each an FRF of measured receptances (translational ``:y`` labels,
+            as tapped) or an object with ``.frf``, ``.sensors`` (names of the
+            assembly's sensors that were on) and ``.removed`` (components taken
+            off); those in which the joint is removed are skipped.
+        """
+        self._check()
+        template = assembly.joint(self.joint)
+        nominal = _joint_values(template) if not template.rigid else {p: 0.0 for p in PARAMETERS}
+        nominal.update(self.initial)
+        missing = [p for p in self.parameters if p in ("k_yf", "k_tm", "c_yf", "c_tm") and nominal[p] <= 0]
+        if missing:
+            raise InvalidValueError(
+                f"initial: the assembly gives no starting value for {', '.join(missing)} of joint "
+                f"{self.joint!r}; pass initial={{...}} in SI units"
+            )
+        cases = []
+        for m in measurements:
+            removed = set(getattr(m, "removed", ()) or ())
+            points = [parse_point(p).component for p in template.between]
+            if any(any(pt in assembly.component(r).component_names for pt in points) for r in removed):
+                continue
+            frf = _frf_of(m)
+            prepared = _configuration(assembly, m).prepare(list(frf.outputs), list(frf.inputs), frf.frequency)
+            cases.append((prepared, frf))
+        if not cases:
+            raise InvalidValueError(
+                f"measurements: none was taken with joint {self.joint!r} in place; the fit needs at least one"
+            )
+        auto = self.band == "auto"
+        if auto:
+            band = auto_band(cases[0][0], self._joint(template, nominal))
+        else:
+            try:
+                lo, hi = (float(x) for x in self.band)
+            except (TypeError, ValueError):
+                raise InvalidValueError(f"band: got {self.band!r}; expected 'auto' or (lo, hi) in Hz") from None
+            if not lo < hi:
+                raise InvalidValueError(f"band: got {self.band!r}; expected lo < hi")
+            band = (lo, hi)
+        for attempt in range(2 if auto else 1):
+            fit, data, values, positive, start, linear_scale, bounds, x0, residual = self._fit_band(
+                template, nominal, cases, band
+            )
+            if not auto:
+                break
+            # The band came from the starting model; once fitted, look again.
+            new_band = auto_band(cases[0][0], self._joint(template, values(fit.x)))
+            if abs(new_band[0] - band[0]) + abs(new_band[1] - band[1]) < 0.02 * (band[1] - band[0]):
+                break
+            band = new_band
+        m, n = fit.fun.size, fit.x.size
+        s2 = float(np.sum(fit.fun**2)) / max(m - n, 1)
+        jtj = fit.jac.T @ fit.jac
+        cov = s2 * np.linalg.pinv(jtj)
+        best = values(fit.x)
+        std = {}
+        for name, pos, var in zip(self.parameters, positive, np.diag(cov)):
+            sd = float(np.sqrt(max(var, 0.0)))
+            std[name] = best[name] * sd if pos else sd * linear_scale[name]
+        if self.bootstrap:
+            std = self._bootstrap(template, data, fit, residual, values, bounds, x0, std)
+        self.joint_ = self._joint(template, best)
+        self.values_ = {p: float(best[p]) for p in self.parameters}
+        self.std_ = std
+        self.band_ = band
+        self.cost_ = float(np.sum(fit.fun**2))
+        self.residual_rms_ = float(np.sqrt(np.mean(fit.fun**2) * 2))
+        self.warnings_ = _passivity(self.joint_)
+        self.n_lines_ = int(sum(d[1].shape[0] for d in data))
+        return self
+
+    def _fit_band(self, template, nominal, cases, band):
+        data = []
+        for prepared, frf in cases:
+            mask = frf.frequency.band_mask(*band)
+            if mask.sum() < len(self.parameters) + 2:
+                raise InvalidValueError(
+                    f"band: {band[0]:.0f}-{band[1]:.0f} Hz holds {int(mask.sum())} lines of the data "
+                    f"({frf.frequency.start:.0f}-{frf.frequency.stop:.0f} Hz); too few to fit"
+                )
+            sub = prepared.frequency.crop(*band)
+            small = type(prepared)(prepared.assembly, _points(frf.outputs), _points(frf.inputs), sub)
+            data.append((small, frf.data[mask]))
+
+        positive = [p not in ("k_ym", "c_ym") for p in self.parameters]
+        start = np.array([nominal[p] for p in self.parameters], dtype=float)
+        linear_scale = {
+            "k_ym": max(abs(nominal["k_yf"] * nominal["k_tm"]) ** 0.5, 1.0),
+            "c_ym": max(abs(nominal["c_yf"] * nominal["c_tm"]) ** 0.5, 1e-6),
+        }
+
+        def values(x):
+            out = dict(nominal)
+            for name, xi, pos, s0 in zip(self.parameters, x, positive, start):
+                out[name] = s0 * np.exp(xi) if pos else s0 + xi * linear_scale[name]
+            return out
+
+        def residual(x, data=data):
+            joint = _MatrixJoint.from_values(template, values(x))
+            parts = []
+            for prepared, measured in data:
+                model = prepared.evaluate(joints={self.joint: joint}).data
+                r = (model - measured) / np.abs(measured)
+                parts.append(r.real.ravel())
+                parts.append(r.imag.ravel())
+            return np.concatenate(parts)
+
+        # A scan over the main stiffness first (one decade either way), against
+        # local minima; then bounded least squares: positive parameters within a
+        # factor 100 of their start, linear ones within +-10 scales.
+        x0 = np.zeros(len(self.parameters))
+        if "k_yf" in self.parameters:
+            i = self.parameters.index("k_yf")
+            trial = []
+            for factor in np.geomspace(0.1, 10.0, 41):
+                x = x0.copy()
+                x[i] = np.log(factor)
+                trial.append((float(np.sum(residual(x) ** 2)), factor))
+            x0[i] = np.log(min(trial)[1])
+        limit = np.where(positive, np.log(100.0), 10.0)
+        bounds = (x0 - limit, x0 + limit)
+        fit = least_squares(residual, x0, bounds=bounds, method="trf", x_scale=1.0, max_nfev=200 * len(x0))
+        return fit, data, values, positive, start, linear_scale, bounds, x0, residual
+
+    def _bootstrap(self, template, data, fit, residual, values, bounds, x0, std):
+        """Standard deviations from refits on the model plus resampled relative residuals."""
+        rng = np.random.default_rng(self.random_state)
+        best = values(fit.x)
+        joint = _MatrixJoint.from_values(template, best)
+        model_data = [prepared.evaluate(joints={self.joint: joint}).data for prepared, _ in data]
+        rel = [(meas - mod) / np.abs(meas) for (_, meas), mod in zip(data, model_data)]
+        samples = []
+        for _ in range(self.bootstrap):
+            boot = []
+            for (prepared, _), mod, r in zip(data, model_data, rel):
+                flat = r.ravel()
+                pick = flat[rng.integers(0, flat.size, flat.size)].reshape(r.shape)
+                boot.append((prepared, mod * (1 + pick)))
+            refit = least_squares(lambda x: residual(x, boot), fit.x, bounds=bounds, method="trf",
+                                  x_scale=1.0, max_nfev=50 * len(x0))
+            samples.append([values(refit.x)[p] for p in self.parameters])
+        spread = np.std(np.array(samples), axis=0, ddof=1)
+        return {p: float(max(std[p], s)) for p, s in zip(self.parameters, spread)}
+
+    def predict(self, assembly: Assembly, outputs, inputs=None, frequency=None) -> FRF:
+        """The assembly's FRF with the fitted joint."""
+        return assembly.with_joint(self.joint_).frf(outputs, inputs, frequency)
+
+
+def _points(labels) -> list[str]:
+    return list(labels)
+
+
+def _passivity(joint: Joint) -> list[str]:
+    notes = []
+    for name, m in (("k", joint.k.values), ("c", joint.c.values)):
+        if m[0, 1] != m[1, 0]:
+            notes.append(f"{name} is not symmetric ({name}_ym != {name}_tf)")
+        det = m[0, 0] * m[1, 1] - m[0, 1] * m[1, 0]
+        if m[0, 0] < 0 or m[1, 1] < 0 or det < 0:
+            notes.append(f"{name} is not positive semi-definite: the joint is not passive")
+    return notes

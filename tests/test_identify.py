@@ -1,0 +1,116 @@
+"""Joint identification: the closed form (thesis eq. 2.3) and the robust band fit."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+from conftest import make_assembly, make_holder, make_spindle, make_tool, thesis_joints
+from substructure import (
+    FRF,
+    Assembly,
+    AssemblyError,
+    Frequency,
+    InvalidValueError,
+    Joint,
+    Segment,
+    Tool,
+    default_assembly,
+)
+from substructure.identify import JointIdentifier, closed_form, joint_sides
+
+GRID = Frequency.from_range("20 Hz", "5000 Hz", "5 Hz")
+
+
+def _closed_form_on_model(assembly, joint, at):
+    side_a, side_b, at_a, at_b = joint_sides(assembly, joint)
+    coupled = assembly.receptance(at, frequency=GRID)
+    ya = side_a.receptance(at_a, frequency=GRID)
+    yb = side_b.frf([at, at_b] if at != at_b else [at], frequency=GRID)
+    return closed_form(coupled, ya, yb, at=at, at_a=at_a, at_b=at_b)
+
+
+def _check_recovers(result, joint, rtol=1e-6):
+    for name in ("k_yf", "k_ym", "k_tf", "k_tm", "c_yf", "c_ym", "c_tf", "c_tm"):
+        kind, entry = name.split("_")
+        expected = (joint.k if kind == "k" else joint.c).get(entry)
+        got = result.parameter(name)
+        if expected == 0:
+            scale = max(abs((joint.k if kind == "k" else joint.c).get(e)) for e in ("yf", "tm"))
+            assert np.abs(got).max() <= rtol * scale, name
+        else:
+            np.testing.assert_allclose(got, expected, rtol=rtol, err_msg=name)
+
+
+def test_closed_form_recovers_table_2_2_at_every_line(assembly):
+    """Noise-free data from the forward model: every parameter of Table 2.2 to 1e-6."""
+    result = _closed_form_on_model(assembly, "holder-tool", "tool.tip")
+    _check_recovers(result, assembly.joint("holder-tool"))
+    assert set(result.condition) == {"T12", "T21", "W", "K_inv"}
+
+
+def test_closed_form_recovers_the_spindle_holder_joint(assembly):
+    """The same for the spindle-holder joint (Table 2.1), measuring at the holder tip."""
+    result = _closed_form_on_model(assembly.without("tool"), "spindle-holder", "holder.tip")
+    _check_recovers(result, assembly.joint("spindle-holder"))
+
+
+def test_closed_form_in_another_topology():
+    """A branch: two tools on one holder; identify one tool's joint, measuring at its tip."""
+    holder = make_holder()
+    a = Tool("a", [Segment("50 mm", "12 mm", material="carbide")])
+    b = Tool("b", [Segment("40 mm", "10 mm", material="carbide")])
+    ja = Joint("ja", ("holder.tip", "a.base"), k={"yf": "3e7 N/m", "ym": "1e5 N", "tf": "1e5 N/rad", "tm": "5e4 N*m/rad"},
+               c={"yf": "40 N*s/m", "tm": "2 N*m*s/rad"})
+    jb = Joint("jb", ("holder@30 mm", "b.base"), k={"yf": "2e7 N/m", "tm": "4e4 N*m/rad"}, c={"yf": "20 N*s/m"})
+    asm = Assembly("branch", components=(holder, a, b), joints=(ja, jb))
+    _check_recovers(_closed_form_on_model(asm, "ja", "a.tip"), ja)
+    # measuring at the joint point itself (T11 = T12 = T22)
+    _check_recovers(_closed_form_on_model(asm, "jb", "b.base"), jb, rtol=1e-5)
+
+
+def test_closed_form_errors(assembly):
+    loop = assembly.connect("spindle@100 mm", "tool@30 mm", name="brace", k={"yf": "1e6 N/m"})
+    with pytest.raises(AssemblyError, match="does not separate"):
+        joint_sides(loop, "holder-tool")
+    side_a, side_b, at_a, at_b = joint_sides(assembly, "holder-tool")
+    coupled = assembly.receptance("tool.tip:y", frequency=GRID)
+    with pytest.raises(InvalidValueError, match="lacks tool.tip:theta"):
+        closed_form(coupled, side_a.receptance(at_a, frequency=GRID), side_b.frf(["tool.tip", at_b], frequency=GRID),
+                    at="tool.tip", at_a=at_a, at_b=at_b)
+
+
+def _noisy(frf, level, seed):
+    rng = np.random.default_rng(seed)
+    noise = (rng.standard_normal(frf.data.shape) + 1j * rng.standard_normal(frf.data.shape)) / np.sqrt(2)
+    return FRF(frf.frequency, frf.data * (1 + level * noise), frf.outputs, frf.inputs)
+
+
+def test_band_fit_recovers_a_passive_joint_from_noisy_tool_point_data():
+    asm = default_assembly()
+    truth = asm.joint("holder-tool")
+    h = asm.receptance("tool.tip:y", frequency=Frequency.from_range("20 Hz", "5000 Hz", "2 Hz"))
+    start = asm.with_joint(truth.with_parameters(k={"yf": "0.6e7 N/m", "tm": "2e5 N*m/rad"},
+                                                 c={"yf": "30 N*s/m", "tm": "1 N*m*s/rad"}))
+    within = 0
+    for seed in range(6):
+        ident = JointIdentifier("holder-tool").fit(start, [_noisy(h, 0.02, seed)])
+        assert ident.values_["k_yf"] == pytest.approx(1.43e7, rel=0.02)
+        assert ident.values_["c_yf"] == pytest.approx(12.0, rel=0.1)
+        errors = [abs(ident.values_[p] - v) / ident.std_[p] for p, v in
+                  (("k_yf", 1.43e7), ("k_tm", 8e4), ("c_yf", 12.0), ("c_tm", 4.0))]
+        within += all(e < 3 for e in errors)
+        assert 0.015 < ident.residual_rms_ < 0.025  # the 2 % noise, not model error
+    assert within >= 5
+    assert ident.warnings_ == []
+
+
+def test_band_fit_errors():
+    asm = default_assembly()
+    h = asm.receptance("tool.tip:y", frequency=Frequency.from_range("1000 Hz", "1100 Hz", "50 Hz"))
+    with pytest.raises(InvalidValueError, match="parameters"):
+        JointIdentifier("holder-tool", parameters=("k_xx",)).fit(asm, [h])
+    with pytest.raises(InvalidValueError, match="too few"):
+        JointIdentifier("holder-tool", band=(1000, 1100)).fit(asm, [h])
+    with pytest.raises(InvalidValueError, match="lo < hi"):
+        JointIdentifier("holder-tool", band=(2000, 1000)).fit(asm, [h])
