@@ -94,11 +94,11 @@ class ClosedFormResult:
         mask = self.frequency.band_mask(*band)
         return float(np.mean(self.parameter(name)[mask]))
 
-    def plot(self, names=("k_yf", "c_yf"), band=None, fitted=None, ax=None):
+    def plot(self, names=("k_yf", "c_yf"), band=None, fitted=None, ax=None, measured=None):
         """The frequency-dependent parameters, the chosen band and fitted constants."""
         from .plot import plot_identification
 
-        return plot_identification(self, names=names, band=band, fitted=fitted, ax=ax)
+        return plot_identification(self, names=names, band=band, fitted=fitted, ax=ax, measured=measured)
 
 
 def closed_form(coupled: FRF, side_a: FRF, side_b: FRF, *, at: str, at_a: str, at_b: str,

@@ -20,7 +20,7 @@ from matplotlib.figure import Figure
 from .errors import InvalidValueError
 from .frf import FRF
 
-__all__ = ["plot_frf"]
+__all__ = ["plot_frf", "plot_identification"]
 
 PARTS = ("magnitude", "phase", "real", "imag")
 
@@ -116,3 +116,64 @@ def plot_frf(
     if any(line.get_label() and not line.get_label().startswith("_") for line in axes[0].lines):
         axes[0].legend(fontsize="small")
     return axes[0].figure
+
+
+_UNITS = {"k_yf": "N/m", "k_ym": "N", "k_tf": "N/rad", "k_tm": "N m/rad",
+          "c_yf": "N s/m", "c_ym": "N s", "c_tf": "N s/rad", "c_tm": "N m s/rad"}
+
+
+def plot_identification(result, names=("k_yf", "c_yf"), band=None, fitted=None, ax=None,
+                        measured: FRF | None = None) -> Figure:
+    """Closed-form joint parameters against frequency, with the band and fitted constants.
+
+    Parameters
+    ----------
+    result : substructure.identify.ClosedFormResult
+    names : sequence of str
+        Parameters to draw, one panel each.
+    band : (lo, hi), optional
+        Shaded band (the one the fit used).
+    fitted : mapping, optional
+        Fitted constant values (SI) drawn as horizontal lines, with
+        ``fitted[name + "_std"]`` as a shaded one-sigma strip when given.
+    measured : FRF, optional
+        A measured point FRF drawn on a second axis of each panel, as the
+        thesis's figures 2.8-2.9 do, to show where the modes are.
+    """
+    names = list(names)
+    if ax is None:
+        fig, axes = plt.subplots(len(names), 1, sharex=True, squeeze=False,
+                                 figsize=(7.0, 1.5 + 2.2 * len(names)), layout="constrained")
+        axes = list(axes[:, 0])
+    else:
+        axes = [ax] if isinstance(ax, Axes) else list(ax)
+        fig = axes[0].figure
+    f = result.frequency.hz
+    bad = result.ill_conditioned()
+    for a, name in zip(axes, names):
+        values = result.parameter(name)
+        a.plot(f, values, lw=0.8, color="0.35", label="closed form (eq. 2.3)")
+        if np.any(bad):
+            a.plot(f[bad], values[bad], ".", ms=2, color="tab:red", label="ill-conditioned lines")
+        if band is not None:
+            a.axvspan(*band, color="tab:green", alpha=0.12, label="fit band")
+            inside = result.frequency.band_mask(*band)
+            lo, hi = np.percentile(values[inside], [5, 95]) if inside.any() else (values.min(), values.max())
+            span = max(hi - lo, abs(hi) * 0.5, 1e-30)
+            a.set_ylim(lo - 2 * span, hi + 2 * span)
+        if fitted is not None and name in fitted:
+            v = fitted[name]
+            a.axhline(v, color="tab:blue", lw=1.5, label=f"band fit {v:.4g}")
+            sd = fitted.get(name + "_std")
+            if sd:
+                a.axhspan(v - sd, v + sd, color="tab:blue", alpha=0.15)
+        a.set_ylabel(f"{name} [{_UNITS.get(name, '')}]")
+        a.grid(True, alpha=0.3)
+        if measured is not None:
+            twin = a.twinx()
+            twin.semilogy(measured.frequency.hz, np.abs(measured.data[:, 0, 0]), color="tab:orange", lw=0.6,
+                          alpha=0.7)
+            twin.set_ylabel("|H| [m/N]", color="tab:orange")
+    axes[0].legend(loc="best", fontsize="small")
+    axes[-1].set_xlabel("frequency [Hz]")
+    return fig
