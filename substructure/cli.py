@@ -237,6 +237,61 @@ def _run_demo(args: argparse.Namespace) -> int:
     return 0
 
 
+# -- identify -------------------------------------------------------------------------
+
+
+def _band(text: str):
+    if text == "auto":
+        return "auto"
+    parts = text.split(":")
+    try:
+        lo, hi = (float(p) for p in parts)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"got {text!r}; expected auto or LO:HI in Hz, e.g. 1200:1700") from None
+    if not lo < hi:
+        raise argparse.ArgumentTypeError(f"got {text!r}; expected LO < HI")
+    return (lo, hi)
+
+
+def _run_identify(args: argparse.Namespace) -> int:
+    from .identify import identify_joint
+    from .io.measurements import load_measurements
+
+    assembly = load_assembly(args.assembly)
+    measurements = load_measurements(args.measurements)
+    parameters = tuple(p.strip() for p in args.parameters.split(",") if p.strip())
+    report = identify_joint(assembly, measurements, args.joint, band=args.band, parameters=parameters,
+                            bootstrap=args.bootstrap)
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        fig = report.plot()
+        try:
+            fig.savefig(args.plot, dpi=120)
+        finally:
+            plt.close(fig)
+    if args.json:
+        print(json.dumps(report.to_json()))
+        return 0
+    lo, hi = report.band
+    print(f"joint {report.joint!r} of {assembly.name}")
+    print(f"band {lo:.0f}-{hi:.0f} Hz, {len(measurements)} measured FRFs, relative residual {report.residual_rms:.3f}")
+    units = {"k": ("N/m", "N", "N/rad", "N*m/rad"), "c": ("N*s/m", "N*s", "N*s/rad", "N*m*s/rad")}
+    for kind, values, stds in (("k", report.k, report.k_std), ("c", report.c, report.c_std)):
+        for (entry, value), unit in zip(values.items(), units[kind]):
+            fitted = f"{kind}_{entry}" in report.fitted or (entry == "tf" and f"{kind}_ym" in report.fitted)
+            tail = f" +- {stds[entry]:.3g} {unit}" if fitted else f" {unit} (kept from the model)"
+            print(f"  {kind}_{entry} = {value:.4g}{tail}")
+    for note in report.warnings:
+        print(f"note: {note}")
+    if args.plot:
+        print(f"wrote {args.plot}")
+    return 0
+
+
 # -- entry point ----------------------------------------------------------------------
 
 
@@ -254,6 +309,19 @@ def _parser() -> _Parser:
     frf.add_argument("--plot", metavar="FILE.png", help="plot the FRF to an image file")
     frf.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
     frf.set_defaults(run=_run_frf)
+    ident = commands.add_parser("identify", help="identify a joint's stiffness and damping from measurements")
+    ident.add_argument("assembly", metavar="ASSEMBLY.toml", help="assembly file (formats.md)")
+    ident.add_argument("measurements", metavar="MEASUREMENTS.toml", help="measurement set (formats.md)")
+    ident.add_argument("--joint", required=True, metavar="NAME", help="name of the joint to identify")
+    ident.add_argument("--band", type=_band, default="auto", metavar="auto|LO:HI",
+                       help="frequency band in Hz (default auto: the mode the joint dominates)")
+    ident.add_argument("--parameters", default="k_yf,k_tm,c_yf,c_tm", metavar="NAMES",
+                       help="parameters to fit, of k_yf,k_ym,k_tm,c_yf,c_ym,c_tm (k_ym stands for k_ym = k_tf)")
+    ident.add_argument("--bootstrap", type=int, default=0, metavar="N",
+                       help="bootstrap refits for the standard deviations (default 0: from the Jacobian)")
+    ident.add_argument("--plot", metavar="FILE.png", help="plot the closed form, the band, the fit and the FRFs")
+    ident.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
+    ident.set_defaults(run=_run_identify)
     demo = commands.add_parser("demo", help="the workflow on the built-in assembly, with plots")
     demo.add_argument("--out", default="out/demo", metavar="DIR", help="output directory (default out/demo)")
     demo.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
@@ -309,7 +377,7 @@ def main(argv: list[str] | None = None) -> int:
             _load_plugins()
             args = _parser().parse_args(argv)
             if args.command is None:
-                raise _UsageError("choose a command: frf, demo (see substructure --help)")
+                raise _UsageError("choose a command: frf, identify, demo (see substructure --help)")
             return args.run(args)
         except _UsageError as exc:
             print(f"{PROG}: error: {_one_line(str(exc))}", file=sys.stderr)

@@ -1,25 +1,11 @@
-"""Inverse identification of a joint's stiffness and damping from FRFs, for any joint.
+"""Robust band identification: constant joint stiffness and damping fitted to measured FRFs.
 
-Two methods, meant to be used together:
-
-* :func:`closed_form` is thesis eq. 2.3 generalised to any joint of any
-  assembly: with the receptances of the two sides of the joint (measured,
-  modelled or mixed) and the coupled receptance measured at a point of one
-  side, the joint's complex stiffness matrix at every frequency line,
-  ``K = [ [T12^-1 (T11 - Y_c) T21^-1]^-1 - T22 - Y_A ]^-1``.  Exact on exact
-  data; very sensitive to noise, because of its four 2x2 inversions, whose
-  condition numbers it reports.
-* :class:`JointIdentifier` is the robust method the thesis asks for as
-  future work: constant ``k`` and ``c`` fitted by least squares to the
-  measured translational FRFs directly, over the band where the joint is
-  observable (the mode it dominates, found from the model's sensitivity to
-  the joint), with standard deviations from the fit's Jacobian (and
-  optionally a bootstrap over the residuals).  No noisy matrix inversion
-  drives the result.
-
-Both take an :class:`~substructure.assembly.Assembly` in which the joint is
-named, and so work for the holder-tool joint, the spindle-holder joint or any
-joint of any topology that separates the assembly in two (a bridge).
+The thesis's future work asks for an identification that no noisy matrix
+inversion drives.  :class:`JointIdentifier` fits constant ``k`` and ``c`` by
+least squares to the measured translational FRFs directly, over the band
+where the joint is observable (the mode it dominates, found from the model's
+sensitivity to the joint, :func:`auto_band`), with standard deviations from
+the fit's Jacobian and optionally a bootstrap over the residuals.
 """
 
 from __future__ import annotations
@@ -31,185 +17,16 @@ import attrs
 import numpy as np
 from scipy.optimize import least_squares
 
-from . import _blocks as bk
-from .assembly import Assembly
-from .errors import AssemblyError, IllConditionedWarning, InvalidValueError, NonPassiveJointWarning
-from .frf import FRF, Frequency
-from .joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint
-from .points import DOFS, parse_point
+from ..assembly import Assembly
+from ..errors import InvalidValueError, NonPassiveJointWarning
+from ..frf import FRF
+from ..joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint
+from ..points import parse_point
+from .closed_form import PARAMETERS
 
-__all__ = ["ClosedFormResult", "closed_form", "joint_sides", "JointIdentifier", "PARAMETERS"]
+__all__ = ["JointIdentifier", "auto_band", "model_of_measurement"]
 
-PARAMETERS = ("k_yf", "k_ym", "k_tm", "c_yf", "c_ym", "c_tm")
-"""Names of the joint parameters (``k_ym`` stands for ``k_ym = k_tf``)."""
-
-_ENTRY = {"yf": (0, 0), "ym": (0, 1), "tf": (1, 0), "tm": (1, 1)}
-COND_WARN = 1e8
-"""Condition numbers above this make the closed-form result meaningless at that line."""
-
-
-def _cond2(a: np.ndarray) -> np.ndarray:
-    """2-norm condition numbers of 2x2 stacks ``(2, 2, n)``."""
-    fro2 = (np.abs(a) ** 2).sum(axis=(0, 1))
-    det = np.abs(a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        root = np.sqrt(np.maximum(fro2**2 - 4 * det**2, 0.0))
-        return np.where(det > 0, (fro2 + root) / (2 * det), np.inf)
-
-
-@attrs.frozen
-class ClosedFormResult:
-    """The joint's complex stiffness at every frequency line (thesis eq. 2.3).
-
-    Attributes
-    ----------
-    frequency : Frequency
-    stiffness : ndarray, shape (n_freq, 2, 2)
-        ``K = k + i omega c``, entries ``[[yf, ym], [tf, tm]]``.
-    condition : dict of str to ndarray
-        2-norm condition numbers of the inverted matrices per line: ``"T12"``,
-        ``"T21"``, ``"W"`` (``T12^-1 (T11 - Y_c) T21^-1``) and ``"K_inv"``.
-    """
-
-    frequency: Frequency
-    stiffness: np.ndarray = attrs.field(eq=attrs.cmp_using(eq=np.array_equal))
-    condition: dict = attrs.field(eq=False)
-
-    def parameter(self, name: str) -> np.ndarray:
-        """``k_yf``, ``k_ym``, ``k_tf``, ``k_tm``, ``c_...`` at every line (SI)."""
-        kind, entry = name.split("_", 1)
-        if kind not in ("k", "c") or entry not in _ENTRY:
-            raise InvalidValueError(f"parameter: got {name!r}; expected k_/c_ with yf, ym, tf or tm")
-        i, j = _ENTRY[entry]
-        k = self.stiffness[:, i, j]
-        return k.real if kind == "k" else k.imag / self.frequency.omega
-
-    def ill_conditioned(self, limit: float = COND_WARN) -> np.ndarray:
-        """Lines where an inversion's condition number exceeds ``limit``."""
-        worst = np.max(np.vstack(list(self.condition.values())), axis=0)
-        return ~(worst <= limit)
-
-    def band_mean(self, name: str, band) -> float:
-        """Mean of a parameter over a band ``(lo, hi)`` in Hz (the thesis's reading of its plots)."""
-        mask = self.frequency.band_mask(*band)
-        return float(np.mean(self.parameter(name)[mask]))
-
-    def plot(self, names=("k_yf", "c_yf"), band=None, fitted=None, ax=None, measured=None):
-        """The frequency-dependent parameters, the chosen band and fitted constants."""
-        from .plot import plot_identification
-
-        return plot_identification(self, names=names, band=band, fitted=fitted, ax=ax, measured=measured)
-
-
-def closed_form(coupled: FRF, side_a: FRF, side_b: FRF, *, at: str, at_a: str, at_b: str,
-                warn: bool = True) -> ClosedFormResult:
-    """Joint stiffness from the coupled and the two sides' receptances (thesis eq. 2.3).
-
-    Parameters
-    ----------
-    coupled : FRF
-        Receptances of the coupled assembly containing the 2x2 point matrix at
-        ``at`` (a point of side B), e.g. ``[[H, L], [N, P]]`` at the tool tip.
-    side_a : FRF
-        Receptances of side A alone containing the 2x2 point matrix at its
-        joint point ``at_a`` (e.g. the spindle-holder at the holder tip).
-    side_b : FRF
-        Receptances of side B alone containing the points ``at`` and ``at_b``
-        (e.g. the free-free tool at its tip and base); ``at`` may equal ``at_b``.
-    at, at_a, at_b : str
-        Point names (without DOF suffix).
-    warn : bool
-        Warn where an inversion is so ill-conditioned that the result is
-        meaningless (condition number above :data:`COND_WARN`).
-
-    Returns
-    -------
-    ClosedFormResult
-    """
-    freq = coupled.frequency
-    for name, frf in (("side_a", side_a), ("side_b", side_b)):
-        if frf.frequency != freq:
-            raise InvalidValueError(
-                f"{name}: on another frequency axis than the coupled receptances; interpolate first"
-            )
-
-    def block(frf: FRF, row: str, col: str, what: str) -> np.ndarray:
-        outs = [f"{row}:{d}" for d in DOFS]
-        ins = [f"{col}:{d}" for d in DOFS]
-        missing = [lbl for lbl in outs if lbl not in frf.outputs] + [lbl for lbl in ins if lbl not in frf.inputs]
-        if missing:
-            raise InvalidValueError(
-                f"closed_form: {what} lacks {', '.join(dict.fromkeys(missing))}; the closed form needs "
-                "y and theta at the points (estimate rotations by finite differences: substructure.rdof)"
-            )
-        return np.moveaxis(frf.select(outs, ins).data, 0, -1)
-
-    t11 = block(side_b, at, at, "side_b")
-    t12 = block(side_b, at, at_b, "side_b")
-    t21 = block(side_b, at_b, at, "side_b")
-    t22 = block(side_b, at_b, at_b, "side_b")
-    ya = block(side_a, at_a, at_a, "side_a")
-    yc = block(coupled, at, at, "coupled")
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        w = bk.mul2(bk.inv2(t12), bk.mul2(t11 - yc, bk.inv2(t21)))
-        k_inv = bk.inv2(w) - t22 - ya
-        k = bk.inv2(k_inv)
-        condition = {"T12": _cond2(t12), "T21": _cond2(t21), "W": _cond2(w), "K_inv": _cond2(k_inv)}
-    result = ClosedFormResult(freq, np.moveaxis(k, -1, 0), condition)
-    bad = result.ill_conditioned()
-    if warn and np.any(bad):
-        f = freq.hz[bad]
-        warnings.warn(
-            f"closed form: {bad.sum()} of {bad.size} lines ({f.min():.0f}-{f.max():.0f} Hz) have an "
-            f"inversion with condition number above {COND_WARN:.0e}; the joint values there are meaningless",
-            IllConditionedWarning,
-            stacklevel=2,
-        )
-    return result
-
-
-def joint_sides(assembly: Assembly, joint: str) -> tuple[Assembly, Assembly, str, str]:
-    """The two sides of an assembly cut at a joint: ``(side_a, side_b, at_a, at_b)``.
-
-    ``side_a`` holds the joint's first point (``between[0]``), ``side_b`` the
-    second.  The joint must separate the assembly in two (a bridge of the
-    graph); the joints, sensors and supports of each side stay with it.
-    """
-    j = assembly.joint(joint)
-    rest = [x for x in assembly.joints if x.name != joint]
-    owner = {}
-    for comp in assembly.components:
-        for name in comp.component_names:
-            owner[name] = comp.name
-    adjacency: dict[str, set] = {c.name: set() for c in assembly.components}
-    for x in rest:
-        a, b = (owner[parse_point(p).component] for p in x.between)
-        adjacency[a].add(b)
-        adjacency[b].add(a)
-    start = owner[parse_point(j.between[0]).component]
-    seen, stack = {start}, [start]
-    while stack:
-        for nxt in adjacency[stack.pop()]:
-            if nxt not in seen:
-                seen.add(nxt)
-                stack.append(nxt)
-    other = owner[parse_point(j.between[1]).component]
-    if other in seen:
-        raise AssemblyError(
-            f"joint {joint!r} does not separate the assembly in two (the components stay connected "
-            "through other joints), so the closed form of thesis eq. 2.3 does not apply; use the band fit"
-        )
-    base = attrs.evolve(assembly, joints=tuple(rest))
-    a_side = base.without(*[c.name for c in assembly.components if c.name not in seen])
-    b_side = base.without(*[c.name for c in assembly.components if c.name in seen])
-    return a_side, b_side, j.between[0], j.between[1]
-
-
-# ---------------------------------------------------------------------------
-# Robust band identification
-
-
-def _configuration(assembly: Assembly, measurement) -> Assembly:
+def model_of_measurement(assembly: Assembly, measurement) -> Assembly:
     """The model of the structure as it was measured: removed components, sensors on."""
     removed = tuple(getattr(measurement, "removed", ()) or ())
     sensors = tuple(getattr(measurement, "sensors", ()) or ())
@@ -265,9 +82,11 @@ def auto_band(prepared, joint: Joint, parameter: str = "k_yf", factor: float = 1
     """The band of the mode the joint dominates, from the model's sensitivity to it.
 
     The model FRF is computed with the joint's ``parameter`` as given and
-    multiplied by ``factor``; the resonance whose frequency moves most
-    (relatively) is the joint's mode, and the band runs between the minima
-    of ``|H|`` on either side of it, within 0.7 to 1.3 times its frequency.
+    multiplied by ``factor``; among the resonances at least 2 % as high as
+    the highest (weaker ones sit near a tap test's noise floor), the one
+    whose frequency moves most (relatively) is the joint's mode, and the band
+    runs between the minima of ``|H|`` on either side of it, within 0.7 to
+    1.3 times its frequency.
     """
     base = prepared.evaluate()
     values = _joint_values(joint)
@@ -280,12 +99,16 @@ def auto_band(prepared, joint: Joint, parameter: str = "k_yf", factor: float = 1
     peaks = base.peaks(base.outputs[0], base.inputs[0])
     if peaks.size == 0:
         raise InvalidValueError("band: the model FRF has no resonance on the grid; give the band explicitly")
-    shifts = []
+    scores = []
+    top = max(h0[np.searchsorted(f, p)] for p in peaks)
     for p in peaks:
         window = (f > 0.8 * p) & (f < 1.25 * p)
         f1 = f[window][np.argmax(h1[window])]
-        shifts.append(abs(f1 - p) / p)
-    peak = peaks[int(np.argmax(shifts))]
+        # relative shift; a mode weaker than 2 % of the strongest sits near the
+        # noise floor of a tap test and is not considered
+        strong = h0[np.searchsorted(f, p)] >= 0.02 * top
+        scores.append(abs(f1 - p) / p if strong else -1.0)
+    peak = peaks[int(np.argmax(scores))]
     i = int(np.searchsorted(f, peak))
     lo = i
     while lo > 0 and h0[lo - 1] <= h0[lo] and f[lo - 1] > 0.7 * peak:
@@ -401,7 +224,7 @@ class JointIdentifier:
             if any(any(pt in assembly.component(r).component_names for pt in points) for r in removed):
                 continue
             frf = _frf_of(m)
-            prepared = _configuration(assembly, m).prepare(list(frf.outputs), list(frf.inputs), frf.frequency)
+            prepared = model_of_measurement(assembly, m).prepare(list(frf.outputs), list(frf.inputs), frf.frequency)
             cases.append((prepared, frf))
         if not cases:
             raise InvalidValueError(

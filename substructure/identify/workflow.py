@@ -1,0 +1,191 @@
+"""Identification from an assembly and a measurement set: what `substructure identify` runs.
+
+:func:`identify_joint` fits the joint by the robust band fit on every
+measured FRF taken with the joint in place (sensor masses and removed
+components applied to the model as the set says), and, when the set holds
+translational FRFs at two or more points along a component of each side,
+also runs the closed form of thesis eq. 2.3 with rotations estimated by
+finite differences, for the plot of the frequency-dependent result.
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import attrs
+import numpy as np
+
+from ..assembly import Assembly
+from ..coupling import remove_mass
+from ..errors import SubstructureError
+from ..frf import FRF
+from ..points import parse_point
+from ..rdof import estimate_rotational, positions_from
+from .band_fit import JointIdentifier, model_of_measurement
+from .closed_form import ClosedFormResult, closed_form, joint_sides
+
+__all__ = ["IdentificationReport", "identify_joint"]
+
+_ENTRIES = ("yf", "ym", "tf", "tm")
+
+
+@attrs.frozen
+class IdentificationReport:
+    """The result of :func:`identify_joint`.
+
+    ``k``, ``c``, ``k_std`` and ``c_std`` map ``yf``, ``ym``, ``tf``, ``tm`` to SI
+    values (standard deviation 0 for entries that were not fitted);
+    ``measured``, ``initial`` and ``predicted`` are the first measured FRF and
+    the model's FRF there before and after the fit.
+    """
+
+    joint: str
+    band: tuple[float, float]
+    k: dict
+    c: dict
+    k_std: dict
+    c_std: dict
+    fitted: tuple[str, ...]
+    warnings: tuple[str, ...]
+    measured: FRF
+    initial: FRF
+    predicted: FRF
+    residual_rms: float
+    closed_form: ClosedFormResult | None = None
+
+    def to_json(self) -> dict:
+        """The JSON object of formats.md (SI units, Hz), plus a few added keys."""
+        return {
+            "joint": self.joint,
+            "band_hz": [self.band[0], self.band[1]],
+            "k": dict(self.k),
+            "c": dict(self.c),
+            "k_std": dict(self.k_std),
+            "c_std": dict(self.c_std),
+            "warnings": list(self.warnings),
+            "fitted": list(self.fitted),
+            "residual_rms": self.residual_rms,
+        }
+
+    def plot(self):
+        """Closed-form parameters with band and fit (when available), and the FRF before/after."""
+        import matplotlib.pyplot as plt
+
+        names = ("k_yf", "c_yf") if self.closed_form is not None else ()
+        fig, axes = plt.subplots(len(names) + 1, 1, figsize=(7.5, 3.0 + 2.2 * len(names)), layout="constrained")
+        axes = np.atleast_1d(axes)
+        if names:
+            fitted = {}
+            for name in names:
+                kind, entry = name.split("_")
+                fitted[name] = (self.k if kind == "k" else self.c)[entry]
+                fitted[name + "_std"] = (self.k_std if kind == "k" else self.c_std)[entry]
+            self.closed_form.plot(names=names, band=self.band, fitted=fitted, ax=list(axes[:-1]))
+        ax = axes[-1]
+        f = self.measured.frequency.hz
+        ax.semilogy(f, np.abs(self.measured.data[:, 0, 0]), color="0.3", lw=0.8, label="measured")
+        ax.semilogy(f, np.abs(self.initial.data[:, 0, 0]), "--", color="tab:gray", lw=1, label="model before")
+        ax.semilogy(f, np.abs(self.predicted.data[:, 0, 0]), color="tab:blue", lw=1.2, label="model, fitted joint")
+        ax.axvspan(*self.band, color="tab:green", alpha=0.12)
+        ax.set_xlabel("frequency [Hz]")
+        ax.set_ylabel(f"|{self.measured.outputs[0]} / {self.measured.inputs[0]}| [m/N]")
+        ax.legend(fontsize="small")
+        ax.grid(True, alpha=0.3)
+        fig.suptitle(f"joint {self.joint!r}: band fit {self.band[0]:.0f}-{self.band[1]:.0f} Hz")
+        return fig
+
+
+def _two_by_two(measurements, assembly: Assembly, points: Sequence[str], at: str, removed=()) -> FRF:
+    """The 2x2 receptance at ``at`` from translational FRFs at ``points`` by finite differences.
+
+    Uses the configuration (sensors on) with the most measurements among those
+    with the given components removed; the sensors' masses are taken out first
+    (thesis eq. 5.4), so the result is as if laser-measured.
+    """
+    configs = [(s, r) for s, r in measurements.configurations() if tuple(sorted(r)) == tuple(sorted(removed))]
+    if not configs:
+        raise SubstructureError(f"no measurements with {list(removed) or 'nothing'} removed")
+    sensors, rem = max(configs, key=lambda sr: len(measurements.select(sensors=sr[0], removed=sr[1])))
+    matrix = measurements.matrix(points, sensors=sensors, removed=rem)
+    for name in sensors:
+        sensor = assembly.sensor(name)
+        matrix = remove_mass(matrix, f"{sensor.at}:y", sensor.mass)
+    return estimate_rotational(matrix, points, positions_from(assembly, points), at)
+
+
+def _points_on(measurements, assembly: Assembly, components: set, removed=()) -> list[str]:
+    points = []
+    for m in measurements:
+        if tuple(sorted(m.removed)) != tuple(sorted(removed)):
+            continue
+        ref = parse_point(m.response)
+        if ref.component in components and str(ref.point) not in points:
+            points.append(str(ref.point))
+    by_component: dict[str, list[str]] = {}
+    for p in points:
+        by_component.setdefault(parse_point(p).component, []).append(p)
+    best = max(by_component.values(), key=len, default=[])
+    return best if len(best) >= 2 else []
+
+
+def identify_joint(assembly: Assembly, measurements, joint: str, band="auto",
+                   parameters: Sequence[str] = ("k_yf", "k_tm", "c_yf", "c_tm"), bootstrap: int = 0,
+                   random_state: int = 0) -> IdentificationReport:
+    """Identify a joint from a measurement set (see the module docstring)."""
+    if hasattr(measurements, "validate"):
+        measurements.validate(assembly)
+    ident = JointIdentifier(joint, parameters=parameters, band=band, bootstrap=bootstrap,
+                            random_state=random_state).fit(assembly, list(measurements))
+    notes = list(ident.warnings_)
+    first = next(m for m in measurements if not set(m.removed) & _sides_components(assembly, joint))
+    model = model_of_measurement(assembly, first)
+    initial = model.frf(list(first.frf.outputs), list(first.frf.inputs), first.frf.frequency)
+    predicted = model.with_joint(ident.joint_).frf(list(first.frf.outputs), list(first.frf.inputs), first.frf.frequency)
+    result = None
+    try:
+        result = _closed_form(assembly, measurements, joint)
+    except (SubstructureError, ValueError) as exc:
+        notes.append(f"closed form skipped: {exc}")
+    if result is not None:
+        bad = result.ill_conditioned()
+        if bad.any():
+            notes.append(f"closed form: {int(bad.sum())} of {bad.size} lines are ill-conditioned")
+    k = {e: ident.joint_.k.get(e) for e in _ENTRIES}
+    c = {e: ident.joint_.c.get(e) for e in _ENTRIES}
+    k_std = {e: 0.0 for e in _ENTRIES}
+    c_std = {e: 0.0 for e in _ENTRIES}
+    for name, sd in ident.std_.items():
+        kind, entry = name.split("_", 1)
+        target = k_std if kind == "k" else c_std
+        for e in (("ym", "tf") if entry == "ym" else (entry,)):
+            target[e] = float(sd)
+    return IdentificationReport(
+        joint=joint, band=ident.band_, k=k, c=c, k_std=k_std, c_std=c_std, fitted=tuple(parameters),
+        warnings=tuple(notes), measured=first.frf, initial=initial, predicted=predicted,
+        residual_rms=ident.residual_rms_, closed_form=result,
+    )
+
+
+def _sides_components(assembly: Assembly, joint: str) -> set:
+    j = assembly.joint(joint)
+    return {parse_point(p).component for p in j.between}
+
+
+def _closed_form(assembly: Assembly, measurements, joint: str) -> ClosedFormResult | None:
+    side_a, side_b, at_a, at_b = joint_sides(assembly, joint)
+    names_b = set(side_b.component_names)
+    points_b = _points_on(measurements, assembly, names_b)
+    if not points_b:
+        raise SubstructureError("no two measured points along one component beyond the joint")
+    at = points_b[0] if parse_point(points_b[0]).where == "tip" else max(
+        points_b, key=lambda p: positions_from(assembly, [p])[0].m_as("m"))
+    coupled = _two_by_two(measurements, assembly, points_b, at)
+    removed_b = tuple(sorted(c.name for c in assembly.components if set(c.component_names) <= names_b))
+    points_a = _points_on(measurements, assembly, set(side_a.component_names), removed=removed_b)
+    f = coupled.frequency
+    if points_a:
+        side_a_frf = _two_by_two(measurements, assembly, points_a, at_a, removed=removed_b)
+    else:
+        side_a_frf = side_a.receptance(at_a, frequency=f)
+    side_b_frf = side_b.frf([at, at_b] if at != at_b else [at], frequency=f)
+    return closed_form(coupled, side_a_frf, side_b_frf, at=at, at_a=at_a, at_b=at_b, warn=False)

@@ -1,0 +1,52 @@
+"""`substructure identify` on a synthetic tap test with an accelerometer on the tool tip."""
+
+import json
+
+import pytest
+
+from substructure import Frequency, Sensor, default_assembly, save_assembly
+from substructure.cli import main
+from substructure.measurements import MeasurementSet
+from substructure.synthetic import simulate, write_measurement_set
+
+POINTS = ["tool.tip", "tool.tip-20 mm", "tool.tip-40 mm"]
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    d = tmp_path_factory.mktemp("identify")
+    truth = default_assembly().attach(Sensor("accelerometer", "tool.tip", "2 g", "5e-8 kg*m^2"))
+    grid = Frequency.from_range("100 Hz", "5000 Hz", "4 Hz")
+    measured = [m for i, e in enumerate(POINTS)
+                for m in simulate(truth, POINTS, e, frequency=grid, noise=0.02, seed=i, sensors=["accelerometer"])]
+    write_measurement_set(MeasurementSet("bench test", tuple(measured)), d)
+    start = truth.with_joint(truth.joint("holder-tool").with_parameters(k={"yf": "0.7e7 N/m"}, c={"yf": "30 N*s/m"}))
+    save_assembly(start, d / "model.toml")
+    return d
+
+
+def test_identify_json_follows_formats_md(files, capsys):
+    status = main(["identify", str(files / "model.toml"), str(files / "measurements.toml"),
+                   "--joint", "holder-tool", "--json", "--plot", str(files / "id.png")])
+    out = json.loads(capsys.readouterr().out)
+    assert status == 0
+    assert set(out) >= {"joint", "band_hz", "k", "c", "k_std", "c_std", "warnings"}
+    assert out["joint"] == "holder-tool" and out["band_hz"][0] < out["band_hz"][1]
+    assert set(out["k"]) == {"yf", "ym", "tf", "tm"} == set(out["c_std"])
+    assert out["k"]["yf"] == pytest.approx(1.43e7, rel=0.01)  # the accelerometer was put on the model
+    assert out["c"]["yf"] == pytest.approx(12.0, rel=0.1)
+    assert abs(out["k"]["yf"] - 1.43e7) < 3 * out["k_std"]["yf"] + 1e-3 * 1.43e7
+    assert (files / "id.png").stat().st_size > 0
+
+
+def test_identify_human_output_and_errors(files, capsys):
+    assert main(["identify", str(files / "model.toml"), str(files / "measurements.toml"),
+                 "--joint", "holder-tool", "--band", "2200:3200"]) == 0
+    text = capsys.readouterr().out
+    assert "band 2200-3200 Hz" in text and "k_yf = 1.43e+07" in text
+    assert main(["identify", str(files / "model.toml"), str(files / "measurements.toml"), "--joint", "nope"]) == 1
+    assert "no joint 'nope'" in capsys.readouterr().err
+    assert main(["identify", str(files / "model.toml"), str(files / "measurements.toml"),
+                 "--joint", "holder-tool", "--band", "3000:1000"]) == 2
+    err = capsys.readouterr().err
+    assert "LO < HI" in err and "Traceback" not in err
