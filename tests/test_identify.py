@@ -114,3 +114,14 @@ def test_band_fit_errors():
         JointIdentifier("holder-tool", band=(1000, 1100)).fit(asm, [h])
     with pytest.raises(InvalidValueError, match="lo < hi"):
         JointIdentifier("holder-tool", band=(2000, 1000)).fit(asm, [h])
+
+
+def test_a_set_without_what_the_fit_needs_says_what_is_missing():
+    from substructure.synthetic import simulate
+
+    asm = default_assembly()
+    only_holder = simulate(asm, ["holder.tip"], frequency=Frequency.from_range("100 Hz", "2000 Hz", "10 Hz"),
+                           removed=["tool"])
+    with pytest.raises(InvalidValueError, match=r"needs at least one FRF measured with the joint in place.*"
+                                                r"holder.tip:y with \['tool'\] removed"):
+        JointIdentifier("holder-tool").fit(asm, list(only_holder))

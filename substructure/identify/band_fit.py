@@ -218,17 +218,20 @@ class JointIdentifier:
                 f"{self.joint!r}; pass initial={{...}} in SI units"
             )
         cases = []
+        points = [parse_point(p).component for p in template.between]
         for m in measurements:
             removed = set(getattr(m, "removed", ()) or ())
-            points = [parse_point(p).component for p in template.between]
             if any(any(pt in assembly.component(r).component_names for pt in points) for r in removed):
                 continue
             frf = _frf_of(m)
             prepared = model_of_measurement(assembly, m).prepare(list(frf.outputs), list(frf.inputs), frf.frequency)
             cases.append((prepared, frf))
         if not cases:
+            have = sorted({f"{getattr(m, 'response', '?')} with {list(getattr(m, 'removed', ()))} removed"
+                           for m in measurements})
             raise InvalidValueError(
-                f"measurements: none was taken with joint {self.joint!r} in place; the fit needs at least one"
+                f"measurements: the fit of joint {self.joint!r} needs at least one FRF measured with the joint "
+                f"in place (neither {' nor '.join(points)} removed); the set has only: {'; '.join(have) or 'nothing'}"
             )
         auto = self.band == "auto"
         if auto:
