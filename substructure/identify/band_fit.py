@@ -92,7 +92,9 @@ def auto_band(prepared, joint: Joint, parameter: str = "k_yf", factor: float = 1
     values = _joint_values(joint)
     k, c = joint.k.as_dict(), joint.c.as_dict()
     _set_parameter(k, c, parameter, values[parameter] * factor)
-    stiffer = prepared.evaluate(joints={joint.name: attrs.evolve(joint, k=k, c=c)})
+    with warnings.catch_warnings():  # the start joint has warned already if it is not passive
+        warnings.simplefilter("ignore", NonPassiveJointWarning)
+        stiffer = prepared.evaluate(joints={joint.name: attrs.evolve(joint, k=k, c=c)})
     f = base.frequency.hz
     h0 = np.abs(base.data[:, 0, 0])
     h1 = np.abs(stiffer.data[:, 0, 0])
@@ -140,7 +142,8 @@ class JointIdentifier:
     random_state : int
         Seed of the bootstrap.
     initial : mapping, optional
-        Starting values (SI) for parameters the assembly gives as 0 or rigid.
+        Starting values (SI), overriding the assembly's joint (needed where it
+        gives 0 or a rigid joint).
 
     Attributes
     ----------
@@ -155,6 +158,8 @@ class JointIdentifier:
         RMS of the relative complex residual over the band.
     warnings_ : list of str
         Passivity and reciprocity findings on the fitted joint.
+    n_lines_ : int
+        Number of frequency lines (over all FRFs) in the fit.
 
     Notes
     -----

@@ -27,15 +27,23 @@ PARAMETERS = ("k_yf", "k_ym", "k_tm", "c_yf", "c_ym", "c_tm")
 """Names of the joint parameters (``k_ym`` stands for ``k_ym = k_tf``)."""
 
 _ENTRY = {"yf": (0, 0), "ym": (0, 1), "tf": (1, 0), "tm": (1, 1)}
-COND_WARN = 1e8
-"""Condition numbers above this make the closed-form result meaningless at that line."""
+COND_WARN = 1e6
+"""Equilibrated condition numbers above this make the closed-form result meaningless at that line."""
 
 
 def _cond2(a: np.ndarray) -> np.ndarray:
-    """2-norm condition numbers of 2x2 stacks ``(2, 2, n)``."""
-    fro2 = (np.abs(a) ** 2).sum(axis=(0, 1))
-    det = np.abs(a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0])
+    """Condition numbers of 2x2 stacks ``(2, 2, n)``, equilibrated by their diagonal.
+
+    The entries mix units (m/N, 1/N, 1/(N m)); scaling rows and columns by
+    ``|a_ii|^-1/2`` makes the number independent of the units chosen for
+    rotations and moments, so that it measures how close the matrix is to
+    singular, not the ratio of metres to radians.
+    """
+    d = np.sqrt(np.abs(np.stack([a[0, 0], a[1, 1]])))
     with np.errstate(divide="ignore", invalid="ignore"):
+        scaled = a / (d[:, None, :] * d[None, :, :])
+        fro2 = (np.abs(scaled) ** 2).sum(axis=(0, 1))
+        det = np.abs(scaled[0, 0] * scaled[1, 1] - scaled[0, 1] * scaled[1, 0])
         root = np.sqrt(np.maximum(fro2**2 - 4 * det**2, 0.0))
         return np.where(det > 0, (fro2 + root) / (2 * det), np.inf)
 
@@ -49,14 +57,34 @@ class ClosedFormResult:
     frequency : Frequency
     stiffness : ndarray, shape (n_freq, 2, 2)
         ``K = k + i omega c``, entries ``[[yf, ym], [tf, tm]]``.
+    amplification : ndarray
+        First-order factor by which a relative error of the coupled
+        receptances grows into ``K`` at each line (see :meth:`reliable`).
     condition : dict of str to ndarray
-        2-norm condition numbers of the inverted matrices per line: ``"T12"``,
+        Condition numbers (2-norm, each matrix equilibrated by its diagonal)
+        of the inverted matrices per line: ``"T12"``,
         ``"T21"``, ``"W"`` (``T12^-1 (T11 - Y_c) T21^-1``) and ``"K_inv"``.
     """
 
     frequency: Frequency
     stiffness: np.ndarray = attrs.field(eq=attrs.cmp_using(eq=np.array_equal))
     condition: dict = attrs.field(eq=False)
+    amplification: np.ndarray | None = attrs.field(default=None, eq=False)
+
+    def reliable(self, noise: float, tolerance: float = 0.1) -> np.ndarray:
+        """Lines where a relative error ``noise`` of the measured coupled
+        receptances gives at most ``tolerance`` relative error in ``K``.
+
+        Uses :attr:`amplification`, a first-order estimate of how the relative
+        error of ``Y_c`` grows through eq. 2.3: the cancellation in
+        ``T11 - Y_c`` (``||T11|| / ||T11 - Y_c||``) times the condition numbers
+        of the two inversions that follow.  The thesis's observation that the
+        closed form is usable only near the joint's mode shows here as the
+        lines where the amplification is small.
+        """
+        if self.amplification is None:
+            raise InvalidValueError("reliable: this result has no error amplification estimate")
+        return self.amplification * noise <= tolerance
 
     def parameter(self, name: str) -> np.ndarray:
         """``k_yf``, ``k_ym``, ``k_tf``, ``k_tm``, ``c_...`` at every line (SI)."""
@@ -137,8 +165,10 @@ def closed_form(coupled: FRF, side_a: FRF, side_b: FRF, *, at: str, at_a: str, a
         w = bk.mul2(bk.inv2(t12), bk.mul2(t11 - yc, bk.inv2(t21)))
         k_inv = bk.inv2(w) - t22 - ya
         k = bk.inv2(k_inv)
+        diff = t11 - yc
+        cancellation = np.sqrt((np.abs(t11) ** 2).sum(axis=(0, 1)) / (np.abs(diff) ** 2).sum(axis=(0, 1)))
         condition = {"T12": _cond2(t12), "T21": _cond2(t21), "W": _cond2(w), "K_inv": _cond2(k_inv)}
-    result = ClosedFormResult(freq, np.moveaxis(k, -1, 0), condition)
+    result = ClosedFormResult(freq, np.moveaxis(k, -1, 0), condition, cancellation * condition["W"] * condition["K_inv"])
     bad = result.ill_conditioned()
     if warn and np.any(bad):
         f = freq.hz[bad]
