@@ -125,3 +125,15 @@ def test_a_set_without_what_the_fit_needs_says_what_is_missing():
     with pytest.raises(InvalidValueError, match=r"needs at least one FRF measured with the joint in place.*"
                                                 r"holder.tip:y with \['tool'\] removed"):
         JointIdentifier("holder-tool").fit(asm, list(only_holder))
+
+
+def test_closed_form_diagonal_model_eq_2_4():
+    """A diagonal joint (eq. 2.4) is recovered by both models; with cross terms only 'full' is exact."""
+    asm = default_assembly()
+    side_a, side_b, at_a, at_b = joint_sides(asm, "holder-tool")
+    args = (asm.receptance("tool.tip", frequency=GRID), side_a.receptance(at_a, frequency=GRID),
+            side_b.frf(["tool.tip", at_b], frequency=GRID))
+    for model in ("full", "diagonal"):
+        _check_recovers(closed_form(*args, at="tool.tip", at_a=at_a, at_b=at_b, model=model), asm.joint("holder-tool"))
+    with pytest.raises(InvalidValueError, match="model"):
+        closed_form(*args, at="tool.tip", at_a=at_a, at_b=at_b, model="banded")

@@ -113,7 +113,7 @@ class ClosedFormResult:
 
 
 def closed_form(coupled: FRF, side_a: FRF, side_b: FRF, *, at: str, at_a: str, at_b: str,
-                warn: bool = True) -> ClosedFormResult:
+                model: str = "full", warn: bool = True) -> ClosedFormResult:
     """Joint stiffness from the coupled and the two sides' receptances (thesis eq. 2.3).
 
     Parameters
@@ -129,6 +129,11 @@ def closed_form(coupled: FRF, side_a: FRF, side_b: FRF, *, at: str, at_a: str, a
         (e.g. the free-free tool at its tip and base); ``at`` may equal ``at_b``.
     at, at_a, at_b : str
         Point names (without DOF suffix).
+    model : {"full", "diagonal"}
+        ``"full"``: the fully populated joint of thesis eq. 2.5; ``"diagonal"``:
+        the joint of eq. 2.4 (no cross terms), whose inverse ``K^-1`` is then
+        diagonal too: its diagonal is inverted entry by entry.  Both are exact
+        for data made with a diagonal joint.
     warn : bool
         Warn where an inversion is so ill-conditioned that the result is
         meaningless (condition number above :data:`COND_WARN`).
@@ -164,7 +169,14 @@ def closed_form(coupled: FRF, side_a: FRF, side_b: FRF, *, at: str, at_a: str, a
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         w = bk.mul2(bk.inv2(t12), bk.mul2(t11 - yc, bk.inv2(t21)))
         k_inv = bk.inv2(w) - t22 - ya
-        k = bk.inv2(k_inv)
+        if model == "full":
+            k = bk.inv2(k_inv)
+        elif model == "diagonal":
+            k = np.zeros_like(k_inv)
+            k[0, 0] = 1.0 / k_inv[0, 0]
+            k[1, 1] = 1.0 / k_inv[1, 1]
+        else:
+            raise InvalidValueError(f"model: got {model!r}; expected 'full' (eq. 2.5) or 'diagonal' (eq. 2.4)")
         diff = t11 - yc
         cancellation = np.sqrt((np.abs(t11) ** 2).sum(axis=(0, 1)) / (np.abs(diff) ** 2).sum(axis=(0, 1)))
         condition = {"T12": _cond2(t12), "T21": _cond2(t21), "W": _cond2(w), "K_inv": _cond2(k_inv)}
