@@ -421,6 +421,7 @@ class PreparedFRF:
         self.inputs, in_idx, in_refs = expand_points(inputs)
         groups, self._out_keys, self._links = assembly._plan(out_refs + in_refs)
         f = self.frequency.hz
+        self._groups = groups
         self._blocks = [
             ([k for k, _ in items], by_chunks(lambda ff, o=owner, r=[ref for _, ref in items]: o.receptance_matrix(r, ff), f))
             for owner, items in groups
@@ -444,9 +445,27 @@ class PreparedFRF:
             )
         return new
 
-    def evaluate(self, joints=None, sensors=None, supports=None) -> FRF:
-        """The FRF with some joints, sensors or supports replaced (mappings by name)."""
+    def evaluate(self, joints=None, sensors=None, supports=None, components=None) -> FRF:
+        """The FRF with some joints, sensors, supports or components replaced (mappings by name).
+
+        A replaced component is recomputed at the same points (it must have
+        them); the others' receptances are reused.
+        """
         joints, sensors, supports = dict(joints or {}), dict(sensors or {}), dict(supports or {})
+        components = dict(components or {})
+        blocks_all = self._blocks
+        if components:
+            f_all = self.frequency.hz
+            blocks_all = list(self._blocks)
+            names = {owner.name: i for i, (owner, _) in enumerate(self._groups)}
+            for name, comp in components.items():
+                if name not in names:
+                    raise UnknownPointError(
+                        f"prepared FRF: no component {name!r} takes part (components: {sorted(names)})"
+                    )
+                i = names[name]
+                refs = [ref for _, ref in self._groups[i][1]]
+                blocks_all[i] = (blocks_all[i][0], by_chunks(lambda ff: comp.receptance_matrix(refs, ff), f_all))
         known = {o.name for _, _, o, _ in self._links if not isinstance(o, (Sensor, Support))}
         unknown = set(joints) - known
         if unknown:
@@ -457,7 +476,7 @@ class PreparedFRF:
         parts = []
         for start in range(0, n, CHUNK_LINES):
             sl = slice(start, min(n, start + CHUNK_LINES))
-            blocks = [(keys, y[..., sl]) for keys, y in self._blocks]
+            blocks = [(keys, y[..., sl]) for keys, y in blocks_all]
             links = [
                 Link(ka, kb, None if getattr(o, "rigid", False) else o.dynamic_stiffness(f[sl]), label)
                 for (ka, kb, _, label), o in zip(self._links, objs)

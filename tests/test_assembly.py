@@ -199,3 +199,14 @@ def test_prepared_frf_equals_full_computation(assembly, grid):
         prepared.evaluate(joints={"nope": joint})
     with pytest.raises(InvalidValueError, match="same points"):
         prepared.evaluate(sensors={"acc": Sensor("acc", "tool.base", "1 g")})
+
+
+def test_prepared_frf_with_a_replaced_component(assembly, grid):
+    prepared = assembly.prepare("tool.tip:y", frequency=grid)
+    shorter = make_tool(50.0)
+    got = prepared.evaluate(components={"tool": shorter})
+    # the same points by name: tool.tip is now at 50 mm
+    expected = assembly.with_component(shorter).receptance("tool.tip:y", frequency=grid)
+    np.testing.assert_allclose(got.data, expected.data, rtol=1e-12)
+    with pytest.raises(UnknownPointError, match="no component"):
+        prepared.evaluate(components={"nope": shorter})
