@@ -242,6 +242,21 @@ class Assembly:
         sup = at if isinstance(at, Support) else Support(at, k=k, c=c)
         return attrs.evolve(self, supports=self.supports + (sup,))
 
+    def with_effect(self, effect) -> "Assembly":
+        """The assembly with a physical effect added (e.g. a fitted one from a diagnosis).
+
+        ``effect`` is any object with ``apply(assembly) -> Assembly``, such as the
+        effects of :mod:`substructure.diagnose.effects`; the result is a normal
+        assembly (a sensor, a joint value, a flutes entry, a support), which
+        :func:`substructure.save_assembly` writes in its usual form.
+        """
+        if not hasattr(effect, "apply"):
+            raise InvalidValueError(f"effect: got {effect!r}; expected an object with apply(assembly)")
+        result = effect.apply(self)
+        if not isinstance(result, Assembly):
+            raise InvalidValueError(f"effect {effect!r}: apply returned {type(result).__name__}, not an Assembly")
+        return result
+
     def with_joint(self, joint: Joint) -> "Assembly":
         """Replace the joint of the same name."""
         self.joint(joint.name)

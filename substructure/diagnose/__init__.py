@@ -1,0 +1,20 @@
+"""Model against measurement: where the model fails, which physical effect it misses, and the fix.
+
+* :mod:`~substructure.diagnose.compare`: the error measure (RMS of the complex
+  log ratio), mode pairing, FRAC, error bands and the noise floor estimated
+  from the data;
+* :mod:`~substructure.diagnose.effects`: the catalogue of physical effects
+  (registered by name; users add their own);
+* :mod:`~substructure.diagnose.diagnosis`: fitting every effect at every
+  place, ranking, deciding, and the greedy refinement whose history shows the
+  error fall.
+"""
+
+from .compare import METRIC, Comparison, compare, error, frac, noise_floor, pair_modes
+from .diagnosis import Candidate, Diagnosis, Step, diagnose
+from .effects import EFFECTS, Effect, Parameter, get_effect, register_effect
+
+__all__ = [
+    "METRIC", "Comparison", "compare", "error", "frac", "noise_floor", "pair_modes", "Candidate",
+    "Diagnosis", "Step", "diagnose", "EFFECTS", "Effect", "Parameter", "get_effect", "register_effect",
+]

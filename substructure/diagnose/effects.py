@@ -1,0 +1,358 @@
+"""The catalogue of physical effects a model may be missing.
+
+Each effect is a class with named, unit-carrying, bounded parameters, a
+``where`` (the point, joint or component it acts on), a way to apply itself
+to an assembly (returning a new assembly, so the fix is a normal model that
+files can hold) and a short explanation of its signature.  Effects are
+registered by name with :func:`register_effect`, so that users add their own
+without touching the core::
+
+    @register_effect
+    class HeavyHolderNut(Effect):
+        name = "holder-nut"
+        parameters = (Parameter("mass", "kg", 0.005, 0.5, 0.05),)
+        explanation = "a clamping nut adds mass at the holder face: the holder mode drops"
+
+        @classmethod
+        def places(cls, assembly, measured_points):
+            return ["holder.tip"]
+
+        def apply(self, assembly):
+            return assembly.attach(Sensor("nut", self.where, f"{self.values['mass']} kg"))
+
+The diagnosis (:mod:`substructure.diagnose.diagnosis`) fits every registered
+effect at every place it proposes.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import ClassVar, Sequence
+
+import attrs
+import numpy as np
+
+from ..assembly import Assembly
+from ..beams import Flutes
+from ..components import Beam, Tool
+from ..errors import InvalidValueError, NonPassiveJointWarning
+from ..joints import Joint, Sensor, Support
+from ..points import parse_point
+from ..units import format_quantity, ureg
+
+__all__ = ["Parameter", "Effect", "EFFECTS", "register_effect", "get_effect"]
+
+EFFECTS: dict[str, type] = {}
+"""Registered effects by name."""
+
+
+def register_effect(cls):
+    """Class decorator: make an :class:`Effect` subclass available by its ``name``."""
+    if not isinstance(getattr(cls, "name", None), str):
+        raise InvalidValueError(f"effect {cls.__name__}: needs a class attribute `name`")
+    EFFECTS[cls.name] = cls
+    return cls
+
+
+def get_effect(name: str) -> type:
+    """The effect class registered under ``name``."""
+    if name not in EFFECTS:
+        raise InvalidValueError(f"effect: unknown effect {name!r}; known: {', '.join(EFFECTS)}")
+    return EFFECTS[name]
+
+
+@attrs.frozen
+class Parameter:
+    """A bounded parameter of an effect, in SI ``unit``; fitted on a log scale when ``log``."""
+
+    name: str
+    unit: str
+    lower: float
+    upper: float
+    start: float
+    log: bool = True
+
+    def quantity(self, value: float):
+        return ureg.Quantity(value, self.unit)
+
+
+class Effect:
+    """A physical effect at a place, with parameter values (SI).
+
+    Subclasses set ``name``, ``parameters``, ``explanation`` and implement
+    ``places(assembly, measured_points)`` (where the effect may act) and
+    ``apply(assembly)``; ``starting_values(assembly, where, shift)`` may refine
+    the starting point from the relative shift of the main mode
+    (measured / model - 1).
+    """
+
+    name: ClassVar[str] = ""
+    parameters: ClassVar[tuple[Parameter, ...]] = ()
+    explanation: ClassVar[str] = ""
+
+    def __init__(self, where: str, **values: float):
+        self.where = where
+        unknown = set(values) - {p.name for p in self.parameters}
+        if unknown:
+            raise InvalidValueError(
+                f"effect {self.name!r}: unknown parameters {sorted(unknown)}; expected "
+                f"{', '.join(p.name for p in self.parameters)}"
+            )
+        self.values = {p.name: float(values.get(p.name, p.start)) for p in self.parameters}
+        for p in self.parameters:
+            v = self.values[p.name]
+            if not (p.lower <= v <= p.upper):
+                raise InvalidValueError(
+                    f"effect {self.name!r}: {p.name} = {v:g} {p.unit} is outside [{p.lower:g}, {p.upper:g}]"
+                )
+
+    def __repr__(self) -> str:
+        vals = ", ".join(f"{k}={v:.4g}" for k, v in self.values.items())
+        return f"{type(self).__name__}(where={self.where!r}, {vals})"
+
+    @classmethod
+    def places(cls, assembly: Assembly, measured_points: Sequence[str]) -> list[str]:
+        return []
+
+    @classmethod
+    def starting_values(cls, assembly: Assembly, where: str, shift: float) -> dict[str, float]:
+        return {p.name: p.start for p in cls.parameters}
+
+    @classmethod
+    def bounds(cls, assembly: Assembly, where: str) -> dict[str, tuple[float, float]]:
+        """Bounds of each parameter at this place (default: the class's)."""
+        return {p.name: (p.lower, p.upper) for p in cls.parameters}
+
+    def apply(self, assembly: Assembly) -> Assembly:
+        raise NotImplementedError
+
+    def parameters_json(self) -> dict:
+        return {p.name: {"value": self.values[p.name], "unit": p.unit} for p in self.parameters}
+
+
+def _quiet_joint(joint: Joint, **kw) -> Joint:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NonPassiveJointWarning)
+        return joint.with_parameters(**kw)
+
+
+def _elastic_joints(assembly: Assembly) -> list[str]:
+    return [j.name for j in assembly.joints if not getattr(j, "rigid", False) and isinstance(j, Joint)]
+
+
+def _si(value: float, unit: str) -> str:
+    return format_quantity(ureg.Quantity(float(value), unit))
+
+
+@register_effect
+class SensorMass(Effect):
+    name = "sensor-mass"
+    parameters = (
+        Parameter("mass", "kg", 1e-4, 0.2, 2e-3),
+        Parameter("inertia", "kg*m^2", 1e-10, 1e-4, 1e-8),
+    )
+    explanation = (
+        "a body on the structure (an accelerometer, a magnet) lowers every mode in proportion to "
+        "the square of its modal displacement at that point: the mode with most motion there "
+        "(the tool mode, for a tool-tip sensor) drops most, the others barely move"
+    )
+
+    @classmethod
+    def places(cls, assembly, measured_points):
+        return list(dict.fromkeys(str(parse_point(p).point) for p in measured_points))
+
+    def apply(self, assembly):
+        sensor = Sensor(f"diagnosed-{self.where.replace('.', '-').replace('@', '-at-').replace(' ', '')}",
+                        self.where, _si(self.values["mass"], "kg"), _si(self.values["inertia"], "kg*m^2"))
+        return assembly.attach(sensor)
+
+
+class _JointEffect(Effect):
+    kind: ClassVar[str] = "k"
+    entries: ClassVar[tuple[str, ...]] = ()
+
+    @classmethod
+    def places(cls, assembly, measured_points):
+        return _elastic_joints(assembly)
+
+    @classmethod
+    def starting_values(cls, assembly, where, shift):
+        joint = assembly.joint(where)
+        out = {}
+        for p in cls.parameters:
+            entry = p.name.split("_", 1)[1]
+            nominal = (joint.k if p.name[0] == "k" else joint.c).get(entry)
+            out[p.name] = float(np.clip(nominal if nominal > 0 else p.start, p.lower, p.upper))
+        return out
+
+    def apply(self, assembly):
+        joint = assembly.joint(self.where)
+        k, c = {}, {}
+        for name, value in self.values.items():
+            kind, entry = name.split("_", 1)
+            target, units = (k, {"yf": "N/m", "tm": "N*m/rad", "ym": "N"}) if kind == "k" else (
+                c, {"yf": "N*s/m", "tm": "N*m*s/rad", "ym": "N*s"})
+            for e in (("ym", "tf") if entry == "ym" else (entry,)):
+                unit = units[entry] if e != "tf" else ("N/rad" if kind == "k" else "N*s/rad")
+                target[e] = _si(value, unit)
+        return assembly.with_joint(_quiet_joint(joint, k=k, c=c))
+
+
+@register_effect
+class JointStiffness(_JointEffect):
+    name = "joint-stiffness"
+    parameters = (
+        Parameter("k_yf", "N/m", 1e4, 1e11, 1e7),
+        Parameter("k_tm", "N*m/rad", 1e2, 1e9, 1e5),
+    )
+    explanation = (
+        "a joint's stiffness sets the frequency of the mode it dominates: a softer joint lowers "
+        "that mode (and raises its peak), leaving modes far from the joint alone"
+    )
+
+
+@register_effect
+class JointDamping(_JointEffect):
+    name = "joint-damping"
+    parameters = (
+        Parameter("c_yf", "N*s/m", 1e-2, 1e5, 50.0),
+        Parameter("c_tm", "N*m*s/rad", 1e-4, 1e3, 1.0),
+    )
+    explanation = (
+        "a joint's damping sets the height and width of the peak of the mode it dominates, "
+        "not its frequency"
+    )
+
+
+@register_effect
+class JointCrossCoupling(_JointEffect):
+    name = "joint-cross-coupling"
+    parameters = (
+        Parameter("k_ym", "N", -1e9, 1e9, 0.0, log=False),
+        Parameter("c_ym", "N*s", -1e4, 1e4, 0.0, log=False),
+    )
+    explanation = (
+        "off-diagonal joint terms (k_ym = k_tf) couple the joint's translation and rotation: they "
+        "shift the joint's modes like a change of its stiffness, but differently at the tip and at "
+        "points further back"
+    )
+
+    @classmethod
+    def starting_values(cls, assembly, where, shift):
+        joint = assembly.joint(where)
+        scale = np.sqrt(max(joint.k.get("yf") * joint.k.get("tm"), 1.0))
+        return {"k_ym": 0.3 * scale * (-1 if shift < 0 else 1), "c_ym": 0.0}
+
+    @classmethod
+    def bounds(cls, assembly, where):
+        """Passive cross terms: ``k_ym^2 < k_yf k_tm`` and ``c_ym^2 < c_yf c_tm``."""
+        joint = assembly.joint(where)
+        k = 0.999 * np.sqrt(max(joint.k.get("yf") * joint.k.get("tm"), 0.0))
+        c = 0.999 * np.sqrt(max(joint.c.get("yf") * joint.c.get("tm"), 0.0))
+        return {"k_ym": (-k, k), "c_ym": (-c, c) if c > 0 else (-1e-12, 1e-12)}
+
+
+@register_effect
+class RigidJointFlexibility(_JointEffect):
+    name = "rigid-joint-flexibility"
+    parameters = (
+        Parameter("k_yf", "N/m", 1e4, 1e12, 1e8),
+        Parameter("k_tm", "N*m/rad", 1e2, 1e10, 1e6),
+    )
+    explanation = (
+        "a connection modelled as rigid is elastic: the modes it takes part in are lower than the "
+        "model says"
+    )
+
+    @classmethod
+    def places(cls, assembly, measured_points):
+        return [j.name for j in assembly.joints if getattr(j, "rigid", False)]
+
+    @classmethod
+    def starting_values(cls, assembly, where, shift):
+        return {p.name: p.start for p in cls.parameters}
+
+    def apply(self, assembly):
+        joint = assembly.joint(self.where)
+        elastic = Joint(joint.name, joint.between, k={"yf": _si(self.values["k_yf"], "N/m"),
+                                                      "tm": _si(self.values["k_tm"], "N*m/rad")})
+        return assembly.with_joint(elastic)
+
+
+def _tools(assembly: Assembly) -> list[Beam]:
+    return [c for c in assembly.components if isinstance(c, Tool)]
+
+
+@register_effect
+class FlutedSection(Effect):
+    name = "fluted-section"
+    parameters = (
+        Parameter("diameter_ratio", "dimensionless", 0.5, 1.0, 0.8, log=False),
+        Parameter("length", "m", 1e-3, 0.2, 0.03),
+    )
+    explanation = (
+        "flutes take stiffness and mass from the tool's last part: the tool modes drop (bending "
+        "stiffness falls faster than mass), the spindle and holder modes hardly move"
+    )
+
+    @classmethod
+    def places(cls, assembly, measured_points):
+        return [t.name for t in _tools(assembly) if not any(s.flutes for s in t.segments)]
+
+    @classmethod
+    def starting_values(cls, assembly, where, shift):
+        tool = assembly.component(where)
+        return {"diameter_ratio": 0.8, "length": min(0.03, 0.5 * tool.length_m)}
+
+    @classmethod
+    def bounds(cls, assembly, where):
+        tool = assembly.component(where)
+        return {"diameter_ratio": (0.5, 1.0), "length": (1e-3, tool.length_m)}
+
+    def apply(self, assembly):
+        tool = assembly.component(self.where)
+        return assembly.with_component(flute_tip(tool, self.values["length"], self.values["diameter_ratio"]))
+
+
+def flute_tip(tool: Beam, length_m: float, ratio: float) -> Beam:
+    """The tool with its last ``length_m`` fluted at ``ratio`` (segments split as needed)."""
+    total = tool.length_m
+    length_m = min(length_m, total)
+    start = total - length_m
+    segments, x = [], 0.0
+    for seg in tool.segments:
+        x0, x1 = x, x + seg.length_m
+        x = x1
+        if x1 <= start + 1e-12:
+            segments.append(seg)
+            continue
+        if x0 < start - 1e-12:
+            segments.append(attrs.evolve(seg, length=_si(start - x0, "m")))
+            x0 = start
+        segments.append(attrs.evolve(seg, length=_si(x1 - x0, "m"), flutes=Flutes(ratio)))
+    return attrs.evolve(tool, segments=segments)
+
+
+@register_effect
+class SupportSprings(Effect):
+    name = "support-springs"
+    parameters = (Parameter("k_yf", "N/m", 1e1, 1e8, 1e5),)
+    explanation = (
+        "springs to the ground (suspension bands of a 'free-free' test, a fixture) turn the "
+        "rigid-body motion into low modes, tens of Hz for bands: the low end of the FRF rises "
+        "from the mass line into peaks"
+    )
+
+    @classmethod
+    def places(cls, assembly, measured_points):
+        beams = [c for c in assembly.components if isinstance(c, Beam)]
+        if not beams:
+            return []
+        heaviest = max(beams, key=lambda b: b.mass())
+        return [heaviest.name]
+
+    def apply(self, assembly):
+        k = _si(self.values["k_yf"], "N/m")
+        comp = self.where
+        return assembly.support(Support(f"{comp}.base", k={"yf": k}, name=f"diagnosed-{comp}-base")).support(
+            Support(f"{comp}.tip", k={"yf": k}, name=f"diagnosed-{comp}-tip"))

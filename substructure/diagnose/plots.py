@@ -1,0 +1,78 @@
+"""Figures of the diagnosis: where the model fails, and the error falling (returned, never shown)."""
+
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+__all__ = ["plot_comparison", "plot_history"]
+
+
+def plot_comparison(comparison, ax=None):
+    """Measured and model |H| and phase overlaid, the log-ratio residual below.
+
+    The bands that carry most of the error are shaded and the paired modes
+    annotated with their shifts (model minus measurement).
+    """
+    if ax is None:
+        fig, axes = plt.subplots(3, 1, sharex=True, figsize=(8.0, 7.5), layout="constrained",
+                                 gridspec_kw={"height_ratios": [3, 1.5, 1.5]})
+    else:
+        axes = list(ax)
+        fig = axes[0].figure
+    meas, model = comparison.measured, comparison.model
+    f = meas.frequency.hz
+    hm, ho = meas.data[:, 0, 0], model.data[:, 0, 0]
+    axes[0].semilogy(f, np.abs(hm), color="0.25", lw=0.8, label="measured")
+    axes[0].semilogy(f, np.abs(ho), color="tab:blue", lw=1.2, label="model")
+    axes[1].plot(f, np.degrees(np.angle(hm)), color="0.25", lw=0.8)
+    axes[1].plot(f, np.degrees(np.angle(ho)), color="tab:blue", lw=1.2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = np.log(ho / hm)
+    axes[2].plot(f, r.real, color="tab:red", lw=0.8, label="ln|model/measured|")
+    axes[2].plot(f, r.imag, color="tab:purple", lw=0.8, label="phase difference [rad]")
+    axes[2].axhline(0, color="0.5", lw=0.5)
+    for lo, hi, share in comparison.bands:
+        for a in axes:
+            a.axvspan(lo, hi, color="tab:orange", alpha=0.15)
+        axes[2].annotate(f"{share:.0%}", ((lo + hi) / 2, 0), ha="center", va="bottom", fontsize="x-small")
+    for m in comparison.modes:
+        if m.model_hz is None:
+            continue
+        axes[0].annotate(f"{m.shift_hz:+.0f} Hz", (m.measured_hz, m.measured_amplitude),
+                         textcoords="offset points", xytext=(0, 6), ha="center", fontsize="x-small")
+    axes[0].set_ylabel(f"|{meas.outputs[0]} / {meas.inputs[0]}| [m/N]")
+    axes[0].legend(fontsize="small")
+    axes[0].set_title(f"error {comparison.error:.3g} (noise floor {comparison.noise_floor:.3g}), "
+                      f"FRAC {comparison.frac:.3f}; shaded: where the error is")
+    axes[1].set_ylabel("phase [deg]")
+    axes[2].set_ylabel("residual")
+    axes[2].legend(fontsize="x-small", loc="upper right")
+    axes[2].set_xlabel("frequency [Hz]")
+    for a in axes:
+        a.grid(True, alpha=0.3)
+    return fig
+
+
+def plot_history(diagnosis, ax=None):
+    """The refinement's error after each step, with the noise floor."""
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(6.5, 3.8), layout="constrained")
+    else:
+        fig = ax.figure
+    steps = diagnosis.refinement
+    x = [s.step for s in steps]
+    y = [s.error for s in steps]
+    ax.semilogy(x, y, "o-", color="tab:blue")
+    for s in steps:
+        label = "model as given" if s.added is None else f"+ {s.added.name}\n({s.added.where})"
+        ax.annotate(label, (s.step, s.error), textcoords="offset points", xytext=(6, 6), fontsize="x-small")
+    ax.axhline(diagnosis.noise_floor, color="tab:green", ls="--", label="noise floor")
+    ax.axhline(1.5 * diagnosis.noise_floor, color="tab:green", ls=":", label="1.5 x noise floor")
+    ax.set_xticks(x)
+    ax.set_xlabel("refinement step")
+    ax.set_ylabel(f"error ({diagnosis.metric})")
+    ax.set_title("watch the error fall")
+    ax.legend(fontsize="small")
+    ax.grid(True, alpha=0.3)
+    return fig
