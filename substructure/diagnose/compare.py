@@ -70,24 +70,41 @@ def error(model: FRF, measured: FRF, mask: np.ndarray | None = None) -> float:
     return float(np.sqrt(np.mean(np.abs(r) ** 2)))
 
 
+def _window(measured: FRF, polyorder: int = 3) -> int:
+    """A smoothing window for noise estimation (no warning: peak bias does not matter here)."""
+    import warnings
+
+    from ..smoothing import CoarseDataWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CoarseDataWarning)
+        return choose_window(measured, polyorder=polyorder)
+
+
 def noise_floor(measured: FRF, window: int | None = None, polyorder: int = 3) -> float:
     """The error a perfect model would show on these data, estimated from the data.
 
     ``r = ln(H / S(H))`` with ``S`` a Savitzky-Golay smoother of window ``w``:
     for white relative noise of RMS ``sigma`` the filter keeps the share
     ``h0`` (its central coefficient) of each line's noise, so
-    ``rms(r) = sigma sqrt(1 - 2 h0 + sum(h^2)) = sigma sqrt(1 - h0)``; the floor
-    is ``rms(r) / sqrt(1 - h0)``.  The smoother also leaves a little of the
-    FRF's curvature in ``r``, so the estimate errs on the high side where the
-    data are coarse.
+    ``var(r) = sigma^2 (1 - 2 h0 + sum(h^2)) = sigma^2 (1 - h0)``.  The scatter
+    of ``r`` is taken robustly (1.4826 times the median absolute deviation, of
+    the real and imaginary parts), so that the few lines where the smoother
+    cannot follow the FRF (very sharp resonances, antiresonances in a noise
+    floor) do not inflate it; the floor is ``sigma``.
     """
-    w = window or choose_window(measured, polyorder=polyorder)
+    w = window or _window(measured, polyorder)
     smoothed = smooth(measured, window=w, polyorder=polyorder)
     with np.errstate(divide="ignore", invalid="ignore"):
         r = np.log(measured.data / smoothed.data)
     r = r[w // 2 : -(w // 2) or None]  # the filter's edges are less reliable
+    r = r[np.isfinite(r)]
     h0 = float(savgol_coeffs(w, polyorder)[w // 2])
-    return float(np.sqrt(np.mean(np.abs(r) ** 2) / (1.0 - h0)))
+
+    def mad(x):
+        return 1.4826 * np.median(np.abs(x - np.median(x)))
+
+    return float(np.sqrt((mad(r.real) ** 2 + mad(r.imag) ** 2) / (1.0 - h0)))
 
 
 def frac(model: FRF, measured: FRF) -> float:
@@ -135,7 +152,7 @@ def pair_modes(model: FRF, measured: FRF, floor: float = 0.02, window: int | Non
     a factor 1.5 in frequency stays unpaired.
     """
     _check(model, measured)
-    w = window or choose_window(measured)
+    w = window or _window(measured)
     fm, hm = _peaks(smooth(measured, window=w), floor)
     fo, ho = _peaks(model, floor)
     candidates = sorted(

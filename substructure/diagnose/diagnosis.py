@@ -66,6 +66,7 @@ class Candidate:
     effect: Effect = attrs.field(eq=False)
     error: float
     nfev: int = 0
+    added: tuple = attrs.field(default=(), eq=False)  # earlier effects, refitted with this one
 
     @property
     def name(self) -> str:
@@ -250,10 +251,15 @@ class _Model:
 
     def evaluate(self, effects: Sequence[Effect]) -> list[np.ndarray]:
         out = []
-        for config, ref, prepared in zip(self.configurations, self.references, self.prepared):
-            changes = _diff(ref, _apply_all(config, effects))
-            out.append(prepared.evaluate(joints=changes["joints"], sensors=changes["sensors"],
-                                         supports=changes["supports"], components=changes["components"]).data)
+        for config, ref, prepared, (_, frf) in zip(self.configurations, self.references, self.prepared,
+                                                   self.data.items):
+            modified = _apply_all(config, effects)
+            changes = _diff(ref, modified)
+            try:
+                out.append(prepared.evaluate(joints=changes["joints"], sensors=changes["sensors"],
+                                             supports=changes["supports"], components=changes["components"]).data)
+            except InvalidValueError:  # the effect moved a point (e.g. a spring's position): compute anew
+                out.append(modified.frf(list(frf.outputs), list(frf.inputs), frf.frequency).data)
         return out
 
 
@@ -308,7 +314,8 @@ def _significant(e0: float, e1: float, floor: float) -> bool:
     return e0 > 1.5 * floor and (e0 - e1) > 0.5 * floor and (e0 - e1) > 0.1 * (e0 - floor)
 
 
-def _candidates(assembly, data, fixed, names, exclude, progress) -> list[Candidate]:
+def _candidates(assembly, data, added, names, exclude, progress) -> list[Candidate]:
+    """Every effect at every place, fitted; with ``added`` effects refitted together with it."""
     points = []
     for m, frf in data.items:
         points += list(frf.outputs) + list(frf.inputs)
@@ -323,13 +330,14 @@ def _candidates(assembly, data, fixed, names, exclude, progress) -> list[Candida
         if progress:
             progress(f"fitting {cls.name} at {where} ({n}/{len(todo)})")
         start = cls.starting_values(assembly, where, 0.0)
+        free = [(cls, where, start)] + [(type(e), e.where, e.values) for e in added]
         try:
-            effects, err, nfev = _fit(assembly, data, fixed, [(cls, where, start)])
-        except (InvalidValueError, ValueError) as exc:
+            effects, err, nfev = _fit(assembly, data, [], free)
+        except InvalidValueError as exc:  # the effect cannot act here (e.g. out of its bounds)
             if progress:
                 progress(f"  skipped {cls.name} at {where}: {exc}")
             continue
-        out.append(Candidate(effects[0], err, nfev))
+        out.append(Candidate(effects[0], err, nfev, tuple(effects[1:])))
     out.sort(key=lambda c: c.error)
     return out
 
@@ -396,9 +404,8 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence[str] = "a
             choice = candidates[0] if candidates else None
             if choice is None or not _significant(current_error, choice.error, floor):
                 break
-            free = [(type(e), e.where, e.values) for e in added] + [(type(choice.effect), choice.where,
-                                                                   choice.effect.values)]
-            added, current_error, _ = _fit(assembly, data, [], free, scan=False)
+            added = list(choice.added) + [choice.effect]
+            current_error = choice.error
             if progress:
                 progress(f"step {len(added)}: added {choice.name} at {choice.where}, error {current_error:.4g}")
             steps.append(Step(len(added), added[-1], current_error))

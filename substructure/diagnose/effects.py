@@ -336,7 +336,10 @@ def flute_tip(tool: Beam, length_m: float, ratio: float) -> Beam:
 @register_effect
 class SupportSprings(Effect):
     name = "support-springs"
-    parameters = (Parameter("k_yf", "N/m", 1e1, 1e8, 1e5),)
+    parameters = (
+        Parameter("k_yf", "N/m", 1e1, 1e8, 1e5),
+        Parameter("inset", "dimensionless", 0.0, 0.45, 0.15, log=False),
+    )
     explanation = (
         "springs to the ground (suspension bands of a 'free-free' test, a fixture) turn the "
         "rigid-body motion into low modes, tens of Hz for bands: the low end of the FRF rises "
@@ -352,7 +355,11 @@ class SupportSprings(Effect):
         return [heaviest.name]
 
     def apply(self, assembly):
+        """Two equal springs (k_yf each) on the component, ``inset`` of its length in from each end."""
+        comp = assembly.component(self.where)
         k = _si(self.values["k_yf"], "N/m")
-        comp = self.where
-        return assembly.support(Support(f"{comp}.base", k={"yf": k}, name=f"diagnosed-{comp}-base")).support(
-            Support(f"{comp}.tip", k={"yf": k}, name=f"diagnosed-{comp}-tip"))
+        inset = self.values["inset"] * comp.length_m
+        near = f"{comp.name}@{_si(inset, 'm')}"
+        far = f"{comp.name}@{_si(comp.length_m - inset, 'm')}"
+        return assembly.support(Support(near, k={"yf": k}, name=f"diagnosed-{comp.name}-1")).support(
+            Support(far, k={"yf": k}, name=f"diagnosed-{comp.name}-2"))

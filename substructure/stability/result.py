@@ -1,0 +1,206 @@
+"""Stability lobes as a result object: speeds, depth limits, chatter frequencies.
+
+:class:`Lobes` is what :func:`~substructure.stability.zoa` and
+:func:`~substructure.stability.sdm` return: for each spindle speed [rpm] the
+depth of cut limit [m] (the lowest lobe at that speed; ``inf`` where the
+method finds no limit) and the chatter frequency [Hz] at that limit.  Depths
+below the limit are stable.  :class:`LobesBand` holds the spread of several
+results (e.g. from FRFs that span an uncertainty band).  Plots are drawn by
+:mod:`substructure.stability.plotting`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import attrs
+import numpy as np
+
+from ..errors import InvalidValueError, SubstructureWarning
+
+__all__ = ["Lobes", "LobesBand", "lobes_band", "StabilityWarning"]
+
+
+class StabilityWarning(SubstructureWarning):
+    """A stability result may mislead: e.g. its limit sits at the edge of the FRF's band."""
+
+
+def _array(value: Any) -> np.ndarray:
+    out = np.array(value, dtype=float, copy=True)
+    out.flags.writeable = False
+    return out
+
+
+_eq = attrs.cmp_using(eq=np.array_equal)
+
+
+def _json_numbers(values: np.ndarray) -> list:
+    return [float(v) if np.isfinite(v) else None for v in values]
+
+
+@attrs.frozen
+class Lobes:
+    """A stability lobe diagram.
+
+    Attributes
+    ----------
+    method : {"zoa", "sdm"}
+    spindle_speed_rpm : ndarray
+    depth_limit_m : ndarray
+        Limiting axial depth of cut at each speed (``inf``: no limit found).
+    chatter_frequency_hz : ndarray
+        Chatter frequency at the limit (``nan`` where there is none).
+    absolute_limit_m : float or None
+        Zero-order: the speed-independent limit (the lowest depth of every
+        lobe); ``None`` for semi-discretization.
+    absolute_limit_frequency_hz : float or None
+        The chatter frequency of the absolute limit.
+    lobes : tuple of (ndarray, ndarray)
+        Zero-order: the individual lobes as ``(speed_rpm, depth_m)``, for
+        plots; empty for semi-discretization.
+    bifurcation : tuple of str
+        Semi-discretization: ``"hopf"`` (chatter at a frequency unrelated to
+        the tooth passing) or ``"flip"`` (period doubling) at each speed.
+    discretisation : dict
+        Semi-discretization: the scheme and the numbers that define it.
+    cut : MillingCut or TurningCut
+    label : str or None
+        Legend label.
+    """
+
+    method: str
+    spindle_speed_rpm: np.ndarray = attrs.field(converter=_array, eq=_eq)
+    depth_limit_m: np.ndarray = attrs.field(converter=_array, eq=_eq)
+    chatter_frequency_hz: np.ndarray = attrs.field(converter=_array, eq=_eq)
+    cut: Any = None
+    absolute_limit_m: float | None = None
+    absolute_limit_frequency_hz: float | None = None
+    lobes: tuple = attrs.field(default=(), eq=False, repr=False)
+    bifurcation: tuple = attrs.field(default=(), converter=tuple, repr=False)
+    discretisation: dict = attrs.field(factory=dict, eq=False)
+    label: str | None = None
+
+    def __attrs_post_init__(self) -> None:
+        n = self.spindle_speed_rpm.size
+        for name in ("depth_limit_m", "chatter_frequency_hz"):
+            if getattr(self, name).shape != (n,):
+                raise InvalidValueError(f"{name}: expected {n} values, one per spindle speed")
+
+    def with_label(self, label: str) -> Lobes:
+        """The same result with another legend label."""
+        return attrs.evolve(self, label=label)
+
+    # -- reading the diagram ----------------------------------------------------
+    def limit_at(self, speed_rpm: Any) -> np.ndarray:
+        """Depth limit in m at speeds in rpm (plain numbers), linearly interpolated."""
+        return np.interp(np.asarray(speed_rpm, float), self.spindle_speed_rpm, self.depth_limit_m)
+
+    def is_stable(self, speed_rpm: Any, depth_m: Any) -> np.ndarray:
+        """Whether cuts at these speeds [rpm] and depths [m] are below the limit."""
+        return np.asarray(depth_m, float) < self.limit_at(speed_rpm)
+
+    def best_speeds(self, count: int = 3) -> list[tuple[float, float]]:
+        """The ``count`` best speeds: local maxima of the limit, ``(rpm, depth_m)``, deepest first.
+
+        A maximum at either end of the speed range counts only when the limit
+        falls away from it (it may lie outside the range).
+        """
+        a = np.where(np.isfinite(self.depth_limit_m), self.depth_limit_m, np.nan)
+        if a.size < 3 or np.all(np.isnan(a)):
+            return []
+        fill = np.nan_to_num(a, nan=-np.inf)
+        inner = (fill[1:-1] >= fill[:-2]) & (fill[1:-1] > fill[2:])
+        index = np.flatnonzero(inner) + 1
+        index = index[np.argsort(-fill[index])][:count]
+        return [(float(self.spindle_speed_rpm[i]), float(a[i])) for i in index]
+
+    @property
+    def min_limit_m(self) -> float:
+        """The lowest depth limit over the speeds computed."""
+        return float(np.min(self.depth_limit_m))
+
+    # -- output -----------------------------------------------------------------
+    def to_json(self) -> dict:
+        """The JSON object of ``substructure lobes --json`` (SI units, ``null`` for no limit)."""
+        out = {
+            "method": self.method,
+            "spindle_speed_rpm": self.spindle_speed_rpm.tolist(),
+            "depth_limit_m": _json_numbers(self.depth_limit_m),
+            "chatter_frequency_hz": _json_numbers(self.chatter_frequency_hz),
+        }
+        if self.method == "zoa":
+            out["absolute_limit_m"] = None if self.absolute_limit_m is None or not np.isfinite(
+                self.absolute_limit_m) else float(self.absolute_limit_m)
+            out["absolute_limit_frequency_hz"] = self.absolute_limit_frequency_hz
+        if self.bifurcation:
+            out["bifurcation"] = list(self.bifurcation)
+        if self.discretisation:
+            out["discretisation"] = dict(self.discretisation)
+        out["best_speeds"] = [{"spindle_speed_rpm": n, "depth_limit_m": a} for n, a in self.best_speeds()]
+        return out
+
+    def plot(self, ax: Any = None, **kw: Any):
+        """Draw onto ``ax`` (new figure when None) with :func:`~substructure.stability.plotting.plot_lobes`.
+
+        Call it again with the same ``ax`` to put several results on one plot.
+        """
+        from .plotting import plot_lobes
+
+        return plot_lobes([self], ax=ax, **kw)
+
+
+@attrs.frozen
+class LobesBand:
+    """The spread of lobes computed from several FRFs (e.g. an FRF uncertainty band).
+
+    Attributes
+    ----------
+    spindle_speed_rpm : ndarray
+    lower_m, upper_m : ndarray
+        The lowest and highest depth limit at each speed over the members.
+    nominal : Lobes or None
+        The result drawn as a line within the band.
+    members : tuple of Lobes
+    label : str or None
+    """
+
+    spindle_speed_rpm: np.ndarray = attrs.field(converter=_array, eq=_eq)
+    lower_m: np.ndarray = attrs.field(converter=_array, eq=_eq)
+    upper_m: np.ndarray = attrs.field(converter=_array, eq=_eq)
+    nominal: Lobes | None = None
+    members: tuple = attrs.field(default=(), converter=tuple, eq=False, repr=False)
+    label: str | None = None
+
+    def plot(self, ax: Any = None, **kw: Any):
+        """Shade the band and draw the nominal lobes (:func:`~substructure.stability.plotting.plot_band`)."""
+        from .plotting import plot_band
+
+        return plot_band(self, ax=ax, **kw)
+
+    def to_json(self) -> dict:
+        return {"spindle_speed_rpm": self.spindle_speed_rpm.tolist(), "lower_m": _json_numbers(self.lower_m),
+                "upper_m": _json_numbers(self.upper_m)}
+
+
+def lobes_band(results: Sequence[Lobes], nominal: Lobes | None = None, label: str | None = None) -> LobesBand:
+    """The band spanned by several lobe diagrams on the same speeds.
+
+    Parameters
+    ----------
+    results : sequence of Lobes
+        E.g. lobes from FRFs at the ends of (or sampled from) an FRF
+        uncertainty band.
+    nominal : Lobes, optional
+        The result drawn as a line; default: none.
+    label : str, optional
+    """
+    results = list(results)
+    if not results or not all(isinstance(r, Lobes) for r in results):
+        raise InvalidValueError("results: expected one or more Lobes")
+    speeds = results[0].spindle_speed_rpm
+    for r in results[1:] + ([nominal] if nominal is not None else []):
+        if not np.array_equal(r.spindle_speed_rpm, speeds):
+            raise InvalidValueError("results: every Lobes must be on the same spindle speeds")
+    depths = np.array([r.depth_limit_m for r in results])
+    return LobesBand(speeds, depths.min(axis=0), depths.max(axis=0), nominal=nominal, members=results, label=label)

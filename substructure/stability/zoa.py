@@ -1,0 +1,202 @@
+"""Zero-order approximation of milling stability (Altintas & Budak 1995).
+
+The cutting force matrix ``K(t)`` (:mod:`~substructure.stability.cutting`) is
+replaced by its average ``K0`` over a tooth period.  Chatter at frequency
+``omega`` with depth ``a`` and delay ``T`` then needs
+
+``det[I - a (1 - exp(-i omega T)) K0 G(i omega)] = 0``,
+
+with ``G`` the 2x2 tool point receptance in x and y.  For each eigenvalue
+``lambda`` of ``K0 G`` with ``Re lambda > 0``:
+
+* depth limit ``a = 1 / (2 Re lambda)`` (Altintas's
+  ``-2 pi Lambda_R (1 + kappa^2) / (N Kt)`` written with ``lambda = -N Kt / (4 pi Lambda)``),
+* phase ``omega T = pi + 2 arg(lambda) + 2 pi k`` for lobe ``k = 0, 1, ...``,
+* spindle speed ``n = 60 / (N T)`` rpm.
+
+Every frequency line of the FRF gives one point of every lobe: no modal fit
+is needed, any number of modes and cross terms are taken as they are.  The
+lobes are mapped onto the requested speeds by linear interpolation between
+neighbouring lines, and the depth limit at a speed is the lowest lobe there.
+The absolute (speed-independent) limit is the smallest ``a`` over all lines,
+refined between lines.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+
+from ..frf import FRF, Frequency
+from .cutting import as_speed_rpm
+from .result import Lobes, StabilityWarning
+from .structure import xy_receptance
+
+__all__ = ["zoa", "zoa_eigenvalues"]
+
+
+def zoa_eigenvalues(k0: np.ndarray, g: np.ndarray) -> np.ndarray:
+    """Eigenvalues of ``K0 @ G`` per line, shape ``(n, 2)``, ordered to follow each branch.
+
+    Parameters
+    ----------
+    k0 : ndarray, shape (2, 2)
+        Mean cutting force matrix in N/m^2.
+    g : ndarray, shape (n, 2, 2)
+        Receptances in m/N.
+    """
+    m = np.einsum("ij,njk->nik", k0, g)
+    half_tr = 0.5 * (m[:, 0, 0] + m[:, 1, 1])
+    det = m[:, 0, 0] * m[:, 1, 1] - m[:, 0, 1] * m[:, 1, 0]
+    root = np.sqrt(half_tr**2 - det)
+    lam = np.stack([half_tr + root, half_tr - root], axis=1)
+    if lam.shape[0] > 1:
+        # keep branches continuous across the branch cut of the square root
+        same = np.abs(lam[1:] - lam[:-1]).sum(axis=1)
+        cross = np.abs(lam[1:] - lam[:-1, ::-1]).sum(axis=1)
+        parity = np.concatenate([[0], np.cumsum(cross < same) % 2])
+        flip = parity == 1
+        lam[flip] = lam[flip, ::-1]
+    return lam
+
+
+def _refine_data(f: np.ndarray, a: np.ndarray, i: int) -> tuple[float, float]:
+    """Vertex of the parabola through three lines around the smallest ``a`` (when it is lower)."""
+    if i == 0 or i == a.size - 1 or not np.all(np.isfinite(a[i - 1:i + 2])):
+        return float(a[i]), float(f[i])
+    x, y = f[i - 1:i + 2], a[i - 1:i + 2]
+    c2, c1, c0 = np.polyfit(x - x[1], y, 2)
+    if c2 <= 0:
+        return float(a[i]), float(f[i])
+    dx = -c1 / (2 * c2)
+    if not x[0] - x[1] <= dx <= x[2] - x[1]:
+        return float(a[i]), float(f[i])
+    return float(min(a[i], c0 - c1**2 / (4 * c2))), float(x[1] + dx)
+
+
+def _refine_model(structure: Any, k0: np.ndarray, f: np.ndarray, i: int, branch: int) -> tuple[float, float]:
+    """Minimise ``a(f)`` of a modal model between the neighbours of line ``i``."""
+    from scipy.optimize import minimize_scalar
+
+    lo, hi = f[max(i - 1, 0)], f[min(i + 1, f.size - 1)]
+
+    def depth(x: float) -> float:
+        lam = zoa_eigenvalues(k0, structure.receptance(np.array([x])))[0]
+        re = lam.real.max()
+        return 1.0 / (2.0 * re) if re > 0 else np.inf
+
+    sol = minimize_scalar(depth, bounds=(lo, hi), method="bounded", options={"xatol": 1e-10 * hi})
+    return float(sol.fun), float(sol.x)
+
+
+def _lobes_on_speeds(speeds: np.ndarray, n: np.ndarray, a: np.ndarray, f: np.ndarray, ok: np.ndarray):
+    """Lowest lobe at each speed; ``n`` (L, m) speeds of L lobes, ``a``/``f`` (L, m), ``ok`` (L, m-1) segments."""
+    lobe, i = np.nonzero(ok)
+    n0, n1 = n[lobe, i], n[lobe, i + 1]
+    lo = np.searchsorted(speeds, np.minimum(n0, n1), side="left")
+    hi = np.searchsorted(speeds, np.maximum(n0, n1), side="right")
+    count = hi - lo
+    keep = count > 0
+    lobe, i, n0, n1, lo, count = lobe[keep], i[keep], n0[keep], n1[keep], lo[keep], count[keep]
+    depth = np.full(speeds.size, np.inf)
+    freq = np.full(speeds.size, np.nan)
+    if count.size == 0:
+        return depth, freq
+    seg = np.repeat(np.arange(count.size), count)
+    start = np.cumsum(count) - count
+    j = lo[seg] + np.arange(seg.size) - start[seg]
+    span = n1[seg] - n0[seg]
+    t = np.where(span != 0, (speeds[j] - n0[seg]) / np.where(span != 0, span, 1.0), 0.0)
+    li, ii = lobe[seg], i[seg]
+    aj = a[li, ii] + t * (a[li, ii + 1] - a[li, ii])
+    fj = f[li, ii] + t * (f[li, ii + 1] - f[li, ii])
+    order = np.lexsort((aj, j))
+    j, aj, fj = j[order], aj[order], fj[order]
+    first = np.flatnonzero(np.diff(j, prepend=-1))
+    depth[j[first]] = aj[first]
+    freq[j[first]] = fj[first]
+    return depth, freq
+
+
+def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = None,
+        label: str | None = None) -> Lobes:
+    """Stability lobes by the zero-order approximation.
+
+    Parameters
+    ----------
+    structure : FRF or ModalModel
+        The tool point receptances: an FRF labelled ``x``/``y``
+        (:func:`~substructure.stability.xy_frf`, cross terms included when
+        given), a one-entry translational FRF (a symmetric tool: ``y = x``),
+        or a :class:`~substructure.stability.ModalModel`.
+    cut : MillingCut or TurningCut
+    speeds : pint.Quantity
+        Spindle speeds in rpm, strictly increasing
+        (:func:`~substructure.stability.spindle_speeds`).
+    frequency : Frequency, optional
+        For a modal model: the lines to evaluate on (default: a grid refined
+        around every mode).
+    label : str, optional
+        Legend label of the result.
+
+    Returns
+    -------
+    Lobes
+        With the absolute limit and the individual lobes.
+
+    Warns
+    -----
+    StabilityWarning
+        When the absolute limit lies at the first or last line of FRF data:
+        the FRF band may leave out what limits the cut (e.g. the rigid-body
+        region of a free-free model); crop or extend it.
+    """
+    speeds_rpm = as_speed_rpm(speeds)
+    f, g = xy_receptance(structure, frequency)
+    k0 = cut.mean_force_matrix()
+    lam = zoa_eigenvalues(k0, g)  # (m, 2)
+    teeth = cut.regenerations_per_revolution
+    with np.errstate(divide="ignore", invalid="ignore"):
+        valid = lam.real > 1e-300
+        a = np.where(valid, 1.0 / (2.0 * lam.real), np.inf)  # (m, 2)
+        theta = np.pi + 2.0 * np.angle(lam)  # in (0, 2 pi) where valid
+    if not valid.any():
+        return Lobes("zoa", speeds_rpm, np.full(speeds_rpm.size, np.inf), np.full(speeds_rpm.size, np.nan),
+                     cut=cut, absolute_limit_m=float("inf"), label=label)
+    # absolute limit
+    flat = np.argmin(a, axis=None)
+    i, branch = np.unravel_index(flat, a.shape)
+    if isinstance(structure, FRF):
+        a_abs, f_abs = _refine_data(f, a[:, branch], i)
+        if i in (0, f.size - 1):
+            warnings.warn(
+                f"zoa: the absolute limit is at the {'first' if i == 0 else 'last'} line of the FRF "
+                f"({f[i]:g} Hz); the FRF band may leave out what limits the cut (a free-free model's "
+                "rigid-body motion, a mode outside the band): crop or extend the band", StabilityWarning,
+                stacklevel=2)
+    else:
+        a_abs, f_abs = _refine_model(structure, k0, f, i, branch)
+    # lobes: n = 60 f / (N (theta / 2 pi + k)), k = 0 .. k_max over both branches
+    k_max = int(np.ceil(60.0 * f[valid.any(axis=1)].max() / (teeth * speeds_rpm[0])))
+    k = np.arange(k_max + 1)
+    phase = theta.T[:, None, :] / (2.0 * np.pi) + k[None, :, None]  # (2, K, m)
+    n = 60.0 * f[None, None, :] / (teeth * phase)
+    ok_line = np.broadcast_to(valid.T[:, None, :], n.shape)
+    ok = ok_line[..., 1:] & ok_line[..., :-1] & (np.abs(np.diff(np.broadcast_to(theta.T[:, None, :], n.shape),
+                                                                  axis=-1)) < np.pi)
+    shape = (n.shape[0] * n.shape[1], n.shape[2])
+    aa = np.broadcast_to(a.T[:, None, :], n.shape).reshape(shape)
+    ff = np.broadcast_to(f[None, None, :], n.shape).reshape(shape)
+    depth, chatter = _lobes_on_speeds(speeds_rpm, n.reshape(shape), aa, ff, ok.reshape(shape[0], -1))
+    # the individual lobes, for plots: within the speed range and below a few times the deepest limit
+    finite = depth[np.isfinite(depth)]
+    cap = 5.0 * (finite.max() if finite.size else a_abs)
+    curves = []
+    for row_n, row_a, row_ok in zip(n.reshape(shape), aa, ok_line.reshape(shape)):
+        show = row_ok & (row_a <= cap) & (row_n >= speeds_rpm[0] * 0.98) & (row_n <= speeds_rpm[-1] * 1.02)
+        if show.sum() > 1:
+            curves.append((np.where(show, row_n, np.nan), np.where(show, row_a, np.nan)))
+    return Lobes("zoa", speeds_rpm, depth, chatter, cut=cut, absolute_limit_m=a_abs,
+                 absolute_limit_frequency_hz=f_abs, lobes=tuple(curves), label=label)
