@@ -1,0 +1,66 @@
+"""`substructure diagnose`: formats.md JSON, human output, figures, the improved model, bad input."""
+
+import json
+
+import pytest
+
+import hidden_data as hd
+from substructure import load_assembly, save_assembly
+from substructure.cli import main
+from substructure.measurements import Measurement, MeasurementSet
+from substructure.synthetic import write_measurement_set
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    d = tmp_path_factory.mktemp("diagnose")
+    frf = hd.measure(sensor_kg=0.002, seed=3)[0]
+    write_measurement_set(MeasurementSet("tap test", (Measurement.from_frf(frf, "tool.tip", "tool.tip"),)), d)
+    save_assembly(hd.nominal_model(), d / "model.toml")
+    return d
+
+
+def _run(files, *extra):
+    return main(["diagnose", str(files / "model.toml"), str(files / "measurements.toml"), "--quiet", *extra])
+
+
+def test_json_is_exactly_formats_md(files, capsys):
+    assert _run(files, "--json", "--effects", "sensor-mass,joint-stiffness") == 0
+    out = json.loads(capsys.readouterr().out)
+    for key in ("metric", "baseline_error", "noise_floor", "missing_effect", "ambiguous_with", "candidates",
+                "refinement"):
+        assert key in out
+    assert out["metric"] == "rms_log_ratio"
+    assert out["missing_effect"] == "sensor-mass"
+    best = out["candidates"][0]
+    assert best["effect"] == "sensor-mass" and best["where"] == "tool.tip"
+    assert best["parameters"]["mass"]["unit"] == "kg"
+    assert best["parameters"]["mass"]["value"] == pytest.approx(0.002, rel=0.15)
+    assert out["refinement"][1]["added"] == "sensor-mass" and out["refinement"][1]["where"] == "tool.tip"
+    assert out["refinement"][-1]["error"] < out["baseline_error"] / 5
+
+
+def test_human_output_figures_and_the_improved_model(files, capsys, tmp_path):
+    model_out = tmp_path / "improved.toml"
+    assert _run(files, "--effects", "sensor-mass,joint-stiffness", "--plot", str(tmp_path / "figs"),
+                "--save-model", str(model_out)) == 0
+    text = capsys.readouterr().out
+    assert "missing effect: sensor-mass at tool.tip" in text and "watch the error fall" in text
+    for name in ("where_it_fails.png", "error_fall.png", "after_refinement.png"):
+        assert (tmp_path / "figs" / name).stat().st_size > 0
+    improved = load_assembly(model_out)
+    (sensor,) = improved.sensors  # written back in its normal form: a [[sensors]] entry
+    assert sensor.at == "tool.tip" and sensor.mass_kg == pytest.approx(0.002, rel=0.15)
+
+
+def test_bad_input(files, capsys, tmp_path):
+    assert _run(files, "--effects", "gremlins") == 1
+    assert "unknown effect 'gremlins'" in capsys.readouterr().err
+    assert _run(files, "--band", "6000:9000") == 1
+    assert "outside the measured data" in capsys.readouterr().err
+    other = tmp_path / "other.toml"
+    other.write_text((files / "measurements.toml").read_text().replace('"tool.tip:y"', '"drill.tip:y"', 1))
+    (tmp_path / "00_tool_tip__tool_tip.csv").write_text((files / "00_tool_tip__tool_tip.csv").read_text())
+    assert main(["diagnose", str(files / "model.toml"), str(other), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert "drill" in err and "Traceback" not in err
