@@ -175,6 +175,7 @@ class DemoState:
     results: dict = attrs.field(factory=dict)
     files: list = attrs.field(factory=list)
     lines: list = attrs.field(factory=list)
+    taps: Any = None
 
 
 def _demo_load(state: DemoState) -> None:
@@ -214,11 +215,61 @@ def _demo_assembly_file(state: DemoState) -> None:
     state.files.append(str(path))
 
 
+def _demo_tap_test(state: DemoState) -> None:
+    """A tap test of the built-in assembly with something the model does not know about."""
+    from .joints import Sensor
+    from .measurements import MeasurementSet
+    from .synthetic import simulate, write_measurement_set
+
+    rig = state.assembly.attach(Sensor("forgotten-accelerometer", "tool.tip", "2 g"))
+    taps = simulate(rig, ["tool.tip"], frequency=state.assembly.frequency, noise=0.015, seed=2026,
+                    sensors=["forgotten-accelerometer"], name="demo tap test (1.5 % noise)")
+    # the measurement file does not mention the sensor: the test report forgot it
+    taps = MeasurementSet(taps.name, tuple(attrs.evolve(m, sensors=()) for m in taps))
+    state.results["measurements"] = str(write_measurement_set(taps, state.out / "tap_test", overwrite=True))
+    state.lines.append("a simulated tap test of the tool point, 1.5 % noise, with a 2 g accelerometer "
+                       "that the test report forgot to mention")
+    state.files.append(state.results["measurements"])
+    state.taps = taps
+
+
+def _demo_diagnose(state: DemoState) -> None:
+    """Model against tap test: where it fails, what is missing, the error falling."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .diagnose import diagnose
+    from .io.assembly_toml import save_assembly
+
+    result = diagnose(state.assembly, state.taps)
+    state.results["diagnosis"] = result.to_json()
+    state.lines.append(f"diagnosis: error {result.baseline_error:.3f} against a noise floor of "
+                       f"{result.noise_floor:.3f}; missing effect: {result.missing_effect} at "
+                       f"{result.missing_where}")
+    for step in result.refinement:
+        what = "model as given" if step.added is None else f"+ {step.added.name} at {step.added.where}"
+        state.lines.append(f"  step {step.step}: {what:45s} error {step.error:.4f}")
+    for name, make in (("where_it_fails.png", result.plot_where), ("error_fall.png", result.plot_history)):
+        fig = make()
+        try:
+            fig.savefig(state.out / name, dpi=120)
+        finally:
+            plt.close(fig)
+        state.files.append(str(state.out / name))
+    path = state.out / "improved_assembly.toml"
+    save_assembly(result.refined_assembly, path, overwrite=True)
+    state.files.append(str(path))
+
+
 DEMO_STEPS: list[tuple[str, Callable[[DemoState], None]]] = [
     ("load the built-in assembly", _demo_load),
     ("compute the tool point FRF", _demo_frf),
     ("plot the tool point FRF", _demo_plot),
     ("write the assembly file to start from", _demo_assembly_file),
+    ("simulate a tap test with a hidden effect", _demo_tap_test),
+    ("diagnose the model against the tap test", _demo_diagnose),
 ]
 """The demo's steps, in order: ``(title, function(state))``; append to add steps."""
 
