@@ -64,3 +64,13 @@ def test_bad_input(files, capsys, tmp_path):
     assert main(["diagnose", str(files / "model.toml"), str(other), "--quiet"]) == 1
     err = capsys.readouterr().err
     assert "drill" in err and "Traceback" not in err
+
+
+def test_demo_runs_the_diagnosis_on_built_in_data(capsys, tmp_path):
+    assert main(["demo", "--out", str(tmp_path), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    diagnosis = out["diagnosis"]
+    assert diagnosis["missing_effect"] == "sensor-mass"
+    assert diagnosis["refinement"][-1]["error"] <= 1.5 * diagnosis["noise_floor"]
+    for name in ("where_it_fails.png", "error_fall.png", "improved_assembly.toml", "tool_point_frf.png"):
+        assert (tmp_path / name).stat().st_size > 0

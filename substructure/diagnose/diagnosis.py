@@ -37,7 +37,11 @@ from ..identify.band_fit import model_of_measurement
 from .compare import METRIC, Comparison, compare, noise_floor
 from .effects import EFFECTS, Effect, get_effect
 
-__all__ = ["Candidate", "Step", "Diagnosis", "diagnose", "SUGGESTIONS"]
+__all__ = ["Candidate", "Step", "Diagnosis", "diagnose", "SUGGESTIONS", "REFIT_TOP"]
+
+REFIT_TOP = 3
+"""In refinement steps after the first, the best this many candidates are refitted together with
+the effects already added (the others keep their fit with those effects held)."""
 
 SUGGESTIONS = {
     frozenset({"sensor-mass", "joint-stiffness"}): "measure once more with a laser vibrometer (or with a "
@@ -304,7 +308,7 @@ def _fit(assembly: Assembly, data: _Data, fixed: Sequence[Effect], free: Sequenc
     x0 = np.clip(x0, lower + 1e-12 * np.abs(lower), upper - 1e-12 * np.abs(upper))
     scale = np.where([p.log for (_, p, _, _, _) in specs], 1.0, np.maximum(upper - lower, 1e-30) / 10)
     fit = least_squares(residual, x0, bounds=(lower, upper), x_scale=scale, method="trf",
-                        max_nfev=60 * len(x0))
+                        max_nfev=25 * len(x0) + 20)
     nfev += fit.nfev
     err = float(np.sqrt(np.mean(fit.fun**2) * 2))
     return effects_of(fit.x), err, nfev
@@ -330,15 +334,25 @@ def _candidates(assembly, data, added, names, exclude, progress) -> list[Candida
         if progress:
             progress(f"fitting {cls.name} at {where} ({n}/{len(todo)})")
         start = cls.starting_values(assembly, where, 0.0)
-        free = [(cls, where, start)] + [(type(e), e.where, e.values) for e in added]
         try:
-            effects, err, nfev = _fit(assembly, data, [], free)
+            effects, err, nfev = _fit(assembly, data, list(added), [(cls, where, start)])
         except InvalidValueError as exc:  # the effect cannot act here (e.g. out of its bounds)
             if progress:
                 progress(f"  skipped {cls.name} at {where}: {exc}")
             continue
-        out.append(Candidate(effects[0], err, nfev, tuple(effects[1:])))
+        out.append(Candidate(effects[0], err, nfev, tuple(added)))
     out.sort(key=lambda c: c.error)
+    if added:
+        # The earlier effects were fitted without this one and may be biased by
+        # it: refit them together with each of the best few candidates.
+        refined = []
+        for c in out[:REFIT_TOP]:
+            if progress:
+                progress(f"refitting {c.name} at {c.where} with the effects added so far")
+            free = [(type(c.effect), c.where, c.effect.values)] + [(type(e), e.where, e.values) for e in added]
+            effects, err, nfev = _fit(assembly, data, [], free, scan=False)
+            refined.append(Candidate(effects[0], err, c.nfev + nfev, tuple(effects[1:])))
+        out = sorted(refined, key=lambda c: c.error) + out[REFIT_TOP:]
     return out
 
 
