@@ -78,7 +78,12 @@ def _window(measured: FRF, polyorder: int = 3) -> int:
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", CoarseDataWarning)
-        return choose_window(measured, polyorder=polyorder)
+        try:
+            return choose_window(measured, polyorder=polyorder)
+        except InvalidValueError:  # no resonance in the band: a window of ~2 % of the lines
+            n = len(measured.frequency)
+            w = max(polyorder + 2, min(31, n // 50))
+            return w + 1 if w % 2 == 0 else w
 
 
 def noise_floor(measured: FRF, window: int | None = None, polyorder: int = 3) -> float:
@@ -133,11 +138,18 @@ class ModePair:
         return None if self.model_amplitude is None else self.model_amplitude / self.measured_amplitude
 
 
-def _peaks(frf: FRF, floor: float) -> tuple[np.ndarray, np.ndarray]:
-    """Resonances of the first entry of a (smoothed) FRF above ``floor`` of the highest."""
+def _peaks(frf: FRF, floor: float, prominence: float) -> tuple[np.ndarray, np.ndarray]:
+    """Resonances of the first entry of a (smoothed) FRF.
+
+    Peaks of ``ln|H|`` with a prominence of at least ``prominence`` (so that
+    noise ripples are not modes) and at least ``floor`` times the highest.
+    """
+    from scipy.signal import find_peaks
+
     h = np.abs(frf.data[:, 0, 0])
     f = frf.frequency.hz
-    idx = np.nonzero((h[1:-1] > h[:-2]) & (h[1:-1] >= h[2:]))[0] + 1
+    with np.errstate(divide="ignore"):
+        idx, _ = find_peaks(np.log(h), prominence=prominence)
     if idx.size:
         idx = idx[h[idx] >= floor * h[idx].max()]
     return f[idx], h[idx]
@@ -153,8 +165,11 @@ def pair_modes(model: FRF, measured: FRF, floor: float = 0.02, window: int | Non
     """
     _check(model, measured)
     w = window or _window(measured)
-    fm, hm = _peaks(smooth(measured, window=w), floor)
-    fo, ho = _peaks(model, floor)
+    # a mode must stand out of the noise: a prominence of 0.1 in ln|H| (10 %) or
+    # five times the noise floor, whichever is larger
+    prominence = max(0.1, 5.0 * noise_floor(measured, window=w))
+    fm, hm = _peaks(smooth(measured, window=w), floor, prominence)
+    fo, ho = _peaks(model, floor, 0.1)
     candidates = sorted(
         (abs(np.log(a / b)), i, j) for i, a in enumerate(fm) for j, b in enumerate(fo) if abs(np.log(a / b)) < np.log(1.5)
     )
@@ -171,13 +186,15 @@ def pair_modes(model: FRF, measured: FRF, floor: float = 0.02, window: int | Non
     ]
 
 
-def error_bands(model: FRF, measured: FRF, share: float = 0.5, width_hz: float | None = None) -> list[tuple[float, float, float]]:
+def error_bands(model: FRF, measured: FRF, share: float = 0.5, width_hz: float | None = None,
+                floor: float = 0.0) -> list[tuple[float, float, float]]:
     """The frequency bands that carry most of the error: ``[(lo, hi, share_of_error), ...]``.
 
     The squared log ratio, smoothed over ``width_hz`` (default 2 % of the
-    band), is cut into contiguous regions above its median; the regions are
+    band), is cut into contiguous regions above its median and above twice
+    the noise ``floor`` (noise is not a failure of the model); the regions are
     ranked by their share of the total and returned until ``share`` of the
-    error is covered.
+    error is covered.  None when the model is within the noise everywhere.
     """
     r2 = np.mean(np.abs(log_ratio(model, measured)) ** 2, axis=(1, 2))
     f = model.frequency.hz
@@ -185,7 +202,7 @@ def error_bands(model: FRF, measured: FRF, share: float = 0.5, width_hz: float |
     width = width_hz or 0.02 * (f[-1] - f[0])
     n = max(1, int(round(width / step)))
     local = np.convolve(r2, np.ones(n) / n, mode="same")
-    above = local > np.median(local)
+    above = (local > np.median(local)) & (local > (2.0 * floor) ** 2)
     total = r2.sum()
     regions = []
     i = 0
@@ -246,12 +263,13 @@ class Comparison:
 
 def compare(model: FRF, measured: FRF) -> Comparison:
     """Compare a model FRF with a measurement on the measured grid."""
+    floor = noise_floor(measured)
     return Comparison(
         model=model,
         measured=measured,
         error=error(model, measured),
-        noise_floor=noise_floor(measured),
+        noise_floor=floor,
         frac=frac(model, measured),
         modes=pair_modes(model, measured),
-        bands=error_bands(model, measured),
+        bands=error_bands(model, measured, floor=floor),
     )

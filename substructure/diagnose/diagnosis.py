@@ -12,9 +12,10 @@ is declared the ``missing_effect`` only when
 * the fit improves the error clearly beyond what noise allows: by more than
   half the noise floor and by more than a tenth of the excess over the floor.
 
-Effects whose fitted error is nearly as low (within 15 % of the improvement,
-or a tenth of the noise floor) are ``ambiguous_with`` it, with a suggestion
-of a measurement that would tell them apart.
+Effects whose fitted error is nearly as low (within 0.3 times the noise
+floor, plus a tenth of the best error's excess over the floor) are
+``ambiguous_with`` it, with a suggestion of a measurement that would tell
+them apart.
 
 The refinement adds the best effect, fits all added effects together, and
 diagnoses again, until nothing beats the noise floor; its history is the
@@ -87,7 +88,8 @@ class Candidate:
 
 @attrs.frozen
 class Step:
-    """One step of the refinement: the effect added (None at step 0) and the error after it."""
+    """One step of the refinement: the effect added (None at step 0), with its values as fitted at
+    that step, and the error after it (earlier effects refitted with it)."""
 
     step: int
     added: Effect | None = attrs.field(eq=False)
@@ -118,11 +120,12 @@ class Diagnosis:
     baseline: tuple[Comparison, ...] = attrs.field(eq=False)
     final: tuple[Comparison, ...] = attrs.field(eq=False)
     refined_assembly: Assembly = attrs.field(eq=False)
+    final_effects: tuple = attrs.field(default=(), eq=False)
 
     @property
     def effects(self) -> list[Effect]:
-        """The effects the refinement added, in order, with their final values."""
-        return [s.added for s in self.refinement if s.added is not None]
+        """The effects the refinement added, in order, with their final values (refitted together)."""
+        return list(self.final_effects)
 
     def to_json(self) -> dict:
         return {
@@ -137,6 +140,8 @@ class Diagnosis:
             "suggestion": self.suggestion,
             "band_hz": list(self.band),
             "final_error": self.refinement[-1].error,
+            "final_effects": [{"effect": e.name, "where": e.where, "parameters": e.parameters_json()}
+                              for e in self.final_effects],
             "modes": [
                 {"measured_hz": m.measured_hz, "model_hz": m.model_hz, "shift_hz": m.shift_hz,
                  "amplitude_ratio": m.amplitude_ratio}
@@ -274,7 +279,7 @@ def _fit(assembly: Assembly, data: _Data, fixed: Sequence[Effect], free: Sequenc
     for i, (cls, where, start) in enumerate(free):
         bounds = cls.bounds(assembly, where)
         for p in cls.parameters:
-            lo, hi = bounds[p.name]
+            lo, hi = max(bounds[p.name][0], p.lower), min(bounds[p.name][1], p.upper)
             specs.append((i, p, lo, hi, float(np.clip(start[p.name], lo, hi))))
     starts = [cls(where, **start) for cls, where, start in free]
     model = _Model(assembly, list(fixed) + starts, data)
@@ -314,11 +319,22 @@ def _fit(assembly: Assembly, data: _Data, fixed: Sequence[Effect], free: Sequenc
     return effects_of(fit.x), err, nfev
 
 
+def _main_shift(comparison: Comparison) -> float:
+    """Relative shift (model / measured - 1) of the strongest paired mode that moved most."""
+    pairs = [m for m in comparison.modes if m.model_hz is not None]
+    if not pairs:
+        return 0.0
+    top = max(m.measured_amplitude for m in pairs)
+    strong = [m for m in pairs if m.measured_amplitude >= 0.1 * top] or pairs
+    best = max(strong, key=lambda m: abs(m.model_hz / m.measured_hz - 1))
+    return float(best.model_hz / best.measured_hz - 1)
+
+
 def _significant(e0: float, e1: float, floor: float) -> bool:
     return e0 > 1.5 * floor and (e0 - e1) > 0.5 * floor and (e0 - e1) > 0.1 * (e0 - floor)
 
 
-def _candidates(assembly, data, added, names, exclude, progress) -> list[Candidate]:
+def _candidates(assembly, data, added, names, exclude, progress, shift: float = 0.0) -> list[Candidate]:
     """Every effect at every place, fitted; with ``added`` effects refitted together with it."""
     points = []
     for m, frf in data.items:
@@ -333,7 +349,7 @@ def _candidates(assembly, data, added, names, exclude, progress) -> list[Candida
     for n, (cls, where) in enumerate(todo, start=1):
         if progress:
             progress(f"fitting {cls.name} at {where} ({n}/{len(todo)})")
-        start = cls.starting_values(assembly, where, 0.0)
+        start = cls.starting_values(assembly, where, shift)
         try:
             effects, err, nfev = _fit(assembly, data, list(added), [(cls, where, start)])
         except InvalidValueError as exc:  # the effect cannot act here (e.g. out of its bounds)
@@ -398,12 +414,14 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence[str] = "a
     floor = float(np.sqrt(np.mean([noise_floor(frf) ** 2 for _, frf in data.items])))
     base_model = _Model(assembly, [], data)
     e0 = data.error(base_model.evaluate([]))
-    first = _candidates(assembly, data, [], names, set(), progress)
+    baseline = _comparisons(assembly, [], data)
+    shift = _main_shift(baseline[0])
+    first = _candidates(assembly, data, [], names, set(), progress, shift)
     best = first[0] if first else None
     missing = best is not None and _significant(e0, best.error, floor)
     ambiguous, suggestion = [], None
     if missing:
-        margin = 0.15 * (e0 - best.error) + 0.1 * floor
+        margin = 0.3 * floor + 0.1 * max(best.error - floor, 0.0)
         for c in first[1:]:
             if c.error <= best.error + margin and c.name != best.name and c.name not in ambiguous:
                 ambiguous.append(c.name)
@@ -422,13 +440,11 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence[str] = "a
             current_error = choice.error
             if progress:
                 progress(f"step {len(added)}: added {choice.name} at {choice.where}, error {current_error:.4g}")
-            steps.append(Step(len(added), added[-1], current_error))
+            steps.append(Step(len(added), choice.effect, current_error))
             if current_error <= 1.5 * floor:
                 break
             exclude = {(e.name, e.where) for e in added}
-            candidates = _candidates(assembly, data, added, names, exclude, progress)
-        # the final values of every added effect
-        steps = [steps[0]] + [Step(i + 1, added[i], s.error) for i, s in enumerate(steps[1:])]
+            candidates = _candidates(assembly, data, added, names, exclude, progress, shift)
     refined = assembly
     for e in added:
         refined = e.apply(refined)
@@ -443,7 +459,8 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence[str] = "a
         candidates=tuple(first),
         refinement=tuple(steps),
         band=band,
-        baseline=_comparisons(assembly, [], data),
+        baseline=baseline,
         final=_comparisons(assembly, added, data),
         refined_assembly=refined,
+        final_effects=tuple(added),
     )

@@ -35,7 +35,7 @@ import numpy as np
 from ..assembly import Assembly
 from ..beams import Flutes
 from ..components import Beam, Tool
-from ..errors import InvalidValueError, NonPassiveJointWarning
+from ..errors import InvalidValueError, NonPassiveJointWarning, UnknownPointError
 from ..joints import Joint, Sensor, Support
 from ..points import parse_point
 from ..units import format_quantity, ureg
@@ -50,6 +50,10 @@ def register_effect(cls):
     """Class decorator: make an :class:`Effect` subclass available by its ``name``."""
     if not isinstance(getattr(cls, "name", None), str):
         raise InvalidValueError(f"effect {cls.__name__}: needs a class attribute `name`")
+    if cls.name in EFFECTS and EFFECTS[cls.name].__qualname__ != cls.__qualname__:
+        raise InvalidValueError(
+            f"effect {cls.name!r} is already registered ({EFFECTS[cls.name].__qualname__}); choose another name"
+        )
     EFFECTS[cls.name] = cls
     return cls
 
@@ -161,9 +165,26 @@ class SensorMass(Effect):
     def places(cls, assembly, measured_points):
         return list(dict.fromkeys(str(parse_point(p).point) for p in measured_points))
 
+    @classmethod
+    def starting_values(cls, assembly, where, shift):
+        """From the main mode's relative shift (model above measurement: a tip mass)."""
+        out = {p.name: p.start for p in cls.parameters}
+        try:
+            body = assembly.component(parse_point(where).component)
+            m_eff = 0.25 * body.mass()  # a cantilever's tip mode: about a quarter of its mass moves
+        except (AttributeError, UnknownPointError):
+            return out
+        if shift > 0:  # f_model / f_measured - 1 = sqrt(1 + dm / m_eff) - 1
+            out["mass"] = float(np.clip(m_eff * ((1 + shift) ** 2 - 1), 1e-4, 0.2))
+        return out
+
     def apply(self, assembly):
-        sensor = Sensor(f"diagnosed-{self.where.replace('.', '-').replace('@', '-at-').replace(' ', '')}",
-                        self.where, _si(self.values["mass"], "kg"), _si(self.values["inertia"], "kg*m^2"))
+        base = f"diagnosed-{self.where.replace('.', '-').replace('@', '-at-').replace(' ', '')}"
+        taken = {s.name for s in assembly.sensors}
+        name, n = base, 2
+        while name in taken:  # a model improved before may carry one already
+            name, n = f"{base}-{n}", n + 1
+        sensor = Sensor(name, self.where, _si(self.values["mass"], "kg"), _si(self.values["inertia"], "kg*m^2"))
         return assembly.attach(sensor)
 
 

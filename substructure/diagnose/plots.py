@@ -25,8 +25,13 @@ def plot_comparison(comparison, ax=None):
     hm, ho = meas.data[:, 0, 0], model.data[:, 0, 0]
     axes[0].semilogy(f, np.abs(hm), color="0.25", lw=0.8, label="measured")
     axes[0].semilogy(f, np.abs(ho), color="tab:blue", lw=1.2, label="model")
-    axes[1].plot(f, np.degrees(np.angle(hm)), color="0.25", lw=0.8)
-    axes[1].plot(f, np.degrees(np.angle(ho)), color="tab:blue", lw=1.2)
+    # phase in (-360, 0]: receptance lags the force, and the mass line at -180 deg
+    # does not flip between +180 and -180 on noise
+    def lag(h):
+        return np.degrees(np.angle(h)) - 360.0 * (np.angle(h) > 0.5 * np.pi)
+
+    axes[1].plot(f, lag(hm), color="0.25", lw=0.8)
+    axes[1].plot(f, lag(ho), color="tab:blue", lw=1.2)
     with np.errstate(divide="ignore", invalid="ignore"):
         r = np.log(ho / hm)
     axes[2].plot(f, r.real, color="tab:red", lw=0.8, label="ln|model/measured|")
