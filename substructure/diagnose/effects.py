@@ -373,11 +373,18 @@ class SupportSprings(Effect):
         if not beams:
             return []
         heaviest = max(beams, key=lambda b: b.mass())
-        return [heaviest.name]
+        return [f"{heaviest.name}.base,{heaviest.name}.tip"]
 
     def apply(self, assembly):
-        """Two equal springs (k_yf each) on the component, ``inset`` of its length in from each end."""
-        comp = assembly.component(self.where)
+        """Two equal springs (k_yf each) near the two points of ``where`` (the ends of a
+        component, ``"spindle.base,spindle.tip"``), ``inset`` of its length in from each."""
+        points = [parse_point(p.strip()) for p in self.where.split(",")]
+        if len({p.component for p in points}) != 1 or {p.where for p in points} != {"base", "tip"}:
+            raise InvalidValueError(
+                f"support-springs: where = {self.where!r}; expected the ends of one component, "
+                "e.g. 'spindle.base,spindle.tip'"
+            )
+        comp = assembly.component(points[0].component)
         k = _si(self.values["k_yf"], "N/m")
         inset = self.values["inset"] * comp.length_m
         near = f"{comp.name}@{_si(inset, 'm')}"
