@@ -469,13 +469,16 @@ class TurningCut:
 
     @property
     def regenerations_per_revolution(self) -> int:
+        """One delay per revolution."""
         return 1
 
     @property
     def period_angle(self) -> float:
+        """The delay is one revolution: ``2*pi``."""
         return 2.0 * np.pi
 
     def describe(self) -> str:
+        """One line for summaries."""
         return f"turning, Kf = {self.kf:~P}, orientation u = {self.orientation:g} along {self.direction}"
 
     def _matrix(self) -> np.ndarray:
@@ -485,15 +488,19 @@ class TurningCut:
         return out
 
     def force_matrix(self, theta: Any) -> np.ndarray:
+        """The constant force matrix in N/m^2 at any angle, shape ``(..., 2, 2)``."""
         theta = np.asarray(theta, dtype=float)
         return np.broadcast_to(self._matrix(), theta.shape + (2, 2)).copy()
 
     def period_arcs(self) -> list[tuple[float, float, bool]]:
+        """One arc, always cutting."""
         return [(0.0, 2.0 * np.pi, True)]
 
     def force_matrix_average(self, theta_a: Any, theta_b: Any) -> np.ndarray:
+        """The constant force matrix for each interval, shape ``(n, 2, 2)``."""
         n = np.atleast_1d(np.asarray(theta_a, float)).size
         return np.broadcast_to(self._matrix(), (n, 2, 2)).copy()
 
     def mean_force_matrix(self) -> np.ndarray:
+        """``-Kf u`` in the oriented direction, N/m^2, shape (2, 2)."""
         return self._matrix()

@@ -66,7 +66,9 @@ def plot_lobes(results: Sequence[Any], ax: Any = None, lobes: bool = False, ylim
     matplotlib.figure.Figure
     """
     ax = _axes(ax)
-    top = ax.get_ylim()[1] if ax.lines else 0.0
+    overlay = bool(ax.lines)
+    top = ax.get_ylim()[1] if overlay else 0.0
+    left, right = ax.get_xlim() if overlay else (np.inf, -np.inf)
     for r in results:
         depth = np.where(np.isfinite(r.depth_limit_m), r.depth_limit_m, np.nan) * 1e3
         (line,) = ax.plot(r.spindle_speed_rpm, depth, label=r.label or r.method, **line_kw)
@@ -78,7 +80,8 @@ def plot_lobes(results: Sequence[Any], ax: Any = None, lobes: bool = False, ylim
         finite = depth[np.isfinite(depth)]
         if finite.size:
             top = max(top, ylim_factor * float(np.median(finite)))
-    ax.set_xlim(min(r.spindle_speed_rpm[0] for r in results), max(r.spindle_speed_rpm[-1] for r in results))
+    ax.set_xlim(min([left] + [r.spindle_speed_rpm[0] for r in results]),
+                max([right] + [r.spindle_speed_rpm[-1] for r in results]))
     if top > 0:
         ax.set_ylim(0.0, top)
     _finish(ax)

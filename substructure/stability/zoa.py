@@ -182,7 +182,8 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
     k_max = int(np.ceil(60.0 * f[valid.any(axis=1)].max() / (teeth * speeds_rpm[0])))
     k = np.arange(k_max + 1)
     phase = theta.T[:, None, :] / (2.0 * np.pi) + k[None, :, None]  # (2, K, m)
-    n = 60.0 * f[None, None, :] / (teeth * phase)
+    with np.errstate(divide="ignore"):
+        n = 60.0 * f[None, None, :] / (teeth * phase)  # inf only on lines that are not valid
     ok_line = np.broadcast_to(valid.T[:, None, :], n.shape)
     ok = ok_line[..., 1:] & ok_line[..., :-1] & (np.abs(np.diff(np.broadcast_to(theta.T[:, None, :], n.shape),
                                                                   axis=-1)) < np.pi)

@@ -1,0 +1,45 @@
+"""Chatter stability of milling and turning: stability lobe diagrams from any tool point FRF.
+
+A machinist has a tool point FRF (tapped, or predicted by the library) and a
+cut; this package gives the stability lobe diagram: for every spindle speed
+the largest axial depth of cut free of chatter, the chatter frequency, the
+best speeds, and how much the lobes move when the FRF changes.
+
+* :class:`MillingCut`, :class:`TurningCut`: the cut, with units
+  (:mod:`~substructure.stability.cutting`).
+* :func:`xy_frf`: the tool point receptances in x (feed) and y from FRFs.
+* :class:`Mode`, :class:`ModalModel`, :class:`ModalFitter`, :func:`fit_modes`:
+  modal parameters, given or fitted.
+* :func:`zoa`: zero-order approximation (Altintas & Budak), from FRF data or
+  modes; all lobes, the envelope, the absolute limit.
+* :func:`sdm`: semi-discretization (Insperger & Stepan), from modes; right at
+  low radial immersion where the zero order is not.
+* :class:`Lobes`, :func:`lobes_band`: results, several on one plot, and a
+  band from an FRF uncertainty band.
+
+Spindle speeds are in rpm (:func:`spindle_speeds`), depths in m, frequencies
+in Hz; see ``docs/stability.md``.
+
+Examples
+--------
+>>> from substructure.stability import MillingCut, ModalModel, Mode, spindle_speeds, zoa
+>>> cut = MillingCut(2, "10 mm", "10 mm", kt="6e8 Pa", kn="2e8 Pa", milling="down")
+>>> model = ModalModel([Mode("x", "922 Hz", 0.011, f"{0.03993 * (2 * 3.141592653589793 * 922) ** 2} N/m")])
+>>> lobes = zoa(model, cut, spindle_speeds("5000 rpm", "25000 rpm", "10 rpm"))
+>>> round(lobes.absolute_limit_m * 1e3, 4)
+0.2981
+"""
+
+from .cutting import MillingCut, TurningCut, as_speed_rpm, spindle_speeds, tooth_passing_hz
+from .modal import MODES_CSV_HEADER, ModalFitter, ModalFitWarning, ModalModel, Mode, fit_modes
+from .result import Lobes, LobesBand, StabilityWarning, lobes_band
+from .sdm import sdm, spectral_radius
+from .structure import XY_LABELS, xy_frf
+from .zoa import zoa
+
+__all__ = [
+    "MillingCut", "TurningCut", "spindle_speeds", "as_speed_rpm", "tooth_passing_hz",
+    "Mode", "ModalModel", "ModalFitter", "fit_modes", "ModalFitWarning", "MODES_CSV_HEADER",
+    "xy_frf", "XY_LABELS", "zoa", "sdm", "spectral_radius",
+    "Lobes", "LobesBand", "lobes_band", "StabilityWarning",
+]

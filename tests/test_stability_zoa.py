@@ -1,0 +1,196 @@
+"""Zero-order lobes (substructure.stability.zoa): closed form, the lobe equation, data vs modes, errors."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from substructure import FRF, Frequency, FrequencyAxisMismatchError, InvalidValueError, UnitError, default_assembly
+from substructure.stability import (MillingCut, ModalModel, Mode, StabilityWarning, TurningCut, spindle_speeds,
+                                    xy_frf, zoa)
+from substructure.units import Q_
+
+M, FN, ZETA = 0.03993, 922.0, 0.011
+K = M * (2 * np.pi * FN) ** 2
+
+
+def benchmark_model() -> ModalModel:
+    return ModalModel([Mode("x", Q_(FN, "Hz"), ZETA, Q_(K, "N/m"))])
+
+
+def benchmark_cut(immersion: float) -> MillingCut:
+    return MillingCut.from_spec(2, "10 mm", immersion=immersion, milling="down", kt="6e8 Pa", kn="2e8 Pa")
+
+
+def multimode_model() -> ModalModel:
+    return ModalModel([
+        Mode("x", "650 Hz", 0.03, "2.0e7 N/m"), Mode("x", "1450 Hz", 0.02, "6.0e6 N/m"),
+        Mode("x", "2900 Hz", 0.015, "1.5e7 N/m"), Mode("y", "700 Hz", 0.025, "1.8e7 N/m"),
+        Mode("y", "1600 Hz", 0.018, "8.0e6 N/m"),
+    ])
+
+
+SPEEDS = spindle_speeds("4000 rpm", "24000 rpm", "20 rpm")
+
+
+# -- closed form ---------------------------------------------------------------------
+
+
+def test_absolute_limit_single_mode_slot_closed_form():
+    cut = benchmark_cut(1.0)
+    h0 = -cut.mean_force_matrix()[0, 0]  # the mean of h(t): N Kn / 4 for the slot
+    assert h0 == pytest.approx(2 * 2e8 / 4)
+    lobes = zoa(benchmark_model(), cut, SPEEDS)
+    closed = 2 * K * ZETA * (1 + ZETA) / h0
+    assert lobes.absolute_limit_m == pytest.approx(closed, rel=1e-6)
+    assert closed * 1e3 == pytest.approx(0.2981, abs=5e-5)  # the benchmark's number
+    assert lobes.absolute_limit_frequency_hz == pytest.approx(FN * np.sqrt(1 + 2 * ZETA), rel=1e-6)
+    assert lobes.depth_limit_m.min() >= closed * (1 - 1e-9)
+
+
+@pytest.mark.parametrize("immersion, milling", [(0.5, "up"), (0.25, "down"), (0.05, "down"), (0.05, "up")])
+def test_absolute_limit_closed_form_with_directional_factor(immersion, milling):
+    cut = MillingCut.from_spec(3, "10 mm", immersion=immersion, milling=milling, kt="6e8 Pa", kn="2e8 Pa")
+    h0 = -cut.mean_force_matrix()[0, 0]
+    # Re G is at least -1/(4 k zeta (1 + zeta)) and at most 1/(4 k zeta (1 - zeta)).
+    closed = 2 * K * ZETA * (1 + ZETA) / h0 if h0 > 0 else 2 * K * ZETA * (1 - ZETA) / -h0
+    assert zoa(benchmark_model(), cut, SPEEDS).absolute_limit_m == pytest.approx(closed, rel=1e-6)
+
+
+def test_turning_is_tlusty():
+    cut = TurningCut("2000 MPa", orientation=0.7)
+    lobes = zoa(benchmark_model(), cut, SPEEDS)
+    assert lobes.absolute_limit_m == pytest.approx(4 * K * ZETA * (1 + ZETA) / (2 * 2e9 * 0.7), rel=1e-6)
+
+
+# -- the lobes solve the characteristic equation ------------------------------------
+
+
+def characteristic_residual(k0, g, depth, chatter_hz, speed_rpm, teeth):
+    """|det(I - a (1 - exp(-i w T)) K0 G)| written out, with the relative size of its terms."""
+    period = 60.0 / (teeth * speed_rpm)
+    m = depth * (1 - np.exp(-2j * np.pi * chatter_hz * period)) * (k0 @ g)
+    det = (1 - m[0, 0]) * (1 - m[1, 1]) - m[0, 1] * m[1, 0]
+    return abs(det) / (1 + np.abs(m).sum() + abs(m[0, 0] * m[1, 1]) + abs(m[0, 1] * m[1, 0]))
+
+
+def test_depth_limits_and_chatter_frequencies_solve_the_characteristic_equation():
+    model = multimode_model()
+    cut = MillingCut(4, "12 mm", "5 mm", kt="700 MPa", kn="210 MPa", milling="up")
+    grid = Frequency.from_range("300 Hz", "4000 Hz", "0.5 Hz")
+    lobes = zoa(FRF(grid, model.receptance(grid.hz), ("x", "y"), ("x", "y")), cut, SPEEDS)
+    k0 = cut.mean_force_matrix()
+    rng = np.random.default_rng(5)
+    for i in rng.choice(np.flatnonzero(np.isfinite(lobes.depth_limit_m)), 40, replace=False):
+        g = model.receptance([lobes.chatter_frequency_hz[i]])[0]
+        res = characteristic_residual(k0, g, lobes.depth_limit_m[i], lobes.chatter_frequency_hz[i],
+                                      lobes.spindle_speed_rpm[i], cut.teeth)
+        assert res < 2e-3, (lobes.spindle_speed_rpm[i], res)
+
+
+def test_cross_terms_are_used_and_solve_the_equation():
+    f = Frequency.from_range("400 Hz", "2500 Hz", "0.1 Hz")
+    g = ModalModel([Mode("x", "900 Hz", 0.02, "1e7 N/m")]).receptance(f.hz)[:, 0, 0]
+    angle = np.radians(30)  # one mode along a direction 30 degrees from x
+    u = np.array([np.cos(angle), np.sin(angle)])
+    data = g[:, None, None] * np.outer(u, u)[None]
+    parts = [FRF.single(f, data[:, i, j]) for i, j in ((0, 0), (1, 1), (0, 1), (1, 0))]
+    full = xy_frf(*parts)
+    diagonal = xy_frf(parts[0], parts[1])
+    cut = MillingCut(3, "10 mm", "4 mm", kt="700 MPa", kn="210 MPa", milling="down")
+    with_cross, without = zoa(full, cut, SPEEDS), zoa(diagonal, cut, SPEEDS)
+    assert np.abs(with_cross.depth_limit_m / without.depth_limit_m - 1).max() > 0.05
+    k0 = cut.mean_force_matrix()
+    for i in np.flatnonzero(np.isfinite(with_cross.depth_limit_m))[::97]:
+        fc = with_cross.chatter_frequency_hz[i]
+        gi = np.array([[np.interp(fc, f.hz, data[:, r, c].real) + 1j * np.interp(fc, f.hz, data[:, r, c].imag)
+                        for c in range(2)] for r in range(2)])
+        assert characteristic_residual(k0, gi, with_cross.depth_limit_m[i], fc, with_cross.spindle_speed_rpm[i],
+                                       cut.teeth) < 2e-3
+
+
+# -- data or modes: the same lobes --------------------------------------------------
+
+
+def test_multimode_frf_as_data_or_as_modes_gives_the_same_lobes():
+    model = multimode_model()
+    cut = MillingCut(4, "12 mm", "3 mm", kt="625 MPa", kn="100 MPa", milling="up")
+    grid = Frequency.from_range("200 Hz", "6000 Hz", "0.5 Hz")
+    data = FRF(grid, model.receptance(grid.hz), ("x", "y"), ("x", "y"))
+    from_data = zoa(data, cut, SPEEDS)
+    from_modes = zoa(model, cut, SPEEDS)
+    assert from_data.absolute_limit_m == pytest.approx(from_modes.absolute_limit_m, rel=1e-4)
+    assert from_data.absolute_limit_frequency_hz == pytest.approx(from_modes.absolute_limit_frequency_hz, rel=1e-3)
+    finite = np.isfinite(from_modes.depth_limit_m)
+    assert finite.mean() > 0.99
+    np.testing.assert_array_equal(finite, np.isfinite(from_data.depth_limit_m))
+    np.testing.assert_allclose(from_data.depth_limit_m[finite], from_modes.depth_limit_m[finite], rtol=5e-3)
+    np.testing.assert_allclose(from_data.chatter_frequency_hz[finite], from_modes.chatter_frequency_hz[finite],
+                               rtol=2e-3)
+    assert np.median(np.abs(from_data.depth_limit_m / from_modes.depth_limit_m - 1)) < 1e-4
+
+
+def test_one_symmetric_frf_means_y_equals_x():
+    grid = Frequency.from_range("300 Hz", "3000 Hz", "1 Hz")
+    h = FRF.single(grid, multimode_model().receptance(grid.hz)[:, 0, 0], "tool.tip:y", "tool.tip:y")
+    cut = MillingCut(4, "12 mm", "3 mm", kt="625 MPa", kn="100 MPa")
+    a, b = zoa(h, cut, SPEEDS), zoa(xy_frf(h, h), cut, SPEEDS)
+    np.testing.assert_array_equal(a.depth_limit_m, b.depth_limit_m)
+
+
+def test_lobes_are_listed_and_the_limit_is_their_lower_envelope():
+    lobes = zoa(benchmark_model(), benchmark_cut(1.0), SPEEDS)
+    env, grid = lobes.depth_limit_m, lobes.spindle_speed_rpm
+    assert len(lobes.lobes) >= 3
+    for speed, depth in lobes.lobes:
+        ok = np.isfinite(speed) & (speed >= grid[0]) & (speed < grid[-1])
+        j = np.searchsorted(grid, speed[ok], side="right") - 1
+        # between two grid speeds a lobe lies above the lower of the two limits (up to its flat floor)
+        assert np.all(depth[ok] >= np.minimum(env[j], env[j + 1]) * (1 - 1e-3))
+
+
+# -- what the FRF must hold, and warnings --------------------------------------------
+
+
+def test_frf_without_the_xy_data_is_an_error():
+    assembly_frf = default_assembly().receptance("tool.tip", frequency=Frequency.from_range("500 Hz", "900 Hz", "100 Hz"))
+    cut = MillingCut(4, "12 mm", "3 mm", kt="625 MPa", kn="100 MPa")
+    with pytest.raises(InvalidValueError, match="x \\(feed\\) and y.*xy_frf"):
+        zoa(assembly_frf, cut, SPEEDS)  # (y, theta) receptances, not x and y
+    with pytest.raises(InvalidValueError, match="rotational"):
+        xy_frf(assembly_frf["tool.tip:theta", "tool.tip:theta"])
+    with pytest.raises(InvalidValueError, match="both cross receptances"):
+        xy_frf(assembly_frf["tool.tip:y", "tool.tip:y"], xy=assembly_frf["tool.tip:y", "tool.tip:y"])
+    other = FRF.single(Frequency.from_range("500 Hz", "900 Hz", "50 Hz"), np.ones(9) * 1e-7)
+    with pytest.raises(FrequencyAxisMismatchError, match="interpolate"):
+        xy_frf(assembly_frf["tool.tip:y", "tool.tip:y"], other)
+    with pytest.raises(InvalidValueError, match="ModalModel"):
+        zoa(np.ones(10), cut, SPEEDS)
+
+
+def test_speeds_in_hz_are_an_error():
+    with pytest.raises(UnitError, match="rpm"):
+        zoa(benchmark_model(), benchmark_cut(1.0), Q_(np.linspace(100, 300, 50), "Hz"))
+    with pytest.raises(UnitError):
+        zoa(benchmark_model(), benchmark_cut(1.0), np.linspace(5000, 20000, 50))
+
+
+def test_a_limit_at_the_edge_of_the_band_warns():
+    assembly = default_assembly()  # free-free: rigid-body motion at the lowest lines
+    h = assembly.receptance("tool.tip:y", frequency=Frequency.from_range("20 Hz", "5000 Hz", "10 Hz"))
+    cut = MillingCut(4, "12 mm", "3 mm", kt="625 MPa", kn="100 MPa")
+    with pytest.warns(StabilityWarning, match="first line"):
+        zoa(h, cut, SPEEDS)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        zoa(h.crop("500 Hz", "5000 Hz"), cut, SPEEDS)
+
+
+def test_no_chatter_possible_gives_no_limit():
+    # a mode only in y and a turning cut in x: the cut cannot excite it
+    model = ModalModel([Mode("y", "900 Hz", 0.02, "1e7 N/m")])
+    lobes = zoa(model, TurningCut("2000 MPa"), SPEEDS)
+    assert np.all(np.isinf(lobes.depth_limit_m)) and lobes.absolute_limit_m == np.inf
+    assert lobes.to_json()["absolute_limit_m"] is None
