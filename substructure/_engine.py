@@ -3,12 +3,15 @@
 ``Y_c = Y - (Y B^T) W (B Y)`` with ``W = (B Y B^T + K^-1)^-1`` written as
 ``K (I + B Y B^T K)^-1`` (no ``K^-1`` needed) or ``(B Y B^T)^-1`` for a rigid
 connection.  :func:`couple_substructures` applies links to substructures
-cluster by cluster, keeping only the points still needed;
-:func:`apply_connection` is the same update on a square matrix at DOF level.
-It depends only on :mod:`substructure._blocks`, so that beams (to join long
-chains in well-conditioned pieces), assemblies and the FRF-level operations
-of :mod:`substructure.coupling` share it.  See :mod:`substructure.coupling`
-for the method.
+cluster by cluster, keeping only the points still needed (the bookkeeping
+here, the update of each link, line by line, in the compiled kernel
+:func:`substructure._kernels.couple_link`); :func:`apply_connection` is the
+same update on a square matrix at DOF level, with numpy (any number of DOFs:
+decoupling and structural modification).  It depends only on
+:mod:`substructure._blocks` and :mod:`substructure._kernels`, so that beams
+(to join long chains in well-conditioned pieces), assemblies and the
+FRF-level operations of :mod:`substructure.coupling` share it.  See
+:mod:`substructure.coupling` for the method.
 """
 
 from __future__ import annotations
@@ -121,6 +124,9 @@ class Link:
     label: str = ""
 
 
+_NO_STIFFNESS = np.zeros((2, 2, 1), dtype=complex)  # placeholder of a rigid link for the kernel
+
+
 def _blk(y: np.ndarray, i: int, j: int) -> np.ndarray:
     return y[2 * i : 2 * i + 2, 2 * j : 2 * j + 2]
 
@@ -149,65 +155,57 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
     points that the outputs or later links need are kept, so the working
     matrices stay as small as the interfaces.  Each step is the update of
     :func:`apply_connection`, with the zero off-diagonal blocks of two
-    uncoupled clusters skipped.
+    uncoupled clusters skipped, computed by
+    :func:`substructure._kernels.couple_link` (the 2x2 determinants
+    compensated near singular lines, so that a line next to a natural
+    frequency is not lost to rounding).
     """
+    from . import _kernels
+
     n = blocks[0][1].shape[-1]
     clusters: dict[int, tuple[list, np.ndarray]] = {}
     where: dict[object, int] = {}
     for cid, (keys, y) in enumerate(blocks):
-        clusters[cid] = (list(keys), y)
+        clusters[cid] = (list(keys), _kernels.c_array(y, complex))
         for k in keys:
             where[k] = cid
+    # the points each link and the outputs need, from the last link backwards
+    needed_after = [set(outputs)]
+    for link in reversed(links[1:]):
+        later = set(needed_after[-1])
+        later.add(link.a)
+        if link.b is not None:
+            later.add(link.b)
+        needed_after.append(later)
+    needed_after.reverse()
     for step, link in enumerate(links):
-        needed = set(outputs)
-        for later in links[step + 1 :]:
-            needed.add(later.a)
-            if later.b is not None:
-                needed.add(later.b)
+        needed = needed_after[step]
         ca = where[link.a]
         cb = None if link.b is None else where[link.b]
         if cb is None or cb == ca:
-            keys, y = clusters.pop(ca)
-            ia = keys.index(link.a)
-            ib = None if link.b is None else keys.index(link.b)
-
-            def u_of(i, keys=keys, y=y, ia=ia, ib=ib):
-                return _blk(y, i, ia) if ib is None else _blk(y, i, ia) - _blk(y, i, ib)
-
-            def v_of(j, keys=keys, y=y, ia=ia, ib=ib):
-                return _blk(y, ia, j) if ib is None else _blk(y, ia, j) - _blk(y, ib, j)
-
-            s = u_of(ia) if ib is None else u_of(ia) - u_of(ib)
-            kept = [i for i, k in enumerate(keys) if k in needed]
-            us = [u_of(i) for i in kept]
-            vs = [v_of(j) for j in kept]
-            base = [[_blk(y, i, j) for j in kept] for i in kept]
-            new_keys = [keys[i] for i in kept]
+            keys, ya = clusters.pop(ca)
+            yb = ya
+            a = (0, keys.index(link.a))
+            b = (-1, 0) if link.b is None else (0, keys.index(link.b))
+            kept = [(0, i) for i, k in enumerate(keys) if k in needed]
+            new_keys = [keys[i] for _, i in kept]
         else:
             ka, ya = clusters.pop(ca)
             kb, yb = clusters.pop(cb)
-            ia, ib = ka.index(link.a), kb.index(link.b)
-            s = _blk(ya, ia, ia) + _blk(yb, ib, ib)
-            kept_a = [i for i, k in enumerate(ka) if k in needed]
-            kept_b = [i for i, k in enumerate(kb) if k in needed]
-            us = [_blk(ya, i, ia) for i in kept_a] + [-_blk(yb, i, ib) for i in kept_b]
-            vs = [_blk(ya, ia, j) for j in kept_a] + [-_blk(yb, ib, j) for j in kept_b]
-            zero = None
-            base = [[_blk(ya, i, j) for j in kept_a] + [zero] * len(kept_b) for i in kept_a]
-            base += [[zero] * len(kept_a) + [_blk(yb, i, j) for j in kept_b] for i in kept_b]
-            new_keys = [ka[i] for i in kept_a] + [kb[i] for i in kept_b]
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            w = interface_update(s, link.stiffness)
-            uw = [bk.mul2(u, w) for u in us]
-            m = len(new_keys)
-            out = np.empty((2 * m, 2 * m, n), dtype=complex)
-            for i in range(m):
-                for j in range(m):
-                    blk = -bk.mul2(uw[i], vs[j])
-                    if base[i][j] is not None:
-                        blk += base[i][j]
-                    out[2 * i : 2 * i + 2, 2 * j : 2 * j + 2] = blk
-        if not np.all(np.isfinite(out)):
+            a, b = (0, ka.index(link.a)), (1, kb.index(link.b))
+            kept = [(0, i) for i, k in enumerate(ka) if k in needed]
+            kept += [(1, i) for i, k in enumerate(kb) if k in needed]
+            new_keys = [(ka, kb)[src][i] for src, i in kept]
+        rigid = link.stiffness is None
+        stiffness = _NO_STIFFNESS if rigid else _kernels.c_array(link.stiffness, complex)
+        if stiffness.shape[:2] != (2, 2) or stiffness.shape[-1] not in (1, n) or stiffness.ndim != 3:
+            raise ValueError(
+                f"{link.label or 'a link'}: stiffness of shape {stiffness.shape}; expected (2, 2, {n}) or (2, 2, 1)"
+            )
+        src = np.array([p for p, _ in kept], dtype=np.int64)
+        idx = np.array([i for _, i in kept], dtype=np.int64)
+        out, finite = _kernels.couple_link(ya, yb, a[0], a[1], b[0], b[1], src, idx, stiffness, rigid)
+        if not finite:
             raise AssemblyError(
                 f"coupling through {link.label or 'a connection'} is singular: a rigid joint that "
                 "closes a loop of rigid joints (redundant), or a connection to a point with no "

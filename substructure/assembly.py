@@ -167,7 +167,9 @@ class Assembly:
         """Every component name whose points this assembly answers for."""
         return frozenset(n for c in self.components for n in c.component_names)
 
-    def _owner(self, ref: PointRef, context: str = ""):
+    def _owner(self, ref: PointRef, context: str = "", index: dict | None = None):
+        if index is not None and ref.component in index:
+            return index[ref.component]
         for comp in self.components:
             if ref.component in comp.component_names:
                 return comp
@@ -178,9 +180,9 @@ class Assembly:
             f"{self.name!r} (components: {known})"
         )
 
-    def _resolve(self, point: str | PointRef, context: str = ""):
+    def _resolve(self, point: str | PointRef, context: str = "", index: dict | None = None):
         ref = parse_point(point)
-        owner = self._owner(ref, context)
+        owner = self._owner(ref, context, index)
         try:
             key = owner.node_key(ref.point)
         except UnknownPointError as exc:
@@ -316,9 +318,11 @@ class Assembly:
         structure give plans that match item by item (used by sweeps).
         """
         nodes: dict[Any, tuple[Any, PointRef]] = {}
+        # component name -> component (names are unique in an assembly)
+        index = {n: c for c in self.components for n in c.component_names}
 
         def node(point) -> Any:
-            ref, owner, key = self._resolve(point)
+            ref, owner, key = self._resolve(point, index=index)
             nodes.setdefault(key, (owner, ref.point))
             return key
 

@@ -21,8 +21,10 @@ transfer matrices between the points and the free-end conditions (see
 only at the beam's own natural frequencies, with the rigid-body ``omega^2``
 factor carried exactly, so that the lowest lines are as accurate as the
 rest.  The segment dynamic stiffness (for joints of beam pieces and for
-teaching) follows from the blocks of ``T``.  Everything is vectorised over
-frequency (and over configurations in sweeps).
+teaching) follows from the blocks of ``T``.  The closed form and the chain
+formula are evaluated by the compiled kernels of :mod:`substructure._kernels`,
+one frequency line at a time (and over configurations in sweeps); this
+module prepares their inputs.
 
 Shear coefficient: Cowper (1966) for a hollow circular section,
 ``kappa = 6(1+nu)(1+m^2)^2 / ((7+6nu)(1+m^2)^2 + (20+12nu)m^2)``, ``m = id/od``
@@ -245,78 +247,14 @@ class Segment:
 
 
 # ---------------------------------------------------------------------------
-# Closed-form segment dynamic stiffness
-
-
-def _squared_wavenumbers(sec: Section, w2: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """``a, e`` (diagonal of A^2) and the eigenvalues ``s1, s2`` of ``A^2``."""
-    a = w2 * (-sec.rhoA / sec.kGA)
-    e = w2 * (-sec.rhoI / sec.EI)
-    half = 0.5 * (a - e)
-    root = np.sqrt(half * half + w2 * (sec.rhoA / sec.EI) + 0j)
-    mean = 0.5 * (a + e)
-    return a, e, mean + root, mean - root
-
-
-def _series(z1: np.ndarray, z2: np.ndarray, length: np.ndarray):
-    """``C(s2), C[s1,s2], S(s2), S[s1,s2]`` by power series, for ``|s L^2| < 0.5``.
-
-    ``z = s L^2``; ``h_n`` is the complete homogeneous symmetric polynomial of
-    degree n in ``z1, z2`` (the divided difference of ``z^(n+1)``); terms are
-    summed until they fall below double precision, ``|z|^n / (2n)! < 1e-18``.
-    """
-    bound = float(np.max(np.maximum(np.abs(z1), np.abs(z2)))) if z1.size else 0.0
-    n_terms = 2
-    while bound**n_terms / math.factorial(2 * n_terms) > 1e-18:
-        n_terms += 1
-    sc = np.ones_like(z2)
-    ss = np.ones_like(z2)
-    dc = np.zeros_like(z2)
-    ds = np.zeros_like(z2)
-    h = np.ones_like(z2)  # h_0
-    pow2 = np.ones_like(z2)
-    for n in range(1, n_terms + 1):
-        rc, rs = 1.0 / math.factorial(2 * n), 1.0 / math.factorial(2 * n + 1)
-        dc += rc * h
-        ds += rs * h
-        pow2 = pow2 * z2
-        sc += rc * pow2
-        ss += rs * pow2
-        h = z1 * h + pow2  # h_n = z1 h_{n-1} + z2^n
-    return sc, length**2 * dc, length * ss, length**3 * ds
-
-
-def _direct(s1: np.ndarray, s2: np.ndarray, length: np.ndarray):
-    """``C(s2), C[s1,s2], S(s2), S[s1,s2]`` from exponentials, for ``|s L^2| >= 0.5``.
-
-    cosh and sinh from one exponential each: the principal square root has
-    ``Re >= 0``, so ``exp(-r L) <= 1`` and nothing overflows before ``exp(r L)``.
-    """
-    r1, r2 = np.sqrt(s1), np.sqrt(s2)
-    e1, e2 = np.exp(r1 * length), np.exp(r2 * length)
-    i1, i2 = 1.0 / e1, 1.0 / e2
-    ch1, ch2 = 0.5 * (e1 + i1), 0.5 * (e2 + i2)
-    sh1, sh2 = 0.5 * (e1 - i1) / r1, 0.5 * (e2 - i2) / r2
-    ds12 = s1 - s2
-    return ch2, (ch1 - ch2) / ds12, sh2, (sh1 - sh2) / ds12
-
-
-def _functions(s1: np.ndarray, s2: np.ndarray, length):
-    """``C(s2), C[s1,s2], S(s2), S[s1,s2]``, vectorised (``length`` scalar or per element)."""
-    length = np.broadcast_to(np.asarray(length, dtype=float), s1.shape)
-    z1, z2 = s1 * length**2, s2 * length**2
-    small = np.maximum(np.abs(z1), np.abs(z2)) < 0.5
-    if small.all():
-        return _series(z1, z2, length)
-    if not small.any():
-        return _direct(s1, s2, length)
-    out = tuple(np.empty_like(z2) for _ in range(4))
-    big = ~small
-    for o, v in zip(out, _series(z1[small], z2[small], length[small])):
-        o[small] = v
-    for o, v in zip(out, _direct(s1[big], s2[big], length[big])):
-        o[big] = v
-    return out
+# Closed-form segment transfer matrices
+#
+# The closed form of the module docstring (and docs/beams.md) is evaluated by
+# the compiled kernels of substructure._kernels, one frequency line at a time:
+# the squared wavenumbers s1, s2 of A^2, C and S and their divided differences
+# (power series where |s L^2| < 0.5, exponentials elsewhere), and
+# T = alpha I + beta A + gamma A^2 + delta A^3.  The kernels are imported on
+# first use, so that numba is loaded only when something is computed.
 
 
 def segment_transfer_matrix(sec: Section, length: float, omega: np.ndarray) -> np.ndarray:
@@ -324,35 +262,14 @@ def segment_transfer_matrix(sec: Section, length: float, omega: np.ndarray) -> n
 
     State ``[w, psi, V, M]`` with ``V = kGA (w' - psi)`` and ``M = EI psi'``.
     """
-    w2 = np.asarray(omega, dtype=float) ** 2
-    a, e, s1, s2 = _squared_wavenumbers(sec, w2)
-    c0, c1, g0, g1 = _functions(s1, s2, length)
-    alpha = c0 - c1 * s2
-    beta = g0 - g1 * s2
-    gamma, delta = c1, g1
-    inv_ei, inv_kga = 1.0 / sec.EI, 1.0 / sec.kGA
-    mA, mI = w2 * sec.rhoA, w2 * sec.rhoI
-    t = np.empty((4, 4, w2.size), dtype=complex)
-    # T = alpha I + beta A + gamma A^2 + delta A^3, written entry by entry
-    # (A, A^2, A^3 are sparse), sharing the repeated entries.
-    t[0, 0] = t[2, 2] = alpha + gamma * a
-    t[1, 1] = t[3, 3] = alpha + gamma * e
-    t[0, 1] = beta + delta * (a + e)
-    t[0, 2] = beta * inv_kga + delta * (a * inv_kga - inv_ei)
-    g_ei = gamma * inv_ei
-    t[0, 3] = g_ei
-    t[1, 2] = -g_ei
-    d_ma_ei = delta * mA * inv_ei
-    t[1, 0] = d_ma_ei
-    t[2, 3] = -d_ma_ei
-    t[1, 3] = (beta + delta * e) * inv_ei
-    t[2, 0] = -(beta + delta * a) * mA
-    g_ma = gamma * mA
-    t[3, 0] = g_ma
-    t[2, 1] = -g_ma
-    t[3, 1] = -beta * mI + delta * (mA - mI * e)
-    t[3, 2] = -beta + delta * (mI * inv_ei - a)
-    return t
+    from . import _kernels
+
+    omega = _kernels.c_array(np.reshape(omega, -1), float)
+    t = _kernels.transfer_matrices(
+        omega, np.array([[sec.EI]], dtype=complex), np.array([[sec.kGA]], dtype=complex),
+        np.array([[sec.rhoA]], dtype=float), np.array([[sec.rhoI]], dtype=float), np.array([[length]], dtype=float),
+    )
+    return np.ascontiguousarray(np.moveaxis(t[0], 0, -1))
 
 
 def segment_dynamic_stiffness(sec: Section, length: float, omega: np.ndarray):
@@ -374,29 +291,18 @@ def segment_dynamic_stiffness(sec: Section, length: float, omega: np.ndarray):
 
 # ---------------------------------------------------------------------------
 # Chains of segments: free-free receptances by transfer matrices
+#
+# An interval is a pair ``(section, length)``.  In a batch of ``n_config``
+# configurations the fields of the section and the length are either scalars
+# (the same in every configuration) or arrays of ``n_config`` values.
 
 
-def _mul4(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Product of 4x4 stacks ``(4, 4, n)`` by 2x2 blocks."""
-    out = np.empty(np.broadcast_shapes(a.shape, b.shape), dtype=complex)
-    a11, a12, a21, a22 = a[:2, :2], a[:2, 2:], a[2:, :2], a[2:, 2:]
-    b11, b12, b21, b22 = b[:2, :2], b[:2, 2:], b[2:, :2], b[2:, 2:]
-    out[:2, :2] = bk.mul2(a11, b11) + bk.mul2(a12, b21)
-    out[:2, 2:] = bk.mul2(a11, b12) + bk.mul2(a12, b22)
-    out[2:, :2] = bk.mul2(a21, b11) + bk.mul2(a22, b21)
-    out[2:, 2:] = bk.mul2(a21, b12) + bk.mul2(a22, b22)
-    return out
+def _is_shared(sec: Section, length) -> bool:
+    return not any(isinstance(v, np.ndarray) for v in (sec.EI, sec.kGA, sec.rhoA, sec.rhoI, length))
 
 
-def _product(mats: list[np.ndarray], n: int) -> np.ndarray | None:
-    """``mats[-1] @ ... @ mats[0]`` (transfer in the +x direction); None when empty."""
-    acc = None
-    for t in mats:
-        acc = t if acc is None else _mul4(t, acc)
-    return acc
-
-
-def _chain_single(intervals: list[tuple[Section, object]], nodes: list[int], omega: np.ndarray) -> np.ndarray:
+def _chain_single(intervals: list[tuple[Section, object]], nodes: list[int], omega: np.ndarray,
+                  n_config: int = 1, place: list[int] | None = None) -> np.ndarray:
     """Free-free receptances of a chain of uniform intervals at some of its nodes.
 
     ``intervals[k]`` spans node ``k`` to node ``k + 1``; ``nodes`` are sorted,
@@ -409,55 +315,45 @@ def _chain_single(intervals: list[tuple[Section, object]], nodes: list[int], ome
     with ``P_i = T(0 -> x_i)``, ``S_j = T(x_j -> L)`` and ``M = T(0 -> L)``.
     ``M_Fu`` is singular only at the free-free natural frequencies, and its
     ``omega^2`` factor carries the rigid-body modes exactly, so the result is
-    well conditioned down to the lowest frequency line.
+    well conditioned down to the lowest frequency line.  The blocks with
+    ``x_i > x_j`` are taken from reciprocity, ``Y_ij = Y_ji^T``: evaluated
+    from their own formula, whose two terms grow like ``exp(k (x_i - x_j))``
+    and cancel, they would lose about ``exp(k L)`` more digits.
+
+    Computed line by line by :func:`substructure._kernels.chain_receptance`.
+    Intervals that are the same object (the equal pieces of a split segment)
+    are one segment for the kernel, computed once per line; in a batch, a
+    segment that is the same in every configuration is computed once per
+    frequency line for all of them.  Node ``nodes[i]`` is put at position
+    ``place[i]`` of the result (default: in order).  Returns
+    ``(2m, 2m, n_config * n_freq)``.
     """
-    n = omega.size
-    cache: dict[tuple, np.ndarray] = {}
-    mats = []
-    for sec, length, *tile in intervals:
+    from . import _kernels
+
+    index: dict[tuple, int] = {}
+    unique: list[tuple[Section, object]] = []
+    seg_of = []
+    for sec, length in intervals:
         key = (id(sec), id(length) if isinstance(length, np.ndarray) else length)
-        if key not in cache:
-            if tile:  # the same in every configuration of a batch: once, then repeated
-                n_f, reps = tile[0]
-                cache[key] = np.tile(segment_transfer_matrix(sec, length, omega[:n_f]), (1, 1, reps))
-            else:
-                cache[key] = segment_transfer_matrix(sec, length, omega)
-        mats.append(cache[key])
-    m = len(nodes)
-    # Transfer matrices between consecutive requested nodes, and the overhangs
-    # (None stands for the identity: an end that is itself a requested node).
-    head = _product(mats[: nodes[0]], n)
-    tail = _product(mats[nodes[-1] :], n)
-    gaps = [_product(mats[nodes[k] : nodes[k + 1]], n) for k in range(m - 1)]
-
-    def then(first, second):  # transfer through `first`, then `second`
-        if first is None:
-            return second
-        if second is None:
-            return first
-        return _mul4(second, first)
-
-    prefix = [head]
-    for g in gaps:
-        prefix.append(then(prefix[-1], g))
-    total = then(prefix[-1], tail)
-    suffix = [None] * m
-    suffix[-1] = tail
-    for k in range(m - 2, -1, -1):
-        suffix[k] = then(gaps[k], suffix[k + 1])
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        mfu_inv = bk.inv2(total[2:, :2])
-        left = [mfu_inv if prefix[i] is None else bk.mul2(prefix[i][:2, :2], mfu_inv) for i in range(m)]
-        y = np.empty((2 * m, 2 * m, n), dtype=complex)
-        for j in range(m):
-            between = None
-            for i in range(m):
-                blk = left[i] if suffix[j] is None else bk.mul2(left[i], suffix[j][2:, 2:])
-                if i > j:
-                    between = gaps[i - 1] if between is None else _mul4(gaps[i - 1], between)
-                    blk = blk - between[:2, 2:]
-                y[2 * i : 2 * i + 2, 2 * j : 2 * j + 2] = blk
-    return y
+        if key not in index:
+            index[key] = len(unique)
+            unique.append((sec, length))
+        seg_of.append(index[key])
+    n_u = len(unique)
+    ei = np.empty((n_u, n_config), dtype=complex)
+    kga = np.empty((n_u, n_config), dtype=complex)
+    rhoa = np.empty((n_u, n_config))
+    rhoi = np.empty((n_u, n_config))
+    lengths = np.empty((n_u, n_config))
+    shared = np.zeros(n_u, dtype=bool)
+    for u, (sec, length) in enumerate(unique):
+        ei[u], kga[u], rhoa[u], rhoi[u], lengths[u] = sec.EI, sec.kGA, sec.rhoA, sec.rhoI, length
+        shared[u] = n_config > 1 and _is_shared(sec, length)
+    return _kernels.chain_receptance(
+        _kernels.c_array(omega, float), ei, kga, rhoa, rhoi, lengths, shared,
+        np.array(seg_of, dtype=np.int64), np.array(nodes, dtype=np.int64),
+        np.arange(len(nodes), dtype=np.int64) if place is None else np.array(place, dtype=np.int64),
+    )
 
 
 _CHUNK_KL = 8.0  # largest k L of one transfer-matrix chain: rounding ~ 1e-16 exp(8) ~ 3e-13
@@ -465,14 +361,22 @@ _CHUNK_KL = 8.0  # largest k L of one transfer-matrix chain: rounding ~ 1e-16 ex
 
 def _phase(sec: Section, length, omega_max: float) -> float:
     """Largest ``k L`` of an interval at ``omega_max`` (over a batch: the maximum)."""
-    fields = [np.atleast_1d(getattr(sec, f)) for f in ("EI", "kGA", "rhoA", "rhoI")]
-    _, _, s1, s2 = _squared_wavenumbers(Section(*fields), np.array(omega_max**2))
-    k = np.sqrt(np.maximum(np.abs(s1), np.abs(s2)))
-    return float(np.max(k * np.asarray(length, dtype=float)))
+    from . import _kernels
+
+    ei, kga, rhoa, rhoi, length = np.broadcast_arrays(
+        *(np.atleast_1d(v) for v in (sec.EI, sec.kGA, sec.rhoA, sec.rhoI, length))
+    )
+    _, k_max = _kernels.segment_coefficients(
+        _kernels.c_array(ei.reshape(1, -1), complex), _kernels.c_array(kga.reshape(1, -1), complex),
+        _kernels.c_array(rhoa.reshape(1, -1), float), _kernels.c_array(rhoi.reshape(1, -1), float),
+        float(omega_max),
+    )
+    return float(np.max(k_max[0] * length))
 
 
 def _chain_receptance(
-    intervals: list[tuple], nodes: list[int], omega: np.ndarray, phases: list[float] | None = None
+    intervals: list[tuple], nodes: list[int], omega: np.ndarray, phases: list[float] | None = None,
+    n_config: int = 1, place: list[int] | None = None,
 ) -> np.ndarray:
     """Free-free receptances of a chain at some of its nodes, for any length and frequency.
 
@@ -481,15 +385,18 @@ def _chain_receptance(
     cut into pieces of ``k L <= 8``: each piece's receptances come from
     :func:`_chain_single` and the pieces are joined by rigid connections with
     the coupling engine, which is exact and well conditioned.  Short chains
-    (the usual case) are one piece.
+    (the usual case) are one piece.  ``omega`` holds the frequency lines of
+    one configuration; the result has ``n_config * omega.size`` lines.
+    ``nodes`` are sorted; node ``nodes[i]`` is put at position ``place[i]``
+    of the result (default: in order).
     """
-    omega_max = float(np.max(omega))
+    omega_max = float(np.max(omega)) if omega.size else 0.0
     if phases is None:
-        phases = [_phase(item[0], item[1], omega_max) for item in intervals]
+        phases = [_phase(sec, length, omega_max) for sec, length in intervals]
     refined, node_map, piece_phases = [], [0], []
     for item, kl in zip(intervals, phases):
         n_sub = max(1, math.ceil(kl / _CHUNK_KL))
-        piece = item if n_sub == 1 else (item[0], item[1] / n_sub, *item[2:])
+        piece = item if n_sub == 1 else (item[0], item[1] / n_sub)
         refined.extend([piece] * n_sub)
         piece_phases.extend([kl / n_sub] * n_sub)
         node_map.append(node_map[-1] + n_sub)
@@ -503,7 +410,7 @@ def _chain_receptance(
         acc += kl
     bounds.append(len(refined))
     if len(bounds) == 2:
-        return _chain_single(refined, nodes, omega)
+        return _chain_single(refined, nodes, omega, n_config, place)
     blocks, links = [], []
     last = len(bounds) - 2
     for c, (n0, n1) in enumerate(zip(bounds[:-1], bounds[1:])):
@@ -514,12 +421,12 @@ def _chain_receptance(
         if c < last:
             local.add(n1)
         local = sorted(local)
-        y = _chain_single(refined[n0:n1], [nd - n0 for nd in local], omega)
+        y = _chain_single(refined[n0:n1], [nd - n0 for nd in local], omega, n_config)
         blocks.append(([(c, nd) for nd in local], y))
-    outputs = []
-    for nd in nodes:
+    outputs = [None] * len(nodes)
+    for i, nd in enumerate(nodes):
         c = next(c for c, (n0, n1) in enumerate(zip(bounds[:-1], bounds[1:])) if n0 <= nd <= n1)
-        outputs.append((c, nd))
+        outputs[i if place is None else place[i]] = (c, nd)
     return couple_substructures(blocks, links, outputs)
 
 
@@ -556,23 +463,17 @@ def stepped_beam_receptance(
         k = int(np.clip(np.searchsorted(ends, 0.5 * (x0 + x1)) - 1, 0, len(segments) - 1))
         intervals.append((sections[k], float(x1 - x0)))
     nodes = [int(i) for i in np.searchsorted(cuts, sorted_pos)]
-    y_sorted = bk.by_chunks(lambda f: _chain_receptance(intervals, nodes, 2.0 * np.pi * f), frequency_hz)
-    m = len(sorted_pos)
-    inverse = np.empty(m, dtype=int)
-    inverse[order] = np.arange(m)
-    dof = np.empty(2 * m, dtype=int)
-    dof[0::2] = 2 * inverse
-    dof[1::2] = 2 * inverse + 1
-    return y_sorted[np.ix_(dof, dof)]
+    omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float).reshape(-1)
+    return _chain_receptance(intervals, nodes, omega, place=[int(i) for i in order])
 
 
-def _stack_sections(sections: Sequence[Section], repeat: int) -> Section:
-    """One Section whose fields are arrays over configurations (each repeated)."""
+def _stack_sections(sections: Sequence[Section]) -> Section:
+    """One Section whose fields are arrays over configurations."""
     return Section(
-        EI=np.repeat(np.array([s.EI for s in sections], dtype=complex), repeat),
-        kGA=np.repeat(np.array([s.kGA for s in sections], dtype=complex), repeat),
-        rhoA=np.repeat(np.array([s.rhoA for s in sections], dtype=float), repeat),
-        rhoI=np.repeat(np.array([s.rhoI for s in sections], dtype=float), repeat),
+        EI=np.array([s.EI for s in sections], dtype=complex),
+        kGA=np.array([s.kGA for s in sections], dtype=complex),
+        rhoA=np.array([s.rhoA for s in sections], dtype=float),
+        rhoI=np.array([s.rhoI for s in sections], dtype=float),
     )
 
 
@@ -599,32 +500,30 @@ def stepped_beam_receptance_batch(
 
     Notes
     -----
-    The same closed form as :func:`stepped_beam_receptance`, evaluated on one
-    long axis that holds every configuration's frequency lines, so that a
-    sweep over tool overhangs costs a few numpy operations per segment.
+    The same closed form as :func:`stepped_beam_receptance`, in one kernel
+    call for all configurations: a segment that is the same in every
+    configuration (e.g. the fluted length in an overhang sweep) is computed
+    once per frequency line, the others per configuration and line.
     """
     n_seg = len(configurations[0])
     if any(len(c) != n_seg for c in configurations):
         raise InvalidValueError("configurations: every beam of a batch needs the same number of segments")
     if not ends or any(e not in ("base", "tip") for e in ends) or len(set(ends)) != len(ends):
         raise InvalidValueError(f"ends: got {ends!r}; expected 'base' and/or 'tip'")
-    f = np.asarray(frequency_hz, dtype=float)
-    n_f = f.size
-    omega = np.tile(2.0 * np.pi * f, len(configurations))
+    f = np.asarray(frequency_hz, dtype=float).reshape(-1)
+    omega = 2.0 * np.pi * f
     omega_max = 2.0 * np.pi * float(f.max())
     intervals, phases = [], []
     for j in range(n_seg):
         column = [cfg[j] for cfg in configurations]
-        secs = [seg.section() for seg in column]
-        lengths = np.array([seg.length_m for seg in column])
-        if all(seg == column[0] for seg in column[1:]):
-            intervals.append((secs[0], lengths[0], (n_f, len(column))))
-            phases.append(_phase(secs[0], lengths[0], omega_max))
+        first = column[0]
+        if all(seg is first or seg == first for seg in column[1:]):
+            sec, length = first.section(), first.length_m
         else:
-            intervals.append((_stack_sections(secs, n_f), np.repeat(lengths, n_f)))
-            phases.append(_phase(_stack_sections(secs, 1), lengths, omega_max))
+            sec = _stack_sections([seg.section() for seg in column])
+            length = np.array([seg.length_m for seg in column])
+        intervals.append((sec, length))
+        phases.append(_phase(sec, length, omega_max))
     nodes = sorted({"base": 0, "tip": n_seg}[e] for e in ends)
-    y = _chain_receptance(intervals, nodes, omega, phases)
-    if len(ends) == 2 and ends[0] == "tip":
-        y = y[np.ix_([2, 3, 0, 1], [2, 3, 0, 1])]
-    return y
+    place = [list(ends).index(e) for e in sorted(ends, key=lambda e: e != "base")]  # base first
+    return _chain_receptance(intervals, nodes, omega, phases, n_config=len(configurations), place=place)

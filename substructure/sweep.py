@@ -89,7 +89,7 @@ def sweep(
     inputs: Sequence[str] | str | None = None,
     frequency=None,
     *,
-    chunk_lines: int = 10_000,
+    chunk_lines: int = 50_000,
     progress: bool = False,
 ) -> SweepResult:
     """Receptances from ``inputs`` to ``outputs`` for every assembly of a sweep.
@@ -104,7 +104,8 @@ def sweep(
         Defaults to the first assembly's grid.
     chunk_lines : int
         Variants are evaluated in chunks of about this many frequency lines
-        in all (bounds the memory: ~1 kB per line).
+        in all (bounds the memory: about 0.5 kB per line for a tool of two
+        points, so 25 MB at the default).
     progress : bool
         Print the progress to standard error.
 
@@ -174,6 +175,7 @@ def sweep(
         ]
         shared_block = (needed, couple_substructures(blocks0, links_s, needed)) if needed else None
 
+    all_beams = {gi: all(isinstance(o, Beam) for o in owners_of[gi]) for gi in range(len(groups0))}
     per_chunk = max(1, chunk_lines // n_f)
     data = np.empty((n_var, n_f, len(rows), len(cols)), dtype=complex)
     constant_links: dict[int, np.ndarray] = {}
@@ -187,15 +189,15 @@ def sweep(
             if gi in const_groups:
                 continue
             owners = owners_of[gi]
-            refs_c = [[r for _, r in plans[c][0][gi][1]] for c in chunk]
             keys = [(gi, ii) for ii in range(len(refs0[gi]))]
-            if all(isinstance(o, Beam) for o in owners) and all(
+            if all_beams[gi] and all(
                 r.where in ("base", "tip") for r in refs0[gi]
             ) and len({len(owners[c].segments) for c in chunk}) == 1:
                 y = stepped_beam_receptance_batch(
                     [owners[c].segments for c in chunk], [r.where for r in refs0[gi]], f
                 )
             else:
+                refs_c = [[r for _, r in plans[c][0][gi][1]] for c in chunk]
                 y = np.concatenate(
                     [owners[c].receptance_matrix(rc, f) for c, rc in zip(chunk, refs_c)], axis=-1
                 )
