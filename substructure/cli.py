@@ -61,23 +61,26 @@ def _one_line(text: str) -> str:
     return " ".join(str(text).split())
 
 
-def _grid(text: str) -> Frequency:
-    """``START:STOP:STEP`` in Hz, or with units (``"20 Hz:5 kHz:2 Hz"``)."""
+def _range_of(text: str, unit: str, build: Callable, example: str):
+    """``START:STOP:STEP`` of quantities: plain numbers are in ``unit``, units may be written."""
     parts = text.split(":")
     if len(parts) != 3:
-        raise argparse.ArgumentTypeError(
-            f"got {text!r}; expected START:STOP:STEP, e.g. 20:5000:2 (Hz) or '20 Hz:5 kHz:2 Hz'"
-        )
+        raise argparse.ArgumentTypeError(f"got {text!r}; expected START:STOP:STEP, e.g. {example}")
     values: list[Any] = []
     for part in parts:
         try:
-            values.append(Q_(float(part), "Hz"))  # plain numbers are Hz
+            values.append(Q_(float(part), unit))
         except ValueError:
             values.append(part.strip())
     try:
-        return Frequency.from_range(*values)
+        return build(*values)
     except SubstructureError as exc:
-        raise argparse.ArgumentTypeError(f"{text!r}: {exc}") from None
+        raise argparse.ArgumentTypeError(f"{text!r}: {_one_line(str(exc))}") from None
+
+
+def _grid(text: str) -> Frequency:
+    """``START:STOP:STEP`` in Hz, or with units (``"20 Hz:5 kHz:2 Hz"``)."""
+    return _range_of(text, "Hz", Frequency.from_range, "20:5000:2 (Hz) or '20 Hz:5 kHz:2 Hz'")
 
 
 def _point(text: str) -> str:
@@ -443,21 +446,7 @@ def _speeds(text: str):
     """``START:STOP:STEP`` spindle speeds: plain numbers are rpm; units allowed, Hz refused."""
     from .stability import spindle_speeds
 
-    parts = text.split(":")
-    if len(parts) != 3:
-        raise argparse.ArgumentTypeError(
-            f"got {text!r}; expected START:STOP:STEP in rpm, e.g. 2000:24000:50 or '2000 rpm:24000 rpm:50 rpm'"
-        )
-    values: list[Any] = []
-    for part in parts:
-        try:
-            values.append(Q_(float(part), "rpm"))  # plain numbers are rpm
-        except ValueError:
-            values.append(part.strip())
-    try:
-        return spindle_speeds(*values)
-    except SubstructureError as exc:
-        raise argparse.ArgumentTypeError(f"{text!r}: {_one_line(str(exc))}") from None
+    return _range_of(text, "rpm", spindle_speeds, "2000:24000:50 (rpm) or '2000 rpm:24000 rpm:50 rpm'")
 
 
 def _lobes_cut(args: argparse.Namespace):
