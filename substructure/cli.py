@@ -595,6 +595,66 @@ def _run_lobes(args: argparse.Namespace) -> int:
 # -- entry point ----------------------------------------------------------------------
 
 
+# -- predict --------------------------------------------------------------------------
+
+
+def _features(text: str) -> dict[str, str]:
+    out = {}
+    for part in text.split(","):
+        if not part.strip():
+            continue
+        name, sep, value = part.partition("=")
+        if not sep or not name.strip() or not value.strip():
+            raise _UsageError(f"--features: cannot read {part.strip()!r}; expected NAME=VALUE, e.g. tool_diameter=14 mm")
+        out[name.strip()] = value.strip()
+    return out
+
+
+def _run_predict(args: argparse.Namespace) -> int:
+    from .surrogate import JointTable, cross_validate, make_surrogate
+
+    table = JointTable.from_csv(args.table)
+    table.check_not_empty()
+    surrogate = make_surrogate(args.model)
+    if args.cross_validate:
+        target = args.target or next(iter(table.parameters))
+        cv = cross_validate(surrogate, table, target, args.cross_validate)
+        if args.plot:
+            import matplotlib
+
+            matplotlib.use("Agg")
+            import matplotlib.pyplot as plt
+
+            fig = cv.plot()
+            try:
+                fig.savefig(args.plot, dpi=120)
+            finally:
+                plt.close(fig)
+        if args.json:
+            print(json.dumps(cv.to_json()))
+            return 0
+        print(f"{args.model}, {args.cross_validate} on {args.table}: {len(cv.folds)} folds, {target} [{cv.unit}]")
+        print(f"  mean |error| {cv.mean_abs_percent_error:.1f} %, max {cv.max_abs_percent_error:.1f} %")
+        print(f"  inside the 68 % interval {cv.coverage(0.68):.0%}, the 95 % interval {cv.coverage(0.95):.0%}")
+        return 0
+    if args.features is None:
+        raise _UsageError("give --features NAME=VALUE,... (or --cross-validate)")
+    if args.assembly or args.joint:
+        raise _UsageError("--assembly/--joint: the FRF band is not available yet in this version")
+    targets = [args.target] if args.target else None
+    model = surrogate.fit(table, targets)
+    prediction = model.predict(_features(args.features))
+    result = prediction.to_json()
+    if args.json:
+        print(json.dumps({"model": args.model, "features": _features(args.features), "parameters": result}))
+        return 0
+    print(f"{args.model} surrogate on {table.describe()}")
+    for name, p in result.items():
+        lo, hi = p["interval_95"]
+        print(f"  {name} = {p['value']:.4g} +- {p['std']:.3g} {p['unit']} (95 %: {lo:.4g} to {hi:.4g})")
+    return 0
+
+
 def _parser() -> _Parser:
     parser = _Parser(prog=PROG, description="Receptance coupling of spindle-holder-tool assemblies.")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND")
@@ -667,6 +727,17 @@ def _parser() -> _Parser:
     lobes.add_argument("--plot", metavar="FILE.png", help="plot the lobes to an image file")
     lobes.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
     lobes.set_defaults(run=_run_lobes)
+    pred = commands.add_parser("predict", help="joint parameters for an untested tool from a joint table")
+    pred.add_argument("table", metavar="TABLE", help="joint-parameter table (CSV, units in the header)")
+    pred.add_argument("--features", metavar="NAME=VALUE,...", help="features of the tool, e.g. 'tool_diameter=14 mm'")
+    pred.add_argument("--model", choices=("mlp", "gp"), default="gp", help="surrogate (default gp)")
+    pred.add_argument("--target", metavar="PARAMETER", help="parameter to predict (default: all of the table)")
+    pred.add_argument("--cross-validate", metavar="loo|group:FEATURE", help="evaluate the surrogate instead")
+    pred.add_argument("--assembly", metavar="A.toml", help="assembly file for the FRF band (not yet available)")
+    pred.add_argument("--joint", metavar="NAME", help="the joint of --assembly the prediction replaces")
+    pred.add_argument("--plot", metavar="FILE.png", help="parity plot of the cross-validation")
+    pred.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
+    pred.set_defaults(run=_run_predict)
     demo = commands.add_parser("demo", help="the workflow on the built-in assembly, with plots")
     demo.add_argument("--out", default="out/demo", metavar="DIR", help="output directory (default out/demo)")
     demo.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
@@ -722,7 +793,7 @@ def main(argv: list[str] | None = None) -> int:
             _load_plugins()
             args = _parser().parse_args(argv)
             if args.command is None:
-                raise _UsageError("choose a command: frf, identify, diagnose, lobes, demo (see substructure --help)")
+                raise _UsageError("choose a command: frf, identify, diagnose, lobes, predict, demo (see substructure --help)")
             return args.run(args)
         except _UsageError as exc:
             print(f"{PROG}: error: {_one_line(str(exc))}", file=sys.stderr)

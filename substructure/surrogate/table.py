@@ -1,0 +1,386 @@
+"""The joint-parameter table: identified joints and the features they were identified for.
+
+Each row is one identified joint: its parameters (``k_yf``, ``c_yf``, ...) with
+units and, when known, their standard deviations, and its features (tool
+diameter, gauge length, holder type, clamping torque, anything the user adds).
+A feature either has a unit (a number with a unit per row) or is categorical
+(a string per row).  The table reads and writes CSV, whose header gives each
+column's unit in brackets::
+
+    tool_diameter [mm],gauge_length [mm],holder_type,k_yf [N/m],k_yf_std [N/m]
+    12,76,BT40-collet,1.43e7,
+
+Columns named like joint parameters (``k_yf``, ``k_ym``, ``k_tf``, ``k_tm``,
+``c_yf``, ...) are parameters, ``NAME_std`` their standard deviations, every
+other column a feature.  Identification results append directly
+(:meth:`JointTable.append_report`).  Tables are immutable: appending returns
+a new table.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import re
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+import attrs
+import numpy as np
+import pint
+
+from ..errors import FileFormatError, InvalidValueError, UnitError
+from ..units import ureg
+
+__all__ = ["JointTable", "PARAMETER_UNITS", "thesis_table_4_2"]
+
+PARAMETER_UNITS = {
+    "k_yf": "N/m", "k_ym": "N", "k_tf": "N/rad", "k_tm": "N*m/rad",
+    "c_yf": "N*s/m", "c_ym": "N*s", "c_tf": "N*s/rad", "c_tm": "N*m*s/rad",
+}
+"""The SI unit of each joint parameter (conventions.md, Joints)."""
+
+_HEADER = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:\[(.*)\])?\s*$")
+
+
+def _dimension(unit: str) -> str:
+    return str(ureg.Quantity(1.0, unit).dimensionality)
+
+
+def _check_unit(unit: str, field: str) -> str:
+    try:
+        ureg.Quantity(1.0, unit)
+    except Exception:
+        raise UnitError(f"{field}: cannot read the unit {unit!r}") from None
+    return unit
+
+
+def _to_unit(value: Any, unit: str, field: str) -> float:
+    """``value`` (a quantity or a string with a unit) as a float in ``unit``."""
+    if isinstance(value, bool) or isinstance(value, (int, float, np.number)):
+        raise UnitError(f"{field}: got the bare number {value!r}; expected a value with a unit like {unit!r}")
+    if isinstance(value, str):
+        try:
+            q = ureg.Quantity(value)
+        except Exception:
+            raise UnitError(f"{field}: cannot read {value!r} as a quantity; expected a unit like {unit!r}") from None
+        if not isinstance(q, pint.Quantity) or q.dimensionless and not ureg.Quantity(1.0, unit).dimensionless:
+            raise UnitError(f"{field}: got {value!r} without a unit; the table gives {field} in {unit}")
+    elif isinstance(value, pint.Quantity):
+        q = value if value._REGISTRY is ureg else ureg.Quantity(str(value))
+    else:
+        raise UnitError(f"{field}: got {value!r}; expected a value with a unit like {unit!r}")
+    if not q.check(_dimension(unit)):
+        raise UnitError(
+            f"{field}: got {value!r} ({q.dimensionality}); the table gives {field} in {unit} "
+            f"({_dimension(unit)}), units that do not match"
+        )
+    out = float(q.m_as(unit))
+    if not math.isfinite(out):
+        raise InvalidValueError(f"{field}: got {value!r}; expected a finite value")
+    return out
+
+
+@attrs.frozen(eq=False)
+class JointTable:
+    """Identified joint parameters (rows) with their features.
+
+    Parameters
+    ----------
+    parameters : mapping of str to str
+        Parameter name to the unit its column is in, e.g. ``{"k_yf": "N/m"}``.
+    features : mapping of str to str or None
+        Feature name to its unit, or ``None`` for a categorical feature.
+    columns : mapping of str to array
+        One array per parameter, per feature and (optional) per ``NAME_std``;
+        numbers in the column's unit, NaN for an unknown standard deviation.
+
+    Use :meth:`from_rows`, :meth:`from_csv` or :func:`thesis_table_4_2` rather
+    than this constructor.
+    """
+
+    parameters: dict = attrs.field(converter=dict)
+    features: dict = attrs.field(converter=dict)
+    columns: dict = attrs.field(converter=dict)
+
+    def __attrs_post_init__(self) -> None:
+        if not self.parameters:
+            raise InvalidValueError("joint table: no parameter columns (names like k_yf, c_yf)")
+        for name, unit in self.parameters.items():
+            _check_unit(unit, name)
+        for name, unit in self.features.items():
+            if unit is not None:
+                _check_unit(unit, name)
+        n = None
+        for name in [*self.parameters, *self.features]:
+            if name not in self.columns:
+                raise InvalidValueError(f"joint table: column {name!r} is missing")
+        for name, col in self.columns.items():
+            if n is None:
+                n = len(col)
+            elif len(col) != n:
+                raise InvalidValueError(f"joint table: column {name!r} has {len(col)} rows, expected {n}")
+        for name in self.parameters:
+            std = name + "_std"
+            if std not in self.columns:
+                self.columns[std] = np.full(n or 0, np.nan)
+
+    # -- construction ---------------------------------------------------------------------
+
+    @classmethod
+    def empty(cls, parameters: Mapping[str, str], features: Mapping[str, str | None]) -> "JointTable":
+        """A table without rows, with the given columns and units."""
+        cols = {p: np.zeros(0) for p in parameters}
+        cols.update({f: np.zeros(0) if u is not None else np.zeros(0, dtype=object) for f, u in features.items()})
+        return cls(parameters, features, cols)
+
+    @classmethod
+    def from_rows(cls, rows: Sequence[Mapping[str, Any]], parameters: Sequence[str] | None = None) -> "JointTable":
+        """A table from rows of quantities (``"12 mm"``) and strings (categorical).
+
+        Parameters are the keys named like joint parameters (or ``parameters``);
+        ``NAME_std`` keys are their standard deviations.  The units of the
+        first row become the table's units.
+        """
+        rows = list(rows)
+        if not rows:
+            raise InvalidValueError("joint table: got no rows (use JointTable.empty for an empty table)")
+        first = rows[0]
+        pnames = list(parameters) if parameters is not None else [k for k in first if k in PARAMETER_UNITS]
+        par_units, feat_units = {}, {}
+        for key, value in first.items():
+            if key.endswith("_std") and key[:-4] in pnames:
+                continue
+            unit = None
+            if isinstance(value, pint.Quantity):
+                unit = f"{value.units:~C}" or None
+            elif isinstance(value, str):
+                try:
+                    q = ureg.Quantity(value)
+                    unit = f"{q.units:~C}" if isinstance(q, pint.Quantity) and not q.dimensionless else None
+                except Exception:
+                    unit = None
+            if key in pnames:
+                if unit is None:
+                    raise UnitError(f"{key}: got {value!r}; a parameter needs a unit, e.g. '1.4e7 N/m'")
+                par_units[key] = unit
+            else:
+                feat_units[key] = unit
+        table = cls.empty(par_units, feat_units)
+        for row in rows:
+            table = table.append(row)
+        return table
+
+    @classmethod
+    def from_csv(cls, path: str | Path, parameters: Sequence[str] | None = None) -> "JointTable":
+        """Read a table written by :meth:`to_csv` (units in brackets in the header)."""
+        path = Path(path)
+        try:
+            text = path.read_text()
+        except OSError:
+            raise
+        return cls._from_csv_text(text, str(path), parameters)
+
+    @classmethod
+    def _from_csv_text(cls, text: str, where: str, parameters=None) -> "JointTable":
+        lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+        if not lines:
+            raise FileFormatError(f"{where}: the joint table is empty (no header, no rows)")
+        reader = csv.reader(lines)
+        header = next(reader)
+        names, units = [], []
+        for col in header:
+            m = _HEADER.match(col)
+            if not m:
+                raise FileFormatError(f"{where}: cannot read the column header {col!r}; expected 'name [unit]' or 'name'")
+            names.append(m.group(1))
+            units.append(m.group(2).strip() if m.group(2) else None)
+        pset = set(parameters) if parameters is not None else {n for n in names if n in PARAMETER_UNITS}
+        par_units, feat_units = {}, {}
+        for n, u in zip(names, units):
+            if n.endswith("_std") and n[:-4] in pset:
+                continue
+            if n in pset:
+                if u is None:
+                    raise FileFormatError(f"{where}: parameter column {n!r} has no unit (write '{n} [N/m]')")
+                par_units[n] = _check_unit(u, f"{where}: column {n}")
+            else:
+                feat_units[n] = _check_unit(u, f"{where}: column {n}") if u else None
+        if not par_units:
+            raise FileFormatError(f"{where}: no parameter column (names like k_yf [N/m])")
+        cols: dict[str, list] = {n: [] for n in names}
+        for lineno, row in enumerate(reader, start=2):
+            if len(row) != len(names):
+                raise FileFormatError(f"{where}, line {lineno}: {len(row)} values, expected {len(names)}")
+            for n, u, cell in zip(names, units, row):
+                cell = cell.strip()
+                if n in feat_units and feat_units[n] is None:
+                    if not cell:
+                        raise FileFormatError(f"{where}, line {lineno}: {n} is empty")
+                    cols[n].append(cell)
+                    continue
+                if not cell and n.endswith("_std"):
+                    cols[n].append(math.nan)
+                    continue
+                try:
+                    cols[n].append(float(cell))
+                except ValueError:
+                    raise FileFormatError(f"{where}, line {lineno}: {n} = {cell!r} is not a number") from None
+        arrays = {n: np.array(v, dtype=object if (n in feat_units and feat_units[n] is None) else float)
+                  for n, v in cols.items()}
+        std_units = {n: u for n, u in zip(names, units) if n.endswith("_std") and n[:-4] in par_units}
+        for n, u in std_units.items():
+            if u is not None and u != par_units[n[:-4]]:
+                arrays[n] = np.array([ureg.Quantity(v, u).m_as(par_units[n[:-4]]) for v in arrays[n]])
+        return cls(par_units, feat_units, arrays)
+
+    # -- access ------------------------------------------------------------------------------
+
+    def __len__(self) -> int:
+        return len(self.columns[next(iter(self.parameters))])
+
+    @property
+    def n_rows(self) -> int:
+        return len(self)
+
+    def values(self, parameter: str) -> np.ndarray:
+        """The column of ``parameter`` in its unit (:attr:`parameters`)."""
+        self._check_parameter(parameter)
+        return np.asarray(self.columns[parameter], dtype=float)
+
+    def stds(self, parameter: str) -> np.ndarray:
+        """Standard deviations of ``parameter`` (NaN where unknown)."""
+        self._check_parameter(parameter)
+        return np.asarray(self.columns[parameter + "_std"], dtype=float)
+
+    def feature(self, name: str) -> np.ndarray:
+        """The column of feature ``name`` (numbers in its unit, or strings)."""
+        if name not in self.features:
+            raise InvalidValueError(f"feature {name!r} is not in the table; it has {', '.join(self.features) or 'none'}")
+        return self.columns[name]
+
+    def _check_parameter(self, parameter: str) -> None:
+        if parameter not in self.parameters:
+            raise InvalidValueError(
+                f"parameter {parameter!r} is not in the table; it has {', '.join(self.parameters)}"
+            )
+
+    def check_not_empty(self) -> None:
+        """Raise :class:`InvalidValueError` for a table without rows."""
+        if len(self) == 0:
+            raise InvalidValueError("the joint table is empty: identify some joints and append them first")
+
+    def feature_values(self, features: Mapping[str, Any], field: str = "features") -> dict[str, Any]:
+        """Check one set of features against the table: every feature, in matching units.
+
+        Returns numbers in the table's units, strings for categorical features.
+        """
+        missing = [f for f in self.features if f not in features]
+        if missing:
+            raise InvalidValueError(
+                f"{field}: {', '.join(missing)} missing; the table's features are "
+                + ", ".join(f"{f} [{u}]" if u else f"{f} (categorical)" for f, u in self.features.items())
+            )
+        unknown = [f for f in features if f not in self.features]
+        if unknown:
+            raise InvalidValueError(
+                f"{field}: {', '.join(unknown)} not in the table; its features are {', '.join(self.features)}"
+            )
+        out = {}
+        for name, unit in self.features.items():
+            value = features[name]
+            if unit is None:
+                if not isinstance(value, str):
+                    raise InvalidValueError(f"{name}: got {value!r}; this feature is categorical (a name)")
+                out[name] = value.strip()
+            else:
+                out[name] = _to_unit(value, unit, name)
+        return out
+
+    # -- changes -----------------------------------------------------------------------------
+
+    def append(self, row: Mapping[str, Any]) -> "JointTable":
+        """A new table with one more row (quantities for parameters and unit features)."""
+        feats = self.feature_values({k: v for k, v in row.items() if k in self.features
+                                     or not (k in self.parameters or k.endswith("_std") and k[:-4] in self.parameters)},
+                                    field="row")
+        missing = [p for p in self.parameters if p not in row]
+        if missing:
+            raise InvalidValueError(f"row: parameter {', '.join(missing)} missing")
+        cols = {k: list(v) for k, v in self.columns.items()}
+        for p, unit in self.parameters.items():
+            cols[p].append(_to_unit(row[p], unit, p))
+            std = row.get(p + "_std")
+            cols[p + "_std"].append(math.nan if std is None else _to_unit(std, unit, p + "_std"))
+        for f, v in feats.items():
+            cols[f].append(v)
+        arrays = {k: np.array(v, dtype=object if (k in self.features and self.features[k] is None) else float)
+                  for k, v in cols.items()}
+        return JointTable(self.parameters, self.features, arrays)
+
+    def append_report(self, report, features: Mapping[str, Any]) -> "JointTable":
+        """A new table with the joint identified in ``report`` (an IdentificationReport).
+
+        The report's values are SI (``k_yf`` in N/m, ...); every parameter of
+        the table is taken from it, with its standard deviation when fitted.
+        """
+        row = dict(features)
+        for p in self.parameters:
+            kind, entry = p.split("_", 1)
+            values = report.k if kind == "k" else report.c
+            stds = report.k_std if kind == "k" else report.c_std
+            if entry not in values:
+                raise InvalidValueError(f"report of joint {report.joint!r} has no {p}")
+            unit = PARAMETER_UNITS[p]
+            row[p] = ureg.Quantity(float(values[entry]), unit)
+            std = float(stds.get(entry, 0.0))
+            row[p + "_std"] = ureg.Quantity(std, unit) if std > 0 else None
+        return self.append(row)
+
+    # -- output ------------------------------------------------------------------------------
+
+    def to_csv(self, path: str | Path | None = None) -> str:
+        """Write the table as CSV (units in the header); returns the text."""
+        header, keys = [], []
+        for f, u in self.features.items():
+            header.append(f"{f} [{u}]" if u else f)
+            keys.append(f)
+        for p, u in self.parameters.items():
+            header += [f"{p} [{u}]", f"{p}_std [{u}]"]
+            keys += [p, p + "_std"]
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(header)
+        for i in range(len(self)):
+            cells = []
+            for k in keys:
+                v = self.columns[k][i]
+                if isinstance(v, str):
+                    cells.append(v)
+                elif isinstance(v, float) and math.isnan(v):
+                    cells.append("")
+                else:
+                    cells.append(repr(float(v)))
+            w.writerow(cells)
+        text = buf.getvalue()
+        if path is not None:
+            Path(path).write_text(text)
+        return text
+
+    def describe(self) -> str:
+        """One line: rows, parameters and features."""
+        feats = ", ".join(f"{f} [{u}]" if u else f"{f} (categorical)" for f, u in self.features.items())
+        return f"{len(self)} joints; parameters {', '.join(self.parameters)}; features {feats}"
+
+
+def thesis_table_4_2() -> JointTable:
+    """Thesis Table 4.2 as a joint table: 13 holder-tool ``k_yf`` over diameter and gauge length."""
+    from ..datasets import thesis_table
+
+    rows = [
+        {"tool_diameter": f"{r['tool_diameter_mm']} mm", "gauge_length": f"{r['gauge_length_mm']} mm",
+         "k_yf": f"{float(r['k_yf_identified_1e7_N_per_m']) * 1e7!r} N/m"}
+        for r in thesis_table("4.2")
+    ]
+    return JointTable.from_rows(rows)

@@ -1,0 +1,44 @@
+"""The ``substructure predict`` command: prediction, cross-validation, errors."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from substructure.cli import main
+from substructure.surrogate import thesis_table_4_2
+
+
+@pytest.fixture
+def table_csv(tmp_path):
+    path = tmp_path / "joints.csv"
+    thesis_table_4_2().to_csv(path)
+    return str(path)
+
+
+def test_predict_json(table_csv, capsys):
+    assert main(["predict", table_csv, "--features", "tool_diameter=14 mm,gauge_length=90 mm", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    k = out["parameters"]["k_yf"]
+    assert k["unit"] == "N/m" and k["value"] > 0 and k["std"] > 0
+
+
+def test_predict_cross_validate_json(table_csv, capsys):
+    assert main(["predict", table_csv, "--target", "k_yf", "--cross-validate", "loo", "--model", "gp", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["model"] == "gp" and len(out["folds"]) == 13
+    assert set(out["folds"][0]) == {"held_out", "true", "predicted", "std"}
+    assert 0 <= out["coverage_95"] <= 1 and out["mean_abs_percent_error"] > 0
+
+
+def test_predict_summary_and_errors(table_csv, capsys):
+    assert main(["predict", table_csv, "--features", "tool_diameter=14 mm,gauge_length=90 mm"]) == 0
+    assert "k_yf" in capsys.readouterr().out
+    assert main(["predict", table_csv, "--features", "tool_diameter=14 mm"]) == 1
+    err = capsys.readouterr().err
+    assert "gauge_length" in err and "Traceback" not in err
+    assert main(["predict", table_csv, "--features", "tool_diameter=14 kg,gauge_length=90 mm"]) == 1
+    assert "do not match" in capsys.readouterr().err
+    assert main(["predict", table_csv, "--features", "tool_diameter=40 mm,gauge_length=90 mm"]) == 0
+    assert "warning" in capsys.readouterr().err

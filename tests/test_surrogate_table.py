@@ -1,0 +1,57 @@
+"""The joint-parameter table: CSV round trip, appending identification results, errors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from substructure.errors import FileFormatError, InvalidValueError, UnitError
+from substructure.surrogate import JointTable, thesis_table_4_2
+
+
+def test_csv_round_trip(tmp_path):
+    table = thesis_table_4_2()
+    path = tmp_path / "joints.csv"
+    table.to_csv(path)
+    back = JointTable.from_csv(path)
+    assert back.parameters == {"k_yf": "N/m"} and back.features == {"tool_diameter": "mm", "gauge_length": "mm"}
+    np.testing.assert_array_equal(back.values("k_yf"), table.values("k_yf"))
+    assert np.isnan(back.stds("k_yf")).all()
+
+
+def test_append_converts_units_and_rejects_mismatch():
+    table = thesis_table_4_2().append({"tool_diameter": "1.4 cm", "gauge_length": "0.09 m",
+                                       "k_yf": "15 MN/m", "k_yf_std": "1 MN/m"})
+    assert len(table) == 14
+    assert table.feature("tool_diameter")[-1] == pytest.approx(14.0)
+    assert table.values("k_yf")[-1] == pytest.approx(1.5e7) and table.stds("k_yf")[-1] == pytest.approx(1e6)
+    with pytest.raises(UnitError, match="do not match"):
+        table.append({"tool_diameter": "14 kg", "gauge_length": "90 mm", "k_yf": "1e7 N/m"})
+    with pytest.raises(InvalidValueError, match="missing"):
+        table.append({"tool_diameter": "14 mm", "k_yf": "1e7 N/m"})
+
+
+def test_append_identification_report():
+    class Report:  # the fields of substructure.identify.IdentificationReport that the table reads
+        joint = "holder-tool"
+        k = {"yf": 1.6e7, "ym": 0.0, "tf": 0.0, "tm": 8e4}
+        c = {"yf": 12.0, "ym": 0.0, "tf": 0.0, "tm": 4.0}
+        k_std = {"yf": 4e5, "ym": 0.0, "tf": 0.0, "tm": 0.0}
+        c_std = {"yf": 0.0, "ym": 0.0, "tf": 0.0, "tm": 0.0}
+
+    table = thesis_table_4_2().append_report(Report(), {"tool_diameter": "14 mm", "gauge_length": "90 mm"})
+    assert table.values("k_yf")[-1] == 1.6e7 and table.stds("k_yf")[-1] == 4e5
+
+
+def test_bad_files(tmp_path):
+    empty = tmp_path / "empty.csv"
+    empty.write_text("")
+    with pytest.raises(FileFormatError, match="empty"):
+        JointTable.from_csv(empty)
+    nounit = tmp_path / "nounit.csv"
+    nounit.write_text("tool_diameter [mm],k_yf\n12,1e7\n")
+    with pytest.raises(FileFormatError, match="no unit"):
+        JointTable.from_csv(nounit)
+    header_only = tmp_path / "header.csv"
+    header_only.write_text("tool_diameter [mm],k_yf [N/m]\n")
+    assert len(JointTable.from_csv(header_only)) == 0
