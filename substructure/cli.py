@@ -639,19 +639,47 @@ def _run_predict(args: argparse.Namespace) -> int:
         return 0
     if args.features is None:
         raise _UsageError("give --features NAME=VALUE,... (or --cross-validate)")
-    if args.assembly or args.joint:
-        raise _UsageError("--assembly/--joint: the FRF band is not available yet in this version")
+    if bool(args.assembly) != bool(args.joint):
+        raise _UsageError("--assembly and --joint go together: the assembly file and the joint to replace")
     targets = [args.target] if args.target else None
     model = surrogate.fit(table, targets)
     prediction = model.predict(_features(args.features))
     result = prediction.to_json()
+    band = None
+    if args.assembly:
+        from .surrogate import predict_frf_band
+
+        band = predict_frf_band(load_assembly(args.assembly), args.joint, prediction, at=_point(args.at),
+                                n_samples=args.samples)
+        if args.plot:
+            import matplotlib
+
+            matplotlib.use("Agg")
+            import matplotlib.pyplot as plt
+
+            fig = band.plot(label=f"{args.model} prediction")
+            try:
+                fig.savefig(args.plot, dpi=120)
+            finally:
+                plt.close(fig)
     if args.json:
-        print(json.dumps({"model": args.model, "features": _features(args.features), "parameters": result}))
+        out = {"model": args.model, "features": _features(args.features), "parameters": result}
+        if band is not None:
+            out["frf"] = {"at": _point(args.at), "joint": args.joint, **band.to_json()}
+        print(json.dumps(out))
         return 0
     print(f"{args.model} surrogate on {table.describe()}")
     for name, p in result.items():
         lo, hi = p["interval_95"]
         print(f"  {name} = {p['value']:.4g} +- {p['std']:.3g} {p['unit']} (95 %: {lo:.4g} to {hi:.4g})")
+    if band is not None:
+        nominal = band.nominal
+        peaks = nominal.peaks()
+        print(f"tool point FRF ({_point(args.at)}) with the predicted {args.joint!r} joint, "
+              f"{len(next(iter(band.samples.values())))} samples: peaks of the median joint at "
+              + ", ".join(f"{f:.0f} Hz" for f in peaks))
+        if args.plot:
+            print(f"wrote {args.plot}")
     return 0
 
 
@@ -733,9 +761,12 @@ def _parser() -> _Parser:
     pred.add_argument("--model", choices=("mlp", "gp"), default="gp", help="surrogate (default gp)")
     pred.add_argument("--target", metavar="PARAMETER", help="parameter to predict (default: all of the table)")
     pred.add_argument("--cross-validate", metavar="loo|group:FEATURE", help="evaluate the surrogate instead")
-    pred.add_argument("--assembly", metavar="A.toml", help="assembly file for the FRF band (not yet available)")
+    pred.add_argument("--assembly", metavar="A.toml", help="assembly file: the tool point FRF and its band")
     pred.add_argument("--joint", metavar="NAME", help="the joint of --assembly the prediction replaces")
-    pred.add_argument("--plot", metavar="FILE.png", help="parity plot of the cross-validation")
+    pred.add_argument("--at", default="tool.tip", metavar="POINT[:dof]", help="FRF point (default tool.tip:y)")
+    pred.add_argument("--samples", type=int, default=64, metavar="N",
+                      help="samples of the predictive distribution for the FRF band (default 64)")
+    pred.add_argument("--plot", metavar="FILE.png", help="parity plot of the cross-validation, or the FRF band")
     pred.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
     pred.set_defaults(run=_run_predict)
     demo = commands.add_parser("demo", help="the workflow on the built-in assembly, with plots")

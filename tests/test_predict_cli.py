@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 
@@ -42,3 +43,25 @@ def test_predict_summary_and_errors(table_csv, capsys):
     assert "do not match" in capsys.readouterr().err
     assert main(["predict", table_csv, "--features", "tool_diameter=40 mm,gauge_length=90 mm"]) == 0
     assert "warning" in capsys.readouterr().err
+
+
+def test_predict_with_an_assembly_gives_the_frf_band(tmp_path, capsys):
+    from substructure.surrogate import thesis_table_4_2
+
+    table = tmp_path / "table.csv"
+    thesis_table_4_2().to_csv(table)
+    assembly = Path(__file__).resolve().parents[1] / "substructure" / "data" / "default_assembly.toml"
+    status = main(["predict", str(table), "--features", "tool_diameter=12 mm,gauge_length=80 mm", "--json",
+                   "--assembly", str(assembly), "--joint", "holder-tool", "--samples", "16",
+                   "--plot", str(tmp_path / "band.png")])
+    out = json.loads(capsys.readouterr().out)
+    assert status == 0
+    frf = out["frf"]
+    assert frf["joint"] == "holder-tool" and frf["n_samples"] == 16
+    assert len(frf["frequency_hz"]) == len(frf["magnitude_lower"]) == len(frf["magnitude_upper"])
+    assert all(lo <= md <= hi for lo, md, hi in zip(frf["magnitude_lower"], frf["magnitude_median"],
+                                                    frf["magnitude_upper"]))
+    assert (tmp_path / "band.png").stat().st_size > 0
+    assert main(["predict", str(table), "--features", "tool_diameter=12 mm,gauge_length=80 mm",
+                 "--assembly", str(assembly)]) == 2
+    assert "go together" in capsys.readouterr().err

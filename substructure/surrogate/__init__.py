@@ -9,7 +9,9 @@ that learn parameters from features with an honest uncertainty
 
 from .models import ExtrapolationWarning, GPSurrogate, JointSurrogate, MLPSurrogate, Prediction, make_surrogate
 from .table import PARAMETER_UNITS, JointTable, thesis_table_4_2
+from .band import FRFBand, predict_frf_band
 from .validation import CrossValidation, cross_validate
 
 __all__ = ["JointTable", "PARAMETER_UNITS", "thesis_table_4_2", "JointSurrogate", "MLPSurrogate", "GPSurrogate",
-           "Prediction", "ExtrapolationWarning", "make_surrogate", "CrossValidation", "cross_validate"]
+           "Prediction", "ExtrapolationWarning", "make_surrogate", "CrossValidation", "cross_validate",
+           "FRFBand", "predict_frf_band"]
