@@ -55,3 +55,21 @@ def test_bad_files(tmp_path):
     header_only = tmp_path / "header.csv"
     header_only.write_text("tool_diameter [mm],k_yf [N/m]\n")
     assert len(JointTable.from_csv(header_only)) == 0
+
+
+def test_toml_round_trip_and_errors(tmp_path):
+    from substructure.surrogate import thesis_table_4_2
+
+    table = thesis_table_4_2()
+    path = tmp_path / "joints.toml"
+    table.to_toml(path)
+    back = JointTable.from_toml(path)
+    assert back.parameters == table.parameters and back.features == table.features
+    for name in (*table.parameters, *table.features):
+        assert list(back.columns[name]) == list(table.columns[name])
+    bad = tmp_path / "bad.toml"
+    bad.write_text(path.read_text().replace('gauge_length = "65.0 mm"', 'gauge_length = "65.0 kg"'))
+    with pytest.raises(FileFormatError, match=r"bad.toml: joints\[0\].*units that do not match"):
+        JointTable.from_toml(bad)
+    with pytest.raises(FileFormatError, match="no such file"):
+        JointTable.from_toml(tmp_path / "missing.toml")

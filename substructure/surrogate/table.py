@@ -368,6 +368,59 @@ class JointTable:
             Path(path).write_text(text)
         return text
 
+    def to_toml(self, path: str | Path | None = None) -> str:
+        """Write the table as TOML: a ``[[joints]]`` table per row, every value with its unit.
+
+        :meth:`from_toml` reads it back to an equal table (units and values).
+        """
+        import tomli_w
+
+        rows = []
+        for i in range(len(self)):
+            row = {}
+            for f, u in self.features.items():
+                v = self.columns[f][i]
+                row[f] = str(v) if u is None else f"{float(v)!r} {u}"
+            for p, u in self.parameters.items():
+                row[p] = f"{float(self.columns[p][i])!r} {u}"
+                std = float(self.columns[p + "_std"][i])
+                if not math.isnan(std):
+                    row[p + "_std"] = f"{std!r} {u}"
+            rows.append(row)
+        header = {"parameters": dict(self.parameters),
+                  "features": {f: (u if u is not None else "categorical") for f, u in self.features.items()}}
+        text = tomli_w.dumps({**header, "joints": rows})
+        if path is not None:
+            Path(path).write_text(text)
+        return text
+
+    @classmethod
+    def from_toml(cls, path: str | Path) -> "JointTable":
+        """Read a table written by :meth:`to_toml` (or by hand in that form)."""
+        import tomllib
+
+        where = str(path)
+        try:
+            data = tomllib.loads(Path(path).read_text())
+        except FileNotFoundError:
+            raise FileFormatError(f"{where}: no such file") from None
+        except tomllib.TOMLDecodeError as exc:
+            raise FileFormatError(f"{where}: invalid TOML: {exc}") from None
+        unknown = set(data) - {"parameters", "features", "joints"}
+        if unknown:
+            raise FileFormatError(f"{where}: unknown keys {sorted(unknown)}; expected parameters, features, joints")
+        for key in ("parameters", "features", "joints"):
+            if key not in data:
+                raise FileFormatError(f"{where}: missing [{key}]")
+        features = {f: (None if u == "categorical" else u) for f, u in data["features"].items()}
+        table = cls.empty(data["parameters"], features)
+        for i, row in enumerate(data["joints"]):
+            try:
+                table = table.append(row)
+            except (InvalidValueError, UnitError) as exc:
+                raise FileFormatError(f"{where}: joints[{i}]: {exc}") from None
+        return table
+
     def describe(self) -> str:
         """One line: rows, parameters and features."""
         feats = ", ".join(f"{f} [{u}]" if u else f"{f} (categorical)" for f, u in self.features.items())
