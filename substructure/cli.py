@@ -101,18 +101,28 @@ def _grid_text(frequency: Frequency) -> str:
     return f"{frequency.start:g} Hz to {frequency.stop:g} Hz, {frequency.n} lines"
 
 
-def _save_plot(frf: FRF, path: str | os.PathLike, title: str) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")  # files only: no window, works without a display
+def _save_figure(fig, path) -> None:
+    """Save a figure to an image file and close it (Agg: files only, no display needed)."""
     import matplotlib.pyplot as plt
 
-    fig = frf.plot()
-    fig.suptitle(title)
     try:
         fig.savefig(path, dpi=120)
     finally:
         plt.close(fig)
+
+
+def _figures() -> None:
+    """Select matplotlib's file-only backend before any figure is made."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+
+
+def _save_plot(frf: FRF, path: str | os.PathLike, title: str) -> None:
+    _figures()
+    fig = frf.plot()
+    fig.suptitle(title)
+    _save_figure(fig, path)
 
 
 def _write_frf(frf: FRF, path: str) -> None:
@@ -242,11 +252,7 @@ def _demo_tap_test(state: DemoState) -> None:
 
 def _demo_diagnose(state: DemoState) -> None:
     """Model against tap test: where it fails, what is missing, the error falling."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    _figures()
     from .diagnose import diagnose
     from .io.assembly_toml import save_assembly
 
@@ -260,10 +266,7 @@ def _demo_diagnose(state: DemoState) -> None:
         state.lines.append(f"  step {step.step}: {what:45s} error {step.error:.4f}")
     for name, make in (("where_it_fails.png", result.plot_where), ("error_fall.png", result.plot_history)):
         fig = make()
-        try:
-            fig.savefig(state.out / name, dpi=120)
-        finally:
-            plt.close(fig)
+        _save_figure(fig, state.out / name)
         state.files.append(str(state.out / name))
     path = state.out / "improved_assembly.toml"
     save_assembly(result.refined_assembly, path, overwrite=True)
@@ -328,16 +331,9 @@ def _run_identify(args: argparse.Namespace) -> int:
     report = identify_joint(assembly, measurements, args.joint, band=args.band, parameters=parameters,
                             bootstrap=args.bootstrap)
     if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
+        _figures()
         fig = report.plot()
-        try:
-            fig.savefig(args.plot, dpi=120)
-        finally:
-            plt.close(fig)
+        _save_figure(fig, args.plot)
     if args.json:
         print(json.dumps(report.to_json()))
         return 0
@@ -375,26 +371,16 @@ def _run_diagnose(args: argparse.Namespace) -> int:
     result = diagnose(assembly, measurements, effects=effects, band=band, progress=progress or False)
     written = []
     if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
+        _figures()
         out = Path(args.plot)
         out.mkdir(parents=True, exist_ok=True)
         for name, make in (("where_it_fails.png", result.plot_where), ("error_fall.png", result.plot_history)):
             fig = make()
-            try:
-                fig.savefig(out / name, dpi=120)
-            finally:
-                plt.close(fig)
+            _save_figure(fig, out / name)
             written.append(str(out / name))
         if len(result.refinement) > 1:
             fig = result.final[0].plot()
-            try:
-                fig.savefig(out / "after_refinement.png", dpi=120)
-            finally:
-                plt.close(fig)
+            _save_figure(fig, out / "after_refinement.png")
             written.append(str(out / "after_refinement.png"))
     if args.save_model:
         save_assembly(result.refined_assembly, args.save_model, overwrite=args.overwrite)
@@ -546,17 +532,10 @@ def _run_lobes(args: argparse.Namespace) -> int:
         notes.append(f"discretisation: {lo}" + (f" to {hi}" if hi != lo else "") + " intervals in the cut per "
                      f"delay period; boundary to {info['depth_rtol']:.1%}")
     if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
+        _figures()
         fig = lobes.plot(lobes=args.method == "zoa")
         fig.axes[0].set_title(_one_line(cut.describe()), fontsize="small")
-        try:
-            fig.savefig(args.plot, dpi=120)
-        finally:
-            plt.close(fig)
+        _save_figure(fig, args.plot)
     if args.json:
         print(json.dumps(lobes.to_json()))
         return 0
@@ -620,16 +599,9 @@ def _run_predict(args: argparse.Namespace) -> int:
         target = args.target or next(iter(table.parameters))
         cv = cross_validate(surrogate, table, target, args.cross_validate)
         if args.plot:
-            import matplotlib
-
-            matplotlib.use("Agg")
-            import matplotlib.pyplot as plt
-
+            _figures()
             fig = cv.plot()
-            try:
-                fig.savefig(args.plot, dpi=120)
-            finally:
-                plt.close(fig)
+            _save_figure(fig, args.plot)
         if args.json:
             print(json.dumps(cv.to_json()))
             return 0
@@ -652,16 +624,9 @@ def _run_predict(args: argparse.Namespace) -> int:
         band = predict_frf_band(load_assembly(args.assembly), args.joint, prediction, at=_point(args.at),
                                 n_samples=args.samples)
         if args.plot:
-            import matplotlib
-
-            matplotlib.use("Agg")
-            import matplotlib.pyplot as plt
-
+            _figures()
             fig = band.plot(label=f"{args.model} prediction")
-            try:
-                fig.savefig(args.plot, dpi=120)
-            finally:
-                plt.close(fig)
+            _save_figure(fig, args.plot)
     if args.json:
         out = {"model": args.model, "features": _features(args.features), "parameters": result}
         if band is not None:

@@ -26,6 +26,7 @@ from typing import Any
 
 import tomli_w
 
+from . import read_text
 from ..assembly import Assembly
 from ..beams import Flutes, Insert, Segment
 from ..components import COMPONENT_TYPES, Beam
@@ -328,13 +329,7 @@ def loads_assembly(text: str, source: str = "<string>") -> Assembly:
 def load_assembly(path: str | os.PathLike) -> Assembly:
     """Read an assembly file (TOML); see :func:`loads_assembly`."""
     name = os.fspath(path)
-    try:
-        with open(path, "rb") as fh:
-            text = fh.read().decode("utf-8")
-    except FileNotFoundError:
-        raise FileFormatError(f"{name}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise FileFormatError(f"{name}: cannot read the file ({exc})") from None
+    text = read_text(path)
     return loads_assembly(text, source=name)
 
 

@@ -36,6 +36,7 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
+from . import read_text
 from ..errors import FileFormatError, SubstructureError
 from ..frf import FRF, QUANTITIES
 from ..measurements import Measurement, MeasurementSet, dof_label
@@ -293,11 +294,5 @@ def loads_measurements(text: str, base_dir: str | os.PathLike = ".", source: str
 def load_measurements(path: str | os.PathLike) -> MeasurementSet:
     """Read a measurement file; data file paths are relative to it (see :func:`loads_measurements`)."""
     name = os.fspath(path)
-    try:
-        with open(path, "rb") as fh:
-            text = fh.read().decode("utf-8")
-    except FileNotFoundError:
-        raise FileFormatError(f"{name}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise FileFormatError(f"{name}: cannot read the file ({exc})") from None
+    text = read_text(path)
     return loads_measurements(text, base_dir=Path(name).parent, source=name)

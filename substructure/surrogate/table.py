@@ -399,11 +399,11 @@ class JointTable:
         """Read a table written by :meth:`to_toml` (or by hand in that form)."""
         import tomllib
 
+        from ..io import read_text
+
         where = str(path)
         try:
-            data = tomllib.loads(Path(path).read_text())
-        except FileNotFoundError:
-            raise FileFormatError(f"{where}: no such file") from None
+            data = tomllib.loads(read_text(path))
         except tomllib.TOMLDecodeError as exc:
             raise FileFormatError(f"{where}: invalid TOML: {exc}") from None
         unknown = set(data) - {"parameters", "features", "joints"}
