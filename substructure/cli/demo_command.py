@@ -1,0 +1,141 @@
+"""The ``substructure demo`` command: the workflow on the built-in assembly, as a list of steps."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any, Callable
+
+import attrs
+
+from ..frf import FRF
+from ..io.assembly_toml import default_assembly
+from ._common import figures, grid_text, peak_table, save_figure, save_plot
+
+TOOL_POINT = "tool.tip:y"
+"""The tool point of the built-in assembly."""
+
+
+@attrs.define
+class DemoState:
+    """What the demo steps share: the output directory, results so far, files written."""
+
+    out: Path
+    assembly: Any = None
+    frf: FRF | None = None
+    results: dict = attrs.field(factory=dict)
+    files: list = attrs.field(factory=list)
+    lines: list = attrs.field(factory=list)
+    taps: Any = None
+
+
+def _demo_load(state: DemoState) -> None:
+    state.assembly = default_assembly()
+    state.lines.append(state.assembly.describe())
+    state.results["components"] = [c.name for c in state.assembly.components]
+    state.results["joints"] = [j.name for j in state.assembly.joints]
+
+
+def _demo_frf(state: DemoState) -> None:
+    state.frf = state.assembly.receptance(TOOL_POINT)
+    peaks = peak_table(state.frf)
+    tool_mode = max(peaks, key=lambda p: p[1])[0] if peaks else None
+    state.results["peaks_hz"] = [f for f, _ in peaks]
+    state.results["tool_mode_hz"] = tool_mode
+    state.lines.append(f"tool point FRF ({TOOL_POINT}) on {grid_text(state.frf.frequency)}")
+    state.lines.append("peaks: " + ", ".join(f"{f:g} Hz" for f, _ in peaks))
+    if tool_mode is not None:
+        state.lines.append(f"tool mode (highest peak): {tool_mode:g} Hz")
+    path = state.out / "tool_point_frf.csv"
+    state.frf.to_csv(path)
+    state.files.append(str(path))
+
+
+def _demo_plot(state: DemoState) -> None:
+    path = state.out / "tool_point_frf.png"
+    save_plot(state.frf, path, f"{state.assembly.name}: tool point FRF")
+    state.files.append(str(path))
+
+
+def _demo_assembly_file(state: DemoState) -> None:
+    import importlib.resources
+
+    path = state.out / "default_assembly.toml"
+    text = (importlib.resources.files("substructure") / "data" / "default_assembly.toml").read_text("utf-8")
+    path.write_text(text, encoding="utf-8")  # the packaged file, with its comments
+    state.files.append(str(path))
+
+
+def _demo_tap_test(state: DemoState) -> None:
+    """A tap test of the built-in assembly with something the model does not know about."""
+    from ..joints import Sensor
+    from ..measurements import MeasurementSet
+    from ..synthetic import simulate, write_measurement_set
+
+    rig = state.assembly.attach(Sensor("forgotten-accelerometer", "tool.tip", "2 g"))
+    taps = simulate(rig, ["tool.tip"], frequency=state.assembly.frequency, noise=0.015, seed=2026,
+                    sensors=["forgotten-accelerometer"], name="demo tap test (1.5 % noise)")
+    # the measurement file does not mention the sensor: the test report forgot it
+    taps = MeasurementSet(taps.name, tuple(attrs.evolve(m, sensors=()) for m in taps))
+    state.results["measurements"] = str(write_measurement_set(taps, state.out / "tap_test", overwrite=True))
+    state.lines.append("a simulated tap test of the tool point, 1.5 % noise, with a 2 g accelerometer "
+                       "that the test report forgot to mention")
+    state.files.append(state.results["measurements"])
+    state.taps = taps
+
+
+def _demo_diagnose(state: DemoState) -> None:
+    """Model against tap test: where it fails, what is missing, the error falling."""
+    figures()
+    from ..diagnose import diagnose
+    from ..io.assembly_toml import save_assembly
+
+    result = diagnose(state.assembly, state.taps)
+    state.results["diagnosis"] = result.to_json()
+    state.lines.append(f"diagnosis: error {result.baseline_error:.3f} against a noise floor of "
+                       f"{result.noise_floor:.3f}; missing effect: {result.missing_effect} at "
+                       f"{result.missing_where}")
+    for step in result.refinement:
+        what = "model as given" if step.added is None else f"+ {step.added.name} at {step.added.where}"
+        state.lines.append(f"  step {step.step}: {what:45s} error {step.error:.4f}")
+    for name, make in (("where_it_fails.png", result.plot_where), ("error_fall.png", result.plot_history)):
+        fig = make()
+        save_figure(fig, state.out / name)
+        state.files.append(str(state.out / name))
+    path = state.out / "improved_assembly.toml"
+    save_assembly(result.refined_assembly, path, overwrite=True)
+    state.files.append(str(path))
+
+
+DEMO_STEPS: list[tuple[str, Callable[[DemoState], None]]] = [
+    ("load the built-in assembly", _demo_load),
+    ("compute the tool point FRF", _demo_frf),
+    ("plot the tool point FRF", _demo_plot),
+    ("write the assembly file to start from", _demo_assembly_file),
+    ("simulate a tap test with a hidden effect", _demo_tap_test),
+    ("diagnose the model against the tap test", _demo_diagnose),
+]
+"""The demo's steps, in order: ``(title, function(state))``; append to add steps."""
+
+
+def run(args: argparse.Namespace) -> int:
+    state = DemoState(out=Path(args.out))
+    state.out.mkdir(parents=True, exist_ok=True)
+    for _title, step in DEMO_STEPS:
+        step(state)
+    if args.json:
+        print(json.dumps({**state.results, "files": state.files}))
+        return 0
+    print("\n".join(state.lines))
+    for path in state.files:
+        print(f"wrote {path}")
+    return 0
+
+
+def add_parser(commands) -> None:
+    """Add the ``demo`` subcommand to the subparsers ``commands``."""
+    demo = commands.add_parser("demo", help="the workflow on the built-in assembly, with plots")
+    demo.add_argument("--out", default="out/demo", metavar="DIR", help="output directory (default out/demo)")
+    demo.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
+    demo.set_defaults(run=run)

@@ -1,0 +1,61 @@
+"""The ``substructure identify`` command: a joint's stiffness and damping from a measurement set."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from ..io.assembly_toml import load_assembly
+from ._common import band_arg, figures, save_figure
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..identify import identify_joint
+    from ..io.measurements import load_measurements
+
+    assembly = load_assembly(args.assembly)
+    measurements = load_measurements(args.measurements)
+    parameters = tuple(p.strip() for p in args.parameters.split(",") if p.strip())
+    report = identify_joint(assembly, measurements, args.joint, band=args.band, parameters=parameters,
+                            bootstrap=args.bootstrap)
+    if args.plot:
+        figures()
+        fig = report.plot()
+        save_figure(fig, args.plot)
+    if args.json:
+        print(json.dumps(report.to_json()))
+        return 0
+    lo, hi = report.band
+    print(f"joint {report.joint!r} of {assembly.name}")
+    print(f"band {lo:.0f}-{hi:.0f} Hz, {len(measurements)} measured FRFs, relative residual {report.residual_rms:.3f}")
+    units = {"k": ("N/m", "N", "N/rad", "N*m/rad"), "c": ("N*s/m", "N*s", "N*s/rad", "N*m*s/rad")}
+    for kind, values, stds in (("k", report.k, report.k_std), ("c", report.c, report.c_std)):
+        for (entry, value), unit in zip(values.items(), units[kind]):
+            fitted = f"{kind}_{entry}" in report.fitted or (entry == "tf" and f"{kind}_ym" in report.fitted)
+            tail = f" +- {stds[entry]:.3g} {unit}" if fitted else f" {unit} (kept from the model)"
+            print(f"  {kind}_{entry} = {value:.4g}{tail}")
+    for note in report.warnings:
+        print(f"note: {note}")
+    if args.plot:
+        print(f"wrote {args.plot}")
+    return 0
+
+
+# -- diagnose -------------------------------------------------------------------------
+
+
+def add_parser(commands) -> None:
+    """Add the ``identify`` subcommand to the subparsers ``commands``."""
+    ident = commands.add_parser("identify", help="identify a joint's stiffness and damping from measurements")
+    ident.add_argument("assembly", metavar="ASSEMBLY.toml", help="assembly file (docs/file-formats.md)")
+    ident.add_argument("measurements", metavar="MEASUREMENTS.toml", help="measurement set (docs/file-formats.md)")
+    ident.add_argument("--joint", required=True, metavar="NAME", help="name of the joint to identify")
+    ident.add_argument("--band", type=band_arg, default="auto", metavar="auto|LO:HI",
+                       help="frequency band in Hz (default auto: the mode the joint dominates)")
+    ident.add_argument("--parameters", default="k_yf,k_tm,c_yf,c_tm", metavar="NAMES",
+                       help="parameters to fit, of k_yf,k_ym,k_tm,c_yf,c_ym,c_tm (k_ym stands for k_ym = k_tf)")
+    ident.add_argument("--bootstrap", type=int, default=0, metavar="N",
+                       help="bootstrap refits for the standard deviations (default 0: from the Jacobian)")
+    ident.add_argument("--plot", metavar="FILE.png", help="plot the closed form, the band, the fit and the FRFs")
+    ident.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
+    ident.set_defaults(run=run)

@@ -1,0 +1,98 @@
+"""The ``substructure predict`` command: joint parameters for an untested tool from a joint table."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from ..io.assembly_toml import load_assembly
+from ._common import UsageError, figures, point_arg, save_figure
+
+
+def _features(text: str) -> dict[str, str]:
+    out = {}
+    for part in text.split(","):
+        if not part.strip():
+            continue
+        name, sep, value = part.partition("=")
+        if not sep or not name.strip() or not value.strip():
+            raise UsageError(f"--features: cannot read {part.strip()!r}; expected NAME=VALUE, e.g. tool_diameter=14 mm")
+        out[name.strip()] = value.strip()
+    return out
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..surrogate import JointTable, cross_validate, make_surrogate
+
+    table = JointTable.from_csv(args.table)
+    table.check_not_empty()
+    surrogate = make_surrogate(args.model)
+    if args.cross_validate:
+        target = args.target or next(iter(table.parameters))
+        cv = cross_validate(surrogate, table, target, args.cross_validate)
+        if args.plot:
+            figures()
+            fig = cv.plot()
+            save_figure(fig, args.plot)
+        if args.json:
+            print(json.dumps(cv.to_json()))
+            return 0
+        print(f"{args.model}, {args.cross_validate} on {args.table}: {len(cv.folds)} folds, {target} [{cv.unit}]")
+        print(f"  mean |error| {cv.mean_abs_percent_error:.1f} %, max {cv.max_abs_percent_error:.1f} %")
+        print(f"  inside the 68 % interval {cv.coverage(0.68):.0%}, the 95 % interval {cv.coverage(0.95):.0%}")
+        return 0
+    if args.features is None:
+        raise UsageError("give --features NAME=VALUE,... (or --cross-validate)")
+    if bool(args.assembly) != bool(args.joint):
+        raise UsageError("--assembly and --joint go together: the assembly file and the joint to replace")
+    targets = [args.target] if args.target else None
+    model = surrogate.fit(table, targets)
+    prediction = model.predict(_features(args.features))
+    result = prediction.to_json()
+    band = None
+    if args.assembly:
+        from ..surrogate import predict_frf_band
+
+        band = predict_frf_band(load_assembly(args.assembly), args.joint, prediction, at=point_arg(args.at),
+                                n_samples=args.samples)
+        if args.plot:
+            figures()
+            fig = band.plot(label=f"{args.model} prediction")
+            save_figure(fig, args.plot)
+    if args.json:
+        out = {"model": args.model, "features": _features(args.features), "parameters": result}
+        if band is not None:
+            out["frf"] = {"at": point_arg(args.at), "joint": args.joint, **band.to_json()}
+        print(json.dumps(out))
+        return 0
+    print(f"{args.model} surrogate on {table.describe()}")
+    for name, p in result.items():
+        lo, hi = p["interval_95"]
+        print(f"  {name} = {p['value']:.4g} +- {p['std']:.3g} {p['unit']} (95 %: {lo:.4g} to {hi:.4g})")
+    if band is not None:
+        nominal = band.nominal
+        peaks = nominal.peaks()
+        print(f"tool point FRF ({point_arg(args.at)}) with the predicted {args.joint!r} joint, "
+              f"{len(next(iter(band.samples.values())))} samples: peaks of the median joint at "
+              + ", ".join(f"{f:.0f} Hz" for f in peaks))
+        if args.plot:
+            print(f"wrote {args.plot}")
+    return 0
+
+
+def add_parser(commands) -> None:
+    """Add the ``predict`` subcommand to the subparsers ``commands``."""
+    pred = commands.add_parser("predict", help="joint parameters for an untested tool from a joint table")
+    pred.add_argument("table", metavar="TABLE", help="joint-parameter table (CSV, units in the header)")
+    pred.add_argument("--features", metavar="NAME=VALUE,...", help="features of the tool, e.g. 'tool_diameter=14 mm'")
+    pred.add_argument("--model", choices=("mlp", "gp"), default="gp", help="surrogate (default gp)")
+    pred.add_argument("--target", metavar="PARAMETER", help="parameter to predict (default: all of the table)")
+    pred.add_argument("--cross-validate", metavar="loo|group:FEATURE", help="evaluate the surrogate instead")
+    pred.add_argument("--assembly", metavar="A.toml", help="assembly file: the tool point FRF and its band")
+    pred.add_argument("--joint", metavar="NAME", help="the joint of --assembly the prediction replaces")
+    pred.add_argument("--at", default="tool.tip", metavar="POINT[:dof]", help="FRF point (default tool.tip:y)")
+    pred.add_argument("--samples", type=int, default=64, metavar="N",
+                      help="samples of the predictive distribution for the FRF band (default 64)")
+    pred.add_argument("--plot", metavar="FILE.png", help="parity plot of the cross-validation, or the FRF band")
+    pred.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
+    pred.set_defaults(run=run)
