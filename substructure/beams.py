@@ -179,6 +179,23 @@ class Flutes:
     diameter_ratio: float = attrs.field(converter=_ratio)
 
 
+def _optional_length(field: str, *, allow_zero: bool = False):
+    convert = _length(field, allow_zero=allow_zero)
+
+    def optional(value):
+        return None if value is None else convert(value)
+
+    return optional
+
+
+def _steps(value) -> int | None:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise InvalidValueError(f"taper_steps: got {value!r}; expected a whole number of steps >= 1")
+    return int(value)
+
+
 @attrs.frozen
 class Segment:
     """A uniform piece of a stepped beam.
@@ -193,7 +210,29 @@ class Segment:
     insert : Insert, optional
         A body of another material filling the bore.
     flutes : Flutes, optional
-        Fluted section (tools).
+        Fluted section (tools).  On a tapered segment the equivalent
+        diameter follows the outer diameter: ``diameter_ratio * od(x)``.
+    od_tip : quantity or str, optional
+        Outer diameter at the tip end of a tapered (conical) segment; the
+        outer diameter varies linearly from ``od`` at the base end to
+        ``od_tip``.  Default: ``od`` (no taper).
+    id_tip : quantity or str, optional
+        Inner diameter at the tip end, likewise from ``id``.  Default: ``id``.
+        An ``insert`` needs a uniform bore (``id_tip`` equal to ``id``).
+    taper_steps : int, optional
+        Number of uniform steps that model a tapered segment.  Default: the
+        number chosen from the error bound of :mod:`substructure.tapers` (see
+        :meth:`taper_step_count` and docs/beams.md, "Tapered segments").
+
+    Examples
+    --------
+    A BT40-like 7:24 steep taper, 65.4 mm long, from 25.375 mm to 44.45 mm:
+
+    >>> cone = Segment("65.4 mm", "25.375 mm", od_tip="44.45 mm")
+    >>> cone.is_tapered, cone.taper_step_count()
+    (True, 11)
+    >>> round(cone.mass(), 3)     # kg, exact for the cone
+    0.504
     """
 
     length: pint.Quantity = attrs.field(converter=_length("length"))
@@ -202,8 +241,15 @@ class Segment:
     material: Material = attrs.field(default="steel", converter=_material)
     insert: Insert | None = attrs.field(default=None)
     flutes: Flutes | None = attrs.field(default=None)
+    od_tip: pint.Quantity | None = attrs.field(default=None, kw_only=True, converter=_optional_length("od_tip"))
+    id_tip: pint.Quantity | None = attrs.field(
+        default=None, kw_only=True, converter=_optional_length("id_tip", allow_zero=True)
+    )
+    taper_steps: int | None = attrs.field(default=None, kw_only=True, converter=_steps)
     # SI values, derived once (the kernels need them at every call)
     _si: tuple = attrs.field(init=False, eq=False, repr=False)
+    # tapered segments: SI end diameters and the sections of the default steps (None when uniform)
+    _taper: tuple | None = attrs.field(init=False, eq=False, repr=False, default=None)
 
     def __attrs_post_init__(self) -> None:
         if self.id >= self.od:
@@ -225,6 +271,14 @@ class Segment:
                     "flutes.diameter_ratio: the equivalent diameter "
                     f"{self.flutes.diameter_ratio} * {self.od:~P} is not larger than the bore {self.id:~P}"
                 )
+        if self.od_tip is not None or self.id_tip is not None:
+            from .tapers import check_taper
+
+            ends = check_taper(self)
+            if ends is not None:  # tapered: no single section
+                object.__setattr__(self, "_si", (float(self.length.m_as("m")), None))
+                object.__setattr__(self, "_taper", ends)
+                return
         od = self.od.m_as("m")
         if self.flutes is not None:
             od = od * self.flutes.diameter_ratio
@@ -238,12 +292,137 @@ class Segment:
         return self._si[0]
 
     def section(self) -> Section:
-        """Section properties in SI units (layers summed)."""
+        """Section properties in SI units (layers summed).
+
+        Raises
+        ------
+        InvalidValueError
+            For a tapered segment, whose section varies along it: use
+            :meth:`section_at` or :meth:`piece_sections`.
+        """
+        if self._taper is not None:
+            raise InvalidValueError(
+                f"section: the segment is tapered (od {self.od:~P} to {self._od_tip:~P}, id {self.id:~P} "
+                f"to {self._id_tip:~P}); its section varies along it: use section_at(x) or piece_sections()"
+            )
         return self._si[1]
 
     def mass(self) -> float:
-        """Mass of the segment (with its insert) in kg."""
+        """Mass of the segment (with its insert) in kg; exact for a tapered segment."""
+        if self._taper is not None:
+            from .tapers import mass
+
+            return mass(self)
         return self.section().rhoA * self.length_m
+
+    # -- tapered (conical) segments: the stepping is in substructure.tapers ----------
+    @property
+    def _od_tip(self) -> pint.Quantity:
+        return self.od if self.od_tip is None else self.od_tip
+
+    @property
+    def _id_tip(self) -> pint.Quantity:
+        return self.id if self.id_tip is None else self.id_tip
+
+    @property
+    def is_tapered(self) -> bool:
+        """True when the outer or inner diameter varies along the segment."""
+        return self._taper is not None
+
+    def taper_step_count(self, max_frequency=None) -> int:
+        """Number of steps that model this segment (1 when it is uniform).
+
+        ``taper_steps`` when given; otherwise the smallest ``n`` for which no
+        section property (``EI``, ``kappa G A``, ``rho A``, ``rho I``) changes by
+        more than :data:`~substructure.tapers.TAPER_STEP_RATIO` (relatively)
+        over one step and, up to ``max_frequency``, no step is longer than
+        :data:`~substructure.tapers.TAPER_STEP_PHASE` over the bending
+        wavenumber.  Static compliances and natural frequencies are then
+        within :data:`~substructure.tapers.TAPER_ERROR_BOUND` (docs/beams.md,
+        "Tapered segments").  The receptance functions pass their highest
+        frequency line.
+
+        Parameters
+        ----------
+        max_frequency : quantity or str, optional
+            Highest frequency the model must serve (e.g. ``"5 kHz"``); without
+            it only the geometric criterion applies.
+
+        Returns
+        -------
+        int
+            The number of steps, >= 1.
+        """
+        from .tapers import step_count
+
+        if max_frequency is None:
+            return step_count(self, 0.0)
+        return step_count(self, 2.0 * math.pi * quantity(max_frequency, "max_frequency", "1 / [time]").m_as("Hz"))
+
+    def section_at(self, x) -> Section:
+        """Section properties at a distance from the base (layers summed, SI).
+
+        Parameters
+        ----------
+        x : quantity or str
+            Distance from the base end, within ``[0, length]`` (e.g. ``"10 mm"``).
+
+        Returns
+        -------
+        Section
+            ``EI`` [N m^2], ``kGA`` [N], ``rhoA`` [kg/m], ``rhoI`` [kg m] there.
+        """
+        from .tapers import section_at
+
+        return section_at(self, x)
+
+    def piece_sections(self, steps: int | None = None, omega_max: float = 0.0) -> list[Section]:
+        """The uniform sections that model this segment, base to tip, all of the same length.
+
+        A uniform segment is ``steps`` copies of its section (one by
+        default).  A tapered segment of ``n`` steps is ``2 n`` half-steps of
+        the fourth-order commutator-free Magnus scheme
+        (:mod:`substructure.tapers`): exact in the limit, with an error
+        falling as ``1/n^4``.
+
+        Parameters
+        ----------
+        steps : int, optional
+            Number of steps; default: ``taper_steps``, else chosen as
+            :meth:`taper_step_count` does for the highest angular frequency
+            ``omega_max``.
+        omega_max : float
+            Highest angular frequency the pieces must serve [rad/s] (0: the
+            geometric criterion only).
+
+        Returns
+        -------
+        list of Section
+            Each ``length / len(list)`` long; SI values (``EI`` [N m^2],
+            ``kGA`` [N], ``rhoA`` [kg/m], ``rhoI`` [kg m]).
+        """
+        from .tapers import piece_sections
+
+        return piece_sections(self, steps, omega_max)
+
+    def split(self, at) -> tuple["Segment", "Segment"]:
+        """Two segments that together are this one, cut at a distance from the base.
+
+        Parameters
+        ----------
+        at : quantity or str
+            Where to cut, strictly inside the segment (e.g. ``"20 mm"``).
+
+        Returns
+        -------
+        (Segment, Segment)
+            Base part and tip part; a tapered segment's diameters are
+            interpolated at the cut, so each part keeps its own taper
+            (explicit ``taper_steps`` are shared in proportion).
+        """
+        from .tapers import split
+
+        return split(self, at)
 
 
 # ---------------------------------------------------------------------------
@@ -455,15 +634,16 @@ def stepped_beam_receptance(
     sorted_pos = pos[order]
     if np.any(np.diff(sorted_pos) <= 0):
         raise InvalidValueError("positions: expected distinct positions")
-    sections = [s.section() for s in segments]
-    ends = np.concatenate([[0.0], np.cumsum([s.length_m for s in segments])])
+    omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float).reshape(-1)
+    from .tapers import piecewise_sections
+
+    sections, ends = piecewise_sections(segments, float(omega.max()) if omega.size else 0.0, sorted_pos)
     cuts = np.unique(np.concatenate([ends, sorted_pos]))
     intervals = []
     for x0, x1 in zip(cuts[:-1], cuts[1:]):
-        k = int(np.clip(np.searchsorted(ends, 0.5 * (x0 + x1)) - 1, 0, len(segments) - 1))
+        k = int(np.clip(np.searchsorted(ends, 0.5 * (x0 + x1)) - 1, 0, len(sections) - 1))
         intervals.append((sections[k], float(x1 - x0)))
     nodes = [int(i) for i in np.searchsorted(cuts, sorted_pos)]
-    omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float).reshape(-1)
     return _chain_receptance(intervals, nodes, omega, place=[int(i) for i in order])
 
 
@@ -517,6 +697,13 @@ def stepped_beam_receptance_batch(
     for j in range(n_seg):
         column = [cfg[j] for cfg in configurations]
         first = column[0]
+        if any(seg.is_tapered for seg in column):  # the same number of steps in every configuration
+            from .tapers import tapered_column
+
+            for sec, length in tapered_column(column, omega_max):
+                intervals.append((sec, length))
+                phases.append(_phase(sec, length, omega_max))
+            continue
         if all(seg is first or seg == first for seg in column[1:]):
             sec, length = first.section(), first.length_m
         else:
@@ -524,6 +711,6 @@ def stepped_beam_receptance_batch(
             length = np.array([seg.length_m for seg in column])
         intervals.append((sec, length))
         phases.append(_phase(sec, length, omega_max))
-    nodes = sorted({"base": 0, "tip": n_seg}[e] for e in ends)
+    nodes = sorted({"base": 0, "tip": len(intervals)}[e] for e in ends)
     place = [list(ends).index(e) for e in sorted(ends, key=lambda e: e != "base")]  # base first
     return _chain_receptance(intervals, nodes, omega, phases, n_config=len(configurations), place=place)

@@ -38,6 +38,16 @@ frequencies of free-free and clamped uniform (L/d = 2 ... 25), stepped
 spindle-like, holder-like and tool-like beams are within 2.5e-6 of converged
 and change by < 2.5e-6 when the mesh is doubled.
 
+Tapered segments
+----------------
+A segment may have a :class:`Taper` instead of a uniform :class:`Section`:
+ring diameters linear along it.  Each element then integrates the varying
+``EI``, ``kappa*G*A``, ``rho*A`` and ``rho*I`` at its own Gauss points
+(``order + 6`` points: exact for the polynomial parts, ``kappa`` varies
+slowly), so the taper is represented continuously and the mesh converges to
+the continuous tapered beam (measured in ``test_fe_reference.py`` against
+the closed-form static compliance of a tapered cantilever).
+
 Usage
 -----
 >>> m = Model()
@@ -127,6 +137,48 @@ def fluted(od: float, ratio: float, mat: Material) -> Section:
     return ring(ratio * od, 0.0, mat)
 
 
+@dataclass(frozen=True)
+class Taper:
+    """A section varying along a segment: ring diameters linear in the position.
+
+    ``od`` goes from ``od0`` (segment start) to ``od1`` (segment end), ``id``
+    from ``id0`` to ``id1``; ``ratio`` scales the outer diameter (fluted
+    parts); an optional uniform ``insert`` ring (``insert_od``/``insert_id``)
+    of another material fills the bore.  ``at(t)`` is the section at the
+    fraction ``t`` of the segment; elements integrate it by Gauss quadrature
+    (:func:`element`), so nothing is stepped.
+    """
+    od0: float
+    od1: float
+    id0: float
+    id1: float
+    mat: Material
+    ratio: float = 1.0
+    insert: Material | None = None
+    insert_od: float = 0.0
+    insert_id: float = 0.0
+
+    def at(self, t: float) -> Section:
+        od = (self.od0 + (self.od1 - self.od0) * t) * self.ratio
+        idd = self.id0 + (self.id1 - self.id0) * t
+        s = ring(od, idd, self.mat)
+        if self.insert is not None:
+            s = s + ring(self.insert_od, self.insert_id, self.insert)
+        return s
+
+    def part(self, t0: float, t1: float) -> "Taper":
+        """The same taper restricted to the fractions ``[t0, t1]`` of the segment."""
+        lin = lambda a, b, t: a + (b - a) * t
+        return Taper(lin(self.od0, self.od1, t0), lin(self.od0, self.od1, t1),
+                     lin(self.id0, self.id1, t0), lin(self.id0, self.id1, t1),
+                     self.mat, self.ratio, self.insert, self.insert_od, self.insert_id)
+
+    def mass(self, length: float) -> float:
+        """Exact mass of a segment of this taper (Gauss quadrature of rho*A)."""
+        xg, wg = np.polynomial.legendre.leggauss(4)
+        return float(sum(w / 2 * self.at((x + 1) / 2).rhoA for x, w in zip(xg, wg)) * length)
+
+
 # --------------------------------------------------------------------------- element
 def _basis(q: int) -> list[P]:
     """Hierarchical degree-q basis on xi in [0, 1]: 1-xi, xi, then the bubbles
@@ -148,7 +200,11 @@ def element(L: float, s: Section, order: int = ORDER):
         raise ValueError("order must be >= 1 (>= 2 for exact statics)")
     by, bt = _basis(p + 1), _basis(p)
     n = 2 * p + 3
-    xg, wg = np.polynomial.legendre.leggauss(p + 2)          # exact to degree 2p+3
+    varying = isinstance(s, Taper)
+    # exact to degree 2p+3 for a uniform section; a taper's rho*A (degree 2) and
+    # rho*I, EI (degree 4) raise the degree to 2p+6: p+4 points, and p+6 for kappa,
+    # which varies as a rational function of id/od when the bore is not proportional.
+    xg, wg = np.polynomial.legendre.leggauss(p + 6 if varying else p + 2)
     xg, wg = (xg + 1) / 2, wg * L / 2
     Ny, dNy, Nt, dNt = (np.zeros((len(xg), n)) for _ in range(4))
     cy = [0, 2, *range(4, 4 + p)]                            # columns of y functions
@@ -158,10 +214,15 @@ def element(L: float, s: Section, order: int = ORDER):
     for c, f in zip(ct, bt):
         Nt[:, c], dNt[:, c] = f(xg), f.deriv()(xg) / L
     g = dNy - Nt                                             # shear strain y' - theta
-    quad = lambda A, B: np.einsum("g,gi,gj->ij", wg, A, B)
-    K = s.EI * quad(dNt, dNt) + s.kGA * quad(g, g)
-    M = s.rhoA * quad(Ny, Ny) + s.rhoI * quad(Nt, Nt)
-    return np.asarray(K, complex), M
+    if varying:
+        secs = [s.at(x) for x in xg]
+        EI, kGA, rhoA, rhoI = (np.array([getattr(q, f) for q in secs]) for f in ("EI", "kGA", "rhoA", "rhoI"))
+    else:
+        EI, kGA, rhoA, rhoI = (np.full(len(xg), getattr(s, f)) for f in ("EI", "kGA", "rhoA", "rhoI"))
+    quad = lambda c, A, B: np.einsum("g,gi,gj->ij", wg * c, A, B)
+    K = quad(EI, dNt, dNt) + quad(kGA, g, g)
+    M = quad(rhoA, Ny, Ny) + quad(rhoI, Nt, Nt)
+    return np.asarray(K, complex), M.real
 
 
 def condensed_stiffness(K: np.ndarray) -> np.ndarray:
@@ -202,7 +263,7 @@ class Model:
 
     # ---- building
     def add_beam(self, segments, n_elem: int | None = None, points=()) -> int:
-        """Add a beam from ``segments = [(length, Section), ...]`` (base to tip).
+        """Add a beam from ``segments = [(length, Section or Taper), ...]`` (base to tip).
 
         ``n_elem``: elements per segment (default: element length about
         ``L_beam/ELEMENTS_PER_BEAM``, >= ``MIN_PER_SEGMENT`` per segment).
@@ -219,7 +280,11 @@ class Model:
             cuts = np.concatenate([[ends[i]], inner, [ends[i + 1]]])
             for a, b in zip(cuts[:-1], cuts[1:]):
                 n = max(1, math.ceil(n_seg * (b - a) / L - 1e-9))
-                elems += [element((b - a) / n, sec, self.order)] * n
+                if isinstance(sec, Taper):   # each element integrates its own part of the taper
+                    t = (a - ends[i] + (b - a) * np.arange(n + 1) / n) / L
+                    elems += [element((b - a) / n, sec.part(t0, t1), self.order) for t0, t1 in zip(t[:-1], t[1:])]
+                else:
+                    elems += [element((b - a) / n, sec, self.order)] * n
                 xs.extend(a + (b - a) * np.arange(1, n + 1) / n)
         n_int = 2 * self.order - 1                       # internal DOFs per element
         first_int = off + 2 * len(xs)

@@ -262,3 +262,59 @@ def test_sparse_and_dense_eigen_paths_agree():
     m = one_beam(stepped_spindle(), n_elem=25)        # > 400 DOFs: shift-invert eigsh
     assert m.ndof > 400
     np.testing.assert_allclose(m.natural_frequencies(5), m.natural_frequencies()[:5], rtol=1e-8)
+
+
+# --------------------------------------------------------------------------- tapered elements
+def taper_compliance(L, tp):
+    """Tip compliance of a cantilever (clamped at x = 0) with a varying section, by the
+    unit-load method, exact for a statically determinate Timoshenko beam:
+    ``int (L-x)^2/EI dx + int 1/kGA dx`` (and the other entries of the 2x2)."""
+    from scipy.integrate import quad
+
+    opts = dict(epsabs=0.0, epsrel=1e-13, limit=200)
+    u = lambda x: 1.0 / tp.at(x / L).EI.real
+    s = lambda x: 1.0 / tp.at(x / L).kGA.real
+    h = quad(lambda x: (L - x) ** 2 * u(x), 0, L, **opts)[0] + quad(s, 0, L, **opts)[0]
+    ln = quad(lambda x: (L - x) * u(x), 0, L, **opts)[0]
+    p = quad(u, 0, L, **opts)[0]
+    return np.array([[h, ln], [ln, p]])
+
+
+TAPERS = [
+    fe.Taper(0.025375, 0.04445, 0.0, 0.0, S),                 # a 7:24 steep taper, clamped at its small end
+    fe.Taper(0.06, 0.02, 0.03, 0.012, S),                     # hollow cone, bore not proportional
+    fe.Taper(0.05, 0.03, 0.016, 0.016, S, insert=C, insert_od=0.016),  # shrink-fit nose with a carbide shank
+    fe.Taper(0.012, 0.010, 0.0, 0.0, C, ratio=0.8),           # tapered fluted tool
+]
+
+
+@pytest.mark.parametrize("tp", TAPERS, ids=["steep-taper", "hollow", "insert", "fluted"])
+def test_tapered_cantilever_static_compliance_converges(tp):
+    """The FE model integrates the varying section: its static compliance converges to the
+    closed form as the mesh is refined, as h^6 for order-3 elements (measured: x64 per halving)."""
+    L = 0.07
+    exact = taper_compliance(L, tp)
+    errors = []
+    for n in (2, 4, 8, 32):
+        m = one_beam([(L, tp)], clamp=True, n_elem=n)
+        H = m.point_receptance(0.0, (0, L))[0].real
+        errors.append(np.abs(H - exact).max() / np.abs(exact).max())
+    assert errors[-1] < 1e-8
+    assert errors[0] / errors[1] > 20 and errors[1] / errors[2] > 20     # sixth order: 64
+
+
+def test_taper_with_equal_ends_is_the_uniform_section():
+    s = fe.ring(0.04, 0.01, S)
+    tp = fe.Taper(0.04, 0.04, 0.01, 0.01, S)
+    K1, M1 = fe.element(0.03, s)
+    K2, M2 = fe.element(0.03, tp)
+    np.testing.assert_allclose(K2, K1, rtol=1e-12, atol=1e-12 * np.abs(K1).max())
+    np.testing.assert_allclose(M2, M1, rtol=1e-12, atol=1e-12 * np.abs(M1).max())
+    assert tp.mass(0.5) == pytest.approx(s.rhoA * 0.5, rel=1e-14)
+
+
+def test_taper_mass_is_the_frustum():
+    tp = fe.Taper(0.03, 0.05, 0.0, 0.0, S)
+    L = 0.1
+    r0, r1 = 0.015, 0.025
+    assert tp.mass(L) == pytest.approx(S.rho * math.pi * L / 3 * (r0**2 + r0 * r1 + r1**2), rel=1e-13)

@@ -1,0 +1,276 @@
+"""Tapered (conical) segments: the fourth-order stepping that feeds them to the exact kernels.
+
+A segment whose outer and inner diameters vary linearly along it
+(:class:`~substructure.beams.Segment` with ``od_tip``/``id_tip``) has no
+closed-form Timoshenko solution.  It is modelled by uniform pieces, so that
+the exact uniform-segment machinery of :mod:`substructure.beams` and
+:mod:`substructure._kernels` serves it unchanged: ``n`` equal steps, each
+the two half-steps of the fourth-order commutator-free Magnus scheme of
+Blanes & Moan (2006).  Over a step of length ``h``, with ``A1`` and ``A2``
+the first-order Timoshenko matrices at the step's two Gauss points
+(``x_mid -+ sqrt(3)/6 h``), the transfer matrix is
+``exp(h/2 (c1 A1 + c2 A2)) exp(h/2 (c2 A1 + c1 A2))`` (base half first),
+``c1, c2 = 1/2 +- sqrt(3)/3``.  ``A`` is linear in ``1/EI``, ``1/kGA``,
+``rhoA`` and ``rhoI`` with fixed unit entries and ``c1 + c2 = 1``, so each
+factor is the exact transfer matrix of a uniform section (harmonic
+combinations of ``EI`` and ``kGA``, arithmetic ones of ``rhoA`` and
+``rhoI``); these sections do not depend on the frequency.  The global error
+falls as ``1/n^4``; the mass is integrated exactly (two-point Gauss per step
+of a quadratic ``rhoA``).
+
+The step count follows a measured error bound (docs/beams.md, "Tapered
+segments"): no section property changes by more than
+:data:`TAPER_STEP_RATIO` over a step, and no step is longer than
+:data:`TAPER_STEP_PHASE` over the bending wavenumber at the highest
+frequency line.  Static compliances and natural frequencies are then within
+:data:`TAPER_ERROR_BOUND` (relative) of the continuous tapered beam.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Sequence
+
+import attrs
+import numpy as np
+
+from .beams import Section, Segment, _phase, _stack_sections, shear_coefficient
+from .errors import InvalidValueError
+from .units import Q_, quantity
+
+__all__ = ["TAPER_STEP_RATIO", "TAPER_STEP_PHASE", "TAPER_ERROR_BOUND", "check_taper", "step_count",
+           "piece_sections", "section_at", "split", "mass"]
+
+TAPER_STEP_RATIO = 0.3
+"""Largest relative change of a section property over one step of a tapered segment (default steps)."""
+
+TAPER_STEP_PHASE = 0.6
+"""Largest bending wavenumber times step length ``k h`` at the highest frequency line (default steps)."""
+
+TAPER_ERROR_BOUND = 1e-4
+"""Bound on the relative error of the default stepped model of a taper (docs/beams.md, "Tapered segments")."""
+
+
+def _taper_arrays(seg: Segment, t: np.ndarray):
+    """``EI, kGA, rhoA, rhoI`` arrays of a tapered segment at fractions ``t`` of its length (SI)."""
+    od0, od1, id0, id1 = seg._taper
+    od = od0 + (od1 - od0) * t
+    idd = id0 + (id1 - id0) * t
+    if seg.flutes is not None:
+        od = od * seg.flutes.diameter_ratio
+    mat = seg.material
+    area = math.pi / 4.0 * (od**2 - idd**2)
+    inertia = math.pi / 64.0 * (od**4 - idd**4)
+    kappa = shear_coefficient(mat.nu, idd / od)
+    ei = mat.E_si * inertia
+    kga = kappa * mat.G_si * area
+    rhoa = mat.rho_si * area
+    rhoi = mat.rho_si * inertia
+    if seg.insert is not None:
+        ins = Section.ring(seg.insert.od.m_as("m"), seg.insert.id.m_as("m"), seg.insert.material)
+        ei, kga, rhoa, rhoi = ei + ins.EI, kga + ins.kGA, rhoa + ins.rhoA, rhoi + ins.rhoI
+    return (np.broadcast_to(np.asarray(ei, dtype=complex), t.shape), np.broadcast_to(np.asarray(kga, dtype=complex), t.shape),
+            np.broadcast_to(np.asarray(rhoa, dtype=float), t.shape), np.broadcast_to(np.asarray(rhoi, dtype=float), t.shape))
+
+
+def _taper_sections(seg: Segment, t: np.ndarray) -> list[Section]:
+    """Sections of a tapered segment at fractions ``t`` of its length."""
+    ei, kga, rhoa, rhoi = _taper_arrays(seg, np.asarray(t, dtype=float))
+    return [Section(complex(a), complex(b), float(c), float(d)) for a, b, c, d in zip(ei, kga, rhoa, rhoi)]
+
+
+_GAUSS = math.sqrt(3.0) / 6.0          # Gauss points of a step at its middle -+ GAUSS * step
+_CF = (0.5 + math.sqrt(3.0) / 3.0, 0.5 - math.sqrt(3.0) / 3.0)  # commutator-free Magnus weights
+
+
+def _magnus_sections(seg: Segment, n: int) -> list[Section]:
+    """The ``2 n`` uniform half-steps of the fourth-order commutator-free Magnus scheme.
+
+    Over a step of length ``h`` with the section ``S1`` at its base-side
+    Gauss point and ``S2`` at its tip-side one, the transfer matrix is
+    ``exp(h/2 (c1 A1 + c2 A2)) exp(h/2 (c2 A1 + c1 A2))`` (applied base half
+    first) with ``c1, c2 = 1/2 +- sqrt(3)/3`` (Blanes & Moan 2006).  ``A`` is
+    linear in ``1/EI``, ``1/kGA``, ``rhoA`` and ``rhoI`` with fixed unit
+    entries, and ``c1 + c2 = 1``, so each factor is the transfer matrix of a
+    uniform section over ``h/2``: ``1/EI = c1/EI1 + c2/EI2``, ``1/kGA``
+    likewise, ``rhoA = c1 rhoA1 + c2 rhoA2``, ``rhoI`` likewise.  The
+    sections do not depend on the frequency.
+    """
+    middle = (np.arange(n) + 0.5) / n
+    t = np.column_stack([middle - _GAUSS / n, middle + _GAUSS / n]).ravel()
+    ei, kga, rhoa, rhoi = _taper_arrays(seg, t)
+    out = []
+    for k in range(n):
+        i, j = 2 * k, 2 * k + 1
+        for a, b in (_CF, _CF[::-1]):
+            out.append(Section(
+                EI=1.0 / (a / ei[i] + b / ei[j]), kGA=1.0 / (a / kga[i] + b / kga[j]),
+                rhoA=float(a * rhoa[i] + b * rhoa[j]), rhoI=float(a * rhoi[i] + b * rhoi[j]),
+            ))
+    return out
+
+
+def _auto_steps(seg: Segment, omega_max: float = 0.0) -> int:
+    """Steps such that no section property changes by more than TAPER_STEP_RATIO over one
+    step and, at ``omega_max``, no step is longer than TAPER_STEP_PHASE over the bending wavenumber.
+
+    The largest logarithmic slope of ``|EI|``, ``|kGA|``, ``rhoA`` and ``rhoI``
+    along the segment (from 257 samples) times the length over the ratio;
+    the largest ``k L`` of the end sections over the phase.
+    """
+    t = np.linspace(0.0, 1.0, 257)
+    slopes = [np.max(np.abs(np.diff(np.log(np.abs(p))))) * (t.size - 1) for p in _taper_arrays(seg, t)]
+    n = math.ceil(max(slopes) / TAPER_STEP_RATIO - 1e-9)
+    if omega_max > 0.0:
+        kl = max(_phase(sec, seg.length_m, omega_max) for sec in _taper_sections(seg, np.array([0.0, 1.0])))
+        n = max(n, math.ceil(kl / TAPER_STEP_PHASE - 1e-9))
+    return max(1, n)
+
+
+def check_taper(seg: Segment) -> tuple[float, float, float, float] | None:
+    """Validate a segment given ``od_tip``/``id_tip``.
+
+    Returns its end diameters ``(od, od_tip, id, id_tip)`` in metres when it
+    is tapered, None when its ends are equal (a uniform segment).
+
+    Raises
+    ------
+    InvalidValueError
+        For ``id_tip >= od_tip``, an insert in a tapered bore, or flutes whose
+        equivalent diameter at the tip does not exceed the bore.
+    """
+    od_tip = seg.od if seg.od_tip is None else seg.od_tip
+    id_tip = seg.id if seg.id_tip is None else seg.id_tip
+    if id_tip >= od_tip:
+        raise InvalidValueError(
+            f"id_tip: got {id_tip:~P} with od_tip {od_tip:~P}; expected id_tip < od_tip"
+        )
+    tapered = not (np.isclose(od_tip.m_as("m"), seg.od.m_as("m"), rtol=1e-12, atol=0.0)
+                   and np.isclose(id_tip.m_as("m"), seg.id.m_as("m"), rtol=1e-12, atol=1e-18))
+    if not tapered:
+        return None
+    if seg.insert is not None:
+        if not np.isclose(id_tip.m_as("m"), seg.id.m_as("m"), rtol=1e-12, atol=0.0):
+            raise InvalidValueError(
+                f"insert: the bore is tapered (id {seg.id:~P} to id_tip {id_tip:~P}); an insert "
+                "(a cylindrical shank) needs a uniform bore: give the segment id_tip equal to id, "
+                "or split it into a tapered segment without insert and a uniform one with it"
+            )
+    if seg.flutes is not None and seg.flutes.diameter_ratio * od_tip <= id_tip:
+        raise InvalidValueError(
+            "flutes.diameter_ratio: the equivalent diameter at the tip "
+            f"{seg.flutes.diameter_ratio} * {od_tip:~P} is not larger than the bore {id_tip:~P}"
+        )
+    return (seg.od.m_as("m"), od_tip.m_as("m"), seg.id.m_as("m"), id_tip.m_as("m"))
+
+
+def step_count(seg: Segment, omega_max: float) -> int:
+    """Steps of a segment for the highest angular frequency ``omega_max`` [rad/s] (1 when uniform)."""
+    if not seg.is_tapered:
+        return 1
+    return seg.taper_steps if seg.taper_steps is not None else _auto_steps(seg, omega_max)
+
+
+def piece_sections(seg: Segment, steps: int | None, omega_max: float) -> list[Section]:
+    """The equal-length uniform sections of a segment (see :meth:`Segment.piece_sections`)."""
+    from .beams import _steps
+
+    n = step_count(seg, omega_max) if steps is None else _steps(steps)
+    if not seg.is_tapered:
+        return [seg.section()] * n
+    return _magnus_sections(seg, n)
+
+
+def mass(seg: Segment) -> float:
+    """Exact mass of a tapered segment [kg]: ``rho*A`` is quadratic in ``x``, Simpson's rule is exact."""
+    ends = _taper_sections(seg, np.array([0.0, 0.5, 1.0]))
+    return seg.length_m * (ends[0].rhoA + 4.0 * ends[1].rhoA + ends[2].rhoA) / 6.0
+
+
+def section_at(seg: Segment, x) -> Section:
+    """Section of a segment at distance ``x`` (quantity) from its base."""
+    at = quantity(x, "x", "[length]").m_as("m")
+    if not -1e-12 * seg.length_m <= at <= seg.length_m * (1 + 1e-12):
+        raise InvalidValueError(f"x: got {x!r}; expected a distance within the segment's length {seg.length:~P}")
+    if not seg.is_tapered:
+        return seg.section()
+    return _taper_sections(seg, np.array([min(max(at / seg.length_m, 0.0), 1.0)]))[0]
+
+
+def split(seg: Segment, at) -> tuple[Segment, Segment]:
+    """A segment cut in two at distance ``at`` from its base (see :meth:`Segment.split`)."""
+    x = quantity(at, "at", "[length]")
+    if not 0 < x.m_as("m") < seg.length_m:
+        raise InvalidValueError(
+            f"at: got {at!r}; expected a distance strictly inside the segment's length {seg.length:~P}"
+        )
+    if not seg.is_tapered:
+        return attrs.evolve(seg, length=x), attrs.evolve(seg, length=seg.length - x)
+    t = x.m_as("m") / seg.length_m
+    od_tip = seg.od if seg.od_tip is None else seg.od_tip
+    id_tip = seg.id if seg.id_tip is None else seg.id_tip
+    od_cut = seg.od + (od_tip - seg.od) * t
+    id_cut = seg.id + (id_tip - seg.id) * t
+    first_steps = rest_steps = None
+    if seg.taper_steps is not None:
+        first_steps = max(1, round(seg.taper_steps * t))
+        rest_steps = max(1, seg.taper_steps - first_steps)
+    first = attrs.evolve(seg, length=x, od_tip=od_cut, id_tip=id_cut, taper_steps=first_steps)
+    second = attrs.evolve(seg, length=seg.length - x, od=od_cut, id=id_cut, od_tip=od_tip, id_tip=id_tip,
+                          taper_steps=rest_steps)
+    return first, second
+
+
+def piecewise_sections(segments: Sequence[Segment], omega_max: float = 0.0,
+                        positions: np.ndarray = np.empty(0)) -> tuple[list[Section], np.ndarray]:
+    """Uniform sections of a stepped beam and their boundaries from the base (m).
+
+    A uniform segment is one piece; a tapered one is cut at the requested
+    ``positions`` inside it (so that they fall on step boundaries, where the
+    stepped model is fourth-order accurate) and each part is
+    :meth:`Segment.piece_sections` for ``omega_max``.  The segment ends are
+    the running sums of the segment lengths, as for a beam without tapers,
+    so that ``tip`` is exactly the last boundary.
+    """
+    sections: list[Section] = []
+    bounds = [0.0]
+    ends = np.concatenate([[0.0], np.cumsum([s.length_m for s in segments])])
+    for seg, x0, x1 in zip(segments, ends[:-1], ends[1:]):
+        if not seg.is_tapered:
+            sections.append(seg.section())
+            bounds.append(x1)
+            continue
+        tol = 1e-12 * max(x1, 1e-300)
+        inner = [float(p) for p in positions if x0 + tol < p < x1 - tol]
+        parts, starts, rest, start = [], [], seg, x0
+        for p in inner:
+            first, rest = rest.split(Q_(p - start, "m"))
+            parts.append(first)
+            starts.append(start)
+            start = p
+        parts.append(rest)
+        starts.append(start)
+        for part, a, b in zip(parts, starts, [*inner, x1]):
+            pieces = piece_sections(part, None, omega_max)
+            sections.extend(pieces)
+            n = len(pieces)
+            bounds.extend(a + (b - a) * np.arange(1, n) / n)
+            bounds.append(b)
+    return sections, np.array(bounds)
+
+
+def tapered_column(column: Sequence[Segment], omega_max: float) -> list[tuple[Section, object]]:
+    """Intervals of one segment position of a batch where some configuration has a taper.
+
+    Every configuration gets the largest step count of the column, so that the
+    chains keep one layout (a uniform segment is cut into as many equal
+    pieces); a piece shared by all configurations is one section for the
+    kernel.
+    """
+    n = max(step_count(seg, omega_max) for seg in column)
+    pieces = [_magnus_sections(seg, n) if seg.is_tapered else [seg.section()] * (2 * n) for seg in column]
+    first = column[0]
+    if all(seg is first or seg == first for seg in column[1:]):
+        return [(sec, first.length_m / (2 * n)) for sec in pieces[0]]
+    length = np.array([seg.length_m / (2 * n) for seg in column])
+    return [(_stack_sections([secs[k] for secs in pieces]), length) for k in range(2 * n)]
