@@ -129,6 +129,14 @@ def _segments(value) -> tuple[Segment, ...]:
     return segs
 
 
+def _text(field: str):
+    def check(instance, attribute, value) -> None:
+        if not isinstance(value, str):
+            raise InvalidValueError(f"{field}: got {value!r}; expected a text")
+
+    return check
+
+
 @register_component("beam")
 @attrs.frozen
 class Beam:
@@ -140,6 +148,10 @@ class Beam:
         Name used in point names (``"tool"`` gives ``"tool.tip"``).
     segments : sequence of Segment
         Base to tip.
+    description : str, optional
+        What the component is and where its numbers come from (keyword only;
+        shown in summaries, kept in assembly files).  Catalogue holders say
+        here that their geometry is approximate.
 
     Examples
     --------
@@ -154,6 +166,7 @@ class Beam:
 
     name: str = attrs.field(converter=check_name)
     segments: tuple[Segment, ...] = attrs.field(converter=_segments)
+    description: str = attrs.field(default="", kw_only=True, validator=_text("description"))
 
     @property
     def component_names(self) -> frozenset[str]:
@@ -250,8 +263,44 @@ class Holder(Beam):
 
     The part of the tool inside the holder is usually modelled as an
     :class:`~substructure.beams.Insert` of the holder's bore segment
-    (thesis section 2.1).
+    (thesis section 2.1).  Standard holders (BT40, CAT40, HSK-A63 with ER
+    collet chucks, shrink-fit or hydraulic noses) come from
+    :meth:`from_catalog`.
     """
+
+    @classmethod
+    def from_catalog(cls, entry: str, *, name: str = "holder", **parameters) -> "Holder":
+        """A standard holder of approximate geometry from the catalogue, with overrides.
+
+        Parameters
+        ----------
+        entry : str
+            ``"<interface> <clamp>"``, e.g. ``"HSK-A63 shrink-fit"``, ``"BT40 ER32"``,
+            ``"CAT40 hydraulic"`` (:func:`substructure.holders.catalog_names`).
+        name : str
+            Component name.
+        **parameters
+            ``bore`` (the tool shank diameter, required), ``gauge_length``,
+            ``clamp_length``, ``material``, ``tool_material``, ``shank_taper``
+            and any geometric value of the catalogue by name, e.g.
+            ``nose_diameter="27 mm"`` (:func:`substructure.holders.design`).
+
+        Returns
+        -------
+        Holder
+            From the gauge line (its base, the spindle-holder joint) to the
+            nose, the tool shank as an insert over the clamped length; its
+            ``description`` says it is approximate and cites the sources.
+
+        Examples
+        --------
+        >>> h = Holder.from_catalog("BT40 ER32", bore="12 mm", gauge_length="70 mm", nut_diameter="48 mm")
+        >>> round(h.mass(), 2)
+        1.11
+        """
+        from .holders import design
+
+        return design(entry, **parameters).holder(name, cls)
 
 
 @register_component("tool")
@@ -376,5 +425,6 @@ def component_info(component: Any) -> str:
     """One line describing a component, for summaries."""
     kind = getattr(component, "kind", type(component).__name__)
     if isinstance(component, Beam):
-        return f"{component.name} ({kind}, {len(component.segments)} segments, {component.length:~P}, {component.mass():.3g} kg)"
+        text = f"{component.name} ({kind}, {len(component.segments)} segments, {component.length:~P}, {component.mass():.3g} kg)"
+        return f"{text}: {component.description}" if component.description else text
     return f"{component.name} ({kind})"

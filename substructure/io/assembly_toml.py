@@ -42,8 +42,9 @@ __all__ = ["load_assembly", "loads_assembly", "save_assembly", "dumps_assembly",
 _TOP_KEYS = ("name", "frequency", "materials", "components", "joints", "supports", "sensors")
 _FREQUENCY_KEYS = ("start", "stop", "step")
 _MATERIAL_KEYS = ("E", "nu", "rho", "loss_factor")
-_COMPONENT_KEYS = ("name", "type", "material", "segments")
-_SEGMENT_KEYS = ("length", "od", "id", "material", "insert", "flutes")
+_COMPONENT_KEYS = ("name", "type", "material", "segments", "description")
+_CATALOG_KEYS = ("name", "type", "catalog")  # and the catalogue holder's parameters
+_SEGMENT_KEYS = ("length", "od", "id", "material", "insert", "flutes", "od_tip", "id_tip", "taper_steps")
 _INSERT_KEYS = ("od", "material", "id")
 _FLUTES_KEYS = ("diameter_ratio",)
 _JOINT_KEYS = ("name", "between", "k", "c", "rigid")
@@ -239,6 +240,8 @@ class _Reader:
         if cls is None:
             known = ", ".join(k for k, c in COMPONENT_TYPES.items() if hasattr(c, "from_toml") or issubclass(c, Beam))
             raise self.error(parts + ["type"], f"unknown component type {kind!r}; known: {known}")
+        if "catalog" in table:
+            return self.catalog_holder(table, parts, cls)
         if hasattr(cls, "from_toml"):
             return self.call(parts, cls.from_toml, table, dict(self.materials), _path(parts))
         if not (isinstance(cls, type) and issubclass(cls, Beam)):
@@ -247,11 +250,30 @@ class _Reader:
         material = self.material(table["material"], parts + ["material"]) if "material" in table else None
         segments = self.array(table["segments"], parts + ["segments"], "an array of segment tables, base to tip")
         segs = [self.segment(s, parts + ["segments", j], material) for j, s in enumerate(segments)]
-        return self.call(parts, cls, table["name"], segs)
+        extra = {"description": table["description"]} if "description" in table else {}
+        return self.call(parts, cls, table["name"], segs, **extra)
+
+    def catalog_holder(self, table, parts, cls):
+        """A ``catalog = "..."`` component: a standard holder of the catalogue with overrides."""
+        from ..components import Holder
+        from ..holders import catalog_parameters, design
+
+        if not (isinstance(cls, type) and issubclass(cls, Holder)):
+            raise self.error(parts + ["catalog"], f"only holders come from the catalogue; this component's "
+                             f"type is {table['type']!r} (use type = \"holder\")")
+        entry = table["catalog"]
+        allowed = _CATALOG_KEYS + self.call(parts, catalog_parameters, entry)
+        self.table(table, parts, allowed, ("name", "type", "catalog"))
+        params = {k: v for k, v in table.items() if k not in _CATALOG_KEYS}
+        for key in ("material", "tool_material"):
+            if key in params and not (key == "tool_material" and params[key] == "none"):
+                params[key] = self.material(params[key], parts + [key])
+        resolved = self.call(parts, design, entry, **params)
+        return self.call(parts, resolved.holder, table["name"], cls)
 
     def segment(self, table, parts, material):
         table = self.table(table, parts, _SEGMENT_KEYS, ("length", "od"), "a segment table {length, od, ...}")
-        kw = {k: table[k] for k in ("length", "od", "id") if k in table}
+        kw = {k: table[k] for k in ("length", "od", "id", "od_tip", "id_tip", "taper_steps") if k in table}
         if "material" in table:
             kw["material"] = self.material(table["material"], parts + ["material"])
         elif material is not None:
@@ -422,6 +444,11 @@ def _segment_table(seg: Segment, with_material: bool) -> dict:
             table["insert"]["id"] = format_quantity(ins.id)
     if seg.flutes is not None:
         table["flutes"] = {"diameter_ratio": seg.flutes.diameter_ratio}
+    for key in ("od_tip", "id_tip"):  # tapered segments
+        if getattr(seg, key) is not None:
+            table[key] = format_quantity(getattr(seg, key))
+    if seg.taper_steps is not None:
+        table["taper_steps"] = seg.taper_steps
     return table
 
 
@@ -435,6 +462,8 @@ def _component_table(component) -> dict:
             "give its class a to_toml method"
         )
     table = {"name": component.name, "type": kind}
+    if getattr(component, "description", ""):
+        table["description"] = component.description
     shared = all(s.material == component.segments[0].material for s in component.segments)
     if shared:
         table["material"] = component.segments[0].material.name
