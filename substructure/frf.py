@@ -566,7 +566,22 @@ class FRF:
 
     # -- edges: plots and files -----------------------------------------------
     def plot(self, ax: Any = None, **kw: Any):
-        """Plot with :func:`substructure.plot.plot_frf`; returns the Figure."""
+        """Plot with :func:`substructure.plot.plot_frf`; returns the Figure.
+
+        Parameters
+        ----------
+        ax : Axes, sequence of Axes, Figure or None
+            Where to draw (an earlier figure overlays); None makes a new figure.
+        **kw
+            Options of :func:`~substructure.plot.plot_frf`: ``kind`` (``"bode"``,
+            ``"real-imag"``, ``"nyquist"``), ``unit`` (``"um/N"`` by default,
+            ``"m/N"``, ``"mm/N"``, ``"nm/N"``), ``title``, ``entries``,
+            ``label``, ``parts``, ``note`` and line options.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from .plot import plot_frf
 
         return plot_frf(self, ax=ax, **kw)

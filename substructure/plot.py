@@ -1,14 +1,20 @@
 """Matplotlib figures of the objects of `substructure`, returned and never shown.
 
-:func:`plot_frf` draws FRFs as stacked panels sharing the frequency axis:
-``|FRF|`` on a logarithmic scale over the phase in degrees by default, real
-and imaginary parts on request.  Passing the axes of an earlier figure (or
-the figure itself) overlays further FRFs, e.g. a model over a measurement.
-Library code never calls ``plt.show()``; scripts save or show the figure.
+:func:`plot_frf` draws FRFs for a person to read: the magnitude on a
+logarithmic scale over the phase (``kind="bode"``), the real and imaginary
+parts (``kind="real-imag"``) or the Nyquist plane (``kind="nyquist"``), in
+um/N by default (``unit=``), with plain-language axis labels and the
+technical names in a small note.  A free-free FRF's rigid-body (mass) line,
+which rises without bound toward 0 Hz, is detected and left out of the
+autoscaling (it is still drawn, in a shaded band), so the modes fill the
+axes.  Passing the axes of an earlier figure (or the figure itself)
+overlays further FRFs, e.g. a model over a measurement.  Library code never
+calls ``plt.show()``; scripts save or show the figure.
 """
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Sequence
 from typing import Any
 
@@ -20,13 +26,27 @@ from matplotlib.figure import Figure
 from .errors import InvalidValueError
 from .frf import FRF
 
-__all__ = ["plot_frf", "plot_identification"]
+__all__ = ["plot_frf", "plot_identification", "rigid_body_cutoff", "FRF_UNITS"]
 
 PARTS = ("magnitude", "phase", "real", "imag")
+KINDS = {"bode": ("magnitude", "phase"), "real-imag": ("real", "imag"), "nyquist": ("nyquist",)}
+FRF_UNITS = {"m/N": 1.0, "mm/N": 1e3, "um/N": 1e6, "µm/N": 1e6, "nm/N": 1e9}
+"""Display units of translational FRFs (displacement per force) and their factors from m/N."""
+_LENGTH = {"m/N": "m", "mm/N": "mm", "um/N": "µm", "µm/N": "µm", "nm/N": "nm"}
+_NAMES = {  # plain name, symbol, definition (for the note)
+    "receptance": ("receptance", "H", "displacement / force"),
+    "mobility": ("mobility", "Y", "velocity / force"),
+    "accelerance": ("accelerance", "A", "acceleration / force"),
+}
+_RIGID_GID = "substructure-rigid-body-region"
+_NOTE_GID = "substructure-note"
 
 
 def _axes_for(ax: Any, parts: Sequence[str]) -> list[Axes]:
     if ax is None:
+        if parts == ("nyquist",):
+            fig, axis = plt.subplots(figsize=(6.4, 6.4), layout="constrained")
+            return [axis]
         fig, axes = plt.subplots(len(parts), 1, sharex=True, squeeze=False,
                                  figsize=(7.0, 2.2 + 1.8 * len(parts)), layout="constrained")
         return list(axes[:, 0])
@@ -41,81 +61,237 @@ def _axes_for(ax: Any, parts: Sequence[str]) -> list[Axes]:
     return axes
 
 
+def rigid_body_cutoff(frequency_hz: np.ndarray, magnitude: np.ndarray) -> float | None:
+    """Upper end of a free-free FRF's rigid-body (mass) line, or None when there is none.
+
+    A free body's receptance is ``-1/(m omega^2)``: from the lowest line the
+    magnitude falls with a log-log slope near -2 down to the first
+    antiresonance, where the flexible modes take over.  When the first lines
+    fall like that (slope between -2.5 and -1.5), the region ends at the
+    first local minimum of the magnitude; a structure on supports (flat,
+    static compliance at low frequency) has none.
+
+    Parameters
+    ----------
+    frequency_hz : ndarray
+        Increasing frequencies in Hz, > 0.
+    magnitude : ndarray
+        ``|FRF|`` at those frequencies.
+
+    Returns
+    -------
+    float or None
+        The frequency in Hz of the first minimum after the mass line, or None.
+    """
+    f = np.asarray(frequency_hz, dtype=float)
+    m = np.asarray(magnitude, dtype=float)
+    if f.size < 5 or f[0] <= 0 or np.any(m <= 0) or not np.all(np.isfinite(m)):
+        return None
+    slope = np.diff(np.log(m)) / np.diff(np.log(f))
+    if not -2.5 < float(np.median(slope[:3])) < -1.5:
+        return None
+    rising = np.nonzero(slope > 0)[0]
+    if rising.size == 0 or rising[0] == 0:
+        return None
+    return float(f[rising[0]])
+
+
+def _scaled(frf: FRF, output: str, input_: str, unit: str) -> tuple[float, str]:
+    """Factor from SI and the display unit of one entry (translational outputs scale, rotations stay SI)."""
+    si = frf.unit(output, input_)
+    if si.startswith("m/"):
+        return FRF_UNITS[unit], _LENGTH[unit] + si[1:]
+    return 1.0, si
+
+
+def _wrap(text: str, fig: Figure, fontsize: float = 12.0) -> str:
+    width = max(20, int(fig.get_figwidth() * 72 / (0.6 * fontsize)))
+    return "\n".join(textwrap.wrap(text, width))
+
+
+def _limits(values: list[np.ndarray], log: bool) -> tuple[float, float] | None:
+    data = np.concatenate([v[np.isfinite(v)] for v in values]) if values else np.empty(0)
+    if log:
+        data = data[data > 0]
+    if data.size == 0:
+        return None
+    lo, hi = float(data.min()), float(data.max())
+    if log:
+        return lo / 2.0, hi * 2.0
+    pad = 0.08 * (hi - lo) if hi > lo else max(abs(hi), 1e-300) * 0.1
+    return lo - pad, hi + pad
+
+
+def _autoscale(axes: list[Axes], parts: Sequence[str]) -> None:
+    """Limits from every line's data above its rigid-body cutoff (lines keep theirs as an attribute)."""
+    for part, axis in zip(parts, axes):
+        if part == "phase":
+            continue
+        lines = [ln for ln in axis.lines if hasattr(ln, "_substructure_freq")]
+        if not any(getattr(ln, "_substructure_cutoff", None) for ln in lines):
+            continue
+        if part == "nyquist":
+            keep = [ln._substructure_freq > (ln._substructure_cutoff or -np.inf) for ln in lines]
+            xs = _limits([np.asarray(ln.get_xdata())[k] for ln, k in zip(lines, keep)], False)
+            ys = _limits([np.asarray(ln.get_ydata())[k] for ln, k in zip(lines, keep)], False)
+            if xs and ys:
+                axis.set_xlim(*xs)
+                axis.set_ylim(*ys)
+            continue
+        keep = [np.asarray(ln.get_xdata()) > (ln._substructure_cutoff or -np.inf) for ln in lines]
+        lim = _limits([np.asarray(ln.get_ydata())[k] for ln, k in zip(lines, keep)], part == "magnitude")
+        if lim:
+            axis.set_ylim(*lim)
+        cutoff = max(ln._substructure_cutoff or 0.0 for ln in lines)
+        if not any(p.get_gid() == _RIGID_GID for p in axis.patches):
+            x0 = min(float(np.min(ln.get_xdata())) for ln in lines)
+            axis.axvspan(x0, cutoff, color="0.5", alpha=0.08, lw=0, gid=_RIGID_GID)
+
+
 def plot_frf(
     frf: FRF,
     ax: Any = None,
     entries: Sequence[tuple[str, str]] | None = None,
-    parts: Sequence[str] = ("magnitude", "phase"),
+    parts: Sequence[str] | None = None,
     label: str | None = None,
+    *,
+    kind: str = "bode",
+    unit: str = "um/N",
+    title: str | None = None,
+    note: bool = True,
     **line_kw: Any,
 ) -> Figure:
-    """Plot entries of an FRF against frequency in Hz.
+    """Plot entries of an FRF: Bode (magnitude and phase), real and imaginary parts, or Nyquist.
 
     Parameters
     ----------
     frf : FRF
         The FRF to draw.
     ax : Axes, sequence of Axes, Figure or None
-        Where to draw: one Axes per panel, in the order of ``parts`` (an
+        Where to draw: one Axes per panel, in the order of the panels (an
         earlier figure or its ``fig.axes`` overlays); ``None`` makes a new
         figure.
     entries : sequence of (output, input), optional
         Entries to draw; all of them by default.
-    parts : sequence of {"magnitude", "phase", "real", "imag"}
-        Panels from top to bottom.  Magnitude is on a log scale; phase in
-        degrees.
+    parts : sequence of {"magnitude", "phase", "real", "imag"}, optional
+        Panels from top to bottom, overriding ``kind`` (magnitude on a log
+        scale, phase in degrees).
     label : str, optional
         Legend label; with several entries each line gets ``"label out / in"``.
         Without a label, lines are labelled ``"out / in"`` when there are
         several entries.  A legend is drawn on the first panel when any line
         is labelled.
+    kind : {"bode", "real-imag", "nyquist"}
+        ``"bode"``: magnitude (log scale) over phase against frequency;
+        ``"real-imag"``: real and imaginary parts against frequency;
+        ``"nyquist"``: imaginary against real part, one panel.
+    unit : {"um/N", "m/N", "mm/N", "nm/N"}
+        Display unit of translational entries (displacement per force; also
+        for mobility and accelerance, whose length unit it sets); rotational
+        entries stay in SI (``1/N``, ``1/(N m)``).  Values convert exactly
+        (factors 1, 1e3, 1e6, 1e9 from m/N).
+    title : str, optional
+        Figure title, wrapped to the figure width.
+    note : bool
+        Add a small note with the technical names (the symbol and its
+        definition, the entries, the rigid-body region when one is excluded
+        from the scale).
     **line_kw
         Passed to ``Axes.plot`` (``color``, ``linestyle``, ...).
 
     Returns
     -------
     matplotlib.figure.Figure
+
+    Notes
+    -----
+    When an entry starts with a free-free rigid-body (mass) line
+    (:func:`rigid_body_cutoff`), the magnitude, real, imaginary and Nyquist
+    axes are scaled on the data above it; the line is still drawn, in a
+    shaded band.
     """
     if not isinstance(frf, FRF):
         raise InvalidValueError(f"frf: got {type(frf).__name__}; expected an FRF")
-    parts = tuple(parts)
-    unknown = [p for p in parts if p not in PARTS]
-    if not parts or unknown:
-        raise InvalidValueError(f"parts: got {parts!r}; expected a non-empty subset of {PARTS}")
+    if kind not in KINDS:
+        raise InvalidValueError(f"kind: got {kind!r}; expected one of {', '.join(KINDS)}")
+    if unit not in FRF_UNITS:
+        raise InvalidValueError(f"unit: got {unit!r}; expected one of {', '.join(FRF_UNITS)}")
+    if parts is None:
+        parts = KINDS[kind]
+    else:
+        parts = tuple(parts)
+        unknown = [p for p in parts if p not in PARTS]
+        if kind == "nyquist" or not parts or unknown:
+            raise InvalidValueError(
+                f"parts: got {parts!r}; expected a non-empty subset of {PARTS} (and no parts with kind='nyquist')"
+            )
     if entries is None:
         entries = [(o, i) for o in frf.outputs for i in frf.inputs]
     entries = [tuple(e) for e in entries]
     values = [frf.entry(o, i) for o, i in entries]  # raises UnknownPointError for bad labels
-    units = sorted({frf.unit(o, i) for o, i in entries})
-    unit = units[0] if len(units) == 1 else "mixed units"
+    scales = [_scaled(frf, o, i, unit) for o, i in entries]
+    units = sorted({u for _, u in scales})
+    shown = units[0] if len(units) == 1 else "mixed units"
     axes = _axes_for(ax, parts)
     hz = frf.frequency.hz
-    for (output, input_), y in zip(entries, values):
+    for (output, input_), y, (factor, _) in zip(entries, values, scales):
         name = f"{output} / {input_}"
         text = (label if len(entries) == 1 else f"{label} {name}") if label else (
             name if len(entries) > 1 else None)
+        cutoff = rigid_body_cutoff(hz, np.abs(y))
+        re, im = y.real * factor, y.imag * factor   # the SI values times an exact factor
         for part, axis in zip(parts, axes):
             if part == "magnitude":
-                axis.semilogy(hz, np.abs(y), label=text, **line_kw)
+                (line,) = axis.semilogy(hz, np.abs(y) * factor, label=text, **line_kw)
             elif part == "phase":
-                axis.plot(hz, np.angle(y, deg=True), label=text, **line_kw)
+                (line,) = axis.plot(hz, np.angle(y, deg=True), label=text, **line_kw)
+            elif part == "nyquist":
+                (line,) = axis.plot(re, im, label=text, **line_kw)
             else:
-                axis.plot(hz, y.real if part == "real" else y.imag, label=text, **line_kw)
+                (line,) = axis.plot(hz, re if part == "real" else im, label=text, **line_kw)
+            line._substructure_freq = hz
+            line._substructure_cutoff = cutoff
+    plain, symbol, definition = _NAMES[frf.quantity]
     ylabels = {
-        "magnitude": f"|{frf.quantity}| [{unit}]",
-        "phase": "phase [deg]",
-        "real": f"Re {frf.quantity} [{unit}]",
-        "imag": f"Im {frf.quantity} [{unit}]",
+        "magnitude": f"{plain} |{symbol}| ({shown})",
+        "phase": "phase (deg)",
+        "real": f"{plain}, real part ({shown})",
+        "imag": f"{plain}, imaginary part ({shown})",
     }
     for part, axis in zip(parts, axes):
+        axis.grid(True, which="both", alpha=0.3)
+        if part == "nyquist":
+            axis.set_xlabel(f"{plain}, real part ({shown})")
+            axis.set_ylabel(f"{plain}, imaginary part ({shown})")
+            axis.axhline(0.0, color="0.6", lw=0.5)
+            axis.axvline(0.0, color="0.6", lw=0.5)
+            continue
         axis.set_ylabel(ylabels[part])
         if part == "phase":
             axis.set_yticks([-180, -90, 0, 90, 180])
-        axis.grid(True, which="both", alpha=0.3)
-    axes[-1].set_xlabel("frequency [Hz]")
+    if parts != ("nyquist",):
+        axes[-1].set_xlabel("frequency (Hz)")
+    _autoscale(axes, parts)
+    fig = axes[0].figure
     if any(line.get_label() and not line.get_label().startswith("_") for line in axes[0].lines):
         axes[0].legend(fontsize="small")
-    return axes[0].figure
+    if title is not None:
+        fig.suptitle(_wrap(str(title), fig))
+    if note:
+        earlier = [t for t in axes[-1].texts if t.get_gid() == _NOTE_GID]
+        text = f"{symbol} = {definition} ({frf.quantity}), time convention x(t) = X exp(i omega t)"
+        if len(entries) == 1 and not earlier:
+            text += f"; response {entries[0][0]}, excitation {entries[0][1]}"
+        found = [ln._substructure_cutoff for a in axes for ln in a.lines
+                 if getattr(ln, "_substructure_cutoff", None) is not None]
+        if found:
+            text += f"; shaded below {max(found):.4g} Hz: rigid-body (mass) line, left out of the scale"
+        for t in earlier:  # an overlay: one note for the figure
+            t.remove()
+        axes[-1].annotate(_wrap(text, fig, 7.0), xy=(0.0, 0.0), xycoords="axes fraction", xytext=(0, -44),
+                          textcoords="offset points", va="top", ha="left", fontsize="x-small", color="0.35",
+                          annotation_clip=False, gid=_NOTE_GID)
+    return fig
 
 
 _UNITS = {"k_yf": "N/m", "k_ym": "N", "k_tf": "N/rad", "k_tm": "N m/rad",

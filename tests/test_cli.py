@@ -165,3 +165,23 @@ def test_python_dash_m_substructure(tmp_path):
                           "--at", "tool.tip"], capture_output=True, text=True, timeout=300)
     assert bad.returncode == 1 and bad.stdout == ""
     assert bad.stderr.startswith("substructure: error: ") and "Traceback" not in bad.stderr
+
+
+def test_frf_plot_unit_and_kind(capsys, tmp_path, monkeypatch):
+    import matplotlib.figure
+
+    saved = []
+    real_savefig = matplotlib.figure.Figure.savefig
+
+    def spy(fig, path, *args, **kwargs):
+        saved.append((fig.axes[0].get_ylabel(), fig.axes[0].get_xlabel(), fig._suptitle.get_text()))
+        return real_savefig(fig, path, *args, **kwargs)
+
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", spy)
+    png = tmp_path / "tip.png"
+    assert run(capsys, "frf", EXAMPLE, "--at", "tool.tip", "--plot", png)[0] == 0
+    assert saved[-1][0] == "receptance |H| (µm/N)" and "tool.tip:y / tool.tip:y" in saved[-1][2].replace("\n", " ")
+    assert run(capsys, "frf", EXAMPLE, "--at", "tool.tip", "--plot", png, "--unit", "m/N", "--kind", "nyquist")[0] == 0
+    assert saved[-1][:2] == ("receptance, imaginary part (m/N)", "receptance, real part (m/N)")
+    status, _, err = run(capsys, "frf", EXAMPLE, "--at", "tool.tip", "--plot", png, "--unit", "in/N")
+    assert status == 2 and "--unit" in err

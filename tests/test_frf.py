@@ -469,10 +469,10 @@ def test_mobility_and_accelerance_to_receptance():
 def test_plot_returns_a_figure_and_overlays():
     f = Frequency.from_range("100 Hz", "1000 Hz", "1 Hz")
     frf = FRF.single(f, sdof(f.hz), output="tool.tip:y", input="tool.tip:y")
-    fig = frf.plot(label="model")
+    fig = frf.plot(label="model", unit="m/N")
     assert isinstance(fig, Figure) and len(fig.axes) == 2
     assert fig.axes[0].get_yscale() == "log" and "m/N" in fig.axes[0].get_ylabel()
-    again = (2 * frf).plot(ax=fig.axes, label="stiffer", linestyle="--")
+    again = (2 * frf).plot(ax=fig.axes, label="stiffer", linestyle="--", unit="m/N")
     assert again is fig and len(fig.axes[0].lines) == 2 and len(fig.axes[1].lines) == 2
     np.testing.assert_allclose(fig.axes[0].lines[1].get_ydata(), 2 * np.abs(sdof(f.hz)))
     np.testing.assert_allclose(fig.axes[1].lines[0].get_ydata(), np.angle(sdof(f.hz), deg=True))
@@ -491,3 +491,87 @@ def test_plot_parts_entries_and_errors():
         frf.plot(parts=("bode",))
     with pytest.raises(UnknownPointError):
         frf.plot(entries=[("z:y", "a:y")])
+
+
+# -- plots a person reads (issue 11) ------------------------------------------------------
+
+
+def free_free_tip():
+    from substructure.io.assembly_toml import default_assembly
+
+    asm = default_assembly()
+    return asm.receptance("tool.tip:y", frequency=Frequency.from_range("10 Hz", "3000 Hz", "5 Hz"))
+
+
+def test_plot_units_convert_exactly_and_label():
+    frf = point_matrix()
+    fig = frf.plot(entries=[("a:y", "a:y")])
+    y = np.abs(frf.entry("a:y", "a:y"))
+    assert fig.axes[0].get_ylabel() == "receptance |H| (µm/N)" and fig.axes[1].get_ylabel() == "phase (deg)"
+    np.testing.assert_array_equal(fig.axes[0].lines[0].get_ydata(), y * 1e6)
+    for unit, factor, shown in (("m/N", 1.0, "m/N"), ("mm/N", 1e3, "mm/N"), ("nm/N", 1e9, "nm/N"), ("µm/N", 1e6, "µm/N")):
+        fig = frf.plot(entries=[("a:y", "a:y")], kind="real-imag", unit=unit)
+        np.testing.assert_array_equal(fig.axes[0].lines[0].get_ydata(), frf.entry("a:y", "a:y").real * factor)
+        np.testing.assert_array_equal(fig.axes[1].lines[0].get_ydata(), frf.entry("a:y", "a:y").imag * factor)
+        assert fig.axes[0].get_ylabel() == f"receptance, real part ({shown})"
+        assert fig.axes[1].get_ylabel() == f"receptance, imaginary part ({shown})"
+        assert fig.axes[1].get_xlabel() == "frequency (Hz)"
+    # rotational entries stay in SI, whatever the unit
+    fig = frf.plot(entries=[("a:theta", "a:theta")], unit="um/N")
+    np.testing.assert_array_equal(fig.axes[0].lines[0].get_ydata(), np.abs(frf.entry("a:theta", "a:theta")))
+    assert "1/(N m)" in fig.axes[0].get_ylabel()
+    mob = attrs.evolve(frf.select("a:y", "a:y"), quantity="mobility")
+    assert mob.plot().axes[0].get_ylabel() == "mobility |Y| (µm/(N s))"
+    with pytest.raises(InvalidValueError, match="unit"):
+        frf.plot(unit="in/N")
+    with pytest.raises(InvalidValueError, match="kind"):
+        frf.plot(kind="polar")
+    with pytest.raises(InvalidValueError, match="parts"):
+        frf.plot(kind="nyquist", parts=("real",))
+
+
+def test_plot_rigid_body_line_is_left_out_of_the_scale():
+    from substructure.plot import rigid_body_cutoff
+
+    frf = free_free_tip()
+    h = np.abs(frf.data[:, 0, 0]) * 1e6
+    cutoff = rigid_body_cutoff(frf.frequency.hz, h)
+    # the mass line falls from 20 Hz to the first antiresonance, found independently here
+    first_min = frf.frequency.hz[np.nonzero(np.diff(h) > 0)[0][0]]
+    assert cutoff == first_min and 50 < cutoff < 1000
+    rest = h[frf.frequency.hz > cutoff]
+    fig = frf.plot()
+    lo, hi = fig.axes[0].get_ylim()
+    assert hi < h[0] / 10                        # the mass line's values at 10 Hz are off the scale
+    assert lo <= rest.min() and hi >= rest.max()  # every mode and antiresonance above it is inside
+    assert hi == pytest.approx(2 * rest.max()) and lo == pytest.approx(rest.min() / 2)
+    np.testing.assert_array_equal(fig.axes[0].lines[0].get_ydata(), h)    # still drawn, whole
+    note = [t.get_text() for t in fig.axes[-1].texts]
+    assert any("rigid-body" in t and "receptance" in t for t in note)
+    # the same for the real/imaginary and Nyquist views
+    fig = frf.plot(kind="real-imag")
+    re_rest = (frf.data[:, 0, 0].real * 1e6)[frf.frequency.hz > cutoff]
+    lo, hi = fig.axes[0].get_ylim()
+    assert lo > frf.data[0, 0, 0].real * 1e6 and lo <= re_rest.min() and hi >= re_rest.max()
+    fig = frf.plot(kind="nyquist")
+    assert len(fig.axes) == 1 and fig.axes[0].get_xlabel() == "receptance, real part (µm/N)"
+    assert fig.axes[0].get_xlim()[0] > frf.data[0, 0, 0].real * 1e6
+    # a supported structure (flat at low frequency) has no rigid-body line
+    sdof = 1 / (1e7 * (1 - (np.arange(1, 400) / 200.0) ** 2 + 0.02j * np.arange(1, 400) / 200.0))
+    assert rigid_body_cutoff(np.arange(1.0, 400.0), np.abs(sdof)) is None
+    assert rigid_body_cutoff(np.array([1.0, 2.0]), np.array([1.0, 0.25])) is None
+
+
+def test_plot_titles_wrap_and_overlays_keep_one_note():
+    frf = free_free_tip()
+    long = "a very long assembly name " * 8
+    fig = frf.plot(title=long)
+    lines = fig._suptitle.get_text().split("\n")
+    assert len(lines) > 1 and all(len(line) <= 80 for line in lines)
+    assert " ".join(lines).split() == long.split()
+    again = (2 * frf).plot(ax=fig, label="stiffer")
+    assert again is fig and len(fig.axes[0].lines) == 2
+    assert len([t for t in fig.axes[-1].texts if "convention" in t.get_text()]) == 1
+    lo, hi = fig.axes[0].get_ylim()
+    rest = (np.abs(frf.data[:, 0, 0]) * 1e6)[frf.frequency.hz > 100]
+    assert hi >= 2 * rest.max()   # the overlay's larger values are inside the new limits

@@ -9,11 +9,12 @@ from pathlib import Path
 from ..io.assembly_toml import load_assembly
 from ._common import (
     UsageError,
+    figures,
     grid_arg,
     grid_text,
     peak_table,
     point_arg,
-    save_plot,
+    save_figure,
     write_frf,
 )
 
@@ -36,7 +37,9 @@ def run(args: argparse.Namespace) -> int:
         write_frf(frf, args.out)
         written.append(args.out)
     if args.plot:
-        save_plot(frf, args.plot, f"{assembly.name}: {at} / {to}")
+        figures()
+        fig = frf.plot(kind=args.kind, unit=args.unit, title=f"{assembly.name}: {at} / {to}")
+        save_figure(fig, args.plot)
         written.append(args.plot)
     if args.json:
         values = frf.data[:, 0, 0]
@@ -73,5 +76,9 @@ def add_parser(commands) -> None:
                      help="frequency grid in Hz or with units (default: the file's [frequency])")
     frf.add_argument("--out", metavar="FILE.csv|FILE.uff", help="write the FRF to a CSV or UFF file")
     frf.add_argument("--plot", metavar="FILE.png", help="plot the FRF to an image file")
+    frf.add_argument("--unit", choices=("um/N", "m/N", "mm/N", "nm/N"), default="um/N",
+                     help="unit of translational FRFs in the plot (default: um/N)")
+    frf.add_argument("--kind", choices=("bode", "nyquist", "real-imag"), default="bode",
+                     help="plot view: magnitude and phase (default), Nyquist plane, or real and imaginary parts")
     frf.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
     frf.set_defaults(run=run)
