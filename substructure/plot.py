@@ -104,8 +104,9 @@ def _scaled(frf: FRF, output: str, input_: str, unit: str) -> tuple[float, str]:
     return 1.0, si
 
 
-def _wrap(text: str, fig: Figure, fontsize: float = 12.0) -> str:
-    width = max(20, int(fig.get_figwidth() * 72 / (0.6 * fontsize)))
+def _wrap(text: str, width_in: float, fontsize: float = 12.0) -> str:
+    """Text wrapped to about ``width_in`` inches at ``fontsize`` points (average glyph 0.55 em)."""
+    width = max(20, int(width_in * 72 / (0.55 * fontsize)))
     return "\n".join(textwrap.wrap(text, width))
 
 
@@ -276,7 +277,8 @@ def plot_frf(
     if any(line.get_label() and not line.get_label().startswith("_") for line in axes[0].lines):
         axes[0].legend(fontsize="small")
     if title is not None:
-        fig.suptitle(_wrap(str(title), fig))
+        fig.suptitle(_wrap(str(title), 0.9 * fig.get_figwidth(), plt.rcParams["figure.titlesize"]
+                           if isinstance(plt.rcParams["figure.titlesize"], (int, float)) else 12.0))
     if note:
         earlier = [t for t in axes[-1].texts if t.get_gid() == _NOTE_GID]
         text = f"{symbol} = {definition} ({frf.quantity}), time convention x(t) = X exp(i omega t)"
@@ -285,10 +287,12 @@ def plot_frf(
         found = [ln._substructure_cutoff for a in axes for ln in a.lines
                  if getattr(ln, "_substructure_cutoff", None) is not None]
         if found:
-            text += f"; shaded below {max(found):.4g} Hz: rigid-body (mass) line, left out of the scale"
+            where = "below" if parts == ("nyquist",) else "shaded, below"
+            text += f"; {where} {max(found):.4g} Hz: rigid-body (mass) line, drawn but left out of the scale"
         for t in earlier:  # an overlay: one note for the figure
             t.remove()
-        axes[-1].annotate(_wrap(text, fig, 7.0), xy=(0.0, 0.0), xycoords="axes fraction", xytext=(0, -44),
+        width = axes[-1].get_position().width * fig.get_figwidth()
+        axes[-1].annotate(_wrap(text, width, 8.5), xy=(0.0, 0.0), xycoords="axes fraction", xytext=(0, -44),
                           textcoords="offset points", va="top", ha="left", fontsize="x-small", color="0.35",
                           annotation_clip=False, gid=_NOTE_GID)
     return fig

@@ -141,7 +141,7 @@ def test_tapered_holder_in_an_assembly_matches_fe_receptances():
     ours = asm.frf(["tool.tip", "holder.tip"], frequency=grid).data
     theirs = m.receptance(grid.hz, [(t, 0.07, "y"), (t, 0.07, "theta"), (h, 0.07, "y"), (h, 0.07, "theta")])
     err = np.abs(ours - theirs).max(axis=0) / np.abs(theirs).max(axis=0)
-    assert err.max() < RECEPTANCE_TOL  # measured 8e-5
+    assert err.max() < RECEPTANCE_TOL  # measured 7e-5 (the FE mesh error included)
     assert asm.frf(["tool.tip"], frequency=grid).reciprocity_error() < 1e-10
 
 
