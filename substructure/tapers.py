@@ -39,7 +39,7 @@ from .errors import InvalidValueError
 from .units import Q_, quantity
 
 __all__ = ["TAPER_STEP_RATIO", "TAPER_STEP_PHASE", "TAPER_ERROR_BOUND", "check_taper", "step_count",
-           "piece_sections", "section_at", "split", "mass"]
+           "piece_sections", "section_at", "split", "mass", "piecewise_sections", "tapered_column"]
 
 TAPER_STEP_RATIO = 0.3
 """Largest relative change of a section property over one step of a tapered segment (default steps)."""
@@ -128,10 +128,18 @@ def _auto_steps(seg: Segment, omega_max: float = 0.0) -> int:
 
 
 def check_taper(seg: Segment) -> tuple[float, float, float, float] | None:
-    """Validate a segment given ``od_tip``/``id_tip``.
+    """Validate a segment given ``od_tip``/``id_tip`` (called by :class:`Segment` itself).
 
-    Returns its end diameters ``(od, od_tip, id, id_tip)`` in metres when it
-    is tapered, None when its ends are equal (a uniform segment).
+    Parameters
+    ----------
+    seg : Segment
+        The segment being built.
+
+    Returns
+    -------
+    tuple of float or None
+        Its end diameters ``(od, od_tip, id, id_tip)`` in metres when it is
+        tapered; None when its ends are equal (a uniform segment).
 
     Raises
     ------
@@ -165,14 +173,44 @@ def check_taper(seg: Segment) -> tuple[float, float, float, float] | None:
 
 
 def step_count(seg: Segment, omega_max: float) -> int:
-    """Steps of a segment for the highest angular frequency ``omega_max`` [rad/s] (1 when uniform)."""
+    """Number of steps that model a segment (see :meth:`Segment.taper_step_count`).
+
+    Parameters
+    ----------
+    seg : Segment
+        Any segment.
+    omega_max : float
+        Highest angular frequency the model serves [rad/s]; 0 for the
+        geometric criterion alone.
+
+    Returns
+    -------
+    int
+        ``taper_steps`` when given, else from the error bound; 1 for a uniform segment.
+    """
     if not seg.is_tapered:
         return 1
     return seg.taper_steps if seg.taper_steps is not None else _auto_steps(seg, omega_max)
 
 
 def piece_sections(seg: Segment, steps: int | None, omega_max: float) -> list[Section]:
-    """The equal-length uniform sections of a segment (see :meth:`Segment.piece_sections`)."""
+    """The equal-length uniform sections of a segment (see :meth:`Segment.piece_sections`).
+
+    Parameters
+    ----------
+    seg : Segment
+        Any segment.
+    steps : int or None
+        Number of steps; None for :func:`step_count`.
+    omega_max : float
+        Highest angular frequency [rad/s] for the default count.
+
+    Returns
+    -------
+    list of Section
+        ``2 * steps`` Magnus half-steps of a tapered segment, or ``steps``
+        copies of a uniform segment's section; all of the same length.
+    """
     from .beams import _steps
 
     n = step_count(seg, omega_max) if steps is None else _steps(steps)
@@ -182,13 +220,37 @@ def piece_sections(seg: Segment, steps: int | None, omega_max: float) -> list[Se
 
 
 def mass(seg: Segment) -> float:
-    """Exact mass of a tapered segment [kg]: ``rho*A`` is quadratic in ``x``, Simpson's rule is exact."""
+    """Exact mass of a tapered segment: ``rho*A`` is quadratic in ``x``, Simpson's rule is exact.
+
+    Parameters
+    ----------
+    seg : Segment
+        A tapered segment.
+
+    Returns
+    -------
+    float
+        Mass in kg, insert included.
+    """
     ends = _taper_sections(seg, np.array([0.0, 0.5, 1.0]))
     return seg.length_m * (ends[0].rhoA + 4.0 * ends[1].rhoA + ends[2].rhoA) / 6.0
 
 
 def section_at(seg: Segment, x) -> Section:
-    """Section of a segment at distance ``x`` (quantity) from its base."""
+    """Section of a segment at a distance from its base (see :meth:`Segment.section_at`).
+
+    Parameters
+    ----------
+    seg : Segment
+        Any segment.
+    x : quantity or str
+        Distance from the base, within the segment's length.
+
+    Returns
+    -------
+    Section
+        SI section properties there.
+    """
     at = quantity(x, "x", "[length]").m_as("m")
     if not -1e-12 * seg.length_m <= at <= seg.length_m * (1 + 1e-12):
         raise InvalidValueError(f"x: got {x!r}; expected a distance within the segment's length {seg.length:~P}")
@@ -198,7 +260,20 @@ def section_at(seg: Segment, x) -> Section:
 
 
 def split(seg: Segment, at) -> tuple[Segment, Segment]:
-    """A segment cut in two at distance ``at`` from its base (see :meth:`Segment.split`)."""
+    """A segment cut in two (see :meth:`Segment.split`).
+
+    Parameters
+    ----------
+    seg : Segment
+        Any segment.
+    at : quantity or str
+        Distance of the cut from the base, strictly inside the segment.
+
+    Returns
+    -------
+    (Segment, Segment)
+        Base part and tip part, diameters continuous at the cut.
+    """
     x = quantity(at, "at", "[length]")
     if not 0 < x.m_as("m") < seg.length_m:
         raise InvalidValueError(
@@ -231,6 +306,22 @@ def piecewise_sections(segments: Sequence[Segment], omega_max: float = 0.0,
     :meth:`Segment.piece_sections` for ``omega_max``.  The segment ends are
     the running sums of the segment lengths, as for a beam without tapers,
     so that ``tip`` is exactly the last boundary.
+
+    Parameters
+    ----------
+    segments : sequence of Segment
+        Base to tip.
+    omega_max : float
+        Highest angular frequency of the computation [rad/s].
+    positions : ndarray
+        Requested points, distances from the base in metres.
+
+    Returns
+    -------
+    sections : list of Section
+        The uniform pieces, base to tip.
+    bounds : ndarray
+        Their ``len(sections) + 1`` boundaries from the base, in metres.
     """
     sections: list[Section] = []
     bounds = [0.0]
@@ -266,6 +357,19 @@ def tapered_column(column: Sequence[Segment], omega_max: float) -> list[tuple[Se
     chains keep one layout (a uniform segment is cut into as many equal
     pieces); a piece shared by all configurations is one section for the
     kernel.
+
+    Parameters
+    ----------
+    column : sequence of Segment
+        The segment at one position of the chain, one per configuration.
+    omega_max : float
+        Highest angular frequency of the computation [rad/s].
+
+    Returns
+    -------
+    list of (Section, length)
+        Intervals base to tip; a field (and the length, in metres) is an
+        array over configurations where they differ.
     """
     n = max(step_count(seg, omega_max) for seg in column)
     pieces = [_magnus_sections(seg, n) if seg.is_tapered else [seg.section()] * (2 * n) for seg in column]
