@@ -426,5 +426,7 @@ def component_info(component: Any) -> str:
     kind = getattr(component, "kind", type(component).__name__)
     if isinstance(component, Beam):
         text = f"{component.name} ({kind}, {len(component.segments)} segments, {component.length:~P}, {component.mass():.3g} kg)"
-        return f"{text}: {component.description}" if component.description else text
+        if component.description:  # its first sentence: catalogue holders carry their sources after it
+            text += ": " + component.description.split(". ")[0].rstrip(".")
+        return text
     return f"{component.name} ({kind})"

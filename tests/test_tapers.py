@@ -256,3 +256,28 @@ def test_taper_input_errors():
     # a tapered od around a uniform bore holds an insert (a shrink-fit nose)
     nose = Segment("40 mm", "40 mm", "12 mm", insert=Insert("12 mm", "carbide"), od_tip="24 mm", id_tip="12 mm")
     assert nose.is_tapered and nose.insert is not None
+
+
+def test_assembly_file_round_trip_and_errors():
+    from substructure.errors import FileFormatError
+    from substructure.io.assembly_toml import dumps_assembly, loads_assembly
+
+    holder = Holder("holder", [
+        Segment("65.4 mm", "25.375 mm", material=STEEL0, od_tip="44.45 mm"),
+        Segment("20 mm", "63 mm", material=STEEL0),
+        Segment("50 mm", "40 mm", "12 mm", STEEL0, insert=Insert("12 mm", CARBIDE0), od_tip="1 in", taper_steps=5),
+    ], description="a tapered holder")
+    tool = Tool("tool", [Segment("30 mm", "12 mm", material=CARBIDE0, flutes=Flutes(0.8), od_tip="10 mm", id_tip="2 mm")])
+    asm = Assembly("tapers", [holder, tool], [Joint("ht", ["holder.tip", "tool.base"], rigid=True)],
+                   frequency=Frequency.from_range("100 Hz", "3000 Hz", "100 Hz"), materials=[STEEL0, CARBIDE0])
+    text = dumps_assembly(asm)
+    assert 'od_tip = "44.45 mm"' in text and "taper_steps = 5" in text and 'id_tip = "2 mm"' in text
+    again = loads_assembly(text)
+    assert again == asm
+    np.testing.assert_array_equal(again.receptance("tool.tip:y").data, asm.receptance("tool.tip:y").data)
+    assert "holder (holder, 3 segments" in asm.describe() and "a tapered holder" in asm.describe()
+    bad = text.replace('od_tip = "44.45 mm"', 'od_tip = "44.45 mm", id_tip = "50 mm"')
+    with pytest.raises(FileFormatError, match=r"components\[0\]\.segments\[0\]\.id_tip: got 50 mm"):
+        loads_assembly(bad, "m.toml")
+    with pytest.raises(FileFormatError, match=r"segments\[2\]\.taper_steps: got 0"):
+        loads_assembly(text.replace("taper_steps = 5", "taper_steps = 0"), "m.toml")
