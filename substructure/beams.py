@@ -248,7 +248,7 @@ class Segment:
     taper_steps: int | None = attrs.field(default=None, kw_only=True, converter=_steps)
     # SI values, derived once (the kernels need them at every call)
     _si: tuple = attrs.field(init=False, eq=False, repr=False)
-    # tapered segments: SI end diameters and the sections of the default steps (None when uniform)
+    # tapered segments: SI end diameters (od, od_tip, id, id_tip); None when uniform
     _taper: tuple | None = attrs.field(init=False, eq=False, repr=False, default=None)
 
     def __attrs_post_init__(self) -> None:
