@@ -374,5 +374,6 @@ segments = [{ length = "30 mm", od = "12 mm" }]
 """
     with pytest.raises(FileFormatError, match=r"frequency.start: got '0 Hz'; expected a frequency > 0 Hz"):
         loads_assembly(text, "x.toml")
-    with pytest.raises(FileFormatError, match=r"components\[0\].segments\[0\].material: missing"):
-        loads_assembly(text.replace('"0 Hz"', '"10 Hz"'), "x.toml")
+    # no material anywhere: steel, the rule of Segment and of docs/assembly-file.md
+    tool = loads_assembly(text.replace('"0 Hz"', '"10 Hz"'), "x.toml").component("tool")
+    assert tool.segments[0].material.name == "steel" and tool == Tool("tool", [Segment("30 mm", "12 mm")])

@@ -3,16 +3,18 @@
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
 from ..io.assembly_toml import load_assembly
 from ._common import (
     UsageError,
+    check_outputs,
+    check_plot,
     grid_arg,
     grid_text,
     peak_table,
     point_arg,
+    print_json,
     save_plot,
     write_frf,
 )
@@ -21,6 +23,8 @@ from ._common import (
 def run(args: argparse.Namespace) -> int:
     if args.out and Path(args.out).suffix.lower() not in (".csv", ".uff", ".unv"):
         raise UsageError(f"argument --out: {args.out!r}: expected a .csv or .uff file")
+    check_plot(args.plot)
+    check_outputs([("--out", args.out), ("--plot", args.plot)], [args.assembly], args.overwrite)
     assembly = load_assembly(args.assembly)
     at = point_arg(args.at)
     to = point_arg(args.to) if args.to else at
@@ -33,20 +37,19 @@ def run(args: argparse.Namespace) -> int:
     peaks = peak_table(frf)
     written = []
     if args.out:
-        write_frf(frf, args.out)
+        write_frf(frf, args.out, args.overwrite)
         written.append(args.out)
     if args.plot:
-        save_plot(frf, args.plot, f"{assembly.name}: {at} / {to}")
+        save_plot(frf, args.plot, f"{assembly.name}: {at} / {to}", args.overwrite)
         written.append(args.plot)
     if args.json:
         values = frf.data[:, 0, 0]
-        print(json.dumps({
+        return print_json({
             "frequency_hz": frf.frequency.hz.tolist(),
             "real": values.real.tolist(),
             "imag": values.imag.tolist(),
             "peaks_hz": [f for f, _ in peaks],
-        }))
-        return 0
+        })
     unit = frf.unit(frf.outputs[0], frf.inputs[0])
     print(f"assembly: {assembly.name}")
     print(f"receptance: response {at}, excitation {to} [{unit}]")
@@ -59,9 +62,6 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-# -- demo -----------------------------------------------------------------------------
-
-
 def add_parser(commands) -> None:
     """Add the ``frf`` subcommand to the subparsers ``commands``."""
     frf = commands.add_parser("frf", help="receptance of an assembly file between two points")
@@ -70,8 +70,10 @@ def add_parser(commands) -> None:
                      help="response point, e.g. tool.tip (DOF y by default)")
     frf.add_argument("--to", metavar="POINT[:dof]", help="excitation point (default: --at)")
     frf.add_argument("--grid", type=grid_arg, metavar="START:STOP:STEP",
-                     help="frequency grid in Hz or with units (default: the file's [frequency])")
+                     help="frequency grid in Hz or with units; rad/s and rpm are converted (default: the "
+                          "file's [frequency])")
     frf.add_argument("--out", metavar="FILE.csv|FILE.uff", help="write the FRF to a CSV or UFF file")
-    frf.add_argument("--plot", metavar="FILE.png", help="plot the FRF to an image file")
+    frf.add_argument("--plot", metavar="FILE.png", help="plot the FRF to an image file (.png, .pdf, .svg, ...)")
+    frf.add_argument("--overwrite", action="store_true", help="let --out and --plot replace existing files")
     frf.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
     frf.set_defaults(run=run)
