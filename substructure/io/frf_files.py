@@ -338,6 +338,11 @@ _TIME_OF = {v: k for k, v in _TIME_EXPONENT.items()}
 _NO_LABEL = ("", "NONE", "N/A", "NA", "-")
 
 
+def _a(word: str) -> str:
+    """``word`` with its indefinite article."""
+    return f"{'an' if word[:1].lower() in 'aeiou' else 'a'} {word}"
+
+
 def _unit_of_label(label: Any):
     """A pint Quantity of 1 of the unit an axis units label names; None for no label; ValueError if unreadable.
 
@@ -423,13 +428,13 @@ def _record_quantity(dset: dict, where: str, given: str | None, system: tuple[fl
     den_type = int(dset.get("orddenom_spec_data_type", 0) or 0)
     if den_type not in (0, 1, 9, 13):
         raise FileFormatError(
-            f"{where}: the ordinate denominator is a {_DATA_TYPES.get(den_type, f'data type {den_type}')}; a "
+            f"{where}: the ordinate denominator is {_a(_DATA_TYPES.get(den_type, f'data type {den_type}'))}; a "
             "receptance, mobility or accelerance is a response per excitation force"
         )
     by_type = {8: "receptance", 11: "mobility", 12: "accelerance"}.get(num_type)
     if by_type is None and num_type not in (0, 1):
         raise FileFormatError(
-            f"{where}: the ordinate is a {_DATA_TYPES.get(num_type, f'data type {num_type}')}, not a "
+            f"{where}: the ordinate is {_a(_DATA_TYPES.get(num_type, f'data type {num_type}'))}, not a "
             "displacement, velocity or acceleration: not a receptance, mobility or accelerance"
         )
     stored = str(dset.get("id3", "")).strip()
@@ -456,7 +461,7 @@ def _record_quantity(dset: dict, where: str, given: str | None, system: tuple[fl
         if by_label is not None and by_type is not None and by_label != by_type:
             raise FileFormatError(
                 f"{where}: its data type says {by_type} ({_DATA_TYPES[num_type]}) but its unit label {label!r} "
-                f"is that of a {by_label}; give the quantity to say which"
+                f"is that of {_a(by_label)}; give the quantity to say which"
             )
         quantity = by_label or by_type or ours
         if quantity is None:
@@ -471,7 +476,7 @@ def _record_quantity(dset: dict, where: str, given: str | None, system: tuple[fl
     elif by_label == given:
         return given, label_factor
     elif not (by_type == given or (by_label is None and by_type is None)):
-        says = f"its unit label {label!r} is that of a {by_label}" if by_label is not None else \
+        says = f"its unit label {label!r} is that of {_a(by_label)}" if by_label is not None else \
             f"its data type says {by_type} ({_DATA_TYPES[num_type]})"
         raise FileFormatError(f"{where}: the quantity given is {given}, but {says}")
     else:
@@ -535,7 +540,7 @@ def _parse_record(dset: dict, name: str, number: int, quantity: str | None,
     if function not in (0, 4) or (function == 0 and int(dset.get("orddenom_spec_data_type", 0) or 0) != 13):
         kind = _FUNCTION_TYPES.get(function, f"function type {function}")
         raise FileFormatError(
-            f"{where}: a {kind} (function type {function}), not a frequency response function (type 4); "
+            f"{where}: {_a(kind)} (function type {function}), not a frequency response function (type 4); "
             "export the FRFs (H1 or H2) from the acquisition software"
         )
     data = np.asarray(dset["data"])
@@ -579,8 +584,7 @@ def _check_complete(name: str) -> None:
     with open(name, "rb") as fh:
         fh.seek(max(0, size - 512))
         tail = fh.read()
-    last = tail.rstrip().splitlines()[-1].strip() if tail.strip() else b""
-    if last == b"-1":
+    if re.search(rb"(?:^|\s)-1\s*$", tail):  # (binary 58b data end right before the closing "    -1")
         return
     with open(name, "rb") as fh:
         starts = [n + 1 for n, line in enumerate(fh) if line.rstrip()[:6].strip() in (b"58", b"58b")]
