@@ -1,4 +1,4 @@
-"""Tests of substructure.io.assembly_toml: assembly files (formats.md) in and out."""
+"""Tests of substructure.io.assembly_toml: assembly files (docs/file-formats.md) in and out."""
 
 from __future__ import annotations
 
@@ -72,7 +72,7 @@ class Collet(Holder):
 
 
 def example_in_python() -> Assembly:
-    """The formats.md example, built with the Python API."""
+    """The example of docs/file-formats.md, built with the Python API."""
     steel = Material("steel", E="210 GPa", nu=0.29, rho="7850 kg/m^3", loss_factor=0.002)
     spindle = Spindle("spindle", [Segment("120 mm", "70 mm", "40 mm", steel),
                                   Segment("150 mm", "90 mm", "40 mm", steel),

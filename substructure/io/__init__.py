@@ -39,7 +39,10 @@ def check_readable_file(path, what: str = "file") -> str:
     str
         ``os.fspath(path)``.
     """
-    name = os.fspath(path)
+    try:
+        name = os.fspath(path)
+    except TypeError:
+        raise FileFormatError(f"got {path!r} of type {type(path).__name__}; expected the name of a {what}") from None
     if os.path.isdir(name):
         raise FileFormatError(f"{name}: is a directory; expected a {what}")
     if not os.path.exists(name):
