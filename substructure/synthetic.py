@@ -107,7 +107,9 @@ def write_measurement_set(measurements: MeasurementSet | Sequence[Measurement], 
     if not overwrite:
         existing = [str(p) for p in [toml_path, *files] if p.exists()]
         if existing:
-            raise FileExistsError(f"{existing[0]} exists; pass overwrite=True to replace it")
+            from .errors import OutputExistsError
+
+            raise OutputExistsError(f"{existing[0]} exists; pass overwrite=True to replace it")
     tables = []
     for m, path in zip(items, files):
         write_csv(m.frf, path, overwrite=overwrite)

@@ -94,7 +94,7 @@ def quantity(value: Any, field: str, dimension: str) -> pint.Quantity:
     if isinstance(value, str):
         if not _NUMBER.match(value):  # pint reads "mm" as 1 mm and "a" as 1 year
             raise UnitError(
-                f"{field}: got {value!r}, which does not start with a number; expected {expected}"
+                f"{field}: cannot read {value!r} as a quantity: it does not start with a number; expected {expected}"
             )
         try:
             q = ureg.Quantity(value)

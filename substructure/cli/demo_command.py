@@ -136,7 +136,7 @@ DEMO_STEPS: list[tuple[str, Callable[[DemoState], None]]] = [
 
 def _check_out(out: Path, overwrite: bool) -> None:
     """Refuse, before any work, an ``--out`` that is a file or holds what the demo would replace."""
-    from ..errors import FileFormatError
+    from ..errors import FileFormatError, OutputExistsError
 
     if out.exists() and not out.is_dir():
         raise FileFormatError(f"--out {out}: is a file; expected a directory (created if missing)")
@@ -145,7 +145,7 @@ def _check_out(out: Path, overwrite: bool) -> None:
     there = [name for name in DEMO_FILES
              if (out / name).exists() and not ((out / name).is_dir() and not any((out / name).iterdir()))]
     if there:
-        raise FileExistsError(
+        raise OutputExistsError(
             f"--out {out}: holds {', '.join(there)}, which the demo would replace; add --overwrite to replace "
             "them, or choose another directory"
         )

@@ -19,7 +19,7 @@ import tempfile
 from pathlib import Path
 from typing import Iterator
 
-from ..errors import FileFormatError
+from ..errors import FileFormatError, OutputExistsError
 
 __all__ = ["read_text", "check_readable_file", "replacing", "write_text", "write_bytes", "check_writable"]
 
@@ -103,9 +103,9 @@ def check_writable(path, overwrite: bool, option: str | None = None) -> Path:
 
     Raises
     ------
-    FileExistsError
-        When the file exists and ``overwrite`` is false (the message says how
-        to replace it).
+    OutputExistsError
+        (a ``FileExistsError``) when the file exists and ``overwrite`` is
+        false; the message says how to replace it.
     FileFormatError
         When the path is a directory or its directory does not exist.
     """
@@ -118,7 +118,7 @@ def check_writable(path, overwrite: bool, option: str | None = None) -> Path:
         raise FileFormatError(f"{who}: the directory {parent} does not exist")
     if p.exists() and not overwrite:
         hint = "add --overwrite to replace it" if option else "pass overwrite=True to replace it"
-        raise FileExistsError(f"{who}: the file exists; {hint}")
+        raise OutputExistsError(f"{who}: the file exists; {hint}")
     return p
 
 
@@ -156,8 +156,8 @@ def replacing(path, overwrite: bool = True) -> Iterator[str]:
 
     Raises
     ------
-    FileExistsError
-        When ``path`` exists and ``overwrite`` is false.
+    OutputExistsError
+        (a ``FileExistsError``) when ``path`` exists and ``overwrite`` is false.
     FileFormatError
         When ``path`` is a directory or its directory is missing or not
         writable.
@@ -178,10 +178,10 @@ def replacing(path, overwrite: bool = True) -> Iterator[str]:
             try:
                 os.link(temporary, target)  # atomic and exclusive: fails if the name exists
             except FileExistsError:
-                raise FileExistsError(f"{target}: the file exists; pass overwrite=True to replace it") from None
+                raise OutputExistsError(f"{target}: the file exists; pass overwrite=True to replace it") from None
             except OSError:  # a file system without hard links: check, then rename
                 if target.exists():
-                    raise FileExistsError(f"{target}: the file exists; pass overwrite=True to replace it") from None
+                    raise OutputExistsError(f"{target}: the file exists; pass overwrite=True to replace it") from None
                 os.replace(temporary, target)
     finally:
         with contextlib.suppress(FileNotFoundError):

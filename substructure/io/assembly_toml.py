@@ -690,7 +690,7 @@ def save_assembly(assembly: Assembly, path: str | os.PathLike, overwrite: bool =
 
     Raises
     ------
-    FileExistsError
+    OutputExistsError
         When ``path`` exists and ``overwrite`` is False.
     InvalidValueError
         For what the file cannot hold (:func:`dumps_assembly`).
