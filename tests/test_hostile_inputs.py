@@ -272,6 +272,15 @@ def test_negative_and_malformed_numbers_say_what_is_wrong(capsys, argv, message)
     assert message in err, err
 
 
+def test_repetitions_are_bounded_before_any_work(capsys):
+    for argv in (["identify", EXAMPLE, EXAMPLE, "--joint", "holder-tool", "--bootstrap", "100000000"],
+                 ["identify", EXAMPLE, EXAMPLE, "--joint", "holder-tool", "--bootstrap", "-1"],
+                 ["predict", EXAMPLE, "--features", "d=1 mm", "--samples", "0"],
+                 ["predict", EXAMPLE, "--features", "d=1 mm", "--samples", "1000000000"]):
+        status, _, err = run(capsys, *argv)
+        assert status == 2 and "to 10000" in err, err
+
+
 def test_byte_order_marks_are_accepted(tap, capsys):
     for name in ("model.toml", "measurements.toml", next(tap.glob("*.csv")).name):
         (tap / name).write_bytes(b"\xef\xbb\xbf" + (tap / name).read_bytes())

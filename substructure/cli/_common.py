@@ -27,6 +27,18 @@ IMAGE_SUFFIXES = (".png", ".pdf", ".svg", ".svgz", ".eps", ".ps", ".jpg", ".jpeg
 """Image files ``--plot`` writes (formats matplotlib saves without extra software)."""
 
 
+MAX_REPEATS = 10_000
+"""The most bootstrap refits (``identify --bootstrap``) or samples (``predict --samples``) a command runs."""
+
+
+def count_arg(option: str, value: int, minimum: int = 0) -> int:
+    """A count of repetitions, ``minimum`` to :data:`MAX_REPEATS`, checked before any work."""
+    if not minimum <= value <= MAX_REPEATS:
+        raise UsageError(f"argument {option}: got {value}; expected {minimum} to {MAX_REPEATS} "
+                         "(each one is a full computation)")
+    return value
+
+
 class UsageError(Exception):
     """Misuse of the command line (exit status 2)."""
 

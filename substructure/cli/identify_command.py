@@ -5,7 +5,16 @@ from __future__ import annotations
 import argparse
 
 from ..io.assembly_toml import load_assembly
-from ._common import band_arg, check_outputs, check_plot, figures, measurement_inputs, print_json, save_figure
+from ._common import (
+    band_arg,
+    check_outputs,
+    check_plot,
+    count_arg,
+    figures,
+    measurement_inputs,
+    print_json,
+    save_figure,
+)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -13,6 +22,7 @@ def run(args: argparse.Namespace) -> int:
     from ..io.measurements import load_measurements
 
     check_plot(args.plot)
+    count_arg("--bootstrap", args.bootstrap)
     check_outputs([("--plot", args.plot)], [args.assembly, *measurement_inputs(args.measurements)], args.overwrite)
     assembly = load_assembly(args.assembly)
     measurements = load_measurements(args.measurements)

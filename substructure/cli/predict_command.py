@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..io.assembly_toml import load_assembly
-from ._common import UsageError, check_outputs, check_plot, figures, point_arg, print_json, save_figure
+from ._common import UsageError, check_outputs, check_plot, count_arg, figures, point_arg, print_json, save_figure
 
 
 def _features(text: str) -> dict[str, str]:
@@ -26,8 +26,7 @@ def run(args: argparse.Namespace) -> int:
 
     check_plot(args.plot)
     check_outputs([("--plot", args.plot)], [args.table, args.assembly], args.overwrite)
-    if args.samples < 1:
-        raise UsageError(f"argument --samples: got {args.samples}; expected a number of samples >= 1")
+    count_arg("--samples", args.samples, minimum=1)
     read = JointTable.from_toml if Path(args.table).suffix.lower() == ".toml" else JointTable.from_csv
     table = read(args.table)
     table.check_not_empty()
