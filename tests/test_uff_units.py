@@ -261,6 +261,16 @@ def binary_record_58(values, x0, dx, num, den):
     return (header + "\n".join(ascii_part) + "\n").encode("ascii") + data + b"    -1\n"
 
 
+def test_files_that_are_not_universal_files(tmp_path):
+    (tmp_path / "photo.uff").write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(100))
+    with pytest.raises(FileFormatError, match="photo.uff: not a universal file"):
+        read_uff(tmp_path / "photo.uff")
+    (tmp_path / "nodes.uff").write_text("    -1\n    15\n         1         0         0         0  0.0  0.0  0.0\n"
+                                        "    -1\n", encoding="ascii")
+    with pytest.raises(FileFormatError, match=r"nodes.uff: no type-58 record \(FRF\); the file holds record types 15"):
+        read_uff(tmp_path / "nodes.uff")
+
+
 def test_binary_records_and_a_spectrum_file(tmp_path):
     hz = grid(start=10.0)
     mobility = 1j * 2 * np.pi * hz * receptance(hz)

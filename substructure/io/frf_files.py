@@ -577,13 +577,20 @@ def _parse_record(dset: dict, name: str, number: int, quantity: str | None,
 
 
 def _check_complete(name: str) -> None:
-    """A universal file must end with its last record's ``-1`` line; otherwise it was cut off."""
+    """A universal file starts and ends with a ``-1`` line; otherwise it is something else, or was cut off."""
     size = os.path.getsize(name)
     if size == 0:
         raise FileFormatError(f"{name}: the file is empty; no type-58 record")
     with open(name, "rb") as fh:
+        head = fh.read(512)
         fh.seek(max(0, size - 512))
         tail = fh.read()
+    first = head.lstrip().split(b"\n", 1)[0].strip()
+    if first != b"-1":
+        raise FileFormatError(
+            f"{name}: not a universal file (it starts with {first[:20].decode('latin-1')!r}, not with the line "
+            "'    -1' that opens a record)"
+        )
     if re.search(rb"(?:^|\s)-1\s*$", tail):  # (binary 58b data end right before the closing "    -1")
         return
     with open(name, "rb") as fh:
