@@ -16,7 +16,7 @@ $(STAMP): $(BIN)/python pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	MPLBACKEND=Agg $(BIN)/substructure demo --out out/demo
+	MPLBACKEND=Agg $(BIN)/substructure demo --out out/demo --overwrite
 
 test: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q

@@ -31,6 +31,7 @@ from .errors import (
     InvalidValueError,
     NonPassiveJointWarning,
     NonReciprocalWarning,
+    OutputExistsError,
     SubstructureError,
     SubstructureWarning,
     UnitError,
@@ -51,7 +52,7 @@ __all__ = [
     "get_material", "COMPONENT_TYPES", "register_component", "shear_coefficient", "add_mass",
     "remove_mass", "modify", "decouple", "ureg", "Q_", "SubstructureError", "UnitError",
     "InvalidValueError", "FrequencyAxisMismatchError", "UnknownPointError", "AssemblyError",
-    "FileFormatError", "SubstructureWarning", "NonPassiveJointWarning", "NonReciprocalWarning",
-    "IllConditionedWarning", "load_assembly", "loads_assembly", "save_assembly", "dumps_assembly",
-    "default_assembly", "sweep", "SweepResult",
+    "FileFormatError", "OutputExistsError", "SubstructureWarning", "NonPassiveJointWarning",
+    "NonReciprocalWarning", "IllConditionedWarning", "load_assembly", "loads_assembly", "save_assembly",
+    "dumps_assembly", "default_assembly", "sweep", "SweepResult",
 ]

@@ -223,16 +223,22 @@ class Assembly:
                 k=None, c=None, rigid: bool = False) -> "Assembly":
         """Connect two points by a joint: ``connect(joint)`` or ``connect(a, b, k=..., c=...)``.
 
-        Without ``k`` the connection is rigid.
+        Without ``k`` and ``c`` the connection is rigid; damping ``c`` without
+        a stiffness ``k`` is refused (as :class:`Joint` refuses it), rather
+        than made rigid with ``c`` lost.
         """
         if not isinstance(a, str):
             joint = a  # a Joint, or any object of the joint protocol
         else:
             if b is None:
                 raise InvalidValueError("connect: expected two points, or a Joint")
-            rigid = rigid or k is None
-            joint = Joint(name or f"joint-{len(self.joints) + 1}", (a, b), k=None if rigid else k,
-                          c=None if rigid else c, rigid=rigid)
+            label = name or f"joint-{len(self.joints) + 1}"
+            if k is None and c is not None:
+                raise InvalidValueError(
+                    f"joint {label!r}: got damping c without stiffness k; an elastic joint needs k "
+                    "(e.g. k={'yf': '1e7 N/m'}), a rigid one takes neither"
+                )
+            joint = Joint(label, (a, b), k=k, c=c, rigid=rigid or (k is None and c is None))
         return attrs.evolve(self, joints=self.joints + (joint,))
 
     def attach(self, *sensors: Sensor) -> "Assembly":

@@ -79,20 +79,26 @@ def register_component(kind: str):
 
 
 def as_frequency(frequency) -> Frequency:
-    """A :class:`Frequency` from a Frequency, an FRF, or an array of frequencies in Hz."""
+    """A :class:`Frequency` from a Frequency, an FRF, an array of frequencies in Hz or a quantity.
+
+    A quantity in angular units is converted explicitly, as everywhere
+    (:func:`substructure.units.frequency_hz`): rad/s divided by ``2*pi``,
+    rpm by 60.
+    """
     if isinstance(frequency, Frequency):
         return frequency
     if isinstance(frequency, FRF):
         return frequency.frequency
     if isinstance(frequency, pint.Quantity):
-        units = str(frequency.units)
-        if not frequency.check("1 / [time]") or any(w in units for w in ("radian", "revolution", "turn", "degree")):
+        from .units import cycles_per_second, ureg
+
+        q = frequency if frequency._REGISTRY is ureg else ureg.Quantity(frequency.magnitude, str(frequency.units))
+        if not q.check("1 / [time]"):
             raise InvalidValueError(
-                f"frequency: got a quantity in {units}; expected frequencies in Hz (cycles per second). "
-                "An angular frequency in rad/s or a speed in rpm is not converted silently: divide "
-                "rad/s by 2*pi, or use substructure.units.rpm_to_hz"
+                f"frequency: got a quantity in {q.units}; expected frequencies (Hz, or rad/s and rpm, "
+                "which are divided by 2*pi and by 60)"
             )
-        return Frequency.from_hz(np.atleast_1d(frequency.m_as("Hz")))
+        return Frequency.from_hz(np.atleast_1d(np.asarray(cycles_per_second(q, "frequency"), dtype=float)))
     if isinstance(frequency, str):
         raise InvalidValueError(
             f"frequency: got {frequency!r}; expected a Frequency (e.g. Frequency.from_range('20 Hz', "

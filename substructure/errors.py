@@ -18,6 +18,7 @@ __all__ = [
     "UnknownPointError",
     "AssemblyError",
     "FileFormatError",
+    "OutputExistsError",
     "SubstructureWarning",
     "NonPassiveJointWarning",
     "NonReciprocalWarning",
@@ -57,6 +58,10 @@ class AssemblyError(SubstructureError, ValueError):
 
 class FileFormatError(SubstructureError, ValueError):
     """A file (TOML, CSV, UFF) cannot be read or does not follow its format."""
+
+
+class OutputExistsError(SubstructureError, FileExistsError):
+    """A file to be written exists and replacing it was not asked for (``overwrite``)."""
 
 
 class SubstructureWarning(UserWarning):

@@ -20,12 +20,20 @@ import attrs
 import numpy as np
 
 from .errors import FrequencyAxisMismatchError, InvalidValueError, NonReciprocalWarning, UnknownPointError
-from .units import to_si
+from .units import frequency_hz
 
-__all__ = ["Frequency", "FRF", "QUANTITIES"]
+__all__ = ["Frequency", "FRF", "QUANTITIES", "MAX_GRID_LINES"]
 
 QUANTITIES = ("receptance", "mobility", "accelerance")
 """The quantities an FRF may hold: displacement, velocity or acceleration per load."""
+
+MAX_GRID_LINES = 1_000_000
+"""The most lines :meth:`Frequency.from_range` builds (a grid, with FRFs on it, is held in memory).
+
+A million lines are 5 mHz steps over 5 kHz, beyond any tap test; the
+receptance of the built-in assembly on them takes about 0.7 GB.  A larger request is refused before memory is allocated,
+naming the number of lines it would have.
+"""
 
 # Relative tolerance (of the largest frequency) with which band limits and
 # interpolation ranges are compared, so that a grid built as start + step*k
@@ -34,10 +42,13 @@ _GRID_RTOL = 1e-12
 
 
 def _hz(value: Any, field: str) -> float:
-    """A frequency in Hz from a plain number (taken as Hz), a quantity or a string."""
+    """A frequency in Hz from a plain number (taken as Hz), a quantity or a string.
+
+    Angular units are converted explicitly (:func:`substructure.units.frequency_hz`).
+    """
     if isinstance(value, numbers.Real) and not isinstance(value, bool):
         return float(value)
-    return to_si(value, field, "Hz")
+    return frequency_hz(value, field)
 
 
 def _readonly(array: np.ndarray) -> np.ndarray:
@@ -100,17 +111,26 @@ class Frequency:
         ----------
         start, stop, step : pint.Quantity or str
             Frequencies with their unit, e.g. ``"20 Hz"``, ``"5 kHz"``.  Bare
-            numbers are rejected.  ``stop`` counts as on the grid when it is
-            within 1e-9 steps of a grid point.
+            numbers are rejected.  Angular units are converted explicitly:
+            ``"628.3 rad/s"`` is 100 Hz, ``"6000 rpm"`` is 100 Hz
+            (:func:`substructure.units.frequency_hz`).  ``stop`` counts as on
+            the grid when it is within 1e-9 steps of a grid point.
+
+        Returns
+        -------
+        Frequency
+            At least two lines and at most :data:`MAX_GRID_LINES`.
 
         Raises
         ------
         UnitError
             For a bare number or a value that is not a frequency.
         InvalidValueError
-            For ``start < 0``, ``step <= 0`` or ``stop < start``.
+            For ``start < 0``, ``step <= 0``, ``stop < start``, a grid of one
+            line (a range needs ``stop >= start + step``) or more lines than
+            :data:`MAX_GRID_LINES`.
         """
-        f0, f1, df = to_si(start, "start", "Hz"), to_si(stop, "stop", "Hz"), to_si(step, "step", "Hz")
+        f0, f1, df = frequency_hz(start, "start"), frequency_hz(stop, "stop"), frequency_hz(step, "step")
         if f0 < 0:
             raise InvalidValueError(f"start: got {start!r}; expected a frequency >= 0 Hz")
         if df <= 0:
@@ -118,8 +138,18 @@ class Frequency:
         if f1 < f0:
             raise InvalidValueError(f"stop: got {stop!r} below start {start!r}; expected stop >= start")
         count = (f1 - f0) / df
+        if count + 1 > MAX_GRID_LINES:
+            raise InvalidValueError(
+                f"step: {start!r} to {stop!r} in steps of {step!r} makes {count + 1:.3g} lines; the limit is "
+                f"{MAX_GRID_LINES:.0e} lines (substructure.frf.MAX_GRID_LINES): choose a larger step"
+            )
         nearest = round(count)
         k = nearest if abs(count - nearest) <= 1e-9 * max(1.0, nearest) else int(np.floor(count))
+        if k < 1:
+            raise InvalidValueError(
+                f"stop: {start!r} to {stop!r} in steps of {step!r} is a single line; a grid needs at "
+                "least two (stop >= start + step)"
+            )
         return cls(f0 + df * np.arange(k + 1))
 
     @classmethod

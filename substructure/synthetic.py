@@ -5,7 +5,7 @@ FRFs a tap test would give on an assembly (with the sensors that were on and
 the components that were off), adds multiplicative complex noise of a given
 level with a fixed seed, and returns a
 :class:`~substructure.measurements.MeasurementSet`; :func:`write_measurement_set`
-saves it as CSV files plus the measurement TOML of formats.md.
+saves it as CSV files plus the measurement TOML of docs/file-formats.md.
 """
 
 from __future__ import annotations
@@ -74,11 +74,31 @@ def _file_name(m: Measurement, i: int) -> str:
 
 def write_measurement_set(measurements: MeasurementSet | Sequence[Measurement], directory, name: str | None = None,
                           file_name: str = "measurements.toml", overwrite: bool = False) -> Path:
-    """Write measurements as CSV files and a measurement TOML (formats.md) into ``directory``.
+    """Write measurements as CSV files and a measurement TOML (docs/file-formats.md) into ``directory``.
 
-    Returns the path of the TOML file.  Existing files are not overwritten
-    unless ``overwrite`` is true.
+    Parameters
+    ----------
+    measurements : MeasurementSet or sequence of Measurement
+        The measurements (receptances on one grid).
+    directory : str or path-like
+        Where the files go; created if missing.
+    name : str, optional
+        The set's name in the file (default: the set's own, else "measurements").
+    file_name : str, default "measurements.toml"
+        The measurement file's name.
+    overwrite : bool, default False
+        Replace existing files; without it any existing file is an error
+        before anything is written.
+
+    Returns
+    -------
+    pathlib.Path
+        The path of the TOML file.  Every file is written through a
+        temporary file and an atomic rename (:func:`substructure.io.write_text`).
     """
+    from .io import write_text
+    from .io.frf_files import write_csv
+
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     items = list(measurements)
@@ -87,10 +107,12 @@ def write_measurement_set(measurements: MeasurementSet | Sequence[Measurement], 
     if not overwrite:
         existing = [str(p) for p in [toml_path, *files] if p.exists()]
         if existing:
-            raise FileExistsError(f"{existing[0]} exists; pass overwrite=True to replace it")
+            from .errors import OutputExistsError
+
+            raise OutputExistsError(f"{existing[0]} exists; pass overwrite=True to replace it")
     tables = []
     for m, path in zip(items, files):
-        m.frf.to_csv(path)
+        write_csv(m.frf, path, overwrite=overwrite)
         table = {"response": m.response, "excitation": m.excitation, "file": os.path.basename(path)}
         if m.sensors:
             table["sensors"] = list(m.sensors)
@@ -98,5 +120,5 @@ def write_measurement_set(measurements: MeasurementSet | Sequence[Measurement], 
             table["removed"] = list(m.removed)
         tables.append(table)
     title = name or getattr(measurements, "name", None) or "measurements"
-    toml_path.write_text(tomli_w.dumps({"name": title, "frf": tables}))
+    write_text(toml_path, tomli_w.dumps({"name": title, "frf": tables}), overwrite=overwrite)
     return toml_path

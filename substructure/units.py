@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import re
 from typing import Any
 
 import numpy as np
@@ -34,6 +35,7 @@ __all__ = [
     "format_quantity",
     "rpm_to_hz",
     "hz_to_rpm",
+    "frequency_hz",
 ]
 
 ureg = pint.UnitRegistry()
@@ -55,6 +57,9 @@ _DIMENSION_NAMES = {
     "[length] ** 2 * [mass] / [time]": "a damping in N*m*s/rad (e.g. '1 N*m*s/rad')",
     "1 / [time]": "a frequency (e.g. '20 Hz')",
 }
+
+
+_NUMBER = re.compile(r"^\s*[-+]?(\d|\.\d|inf|nan)", re.IGNORECASE)
 
 
 def _describe(dimension: str) -> str:
@@ -87,6 +92,10 @@ def quantity(value: Any, field: str, dimension: str) -> pint.Quantity:
             f"{field}: got the bare number {value!r}; expected {expected}, with its unit"
         )
     if isinstance(value, str):
+        if not _NUMBER.match(value):  # pint reads "mm" as 1 mm and "a" as 1 year
+            raise UnitError(
+                f"{field}: cannot read {value!r} as a quantity: it does not start with a number; expected {expected}"
+            )
         try:
             q = ureg.Quantity(value)
         except Exception as exc:  # pint raises several types for bad strings
@@ -177,3 +186,61 @@ def rpm_to_hz(speed_rpm: float | np.ndarray) -> float | np.ndarray:
 def hz_to_rpm(frequency_hz: float | np.ndarray) -> float | np.ndarray:
     """Revolutions per second (Hz) to revolutions per minute: multiply by 60."""
     return np.asarray(frequency_hz, dtype=float) * 60.0
+
+
+def frequency_hz(value: Any, field: str) -> float:
+    """A frequency in Hz (cycles per second) from a quantity or a string with its unit.
+
+    The unit says what is counted.  ``Hz``, ``kHz`` and ``1/s`` count cycles
+    and are taken as they are.  Angular units count an angle per time and
+    are converted by the angle of one cycle, explicitly: ``rad/s`` is divided
+    by ``2*pi``, ``deg/s`` by 360, ``rpm`` (revolutions per minute) by 60.
+    (pint alone would take ``628.3 rad/s`` as 628.3 Hz and ``6000 rpm`` as
+    628.3 Hz, both wrong by ``2*pi``.)
+
+    Parameters
+    ----------
+    value : pint.Quantity or str
+        E.g. ``"20 Hz"``, ``"5 kHz"``, ``"628.3 rad/s"``, ``"6000 rpm"``.
+    field : str
+        Name of the value in error messages.
+
+    Returns
+    -------
+    float
+        The frequency in Hz.
+
+    Raises
+    ------
+    UnitError
+        For a bare number, a value that is not a frequency, or an angle to a
+        power other than one (e.g. ``rad^2/s``).
+    """
+    return float(cycles_per_second(quantity(value, field, "1 / [time]"), field))
+
+
+def cycles_per_second(q: pint.Quantity, field: str) -> Any:
+    """The magnitude in Hz of a frequency quantity (scalar or array), angular units divided by 2*pi.
+
+    The rule of :func:`frequency_hz` for a quantity already checked to be
+    ``1 / [time]``.
+
+    Parameters
+    ----------
+    q : pint.Quantity
+        Of this registry, dimension ``1 / [time]``.
+    field : str
+        Name of the value in error messages.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Frequencies in Hz.
+    """
+    root = q.to_root_units()
+    angle = dict(root._units).get("radian", 0)
+    if angle == 0:
+        return root.magnitude
+    if angle == 1:
+        return root.magnitude / (2.0 * math.pi)
+    raise UnitError(f"{field}: got {q!r}, an angle to the power {angle} per time; expected a frequency")

@@ -1,4 +1,4 @@
-"""Tests of substructure.cli: the `substructure` command (formats.md)."""
+"""Tests of substructure.cli: the `substructure` command (docs/file-formats.md)."""
 
 from __future__ import annotations
 

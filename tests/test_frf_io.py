@@ -7,7 +7,7 @@ import os
 import numpy as np
 import pyuff
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from substructure.errors import FileFormatError, InvalidValueError
@@ -58,6 +58,7 @@ finite = st.floats(allow_nan=False, allow_infinity=False, width=64)
 )
 def test_csv_round_trip_of_arbitrary_floats(tmp_path_factory, values, hz):
     n = min(len(values), len(hz))
+    assume(any(r or i for r, i in values[:n]))  # all zero: a dead channel, refused (test_dead_channel_...)
     frequency = Frequency.from_hz(np.sort(hz[:n]))
     frf = FRF.single(frequency, [complex(r, i) for r, i in values[:n]])
     path = tmp_path_factory.mktemp("csv") / "frf.csv"
@@ -229,7 +230,10 @@ def test_read_uff_of_another_program(tmp_path):
     assert frf.quantity == "mobility"
     np.testing.assert_array_equal(frf.frequency.hz, x)
     assert_close_parts(frf.data[:, 1, 0], 2 * data)
-    assert read_uff(path, record=0, quantity="receptance").quantity == "receptance"
+    assert read_uff(path, record=0, quantity="mobility").quantity == "mobility"
+    # a quantity that contradicts the record's data type (11, velocity) is refused, not taken
+    with pytest.raises(FileFormatError, match="quantity given is receptance, but its data type says mobility"):
+        read_uff(path, record=0, quantity="receptance")
 
 
 def test_read_uff_refuses_records_on_different_grids(tmp_path):
@@ -239,7 +243,8 @@ def test_read_uff_refuses_records_on_different_grids(tmp_path):
     write_uff(one, path)
     pyuff.UFF(str(path)).write_sets(
         pyuff.prepare_58(func_type=4, id1="response=b:y", id2="excitation=a:y", rsp_node=2, rsp_dir=2,
-                         ref_node=1, ref_dir=2, abscissa_spacing=1, orddenom_spec_data_type=13, data=two.data[:, 0, 0],
+                         ref_node=1, ref_dir=2, abscissa_spacing=1, ordinate_spec_data_type=8,
+                         orddenom_spec_data_type=13, data=two.data[:, 0, 0],
                          x=np.array(two.frequency.hz)),
         mode="add",
     )
@@ -254,7 +259,7 @@ def test_read_uff_errors_name_the_file(tmp_path):
         read_uff(missing)
     empty = tmp_path / "empty.uff"
     empty.write_text("")
-    with pytest.raises(FileFormatError, match="empty.uff: no type-58 record"):
+    with pytest.raises(FileFormatError, match="empty.uff: the file is empty; no type-58 record"):
         read_uff(empty)
     incomplete = tmp_path / "incomplete.uff"
     write_uff(random_frf(2, 2, seed=3), incomplete)

@@ -59,7 +59,7 @@ file = "holder_tip__holder_tip.csv"
 """
 
 
-def test_example_of_formats_md(tmp_path, model):
+def test_example_of_the_file_formats_page(tmp_path, model):
     write(model, "tool.tip", "tool.tip", tmp_path / "tool_tip__tool_tip.csv")
     write(model, "tool.tip-5 mm", "tool.tip-5 mm", tmp_path / "holder_tip__holder_tip.csv")
     (tmp_path / "set.toml").write_text(EXAMPLE)

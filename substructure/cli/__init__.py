@@ -7,11 +7,15 @@ the library only when their command runs, so that a one-shot command loads what
 it needs and nothing more.  The options and JSON outputs are documented in
 docs/cli.md and docs/file-formats.md.
 
-Every subcommand prints a human summary, or with ``--json`` exactly one JSON
-object (SI units, Hz) and nothing else on standard output.  A user's mistake
-prints ``substructure: error: ...`` on standard error and returns 1 (2 for
-misuse of the options), never a traceback; warnings print once each as
-``substructure: warning: ...`` on standard error.
+Every subcommand prints a human summary, or with ``--json`` exactly one strict
+JSON object (SI units, Hz; no NaN or Infinity) and nothing else on standard
+output.  A user's mistake prints ``substructure: error: ...`` on standard error
+and returns 1 (2 for misuse of the options), never a traceback; an unexpected
+exception (a bug) prints one ``substructure: error: internal error: ...`` line
+with a request to report it and returns 70 (``SUBSTRUCTURE_DEBUG=1`` shows the
+traceback instead); warnings print once each as ``substructure: warning: ...``
+on standard error.  No command writes over an existing file without
+``--overwrite``, nor over one of its inputs.
 """
 
 from __future__ import annotations
@@ -22,7 +26,7 @@ import sys
 import warnings
 
 from ..errors import SubstructureError
-from ._common import PROG, Parser, UsageError, one_line
+from ._common import EXIT_ERROR, EXIT_INTERNAL, EXIT_INTERRUPTED, EXIT_USAGE, PROG, Parser, UsageError, one_line
 
 __all__ = ["main", "DEMO_STEPS", "DemoState", "COMMANDS"]
 
@@ -71,13 +75,27 @@ def _load_plugins() -> None:
             warnings.warn(f"plugin {ep.name!r} ({ep.value}) failed to load: {exc}", stacklevel=2)
 
 
+def _internal(exc: BaseException) -> str:
+    return (f"internal error: {type(exc).__name__}: {one_line(str(exc)) or 'no message'}; this is a bug in "
+            f"{PROG}: please report it with the command line and the input files "
+            "(SUBSTRUCTURE_DEBUG=1 shows the traceback)")
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line; returns the exit status (0 ok, 1 error, 2 usage).
+    """Run the command line; returns the exit status.
 
     Parameters
     ----------
     argv : list of str, optional
         The arguments without the program name (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        0 success, 1 an error in the input (a file, a value), 2 misuse of
+        the command line, 70 an internal error (a bug: one line asking to
+        report it, never a traceback unless ``SUBSTRUCTURE_DEBUG=1``), 130
+        interrupted.
     """
     reported: set[str] = set()
 
@@ -98,18 +116,27 @@ def main(argv: list[str] | None = None) -> int:
             return args.run(args)
         except UsageError as exc:
             print(f"{PROG}: error: {one_line(str(exc))}", file=sys.stderr)
-            return 2
+            return EXIT_USAGE
         except BrokenPipeError:  # e.g. piped into `head`: stop quietly
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-            return 1
+            return EXIT_ERROR
         except (SubstructureError, OSError) as exc:
             print(f"{PROG}: error: {_error(exc)}", file=sys.stderr)
-            return 1
+            return EXIT_ERROR
+        except MemoryError:
+            print(f"{PROG}: error: out of memory; the problem is too large for this computer (fewer frequency "
+                  "lines, speeds or variants)", file=sys.stderr)
+            return EXIT_ERROR
         except SystemExit as exc:  # --help and --version print and exit
             return exc.code if isinstance(exc.code, int) else 0
         except KeyboardInterrupt:
             print(f"{PROG}: interrupted", file=sys.stderr)
-            return 130
+            return EXIT_INTERRUPTED
+        except Exception as exc:  # a bug: one line, never a traceback, unless asked for
+            if os.environ.get("SUBSTRUCTURE_DEBUG"):
+                raise
+            print(f"{PROG}: error: {_internal(exc)}", file=sys.stderr)
+            return EXIT_INTERNAL
 
 
 if __name__ == "__main__":

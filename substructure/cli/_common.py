@@ -1,11 +1,14 @@
-"""What the subcommands share: the parser that raises, option types, figures and output files."""
+"""What the subcommands share: the parser that raises, option types, strict JSON, figures and output files."""
 
 from __future__ import annotations
 
 import argparse
+import json
+import math
 import os
+import re
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Iterable
 
 import attrs
 import numpy as np
@@ -13,9 +16,27 @@ import numpy as np
 from ..errors import SubstructureError
 from ..frf import FRF, Frequency
 from ..points import parse_point
-from ..units import Q_
 
 PROG = "substructure"
+
+EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 0, 1, 2, 70, 130
+"""Exit statuses: success, an error in the input, misuse of the command line, an internal error (a bug,
+``EX_SOFTWARE`` of sysexits.h), interrupted."""
+
+IMAGE_SUFFIXES = (".png", ".pdf", ".svg", ".svgz", ".eps", ".ps", ".jpg", ".jpeg", ".tif", ".tiff", ".webp")
+"""Image files ``--plot`` writes (formats matplotlib saves without extra software)."""
+
+
+MAX_REPEATS = 10_000
+"""The most bootstrap refits (``identify --bootstrap``) or samples (``predict --samples``) a command runs."""
+
+
+def count_arg(option: str, value: int, minimum: int = 0) -> int:
+    """A count of repetitions, ``minimum`` to :data:`MAX_REPEATS`, checked before any work."""
+    if not minimum <= value <= MAX_REPEATS:
+        raise UsageError(f"argument {option}: got {value}; expected {minimum} to {MAX_REPEATS} "
+                         "(each one is a full computation)")
+    return value
 
 
 class UsageError(Exception):
@@ -23,14 +44,63 @@ class UsageError(Exception):
 
 
 class Parser(argparse.ArgumentParser):
-    """An argument parser that raises instead of printing usage and exiting."""
+    """An argument parser that raises instead of printing usage and exiting.
+
+    An argument that starts with a minus and a digit (``--band -5:10``,
+    ``--grid "-20 Hz:..."``) is a value, not an option, so that its own
+    check can say what is wrong with it (no option of the command starts
+    with a digit).
+    """
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-\.?\d")
 
     def error(self, message: str):
         raise UsageError(message)
 
 
 def one_line(text: str) -> str:
+    """The text on one line, runs of white space made one space."""
     return " ".join(str(text).split())
+
+
+def strict(value: Any) -> Any:
+    """``value`` made of JSON types only: NaN and infinities become ``null``, numpy values plain ones."""
+    if isinstance(value, dict):
+        return {str(k): strict(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [strict(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return [strict(v) for v in value.tolist()]
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        value = float(value)
+        return value if math.isfinite(value) else None
+    if isinstance(value, complex):
+        raise TypeError(f"JSON output: a complex number {value!r}; give real and imaginary parts")
+    if value is None or isinstance(value, str):
+        return value
+    if isinstance(value, os.PathLike):
+        return os.fspath(value)
+    raise TypeError(f"JSON output: a {type(value).__name__} is not a JSON value")
+
+
+def json_text(value: Any) -> str:
+    """Strict JSON of ``value`` (:func:`strict`): never ``NaN`` or ``Infinity``, which JSON does not have."""
+    return json.dumps(strict(value), allow_nan=False)
+
+
+def print_json(value: Any) -> int:
+    """Print the one JSON object of ``--json`` (strict, :func:`json_text`) and return exit status 0."""
+    print(json_text(value))
+    return EXIT_OK
+
+
+_LEADING_NUMBER = re.compile(r"^\s*[-+]?(\d|\.\d)")
 
 
 def range_arg(text: str, unit: str, build: Callable, example: str):
@@ -39,9 +109,13 @@ def range_arg(text: str, unit: str, build: Callable, example: str):
     if len(parts) != 3:
         raise argparse.ArgumentTypeError(f"got {text!r}; expected START:STOP:STEP, e.g. {example}")
     values: list[Any] = []
-    for part in parts:
+    for name, part in zip(("START", "STOP", "STEP"), parts):
+        if not _LEADING_NUMBER.match(part):
+            raise argparse.ArgumentTypeError(
+                f"got {text!r}; {name} {part.strip()!r} is not a number; expected START:STOP:STEP, e.g. {example}"
+            )
         try:
-            values.append(Q_(float(part), unit))
+            values.append(f"{float(part)!r} {unit}")  # a plain number: in the option's unit
         except ValueError:
             values.append(part.strip())
     try:
@@ -73,12 +147,16 @@ def grid_text(frequency: Frequency) -> str:
     return f"{frequency.start:g} Hz to {frequency.stop:g} Hz, {frequency.n} lines"
 
 
-def save_figure(fig, path) -> None:
-    """Save a figure to an image file and close it (Agg: files only, no display needed)."""
+def save_figure(fig, path, overwrite: bool = True) -> None:
+    """Save a figure to an image file (atomically, :func:`substructure.io.replacing`) and close it."""
     import matplotlib.pyplot as plt
 
+    from ..io import replacing
+
     try:
-        fig.savefig(path, dpi=120)
+        suffix = Path(path).suffix.lower().lstrip(".") or "png"
+        with replacing(path, overwrite) as temporary:
+            fig.savefig(temporary, dpi=120, format=suffix)
     finally:
         plt.close(fig)
 
@@ -90,41 +168,138 @@ def figures() -> None:
     matplotlib.use("Agg")
 
 
-def save_plot(frf: FRF, path: str | os.PathLike, title: str) -> None:
+def save_plot(frf: FRF, path: str | os.PathLike, title: str, overwrite: bool = True) -> None:
+    """Plot an FRF (magnitude and phase) with a title to an image file."""
     figures()
     fig = frf.plot()
     fig.suptitle(title)
-    save_figure(fig, path)
+    save_figure(fig, path, overwrite)
 
 
-def write_frf(frf: FRF, path: str) -> None:
+def write_frf(frf: FRF, path: str, overwrite: bool = True) -> None:
+    """Write an FRF to a CSV or UFF file, chosen by the suffix (atomically)."""
+    from ..io.frf_files import write_csv, write_uff
+
     suffix = Path(path).suffix.lower()
     if suffix == ".csv":
-        frf.to_csv(path)
+        write_csv(frf, path, overwrite)
     elif suffix in (".uff", ".unv"):
-        frf.to_uff(path)
+        write_uff(frf, path, overwrite)
     else:  # checked before computing; kept for callers of this helper
         raise UsageError(f"argument --out: {path!r}: expected a .csv or .uff file")
 
 
-# -- frf ------------------------------------------------------------------------------
+def check_plot(path: str | None, option: str = "--plot") -> None:
+    """Refuse, before any work, a figure file whose suffix is not an image format matplotlib writes."""
+    if path is None:
+        return
+    suffix = Path(path).suffix.lower()
+    if suffix not in IMAGE_SUFFIXES:
+        got = f"the suffix {suffix!r}" if suffix else "no suffix"
+        raise UsageError(f"argument {option}: {path!r} has {got}; expected an image file: "
+                         + ", ".join(IMAGE_SUFFIXES))
+
+
+def _resolved(path) -> Path:
+    return Path(os.path.abspath(os.path.expanduser(os.fspath(path)))).resolve()
+
+
+def check_outputs(outputs: Iterable[tuple[str, Any]], inputs: Iterable[Any], overwrite: bool) -> None:
+    """Check, before any work, the files a command will write.
+
+    Parameters
+    ----------
+    outputs : iterable of (str, path)
+        The option that names each file (``"--out"``) and its path; ``None``
+        paths are skipped.
+    inputs : iterable of path
+        Every file the command reads (``None`` skipped).
+    overwrite : bool
+        Whether ``--overwrite`` was given.
+
+    Raises
+    ------
+    UsageError
+        When an output is one of the inputs (compared as resolved paths:
+        links and ``..`` do not hide it; even with ``--overwrite``), or two
+        outputs are the same file.
+    FileExistsError
+        When an output exists and ``overwrite`` is false.
+    substructure.errors.FileFormatError
+        When an output is a directory or its directory does not exist.
+    """
+    from ..io import check_writable
+
+    read = {}
+    for path in inputs:
+        if path is not None:
+            read[_resolved(path)] = os.fspath(path)
+    seen: dict[Path, str] = {}
+    for option, path in outputs:
+        if path is None:
+            continue
+        where = _resolved(path)
+        if where in read:
+            raise UsageError(f"argument {option}: {os.fspath(path)} is the input {read[where]}; an output is "
+                             "never written onto an input, choose another file")
+        if where in seen:
+            raise UsageError(f"argument {option}: {os.fspath(path)} is also the file of {seen[where]}")
+        seen[where] = option
+        check_writable(path, overwrite, option)
+
 
 
 def band_arg(text: str):
-    if text == "auto":
+    """``auto`` or ``LO:HI``: plain numbers in Hz, or frequencies with units (rad/s, rpm converted)."""
+    from ..units import frequency_hz
+
+    if text.strip() == "auto":
         return "auto"
     parts = text.split(":")
-    try:
-        lo, hi = (float(p) for p in parts)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"got {text!r}; expected auto or LO:HI in Hz, e.g. 1200:1700") from None
+    if len(parts) != 2 or not all(_LEADING_NUMBER.match(p) for p in parts):
+        raise argparse.ArgumentTypeError(f"got {text!r}; expected auto or LO:HI in Hz, e.g. 1200:1700")
+    values = []
+    for part in parts:
+        try:
+            values.append(float(part))
+        except ValueError:
+            try:
+                values.append(frequency_hz(part.strip(), "band"))
+            except SubstructureError as exc:
+                raise argparse.ArgumentTypeError(f"got {text!r}: {one_line(str(exc))}") from None
+    lo, hi = values
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        raise argparse.ArgumentTypeError(f"got {text!r}; expected finite frequencies")
+    if lo < 0:
+        raise argparse.ArgumentTypeError(f"got {text!r}; LO is {lo:g} Hz, expected frequencies >= 0 Hz")
     if not lo < hi:
         raise argparse.ArgumentTypeError(f"got {text!r}; expected LO < HI")
     return (lo, hi)
 
 
 def band_range_arg(text: str):
+    """``LO:HI`` as :func:`band_arg`, without ``auto``."""
     band = band_arg(text)
     if band == "auto":
         raise argparse.ArgumentTypeError("expected LO:HI in Hz, e.g. 200:3000")
     return band
+
+
+def measurement_inputs(path) -> list:
+    """A measurement file and the data files it names (for :func:`check_outputs`), as far as they can be read.
+
+    A file that cannot be read yields itself only: loading it reports the
+    problem properly.
+    """
+    import tomllib
+
+    files: list = [path]
+    try:
+        with open(path, "rb") as fh:
+            data = tomllib.loads(fh.read().decode("utf-8-sig"))
+        for table in data.get("frf", []):
+            if isinstance(table, dict) and isinstance(table.get("file"), str):
+                files.append(Path(path).parent / table["file"])
+    except (OSError, ValueError, AttributeError):
+        pass
+    return files

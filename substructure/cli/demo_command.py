@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 from typing import Any, Callable
 
@@ -11,17 +10,28 @@ import attrs
 
 from ..frf import FRF
 from ..io.assembly_toml import default_assembly
-from ._common import figures, grid_text, peak_table, save_figure, save_plot
+from ._common import figures, grid_text, peak_table, print_json, save_figure, save_plot
 
 TOOL_POINT = "tool.tip:y"
 """The tool point of the built-in assembly."""
 
 
+DEMO_FILES = ("tool_point_frf.csv", "tool_point_frf.png", "default_assembly.toml", "tap_test",
+              "where_it_fails.png", "error_fall.png", "improved_assembly.toml")
+"""What the built-in steps write into ``--out`` (checked before the first step)."""
+
+
 @attrs.define
 class DemoState:
-    """What the demo steps share: the output directory, results so far, files written."""
+    """What the demo steps share: the output directory, results so far, files written.
+
+    ``overwrite`` says whether a step may replace an existing file (the
+    command's ``--overwrite``); steps write every file through
+    :mod:`substructure.io`'s atomic writers with it.
+    """
 
     out: Path
+    overwrite: bool = False
     assembly: Any = None
     frf: FRF | None = None
     results: dict = attrs.field(factory=dict)
@@ -47,23 +57,27 @@ def _demo_frf(state: DemoState) -> None:
     state.lines.append("peaks: " + ", ".join(f"{f:g} Hz" for f, _ in peaks))
     if tool_mode is not None:
         state.lines.append(f"tool mode (highest peak): {tool_mode:g} Hz")
+    from ..io.frf_files import write_csv
+
     path = state.out / "tool_point_frf.csv"
-    state.frf.to_csv(path)
+    write_csv(state.frf, path, state.overwrite)
     state.files.append(str(path))
 
 
 def _demo_plot(state: DemoState) -> None:
     path = state.out / "tool_point_frf.png"
-    save_plot(state.frf, path, f"{state.assembly.name}: tool point FRF")
+    save_plot(state.frf, path, f"{state.assembly.name}: tool point FRF", state.overwrite)
     state.files.append(str(path))
 
 
 def _demo_assembly_file(state: DemoState) -> None:
     import importlib.resources
 
+    from ..io import write_text
+
     path = state.out / "default_assembly.toml"
     text = (importlib.resources.files("substructure") / "data" / "default_assembly.toml").read_text("utf-8")
-    path.write_text(text, encoding="utf-8")  # the packaged file, with its comments
+    write_text(path, text, state.overwrite)  # the packaged file, with its comments
     state.files.append(str(path))
 
 
@@ -78,7 +92,8 @@ def _demo_tap_test(state: DemoState) -> None:
                     sensors=["forgotten-accelerometer"], name="demo tap test (1.5 % noise)")
     # the measurement file does not mention the sensor: the test report forgot it
     taps = MeasurementSet(taps.name, tuple(attrs.evolve(m, sensors=()) for m in taps))
-    state.results["measurements"] = str(write_measurement_set(taps, state.out / "tap_test", overwrite=True))
+    state.results["measurements"] = str(write_measurement_set(taps, state.out / "tap_test",
+                                                              overwrite=state.overwrite))
     state.lines.append("a simulated tap test of the tool point, 1.5 % noise, with a 2 g accelerometer "
                        "that the test report forgot to mention")
     state.files.append(state.results["measurements"])
@@ -101,10 +116,10 @@ def _demo_diagnose(state: DemoState) -> None:
         state.lines.append(f"  step {step.step}: {what:45s} error {step.error:.4f}")
     for name, make in (("where_it_fails.png", result.plot_where), ("error_fall.png", result.plot_history)):
         fig = make()
-        save_figure(fig, state.out / name)
+        save_figure(fig, state.out / name, state.overwrite)
         state.files.append(str(state.out / name))
     path = state.out / "improved_assembly.toml"
-    save_assembly(result.refined_assembly, path, overwrite=True)
+    save_assembly(result.refined_assembly, path, overwrite=state.overwrite)
     state.files.append(str(path))
 
 
@@ -119,14 +134,31 @@ DEMO_STEPS: list[tuple[str, Callable[[DemoState], None]]] = [
 """The demo's steps, in order: ``(title, function(state))``; append to add steps."""
 
 
+def _check_out(out: Path, overwrite: bool) -> None:
+    """Refuse, before any work, an ``--out`` that is a file or holds what the demo would replace."""
+    from ..errors import FileFormatError, OutputExistsError
+
+    if out.exists() and not out.is_dir():
+        raise FileFormatError(f"--out {out}: is a file; expected a directory (created if missing)")
+    if overwrite:
+        return
+    there = [name for name in DEMO_FILES
+             if (out / name).exists() and not ((out / name).is_dir() and not any((out / name).iterdir()))]
+    if there:
+        raise OutputExistsError(
+            f"--out {out}: holds {', '.join(there)}, which the demo would replace; add --overwrite to replace "
+            "them, or choose another directory"
+        )
+
+
 def run(args: argparse.Namespace) -> int:
-    state = DemoState(out=Path(args.out))
+    state = DemoState(out=Path(args.out), overwrite=args.overwrite)
+    _check_out(state.out, args.overwrite)
     state.out.mkdir(parents=True, exist_ok=True)
     for _title, step in DEMO_STEPS:
         step(state)
     if args.json:
-        print(json.dumps({**state.results, "files": state.files}))
-        return 0
+        return print_json({**state.results, "files": state.files})
     print("\n".join(state.lines))
     for path in state.files:
         print(f"wrote {path}")
@@ -137,5 +169,7 @@ def add_parser(commands) -> None:
     """Add the ``demo`` subcommand to the subparsers ``commands``."""
     demo = commands.add_parser("demo", help="the workflow on the built-in assembly, with plots")
     demo.add_argument("--out", default="out/demo", metavar="DIR", help="output directory (default out/demo)")
+    demo.add_argument("--overwrite", action="store_true",
+                      help="replace the demo's files in --out (from an earlier run); other files are never touched")
     demo.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
     demo.set_defaults(run=run)

@@ -3,12 +3,23 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
 from ..io.assembly_toml import load_assembly
-from ._common import PROG, UsageError, band_range_arg, figures, save_figure
+from ._common import (
+    PROG,
+    UsageError,
+    band_range_arg,
+    check_outputs,
+    figures,
+    measurement_inputs,
+    print_json,
+    save_figure,
+)
+
+FIGURES = ("where_it_fails.png", "error_fall.png", "after_refinement.png")
+"""The figures ``--plot DIR`` writes."""
 
 
 def run(args: argparse.Namespace) -> int:
@@ -16,8 +27,13 @@ def run(args: argparse.Namespace) -> int:
     from ..io.assembly_toml import save_assembly
     from ..io.measurements import load_measurements
 
-    if args.save_model and Path(args.save_model).exists() and not args.overwrite:
-        raise UsageError(f"argument --save-model: {args.save_model} exists; add --overwrite to replace it")
+    if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
+        raise UsageError(f"argument --plot: {args.plot} is a file; expected a directory for the figures")
+    # figures go into DIR (created if missing): the ones there already are checked like any output
+    into_dir = args.plot is not None and Path(args.plot).is_dir()
+    figures_out = [("--plot", Path(args.plot) / name) for name in FIGURES] if into_dir else []
+    check_outputs([("--save-model", args.save_model), *figures_out],
+                  [args.assembly, *measurement_inputs(args.measurements)], args.overwrite)
     assembly = load_assembly(args.assembly)
     measurements = load_measurements(args.measurements)
     effects = "all" if args.effects == "all" else [e.strip() for e in args.effects.split(",") if e.strip()]
@@ -29,20 +45,19 @@ def run(args: argparse.Namespace) -> int:
         figures()
         out = Path(args.plot)
         out.mkdir(parents=True, exist_ok=True)
-        for name, make in (("where_it_fails.png", result.plot_where), ("error_fall.png", result.plot_history)):
+        for name, make in ((FIGURES[0], result.plot_where), (FIGURES[1], result.plot_history)):
             fig = make()
-            save_figure(fig, out / name)
+            save_figure(fig, out / name, args.overwrite)
             written.append(str(out / name))
         if len(result.refinement) > 1:
             fig = result.final[0].plot()
-            save_figure(fig, out / "after_refinement.png")
-            written.append(str(out / "after_refinement.png"))
+            save_figure(fig, out / FIGURES[2], args.overwrite)
+            written.append(str(out / FIGURES[2]))
     if args.save_model:
         save_assembly(result.refined_assembly, args.save_model, overwrite=args.overwrite)
         written.append(args.save_model)
     if args.json:
-        print(json.dumps(result.to_json()))
-        return 0
+        return print_json(result.to_json())
     floor = result.noise_floor
     print(f"model {assembly.name!r} against {len(measurements)} measured FRF(s), "
           f"{result.band[0]:.0f}-{result.band[1]:.0f} Hz")
@@ -80,9 +95,6 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-# -- lobes ----------------------------------------------------------------------------
-
-
 def add_parser(commands) -> None:
     """Add the ``diagnose`` subcommand to the subparsers ``commands``."""
     diag = commands.add_parser("diagnose", help="which physical effect the model misses against measurements")
@@ -93,7 +105,8 @@ def add_parser(commands) -> None:
     diag.add_argument("--band", type=band_range_arg, metavar="LO:HI", help="frequency band in Hz (default: all data)")
     diag.add_argument("--plot", metavar="DIR", help="write the figures (where it fails, error fall) to DIR")
     diag.add_argument("--save-model", metavar="FILE.toml", help="write the model with the effects found")
-    diag.add_argument("--overwrite", action="store_true", help="let --save-model replace an existing file")
+    diag.add_argument("--overwrite", action="store_true",
+                      help="let --save-model and --plot replace existing files (never an input)")
     diag.add_argument("--quiet", action="store_true", help="no progress on standard error")
     diag.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
     diag.set_defaults(run=run)

@@ -3,17 +3,19 @@
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
 from ..io.assembly_toml import load_assembly
 from ._common import (
     UsageError,
+    check_outputs,
+    check_plot,
     figures,
     grid_arg,
     grid_text,
     peak_table,
     point_arg,
+    print_json,
     save_figure,
     write_frf,
 )
@@ -22,6 +24,8 @@ from ._common import (
 def run(args: argparse.Namespace) -> int:
     if args.out and Path(args.out).suffix.lower() not in (".csv", ".uff", ".unv"):
         raise UsageError(f"argument --out: {args.out!r}: expected a .csv or .uff file")
+    check_plot(args.plot)
+    check_outputs([("--out", args.out), ("--plot", args.plot)], [args.assembly], args.overwrite)
     assembly = load_assembly(args.assembly)
     at = point_arg(args.at)
     to = point_arg(args.to) if args.to else at
@@ -34,22 +38,21 @@ def run(args: argparse.Namespace) -> int:
     peaks = peak_table(frf)
     written = []
     if args.out:
-        write_frf(frf, args.out)
+        write_frf(frf, args.out, args.overwrite)
         written.append(args.out)
     if args.plot:
         figures()
         fig = frf.plot(kind=args.kind, unit=args.unit, title=f"{assembly.name}: {at} / {to}")
-        save_figure(fig, args.plot)
+        save_figure(fig, args.plot, args.overwrite)
         written.append(args.plot)
     if args.json:
         values = frf.data[:, 0, 0]
-        print(json.dumps({
+        return print_json({
             "frequency_hz": frf.frequency.hz.tolist(),
             "real": values.real.tolist(),
             "imag": values.imag.tolist(),
             "peaks_hz": [f for f, _ in peaks],
-        }))
-        return 0
+        })
     unit = frf.unit(frf.outputs[0], frf.inputs[0])
     print(f"assembly: {assembly.name}")
     print(f"receptance: response {at}, excitation {to} [{unit}]")
@@ -62,9 +65,6 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-# -- demo -----------------------------------------------------------------------------
-
-
 def add_parser(commands) -> None:
     """Add the ``frf`` subcommand to the subparsers ``commands``."""
     frf = commands.add_parser("frf", help="receptance of an assembly file between two points")
@@ -73,12 +73,14 @@ def add_parser(commands) -> None:
                      help="response point, e.g. tool.tip (DOF y by default)")
     frf.add_argument("--to", metavar="POINT[:dof]", help="excitation point (default: --at)")
     frf.add_argument("--grid", type=grid_arg, metavar="START:STOP:STEP",
-                     help="frequency grid in Hz or with units (default: the file's [frequency])")
+                     help="frequency grid in Hz or with units; rad/s and rpm are converted (default: the "
+                          "file's [frequency])")
     frf.add_argument("--out", metavar="FILE.csv|FILE.uff", help="write the FRF to a CSV or UFF file")
-    frf.add_argument("--plot", metavar="FILE.png", help="plot the FRF to an image file")
+    frf.add_argument("--plot", metavar="FILE.png", help="plot the FRF to an image file (.png, .pdf, .svg, ...)")
     frf.add_argument("--unit", choices=("um/N", "m/N", "mm/N", "nm/N"), default="um/N",
                      help="unit of translational FRFs in the plot (default: um/N)")
     frf.add_argument("--kind", choices=("bode", "nyquist", "real-imag"), default="bode",
                      help="plot view: magnitude and phase (default), Nyquist plane, or real and imaginary parts")
+    frf.add_argument("--overwrite", action="store_true", help="let --out and --plot replace existing files")
     frf.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
     frf.set_defaults(run=run)

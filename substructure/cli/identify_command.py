@@ -3,16 +3,27 @@
 from __future__ import annotations
 
 import argparse
-import json
 
 from ..io.assembly_toml import load_assembly
-from ._common import band_arg, figures, save_figure
+from ._common import (
+    band_arg,
+    check_outputs,
+    check_plot,
+    count_arg,
+    figures,
+    measurement_inputs,
+    print_json,
+    save_figure,
+)
 
 
 def run(args: argparse.Namespace) -> int:
     from ..identify import identify_joint
     from ..io.measurements import load_measurements
 
+    check_plot(args.plot)
+    count_arg("--bootstrap", args.bootstrap)
+    check_outputs([("--plot", args.plot)], [args.assembly, *measurement_inputs(args.measurements)], args.overwrite)
     assembly = load_assembly(args.assembly)
     measurements = load_measurements(args.measurements)
     parameters = tuple(p.strip() for p in args.parameters.split(",") if p.strip())
@@ -21,10 +32,9 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         figures()
         fig = report.plot()
-        save_figure(fig, args.plot)
+        save_figure(fig, args.plot, args.overwrite)
     if args.json:
-        print(json.dumps(report.to_json()))
-        return 0
+        return print_json(report.to_json())
     lo, hi = report.band
     print(f"joint {report.joint!r} of {assembly.name}")
     print(f"band {lo:.0f}-{hi:.0f} Hz, {len(measurements)} measured FRFs, relative residual {report.residual_rms:.3f}")
@@ -41,9 +51,6 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-# -- diagnose -------------------------------------------------------------------------
-
-
 def add_parser(commands) -> None:
     """Add the ``identify`` subcommand to the subparsers ``commands``."""
     ident = commands.add_parser("identify", help="identify a joint's stiffness and damping from measurements")
@@ -57,5 +64,6 @@ def add_parser(commands) -> None:
     ident.add_argument("--bootstrap", type=int, default=0, metavar="N",
                        help="bootstrap refits for the standard deviations (default 0: from the Jacobian)")
     ident.add_argument("--plot", metavar="FILE.png", help="plot the closed form, the band, the fit and the FRFs")
+    ident.add_argument("--overwrite", action="store_true", help="let --plot replace an existing file")
     ident.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
     ident.set_defaults(run=run)

@@ -3,9 +3,7 @@
 from __future__ import annotations
 
 import argparse
-import json
 import warnings
-from pathlib import Path
 
 import numpy as np
 
@@ -15,10 +13,13 @@ from ..io.assembly_toml import load_assembly
 from ._common import (
     UsageError,
     band_range_arg,
+    check_outputs,
+    check_plot,
     figures,
     grid_text,
     one_line,
     point_arg,
+    print_json,
     range_arg,
     save_figure,
 )
@@ -101,8 +102,8 @@ def _lobes_structure(args: argparse.Namespace):
 def run(args: argparse.Namespace) -> int:
     from ..stability import ModalFitter, ModalFitWarning, ModalModel, sdm, zoa
 
-    if args.plot and Path(args.plot).suffix.lower() not in (".png", ".pdf", ".svg"):
-        raise UsageError(f"argument --plot: {args.plot!r}: expected a .png, .pdf or .svg file")
+    check_plot(args.plot)
+    check_outputs([("--plot", args.plot)], [args.assembly, args.frf, args.frf_y, args.modes], args.overwrite)
     if args.intervals is not None and args.method != "sdm":
         raise UsageError("--intervals sets the semi-discretization: use it with --method sdm")
     cut = _lobes_cut(args)
@@ -131,10 +132,9 @@ def run(args: argparse.Namespace) -> int:
         figures()
         fig = lobes.plot(lobes=args.method == "zoa")
         fig.axes[0].set_title(one_line(cut.describe()), fontsize="small")
-        save_figure(fig, args.plot)
+        save_figure(fig, args.plot, args.overwrite)
     if args.json:
-        print(json.dumps(lobes.to_json()))
-        return 0
+        return print_json(lobes.to_json())
     speeds = lobes.spindle_speed_rpm
     print(f"structure: {what}")
     print(f"cut: {cut.describe()}")
@@ -166,11 +166,6 @@ def run(args: argparse.Namespace) -> int:
         print(f"wrote {args.plot}")
     return 0
 
-
-# -- entry point ----------------------------------------------------------------------
-
-
-# -- predict --------------------------------------------------------------------------
 
 
 def add_parser(commands) -> None:
@@ -206,5 +201,6 @@ def add_parser(commands) -> None:
     lobes.add_argument("--intervals", type=int, metavar="M",
                        help="sdm: intervals in the cut per delay period (default: chosen per speed)")
     lobes.add_argument("--plot", metavar="FILE.png", help="plot the lobes to an image file")
+    lobes.add_argument("--overwrite", action="store_true", help="let --plot replace an existing file")
     lobes.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
     lobes.set_defaults(run=run)

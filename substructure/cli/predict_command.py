@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import json
+from pathlib import Path
 
 from ..io.assembly_toml import load_assembly
-from ._common import UsageError, figures, point_arg, save_figure
+from ._common import UsageError, check_outputs, check_plot, count_arg, figures, point_arg, print_json, save_figure
 
 
 def _features(text: str) -> dict[str, str]:
@@ -24,7 +24,11 @@ def _features(text: str) -> dict[str, str]:
 def run(args: argparse.Namespace) -> int:
     from ..surrogate import JointTable, cross_validate, make_surrogate
 
-    table = JointTable.from_csv(args.table)
+    check_plot(args.plot)
+    check_outputs([("--plot", args.plot)], [args.table, args.assembly], args.overwrite)
+    count_arg("--samples", args.samples, minimum=1)
+    read = JointTable.from_toml if Path(args.table).suffix.lower() == ".toml" else JointTable.from_csv
+    table = read(args.table)
     table.check_not_empty()
     surrogate = make_surrogate(args.model)
     if args.cross_validate:
@@ -33,10 +37,9 @@ def run(args: argparse.Namespace) -> int:
         if args.plot:
             figures()
             fig = cv.plot()
-            save_figure(fig, args.plot)
+            save_figure(fig, args.plot, args.overwrite)
         if args.json:
-            print(json.dumps(cv.to_json()))
-            return 0
+            return print_json(cv.to_json())
         print(f"{args.model}, {args.cross_validate} on {args.table}: {len(cv.folds)} folds, {target} [{cv.unit}]")
         print(f"  mean |error| {cv.mean_abs_percent_error:.1f} %, max {cv.max_abs_percent_error:.1f} %")
         print(f"  inside the 68 % interval {cv.coverage(0.68):.0%}, the 95 % interval {cv.coverage(0.95):.0%}")
@@ -58,13 +61,12 @@ def run(args: argparse.Namespace) -> int:
         if args.plot:
             figures()
             fig = band.plot(label=f"{args.model} prediction")
-            save_figure(fig, args.plot)
+            save_figure(fig, args.plot, args.overwrite)
     if args.json:
         out = {"model": args.model, "features": _features(args.features), "parameters": result}
         if band is not None:
             out["frf"] = {"at": point_arg(args.at), "joint": args.joint, **band.to_json()}
-        print(json.dumps(out))
-        return 0
+        return print_json(out)
     print(f"{args.model} surrogate on {table.describe()}")
     for name, p in result.items():
         lo, hi = p["interval_95"]
@@ -83,7 +85,8 @@ def run(args: argparse.Namespace) -> int:
 def add_parser(commands) -> None:
     """Add the ``predict`` subcommand to the subparsers ``commands``."""
     pred = commands.add_parser("predict", help="joint parameters for an untested tool from a joint table")
-    pred.add_argument("table", metavar="TABLE", help="joint-parameter table (CSV, units in the header)")
+    pred.add_argument("table", metavar="TABLE",
+                      help="joint-parameter table: CSV (units in the header) or TOML (.toml, [[joints]] rows)")
     pred.add_argument("--features", metavar="NAME=VALUE,...", help="features of the tool, e.g. 'tool_diameter=14 mm'")
     pred.add_argument("--model", choices=("mlp", "gp"), default="gp", help="surrogate (default gp)")
     pred.add_argument("--target", metavar="PARAMETER", help="parameter to predict (default: all of the table)")
@@ -94,5 +97,6 @@ def add_parser(commands) -> None:
     pred.add_argument("--samples", type=int, default=64, metavar="N",
                       help="samples of the predictive distribution for the FRF band (default 64)")
     pred.add_argument("--plot", metavar="FILE.png", help="parity plot of the cross-validation, or the FRF band")
+    pred.add_argument("--overwrite", action="store_true", help="let --plot replace an existing file")
     pred.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
     pred.set_defaults(run=run)

@@ -1,4 +1,4 @@
-"""Assembly files (TOML): read and write assemblies in the format of formats.md.
+"""Assembly files (TOML): read and write assemblies in the format of docs/file-formats.md.
 
 :func:`load_assembly` and :func:`loads_assembly` read a file or a string into
 an :class:`~substructure.assembly.Assembly`; :func:`save_assembly` and
@@ -13,7 +13,11 @@ Component types are looked up in :data:`substructure.components.COMPONENT_TYPES`
 so registered user types work: a class with a classmethod
 ``from_toml(table, materials, key)`` and a method ``to_toml()`` reads and
 writes its own table; any other :class:`~substructure.components.Beam`
-subclass uses the generic ``name``/``type``/``material``/``segments`` table.
+subclass uses the generic ``name``/``type``/``material``/``segments`` table,
+plus one key per further field of its class (quantities written with their
+unit).  Writing checks that the text reads back to an equal assembly and
+refuses, naming the component and the fields, what would not: a file never
+silently loses a value.
 """
 
 from __future__ import annotations
@@ -22,11 +26,14 @@ import importlib.resources
 import os
 import re
 import tomllib
+import warnings
 from typing import Any
 
+import attrs
+import pint
 import tomli_w
 
-from . import read_text
+from . import read_text, write_text
 from ..assembly import Assembly
 from ..beams import Flutes, Insert, Segment
 from ..components import COMPONENT_TYPES, Beam
@@ -54,7 +61,11 @@ _MATRIX_KEYS = ("yf", "ym", "tf", "tm")
 _MISSING = object()
 _FIELD = re.compile(r"^([A-Za-z_][A-Za-z0-9_.\[\]]*): (.*)$", re.DOTALL)
 _HEADER = re.compile(r"^\s*(\[\[?)\s*([^\[\]#]+?)\s*\]\]?\s*(?:#.*)?$")
-_HEADER_COMMENT = "# substructure assembly file (formats.md): units on every dimensional value\n"
+_HEADER_COMMENT = (
+    "# substructure assembly file (format: docs/file-formats.md of substructure): "
+    "units on every dimensional value\n"
+)
+_STANDARD_FIELDS = ("name", "segments", "description")
 
 
 def _path(parts) -> str:
@@ -246,12 +257,22 @@ class _Reader:
             return self.call(parts, cls.from_toml, table, dict(self.materials), _path(parts))
         if not (isinstance(cls, type) and issubclass(cls, Beam)):
             raise self.error(parts + ["type"], f"components of type {kind!r} cannot be described in an assembly file")
-        self.table(table, parts, _COMPONENT_KEYS, ("name", "type", "segments"))
+        extra = _extra_fields(cls)
+        with_segments = "segments" in _init_fields(cls)
+        allowed = (_COMPONENT_KEYS if with_segments else ("name", "type")) + tuple(
+            f for f in extra if f not in _COMPONENT_KEYS)
+        self.table(table, parts, allowed, ("name", "type", "segments") if with_segments else ("name", "type"))
+        kwargs = {f: table[f] for f in extra if f in table and f not in _COMPONENT_KEYS}
+        if not with_segments:
+            if "material" in extra and "material" in table:
+                kwargs["material"] = self.material(table["material"], parts + ["material"])
+            return self.call(parts, cls, table["name"], **kwargs)
         material = self.material(table["material"], parts + ["material"]) if "material" in table else None
         segments = self.array(table["segments"], parts + ["segments"], "an array of segment tables, base to tip")
         segs = [self.segment(s, parts + ["segments", j], material) for j, s in enumerate(segments)]
-        extra = {"description": table["description"]} if "description" in table else {}
-        return self.call(parts, cls, table["name"], segs, **extra)
+        if "description" in table:
+            kwargs["description"] = table["description"]
+        return self.call(parts, cls, table["name"], segs, **kwargs)
 
     def catalog_holder(self, table, parts, cls):
         """A ``catalog = "..."`` component: a standard holder of the catalogue with overrides."""
@@ -278,9 +299,8 @@ class _Reader:
             kw["material"] = self.material(table["material"], parts + ["material"])
         elif material is not None:
             kw["material"] = material
-        else:
-            raise self.error(parts + ["material"], "missing; give the segment's material, or the "
-                             "component's `material` (steel, carbide, aluminium or a [materials.NAME])")
+        else:  # the rule of Segment: steel unless said otherwise (a [materials.steel] of the file counts)
+            kw["material"] = self.materials["steel"]
         if "insert" in table:
             ins = self.table(table["insert"], parts + ["insert"], _INSERT_KEYS, ("od", "material"))
             mat = self.material(ins["material"], parts + ["insert", "material"])
@@ -323,13 +343,22 @@ class _Reader:
         return self.call(parts, Sensor, table["name"], at, table["mass"], **extra)
 
 
+def _init_fields(cls) -> tuple[str, ...]:
+    return tuple(f.name for f in attrs.fields(cls) if f.init) if attrs.has(cls) else _STANDARD_FIELDS
+
+
+def _extra_fields(cls) -> tuple[str, ...]:
+    """The init fields of a Beam subclass beyond ``name`` and ``segments``: one key each in its table."""
+    return tuple(f for f in _init_fields(cls) if f not in _STANDARD_FIELDS)
+
+
 def loads_assembly(text: str, source: str = "<string>") -> Assembly:
     """Read an assembly from TOML text.
 
     Parameters
     ----------
     text : str
-        The TOML document (formats.md, "Assembly file").
+        The TOML document (docs/file-formats.md, "Assembly file").
     source : str
         Name of the text in error messages, e.g. the file name.
 
@@ -341,6 +370,11 @@ def loads_assembly(text: str, source: str = "<string>") -> Assembly:
         types and points that do not exist; the message starts with
         ``source`` and names the key path.
     """
+    if not isinstance(text, str):
+        raise FileFormatError(f"{source}: got {type(text).__name__}; expected the TOML text as a str")
+    text = text.removeprefix("\ufeff")  # a byte-order mark left by an editor is not part of the document
+    if not text.strip():
+        raise FileFormatError(f"{source}: the file is empty; expected an assembly (docs/file-formats.md)")
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -375,7 +409,10 @@ def _hz(value: float) -> str:
 def _frequency_table(frequency: Frequency) -> dict:
     hz = frequency.hz
     if hz.size == 1:
-        return {"start": _hz(hz[0]), "stop": _hz(hz[0]), "step": "1 Hz"}
+        raise InvalidValueError(
+            f"frequency: the grid {frequency!r} has one line; an assembly file's [frequency] is a range "
+            "of at least two lines (Frequency.from_range)"
+        )
     raw = [hz[1] - hz[0], (hz[-1] - hz[0]) / (hz.size - 1)]
     for step in raw + [float(f"{d:.{digits}g}") for d in raw for digits in (15, 12)]:
         table = {"start": _hz(hz[0]), "stop": _hz(hz[-1]), "step": _hz(float(step))}
@@ -418,6 +455,11 @@ def _collect_materials(assembly: Assembly) -> dict[str, Material]:
                 add(seg.material, False)
                 if seg.insert is not None:
                     add(seg.insert.material, False)
+        if isinstance(comp, Beam) and not hasattr(comp, "to_toml"):
+            for field in _extra_fields(type(comp)):
+                value = getattr(comp, field)
+                if isinstance(value, Material):
+                    add(value, False)
     return found
 
 
@@ -464,11 +506,42 @@ def _component_table(component) -> dict:
     table = {"name": component.name, "type": kind}
     if getattr(component, "description", ""):
         table["description"] = component.description
-    shared = all(s.material == component.segments[0].material for s in component.segments)
-    if shared:
-        table["material"] = component.segments[0].material.name
-    table["segments"] = [_segment_table(s, not shared) for s in component.segments]
+    cls = type(component)
+    if "segments" in _init_fields(cls):
+        shared = all(s.material == component.segments[0].material for s in component.segments)
+        if shared:
+            table["material"] = component.segments[0].material.name
+        table["segments"] = [_segment_table(s, not shared) for s in component.segments]
+    for field in _extra_fields(cls):
+        if field in table:
+            raise InvalidValueError(
+                f"components: {component.name!r} ({kind}) has a field {field!r} that clashes with the key of "
+                f"the segments' material; give {cls.__name__} to_toml/from_toml hooks (docs/extending.md)"
+            )
+        table[field] = _field_value(component, kind, field, getattr(component, field))
     return table
+
+
+def _field_value(component, kind: str, field: str, value):
+    """A field of a component subclass as a TOML value that its converter reads back."""
+    if isinstance(value, pint.Quantity):
+        if value.ndim != 0:
+            raise InvalidValueError(
+                f"components: {component.name!r} ({kind}) field {field!r} is an array quantity, which the "
+                f"generic table cannot hold; give {type(component).__name__} to_toml/from_toml hooks"
+            )
+        return format_quantity(value)
+    if isinstance(value, Material):
+        return value.name
+    if isinstance(value, (bool, int, float, str)):
+        return value
+    if isinstance(value, (tuple, list)) and all(isinstance(v, (bool, int, float, str)) for v in value):
+        return list(value)
+    raise InvalidValueError(
+        f"components: {component.name!r} ({kind}) field {field!r} holds a {type(value).__name__}, which an "
+        f"assembly file cannot hold; give {type(component).__name__} to_toml/from_toml hooks "
+        "(docs/extending.md) rather than lose it"
+    )
 
 
 def _matrices(item) -> dict:
@@ -499,7 +572,7 @@ def _body(table: dict) -> list[str]:
 
 
 def _emit(doc: dict) -> str:
-    """The document laid out as formats.md shows it: tables per section, segments one per line."""
+    """The document laid out as docs/file-formats.md shows it: tables per section, segments one per line."""
     out = [f"{_key(k)} = {_inline(v)}" for k, v in doc.items() if not isinstance(v, (dict, list))]
     for key, value in doc.items():
         if isinstance(value, dict) and value and all(isinstance(v, dict) for v in value.values()):
@@ -559,30 +632,98 @@ def dumps_assembly(assembly: Assembly) -> str:
              **({"inertia": format_quantity(s.inertia)} if s.inertia.magnitude != 0 else {})}
             for s in assembly.sensors
         ]
-    return _HEADER_COMMENT + _emit(doc)
+    text = _HEADER_COMMENT + _emit(doc)
+    _check_round_trip(assembly, text)
+    return text
+
+
+def _differences(a, b) -> list[str]:
+    """The fields in which two components of one attrs class differ (all of them if that is unclear)."""
+    if type(a) is not type(b):
+        return [f"type {type(b).__name__} instead of {type(a).__name__}"]
+    if not attrs.has(type(a)):
+        return ["its value"]
+    out = []
+    for field in attrs.fields(type(a)):
+        x, y = getattr(a, field.name), getattr(b, field.name)
+        try:
+            same = bool(x == y)
+        except Exception:  # e.g. arrays: no single truth value
+            same = False
+        if not same:
+            out.append(f"{field.name} {x!r} read back as {y!r}")
+    return out or ["its value"]
+
+
+def _check_round_trip(assembly: Assembly, text: str) -> None:
+    """Refuse to write what would not read back equal (a file never loses a value silently)."""
+    try:
+        with warnings.catch_warnings():  # the user saw them when the assembly was built
+            warnings.simplefilter("ignore")
+            back = loads_assembly(text, source="the written text")
+    except FileFormatError as exc:
+        raise InvalidValueError(
+            f"assembly {assembly.name!r}: the file would not read back ({exc}); a component's to_toml and "
+            "from_toml must agree"
+        ) from None
+    # materials in use are declared on writing: the list may grow, no value is lost
+    declared = all(any(_equal(m, n) for n in back.materials) for m in assembly.materials)
+    if declared:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            back = attrs.evolve(back, materials=assembly.materials)
+        if _equal(back, assembly):
+            return
+    for mine, theirs in zip(assembly.components, back.components):
+        if _equal(mine, theirs):
+            continue
+        problems = _differences(mine, theirs)
+        raise InvalidValueError(
+            f"components: {mine.name!r} ({type(mine).__name__}) would not read back equal from an assembly "
+            f"file: {'; '.join(problems)}; give its class to_toml/from_toml hooks that keep every field "
+            "(docs/extending.md), or save it another way"
+        )
+    if not declared:
+        raise InvalidValueError("materials: would not read back equal from an assembly file; refusing to "
+                                "write a file that loses a value")
+    for what in ("frequency", "joints", "supports", "sensors", "name"):
+        if not _equal(getattr(assembly, what), getattr(back, what)):
+            raise InvalidValueError(f"{what}: would not read back equal from an assembly file; refusing to "
+                                    "write a file that loses a value")
+    raise InvalidValueError(f"assembly {assembly.name!r} would not read back equal from an assembly file")
+
+
+def _equal(a, b) -> bool:
+    try:
+        return bool(a == b)
+    except Exception:
+        return False
 
 
 def save_assembly(assembly: Assembly, path: str | os.PathLike, overwrite: bool = False) -> None:
     """Write an assembly file (TOML); see :func:`dumps_assembly`.
 
+    The file is written through a temporary file in the same directory and
+    an atomic rename (:func:`substructure.io.replacing`): a reader never sees
+    half a file, and a failure leaves an existing file as it was.
+
     Parameters
     ----------
     assembly : Assembly
+        The assembly; what a file cannot hold without loss is refused
+        (:func:`dumps_assembly`).
     path : str or path-like
+        The file to write.
     overwrite : bool, default False
         Replace an existing file; without it an existing file is an error,
         so that a user's input is never overwritten silently.
 
     Raises
     ------
-    FileExistsError
+    OutputExistsError
         When ``path`` exists and ``overwrite`` is False.
+    InvalidValueError
+        For what the file cannot hold (:func:`dumps_assembly`).
     """
     text = dumps_assembly(assembly)
-    try:
-        with open(path, "w" if overwrite else "x", encoding="utf-8", newline="\n") as fh:
-            fh.write(text)
-    except FileExistsError:
-        raise FileExistsError(
-            f"{os.fspath(path)}: the file exists; pass overwrite=True to replace it"
-        ) from None
+    write_text(path, text, overwrite=overwrite)

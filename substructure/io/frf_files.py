@@ -26,8 +26,6 @@ from __future__ import annotations
 
 import os
 import re
-import tempfile
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -52,10 +50,21 @@ def _require_frf(frf: Any, function: str) -> FRF:
     return frf
 
 
+def _refuse_all_zero(frf: FRF, name: str) -> None:
+    """Readers take an FRF that is 0 at every line for a dead channel: such a file is not written."""
+    dead = ~np.any(frf.data, axis=0)
+    if dead.any():
+        i, j = np.argwhere(dead)[0]
+        raise InvalidValueError(
+            f"frf: cannot write {name}: the entry ({frf.outputs[i]!r}, {frf.inputs[j]!r}) is 0 at every line, "
+            "which readers refuse as a dead channel"
+        )
+
+
 # -- CSV ----------------------------------------------------------------------
 
 
-def write_csv(frf: FRF, path: str | os.PathLike) -> None:
+def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True) -> None:
     """Write a one-entry FRF to a CSV file ``frequency_hz,real,imag``.
 
     Parameters
@@ -65,9 +74,24 @@ def write_csv(frf: FRF, path: str | os.PathLike) -> None:
         e.g. ``frf["tool.tip:y", "tool.tip:y"]``.  The data are written as
         they are (the file does not record labels or quantity).
     path : str or path-like
-        The file, overwritten if it exists.
+        The file, written through a temporary file and an atomic rename
+        (:func:`substructure.io.replacing`).
+    overwrite : bool, default True
+        Whether an existing file may be replaced.
+
+    Raises
+    ------
+    InvalidValueError
+        For an FRF of more than one entry or of fewer than 2 lines (which
+        no reader takes).
     """
+    from . import write_text
+
     frf = _require_frf(frf, "write_csv")
+    if frf.frequency.n < 2:
+        raise InvalidValueError(
+            f"frf: cannot write {os.fspath(path)}: an FRF file needs at least 2 frequency lines (readers refuse fewer)"
+        )
     if frf.shape[1:] != (1, 1):
         raise InvalidValueError(
             f"frf: a CSV file holds one FRF, this one has {frf.shape[1]}x{frf.shape[2]} entries "
@@ -75,10 +99,10 @@ def write_csv(frf: FRF, path: str | os.PathLike) -> None:
             f"e.g. frf[{frf.outputs[0]!r}, {frf.inputs[0]!r}]"
         )
     values = frf.data[:, 0, 0]
+    _refuse_all_zero(frf, os.fspath(path))
     rows = zip(frf.frequency.hz.tolist(), values.real.tolist(), values.imag.tolist())
     text = "".join(f"{f!r},{re_!r},{im!r}\n" for f, re_, im in rows)
-    with open(path, "w", encoding="utf-8", newline="\n") as fh:
-        fh.write(CSV_HEADER + "\n" + text)
+    write_text(path, CSV_HEADER + "\n" + text, overwrite=overwrite)
 
 
 def read_csv(
@@ -101,18 +125,15 @@ def read_csv(
     Raises
     ------
     FileFormatError
-        Naming the file and the line, for a missing file, a wrong header, a
-        row without three numbers, NaN or inf, a negative, repeated or
-        decreasing frequency, or fewer than two rows.
+        Naming the file and the line, for a missing file, a directory, a
+        wrong header, a row without three numbers, NaN or inf, a negative,
+        repeated or decreasing frequency, fewer than two rows, or a dead
+        channel (every value 0).
     """
+    from . import read_text
+
     name = os.fspath(path)
-    try:
-        with open(path, encoding="utf-8-sig") as fh:
-            lines = fh.read().splitlines()
-    except FileNotFoundError:
-        raise FileFormatError(f"{name}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise FileFormatError(f"{name}: cannot read the file ({exc})") from None
+    lines = read_text(path).splitlines()
     numbered = [(k + 1, line) for k, line in enumerate(lines) if line.strip()]
     if not numbered:
         raise FileFormatError(f"{name}: the file is empty; expected the header {CSV_HEADER!r}")
@@ -165,6 +186,11 @@ def read_csv(
             f"of line {lines_of[k - 1]}; frequencies must be strictly increasing, without repeats"
         )
     values = table[:, 1] + 1j * table[:, 2]
+    if not np.any(values):
+        raise FileFormatError(
+            f"{name}: every value is 0, a dead channel (a sensor or the hammer not connected?); leave this "
+            "FRF out or measure it again"
+        )
     return FRF.single(Frequency.from_hz(hz), values, output=output, input=input, quantity=quantity)
 
 
@@ -208,12 +234,18 @@ def _uff_grid(hz: np.ndarray, name: str) -> tuple[int, str]:
     return 1, f"grid start={grid[0]!r} step={grid[1]!r} n={hz.size}"
 
 
-def write_uff(frf: FRF, path: str | os.PathLike) -> None:
+def write_uff(frf: FRF, path: str | os.PathLike, overwrite: bool = True) -> None:
     """Write an FRF as ASCII type-58 records, one per entry, replacing the file.
 
-    Entries are written output by output, input by input.  The file is
-    written to a temporary name next to ``path`` and renamed, so that a
-    failure leaves an existing file untouched.
+    Entries are written output by output, input by input, each with the
+    data types and unit exponents of UFF 58 (ordinate: displacement,
+    velocity or acceleration, length exponent 1 for ``y`` and 0 for
+    ``theta``; denominator: excitation force, force exponent 1, length
+    exponent 1 for a moment) and its SI unit label (``"m/N"``,
+    ``"m/(N s^2)"``, ...), so that other programs read the quantity and the
+    units.  The file is written to a temporary name next to ``path`` and
+    renamed (:func:`substructure.io.replacing`), so that a failure leaves an
+    existing file untouched.
 
     Parameters
     ----------
@@ -221,6 +253,8 @@ def write_uff(frf: FRF, path: str | os.PathLike) -> None:
         At least 2 frequency lines; labels of at most ~68 ASCII characters.
     path : str or path-like
         The universal file (``.uff`` or ``.unv``).
+    overwrite : bool, default True
+        Whether an existing file may be replaced.
     """
     import pyuff
 
@@ -229,6 +263,7 @@ def write_uff(frf: FRF, path: str | os.PathLike) -> None:
     hz = frf.frequency.hz
     if hz.size < 2:
         raise InvalidValueError(f"frf: cannot write {name}: UFF 58 needs at least 2 frequency lines")
+    _refuse_all_zero(frf, name)
     spacing, grid_line = _uff_grid(hz, name)
     points = list(dict.fromkeys(_split_label(x)[0] for x in frf.outputs + frf.inputs))
     records = []
@@ -251,30 +286,26 @@ def write_uff(frf: FRF, path: str | os.PathLike) -> None:
                     abscissa_spacing=spacing,
                     abscissa_spec_data_type=18, abscissa_axis_units_lab="Hz",
                     ordinate_spec_data_type=_SPEC_TYPE[frf.quantity],
+                    ordinate_len_unit_exp=1 if out_dof == "y" else 0, ordinate_force_unit_exp=0,
+                    ordinate_temp_unit_exp=0,
                     ordinate_axis_units_lab=frf.unit(output, input_),
                     orddenom_spec_data_type=13,
+                    orddenom_len_unit_exp=1 if in_dof == "theta" else 0, orddenom_force_unit_exp=1,
+                    orddenom_temp_unit_exp=0,
                     data=np.ascontiguousarray(frf.data[:, i, j]),
                     x=np.array(hz),
                 )
             )
-    try:
-        fd, temporary = tempfile.mkstemp(suffix=".uff", dir=os.path.dirname(os.path.abspath(name)))
-        os.close(fd)
-    except OSError as exc:
-        raise FileFormatError(f"{name}: cannot write the universal file ({exc})") from None
-    try:
-        os.remove(temporary)  # pyuff creates it in "add" mode
-        pyuff.UFF(temporary).write_sets(records, mode="add")
-        if os.path.getsize(temporary) == 0:
+    from . import replacing
+
+    with replacing(name, overwrite) as temporary:
+        try:
+            os.remove(temporary)  # pyuff creates it in "add" mode
+            pyuff.UFF(temporary).write_sets(records, mode="add")
+        except Exception as exc:  # pyuff raises bare Exception
+            raise FileFormatError(f"{name}: cannot write the universal file ({exc})") from None
+        if not os.path.exists(temporary) or os.path.getsize(temporary) == 0:
             raise FileFormatError(f"{name}: pyuff wrote an empty file")
-        os.replace(temporary, name)
-    except FileFormatError:
-        raise
-    except Exception as exc:  # pyuff raises bare Exception
-        raise FileFormatError(f"{name}: cannot write the universal file ({exc})") from None
-    finally:
-        if os.path.exists(temporary):
-            os.remove(temporary)
 
 
 def _label(dset: dict, id_key: str, prefix: str, node_key: str, dir_key: str) -> str:
@@ -286,16 +317,242 @@ def _label(dset: dict, id_key: str, prefix: str, node_key: str, dir_key: str) ->
     return f"node{int(dset.get(node_key, 0))}:{dof}"
 
 
-def _parse_record(dset: dict, name: str, number: int, quantity: str | None) -> tuple:
-    where = f"{name}, type-58 record {number}"
-    if int(dset.get("func_type", -1)) != 4:
+# Function types (record 6, field 1) and specific data types (records 8-10, field 1) of UFF 58.
+_FUNCTION_TYPES = {
+    0: "general or unknown function", 1: "time response", 2: "auto spectrum", 3: "cross spectrum",
+    4: "frequency response function", 5: "transmissibility", 6: "coherence", 7: "auto correlation",
+    8: "cross correlation", 9: "power spectral density", 10: "energy spectral density",
+    11: "probability density function", 12: "spectrum", 13: "cumulative frequency distribution",
+    14: "peaks valley", 15: "stress/cycles", 16: "strain/cycles", 17: "orbit", 18: "mode indicator function",
+    19: "force pattern", 20: "partial power", 21: "partial coherence", 22: "eigenvalue", 23: "eigenvector",
+    24: "shock response spectrum", 25: "finite impulse response filter", 26: "multiple coherence",
+    27: "order function",
+}
+_DATA_TYPES = {
+    0: "unknown", 1: "general", 2: "stress", 3: "strain", 5: "temperature", 6: "heat flux", 8: "displacement",
+    9: "reaction force", 11: "velocity", 12: "acceleration", 13: "excitation force", 15: "pressure", 16: "mass",
+    17: "time", 18: "frequency", 19: "rpm", 20: "order",
+}
+_TIME_EXPONENT = {0: "receptance", -1: "mobility", -2: "accelerance"}  # of an FRF unit m^a N^-1 s^t
+_TIME_OF = {v: k for k, v in _TIME_EXPONENT.items()}
+_NO_LABEL = ("", "NONE", "N/A", "NA", "-")
+
+
+def _a(word: str) -> str:
+    """``word`` with its indefinite article."""
+    return f"{'an' if word[:1].lower() in 'aeiou' else 'a'} {word}"
+
+
+def _unit_of_label(label: Any):
+    """A pint Quantity of 1 of the unit an axis units label names; None for no label; ValueError if unreadable.
+
+    Labels of acquisition systems are made readable first: ``g`` is the
+    standard acceleration of gravity (not the gram), ``s2`` and ``s²`` are
+    ``s^2``.
+    """
+    from ..units import ureg
+
+    text = str(label if label is not None else "").strip()
+    if text.upper() in _NO_LABEL:
+        return None
+    cleaned = text.replace("²", "^2").replace("³", "^3").replace("·", "*").replace("**", "^")
+    cleaned = re.sub(r"(?<![A-Za-z_])g(?![A-Za-z_0-9])", "g_n", cleaned)  # g: gravity, in an FRF label
+    cleaned = re.sub(r"([A-Za-z])(\d)", r"\1^\2", cleaned)  # m/s2 -> m/s^2
+    try:
+        q = ureg.Quantity(1.0, cleaned)
+    except Exception:
+        raise ValueError(text) from None
+    return q
+
+
+def _exponents(q) -> tuple[int, int, int] | None:
+    """``(force, length, time)`` exponents of a unit made of mass, length and time; None otherwise."""
+    dims = dict(q.dimensionality)
+    if set(dims) - {"[mass]", "[length]", "[time]"}:
+        return None
+    m, l, t = (dims.get(k, 0) for k in ("[mass]", "[length]", "[time]"))
+    if any(float(x) != int(x) for x in (m, l, t)):
+        return None
+    m, l, t = int(m), int(l), int(t)
+    return m, l - m, t + 2 * m  # M^m L^l T^t = F^m L^(l-m) T^(t+2m)
+
+
+def _frf_unit(dset: dict, where: str):
+    """The FRF unit its labels give (a pint Quantity of 1 per force), None without labels.
+
+    Raises FileFormatError for a label that cannot be read or is not a
+    response per force.
+    """
+    from ..units import ureg
+
+    labels = {}
+    for key in ("ordinate_axis_units_lab", "orddenom_axis_units_lab"):
+        try:
+            labels[key] = _unit_of_label(dset.get(key))
+        except ValueError as exc:
+            raise FileFormatError(
+                f"{where}: cannot read the unit label {str(exc)!r} ({key.split('_')[0]}); give the quantity "
+                "(receptance, mobility or accelerance, in SI units) to read it as such"
+            ) from None
+    num, den = labels["ordinate_axis_units_lab"], labels["orddenom_axis_units_lab"]
+    if num is None:
+        return None
+    exps = _exponents(num)
+    if exps is not None and exps[0] == -1:  # the whole FRF unit, e.g. (1/N)*(m/s^2)
+        return num
+    if exps is not None and exps[0] == 0:  # the response alone: the force is the denominator's
+        force = ureg.Quantity(1.0, "N") if den is None else den
+        fexps = _exponents(force)
+        if fexps is not None and fexps[0] == 1 and fexps[2] == 0:
+            return num / force
         raise FileFormatError(
-            f"{where}: function type {dset.get('func_type')}; expected 4 (frequency response function)"
+            f"{where}: the ordinate denominator's unit {dset.get('orddenom_axis_units_lab')!r} is not a force "
+            "or a moment; an FRF here is a response per excitation force"
+        )
+    raise FileFormatError(
+        f"{where}: the unit label {dset.get('ordinate_axis_units_lab')!r} is not a displacement, velocity or "
+        "acceleration (per force); this record is not a receptance, mobility or accelerance"
+    )
+
+
+def _record_quantity(dset: dict, where: str, given: str | None, system: tuple[float, float] | None):
+    """The quantity of a type-58 record and the factor to SI, from its data types, unit labels and exponents.
+
+    Returns ``(quantity, factor)``; raises FileFormatError when the
+    record contradicts itself or does not say what it holds.
+    """
+    rotation = abs(int(dset.get("rsp_dir", 0) or 0)) in (4, 5, 6)
+    moment = abs(int(dset.get("ref_dir", 0) or 0)) in (4, 5, 6)
+    length_exponent = (0 if rotation else 1) - (1 if moment else 0)  # y/f: m/N, y/m and theta/f: 1/N, ...
+    num_type = int(dset.get("ordinate_spec_data_type", 0) or 0)
+    den_type = int(dset.get("orddenom_spec_data_type", 0) or 0)
+    if den_type not in (0, 1, 9, 13):
+        raise FileFormatError(
+            f"{where}: the ordinate denominator is {_a(_DATA_TYPES.get(den_type, f'data type {den_type}'))}; a "
+            "receptance, mobility or accelerance is a response per excitation force"
+        )
+    by_type = {8: "receptance", 11: "mobility", 12: "accelerance"}.get(num_type)
+    if by_type is None and num_type not in (0, 1):
+        raise FileFormatError(
+            f"{where}: the ordinate is {_a(_DATA_TYPES.get(num_type, f'data type {num_type}'))}, not a "
+            "displacement, velocity or acceleration: not a receptance, mobility or accelerance"
+        )
+    stored = str(dset.get("id3", "")).strip()
+    ours = stored[len("quantity="):] if stored.startswith("quantity=") else None
+    ours = ours if ours in QUANTITIES else None
+    try:
+        unit = _frf_unit(dset, where)
+    except FileFormatError:
+        if given is None:
+            raise
+        unit = None  # the user says what it is: the unreadable label is left aside
+    by_label, label_factor = None, None
+    label = dset.get("ordinate_axis_units_lab")
+    if unit is not None:
+        force, length, time = _exponents(unit)
+        by_label = _TIME_EXPONENT.get(time)
+        if by_label is None or (int(dset.get("rsp_dir", 0) or 0) and length != length_exponent):
+            raise FileFormatError(
+                f"{where}: the unit label {label!r} is not that of a receptance, mobility or accelerance of "
+                f"this record's directions (response {dset.get('rsp_dir')}, reference {dset.get('ref_dir')})"
+            )
+        label_factor = float(unit.m_as(f"meter ** {length} / newton * second ** {time}"))
+    if given is None:
+        if by_label is not None and by_type is not None and by_label != by_type:
+            raise FileFormatError(
+                f"{where}: its data type says {by_type} ({_DATA_TYPES[num_type]}) but its unit label {label!r} "
+                f"is that of {_a(by_label)}; give the quantity to say which"
+            )
+        quantity = by_label or by_type or ours
+        if quantity is None:
+            raise FileFormatError(
+                f"{where}: the record does not say whether it holds a receptance, a mobility or an accelerance "
+                f"(ordinate data type {_DATA_TYPES.get(num_type, num_type)}, no unit label); give the quantity "
+                "(quantity = \"...\" in the measurement set, or read_uff(..., quantity=...)); values are then "
+                "taken in SI units"
+            )
+        if by_label is not None:
+            return quantity, label_factor
+    elif by_label == given:
+        return given, label_factor
+    elif not (by_type == given or (by_label is None and by_type is None)):
+        says = f"its unit label {label!r} is that of {_a(by_label)}" if by_label is not None else \
+            f"its data type says {by_type} ({_DATA_TYPES[num_type]})"
+        raise FileFormatError(f"{where}: the quantity given is {given}, but {says}")
+    else:
+        quantity = given
+    if system is None:
+        return quantity, 1.0
+    # no labels: the file's unit system (a type-164 record) with the exponents of the data types
+    # (UFF 58, Addendum A), or those the record gives for the data type "general"
+    length_factor, force_factor = system
+    if num_type == 1:
+        num_length, num_force = int(dset.get("ordinate_len_unit_exp", 0)), int(dset.get("ordinate_force_unit_exp", 0))
+    else:
+        num_length, num_force = (0 if rotation else 1), 0
+    if den_type == 1:
+        den_length, den_force = int(dset.get("orddenom_len_unit_exp", 0)), int(dset.get("orddenom_force_unit_exp", 0))
+    else:
+        den_length, den_force = (1 if moment else 0), 1
+    factor = length_factor ** -(num_length - den_length) * force_factor ** -(num_force - den_force)
+    return quantity, factor
+
+
+def _unit_system(dset: dict, name: str) -> tuple[float, float] | None:
+    """``(length, force)`` factors of a type-164 record (file units per SI unit); None for SI."""
+    try:
+        length, force = float(dset["length"]), float(dset["force"])
+    except (KeyError, TypeError, ValueError):
+        raise FileFormatError(f"{name}: a units record (type 164) without length and force factors") from None
+    if not (np.isfinite(length) and np.isfinite(force) and length > 0 and force > 0):
+        raise FileFormatError(f"{name}: the units record (type 164) has factors {length}, {force}; expected > 0")
+    return None if length == 1.0 and force == 1.0 else (length, force)
+
+
+def _abscissa_hz(dset: dict, where: str) -> np.ndarray:
+    """The abscissa in Hz: a frequency axis (a label in rad/s is divided by 2 pi); time or orders refused."""
+    from ..units import cycles_per_second
+
+    kind = int(dset.get("abscissa_spec_data_type", 0) or 0)
+    if kind not in (0, 1, 18):
+        raise FileFormatError(
+            f"{where}: the abscissa is {_DATA_TYPES.get(kind, f'data type {kind}')}, not frequency; an FRF "
+            "is a function of frequency"
+        )
+    hz = np.asarray(dset["x"], dtype=np.float64)
+    try:
+        unit = _unit_of_label(dset.get("abscissa_axis_units_lab"))
+    except ValueError:
+        unit = None
+    if unit is not None and unit.check("1 / [time]"):
+        hz = np.asarray(cycles_per_second(hz * unit, "abscissa"), dtype=np.float64)
+    elif unit is not None and not unit.dimensionless:
+        raise FileFormatError(
+            f"{where}: the abscissa's unit is {dset.get('abscissa_axis_units_lab')!r}, not a frequency"
+        )
+    return hz
+
+
+def _parse_record(dset: dict, name: str, number: int, quantity: str | None,
+                  system: tuple[float, float] | None = None) -> tuple:
+    where = f"{name}, type-58 record {number}"
+    function = int(dset.get("func_type", -1))
+    if function not in (0, 4) or (function == 0 and int(dset.get("orddenom_spec_data_type", 0) or 0) != 13):
+        kind = _FUNCTION_TYPES.get(function, f"function type {function}")
+        raise FileFormatError(
+            f"{where}: {_a(kind)} (function type {function}), not a frequency response function (type 4); "
+            "export the FRFs (H1 or H2) from the acquisition software"
         )
     data = np.asarray(dset["data"])
     if not np.iscomplexobj(data):
-        raise FileFormatError(f"{where}: real ordinates; an FRF needs complex data")
-    hz = np.asarray(dset["x"], dtype=np.float64)
+        raise FileFormatError(f"{where}: real ordinates; an FRF needs complex data (real and imaginary parts)")
+    expected = dset.get("num_pts")
+    if expected is not None and int(expected) != data.size:
+        raise FileFormatError(
+            f"{where}: its header announces {int(expected)} values but it holds {data.size}: the file is "
+            "truncated or damaged; copy or export it again"
+        )
+    hz = _abscissa_hz(dset, where)
     grid = _GRID_LINE.match(str(dset.get("id4", "")).strip())
     if grid and int(grid[3]) == hz.size:
         exact = float(grid[1]) + float(grid[2]) * np.arange(hz.size)
@@ -305,18 +562,48 @@ def _parse_record(dset: dict, name: str, number: int, quantity: str | None) -> t
         frequency = Frequency.from_hz(hz)
     except InvalidValueError as exc:
         raise FileFormatError(f"{where}: invalid frequencies ({exc})") from None
-    if quantity is None:
-        text = str(dset.get("id3", "")).strip()
-        stored = text[len("quantity="):] if text.startswith("quantity=") else None
-        spec = _QUANTITY_OF_SPEC.get(int(dset.get("ordinate_spec_data_type", 0)), "receptance")
-        quantity = stored if stored in QUANTITIES else spec
+    if not np.isfinite(data).all():
+        k = int(np.argmax(~np.isfinite(data)))
+        raise FileFormatError(f"{where}: the value at {hz[k]:g} Hz is {data[k]}; expected finite values")
+    kind, factor = _record_quantity(dset, where, quantity, system)
     output = _label(dset, "id1", "response=", "rsp_node", "rsp_dir")
     input_ = _label(dset, "id2", "excitation=", "ref_node", "ref_dir")
-    return frequency, data, output, input_, quantity
+    if not np.any(data):
+        raise FileFormatError(
+            f"{where} (response {output}, excitation {input_}): every value is 0, a dead channel (a sensor "
+            "or the hammer not connected?); leave this FRF out or measure it again"
+        )
+    return frequency, data * factor if factor != 1.0 else data, output, input_, kind
+
+
+def _check_complete(name: str) -> None:
+    """A universal file starts and ends with a ``-1`` line; otherwise it is something else, or was cut off."""
+    size = os.path.getsize(name)
+    if size == 0:
+        raise FileFormatError(f"{name}: the file is empty; no type-58 record")
+    with open(name, "rb") as fh:
+        head = fh.read(512)
+        fh.seek(max(0, size - 512))
+        tail = fh.read()
+    first = head.lstrip().split(b"\n", 1)[0].strip()
+    if first != b"-1":
+        raise FileFormatError(
+            f"{name}: not a universal file (it starts with {first[:20].decode('latin-1')!r}, not with the line "
+            "'    -1' that opens a record)"
+        )
+    if re.search(rb"(?:^|\s)-1\s*$", tail):  # (binary 58b data end right before the closing "    -1")
+        return
+    with open(name, "rb") as fh:
+        starts = [n + 1 for n, line in enumerate(fh) if line.rstrip()[:6].strip() in (b"58", b"58b")]
+    where = f" (the last type-58 record starts at line {starts[-1]})" if starts else ""
+    raise FileFormatError(
+        f"{name}: the file is truncated: it does not end with the '-1' line that closes a record{where}; "
+        "copy or export it again"
+    )
 
 
 def read_uff(path: str | os.PathLike, record: int | None = None, quantity: str | None = None) -> FRF:
-    """Read type-58 records of a universal file into an FRF.
+    """Read type-58 records of a universal file into an FRF, in SI units.
 
     Parameters
     ----------
@@ -328,23 +615,46 @@ def read_uff(path: str | os.PathLike, record: int | None = None, quantity: str |
         share one frequency grid and one quantity, and hold each (output,
         input) pair once and every pair.
     quantity : str, optional
-        Overrides the quantity; by default taken from the ID line this module
-        writes, else from the ordinate data type (8 displacement, 11
-        velocity, 12 acceleration), else receptance.
+        What the records hold, for records that do not say; a quantity that
+        contradicts what a record says is refused.
+
+    Returns
+    -------
+    FRF
+        The data converted to SI units (m/N, (m/s)/N, (m/s^2)/N, ...), with
+        the quantity the records hold.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the file and the record: a missing, empty or truncated file,
+        no type-58 record, a record that is not an FRF (a time history, a
+        spectrum, a coherence), real ordinates, a dead channel (every value
+        0), a record that does not say its quantity (when ``quantity`` is not
+        given) or contradicts itself.
 
     Notes
     -----
-    Labels come from the ID lines this module writes; records of other
-    programs get ``"node<N>:y"`` / ``"node<N>:theta"`` (``dir<D>`` for other
-    directions).  Values are taken as SI; unit exponents are not applied.
+    The quantity and the units come from the record (UFF 58, records 8-10):
+    the unit labels first (``"(1/N)*(m/s^2)"``, ``"g/N"`` with ``g`` the
+    standard gravity, ``"mm/N"``, ``"m/s"`` over ``"N"``), which the format
+    says take precedence; else the ordinate's data type (8 displacement,
+    11 velocity, 12 acceleration over 13 excitation force) in the units of
+    the file's units record (type 164; SI without one), with the unit
+    exponents of the data types (or those of the record for the data type
+    "general"); else the ID line ``quantity=`` this module writes.  An
+    abscissa labelled in rad/s is divided by 2 pi.  Labels come from the ID
+    lines this module writes; records of other programs get
+    ``"node<N>:y"`` / ``"node<N>:theta"`` (``dir<D>`` for other directions).
     """
     import pyuff
 
-    name = os.fspath(path)
-    if not Path(name).is_file():
-        raise FileFormatError(f"{name}: no such file")
+    from . import check_readable_file
+
+    name = check_readable_file(path, "universal file")
     if quantity is not None and quantity not in QUANTITIES:
         raise InvalidValueError(f"quantity: got {quantity!r}; expected one of {', '.join(QUANTITIES)}")
+    _check_complete(name)
     try:
         uff = pyuff.UFF(name)
         types = [int(t) for t in uff.get_set_types()]
@@ -352,9 +662,8 @@ def read_uff(path: str | os.PathLike, record: int | None = None, quantity: str |
         raise FileFormatError(f"{name}: not a readable universal file ({exc})") from None
     positions = [k for k, t in enumerate(types) if t == 58]
     if not positions:
-        raise FileFormatError(
-            f"{name}: no type-58 record (found record types {sorted(set(types)) or 'none'})"
-        )
+        found = ", ".join(f"{t} ({_RECORD_TYPES.get(t, 'other')})" for t in sorted(set(types))) or "none"
+        raise FileFormatError(f"{name}: no type-58 record (FRF); the file holds record types {found}")
     if record is not None:
         if isinstance(record, bool) or not isinstance(record, (int, np.integer)):
             raise InvalidValueError(f"record: got {record!r}; expected an integer index or None")
@@ -363,18 +672,30 @@ def read_uff(path: str | os.PathLike, record: int | None = None, quantity: str |
                 f"record: got {record}; {name} has {len(positions)} type-58 record(s), "
                 f"indices 0..{len(positions) - 1}"
             )
+    units = [k for k, t in enumerate(types) if t == 164]
     chosen = range(len(positions)) if record is None else [int(record)]
     parsed = []
     for number in chosen:
+        system = None
+        before = [k for k in units if k < positions[number]]
         try:
+            if before:
+                system = _unit_system(uff.read_sets(before[-1]), name)
             dset = uff.read_sets(positions[number])
+        except FileFormatError:
+            raise
         except Exception as exc:  # pyuff raises bare Exception
             raise FileFormatError(f"{name}, type-58 record {number}: cannot read it ({exc})") from None
-        parsed.append((number, *_parse_record(dset, name, number, quantity)))
+        parsed.append((number, *_parse_record(dset, name, number, quantity, system)))
     if len(parsed) == 1:
         _, frequency, data, output, input_, kind = parsed[0]
         return FRF.single(frequency, data, output=output, input=input_, quantity=kind)
     return _assemble(parsed, name)
+
+
+_RECORD_TYPES = {15: "nodes", 18: "coordinate systems", 55: "data at nodes (modes)", 58: "functions",
+                 82: "trace lines", 151: "header", 164: "units", 2411: "nodes", 2412: "elements",
+                 2414: "analysis data", 2420: "coordinate systems"}
 
 
 def _assemble(parsed: list[tuple], name: str) -> FRF:

@@ -1,4 +1,4 @@
-"""Measurement files (TOML): read a measurement set in the format of formats.md.
+"""Measurement files (TOML): read a measurement set in the format of docs/file-formats.md.
 
 A measurement file says which measured FRFs exist, where they were taken and
 on what configuration::
@@ -17,15 +17,18 @@ on what configuration::
 :class:`~substructure.measurements.MeasurementSet`.  Data file paths are
 relative to the measurement file.  Files ending in ``.csv`` are CSV
 (``frequency_hz,real,imag``); ``.uff`` and ``.unv`` are universal files,
-read with :func:`~substructure.io.frf_files.read_uff`.  Mobilities and
-accelerances are converted to receptances on reading.
+read with :func:`~substructure.io.frf_files.read_uff` (which takes the
+quantity and the units from the record).  Mobilities and accelerances are
+converted to receptances on reading; their 0 Hz line, which has no
+receptance, is dropped with a warning.
 
 Every problem raises :class:`~substructure.errors.FileFormatError` whose
 message starts with the measurement file (and the line, where it can be
 found), names the key path (``frf[2].file``) and, for problems of the data,
 the data file: unknown keys, missing or mistyped values, unknown quantities,
 missing or unreadable data files, NaN or non-increasing frequencies in them,
-and data files on different frequency grids (never reconciled silently).
+dead channels (an FRF that is 0 at every line), and data files on
+different frequency grids (never reconciled silently).
 """
 
 from __future__ import annotations
@@ -33,11 +36,12 @@ from __future__ import annotations
 import os
 import re
 import tomllib
+import warnings
 from pathlib import Path
 from typing import Any
 
 from . import read_text
-from ..errors import FileFormatError, SubstructureError
+from ..errors import FileFormatError, SubstructureError, SubstructureWarning
 from ..frf import FRF, QUANTITIES
 from ..measurements import Measurement, MeasurementSet, dof_label
 from ..points import check_name
@@ -146,6 +150,8 @@ class _Reader:
         suffix = path.suffix.lower()
         if suffix not in _CSV + _UFF:
             raise self.error(index, "file", f"{file!r}: unknown kind of file; expected .csv, .uff or .unv")
+        if path.is_dir():
+            raise self.error(index, "file", f"{path}: is a directory; expected a data file")
         if not path.is_file():
             raise self.error(index, "file", f"{path}: no such file (paths are relative to the measurement file)")
         try:
@@ -224,6 +230,14 @@ class _Reader:
         quantity, record = self.quantity(table, index), self.record(table, index)
         sensors, removed = self.names(table, index, "sensors"), self.names(table, index, "removed")
         raw = self.data(index, file, record, quantity, response, excitation)
+        if raw.quantity != "receptance" and raw.frequency.hz[0] == 0.0:
+            line = self.lines.line(index, "file")
+            warnings.warn(
+                f"{self.source}{f', line {line}' if line else ''}: frf[{index}].file: {file}: dropped the 0 Hz "
+                f"line: a {raw.quantity} has no receptance at 0 Hz",
+                SubstructureWarning, stacklevel=2,
+            )
+            raw = raw.crop(lo=raw.frequency.hz[1])
         try:
             receptance = raw.to_receptance()
         except SubstructureError as exc:
@@ -261,7 +275,7 @@ def loads_measurements(text: str, base_dir: str | os.PathLike = ".", source: str
     Parameters
     ----------
     text : str
-        The TOML document (formats.md, "Measurement set").
+        The TOML document (docs/file-formats.md, "Measurement set").
     base_dir : str or path-like
         Directory that relative data file paths start from.
     source : str
@@ -281,6 +295,11 @@ def loads_measurements(text: str, base_dir: str | os.PathLike = ".", source: str
         Naming ``source``, the key path and the data file; see the module
         documentation for the checks.
     """
+    if not isinstance(text, str):
+        raise FileFormatError(f"{source}: got {type(text).__name__}; expected the TOML text as a str")
+    text = text.removeprefix("\ufeff")  # a byte-order mark left by an editor is not part of the document
+    if not text.strip():
+        raise FileFormatError(f"{source}: the file is empty; expected a measurement set (docs/file-formats.md)")
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

@@ -101,14 +101,20 @@ class _Encoder:
         self.names = list(table.features)
         self.units = dict(table.features)
         self.mean, self.scale, self.lo, self.hi, self.categories = {}, {}, {}, {}, {}
+        self.constant: dict[str, Any] = {}  # features with one value in every row: they teach nothing
         for f, u in self.units.items():
             col = table.feature(f)
             if u is None:
                 self.categories[f] = sorted(set(col))
+                if len(self.categories[f]) == 1:
+                    self.constant[f] = self.categories[f][0]
             else:
                 col = np.asarray(col, dtype=float)
                 self.mean[f], self.lo[f], self.hi[f] = col.mean(), col.min(), col.max()
-                self.scale[f] = col.std() if col.std() > 0 else 1.0
+                spread = col.std()
+                if spread <= 1e-12 * max(abs(self.mean[f]), 1e-300):
+                    self.constant[f] = float(self.mean[f])
+                self.scale[f] = spread if f not in self.constant else 1.0
 
     def encode_columns(self, columns: Mapping[str, Sequence]) -> np.ndarray:
         parts = []
@@ -126,9 +132,28 @@ class _Encoder:
                 parts.append(((np.asarray(col, dtype=float) - self.mean[f]) / self.scale[f])[:, None])
         return np.hstack(parts) if parts else np.zeros((0, 0))
 
+    def check_constant(self, columns: Mapping[str, Sequence]) -> None:
+        """Refuse a prediction at another value of a feature that is the same in every row of the table.
+
+        Such a column says nothing about how the joint depends on the
+        feature: a prediction elsewhere would be a guess with a falsely
+        narrow interval.
+        """
+        for f, value in self.constant.items():
+            unit = self.units[f]
+            for v in columns[f]:
+                same = v == value if unit is None else abs(float(v) - value) <= 1e-9 * max(abs(value), 1e-300)
+                if not same:
+                    shown = (f"{v!r}", f"{value!r}") if unit is None else (f"{float(v):g} {unit}", f"{value:g} {unit}")
+                    raise InvalidValueError(
+                        f"{f}: got {shown[0]}, but every row of the joint table has {f} = {shown[1]}, so the "
+                        f"table says nothing about how the joint changes with {f}; predict at {shown[1]}, or "
+                        "add identified joints with other values (or leave the column out)"
+                    )
+
     def check_range(self, columns: Mapping[str, Sequence], tolerance: float) -> None:
         for f in self.names:
-            if self.units[f] is None:
+            if self.units[f] is None or f in self.constant:
                 continue
             lo, hi = self.lo[f], self.hi[f]
             span = max(hi - lo, 1e-12 * max(abs(hi), 1.0))
@@ -155,14 +180,12 @@ class JointSurrogate(BaseEstimator):
 
     def fit(self, table: JointTable, targets: Sequence[str] | str | None = None) -> "JointSurrogate":
         """Fit one model per target parameter (default: every parameter of the table)."""
-        table.check_not_empty()
         if isinstance(targets, str):
             targets = [targets]
         targets = list(table.parameters) if targets is None else list(targets)
         for t in targets:
             table._check_parameter(t)
-        if len(table) < 3:
-            raise InvalidValueError(f"the joint table has {len(table)} rows; a surrogate needs at least 3")
+        table.check_not_empty(3, "a surrogate")
         self.encoder_ = _Encoder(table)
         X = self.encoder_.encode_columns(table.columns)
         self.targets_ = tuple(targets)
@@ -198,6 +221,7 @@ class JointSurrogate(BaseEstimator):
 
     def _predict_columns(self, columns, check_range: bool = True) -> Prediction:
         if check_range:
+            self.encoder_.check_constant(columns)
             self.encoder_.check_range(columns, self.extrapolation_tolerance)
         X = self.encoder_.encode_columns(columns)
         means, stds = {}, {}

@@ -43,6 +43,12 @@ PARAMETER_UNITS = {
 
 _HEADER = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:\[(.*)\])?\s*$")
 
+_DIRECT = ("k_yf", "k_tm", "c_yf", "c_tm")
+"""Direct terms of the joint matrices (conventions.md): positive stiffness, non-negative damping.
+The cross terms (``_ym``, ``_tf``) may have either sign."""
+
+_WHAT = {"k": "a stiffness", "c": "a damping"}
+
 
 def _dimension(unit: str) -> str:
     return str(ureg.Quantity(1.0, unit).dimensionality)
@@ -50,10 +56,67 @@ def _dimension(unit: str) -> str:
 
 def _check_unit(unit: str, field: str) -> str:
     try:
-        ureg.Quantity(1.0, unit)
+        q = ureg.Quantity(1.0, unit)
     except Exception:
         raise UnitError(f"{field}: cannot read the unit {unit!r}") from None
+    if not isinstance(q, pint.Quantity):
+        raise UnitError(f"{field}: cannot read the unit {unit!r}")
     return unit
+
+
+def _check_parameter_unit(name: str, unit: str, field: str) -> str:
+    """A parameter's unit, which must have the dimension of its SI unit when it is a joint parameter."""
+    _check_unit(unit, field)
+    si = PARAMETER_UNITS.get(name[:-4] if name.endswith("_std") else name)
+    if si is not None and _dimension(unit) != _dimension(si):
+        raise UnitError(
+            f"{field}: the unit {unit!r} ({_dimension(unit)}) is not one of {_WHAT[name[0]]} {name[:4]} "
+            f"(in {si}, {_dimension(si)})"
+        )
+    return unit
+
+
+def _check_columns(parameters: Mapping[str, str], features: Mapping[str, str | None],
+                   columns: Mapping[str, Any], locate, error=InvalidValueError) -> None:
+    """Values a joint table may hold: finite numbers, positive direct stiffness, non-negative damping and std.
+
+    ``locate(i)`` names row ``i`` (0-based) in messages; ``error`` is the class raised.
+    """
+    both = sorted(set(parameters) & set(features))
+    if both:
+        raise error(f"joint table: {', '.join(both)} is both a parameter and a feature")
+    for name in parameters:
+        values = np.asarray(columns[name], dtype=float)
+        bad = ~np.isfinite(values)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise error(f"{locate(i)}: {name} is {values[i]}; expected a finite value")
+        if name in _DIRECT:
+            wrong = values <= 0 if name.startswith("k") else values < 0
+            if wrong.any():
+                i = int(np.argmax(wrong))
+                expected = "a positive stiffness" if name.startswith("k") else "a damping >= 0"
+                raise error(f"{locate(i)}: {name} is {values[i]:g} {parameters[name]}; expected {expected} "
+                            "(a direct term of the joint matrix)")
+        std_name = name + "_std"
+        if std_name in columns:
+            stds = np.asarray(columns[std_name], dtype=float)
+            wrong = np.isinf(stds) | (stds < 0)
+            if wrong.any():
+                i = int(np.argmax(wrong))
+                raise error(f"{locate(i)}: {std_name} is {stds[i]:g}; expected a standard deviation >= 0 "
+                            "(or an empty cell when it is unknown)")
+    for name, unit in features.items():
+        if unit is None:
+            for i, value in enumerate(columns[name]):
+                if not isinstance(value, str) or not value.strip():
+                    raise error(f"{locate(i)}: {name} is {value!r}; expected a name (a categorical feature)")
+            continue
+        values = np.asarray(columns[name], dtype=float)
+        bad = ~np.isfinite(values)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise error(f"{locate(i)}: {name} is {values[i]}; expected a finite value")
 
 
 def _to_unit(value: Any, unit: str, field: str) -> float:
@@ -108,7 +171,7 @@ class JointTable:
         if not self.parameters:
             raise InvalidValueError("joint table: no parameter columns (names like k_yf, c_yf)")
         for name, unit in self.parameters.items():
-            _check_unit(unit, name)
+            _check_parameter_unit(name, unit, name)
         for name, unit in self.features.items():
             if unit is not None:
                 _check_unit(unit, name)
@@ -125,6 +188,7 @@ class JointTable:
             std = name + "_std"
             if std not in self.columns:
                 self.columns[std] = np.full(n or 0, np.nan)
+        _check_columns(self.parameters, self.features, self.columns, lambda i: f"joint table, row {i + 1}")
 
     # -- construction ---------------------------------------------------------------------
 
@@ -175,19 +239,18 @@ class JointTable:
     @classmethod
     def from_csv(cls, path: str | Path, parameters: Sequence[str] | None = None) -> "JointTable":
         """Read a table written by :meth:`to_csv` (units in brackets in the header)."""
-        path = Path(path)
-        try:
-            text = path.read_text()
-        except OSError:
-            raise
-        return cls._from_csv_text(text, str(path), parameters)
+        from ..io import read_text
+
+        return cls._from_csv_text(read_text(path), str(path), parameters)
 
     @classmethod
     def _from_csv_text(cls, text: str, where: str, parameters=None) -> "JointTable":
-        lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
-        if not lines:
+        numbered = [(k + 1, ln) for k, ln in enumerate(text.removeprefix("\ufeff").splitlines())
+                    if ln.strip() and not ln.lstrip().startswith("#")]
+        if not numbered:
             raise FileFormatError(f"{where}: the joint table is empty (no header, no rows)")
-        reader = csv.reader(lines)
+        line_of = [k for k, _ in numbered]
+        reader = csv.reader([ln for _, ln in numbered])
         header = next(reader)
         names, units = [], []
         for col in header:
@@ -196,21 +259,39 @@ class JointTable:
                 raise FileFormatError(f"{where}: cannot read the column header {col!r}; expected 'name [unit]' or 'name'")
             names.append(m.group(1))
             units.append(m.group(2).strip() if m.group(2) else None)
+        twice = sorted({n for n in names if names.count(n) > 1})
+        if twice:
+            raise FileFormatError(f"{where}, line {line_of[0]}: the column {', '.join(twice)} is given more than "
+                                  "once; keep one")
         pset = set(parameters) if parameters is not None else {n for n in names if n in PARAMETER_UNITS}
         par_units, feat_units = {}, {}
         for n, u in zip(names, units):
             if n.endswith("_std") and n[:-4] in pset:
                 continue
-            if n in pset:
-                if u is None:
-                    raise FileFormatError(f"{where}: parameter column {n!r} has no unit (write '{n} [N/m]')")
-                par_units[n] = _check_unit(u, f"{where}: column {n}")
-            else:
-                feat_units[n] = _check_unit(u, f"{where}: column {n}") if u else None
+            try:
+                if n in pset:
+                    if u is None:
+                        raise FileFormatError(f"{where}: parameter column {n!r} has no unit "
+                                              f"(write '{n} [{PARAMETER_UNITS.get(n, 'N/m')}]')")
+                    par_units[n] = _check_parameter_unit(n, u, f"{where}: column {n}")
+                else:
+                    feat_units[n] = _check_unit(u, f"{where}: column {n}") if u else None
+            except UnitError as exc:
+                raise FileFormatError(str(exc)) from None
+        for n, u in zip(names, units):
+            if n.endswith("_std") and n[:-4] in par_units and u is not None:
+                try:
+                    _check_parameter_unit(n, u, f"{where}: column {n}")
+                    if _dimension(u) != _dimension(par_units[n[:-4]]):
+                        raise UnitError(f"{where}: column {n}: the unit {u!r} does not match "
+                                        f"{n[:-4]} [{par_units[n[:-4]]}]")
+                except UnitError as exc:
+                    raise FileFormatError(str(exc)) from None
         if not par_units:
             raise FileFormatError(f"{where}: no parameter column (names like k_yf [N/m])")
         cols: dict[str, list] = {n: [] for n in names}
-        for lineno, row in enumerate(reader, start=2):
+        for row_index, row in enumerate(reader):
+            lineno = line_of[row_index + 1]
             if len(row) != len(names):
                 raise FileFormatError(f"{where}, line {lineno}: {len(row)} values, expected {len(names)}")
             for n, u, cell in zip(names, units, row):
@@ -224,15 +305,21 @@ class JointTable:
                     cols[n].append(math.nan)
                     continue
                 try:
-                    cols[n].append(float(cell))
+                    value = float(cell)
                 except ValueError:
                     raise FileFormatError(f"{where}, line {lineno}: {n} = {cell!r} is not a number") from None
+                if not math.isfinite(value):  # an unknown std is an empty cell, never a written nan
+                    raise FileFormatError(f"{where}, line {lineno}: {n} = {cell!r}; expected a finite number"
+                                          + (" (leave the cell empty for an unknown std)" if n.endswith("_std")
+                                             else ""))
+                cols[n].append(value)
         arrays = {n: np.array(v, dtype=object if (n in feat_units and feat_units[n] is None) else float)
                   for n, v in cols.items()}
         std_units = {n: u for n, u in zip(names, units) if n.endswith("_std") and n[:-4] in par_units}
         for n, u in std_units.items():
             if u is not None and u != par_units[n[:-4]]:
                 arrays[n] = np.array([ureg.Quantity(v, u).m_as(par_units[n[:-4]]) for v in arrays[n]])
+        _check_columns(par_units, feat_units, arrays, lambda i: f"{where}, line {line_of[i + 1]}", FileFormatError)
         return cls(par_units, feat_units, arrays)
 
     # -- access ------------------------------------------------------------------------------
@@ -266,10 +353,21 @@ class JointTable:
                 f"parameter {parameter!r} is not in the table; it has {', '.join(self.parameters)}"
             )
 
-    def check_not_empty(self) -> None:
-        """Raise :class:`InvalidValueError` for a table without rows."""
+    def check_not_empty(self, minimum: int = 1, purpose: str = "") -> None:
+        """Raise :class:`InvalidValueError` for a table with fewer than ``minimum`` rows.
+
+        Parameters
+        ----------
+        minimum : int, default 1
+            The rows needed.
+        purpose : str
+            What needs them, for the message (e.g. ``"a surrogate"``).
+        """
         if len(self) == 0:
             raise InvalidValueError("the joint table is empty: identify some joints and append them first")
+        if len(self) < minimum:
+            rows = "1 row" if len(self) == 1 else f"{len(self)} rows"
+            raise InvalidValueError(f"the joint table has {rows}; {purpose or 'this'} needs at least {minimum}")
 
     def feature_values(self, features: Mapping[str, Any], field: str = "features") -> dict[str, Any]:
         """Check one set of features against the table: every feature, in matching units.
@@ -365,7 +463,9 @@ class JointTable:
             w.writerow(cells)
         text = buf.getvalue()
         if path is not None:
-            Path(path).write_text(text)
+            from ..io import write_text
+
+            write_text(path, text)
         return text
 
     def to_toml(self, path: str | Path | None = None) -> str:
@@ -391,7 +491,9 @@ class JointTable:
                   "features": {f: (u if u is not None else "categorical") for f, u in self.features.items()}}
         text = tomli_w.dumps({**header, "joints": rows})
         if path is not None:
-            Path(path).write_text(text)
+            from ..io import write_text
+
+            write_text(path, text)
         return text
 
     @classmethod
@@ -412,8 +514,16 @@ class JointTable:
         for key in ("parameters", "features", "joints"):
             if key not in data:
                 raise FileFormatError(f"{where}: missing [{key}]")
+        for key in ("parameters", "features"):
+            if not isinstance(data[key], dict) or not all(isinstance(u, str) for u in data[key].values()):
+                raise FileFormatError(f"{where}: [{key}]: expected NAME = \"unit\" entries")
+        if not isinstance(data["joints"], list) or not all(isinstance(r, dict) for r in data["joints"]):
+            raise FileFormatError(f"{where}: joints: expected [[joints]] tables")
         features = {f: (None if u == "categorical" else u) for f, u in data["features"].items()}
-        table = cls.empty(data["parameters"], features)
+        try:
+            table = cls.empty(data["parameters"], features)
+        except (InvalidValueError, UnitError) as exc:
+            raise FileFormatError(f"{where}: {exc}") from None
         for i, row in enumerate(data["joints"]):
             try:
                 table = table.append(row)

@@ -107,6 +107,14 @@ def cross_validate(surrogate: JointSurrogate, table: JointTable, target: str, sc
             raise InvalidValueError(f"{scheme}: the table has one value of {scheme[6:]} only; nothing to hold out")
     else:
         raise InvalidValueError(f"cross-validation: got {scheme!r}; expected 'loo' or 'group:FEATURE'")
+    smallest = n - max(len(g) for g in groups)
+    if smallest < 3:
+        rows = "1 row" if n == 1 else f"{n} rows"
+        raise InvalidValueError(
+            f"cross-validation ({scheme}): the joint table has {rows}; holding out "
+            f"{'one row' if scheme == 'loo' else 'the largest group'} leaves {smallest} to fit, and a surrogate "
+            "needs at least 3"
+        )
     y = table.values(target)
     folds = []
     for held in groups:
