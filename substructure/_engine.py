@@ -5,7 +5,7 @@
 connection.  :func:`couple_substructures` applies links to substructures
 cluster by cluster, keeping only the points still needed (the bookkeeping
 here, the update of each link, line by line, in the compiled kernel
-:func:`substructure._kernels.couple_link`); :func:`apply_connection` is the
+``substructure._kernels.couple_link``); :func:`apply_connection` is the
 same update on a square matrix at DOF level, with numpy (any number of DOFs:
 decoupling and structural modification).  It depends only on
 :mod:`substructure._blocks` and :mod:`substructure._kernels`, so that beams
@@ -156,7 +156,7 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
     matrices stay as small as the interfaces.  Each step is the update of
     :func:`apply_connection`, with the zero off-diagonal blocks of two
     uncoupled clusters skipped, computed by
-    :func:`substructure._kernels.couple_link` (the 2x2 determinants
+    ``substructure._kernels.couple_link`` (the 2x2 determinants
     compensated near singular lines, so that a line next to a natural
     frequency is not lost to rounding).
     """

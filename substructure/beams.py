@@ -17,7 +17,7 @@ equations, with no discretisation and no modal truncation:
 
 Receptances between any points of a free-free stepped beam follow from the
 transfer matrices between the points and the free-end conditions (see
-:func:`_chain_receptance`): one 2x2 inversion per frequency line, singular
+``_chain_receptance``): one 2x2 inversion per frequency line, singular
 only at the beam's own natural frequencies, with the rigid-body ``omega^2``
 factor carried exactly, so that the lowest lines are as accurate as the
 rest.  The segment dynamic stiffness (for joints of beam pieces and for

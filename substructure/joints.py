@@ -44,7 +44,7 @@ _DIMENSIONS = {
 class JointMatrix:
     """A 2x2 joint stiffness or damping matrix with units per entry.
 
-    Build it with :meth:`from_mapping` from ``{"yf": "4.19e7 N/m", "tm": ...}``
+    Build it with :meth:`JointMatrix.from_mapping` from ``{"yf": "4.19e7 N/m", "tm": ...}``
     (missing entries are 0).  ``values`` holds SI floats ``[[yf, ym], [tf, tm]]``.
     """
 

@@ -75,7 +75,7 @@ class ClosedFormResult:
         """Lines where a relative error ``noise`` of the measured coupled
         receptances gives at most ``tolerance`` relative error in ``K``.
 
-        Uses :attr:`amplification`, a first-order estimate of how the relative
+        Uses ``amplification``, a first-order estimate of how the relative
         error of ``Y_c`` grows through eq. 2.3: the cancellation in
         ``T11 - Y_c`` (``||T11|| / ||T11 - Y_c||``) times the condition numbers
         of the two inversions that follow.  The thesis's observation that the

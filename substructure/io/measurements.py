@@ -271,7 +271,7 @@ def loads_measurements(text: str, base_dir: str | os.PathLike = ".", source: str
     -------
     MeasurementSet
         Measurements in the order of the ``[[frf]]`` tables, receptances.
-        :attr:`Measurement.quantity` is the quantity the file gave (for a
+        ``Measurement.quantity`` is the quantity the file gave (for a
         UFF record without ``quantity``: the one the record states, by
         default receptance).
 

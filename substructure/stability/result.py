@@ -141,7 +141,7 @@ class Lobes:
         return out
 
     def plot(self, ax: Any = None, **kw: Any):
-        """Draw onto ``ax`` (new figure when None) with :func:`~substructure.stability.plotting.plot_lobes`.
+        """Draw onto ``ax`` (new figure when None) with ``substructure.stability.plotting.plot_lobes``.
 
         Call it again with the same ``ax`` to put several results on one plot.
         """
@@ -173,7 +173,7 @@ class LobesBand:
     label: str | None = None
 
     def plot(self, ax: Any = None, **kw: Any):
-        """Shade the band and draw the nominal lobes (:func:`~substructure.stability.plotting.plot_band`)."""
+        """Shade the band and draw the nominal lobes (``substructure.stability.plotting.plot_band``)."""
         from .plotting import plot_band
 
         return plot_band(self, ax=ax, **kw)

@@ -245,7 +245,7 @@ class JointTable:
         return len(self)
 
     def values(self, parameter: str) -> np.ndarray:
-        """The column of ``parameter`` in its unit (:attr:`parameters`)."""
+        """The column of ``parameter`` in its unit (``parameters``)."""
         self._check_parameter(parameter)
         return np.asarray(self.columns[parameter], dtype=float)
 
