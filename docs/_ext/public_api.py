@@ -100,9 +100,9 @@ def _candidate_modules(package: str = PACKAGE) -> list[str]:
     return [package] + packages + modules
 
 
-def _kind(obj) -> str:
+def _kind(obj, package: str = PACKAGE) -> str:
     """How a name is documented: 'class', 'exception', 'function' or 'data'."""
-    own = str(getattr(obj, "__module__", "") or "").split(".")[0] == PACKAGE
+    own = str(getattr(obj, "__module__", "") or "").split(".")[0] == package
     if inspect.isclass(obj) and own:
         return "exception" if issubclass(obj, BaseException) else "class"
     if callable(obj) and own and hasattr(obj, "__name__") and not inspect.isclass(obj):
@@ -133,7 +133,7 @@ def public_modules(package: str = PACKAGE) -> list[PublicModule]:
             if not hasattr(module, name):
                 raise AttributeError(f"{modname}.__all__ lists {name!r}, which the module does not define")
             obj = getattr(module, name)
-            kind = _kind(obj)
+            kind = _kind(obj, package)
             if kind != "data":  # functions and classes: documented once, where first exported
                 if id(obj) in seen:
                     continue
@@ -231,7 +231,7 @@ def _attribute_doc(module, name: str) -> str | None:
     return None
 
 
-def members(cls) -> list[str]:
+def members(cls, package: str = PACKAGE) -> list[str]:
     """The public methods and properties of a class that its page documents.
 
     Members defined by the project's own classes, inherited ones included;
@@ -242,6 +242,8 @@ def members(cls) -> list[str]:
     ----------
     cls : type
         A class of the project.
+    package : str
+        The top-level package: members defined in it are documented.
 
     Returns
     -------
@@ -258,7 +260,7 @@ def members(cls) -> list[str]:
                 break
         else:
             continue
-        if not str(getattr(klass, "__module__", "")).startswith(PACKAGE):
+        if str(getattr(klass, "__module__", "")).split(".")[0] != package:
             continue
         if isinstance(raw, (staticmethod, classmethod)):
             raw = raw.__func__
@@ -288,7 +290,7 @@ def documented_objects(package: str = PACKAGE) -> list[tuple[str, object, str]]:
             cls = getattr(entry.module, name)
             kind = "exception" if name in entry.exceptions else "class"
             out.append((f"{entry.name}.{name}", cls, kind))
-            for member in members(cls):
+            for member in members(cls, package):
                 raw = inspect.getattr_static(cls, member)
                 out.append((f"{entry.name}.{name}.{member}", getattr(cls, member),
                             "property" if isinstance(raw, property) else "method"))
