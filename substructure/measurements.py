@@ -8,7 +8,7 @@ campaign on one frequency axis, builds the translational receptance matrices
 that identification needs (:meth:`MeasurementSet.matrix`, using reciprocity
 only when asked to) and checks itself against an assembly
 (:meth:`MeasurementSet.validate`).  Both are frozen value objects; files in
-the format of formats.md ("Measurement set (TOML)") are read by
+the format of docs/file-formats.md ("Measurement set (TOML)") are read by
 :mod:`substructure.io.measurements`.
 """
 

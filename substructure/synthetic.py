@@ -5,7 +5,7 @@ FRFs a tap test would give on an assembly (with the sensors that were on and
 the components that were off), adds multiplicative complex noise of a given
 level with a fixed seed, and returns a
 :class:`~substructure.measurements.MeasurementSet`; :func:`write_measurement_set`
-saves it as CSV files plus the measurement TOML of formats.md.
+saves it as CSV files plus the measurement TOML of docs/file-formats.md.
 """
 
 from __future__ import annotations
@@ -74,7 +74,7 @@ def _file_name(m: Measurement, i: int) -> str:
 
 def write_measurement_set(measurements: MeasurementSet | Sequence[Measurement], directory, name: str | None = None,
                           file_name: str = "measurements.toml", overwrite: bool = False) -> Path:
-    """Write measurements as CSV files and a measurement TOML (formats.md) into ``directory``.
+    """Write measurements as CSV files and a measurement TOML (docs/file-formats.md) into ``directory``.
 
     Returns the path of the TOML file.  Existing files are not overwritten
     unless ``overwrite`` is true.

@@ -229,14 +229,20 @@ def error_bands(model: FRF, measured: FRF, share: float = 0.5, width_hz: float |
 class Comparison:
     """Model against measurement: the numbers a report needs.
 
-    Attributes
+    Parameters
     ----------
+    model : FRF
+        The model's FRF (m/N for a tool point H).
+    measured : FRF
+        The measured FRF, on the same lines and labels.
     error : float
         The error measure (:data:`METRIC`).
     noise_floor : float
         The error a perfect model would show (estimated from the data).
     frac : float
+        Frequency response assurance criterion, in [0, 1] (1: same shape).
     modes : list of ModePair
+        Measured and model peaks paired, with their shifts in Hz and height ratios.
     bands : list of (lo, hi, share)
         Where the error is.
     """

@@ -66,7 +66,19 @@ def _suggestion(a: str, b: str) -> str:
 
 @attrs.frozen
 class Candidate:
-    """One effect at one place, fitted: its error after the fit."""
+    """One effect at one place, fitted: its error after the fit.
+
+    Parameters
+    ----------
+    effect : Effect
+        The effect with its fitted values (SI units of its parameters).
+    error : float
+        The error measure after the fit (dimensionless, :data:`METRIC`).
+    nfev : int
+        Model evaluations the fit took.
+    added : tuple of Effect
+        Effects added earlier in the refinement, refitted with this one.
+    """
 
     effect: Effect = attrs.field(eq=False)
     error: float
@@ -89,7 +101,17 @@ class Candidate:
 @attrs.frozen
 class Step:
     """One step of the refinement: the effect added (None at step 0), with its values as fitted at
-    that step, and the error after it (earlier effects refitted with it)."""
+    that step, and the error after it (earlier effects refitted with it).
+
+    Parameters
+    ----------
+    step : int
+        The step number, 0 for the model as given.
+    added : Effect or None
+        The effect added at this step, with its values then (None at step 0).
+    error : float
+        The error measure after the step (dimensionless).
+    """
 
     step: int
     added: Effect | None = attrs.field(eq=False)
@@ -105,7 +127,39 @@ class Step:
 
 @attrs.frozen
 class Diagnosis:
-    """What :func:`diagnose` found.  ``to_json`` gives the JSON of formats.md."""
+    """What :func:`diagnose` found.  ``to_json`` gives the JSON of ``substructure diagnose --json``.
+
+    Parameters
+    ----------
+    metric : str
+        The error measure's name, :data:`METRIC`.
+    baseline_error : float
+        The error of the model as given (dimensionless).
+    noise_floor : float
+        The error a perfect model would show, estimated from the data.
+    missing_effect : str or None
+        The name of the effect found missing; None when nothing beats the noise floor.
+    missing_where : str or None
+        Where it acts (a point or a joint name).
+    ambiguous_with : tuple of str
+        Other effects that fit as well (the data cannot tell them apart).
+    suggestion : str or None
+        How to tell the ambiguous effects apart.
+    candidates : tuple of Candidate
+        Every effect at every place, fitted, the best first.
+    refinement : tuple of Step
+        The refinement's steps: the error falling as effects are added.
+    band : tuple of float
+        The frequency band compared, ``(lo, hi)`` in Hz.
+    baseline : tuple of Comparison
+        The model as given against each measurement.
+    final : tuple of Comparison
+        The refined model against each measurement.
+    refined_assembly : Assembly
+        The model with the effects added.
+    final_effects : tuple of Effect
+        The effects added, with their final (jointly refitted) values.
+    """
 
     metric: str
     baseline_error: float

@@ -67,7 +67,23 @@ def get_effect(name: str) -> type:
 
 @attrs.frozen
 class Parameter:
-    """A bounded parameter of an effect, in SI ``unit``; fitted on a log scale when ``log``."""
+    """A bounded parameter of an effect, in SI ``unit``; fitted on a log scale when ``log``.
+
+    Parameters
+    ----------
+    name : str
+        The parameter's name (``mass``, ``k_yf``).
+    unit : str
+        Its SI unit (``kg``, ``N/m``).
+    lower : float
+        Lower bound, in ``unit``.
+    upper : float
+        Upper bound, in ``unit``.
+    start : float
+        Starting value of the fit, in ``unit``.
+    log : bool
+        Fit the logarithm (for positive values spanning decades).
+    """
 
     name: str
     unit: str

@@ -52,18 +52,20 @@ def _cond2(a: np.ndarray) -> np.ndarray:
 class ClosedFormResult:
     """The joint's complex stiffness at every frequency line (thesis eq. 2.3).
 
-    Attributes
+    Parameters
     ----------
     frequency : Frequency
+        The frequency lines, in Hz.
     stiffness : ndarray, shape (n_freq, 2, 2)
-        ``K = k + i omega c``, entries ``[[yf, ym], [tf, tm]]``.
-    amplification : ndarray
-        First-order factor by which a relative error of the coupled
-        receptances grows into ``K`` at each line (see :meth:`reliable`).
+        ``K = k + i omega c`` (thesis eq. 2.5), entries ``[[yf, ym], [tf, tm]]`` in N/m, N, N/rad
+        and N m/rad.
     condition : dict of str to ndarray
         Condition numbers (2-norm, each matrix equilibrated by its diagonal)
         of the inverted matrices per line: ``"T12"``,
         ``"T21"``, ``"W"`` (``T12^-1 (T11 - Y_c) T21^-1``) and ``"K_inv"``.
+    amplification : ndarray
+        First-order factor by which a relative error of the coupled
+        receptances grows into ``K`` at each line (see :meth:`reliable`).
     """
 
     frequency: Frequency

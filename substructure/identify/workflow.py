@@ -37,6 +37,35 @@ class IdentificationReport:
     values (standard deviation 0 for entries that were not fitted);
     ``measured``, ``initial`` and ``predicted`` are the first measured FRF and
     the model's FRF there before and after the fit.
+
+    Parameters
+    ----------
+    joint : str
+        The joint's name.
+    band : tuple of float
+        The band fitted, ``(lo, hi)`` in Hz.
+    k : dict
+        Stiffness entries ``yf, ym, tf, tm`` in N/m, N, N/rad and N m/rad.
+    c : dict
+        Damping entries in N s/m, N s, N s/rad and N m s/rad.
+    k_std : dict
+        Standard deviations of ``k``, same units (0 where not fitted).
+    c_std : dict
+        Standard deviations of ``c``, same units.
+    fitted : tuple of str
+        The parameters fitted (``k_yf``, ...).
+    warnings : tuple of str
+        Problems found (a non-passive result, a poor fit).
+    measured : FRF
+        The first measured FRF (m/N for H).
+    initial : FRF
+        The model's FRF there before the fit.
+    predicted : FRF
+        The model's FRF there after the fit.
+    residual_rms : float
+        Relative RMS of the fit's residual (dimensionless).
+    closed_form : ClosedFormResult or None
+        The closed form of thesis eq. 2.3, when the data allowed it.
     """
 
     joint: str
@@ -54,7 +83,7 @@ class IdentificationReport:
     closed_form: ClosedFormResult | None = None
 
     def to_json(self) -> dict:
-        """The JSON object of formats.md (SI units, Hz), plus a few added keys."""
+        """The JSON object of docs/file-formats.md (SI units, Hz), plus a few added keys."""
         return {
             "joint": self.joint,
             "band_hz": [self.band[0], self.band[1]],

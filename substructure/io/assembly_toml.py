@@ -1,4 +1,4 @@
-"""Assembly files (TOML): read and write assemblies in the format of formats.md.
+"""Assembly files (TOML): read and write assemblies in the format of docs/file-formats.md.
 
 :func:`load_assembly` and :func:`loads_assembly` read a file or a string into
 an :class:`~substructure.assembly.Assembly`; :func:`save_assembly` and
@@ -54,7 +54,7 @@ _MATRIX_KEYS = ("yf", "ym", "tf", "tm")
 _MISSING = object()
 _FIELD = re.compile(r"^([A-Za-z_][A-Za-z0-9_.\[\]]*): (.*)$", re.DOTALL)
 _HEADER = re.compile(r"^\s*(\[\[?)\s*([^\[\]#]+?)\s*\]\]?\s*(?:#.*)?$")
-_HEADER_COMMENT = "# substructure assembly file (formats.md): units on every dimensional value\n"
+_HEADER_COMMENT = "# substructure assembly file (docs/file-formats.md): units on every dimensional value\n"
 
 
 def _path(parts) -> str:
@@ -329,7 +329,7 @@ def loads_assembly(text: str, source: str = "<string>") -> Assembly:
     Parameters
     ----------
     text : str
-        The TOML document (formats.md, "Assembly file").
+        The TOML document (docs/file-formats.md, "Assembly file").
     source : str
         Name of the text in error messages, e.g. the file name.
 
@@ -499,7 +499,7 @@ def _body(table: dict) -> list[str]:
 
 
 def _emit(doc: dict) -> str:
-    """The document laid out as formats.md shows it: tables per section, segments one per line."""
+    """The document laid out as docs/file-formats.md shows it: tables per section, segments one per line."""
     out = [f"{_key(k)} = {_inline(v)}" for k, v in doc.items() if not isinstance(v, (dict, list))]
     for key, value in doc.items():
         if isinstance(value, dict) and value and all(isinstance(v, dict) for v in value.values()):

@@ -1,4 +1,4 @@
-"""Measurement files (TOML): read a measurement set in the format of formats.md.
+"""Measurement files (TOML): read a measurement set in the format of docs/file-formats.md.
 
 A measurement file says which measured FRFs exist, where they were taken and
 on what configuration::
@@ -261,7 +261,7 @@ def loads_measurements(text: str, base_dir: str | os.PathLike = ".", source: str
     Parameters
     ----------
     text : str
-        The TOML document (formats.md, "Measurement set").
+        The TOML document (docs/file-formats.md, "Measurement set").
     base_dir : str or path-like
         Directory that relative data file paths start from.
     source : str

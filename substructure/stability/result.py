@@ -43,14 +43,18 @@ def _json_numbers(values: np.ndarray) -> list:
 class Lobes:
     """A stability lobe diagram.
 
-    Attributes
+    Parameters
     ----------
     method : {"zoa", "sdm"}
+        The method: zero-order approximation or semi-discretization.
     spindle_speed_rpm : ndarray
+        Spindle speeds in rpm, increasing.
     depth_limit_m : ndarray
         Limiting axial depth of cut at each speed (``inf``: no limit found).
     chatter_frequency_hz : ndarray
         Chatter frequency at the limit (``nan`` where there is none).
+    cut : MillingCut or TurningCut
+        The cut the lobes are for.
     absolute_limit_m : float or None
         Zero-order: the speed-independent limit (the lowest depth of every
         lobe); ``None`` for semi-discretization.
@@ -64,7 +68,6 @@ class Lobes:
         the tooth passing) or ``"flip"`` (period doubling) at each speed.
     discretisation : dict
         Semi-discretization: the scheme and the numbers that define it.
-    cut : MillingCut or TurningCut
     label : str or None
         Legend label.
     """
@@ -154,15 +157,20 @@ class Lobes:
 class LobesBand:
     """The spread of lobes computed from several FRFs (e.g. an FRF uncertainty band).
 
-    Attributes
+    Parameters
     ----------
     spindle_speed_rpm : ndarray
-    lower_m, upper_m : ndarray
+        Spindle speeds in rpm, common to the members.
+    lower_m : ndarray
+        The lowest and highest depth limit at each speed over the members.
+    upper_m : ndarray
         The lowest and highest depth limit at each speed over the members.
     nominal : Lobes or None
         The result drawn as a line within the band.
     members : tuple of Lobes
+        The results the band spans.
     label : str or None
+        Legend label.
     """
 
     spindle_speed_rpm: np.ndarray = attrs.field(converter=_array, eq=_eq)
