@@ -117,6 +117,8 @@ def sweep(
     Returns
     -------
     SweepResult
+        The receptances of every variant, shape ``(n_variants, n_freq, n_out, n_in)``
+        (m/N, m/(N m), rad/N, rad/(N m)).
     """
     assemblies = list(assemblies)
     if not assemblies:

@@ -39,12 +39,21 @@ def simulate(assembly: Assembly, points: Sequence[str], excitation: str | None =
         Response points (translational DOF ``y``).
     excitation : str, optional
         Where the hammer hits; default the first point.
+    frequency : Frequency or array_like, optional
+        Frequency lines (plain numbers in Hz); default the assembly's grid.
     noise : float
         Relative level of complex Gaussian multiplicative noise (0.02 for 2 %).
     seed : int
         Seed of the noise.
     sensors, removed : sequence of str
         Sensors (names declared in the assembly) on the structure, components off.
+    name : str
+        Name of the measurement set.
+
+    Returns
+    -------
+    MeasurementSet
+        One receptance (m/N) per point, recorded with the sensors and removed components.
     """
     if noise < 0:
         raise InvalidValueError(f"noise: got {noise!r}; expected a level >= 0")
@@ -76,8 +85,25 @@ def write_measurement_set(measurements: MeasurementSet | Sequence[Measurement], 
                           file_name: str = "measurements.toml", overwrite: bool = False) -> Path:
     """Write measurements as CSV files and a measurement TOML (docs/file-formats.md) into ``directory``.
 
-    Returns the path of the TOML file.  Existing files are not overwritten
-    unless ``overwrite`` is true.
+    Existing files are not overwritten unless ``overwrite`` is true.
+
+    Parameters
+    ----------
+    measurements : MeasurementSet or sequence of Measurement
+        The measurements (receptances in m/N).
+    directory : str or os.PathLike
+        Where to write; created when missing.
+    name : str, optional
+        Name of the set in the TOML file; default the set's own.
+    file_name : str
+        Name of the TOML file.
+    overwrite : bool
+        Replace existing files.
+
+    Returns
+    -------
+    pathlib.Path
+        The path of the TOML file.
     """
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)

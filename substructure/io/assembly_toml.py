@@ -340,6 +340,11 @@ def loads_assembly(text: str, source: str = "<string>") -> Assembly:
         wrong units, non-physical values, unknown materials or component
         types and points that do not exist; the message starts with
         ``source`` and names the key path.
+
+    Returns
+    -------
+    Assembly
+        The assembly.
     """
     try:
         data = tomllib.loads(text)
@@ -349,7 +354,18 @@ def loads_assembly(text: str, source: str = "<string>") -> Assembly:
 
 
 def load_assembly(path: str | os.PathLike) -> Assembly:
-    """Read an assembly file (TOML); see :func:`loads_assembly`."""
+    """Read an assembly file (TOML); see :func:`loads_assembly`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+
+    Returns
+    -------
+    Assembly
+        The assembly; errors name the file and the key.
+    """
     name = os.fspath(path)
     text = read_text(path)
     return loads_assembly(text, source=name)
@@ -360,6 +376,11 @@ def default_assembly() -> Assembly:
 
     Read from ``substructure/data/default_assembly.toml``, which documents
     where its numbers come from.
+
+    Returns
+    -------
+    Assembly
+        The assembly, with its frequency grid (20 Hz to 5 kHz, 2 Hz).
     """
     resource = importlib.resources.files("substructure") / "data" / "default_assembly.toml"
     return loads_assembly(resource.read_text(encoding="utf-8"), source="default_assembly.toml")
@@ -520,6 +541,16 @@ def dumps_assembly(assembly: Assembly) -> str:
     material its segments use) are written to ``[materials.NAME]`` tables; a
     component's material is written once when all its segments share it.
 
+    Parameters
+    ----------
+    assembly : Assembly
+        The assembly.
+
+    Returns
+    -------
+    str
+        The TOML text, every dimensional value with its unit.
+
     Raises
     ------
     InvalidValueError
@@ -568,7 +599,9 @@ def save_assembly(assembly: Assembly, path: str | os.PathLike, overwrite: bool =
     Parameters
     ----------
     assembly : Assembly
+        The assembly.
     path : str or path-like
+        The file to write.
     overwrite : bool, default False
         Replace an existing file; without it an existing file is an error,
         so that a user's input is never overwritten silently.

@@ -104,6 +104,11 @@ def read_csv(
         Naming the file and the line, for a missing file, a wrong header, a
         row without three numbers, NaN or inf, a negative, repeated or
         decreasing frequency, or fewer than two rows.
+
+    Returns
+    -------
+    FRF
+        Shape ``(n_freq, 1, 1)``: frequencies in Hz, values as in the file (SI).
     """
     name = os.fspath(path)
     try:
@@ -337,6 +342,11 @@ def read_uff(path: str | os.PathLike, record: int | None = None, quantity: str |
     Labels come from the ID lines this module writes; records of other
     programs get ``"node<N>:y"`` / ``"node<N>:theta"`` (``dir<D>`` for other
     directions).  Values are taken as SI; unit exponents are not applied.
+
+    Returns
+    -------
+    FRF
+        Frequencies in Hz, values in SI units (m/N for a receptance y/f).
     """
     import pyuff
 
