@@ -87,13 +87,23 @@ class Candidate:
 
     @property
     def name(self) -> str:
+        """The effect's name (``"sensor_mass"``)."""
         return self.effect.name
 
     @property
     def where(self) -> str:
+        """Where the effect acts: a point or a joint name."""
         return self.effect.where
 
     def to_json(self) -> dict:
+        """The candidate as in ``substructure diagnose --json``.
+
+        Returns
+        -------
+        dict
+            ``effect``, ``where``, ``parameters`` (values with their SI units), ``error``,
+            ``explanation``.
+        """
         return {"effect": self.name, "where": self.where, "parameters": self.effect.parameters_json(),
                 "error": self.error, "explanation": self.effect.explanation}
 
@@ -118,6 +128,14 @@ class Step:
     error: float
 
     def to_json(self) -> dict:
+        """The step as in ``substructure diagnose --json``.
+
+        Returns
+        -------
+        dict
+            ``step``, ``added`` (a name or None), ``error``; ``where`` and ``parameters``
+            (values with their SI units) when an effect was added.
+        """
         out = {"step": self.step, "added": None if self.added is None else self.added.name, "error": self.error}
         if self.added is not None:
             out["where"] = self.added.where
@@ -182,6 +200,13 @@ class Diagnosis:
         return list(self.final_effects)
 
     def to_json(self) -> dict:
+        """The JSON object of ``substructure diagnose --json`` (SI units, frequencies in Hz).
+
+        Returns
+        -------
+        dict
+            The diagnosis: errors, candidates, refinement, modes and error bands.
+        """
         return {
             "metric": self.metric,
             "baseline_error": self.baseline_error,
@@ -205,11 +230,33 @@ class Diagnosis:
         }
 
     def plot_where(self, ax=None):
-        """The baseline comparison: FRFs overlaid, residual, error bands, mode shifts."""
+        """The baseline comparison: FRFs overlaid, residual, error bands, mode shifts.
+
+        Parameters
+        ----------
+        ax : Axes or sequence of Axes, optional
+            Where to draw; a new figure when None.
+
+        Returns
+        -------
+        Figure
+            The figure (never shown by the library).
+        """
         return self.baseline[0].plot(ax=ax)
 
     def plot_history(self, ax=None):
-        """The error falling step by step, against the noise floor."""
+        """The error falling step by step, against the noise floor.
+
+        Parameters
+        ----------
+        ax : Axes or sequence of Axes, optional
+            Where to draw; a new figure when None.
+
+        Returns
+        -------
+        Figure
+            The figure (never shown by the library).
+        """
         from .plots import plot_history
 
         return plot_history(self, ax=ax)
@@ -442,6 +489,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence[str] = "a
     assembly : Assembly
         The model (sensors declared in it are applied as each measurement says).
     measurements : MeasurementSet, or sequence of measurements or FRFs
+        The tap tests (receptances in m/N).
     effects : "all" or sequence of str
         Names of registered effects to consider.
     band : (lo, hi), optional
@@ -452,6 +500,11 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence[str] = "a
         Most effects the refinement adds.
     progress : bool or callable
         Report progress (to standard error when True).
+
+    Returns
+    -------
+    Diagnosis
+        The missing effect with its fitted values (SI), the candidates, and the refinement.
     """
     if effects == "all":
         names = list(EFFECTS)
