@@ -33,6 +33,8 @@ from .structure import XY_LABELS, _one_entry, xy_receptance
 
 __all__ = ["Mode", "ModalModel", "ModalFitter", "fit_modes", "MODES_CSV_HEADER", "ModalFitWarning"]
 
+#: The header of a modes CSV file (:meth:`ModalModel.from_csv`): direction ``x`` or ``y``,
+#: natural frequency in Hz, damping ratio, modal stiffness in N/m.
 MODES_CSV_HEADER = "direction,frequency_hz,damping_ratio,stiffness_n_per_m"
 
 
