@@ -54,7 +54,7 @@ myst_heading_anchors = 4  # GitHub's anchors (#8-adding-an-effect), as the pages
 myst_enable_extensions = ["colon_fence", "deflist"]
 
 # -- API reference: autodoc, autosummary, numpydoc --------------------------------------------------
-autosummary_generate = True
+autosummary_generate = True  # the list of API pages is set by docs/_ext/api_pages.py
 autosummary_imported_members = True
 autodoc_typehints = "none"  # types and units are in the numpydoc text
 autodoc_member_order = "groupwise"

@@ -353,6 +353,8 @@ class Spindle(Beam):
         Name used in point names (``"spindle"`` gives ``"spindle.tip"``).
     segments : sequence of Segment
         Base to tip.
+    description : str, optional
+        What the component is and where its numbers come from (keyword only).
     """
 
 
@@ -367,6 +369,8 @@ class Holder(Beam):
         Name used in point names (``"holder"`` gives ``"holder.tip"``).
     segments : sequence of Segment
         Base to tip.
+    description : str, optional
+        What the component is and where its numbers come from (keyword only).
 
     Notes
     -----
@@ -423,6 +427,8 @@ class Tool(Beam):
         Name used in point names (``"tool"`` gives ``"tool.tip"``).
     segments : sequence of Segment
         Base to tip.
+    description : str, optional
+        What the component is and where its numbers come from (keyword only).
     """
 
     @classmethod

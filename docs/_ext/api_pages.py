@@ -121,6 +121,9 @@ def write_pages(app, config=None) -> None:
     api = Path(app.srcdir) / "api"
     api.mkdir(exist_ok=True)
     entries = public_api.public_modules()
+    # autosummary writes the stubs of exactly these pages (not of the files Sphinx knew at the
+    # last build, which would miss a module page written for the first time now)
+    (config or app.config).autosummary_generate = ["api/index.rst"] + [f"api/{e.name}.rst" for e in entries]
     wanted = {"index.rst"} | {f"{entry.name}.rst" for entry in entries}
     for stale in api.glob("*.rst"):
         if stale.name not in wanted:
