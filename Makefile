@@ -4,8 +4,9 @@ PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
+DOCS_STAMP := $(VENV)/.installed-docs
 
-.PHONY: demo test bench examples clean
+.PHONY: demo test bench examples docs clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -27,5 +28,17 @@ bench: $(STAMP)
 examples: $(STAMP)
 	for f in examples/[0-9]*.py; do MPLBACKEND=Agg SUBSTRUCTURE_EXAMPLES_OUT=out/examples $(BIN)/python $$f || exit 1; done
 
+# The documentation site: HTML in docs/_build/html (open docs/_build/html/index.html).
+# Warnings are errors: an unresolved reference or link, a docstring the numpydoc check
+# rejects, or an example that fails, prints nothing or draws nothing fails the build.
+# The examples run here (and only here in CI); see docs/writing-docs.md.
+$(DOCS_STAMP): $(STAMP)
+	$(BIN)/python -m pip install --quiet -e ".[test,docs]"
+	touch $(DOCS_STAMP)
+
+docs: $(DOCS_STAMP)
+	MPLBACKEND=Agg $(BIN)/python -m sphinx -b html -W --keep-going docs docs/_build/html
+	@echo "docs: open docs/_build/html/index.html"
+
 clean:
-	rm -rf $(VENV) out .pytest_cache
+	rm -rf $(VENV) out .pytest_cache docs/_build docs/api docs/auto_examples

@@ -11,7 +11,8 @@ Steps: (a) free-free receptances of the components; (b) thesis eq. 2.1 and
 "measured" spindle-holder coupled to a tool model; (e) a 2 g accelerometer
 at the tool tip (thesis eq. 5.1-5.4); (f) a sweep over the tool overhang.
 
-Figures are written to $SUBSTRUCTURE_EXAMPLES_OUT (default: out/examples).
+Each step names the thesis equation it implements.  Figures are written to
+$SUBSTRUCTURE_EXAMPLES_OUT (default: out/examples).
 """
 
 # %%
@@ -38,9 +39,8 @@ inv = np.linalg.inv  # inverts stacks of matrices, shape (n_freq, 2, 2)
 
 
 def save(fig, name):
-    """Write a figure to the output directory (never shown: this runs in tests too)."""
+    """Write a figure to the output directory; it stays open, so that a notebook shows it."""
     fig.savefig(out / name, dpi=110)
-    plt.close(fig)
     print(f"    wrote {out / name}")
 
 
@@ -85,7 +85,16 @@ for part in (spindle, holder, tool):
 # relative displacement and rotation the joint then has a negative stiffness,
 # and its damping does negative work: it can feed energy into the structure.
 # The thesis made the off-diagonal terms equal (reciprocity) but did not ask
-# for passivity.  The values are accepted; we record the warnings while the
+# for passivity.  Each joint is the fully populated complex stiffness matrix of
+# thesis eq. 2.5 (y the displacement, theta the slope, f the force, m the moment):
+#
+# .. math::
+#
+#    [K] = \begin{bmatrix} k_{yf} + i\omega c_{yf} & k_{ym} + i\omega c_{ym} \\
+#          k_{\theta f} + i\omega c_{\theta f} & k_{\theta m} + i\omega c_{\theta m} \end{bmatrix}
+#    \qquad (2.5)
+#
+# The values are accepted; we record the warnings while the
 # joints are built, print them, and so keep them out of the rest of the script.
 print("2. Joints of thesis Tables 2.1 and 2.2")
 with warnings.catch_warnings(record=True) as caught:
@@ -104,8 +113,17 @@ assembly = Assembly("thesis analytical case", components=(spindle, holder, tool)
 # (a) Free-free receptances
 # -------------------------
 # A component's receptance between points is an FRF of shape (n_freq, 2p, 2p),
-# with labels "point:y" and "point:theta": at one point, [[H, L], [N, P]].
-# At low frequency a free-free beam moves as a rigid body, |H| ~ 1/(m omega^2).
+# with labels "point:y" and "point:theta": at one point, [[H, L], [N, P]], the
+# receptances of thesis eq. 2.7,
+#
+# .. math::
+#
+#    H = \frac{y}{f}, \quad N = \frac{\theta}{f}, \quad L = \frac{y}{m}, \quad P = \frac{\theta}{m}
+#    \qquad (2.7)
+#
+# computed here from the exact Timoshenko beam, not from the modal series of
+# eq. 2.8-2.11.  At low frequency a free-free beam moves as a rigid body:
+# :math:`|H| \approx 1/(m \omega^2)`.
 print("3. (a) Free-free tip receptances H = y/f")
 fig, ax = plt.subplots(figsize=(7, 4), layout="constrained")
 for part in (spindle, holder, tool):
@@ -120,8 +138,16 @@ save(fig, "01a_free_free.png")
 # %%
 # (b) Thesis eq. 2.1: the spindle-holder subassembly
 # --------------------------------------------------
-# [SH11] = [H11] - [H12] ([H22] + [K_sh]^-1 + [S11])^-1 [H21], point 1 the
-# holder tip, point 2 the holder base, S11 the spindle tip.
+# The holder (receptances H, point 1 its tip, point 2 its base) is coupled to
+# the spindle (S11 at its tip) through the spindle-holder joint K_sh:
+#
+# .. math::
+#
+#    [SH_{11}] = [H_{11}] - [H_{12}] \left[ [H_{22}] + [K_{sh}]^{-1} + [S_{11}] \right]^{-1} [H_{21}]
+#    \qquad (2.1)
+#
+# written out below with numpy, one 2x2 inversion per frequency line, and
+# compared with the library's Assembly.
 print("4. (b) Thesis eq. 2.1 against Assembly(spindle, holder)")
 S = spindle.receptance(grid, ["tip"]).data                  # (n, 2, 2)
 H = holder.receptance(grid, ["tip", "base"]).data           # (n, 4, 4): tip first, then base
@@ -136,7 +162,13 @@ print(f"    max relative difference: {rel_diff(SH11_eq, SH11.data):.1e}")
 # %%
 # (c) Thesis eq. 2.2: the tool point
 # ----------------------------------
-# [SHT11] = [T11] - [T12] ([T22] + [K_ht]^-1 + [SH11])^-1 [T21]
+# The tool (T, point 1 its tip, point 2 its base) is coupled to the
+# spindle-holder subassembly of step (b) through the holder-tool joint K_ht:
+#
+# .. math::
+#
+#    [SHT_{11}] = [T_{11}] - [T_{12}] \left[ [T_{22}] + [K_{ht}]^{-1} + [SH_{11}] \right]^{-1} [T_{21}]
+#    \qquad (2.2)
 print("5. (c) Thesis eq. 2.2 against the full assembly")
 T = tool.receptance(grid, ["tip", "base"]).data
 K_ht = np.moveaxis(ht_joint.dynamic_stiffness(grid.hz), -1, 0)
@@ -184,8 +216,16 @@ save(fig, "01bcd_coupling.png")
 # (e) A 2 g accelerometer at the tool tip
 # ---------------------------------------
 # As part of the model (Assembly.attach), or as a structural modification of
-# the sensor-free FRF (thesis eq. 5.1-5.3: add_mass); remove_mass (eq. 5.4)
-# takes it off a measurement again.
+# the sensor-free FRF (add_mass): with the modification matrix
+# :math:`[D] = -\omega^2 M` (eq. 5.2), thesis eq. 5.1 reads
+#
+# .. math::
+#
+#    [SHT_{11}]^{modified} = \left[ [I] + [SHT_{11}]^{unmodified} [D] \right]^{-1} [SHT_{11}]^{unmodified}
+#    \qquad (5.1)
+#
+# and with H alone (eq. 5.3) :math:`H_{mod} = H / (1 - \omega^2 M H)`.
+# remove_mass (eq. 5.4) takes the mass off a measurement again.
 print("7. (e) 2 g accelerometer at the tool tip")
 accelerometer = Sensor("accelerometer", "tool.tip", "2 g")
 H_mass = assembly.attach(accelerometer).receptance("tool.tip:y", frequency=grid)

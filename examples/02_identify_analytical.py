@@ -40,9 +40,8 @@ NAMES = tuple(UNITS)   # k_ym stands for k_ym = k_tf (the thesis makes them equa
 
 
 def save(fig, name):
-    """Write a figure to the output directory (never shown: this runs in tests too)."""
+    """Write a figure to the output directory; it stays open, so that a notebook shows it."""
     fig.savefig(out / name, dpi=110)
-    plt.close(fig)
     print(f"    wrote {out / name}")
 
 
@@ -75,8 +74,16 @@ truth = {name: (ht_joint.k if name[0] == "k" else ht_joint.c).get(name[2:]) for 
 # tool.base).  Eq. 2.3 needs, at every line, the 2x2 receptances [[H, L],
 # [N, P]] of side A at its joint point (SH11), of side B at the measured
 # point and the joint point (T11, T12, T21, T22), and of the coupled
-# assembly at the measured point, the tool tip (SHT11):
-#   K = [ [T12^-1 (T11 - SHT11) T21^-1]^-1 - T22 - SH11 ]^-1.
+# assembly at the measured point, the tool tip (SHT11).  Thesis eq. 2.2
+# solved for the joint gives the closed form of thesis eq. 2.3:
+#
+# .. math::
+#
+#    [K_{ht}] = \left[ \left[ [T_{12}]^{-1} \left[ [T_{11}] - [SHT_{11}] \right] [T_{21}]^{-1} \right]^{-1}
+#    - [T_{22}] - [SH_{11}] \right]^{-1} \qquad (2.3)
+#
+# Its real part is the stiffness k and its imaginary part omega times the
+# damping c (eq. 2.5), at every frequency line.
 print("2. (a) Closed form (eq. 2.3) on noise-free receptances")
 side_a, side_b, at_a, at_b = joint_sides(assembly, "holder-tool")
 print(f"    side A: {', '.join(c.name for c in side_a.components)} (at {at_a}); "
@@ -145,7 +152,9 @@ band_mean = {name: noisy.band_mean(name, band) for name in NAMES}
 # The band fit
 # ------------
 # Constant k and c fitted to the polluted tool point H over the band by least
-# squares: no matrix of measured data is inverted.  Start: the closed form's
+# squares: the model's H (eq. 2.1-2.2 with the joint of eq. 2.5) is compared
+# with the measured one, and no matrix of measured data is inverted, unlike
+# eq. 2.3.  This is the robust method the thesis asks for as future work.  Start: the closed form's
 # band means (absolute values for the dampings, which may come out negative).
 print("4. Band fit of the six parameters to the polluted tool point H")
 start = {name: abs(v) if name[0] == "c" else v for name, v in band_mean.items()}
@@ -175,7 +184,8 @@ for name in NAMES:
 
 fitted = {name: ident.values_[name] for name in ("k_yf", "c_yf")}
 fitted.update({name + "_std": ident.std_[name] for name in ("k_yf", "c_yf")})
-# Left: all lines; right: the band, with |H| on a second axis (thesis Figs 2.8b, 2.9b).
+# Left: all lines; right: the band, with the magnitude of H on a second axis
+# (thesis Figs 2.8b, 2.9b).
 fig, axes = plt.subplots(2, 2, sharex="col", figsize=(11, 6), layout="constrained")
 noisy.plot(names=("k_yf", "c_yf"), band=band, fitted=fitted, ax=axes[:, 0])
 noisy.plot(names=("k_yf", "c_yf"), band=band, fitted=fitted, ax=axes[:, 1], measured=noisyH)

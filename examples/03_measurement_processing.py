@@ -35,9 +35,8 @@ out.mkdir(parents=True, exist_ok=True)
 
 
 def save(fig, name):
-    """Write a figure to the output directory (never shown: this runs in tests too)."""
+    """Write a figure to the output directory; it stays open, so that a notebook shows it."""
     fig.savefig(out / name, dpi=110)
-    plt.close(fig)
     print(f"    wrote {out / name}")
 
 
@@ -61,10 +60,17 @@ print(f"1. The built-in model: {assembly.name}, grid {grid.start:g}-{grid.stop:g
 # ------------------------------------------------
 # Translational FRFs between the y DOFs of the tool tip and of points 5 mm and
 # 10 mm behind it (the 3x3 matrix a tap test with a roving hammer gives; here
-# computed noise-free).  estimate_rotational forms H_est = T H_meas T^T
-# (eq. 2.17): the row of T for y picks the tip, the row for theta holds the
-# weights of a backward difference at the tip (first order with 2 points,
-# second order with 3).  Positions run from the tool's base to its tip.
+# computed noise-free).  estimate_rotational forms, as thesis eq. 2.17,
+#
+# .. math::
+#
+#    [H_{est}] = \begin{bmatrix} H_{yy} & H_{\theta y}^T \\ H_{\theta y} & H_{\theta\theta} \end{bmatrix}
+#    = [T] [H_{meas}] [T]^T \qquad (2.17)
+#
+# the row of T for y picks the tip, the row for theta holds the weights of a
+# backward difference at the tip: first order with 2 points at spacing s,
+# :math:`[T_{1b}] = \begin{bmatrix} 0 & 1 \\ -1/s & 1/s \end{bmatrix}` (eq. 2.13), second order
+# with 3 points (eq. 2.16).  Positions run from the tool's base to its tip.
 print("2. (a) Rotational receptances at the tool tip by finite differences")
 points = ["tool.tip", "tool.tip-5 mm", "tool.tip-10 mm"]
 positions = positions_from(assembly, points)
@@ -188,7 +194,12 @@ print(f"    our model, tool mode (highest peak): {m0:g} Hz -> {m1:g} Hz ({m1 - m
 for who, a, b in (("thesis", f0, f1), ("model", m0, m1)):
     print(f"    effective mass of the tool mode at the tip ({who}): {2.0 / ((a / b) ** 2 - 1):.1f} g")
 
-# Thesis eq. 5.4: H_free = H / (1 + omega^2 m H), only the measured y DOF.
+# Thesis eq. 5.4, the structural modification of eq. 5.1 run backwards with
+# the mass m of the sensor, on the measured y DOF only:
+#
+# .. math::
+#
+#    H_{free} = \frac{H}{1 + \omega^2 m H} \qquad (5.4)
 compensated = remove_mass(loaded, "tool.tip:y", "2 g")
 print(f"    noise-free: compensated vs sensor-free, max |ratio - 1| = "
       f"{np.abs(compensated.data / free.data - 1).max():.1e}")

@@ -7,6 +7,10 @@ does the model lack? Here the "measured" data are made with the library's own
 model plus an effect the model does not have, and 1.5 % noise (fixed seeds),
 so that we know the answer the diagnosis should find.
 
+The first hidden effect is the one of thesis chapter 5: an accelerometer's
+mass lowers the tool mode of a tap test (thesis Table 5.1), which the
+structural modification of eq. 5.1-5.3 predicts.
+
 Steps: (a) compare the model with the tap test; (b) diagnose: every effect of
 the catalogue fitted at every place, ranked; (c) add the effect found to the
 model and save it as a TOML file; (d) the refinement: watch the error fall;
@@ -36,9 +40,8 @@ out.mkdir(parents=True, exist_ok=True)
 
 
 def save(fig, name):
-    """Write a figure to the output directory (never shown: this runs in tests too)."""
+    """Write a figure to the output directory; it stays open, so that a notebook shows it."""
     fig.savefig(out / name, dpi=110)
-    plt.close(fig)
     print(f"    wrote {out / name}")
 
 
@@ -84,9 +87,14 @@ print(f"1. Model: {model.name}; tap test: {measured.outputs[0]} / {measured.inpu
 # %%
 # (a) Compare: the error, the noise floor, the modes, where the error is
 # ----------------------------------------------------------------------
-# The error is the RMS over the band of |ln(H_model / H_measured)|: log
-# magnitude and phase (rad) together, every line weighted alike; 1 % off on
-# every line gives 0.01. The noise floor is what a perfect model would still
+# The error is the RMS over the band of the complex log ratio,
+#
+# .. math::
+#
+#    e = \sqrt{\frac{1}{n} \sum_{j=1}^{n} \left| \ln \frac{H_{model}(\omega_j)}{H_{measured}(\omega_j)} \right|^2}
+#
+# log magnitude and phase (rad) together, every line weighted alike; 1 % off
+# on every line gives 0.01. The noise floor is what a perfect model would still
 # show, estimated from the scatter of the data about a smoothed version.
 print("2. (a) Model against measurement")
 H_model = model.frf(list(measured.outputs), list(measured.inputs), measured.frequency)
@@ -104,7 +112,9 @@ save(c.plot(), "04a_where_it_fails.png")
 # (b) Diagnose: which effect is missing?
 # --------------------------------------
 # Each effect of the catalogue is fitted at each place it may act (bounded
-# least squares on the complex log ratio), and the candidates are ranked by
+# least squares on the complex log ratio; the sensor-mass effect is the
+# structural modification of thesis eq. 5.1-5.3, the joint effects change the
+# entries of eq. 2.5), and the candidates are ranked by
 # their error after the fit. The best is the missing effect only when it
 # beats what noise allows.
 d = diagnose(model, taps)

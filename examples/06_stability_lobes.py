@@ -39,9 +39,8 @@ out.mkdir(parents=True, exist_ok=True)
 
 
 def save(fig, name):
-    """Write a figure to the output directory (never shown: this runs in tests too)."""
+    """Write a figure to the output directory; it stays open, so that a notebook shows it."""
     fig.savefig(out / name, dpi=110)
-    plt.close(fig)
     print(f"    wrote {out / name}")
 
 
@@ -84,7 +83,16 @@ print(f"    peaks with a 2 g accelerometer: {with_sensor.peaks()} Hz")
 # %%
 # (c) Zero-order lobes with and without the accelerometer
 # -------------------------------------------------------
-# A rotating symmetric tool: x and y receptances are equal (xy_frf(H)).
+# A rotating symmetric tool: x and y receptances are equal (xy_frf(H)).  The
+# zero-order method (Altintas and Budak, 1995; the method behind the thesis's
+# lobes, Figures 4.5 and 5.2) takes the eigenvalues Lambda of the oriented
+# FRF at each chatter frequency and gives, for N teeth,
+#
+# .. math::
+#
+#    a_{lim} = -\frac{2\pi \Lambda_R}{N K_t} \left(1 + \left(\frac{\Lambda_I}{\Lambda_R}\right)^2\right)
+#
+# the chatter frequency and the lobe number fixing the spindle speed.
 lobes_bare = zoa(xy_frf(bare), cut, speeds, label="model, no sensor")
 lobes_sensor = zoa(xy_frf(with_sensor), cut, speeds, label="model with a 2 g accelerometer")
 print("3. Zero-order lobes (Altintas & Budak)")

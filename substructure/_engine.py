@@ -5,7 +5,7 @@
 connection.  :func:`couple_substructures` applies links to substructures
 cluster by cluster, keeping only the points still needed (the bookkeeping
 here, the update of each link, line by line, in the compiled kernel
-:func:`substructure._kernels.couple_link`); :func:`apply_connection` is the
+``substructure._kernels.couple_link``); :func:`apply_connection` is the
 same update on a square matrix at DOF level, with numpy (any number of DOFs:
 decoupling and structural modification).  It depends only on
 :mod:`substructure._blocks` and :mod:`substructure._kernels`, so that beams
@@ -31,7 +31,7 @@ __all__ = ["Connection", "Link", "interface_update", "apply_connection", "couple
 class Connection:
     """A connection between DOF groups of a receptance matrix.
 
-    Attributes
+    Parameters
     ----------
     a : tuple of int
         DOF indices on one side.
@@ -78,7 +78,20 @@ def interface_update(s: np.ndarray, stiffness: np.ndarray | None) -> np.ndarray:
 
 
 def apply_connection(y: np.ndarray, conn: Connection) -> np.ndarray:
-    """One coupling step on a frequency-last receptance matrix ``(M, M, n)``."""
+    """One coupling step on a frequency-last receptance matrix ``(M, M, n)``.
+
+    Parameters
+    ----------
+    y : ndarray
+        Complex receptances, shape ``(M, M, n_freq)`` (m/N, m/(N m), rad/N, rad/(N m)).
+    conn : Connection
+        The connection.
+
+    Returns
+    -------
+    ndarray
+        The coupled receptances, same shape and units.
+    """
     a = list(conn.a)
     if conn.b is None:
         u = y[:, a]  # Y B^T
@@ -104,7 +117,20 @@ def apply_connection(y: np.ndarray, conn: Connection) -> np.ndarray:
 
 
 def couple(y: np.ndarray, connections: Sequence[Connection]) -> np.ndarray:
-    """Apply connections one after the other; returns the coupled ``(M, M, n)`` matrix."""
+    """Apply connections one after the other.
+
+    Parameters
+    ----------
+    y : ndarray
+        Complex receptances, shape ``(M, M, n_freq)``.
+    connections : sequence of Connection
+        The connections, applied in order.
+
+    Returns
+    -------
+    ndarray
+        The coupled ``(M, M, n_freq)`` matrix, same units.
+    """
     for conn in connections:
         y = apply_connection(y, conn)
     return y
@@ -114,8 +140,17 @@ def couple(y: np.ndarray, connections: Sequence[Connection]) -> np.ndarray:
 class Link:
     """A connection between two points (2 DOFs each) of substructures, or to the ground.
 
-    ``stiffness`` is ``(2, 2, n_freq)`` acting on ``u_a - u_b`` (or ``u_a``), or
-    ``None`` for a rigid connection.
+    Parameters
+    ----------
+    a : object
+        Node key of the first point.
+    b : object or None
+        Node key of the second point; None for the ground.
+    stiffness : ndarray or None
+        Dynamic stiffness ``(2, 2, n_freq)`` acting on ``u_a - u_b`` (or ``u_a``), in N/m,
+        N/rad, N m/m and N m/rad; None for a rigid connection.
+    label : str
+        For messages.
     """
 
     a: object
@@ -156,7 +191,7 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
     matrices stay as small as the interfaces.  Each step is the update of
     :func:`apply_connection`, with the zero off-diagonal blocks of two
     uncoupled clusters skipped, computed by
-    :func:`substructure._kernels.couple_link` (the 2x2 determinants
+    ``substructure._kernels.couple_link`` (the 2x2 determinants
     compensated near singular lines, so that a line next to a natural
     frequency is not lost to rounding).
     """

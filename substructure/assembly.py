@@ -51,6 +51,20 @@ def expand_points(points: Sequence[str] | str):
     """DOF labels of point names, and where they sit: ``(labels, [(point, dof)], refs)``.
 
     A point without a DOF suffix stands for both of its DOFs ``(y, theta)``.
+
+    Parameters
+    ----------
+    points : str or sequence of str
+        Point names, with or without a DOF suffix (``"tool.tip"``, ``"tool.tip:y"``).
+
+    Returns
+    -------
+    labels : list of str
+        The DOF labels (``"tool.tip:y"``, ``"tool.tip:theta"``).
+    dof_index : list of tuple
+        For each label, ``(index of its point in refs, 0 for y or 1 for theta)``.
+    refs : list of PointRef
+        The points, in order.
     """
     points = [points] if isinstance(points, str) else list(points)
     if not points:
@@ -112,10 +126,14 @@ class Assembly:
     Parameters
     ----------
     name : str
+        Name of the assembly, in summaries and saved files.
     components : sequence
         Beams, measured components or subassemblies.
     joints : sequence of Joint
+        Connections between points of the components (stiffness in N/m, N and
+        N m/rad, damping in N s/m, N s and N m s/rad; or rigid).
     supports : sequence of Support
+        Springs and dampers from points to the ground.
     sensors : sequence of Sensor
         Bodies on the structure (they are part of the model: their mass acts).
     frequency : Frequency, optional
@@ -190,7 +208,23 @@ class Assembly:
         return ref, owner, key
 
     def component(self, name: str):
-        """The component (or the subassembly holding it) called ``name``."""
+        """The component (or the subassembly holding it) called ``name``.
+
+        Parameters
+        ----------
+        name : str
+            A component name.
+
+        Returns
+        -------
+        object
+            The component.
+
+        Raises
+        ------
+        UnknownPointError
+            When there is no such component.
+        """
         for comp in self.components:
             if comp.name == name:
                 return comp
@@ -200,6 +234,23 @@ class Assembly:
         raise UnknownPointError(f"no component {name!r} in assembly {self.name!r}")
 
     def joint(self, name: str) -> Joint:
+        """The joint called ``name``.
+
+        Parameters
+        ----------
+        name : str
+            A joint name.
+
+        Returns
+        -------
+        Joint
+            The joint.
+
+        Raises
+        ------
+        UnknownPointError
+            When there is no such joint (the message lists the joints).
+        """
         for j in self.joints:
             if j.name == name:
                 return j
@@ -207,6 +258,23 @@ class Assembly:
         raise UnknownPointError(f"no joint {name!r} in assembly {self.name!r} (joints: {known})")
 
     def sensor(self, name: str) -> Sensor:
+        """The sensor called ``name``.
+
+        Parameters
+        ----------
+        name : str
+            A sensor name.
+
+        Returns
+        -------
+        Sensor
+            The sensor.
+
+        Raises
+        ------
+        UnknownPointError
+            When there is no such sensor (the message lists the sensors).
+        """
         for s in self.sensors:
             if s.name == name:
                 return s
@@ -216,7 +284,18 @@ class Assembly:
     # -- building (each returns a new assembly) ---------------------------
 
     def add(self, *components) -> "Assembly":
-        """Add components (beams, measured components, subassemblies)."""
+        """Add components (beams, measured components, subassemblies).
+
+        Parameters
+        ----------
+        *components : object
+            The components to add.
+
+        Returns
+        -------
+        Assembly
+            A new assembly; this one is unchanged.
+        """
         return attrs.evolve(self, components=self.components + components)
 
     def connect(self, a, b: str | None = None, *, name: str | None = None,
@@ -226,6 +305,27 @@ class Assembly:
         Without ``k`` and ``c`` the connection is rigid; damping ``c`` without
         a stiffness ``k`` is refused (as :class:`Joint` refuses it), rather
         than made rigid with ``c`` lost.
+
+        Parameters
+        ----------
+        a : str or Joint
+            The first point (``"holder.tip"``), or a whole :class:`Joint`.
+        b : str, optional
+            The second point; needed when ``a`` is a point.
+        name : str, optional
+            The joint's name; default ``"joint-N"``.
+        k : mapping, optional
+            Stiffness entries ``{"yf": "4.1e7 N/m", "ym": "... N", "tf": "... N", "tm": "... N*m/rad"}``
+            (thesis eq. 2.5); None for a rigid connection.
+        c : mapping, optional
+            Damping entries ``{"yf": "... N*s/m", "ym": "... N*s", "tf": "... N*s", "tm": "... N*m*s/rad"}``.
+        rigid : bool
+            A rigid connection (same displacement and slope at both points).
+
+        Returns
+        -------
+        Assembly
+            A new assembly; this one is unchanged.
         """
         if not isinstance(a, str):
             joint = a  # a Joint, or any object of the joint protocol
@@ -242,11 +342,37 @@ class Assembly:
         return attrs.evolve(self, joints=self.joints + (joint,))
 
     def attach(self, *sensors: Sensor) -> "Assembly":
-        """Put sensors on the structure."""
+        """Put sensors on the structure.
+
+        Parameters
+        ----------
+        *sensors : Sensor
+            The sensors (their mass in kg and rotary inertia act on the model).
+
+        Returns
+        -------
+        Assembly
+            A new assembly; this one is unchanged.
+        """
         return attrs.evolve(self, sensors=self.sensors + sensors)
 
     def support(self, at: str | Support, k=None, c=None) -> "Assembly":
-        """Add springs/dampers to the ground at a point: ``support(Support(...))`` or ``support(at, k, c)``."""
+        """Add springs/dampers to the ground at a point: ``support(Support(...))`` or ``support(at, k, c)``.
+
+        Parameters
+        ----------
+        at : str or Support
+            The point (``"spindle.base"``), or a whole :class:`Support`.
+        k : mapping, optional
+            Stiffness entries ``{"yf": "... N/m", "tm": "... N*m/rad", ...}``.
+        c : mapping, optional
+            Damping entries ``{"yf": "... N*s/m", "tm": "... N*m*s/rad", ...}``.
+
+        Returns
+        -------
+        Assembly
+            A new assembly; this one is unchanged.
+        """
         sup = at if isinstance(at, Support) else Support(at, k=k, c=c)
         return attrs.evolve(self, supports=self.supports + (sup,))
 
@@ -257,6 +383,16 @@ class Assembly:
         effects of :mod:`substructure.diagnose.effects`; the result is a normal
         assembly (a sensor, a joint value, a flutes entry, a support), which
         :func:`substructure.save_assembly` writes in its usual form.
+
+        Parameters
+        ----------
+        effect : object
+            An object with ``apply(assembly) -> Assembly``.
+
+        Returns
+        -------
+        Assembly
+            The assembly the effect returns; this one is unchanged.
         """
         if not hasattr(effect, "apply"):
             raise InvalidValueError(f"effect: got {effect!r}; expected an object with apply(assembly)")
@@ -266,12 +402,34 @@ class Assembly:
         return result
 
     def with_joint(self, joint: Joint) -> "Assembly":
-        """Replace the joint of the same name."""
+        """Replace the joint of the same name.
+
+        Parameters
+        ----------
+        joint : Joint
+            The new joint; an assembly's joint of that name must exist.
+
+        Returns
+        -------
+        Assembly
+            A new assembly; this one is unchanged.
+        """
         self.joint(joint.name)
         return attrs.evolve(self, joints=tuple(joint if j.name == joint.name else j for j in self.joints))
 
     def with_component(self, component) -> "Assembly":
-        """Replace the component of the same name."""
+        """Replace the component of the same name.
+
+        Parameters
+        ----------
+        component : object
+            The new component; an assembly's component of that name must exist.
+
+        Returns
+        -------
+        Assembly
+            A new assembly; this one is unchanged.
+        """
         if not any(c.name == component.name for c in self.components):
             raise UnknownPointError(f"no component {component.name!r} in assembly {self.name!r}")
         return attrs.evolve(
@@ -279,14 +437,38 @@ class Assembly:
         )
 
     def without_sensors(self, *names: str) -> "Assembly":
-        """The assembly without the named sensors (all when none is named)."""
+        """The assembly without the named sensors (all when none is named).
+
+        Parameters
+        ----------
+        *names : str
+            Sensor names; none for all sensors.
+
+        Returns
+        -------
+        Assembly
+            A new assembly; this one is unchanged.
+        """
         for n in names:
             self.sensor(n)
         keep = tuple(s for s in self.sensors if names and s.name not in names)
         return attrs.evolve(self, sensors=keep)
 
     def without(self, *names: str) -> "Assembly":
-        """The assembly without the named components and what hangs on them."""
+        """The assembly without the named components and what hangs on them.
+
+        Joints, sensors and supports on a removed component are removed too.
+
+        Parameters
+        ----------
+        *names : str
+            Component names.
+
+        Returns
+        -------
+        Assembly
+            A new assembly; this one is unchanged.
+        """
         for n in names:
             if not any(c.name == n for c in self.components):
                 raise UnknownPointError(f"no component {n!r} in assembly {self.name!r}")
@@ -349,7 +531,21 @@ class Assembly:
         return [tuple(g) for g in groups.values()], out_keys, links
 
     def receptance_matrix(self, refs: Sequence[PointRef], frequency_hz: np.ndarray) -> np.ndarray:
-        """Coupled receptances between points, ``(2p, 2p, n)`` frequency-last (component protocol)."""
+        """Coupled receptances between points, frequency last (the component protocol).
+
+        Parameters
+        ----------
+        refs : sequence of PointRef
+            The p points.
+        frequency_hz : ndarray
+            Frequencies in Hz.
+
+        Returns
+        -------
+        ndarray
+            Complex, shape ``(2p, 2p, n_freq)``, DOFs ``(y, theta)`` per point: m/N, m/(N m),
+            rad/N and rad/(N m).
+        """
         groups, out_keys, links = self._plan(refs)
         return by_chunks(lambda f: self._compute(groups, out_keys, links, f), frequency_hz)
 
@@ -371,10 +567,36 @@ class Assembly:
         The components' receptances are computed once; :meth:`PreparedFRF.evaluate`
         then only re-couples, with some joints, sensors or supports replaced.
         Identification and diagnosis fits evaluate the model this way.
+
+        Parameters
+        ----------
+        outputs : str or sequence of str
+            Response points (``"tool.tip:y"``; without a DOF suffix, both DOFs).
+        inputs : str or sequence of str, optional
+            Excitation points; default ``outputs``.
+        frequency : Frequency or array_like, optional
+            Frequency lines (plain numbers in Hz); default the assembly's grid.
+
+        Returns
+        -------
+        PreparedFRF
+            The FRF, to be evaluated with :meth:`PreparedFRF.evaluate`.
         """
         return PreparedFRF(self, outputs, inputs, frequency)
 
     def node_key(self, ref: PointRef):
+        """A key of the physical point (the component protocol, for subassemblies).
+
+        Parameters
+        ----------
+        ref : PointRef
+            A point of one of the components.
+
+        Returns
+        -------
+        object
+            The key the owning component gives the point.
+        """
         return self._resolve(ref)[2]
 
     def frf(self, outputs: Sequence[str] | str, inputs: Sequence[str] | str | None = None,
@@ -383,11 +605,19 @@ class Assembly:
 
         Parameters
         ----------
-        outputs, inputs : str or sequence of str
-            Point names; a point without a DOF suffix stands for both its
-            DOFs ``(y, theta)``.  ``inputs`` defaults to ``outputs``.
-        frequency : Frequency or array of Hz, optional
-            Defaults to the assembly's grid.
+        outputs : str or sequence of str
+            Response points; a point without a DOF suffix stands for both its
+            DOFs ``(y, theta)``.
+        inputs : str or sequence of str, optional
+            Excitation points, likewise; default ``outputs``.
+        frequency : Frequency or array_like, optional
+            Frequency lines (plain numbers in Hz); default the assembly's grid.
+
+        Returns
+        -------
+        FRF
+            Shape ``(n_freq, n_out, n_in)``: displacement y in m or slope theta in rad per
+            force in N or moment in N m (H in m/N, L in m/(N m), N in rad/N, P in rad/(N m)).
         """
         freq = self._frequency(frequency)
         outputs = [outputs] if isinstance(outputs, str) else list(outputs)
@@ -408,12 +638,32 @@ class Assembly:
         """Receptance at ``at`` due to a load at ``to`` (default: the point receptance).
 
         Without DOF suffixes this is the 2x2 matrix ``[[H, L], [N, P]]``
-        (conventions.md); ``"tool.tip:y"`` picks one DOF.
+        (thesis eq. 2.7); ``"tool.tip:y"`` picks one DOF.
+
+        Parameters
+        ----------
+        at : str
+            Response point, with or without a DOF suffix.
+        to : str, optional
+            Excitation point; default ``at`` (a point receptance).
+        frequency : Frequency or array_like, optional
+            Frequency lines (plain numbers in Hz); default the assembly's grid.
+
+        Returns
+        -------
+        FRF
+            H in m/N, L in m/(N m), N in rad/N, P in rad/(N m).
         """
         return self.frf([at], [to if to is not None else at], frequency)
 
     def describe(self) -> str:
-        """A few lines describing the assembly, for summaries and teaching."""
+        """A few lines describing the assembly, for summaries and teaching.
+
+        Returns
+        -------
+        str
+            One line per component, joint, support and sensor, with units.
+        """
         from .components import component_info
 
         lines = [f"{self.name}:"]
@@ -435,6 +685,17 @@ class PreparedFRF:
     for joints (by name), sensors (by name) and supports (by name or label),
     which must act on the same points as the ones they replace; everything
     else (the components' free-free receptances) is reused.
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model.
+    outputs : str or sequence of str
+        Response points (``"tool.tip:y"``; without a DOF suffix, both DOFs).
+    inputs : str or sequence of str, optional
+        Excitation points; default ``outputs``.
+    frequency : Frequency or array_like, optional
+        Frequency lines (plain numbers in Hz); default the assembly's grid.
     """
 
     def __init__(self, assembly: Assembly, outputs, inputs=None, frequency=None):
@@ -475,6 +736,22 @@ class PreparedFRF:
 
         A replaced component is recomputed at the same points (it must have
         them); the others' receptances are reused.
+
+        Parameters
+        ----------
+        joints : mapping, optional
+            ``{joint name: Joint}``: joints acting between the same points.
+        sensors : mapping, optional
+            ``{sensor name: Sensor}``: sensors at the same points.
+        supports : mapping, optional
+            ``{support name or "support at POINT": Support}``.
+        components : mapping, optional
+            ``{component name: component}``, recomputed at the same points.
+
+        Returns
+        -------
+        FRF
+            The FRF at the prepared points and lines (m/N, m/(N m), rad/N, rad/(N m)).
         """
         joints, sensors, supports = dict(joints or {}), dict(sensors or {}), dict(supports or {})
         components = dict(components or {})

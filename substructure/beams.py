@@ -17,7 +17,7 @@ equations, with no discretisation and no modal truncation:
 
 Receptances between any points of a free-free stepped beam follow from the
 transfer matrices between the points and the free-end conditions (see
-:func:`_chain_receptance`): one 2x2 inversion per frequency line, singular
+``_chain_receptance``): one 2x2 inversion per frequency line, singular
 only at the beam's own natural frequencies, with the rigid-body ``omega^2``
 factor carried exactly, so that the lowest lines are as accurate as the
 rest.  The segment dynamic stiffness (for joints of beam pieces and for
@@ -92,6 +92,11 @@ def shear_coefficient(nu: float, ratio: float = 0.0) -> float:
         Poisson ratio.
     ratio : float
         Inner to outer diameter, ``m = id / od`` (0 for a solid section).
+
+    Returns
+    -------
+    float
+        The shear coefficient kappa (dimensionless).
     """
     m2 = ratio * ratio
     a = (1.0 + m2) ** 2
@@ -102,7 +107,7 @@ def shear_coefficient(nu: float, ratio: float = 0.0) -> float:
 class Section:
     """Section properties of a segment in SI units (complex with loss factor).
 
-    Attributes
+    Parameters
     ----------
     EI : complex
         Bending stiffness [N m^2].
@@ -124,7 +129,22 @@ class Section:
 
     @classmethod
     def ring(cls, od: float, id: float, material: Material) -> "Section":
-        """A circular ring of one material (``id = 0`` for a solid circle), SI inputs."""
+        """A circular ring of one material (``id = 0`` for a solid circle), SI inputs.
+
+        Parameters
+        ----------
+        od : float
+            Outer diameter in m.
+        id : float
+            Inner diameter in m (0 for a solid circle).
+        material : Material
+            The material.
+
+        Returns
+        -------
+        Section
+            The section properties, SI.
+        """
         area = math.pi / 4.0 * (od**2 - id**2)
         inertia = math.pi / 64.0 * (od**4 - id**4)
         kappa = shear_coefficient(material.nu, id / od)
@@ -145,6 +165,7 @@ class Insert:
     od : quantity or str
         Outer diameter of the insert; at most the bore (``id``) of its segment.
     material : Material or str
+        The insert's material (a catalogue name such as ``"carbide"``).
     id : quantity or str, default "0 mm"
         Inner diameter of the insert (0 for a solid shank).
     """
@@ -174,6 +195,11 @@ class Flutes:
     The fluted section is a circle of diameter ``diameter_ratio * od`` for
     both its stiffness and its mass (0.8 is a common value for two- to
     four-flute end mills).
+
+    Parameters
+    ----------
+    diameter_ratio : float
+        Equivalent diameter over the outer diameter, in (0, 1] (dimensionless).
     """
 
     diameter_ratio: float = attrs.field(converter=_ratio)
@@ -207,6 +233,7 @@ class Segment:
     id : quantity or str, default "0 mm"
         Inner diameter (bore); 0 for a solid section.
     material : Material or str, default "steel"
+        The segment's material (a catalogue name or a :class:`Material`).
     insert : Insert, optional
         A body of another material filling the bore.
     flutes : Flutes, optional
@@ -289,10 +316,16 @@ class Segment:
 
     @property
     def length_m(self) -> float:
+        """Length in m (a float)."""
         return self._si[0]
 
     def section(self) -> Section:
         """Section properties in SI units (layers summed).
+
+        Returns
+        -------
+        Section
+            EI in N m^2, kGA in N, rhoA in kg/m, rhoI in kg m.
 
         Raises
         ------
@@ -308,7 +341,13 @@ class Segment:
         return self._si[1]
 
     def mass(self) -> float:
-        """Mass of the segment (with its insert) in kg; exact for a tapered segment."""
+        """Mass of the segment (with its insert); exact for a tapered segment.
+
+        Returns
+        -------
+        float
+            The mass in kg.
+        """
         if self._taper is not None:
             from .tapers import mass
 
@@ -457,6 +496,20 @@ def segment_dynamic_stiffness(sec: Section, length: float, omega: np.ndarray):
     Each block has shape ``(2, 2, n)`` and relates the loads ``[f, m]`` applied
     at the ends to the displacements ``[y, theta]`` of the ends (1: base at
     ``x = 0``, 2: tip at ``x = length``).  Exact: no discretisation.
+
+    Parameters
+    ----------
+    sec : Section
+        Section properties, SI.
+    length : float
+        Length in m.
+    omega : ndarray
+        Angular frequencies in rad/s.
+
+    Returns
+    -------
+    tuple of ndarray
+        ``(D11, D12, D21, D22)``, complex, each ``(2, 2, n)``: N/m, N/rad, N m/m and N m/rad.
     """
     t = segment_transfer_matrix(sec, length, omega)
     t11, t12, t21, t22 = t[:2, :2], t[:2, 2:], t[2:, :2], t[2:, 2:]

@@ -61,6 +61,22 @@ COMPONENT_TYPES: dict[str, type] = {}
 def register_component(kind: str):
     """Class decorator registering a component type under ``kind``.
 
+    Parameters
+    ----------
+    kind : str
+        The name of the type in assembly files (``type = "shrink-fit-holder"``).
+
+    Returns
+    -------
+    callable
+        The decorator: it sets ``cls.kind``, adds the class to
+        :data:`COMPONENT_TYPES` and returns the class unchanged.
+
+    Raises
+    ------
+    InvalidValueError
+        When another class is already registered under ``kind``.
+
     Examples
     --------
     >>> @register_component("shrink-fit-holder")          # doctest: +SKIP
@@ -84,6 +100,17 @@ def as_frequency(frequency) -> Frequency:
     A quantity in angular units is converted explicitly, as everywhere
     (:func:`substructure.units.frequency_hz`): rad/s divided by ``2*pi``,
     rpm by 60.
+
+    Parameters
+    ----------
+    frequency : Frequency, FRF, pint.Quantity or array_like
+        The frequency lines: a Frequency, the axis of an FRF, a quantity in Hz
+        (rad/s and rpm converted: divided by 2*pi and by 60), or plain numbers in Hz.
+
+    Returns
+    -------
+    Frequency
+        The frequency axis, in Hz.
     """
     if isinstance(frequency, Frequency):
         return frequency
@@ -108,7 +135,18 @@ def as_frequency(frequency) -> Frequency:
 
 
 def dof_labels(points: Iterable[str]) -> tuple[str, ...]:
-    """DOF labels ``("p:y", "p:theta", ...)`` of point names."""
+    """DOF labels ``("p:y", "p:theta", ...)`` of point names.
+
+    Parameters
+    ----------
+    points : iterable of str
+        Point names (``"tool.tip"``).
+
+    Returns
+    -------
+    tuple of str
+        Two labels per point: the displacement ``y`` (m) and the slope ``theta`` (rad).
+    """
     return tuple(f"{p}:{d}" for p in points for d in DOFS)
 
 
@@ -153,7 +191,7 @@ class Beam:
     name : str
         Name used in point names (``"tool"`` gives ``"tool.tip"``).
     segments : sequence of Segment
-        Base to tip.
+        Base to tip (lengths and diameters with units, see :class:`Segment`).
     description : str, optional
         What the component is and where its numbers come from (keyword only;
         shown in summaries, kept in assembly files).  Catalogue holders say
@@ -176,6 +214,7 @@ class Beam:
 
     @property
     def component_names(self) -> frozenset[str]:
+        """The component names whose points this beam answers for: its own name."""
         return frozenset({self.name})
 
     @property
@@ -188,14 +227,37 @@ class Beam:
 
     @property
     def length_m(self) -> float:
+        """Total length in m (a float)."""
         return float(sum(s.length_m for s in self.segments))
 
     def mass(self) -> float:
-        """Total mass in kg (inserts included)."""
+        """Total mass (inserts included).
+
+        Returns
+        -------
+        float
+            The mass in kg.
+        """
         return float(sum(s.mass() for s in self.segments))
 
     def position(self, ref: PointRef | str) -> float:
-        """Distance of a point from the base, in metres."""
+        """Distance of a point from the base.
+
+        Parameters
+        ----------
+        ref : PointRef or str
+            A point of this beam: ``"tool.tip"``, ``"base"``, ``"@30 mm"``, ``"tip-15 mm"``.
+
+        Returns
+        -------
+        float
+            The distance from the base, in m.
+
+        Raises
+        ------
+        UnknownPointError
+            When the point is not on this beam or lies outside it.
+        """
         if isinstance(ref, str):
             ref = self._ref(ref)
         if ref.component != self.name:
@@ -221,9 +283,36 @@ class Beam:
         return min(max(x, 0.0), total)
 
     def node_key(self, ref: PointRef):
+        """A key of the physical point: two names of the same place give the same key.
+
+        Parameters
+        ----------
+        ref : PointRef
+            A point of this beam.
+
+        Returns
+        -------
+        tuple
+            ``(name, position in m rounded to 1e-12)``.
+        """
         return (self.name, round(self.position(ref), 12))
 
     def receptance_matrix(self, refs: Sequence[PointRef], frequency_hz: np.ndarray) -> np.ndarray:
+        """The free-free receptances between points, frequency last (the component protocol).
+
+        Parameters
+        ----------
+        refs : sequence of PointRef
+            The p points.
+        frequency_hz : ndarray
+            Frequencies in Hz, all > 0 (a free-free beam has no static receptance).
+
+        Returns
+        -------
+        ndarray
+            Complex, shape ``(2p, 2p, n_freq)``, DOFs ``(y, theta)`` per point: m/N, m/(N m),
+            rad/N and rad/(N m).
+        """
         f = np.asarray(frequency_hz, dtype=float)
         _positive_frequencies(f, f"component {self.name!r}")
         return stepped_beam_receptance(self.segments, [self.position(r) for r in refs], f)
@@ -239,7 +328,8 @@ class Beam:
 
         Parameters
         ----------
-        frequency : Frequency or array of Hz
+        frequency : Frequency or array_like
+            The frequency lines (plain numbers are in Hz), all > 0.
         points : sequence of str
             Point names, full (``"tool.tip"``) or local (``"tip"``, ``"base"``,
             ``"@30 mm"``, ``"tip-15 mm"``).
@@ -247,7 +337,8 @@ class Beam:
         Returns
         -------
         FRF
-            Outputs and inputs ``(p:y, p:theta)`` per point.
+            Outputs and inputs ``(p:y, p:theta)`` per point: H in m/N, L in m/(N m),
+            N in rad/N, P in rad/(N m).
         """
         freq = as_frequency(frequency)
         refs = [self._ref(p) for p in points]
@@ -259,7 +350,17 @@ class Beam:
 @register_component("spindle")
 @attrs.frozen
 class Spindle(Beam):
-    """A spindle: base at its rear end, tip at its nose."""
+    """A spindle: base at its rear end, tip at its nose.
+
+    Parameters
+    ----------
+    name : str
+        Name used in point names (``"spindle"`` gives ``"spindle.tip"``).
+    segments : sequence of Segment
+        Base to tip.
+    description : str, optional
+        What the component is and where its numbers come from (keyword only).
+    """
 
 
 @register_component("holder")
@@ -267,6 +368,17 @@ class Spindle(Beam):
 class Holder(Beam):
     """A tool holder: base at the taper end, tip at its face.
 
+    Parameters
+    ----------
+    name : str
+        Name used in point names (``"holder"`` gives ``"holder.tip"``).
+    segments : sequence of Segment
+        Base to tip.
+    description : str, optional
+        What the component is and where its numbers come from (keyword only).
+
+    Notes
+    -----
     The part of the tool inside the holder is usually modelled as an
     :class:`~substructure.beams.Insert` of the holder's bore segment
     (thesis section 2.1).  Standard holders (BT40, CAT40, HSK-A63 with ER
@@ -312,7 +424,17 @@ class Holder(Beam):
 @register_component("tool")
 @attrs.frozen
 class Tool(Beam):
-    """A cutting tool: base at the shank end, tip at the cutting end."""
+    """A cutting tool: base at the shank end, tip at the cutting end.
+
+    Parameters
+    ----------
+    name : str
+        Name used in point names (``"tool"`` gives ``"tool.tip"``).
+    segments : sequence of Segment
+        Base to tip.
+    description : str, optional
+        What the component is and where its numbers come from (keyword only).
+    """
 
     @classmethod
     def end_mill(
@@ -330,6 +452,28 @@ class Tool(Beam):
         The shank inside the holder belongs to the holder (as an insert); this
         tool is the overhang: a solid shank, then ``flute_length`` of flutes
         modelled by the equivalent diameter ``diameter_ratio * diameter``.
+
+        Parameters
+        ----------
+        diameter : str or pint.Quantity
+            Shank and cutting diameter, a length (``"12 mm"``).
+        overhang : str or pint.Quantity
+            Length out of the holder, a length.
+        flute_length : str or pint.Quantity, optional
+            Length of the fluted part at the tip, a length no longer than the
+            overhang; None (default) or zero for a plain rod.
+        material : str or Material
+            Material name in the catalogue or a :class:`Material`; default carbide.
+        diameter_ratio : float
+            Equivalent diameter of the fluted section over the diameter, in (0, 1]
+            (dimensionless); default 0.8.
+        name : str
+            Component name; default ``"tool"``.
+
+        Returns
+        -------
+        Tool
+            The overhang: a solid shank segment (if any), then the fluted segment.
         """
         from .units import quantity
 
@@ -387,16 +531,35 @@ class MeasuredComponent:
 
     @property
     def component_names(self) -> frozenset[str]:
+        """The component names in the FRF's labels: the points this component answers for."""
         return frozenset(parse_point(lbl).component for lbl in self.frf.outputs)
 
     @property
     def points(self) -> tuple[str, ...]:
+        """The point names of the FRF's labels, in order."""
         seen: dict[str, None] = {}
         for lbl in self.frf.outputs:
             seen[str(parse_point(lbl).point)] = None
         return tuple(seen)
 
     def node_key(self, ref: PointRef):
+        """A key of the physical point, after checking that both DOFs were measured.
+
+        Parameters
+        ----------
+        ref : PointRef
+            A point named in the FRF's labels.
+
+        Returns
+        -------
+        tuple
+            ``(name, point name)``.
+
+        Raises
+        ------
+        UnknownPointError
+            When the point, or one of its DOFs ``y`` and ``theta``, is not in the FRF.
+        """
         point = str(ref.point)
         missing = [f"{point}:{d}" for d in DOFS if f"{point}:{d}" not in self.frf.outputs]
         if len(missing) == 2:
@@ -411,6 +574,26 @@ class MeasuredComponent:
         return (self.name, point)
 
     def receptance_matrix(self, refs: Sequence[PointRef], frequency_hz: np.ndarray) -> np.ndarray:
+        """The measured receptances between points, frequency last (the component protocol).
+
+        Parameters
+        ----------
+        refs : sequence of PointRef
+            The p points.
+        frequency_hz : ndarray
+            Frequencies in Hz: a contiguous run of the FRF's own lines (never interpolated).
+
+        Returns
+        -------
+        ndarray
+            Complex, shape ``(2p, 2p, n_freq)``, DOFs ``(y, theta)`` per point, in m/N, m/(N m),
+            rad/N and rad/(N m).
+
+        Raises
+        ------
+        FrequencyAxisMismatchError
+            When the frequencies are not lines of the FRF.
+        """
         f = np.asarray(frequency_hz, dtype=float)
         hz = self.frf.frequency.hz
         start = int(np.searchsorted(hz, f[0])) if f.size else 0

@@ -89,7 +89,12 @@ def modify(frf: FRF, at: str, delta_stiffness) -> FRF:
     delta_stiffness : ndarray or callable
         ``(r, r, n_freq)`` with ``r`` the number of the point's DOFs present
         (y first), or a callable ``f(frequency_hz) -> (2, 2, n)`` whose block
-        for the present DOFs is used.
+        for the present DOFs is used; in N/m on y, N m/rad on theta.
+
+    Returns
+    -------
+    FRF
+        The modified FRF, same labels and units.
     """
     dofs = _point_dofs(frf, at)
     f = frf.frequency.hz
@@ -156,6 +161,23 @@ def add_mass(frf: FRF, at: str, mass, inertia=None) -> FRF:
 
     With only the ``y`` DOF of the point in the FRF, a mass without inertia is
     the scalar form ``H / (1 - omega^2 m H)``.
+
+    Parameters
+    ----------
+    frf : FRF
+        Receptances in m/N, m/(N m), rad/N, rad/(N m), with the point's DOFs among the
+        outputs and the inputs (a driving point).
+    at : str
+        The point (``"tool.tip"``).
+    mass : str or pint.Quantity
+        The mass, e.g. ``"2 g"``.
+    inertia : str or pint.Quantity, optional
+        Rotary inertia about the bending axis, e.g. ``"0.1 kg*mm^2"``; default none.
+
+    Returns
+    -------
+    FRF
+        The modified FRF, same labels and units.
     """
     m, j = _mass_si(mass, inertia)
     return modify(frf, at, _mass_stiffness(-1.0, m, j))
@@ -165,6 +187,23 @@ def remove_mass(frf: FRF, at: str, mass, inertia=None) -> FRF:
     """FRF with a rigid mass (and rotary inertia) removed from a point (thesis eq. 5.4).
 
     Use it to make an accelerometer measurement look like a laser measurement.
+
+    Parameters
+    ----------
+    frf : FRF
+        Receptances in m/N, m/(N m), rad/N, rad/(N m), with the point's DOFs among the
+        outputs and the inputs (a driving point).
+    at : str
+        The point (``"tool.tip"``).
+    mass : str or pint.Quantity
+        The mass, e.g. ``"2 g"``.
+    inertia : str or pint.Quantity, optional
+        Rotary inertia about the bending axis, e.g. ``"0.1 kg*mm^2"``; default none.
+
+    Returns
+    -------
+    FRF
+        The modified FRF, same labels and units.
     """
     m, j = _mass_si(mass, inertia)
     return modify(frf, at, _mass_stiffness(+1.0, m, j))

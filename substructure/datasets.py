@@ -36,7 +36,18 @@ TABLES = {
 
 
 def thesis_table(table: str) -> list[dict[str, str]]:
-    """Rows of a thesis table (``"2.1"``, ``"2.2"``, ``"3.1"``, ``"4.1"``, ``"4.2"``, ``"5.1"``)."""
+    """Rows of a thesis table (``"2.1"``, ``"2.2"``, ``"3.1"``, ``"4.1"``, ``"4.2"``, ``"5.1"``).
+
+    Parameters
+    ----------
+    table : str
+        The table number.
+
+    Returns
+    -------
+    list of dict
+        One ``{column: text}`` per row; the columns name their units.
+    """
     if table not in TABLES:
         raise InvalidValueError(f"table: got {table!r}; expected one of {', '.join(TABLES)}")
     text = resources.files("substructure").joinpath("data", TABLES[table]).read_text()
@@ -46,8 +57,20 @@ def thesis_table(table: str) -> list[dict[str, str]]:
 def thesis_joint(table: str = "2.2") -> tuple[dict[str, str], dict[str, str]]:
     """Joint stiffness and damping of thesis Table 2.1 or 2.2 as ``(k, c)`` mappings.
 
-    Units are those of conventions.md (k: N/m, N, N/rad, N*m/rad; c: the same
+    Units are those of docs/conventions.md (k: N/m, N, N/rad, N*m/rad; c: the same
     times s).
+
+    Parameters
+    ----------
+    table : {"2.1", "2.2"}
+        Table 2.1 (spindle-holder) or 2.2 (holder-tool).
+
+    Returns
+    -------
+    k : dict of str to str
+        Stiffness entries ``yf, ym, tf, tm`` with units (``"4.19e+07 N/m"``).
+    c : dict of str to str
+        Damping entries with units.
     """
     if table not in ("2.1", "2.2"):
         raise InvalidValueError(f"table: got {table!r}; expected '2.1' or '2.2' (full joint tables)")

@@ -158,6 +158,16 @@ class Frequency:
 
         Pint quantities are refused, to rule out a silent ``2*pi`` between
         rad/s and Hz: convert them explicitly with ``q.m_as("Hz")``.
+
+        Parameters
+        ----------
+        values : array_like
+            Frequencies in Hz, increasing.
+
+        Returns
+        -------
+        Frequency
+            The axis.
         """
         if hasattr(values, "units") and hasattr(values, "magnitude"):
             raise InvalidValueError(
@@ -199,6 +209,11 @@ class Frequency:
             Limits are compared with a relative tolerance of 1e-12 of the
             largest frequency, so that rounding of the grid does not drop a
             line that is meant to be on the limit.
+
+        Returns
+        -------
+        ndarray
+            Boolean, shape ``(n_freq,)``.
         """
         f_lo = -np.inf if lo is None else _hz(lo, "lo")
         f_hi = np.inf if hi is None else _hz(hi, "hi")
@@ -208,7 +223,18 @@ class Frequency:
         return (self.hz >= f_lo - tol) & (self.hz <= f_hi + tol)
 
     def crop(self, lo: Any = None, hi: Any = None) -> Frequency:
-        """New axis with the lines of :meth:`band_mask`; an empty band is an error."""
+        """New axis with the lines of :meth:`band_mask`; an empty band is an error.
+
+        Parameters
+        ----------
+        lo, hi : float, pint.Quantity, str or None
+            Band limits; plain numbers are in Hz; ``None`` leaves that side open.
+
+        Returns
+        -------
+        Frequency
+            The lines with ``lo <= f <= hi``, in Hz.
+        """
         mask = self.band_mask(lo, hi)
         if not mask.any():
             raise InvalidValueError(
@@ -342,7 +368,27 @@ class FRF:
         cls, frequency: Frequency, values: Any, output: str = "response", input: str = "excitation",
         quantity: str = "receptance",
     ) -> FRF:
-        """One FRF, shape ``(n_freq, 1, 1)``, from a 1-D array of ``n_freq`` complex values."""
+        """One FRF, shape ``(n_freq, 1, 1)``, from a 1-D array of ``n_freq`` complex values.
+
+        Parameters
+        ----------
+        frequency : Frequency
+            The axis, in Hz.
+        values : array_like
+            ``n_freq`` complex values, in the SI unit of the quantity (receptance
+            m/N, mobility m/(N s), accelerance m/(N s^2) for a y/f entry).
+        output : str
+            Output label, e.g. ``"tool.tip:y"``.
+        input : str
+            Input label.
+        quantity : {"receptance", "mobility", "accelerance"}
+            What the values are.
+
+        Returns
+        -------
+        FRF
+            The one-entry FRF.
+        """
         values = np.asarray(values)
         if values.ndim != 1:
             raise InvalidValueError(f"values: got shape {values.shape}; expected a 1-D array of n_freq values")
@@ -366,7 +412,20 @@ class FRF:
         return [have.index(x) for x in wanted]
 
     def entry(self, output: str, input: str) -> np.ndarray:
-        """The 1-D complex FRF from ``input`` to ``output`` (read-only view)."""
+        """The 1-D complex FRF from ``input`` to ``output`` (read-only view).
+
+        Parameters
+        ----------
+        output : str
+            One output label.
+        input : str
+            One input label.
+
+        Returns
+        -------
+        ndarray
+            Complex, shape ``(n_freq,)``, in the entry's unit (:meth:`unit`).
+        """
         if not isinstance(output, str) or not isinstance(input, str):
             raise InvalidValueError(
                 f"output, input: got {output!r}, {input!r}; expected one label each (use select for more)"
@@ -375,7 +434,20 @@ class FRF:
         return self.data[:, i, j]
 
     def select(self, outputs: Any = None, inputs: Any = None) -> FRF:
-        """Sub-FRF with these outputs and inputs (a label or a list; ``None`` keeps all)."""
+        """Sub-FRF with these outputs and inputs (a label or a list; ``None`` keeps all).
+
+        Parameters
+        ----------
+        outputs : str or list of str, optional
+            Output labels to keep, in this order.
+        inputs : str or list of str, optional
+            Input labels to keep, in this order.
+
+        Returns
+        -------
+        FRF
+            Shape ``(n_freq, n_outputs, n_inputs)``, same units.
+        """
         rows = self._index(slice(None) if outputs is None else outputs, "output")
         cols = self._index(slice(None) if inputs is None else inputs, "input")
         outputs, inputs = [self.outputs[i] for i in rows], [self.inputs[j] for j in cols]
@@ -391,11 +463,38 @@ class FRF:
         return self.select(*key)
 
     def with_labels(self, outputs: Sequence[str], inputs: Sequence[str]) -> FRF:
-        """Same data under new output and input labels."""
+        """Same data under new output and input labels.
+
+        Parameters
+        ----------
+        outputs : sequence of str
+            New output labels, one per output.
+        inputs : sequence of str
+            New input labels, one per input.
+
+        Returns
+        -------
+        FRF
+            The relabelled FRF.
+        """
         return attrs.evolve(self, outputs=outputs, inputs=inputs)
 
     def unit(self, output: str, input: str) -> str:
-        """SI unit of one entry, from the DOF kinds and the quantity (e.g. ``"m/N"``)."""
+        """SI unit of one entry, from the DOF kinds and the quantity (e.g. ``"m/N"``).
+
+        Parameters
+        ----------
+        output : str
+            An output label (``":theta"`` for a rotation, else a displacement).
+        input : str
+            An input label (``":theta"`` for a moment, else a force).
+
+        Returns
+        -------
+        str
+            The unit: ``"m/N"``, ``"1/N"`` (m/(N m) or rad/N), ``"1/(N m)"``, with
+            ``s`` or ``s^2`` more for a mobility or an accelerance.
+        """
         self._index(output, "output"), self._index(input, "input")
         rotation, moment = output.endswith(":theta"), input.endswith(":theta")  # else y (default)
         # y/f in m/N; y/m = m/(N m) and theta/f = rad/N in 1/N; theta/m in 1/(N m)
@@ -417,7 +516,18 @@ class FRF:
         return np.abs(self.data)
 
     def phase(self, deg: bool = False) -> np.ndarray:
-        """Phase angle of the data in rad (or degrees), in (-pi, pi]."""
+        """Phase angle of the data in rad (or degrees), in (-pi, pi].
+
+        Parameters
+        ----------
+        deg : bool
+            Degrees instead of radians.
+
+        Returns
+        -------
+        ndarray
+            Same shape as the data, in rad (or deg).
+        """
         return np.angle(self.data, deg=deg)
 
     @property
@@ -432,7 +542,18 @@ class FRF:
 
     # -- frequency axis -------------------------------------------------------
     def crop(self, lo: Any = None, hi: Any = None) -> FRF:
-        """FRF restricted to ``lo <= f <= hi`` (floats in Hz, quantities or strings)."""
+        """FRF restricted to ``lo <= f <= hi`` (floats in Hz, quantities or strings).
+
+        Parameters
+        ----------
+        lo, hi : float, pint.Quantity, str or None
+            Band limits; plain numbers are in Hz; ``None`` leaves that side open.
+
+        Returns
+        -------
+        FRF
+            The lines of the band; an empty band is an error.
+        """
         mask = self.frequency.band_mask(lo, hi)
         return attrs.evolve(self, frequency=self.frequency.crop(lo, hi), data=self.data[mask])
 
@@ -446,6 +567,11 @@ class FRF:
             up to a rounding tolerance of 1e-12 of the largest frequency).
         kind : {"linear", "cubic"}
             Piecewise linear, or a not-a-knot cubic spline (needs 4 lines).
+
+        Returns
+        -------
+        FRF
+            The FRF on the new grid, same units.
         """
         if not isinstance(frequency, Frequency):
             raise InvalidValueError(
@@ -532,6 +658,11 @@ class FRF:
             Keep only peaks whose prominence is at least this fraction of the
             largest ``|FRF|`` of the entry (``scipy.signal.find_peaks``).
 
+        Returns
+        -------
+        ndarray
+            Peak frequencies in Hz, ascending.
+
         Notes
         -----
         A maximum at the first or last line is not a peak (it may be outside
@@ -562,6 +693,11 @@ class FRF:
         Taken over the frequency lines and every pair of labels ``p, q`` that
         are both outputs and inputs (``H_ij = H_ji``, ``L_ij = N_ji``); 0.0 when
         there is no such pair.
+
+        Returns
+        -------
+        float
+            The relative asymmetry (dimensionless).
         """
         common = [x for x in self.outputs if x in self.inputs]
         if len(common) < 2:
@@ -574,7 +710,18 @@ class FRF:
         return float((np.abs(block - transposed) / scale).max())
 
     def check_reciprocity(self, rtol: float = 1e-6) -> float:
-        """:meth:`reciprocity_error`, warning with NonReciprocalWarning above ``rtol``."""
+        """:meth:`reciprocity_error`, warning with NonReciprocalWarning above ``rtol``.
+
+        Parameters
+        ----------
+        rtol : float
+            Largest relative asymmetry accepted without a warning (dimensionless).
+
+        Returns
+        -------
+        float
+            The relative asymmetry.
+        """
         error = self.reciprocity_error()
         if error > rtol:
             message = f"FRF is not reciprocal: relative asymmetry {error:.3g} exceeds rtol={rtol:g}"
@@ -582,7 +729,13 @@ class FRF:
         return error
 
     def to_receptance(self) -> FRF:
-        """Receptance from mobility (``/ (i omega)``) or accelerance (``/ -omega**2``)."""
+        """Receptance from mobility (``/ (i omega)``) or accelerance (``/ -omega**2``).
+
+        Returns
+        -------
+        FRF
+            The receptance (m/N for y/f); this FRF itself when it is one.
+        """
         if self.quantity == "receptance":
             return self
         omega = self.frequency.omega
@@ -611,13 +764,20 @@ class FRF:
         Returns
         -------
         matplotlib.figure.Figure
+            The figure (never shown by the library).
         """
         from .plot import plot_frf
 
         return plot_frf(self, ax=ax, **kw)
 
     def to_csv(self, path: Any) -> None:
-        """Write a 1x1 FRF to a CSV file (:func:`substructure.io.frf_files.write_csv`)."""
+        """Write a 1x1 FRF to a CSV file (:func:`substructure.io.frf_files.write_csv`).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file.
+        """
         from .io.frf_files import write_csv
 
         write_csv(self, path)
@@ -625,20 +785,58 @@ class FRF:
     @classmethod
     def from_csv(cls, path: Any, output: str = "response", input: str = "excitation",
                  quantity: str = "receptance") -> FRF:
-        """Read a CSV file (:func:`substructure.io.frf_files.read_csv`)."""
+        """Read a CSV file (:func:`substructure.io.frf_files.read_csv`).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file.
+        output : str
+            Output label of the FRF read.
+        input : str
+            Input label.
+        quantity : {"receptance", "mobility", "accelerance"}
+            What the file holds.
+
+        Returns
+        -------
+        FRF
+            The FRF, shape ``(n_freq, 1, 1)``.
+        """
         from .io.frf_files import read_csv
 
         return read_csv(path, output=output, input=input, quantity=quantity)
 
     def to_uff(self, path: Any) -> None:
-        """Write type-58 records, one per entry (:func:`substructure.io.frf_files.write_uff`)."""
+        """Write type-58 records, one per entry (:func:`substructure.io.frf_files.write_uff`).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file.
+        """
         from .io.frf_files import write_uff
 
         write_uff(self, path)
 
     @classmethod
     def from_uff(cls, path: Any, record: int | None = None, quantity: str | None = None) -> FRF:
-        """Read type-58 records (:func:`substructure.io.frf_files.read_uff`)."""
+        """Read type-58 records (:func:`substructure.io.frf_files.read_uff`).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file.
+        record : int, optional
+            Read only this record (0-based); default all.
+        quantity : {"receptance", "mobility", "accelerance"}, optional
+            What the records hold when the file does not say.
+
+        Returns
+        -------
+        FRF
+            The FRF.
+        """
         from .io.frf_files import read_uff
 
         return read_uff(path, record=record, quantity=quantity)

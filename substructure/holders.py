@@ -15,7 +15,7 @@ face, to its nose: ``holder.base`` is the spindle-holder joint, as in the
 thesis, whose spindle model includes the part of the holder inside the
 spindle.  ``shank_taper=True`` adds the taper shank before the gauge line as
 a tapered segment (:mod:`substructure.tapers`); the gauge line is then at
-:attr:`HolderDesign.gauge_line` from the base.  The tool shank fills the
+``HolderDesign.gauge_line`` from the base.  The tool shank fills the
 bore over the clamped length as an :class:`~substructure.beams.Insert`
 (thesis section 2.1: the part of the tool inside the holder is coupled to it
 rigidly).  See docs/holders.md.
@@ -115,7 +115,7 @@ def catalog_parameters(name: str) -> tuple[str, ...]:
 class HolderDesign:
     """A catalogue holder resolved: its parameters, segments and description.
 
-    Attributes
+    Parameters
     ----------
     entry : str
         Catalogue name, e.g. ``"HSK-A63 shrink-fit"``.
@@ -208,6 +208,7 @@ def design(entry: str, **parameters: Any) -> HolderDesign:
     Returns
     -------
     HolderDesign
+        The parameters used (lengths with units), the segments and the description.
 
     Raises
     ------

@@ -30,7 +30,10 @@ from .units import format_quantity, quantity
 __all__ = ["JointMatrix", "Joint", "Support", "Sensor", "STIFFNESS_UNITS", "DAMPING_UNITS"]
 
 ENTRIES = ("yf", "ym", "tf", "tm")
+#: The SI unit of each stiffness entry: ``yf`` force per displacement, ``ym`` moment per
+#: displacement, ``tf`` force per rotation, ``tm`` moment per rotation (thesis eq. 2.5).
 STIFFNESS_UNITS = {"yf": "N/m", "ym": "N", "tf": "N/rad", "tm": "N*m/rad"}
+#: The SI unit of each damping entry (the stiffness units times s).
 DAMPING_UNITS = {"yf": "N*s/m", "ym": "N*s", "tf": "N*s/rad", "tm": "N*m*s/rad"}
 _DIMENSIONS = {
     "stiffness": {"yf": "[mass] / [time] ** 2", "ym": "[length] * [mass] / [time] ** 2",
@@ -44,8 +47,15 @@ _DIMENSIONS = {
 class JointMatrix:
     """A 2x2 joint stiffness or damping matrix with units per entry.
 
-    Build it with :meth:`from_mapping` from ``{"yf": "4.19e7 N/m", "tm": ...}``
+    Build it with :meth:`JointMatrix.from_mapping` from ``{"yf": "4.19e7 N/m", "tm": ...}``
     (missing entries are 0).  ``values`` holds SI floats ``[[yf, ym], [tf, tm]]``.
+
+    Parameters
+    ----------
+    kind : {"stiffness", "damping"}
+        Which matrix: the units are :data:`STIFFNESS_UNITS` or :data:`DAMPING_UNITS`.
+    entries : tuple of (str, pint.Quantity)
+        The given entries ``(key, quantity)``, keys among ``yf, ym, tf, tm``.
     """
 
     kind: str
@@ -53,6 +63,23 @@ class JointMatrix:
 
     @classmethod
     def from_mapping(cls, mapping, kind: str, field: str) -> "JointMatrix":
+        """A matrix from ``{"yf": "4.19e7 N/m", "tm": "8e4 N*m/rad", ...}``, units checked.
+
+        Parameters
+        ----------
+        mapping : mapping or JointMatrix or None
+            Entries ``yf, ym, tf, tm`` as quantities or strings with units (any units of
+            the right dimension); None for none.
+        kind : {"stiffness", "damping"}
+            Which matrix.
+        field : str
+            Name of the argument, for error messages (``"k"``, ``"c"``).
+
+        Returns
+        -------
+        JointMatrix
+            The matrix.
+        """
         if isinstance(mapping, JointMatrix):
             return mapping
         if mapping is None:
@@ -74,7 +101,18 @@ class JointMatrix:
         return cls(kind, tuple(items))
 
     def get(self, key: str) -> float:
-        """Entry ``key`` in SI units (0 when not given)."""
+        """Entry ``key`` in SI units (0 when not given).
+
+        Parameters
+        ----------
+        key : {"yf", "ym", "tf", "tm"}
+            The entry.
+
+        Returns
+        -------
+        float
+            The value in the entry's SI unit (:data:`STIFFNESS_UNITS` or :data:`DAMPING_UNITS`).
+        """
         units = STIFFNESS_UNITS if self.kind == "stiffness" else DAMPING_UNITS
         for k, q in self.entries:
             if k == key:
@@ -87,7 +125,13 @@ class JointMatrix:
         return np.array([[self.get("yf"), self.get("ym")], [self.get("tf"), self.get("tm")]])
 
     def as_dict(self) -> dict[str, str]:
-        """Entries as strings that read back to the same quantities."""
+        """Entries as strings that read back to the same quantities.
+
+        Returns
+        -------
+        dict
+            ``{key: "4.19e+07 N/m"}`` for the given entries, in their own units.
+        """
         return {k: format_quantity(q) for k, q in self.entries}
 
     def __bool__(self) -> bool:
@@ -147,6 +191,7 @@ class Joint:
     Parameters
     ----------
     name : str
+        The joint's name (``"holder-tool"``).
     between : (str, str)
         The two points, e.g. ``("holder.tip", "tool.base")``.
     k, c : mapping, optional
@@ -185,18 +230,57 @@ class Joint:
 
     @classmethod
     def rigid_between(cls, name: str, a: str, b: str) -> "Joint":
-        """A rigid joint."""
+        """A rigid joint.
+
+        Parameters
+        ----------
+        name : str
+            The joint's name.
+        a : str
+            The first point.
+        b : str
+            The second point.
+
+        Returns
+        -------
+        Joint
+            A joint with equal displacement and slope at both points.
+        """
         return cls(name, (a, b), rigid=True)
 
     def dynamic_stiffness(self, frequency_hz: np.ndarray) -> np.ndarray:
-        """``K + i omega C`` as an array ``(2, 2, n_freq)``; rigid joints have none."""
+        """``K + i omega C`` (thesis eq. 2.5) as an array ``(2, 2, n_freq)``; rigid joints have none.
+
+        Parameters
+        ----------
+        frequency_hz : array_like
+            Frequencies in Hz.
+
+        Returns
+        -------
+        ndarray
+            Complex, shape ``(2, 2, n_freq)``, entries in N/m, N, N/rad and N m/rad.
+        """
         if self.rigid:
             raise InvalidValueError(f"joint {self.name!r} is rigid: it has no finite stiffness")
         omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
         return self.k.values[:, :, None] + 1j * omega * self.c.values[:, :, None]
 
     def with_parameters(self, k=None, c=None) -> "Joint":
-        """A copy with some entries of ``k`` and ``c`` replaced (others kept)."""
+        """A copy with some entries of ``k`` and ``c`` replaced (others kept).
+
+        Parameters
+        ----------
+        k : mapping, optional
+            Stiffness entries to replace, with units (``{"yf": "1.2e7 N/m"}``).
+        c : mapping, optional
+            Damping entries to replace, with units (``{"yf": "15 N*s/m"}``).
+
+        Returns
+        -------
+        Joint
+            The new, elastic joint.
+        """
         new_k = {**self.k.as_dict(), **(k or {})}
         new_c = {**self.c.as_dict(), **(c or {})}
         return attrs.evolve(self, k=new_k, c=new_c, rigid=False)
@@ -229,6 +313,18 @@ class Support:
         _check_matrices(self.k.values, self.c.values, f"support at {self.at}")
 
     def dynamic_stiffness(self, frequency_hz: np.ndarray) -> np.ndarray:
+        """``K + i omega C`` of the support, as for a joint.
+
+        Parameters
+        ----------
+        frequency_hz : array_like
+            Frequencies in Hz.
+
+        Returns
+        -------
+        ndarray
+            Complex, shape ``(2, 2, n_freq)``, entries in N/m, N, N/rad and N m/rad.
+        """
         omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
         return self.k.values[:, :, None] + 1j * omega * self.c.values[:, :, None]
 
@@ -254,6 +350,7 @@ class Sensor:
     Parameters
     ----------
     name : str
+        The sensor's name (``"accelerometer"``).
     at : str
         The point, e.g. ``"tool.tip"``.
     mass : quantity or str
@@ -269,19 +366,45 @@ class Sensor:
 
     @classmethod
     def laser(cls, name: str, at: str) -> "Sensor":
-        """A non-contact sensor: no mass."""
+        """A non-contact sensor: no mass.
+
+        Parameters
+        ----------
+        name : str
+            The sensor's name.
+        at : str
+            The point it measures.
+
+        Returns
+        -------
+        Sensor
+            A sensor of 0 g.
+        """
         return cls(name, at, "0 g")
 
     @property
     def mass_kg(self) -> float:
+        """The mass in kg (a float)."""
         return float(self.mass.m_as("kg"))
 
     @property
     def inertia_si(self) -> float:
+        """The rotary inertia in kg m^2 (a float)."""
         return float(self.inertia.m_as("kg*m^2"))
 
     def dynamic_stiffness(self, frequency_hz: np.ndarray) -> np.ndarray:
-        """``-omega^2 diag(m, J)``, shape ``(2, 2, n_freq)``."""
+        """``-omega^2 diag(m, J)`` (thesis eq. 5.2, with the rotary inertia J).
+
+        Parameters
+        ----------
+        frequency_hz : array_like
+            Frequencies in Hz.
+
+        Returns
+        -------
+        ndarray
+            Complex, shape ``(2, 2, n_freq)``: N/m on y, N m/rad on theta.
+        """
         w2 = (2.0 * np.pi * np.asarray(frequency_hz, dtype=float)) ** 2
         out = np.zeros((2, 2, w2.size), dtype=complex)
         out[0, 0] = -w2 * self.mass_kg

@@ -101,7 +101,18 @@ class Material:
 
     @classmethod
     def from_catalog(cls, name: str) -> "Material":
-        """The catalogue material called ``name`` (see :data:`CATALOG`)."""
+        """The catalogue material called ``name`` (see :data:`CATALOG`).
+
+        Parameters
+        ----------
+        name : str
+            ``"steel"``, ``"carbide"`` or ``"aluminium"``.
+
+        Returns
+        -------
+        Material
+            The material.
+        """
         return get_material(name)
 
 
@@ -117,7 +128,25 @@ CATALOG: dict[str, Material] = {m.name: m for m in (steel, carbide, aluminium)}
 
 
 def get_material(name: str, extra: dict[str, Material] | None = None) -> Material:
-    """Look a material up by name, first in ``extra`` then in the catalogue."""
+    """Look a material up by name, first in ``extra`` then in the catalogue.
+
+    Parameters
+    ----------
+    name : str
+        The material's name.
+    extra : dict of str to Material, optional
+        Custom materials, looked up first.
+
+    Returns
+    -------
+    Material
+        The material (E and G in Pa, rho in kg/m^3).
+
+    Raises
+    ------
+    InvalidValueError
+        For an unknown name (the message lists the known ones).
+    """
     if extra and name in extra:
         return extra[name]
     if name in CATALOG:

@@ -32,10 +32,12 @@ Configuration = tuple[tuple[str, ...], tuple[str, ...]]
 class MeasurementSetError(SubstructureError, ValueError):
     """A measurement set does not fit an assembly, or lacks what a computation needs.
 
-    Attributes
+    Parameters
     ----------
-    problems : tuple of str
-        One line per problem found (the message lists them all).
+    message : str
+        The message (it lists every problem).
+    problems : sequence of str
+        One line per problem found; kept as the attribute ``problems``.
     """
 
     def __init__(self, message: str, problems: Sequence[str] = ()):
@@ -46,10 +48,13 @@ class MeasurementSetError(SubstructureError, ValueError):
 class MissingMeasurementError(MeasurementSetError):
     """FRFs needed for a receptance matrix are not in the measurement set.
 
-    Attributes
+    Parameters
     ----------
-    missing : tuple of (str, str)
-        The ``(response, excitation)`` DOF labels that are missing.
+    message : str
+        The message.
+    missing : sequence of (str, str)
+        The ``(response, excitation)`` DOF labels that are missing; kept as the
+        attribute ``missing``.
     """
 
     def __init__(self, message: str, missing: Sequence[tuple[str, str]] = ()):
@@ -63,6 +68,18 @@ def dof_label(point: Any, field: str = "point") -> str:
     ``"tool.tip"`` gives ``"tool.tip:y"``, ``"tool@30mm:theta"`` gives
     ``"tool@30 mm:theta"`` (the spelling :class:`~substructure.assembly.Assembly`
     uses in its labels).
+
+    Parameters
+    ----------
+    point : str
+        A point name, with or without a DOF suffix.
+    field : str
+        Name of the argument, for error messages.
+
+    Returns
+    -------
+    str
+        The DOF label.
 
     Raises
     ------
@@ -167,7 +184,29 @@ class Measurement:
 
         The FRF is relabelled with the canonical labels of ``response`` and
         ``excitation`` and converted to receptance; its quantity is kept in
-        :attr:`quantity`.
+        ``quantity``.
+
+        Parameters
+        ----------
+        frf : FRF
+            One entry: a receptance (m/N), mobility (m/(N s)) or accelerance (m/(N s^2)).
+        response : str
+            The response point, e.g. ``"tool.tip"`` (``:y`` by default).
+        excitation : str
+            The excitation point.
+        sensors : sequence of str
+            Sensors on the structure during the test (names declared in the assembly).
+        removed : sequence of str
+            Components absent during the test.
+        file : str, optional
+            The file the FRF came from, for messages.
+        record : int, optional
+            Its record in a universal file.
+
+        Returns
+        -------
+        Measurement
+            The measurement, its FRF a receptance in m/N.
         """
         if not isinstance(frf, FRF):
             raise InvalidValueError(f"frf: got {type(frf).__name__}; expected an FRF")
@@ -190,7 +229,13 @@ class Measurement:
         return self.frf.data[:, 0, 0]
 
     def describe(self) -> str:
-        """``response / excitation`` and, when known, the file: for messages."""
+        """``response / excitation`` and, when known, the file: for messages.
+
+        Returns
+        -------
+        str
+            The description.
+        """
         where = "" if self.file is None else f" ({self.file}{'' if self.record is None else f', record {self.record}'})"
         return f"{self.response} / {self.excitation}{where}"
 
@@ -274,7 +319,18 @@ class MeasurementSet:
 
     @classmethod
     def from_file(cls, path: str | os.PathLike) -> "MeasurementSet":
-        """Read a measurement file (:func:`substructure.io.measurements.load_measurements`)."""
+        """Read a measurement file (:func:`substructure.io.measurements.load_measurements`).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The measurement set file (TOML).
+
+        Returns
+        -------
+        MeasurementSet
+            The measurements.
+        """
         from .io.measurements import load_measurements
 
         return load_measurements(path)
@@ -298,11 +354,29 @@ class MeasurementSet:
 
         Each is a pair of sorted tuples of names, e.g.
         ``(("accelerometer",), ())`` or ``((), ("tool",))``.
+
+        Returns
+        -------
+        tuple of tuple
+            The configurations.
         """
         return tuple(dict.fromkeys(m.configuration for m in self.measurements))
 
     def select(self, sensors: Sequence[str] | str = (), removed: Sequence[str] | str = ()) -> tuple[Measurement, ...]:
-        """The measurements taken in one configuration (order does not matter); may be empty."""
+        """The measurements taken in one configuration (order does not matter); may be empty.
+
+        Parameters
+        ----------
+        sensors : str or sequence of str
+            Sensors on the structure in that configuration.
+        removed : str or sequence of str
+            Components removed in that configuration.
+
+        Returns
+        -------
+        tuple of Measurement
+            The measurements of the configuration.
+        """
         wanted = _configuration_of(sensors, removed)
         return tuple(m for m in self.measurements if m.configuration == wanted)
 
@@ -383,6 +457,11 @@ class MeasurementSet:
         sensor must be declared in the assembly (and not sit on a removed
         component); every removed name must be a component of the assembly
         (top level, as :meth:`Assembly.without` needs).
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model the measurements are of.
 
         Raises
         ------

@@ -203,6 +203,7 @@ def plot_frf(
     Returns
     -------
     matplotlib.figure.Figure
+        The figure (never shown by the library).
 
     Notes
     -----
@@ -309,6 +310,7 @@ def plot_identification(result, names=("k_yf", "c_yf"), band=None, fitted=None, 
     Parameters
     ----------
     result : substructure.identify.ClosedFormResult
+        The closed form's stiffness at every line.
     names : sequence of str
         Parameters to draw, one panel each.
     band : (lo, hi), optional
@@ -316,9 +318,16 @@ def plot_identification(result, names=("k_yf", "c_yf"), band=None, fitted=None, 
     fitted : mapping, optional
         Fitted constant values (SI) drawn as horizontal lines, with
         ``fitted[name + "_std"]`` as a shaded one-sigma strip when given.
+    ax : Axes or sequence of Axes, optional
+        One Axes per name; a new figure when None.
     measured : FRF, optional
         A measured point FRF drawn on a second axis of each panel, as the
         thesis's figures 2.8-2.9 do, to show where the modes are.
+
+    Returns
+    -------
+    Figure
+        The figure: k in N/m (or N, N/rad, N m/rad), c in N s/m (and so on) against Hz.
     """
     names = list(names)
     if ax is None:

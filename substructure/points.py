@@ -17,12 +17,27 @@ from .units import format_quantity, quantity
 
 __all__ = ["PointRef", "parse_point", "check_name", "DOFS"]
 
+#: The two degrees of freedom of a point: the displacement ``y`` (m) and the slope
+#: ``theta`` (rad), in this order in every receptance matrix.
 DOFS = ("y", "theta")
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
 
 
 def check_name(value, field: str = "name") -> str:
-    """Validate a component, joint or sensor name (letters, digits, ``_``, ``-``)."""
+    """Validate a component, joint or sensor name (letters, digits, ``_``, ``-``).
+
+    Parameters
+    ----------
+    value : str
+        The name.
+    field : str
+        Name of the argument, for error messages.
+
+    Returns
+    -------
+    str
+        The name, unchanged.
+    """
     if not isinstance(value, str) or not _NAME.match(value):
         raise InvalidValueError(
             f"{field}: got {value!r}; expected a name of letters, digits, '_' or '-' "
@@ -35,7 +50,7 @@ def check_name(value, field: str = "name") -> str:
 class PointRef:
     """A parsed point name.
 
-    Attributes
+    Parameters
     ----------
     component : str
         Name of the component the point is on.
@@ -81,6 +96,18 @@ def _distance(text: str, spec: str) -> pint.Quantity:
 
 def parse_point(spec, *, allow_dof: bool = True) -> PointRef:
     """Parse a point name such as ``"tool.tip"``, ``"spindle@310 mm"`` or ``"tool.tip-15 mm:theta"``.
+
+    Parameters
+    ----------
+    spec : str or PointRef
+        The point name.
+    allow_dof : bool
+        Accept a ``:y`` or ``:theta`` suffix.
+
+    Returns
+    -------
+    PointRef
+        The parsed point (distances as quantities).
 
     Raises
     ------

@@ -323,10 +323,12 @@ def estimate_rotational_cross(
     frf : FRF
         Translational receptances whose outputs include the ``y`` DOFs of
         ``points_a`` and whose inputs include those of ``points_b``.
-    points_a, positions_a, at_a, at_position_a
-        The response side, as in :func:`estimate_rotational`.
-    points_b, positions_b, at_b, at_position_b
+    points_a, positions_a, at_a
+        The response side, as in :func:`estimate_rotational` (positions with units).
+    points_b, positions_b, at_b
         The excitation side; may be on another component.
+    at_position_a, at_position_b : quantity or str, optional
+        Positions of ``at_a`` and ``at_b`` when they are not among the points (lengths).
 
     Returns
     -------

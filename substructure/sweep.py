@@ -42,11 +42,16 @@ __all__ = ["SweepResult", "sweep"]
 class SweepResult:
     """Receptances of every variant of a sweep.
 
-    Attributes
+    Parameters
     ----------
     frequency : Frequency
+        The frequency lines, in Hz.
     data : ndarray, shape (n_variants, n_freq, n_out, n_in)
-    outputs, inputs : tuple of str
+        Complex receptances of every variant (m/N, m/(N m), rad/N, rad/(N m)).
+    outputs : tuple of str
+        Output DOF labels (``"tool.tip:y"``).
+    inputs : tuple of str
+        Input DOF labels.
     """
 
     frequency: Frequency
@@ -112,6 +117,8 @@ def sweep(
     Returns
     -------
     SweepResult
+        The receptances of every variant, shape ``(n_variants, n_freq, n_out, n_in)``
+        (m/N, m/(N m), rad/N, rad/(N m)).
     """
     assemblies = list(assemblies)
     if not assemblies:

@@ -39,12 +39,21 @@ def simulate(assembly: Assembly, points: Sequence[str], excitation: str | None =
         Response points (translational DOF ``y``).
     excitation : str, optional
         Where the hammer hits; default the first point.
+    frequency : Frequency or array_like, optional
+        Frequency lines (plain numbers in Hz); default the assembly's grid.
     noise : float
         Relative level of complex Gaussian multiplicative noise (0.02 for 2 %).
     seed : int
         Seed of the noise.
     sensors, removed : sequence of str
         Sensors (names declared in the assembly) on the structure, components off.
+    name : str
+        Name of the measurement set.
+
+    Returns
+    -------
+    MeasurementSet
+        One receptance (m/N) per point, recorded with the sensors and removed components.
     """
     if noise < 0:
         raise InvalidValueError(f"noise: got {noise!r}; expected a level >= 0")

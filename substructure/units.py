@@ -41,6 +41,7 @@ __all__ = [
 ureg = pint.UnitRegistry()
 """The registry every quantity of the package belongs to."""
 Q_ = ureg.Quantity
+"""The quantity class of that registry: ``Q_(12, "mm")`` or ``Q_("12 mm")`` (a :class:`pint.Quantity`)."""
 
 # Human names of the dimensions the package uses, for error messages.
 _DIMENSION_NAMES = {
@@ -85,6 +86,11 @@ def quantity(value: Any, field: str, dimension: str) -> pint.Quantity:
         For a bare number, an unparsable string or a wrong dimension.
     InvalidValueError
         For a non-finite magnitude.
+
+    Returns
+    -------
+    pint.Quantity
+        The value, a scalar quantity of :data:`substructure.ureg`, in the units it was given in.
     """
     expected = _describe(dimension)
     if isinstance(value, bool) or isinstance(value, numbers.Number) or isinstance(value, np.ndarray):
@@ -127,13 +133,40 @@ def to_si(value: Any, field: str, unit: str) -> float:
     """Check ``value`` and return its magnitude in ``unit`` (an SI unit) as float.
 
     The dimension expected is that of ``unit``.
+
+    Parameters
+    ----------
+    value : pint.Quantity or str
+        The value as given by the user (``"60 mm"``).
+    field : str
+        Name of the field, used in error messages.
+    unit : str
+        The unit to return the magnitude in (``"m"``).
+
+    Returns
+    -------
+    float
+        The magnitude in ``unit``.
     """
     dimension = str(ureg.Quantity(1.0, unit).dimensionality)
     return float(quantity(value, field, dimension).m_as(unit))
 
 
 def dimensionless(value: Any, field: str) -> float:
-    """Check a dimensionless value (a plain number or a dimensionless quantity)."""
+    """Check a dimensionless value (a plain number or a dimensionless quantity).
+
+    Parameters
+    ----------
+    value : float or pint.Quantity or str
+        The value.
+    field : str
+        Name of the field, used in error messages.
+
+    Returns
+    -------
+    float
+        The value, finite.
+    """
     if isinstance(value, bool):
         raise InvalidValueError(f"{field}: got {value!r}; expected a number")
     if isinstance(value, pint.Quantity):
@@ -164,6 +197,16 @@ def format_quantity(q: pint.Quantity) -> str:
 
     ``repr`` of the float keeps every digit, so that save/load round-trips
     without loss; integral values are written without a trailing ``.0``.
+
+    Parameters
+    ----------
+    q : pint.Quantity
+        A scalar quantity.
+
+    Returns
+    -------
+    str
+        ``"magnitude unit"`` in the quantity's own unit (``"2.5 mm"``).
     """
     m = q.magnitude
     if isinstance(m, float) and m.is_integer() and abs(m) < 1e15:
@@ -179,12 +222,33 @@ def rpm_to_hz(speed_rpm: float | np.ndarray) -> float | np.ndarray:
 
     An explicit helper on purpose: pint converts ``rpm`` to ``Hz`` as angular
     velocity to frequency, which is off by ``2*pi``.
+
+    Parameters
+    ----------
+    speed_rpm : float or ndarray
+        Speeds in rpm.
+
+    Returns
+    -------
+    float or ndarray
+        The same speeds in revolutions per second (Hz).
     """
     return np.asarray(speed_rpm, dtype=float) / 60.0
 
 
 def hz_to_rpm(frequency_hz: float | np.ndarray) -> float | np.ndarray:
-    """Revolutions per second (Hz) to revolutions per minute: multiply by 60."""
+    """Revolutions per second (Hz) to revolutions per minute: multiply by 60.
+
+    Parameters
+    ----------
+    frequency_hz : float or ndarray
+        Revolutions per second (Hz).
+
+    Returns
+    -------
+    float or ndarray
+        The same speeds in rpm.
+    """
     return np.asarray(frequency_hz, dtype=float) * 60.0
 
 

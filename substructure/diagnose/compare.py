@@ -63,7 +63,22 @@ def log_ratio(model: FRF, measured: FRF) -> np.ndarray:
 
 
 def error(model: FRF, measured: FRF, mask: np.ndarray | None = None) -> float:
-    """The error measure ``rms_log_ratio`` over all entries (and the lines of ``mask``)."""
+    """The error measure ``rms_log_ratio`` over all entries (and the lines of ``mask``).
+
+    Parameters
+    ----------
+    model : FRF
+        The model's FRF (m/N for a tool point H).
+    measured : FRF
+        The measured FRF, on the same lines and labels.
+    mask : ndarray of bool, optional
+        The lines to use (``(n_freq,)``); default all.
+
+    Returns
+    -------
+    float
+        ``sqrt(mean |ln(model / measured)|^2)``: dimensionless, 0.01 for 1 % off on every line.
+    """
     r = log_ratio(model, measured)
     if mask is not None:
         r = r[mask]
@@ -97,6 +112,20 @@ def noise_floor(measured: FRF, window: int | None = None, polyorder: int = 3) ->
     the real and imaginary parts), so that the few lines where the smoother
     cannot follow the FRF (very sharp resonances, antiresonances in a noise
     floor) do not inflate it; the floor is ``sigma``.
+
+    Parameters
+    ----------
+    measured : FRF
+        The measured FRF.
+    window : int, optional
+        Odd window of the smoother, in lines; default chosen from the narrowest resonance.
+    polyorder : int
+        Order of the smoother's polynomial.
+
+    Returns
+    -------
+    float
+        The floor, on the scale of the error measure (dimensionless).
     """
     w = window or _window(measured, polyorder)
     smoothed = smooth(measured, window=w, polyorder=polyorder)
@@ -113,7 +142,20 @@ def noise_floor(measured: FRF, window: int | None = None, polyorder: int = 3) ->
 
 
 def frac(model: FRF, measured: FRF) -> float:
-    """Frequency response assurance criterion: 1 for FRFs of the same shape, 0 for unrelated."""
+    """Frequency response assurance criterion: 1 for FRFs of the same shape, 0 for unrelated.
+
+    Parameters
+    ----------
+    model : FRF
+        The model's FRF (m/N for a tool point H).
+    measured : FRF
+        The measured FRF, on the same lines and labels.
+
+    Returns
+    -------
+    float
+        The criterion, in [0, 1].
+    """
     _check(model, measured)
     a, b = model.data.ravel(), measured.data.ravel()
     return float(np.abs(np.vdot(a, b)) ** 2 / (np.vdot(a, a).real * np.vdot(b, b).real))
@@ -162,6 +204,22 @@ def pair_modes(model: FRF, measured: FRF, floor: float = 0.02, window: int | Non
     not peaks), both above ``floor`` times the highest peak; each model peak
     is used once, nearest first; a measured mode without a model mode within
     a factor 1.5 in frequency stays unpaired.
+
+    Parameters
+    ----------
+    model : FRF
+        The model's FRF (m/N for a tool point H).
+    measured : FRF
+        The measured FRF, on the same lines and labels.
+    floor : float
+        Peaks below this fraction of the highest one are ignored.
+    window : int, optional
+        Smoothing window in lines; default chosen from the data.
+
+    Returns
+    -------
+    list of ModePair
+        One per measured peak, with the model's frequency (Hz) when paired.
     """
     _check(model, measured)
     w = window or _window(measured)
@@ -229,14 +287,20 @@ def error_bands(model: FRF, measured: FRF, share: float = 0.5, width_hz: float |
 class Comparison:
     """Model against measurement: the numbers a report needs.
 
-    Attributes
+    Parameters
     ----------
+    model : FRF
+        The model's FRF (m/N for a tool point H).
+    measured : FRF
+        The measured FRF, on the same lines and labels.
     error : float
         The error measure (:data:`METRIC`).
     noise_floor : float
         The error a perfect model would show (estimated from the data).
     frac : float
+        Frequency response assurance criterion, in [0, 1] (1: same shape).
     modes : list of ModePair
+        Measured and model peaks paired, with their shifts in Hz and height ratios.
     bands : list of (lo, hi, share)
         Where the error is.
     """
@@ -255,14 +319,38 @@ class Comparison:
         return self.error <= 1.5 * self.noise_floor
 
     def plot(self, ax=None):
-        """Measured and model FRFs overlaid with the residual below, error bands shaded."""
+        """Measured and model FRFs overlaid with the residual below, error bands shaded.
+
+        Parameters
+        ----------
+        ax : sequence of Axes, optional
+            Where to draw; a new figure when None.
+
+        Returns
+        -------
+        Figure
+            The figure (never shown by the library).
+        """
         from .plots import plot_comparison
 
         return plot_comparison(self, ax=ax)
 
 
 def compare(model: FRF, measured: FRF) -> Comparison:
-    """Compare a model FRF with a measurement on the measured grid."""
+    """Compare a model FRF with a measurement on the measured grid.
+
+    Parameters
+    ----------
+    model : FRF
+        The model's FRF (m/N for a tool point H).
+    measured : FRF
+        The measured FRF, on the same lines and labels.
+
+    Returns
+    -------
+    Comparison
+        The error, the noise floor, FRAC, paired modes and error bands.
+    """
     floor = noise_floor(measured)
     return Comparison(
         model=model,

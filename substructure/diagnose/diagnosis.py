@@ -66,7 +66,19 @@ def _suggestion(a: str, b: str) -> str:
 
 @attrs.frozen
 class Candidate:
-    """One effect at one place, fitted: its error after the fit."""
+    """One effect at one place, fitted: its error after the fit.
+
+    Parameters
+    ----------
+    effect : Effect
+        The effect with its fitted values (SI units of its parameters).
+    error : float
+        The error measure after the fit (dimensionless, :data:`METRIC`).
+    nfev : int
+        Model evaluations the fit took.
+    added : tuple of Effect
+        Effects added earlier in the refinement, refitted with this one.
+    """
 
     effect: Effect = attrs.field(eq=False)
     error: float
@@ -75,13 +87,23 @@ class Candidate:
 
     @property
     def name(self) -> str:
+        """The effect's name (``"sensor_mass"``)."""
         return self.effect.name
 
     @property
     def where(self) -> str:
+        """Where the effect acts: a point or a joint name."""
         return self.effect.where
 
     def to_json(self) -> dict:
+        """The candidate as in ``substructure diagnose --json``.
+
+        Returns
+        -------
+        dict
+            ``effect``, ``where``, ``parameters`` (values with their SI units), ``error``,
+            ``explanation``.
+        """
         return {"effect": self.name, "where": self.where, "parameters": self.effect.parameters_json(),
                 "error": self.error, "explanation": self.effect.explanation}
 
@@ -89,13 +111,31 @@ class Candidate:
 @attrs.frozen
 class Step:
     """One step of the refinement: the effect added (None at step 0), with its values as fitted at
-    that step, and the error after it (earlier effects refitted with it)."""
+    that step, and the error after it (earlier effects refitted with it).
+
+    Parameters
+    ----------
+    step : int
+        The step number, 0 for the model as given.
+    added : Effect or None
+        The effect added at this step, with its values then (None at step 0).
+    error : float
+        The error measure after the step (dimensionless).
+    """
 
     step: int
     added: Effect | None = attrs.field(eq=False)
     error: float
 
     def to_json(self) -> dict:
+        """The step as in ``substructure diagnose --json``.
+
+        Returns
+        -------
+        dict
+            ``step``, ``added`` (a name or None), ``error``; ``where`` and ``parameters``
+            (values with their SI units) when an effect was added.
+        """
         out = {"step": self.step, "added": None if self.added is None else self.added.name, "error": self.error}
         if self.added is not None:
             out["where"] = self.added.where
@@ -105,7 +145,39 @@ class Step:
 
 @attrs.frozen
 class Diagnosis:
-    """What :func:`diagnose` found.  ``to_json`` gives the JSON of formats.md."""
+    """What :func:`diagnose` found.  ``to_json`` gives the JSON of ``substructure diagnose --json``.
+
+    Parameters
+    ----------
+    metric : str
+        The error measure's name, :data:`METRIC`.
+    baseline_error : float
+        The error of the model as given (dimensionless).
+    noise_floor : float
+        The error a perfect model would show, estimated from the data.
+    missing_effect : str or None
+        The name of the effect found missing; None when nothing beats the noise floor.
+    missing_where : str or None
+        Where it acts (a point or a joint name).
+    ambiguous_with : tuple of str
+        Other effects that fit as well (the data cannot tell them apart).
+    suggestion : str or None
+        How to tell the ambiguous effects apart.
+    candidates : tuple of Candidate
+        Every effect at every place, fitted, the best first.
+    refinement : tuple of Step
+        The refinement's steps: the error falling as effects are added.
+    band : tuple of float
+        The frequency band compared, ``(lo, hi)`` in Hz.
+    baseline : tuple of Comparison
+        The model as given against each measurement.
+    final : tuple of Comparison
+        The refined model against each measurement.
+    refined_assembly : Assembly
+        The model with the effects added.
+    final_effects : tuple of Effect
+        The effects added, with their final (jointly refitted) values.
+    """
 
     metric: str
     baseline_error: float
@@ -128,6 +200,13 @@ class Diagnosis:
         return list(self.final_effects)
 
     def to_json(self) -> dict:
+        """The JSON object of ``substructure diagnose --json`` (SI units, frequencies in Hz).
+
+        Returns
+        -------
+        dict
+            The diagnosis: errors, candidates, refinement, modes and error bands.
+        """
         return {
             "metric": self.metric,
             "baseline_error": self.baseline_error,
@@ -151,11 +230,33 @@ class Diagnosis:
         }
 
     def plot_where(self, ax=None):
-        """The baseline comparison: FRFs overlaid, residual, error bands, mode shifts."""
+        """The baseline comparison: FRFs overlaid, residual, error bands, mode shifts.
+
+        Parameters
+        ----------
+        ax : Axes or sequence of Axes, optional
+            Where to draw; a new figure when None.
+
+        Returns
+        -------
+        Figure
+            The figure (never shown by the library).
+        """
         return self.baseline[0].plot(ax=ax)
 
     def plot_history(self, ax=None):
-        """The error falling step by step, against the noise floor."""
+        """The error falling step by step, against the noise floor.
+
+        Parameters
+        ----------
+        ax : Axes or sequence of Axes, optional
+            Where to draw; a new figure when None.
+
+        Returns
+        -------
+        Figure
+            The figure (never shown by the library).
+        """
         from .plots import plot_history
 
         return plot_history(self, ax=ax)
@@ -388,6 +489,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence[str] = "a
     assembly : Assembly
         The model (sensors declared in it are applied as each measurement says).
     measurements : MeasurementSet, or sequence of measurements or FRFs
+        The tap tests (receptances in m/N).
     effects : "all" or sequence of str
         Names of registered effects to consider.
     band : (lo, hi), optional
@@ -398,6 +500,11 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence[str] = "a
         Most effects the refinement adds.
     progress : bool or callable
         Report progress (to standard error when True).
+
+    Returns
+    -------
+    Diagnosis
+        The missing effect with its fitted values (SI), the candidates, and the refinement.
     """
     if effects == "all":
         names = list(EFFECTS)

@@ -47,7 +47,15 @@ EFFECTS: dict[str, type] = {}
 
 
 def register_effect(cls):
-    """Class decorator: make an :class:`Effect` subclass available by its ``name``."""
+    """Class decorator: make an :class:`Effect` subclass available by its ``name``.
+
+    The decorated class is a subclass of :class:`Effect` with a class attribute ``name``.
+
+    Returns
+    -------
+    type
+        The class, unchanged, now in :data:`EFFECTS`.
+    """
     if not isinstance(getattr(cls, "name", None), str):
         raise InvalidValueError(f"effect {cls.__name__}: needs a class attribute `name`")
     if cls.name in EFFECTS and EFFECTS[cls.name].__qualname__ != cls.__qualname__:
@@ -59,7 +67,18 @@ def register_effect(cls):
 
 
 def get_effect(name: str) -> type:
-    """The effect class registered under ``name``."""
+    """The effect class registered under ``name``.
+
+    Parameters
+    ----------
+    name : str
+        A registered name (``"sensor_mass"``).
+
+    Returns
+    -------
+    type
+        The subclass of :class:`Effect`.
+    """
     if name not in EFFECTS:
         raise InvalidValueError(f"effect: unknown effect {name!r}; known: {', '.join(EFFECTS)}")
     return EFFECTS[name]
@@ -67,7 +86,23 @@ def get_effect(name: str) -> type:
 
 @attrs.frozen
 class Parameter:
-    """A bounded parameter of an effect, in SI ``unit``; fitted on a log scale when ``log``."""
+    """A bounded parameter of an effect, in SI ``unit``; fitted on a log scale when ``log``.
+
+    Parameters
+    ----------
+    name : str
+        The parameter's name (``mass``, ``k_yf``).
+    unit : str
+        Its SI unit (``kg``, ``N/m``).
+    lower : float
+        Lower bound, in ``unit``.
+    upper : float
+        Upper bound, in ``unit``.
+    start : float
+        Starting value of the fit, in ``unit``.
+    log : bool
+        Fit the logarithm (for positive values spanning decades).
+    """
 
     name: str
     unit: str
@@ -77,6 +112,18 @@ class Parameter:
     log: bool = True
 
     def quantity(self, value: float):
+        """A value of the parameter with its unit.
+
+        Parameters
+        ----------
+        value : float
+            The value in ``unit``.
+
+        Returns
+        -------
+        pint.Quantity
+            The quantity.
+        """
         return ureg.Quantity(value, self.unit)
 
 
@@ -88,6 +135,13 @@ class Effect:
     ``apply(assembly)``; ``starting_values(assembly, where, shift)`` may refine
     the starting point from the relative shift of the main mode
     (measured / model - 1).
+
+    Parameters
+    ----------
+    where : str
+        Where the effect acts: a point (``"tool.tip"``) or a joint name.
+    **values : float
+        Parameter values in their SI units (``mass=0.002``); missing ones take the start.
     """
 
     name: ClassVar[str] = ""
@@ -116,21 +170,83 @@ class Effect:
 
     @classmethod
     def places(cls, assembly: Assembly, measured_points: Sequence[str]) -> list[str]:
+        """Where this effect may act in an assembly (subclasses say; none by default).
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        measured_points : sequence of str
+            The points the measurements respond or are excited at.
+
+        Returns
+        -------
+        list of str
+            Points or joint names.
+        """
         return []
 
     @classmethod
     def starting_values(cls, assembly: Assembly, where: str, shift: float) -> dict[str, float]:
+        """Starting values of the fit at a place (default: each parameter's ``start``).
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        where : str
+            The place.
+        shift : float
+            Relative shift of the main mode, measured / model - 1 (dimensionless).
+
+        Returns
+        -------
+        dict of str to float
+            Values in the parameters' SI units.
+        """
         return {p.name: p.start for p in cls.parameters}
 
     @classmethod
     def bounds(cls, assembly: Assembly, where: str) -> dict[str, tuple[float, float]]:
-        """Bounds of each parameter at this place (default: the class's)."""
+        """Bounds of each parameter at this place (default: the class's).
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        where : str
+            The place.
+
+        Returns
+        -------
+        dict of str to tuple
+            ``{name: (lower, upper)}`` in the parameters' SI units.
+        """
         return {p.name: (p.lower, p.upper) for p in cls.parameters}
 
     def apply(self, assembly: Assembly) -> Assembly:
+        """The assembly with this effect added (subclasses implement it).
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+
+        Returns
+        -------
+        Assembly
+            A new assembly: a sensor, a joint value, flutes or a support added or changed.
+        """
         raise NotImplementedError
 
     def parameters_json(self) -> dict:
+        """The values with their units, for JSON.
+
+        Returns
+        -------
+        dict
+            ``{name: {"value": float, "unit": SI unit}}``.
+        """
         return {p.name: {"value": self.values[p.name], "unit": p.unit} for p in self.parameters}
 
 

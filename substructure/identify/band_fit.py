@@ -27,7 +27,20 @@ from .closed_form import PARAMETERS
 __all__ = ["JointIdentifier", "auto_band", "model_of_measurement"]
 
 def model_of_measurement(assembly: Assembly, measurement) -> Assembly:
-    """The model of the structure as it was measured: removed components, sensors on."""
+    """The model of the structure as it was measured: removed components, sensors on.
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model, with every sensor the measurements name declared in it.
+    measurement : Measurement or FRF
+        A measurement with ``.sensors`` and ``.removed`` (a bare FRF has neither).
+
+    Returns
+    -------
+    Assembly
+        The model without the removed components, with exactly the listed sensors on.
+    """
     removed = tuple(getattr(measurement, "removed", ()) or ())
     sensors = tuple(getattr(measurement, "sensors", ()) or ())
     model = assembly.without(*removed) if removed else assembly
@@ -87,6 +100,22 @@ def auto_band(prepared, joint: Joint, parameter: str = "k_yf", factor: float = 1
     whose frequency moves most (relatively) is the joint's mode, and the band
     runs between the minima of ``|H|`` on either side of it, within 0.7 to
     1.3 times its frequency.
+
+    Parameters
+    ----------
+    prepared : PreparedFRF
+        The model's FRF at the measured point (:meth:`Assembly.prepare`).
+    joint : Joint
+        The joint to identify.
+    parameter : str
+        The joint parameter to vary (``"k_yf"``).
+    factor : float
+        The factor it is multiplied by (dimensionless).
+
+    Returns
+    -------
+    tuple of float
+        The band ``(lo, hi)`` in Hz.
     """
     base = prepared.evaluate()
     values = _joint_values(joint)
@@ -211,6 +240,12 @@ class JointIdentifier:
             as tapped) or an object with ``.frf``, ``.sensors`` (names of the
             assembly's sensors that were on) and ``.removed`` (components taken
             off); those in which the joint is removed are skipped.
+
+        Returns
+        -------
+        JointIdentifier
+            ``self``, with ``values_`` and ``std_`` (SI units: N/m, N, N/rad, N m/rad and
+            the same times s), ``joint_`` and the fit's residual.
         """
         self._check()
         template = assembly.joint(self.joint)
@@ -355,7 +390,24 @@ class JointIdentifier:
         return {p: float(max(std[p], s)) for p, s in zip(self.parameters, spread)}
 
     def predict(self, assembly: Assembly, outputs, inputs=None, frequency=None) -> FRF:
-        """The assembly's FRF with the fitted joint."""
+        """The assembly's FRF with the fitted joint.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        outputs : str or sequence of str
+            Response points (``"tool.tip:y"``).
+        inputs : str or sequence of str, optional
+            Excitation points; default ``outputs``.
+        frequency : Frequency or array_like, optional
+            Frequency lines (plain numbers in Hz); default the assembly's grid.
+
+        Returns
+        -------
+        FRF
+            The receptances with the fitted joint (m/N, ...).
+        """
         return assembly.with_joint(self.joint_).frf(outputs, inputs, frequency)
 
 

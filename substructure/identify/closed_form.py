@@ -52,18 +52,20 @@ def _cond2(a: np.ndarray) -> np.ndarray:
 class ClosedFormResult:
     """The joint's complex stiffness at every frequency line (thesis eq. 2.3).
 
-    Attributes
+    Parameters
     ----------
     frequency : Frequency
+        The frequency lines, in Hz.
     stiffness : ndarray, shape (n_freq, 2, 2)
-        ``K = k + i omega c``, entries ``[[yf, ym], [tf, tm]]``.
-    amplification : ndarray
-        First-order factor by which a relative error of the coupled
-        receptances grows into ``K`` at each line (see :meth:`reliable`).
+        ``K = k + i omega c`` (thesis eq. 2.5), entries ``[[yf, ym], [tf, tm]]`` in N/m, N, N/rad
+        and N m/rad.
     condition : dict of str to ndarray
         Condition numbers (2-norm, each matrix equilibrated by its diagonal)
         of the inverted matrices per line: ``"T12"``,
         ``"T21"``, ``"W"`` (``T12^-1 (T11 - Y_c) T21^-1``) and ``"K_inv"``.
+    amplification : ndarray
+        First-order factor by which a relative error of the coupled
+        receptances grows into ``K`` at each line (see :meth:`reliable`).
     """
 
     frequency: Frequency
@@ -75,19 +77,42 @@ class ClosedFormResult:
         """Lines where a relative error ``noise`` of the measured coupled
         receptances gives at most ``tolerance`` relative error in ``K``.
 
-        Uses :attr:`amplification`, a first-order estimate of how the relative
+        Uses ``amplification``, a first-order estimate of how the relative
         error of ``Y_c`` grows through eq. 2.3: the cancellation in
         ``T11 - Y_c`` (``||T11|| / ||T11 - Y_c||``) times the condition numbers
         of the two inversions that follow.  The thesis's observation that the
         closed form is usable only near the joint's mode shows here as the
         lines where the amplification is small.
+
+        Parameters
+        ----------
+        noise : float
+            Relative error of the measured coupled receptances (0.05 for 5 %).
+        tolerance : float
+            Largest relative error of ``K`` accepted.
+
+        Returns
+        -------
+        ndarray
+            Boolean, one value per frequency line.
         """
         if self.amplification is None:
             raise InvalidValueError("reliable: this result has no error amplification estimate")
         return self.amplification * noise <= tolerance
 
     def parameter(self, name: str) -> np.ndarray:
-        """``k_yf``, ``k_ym``, ``k_tf``, ``k_tm``, ``c_...`` at every line (SI)."""
+        """``k_yf``, ``k_ym``, ``k_tf``, ``k_tm``, ``c_...`` at every line (SI).
+
+        Parameters
+        ----------
+        name : str
+            ``k_`` or ``c_`` followed by ``yf``, ``ym``, ``tf`` or ``tm``.
+
+        Returns
+        -------
+        ndarray
+            One value per line: k in N/m, N, N/rad or N m/rad; c in the same times s.
+        """
         kind, entry = name.split("_", 1)
         if kind not in ("k", "c") or entry not in _ENTRY:
             raise InvalidValueError(f"parameter: got {name!r}; expected k_/c_ with yf, ym, tf or tm")
@@ -96,17 +121,60 @@ class ClosedFormResult:
         return k.real if kind == "k" else k.imag / self.frequency.omega
 
     def ill_conditioned(self, limit: float = COND_WARN) -> np.ndarray:
-        """Lines where an inversion's condition number exceeds ``limit``."""
+        """Lines where an inversion's condition number exceeds ``limit``.
+
+        Parameters
+        ----------
+        limit : float
+            The largest condition number accepted (dimensionless).
+
+        Returns
+        -------
+        ndarray
+            Boolean, one value per frequency line.
+        """
         worst = np.max(np.vstack(list(self.condition.values())), axis=0)
         return ~(worst <= limit)
 
     def band_mean(self, name: str, band) -> float:
-        """Mean of a parameter over a band ``(lo, hi)`` in Hz (the thesis's reading of its plots)."""
+        """Mean of a parameter over a band ``(lo, hi)`` in Hz (the thesis's reading of its plots).
+
+        Parameters
+        ----------
+        name : str
+            The parameter, as for :meth:`parameter`.
+        band : tuple of float
+            ``(lo, hi)`` in Hz.
+
+        Returns
+        -------
+        float
+            The mean, in the parameter's SI unit.
+        """
         mask = self.frequency.band_mask(*band)
         return float(np.mean(self.parameter(name)[mask]))
 
     def plot(self, names=("k_yf", "c_yf"), band=None, fitted=None, ax=None, measured=None):
-        """The frequency-dependent parameters, the chosen band and fitted constants."""
+        """The frequency-dependent parameters, the chosen band and fitted constants.
+
+        Parameters
+        ----------
+        names : sequence of str
+            Parameters to draw, one panel each.
+        band : tuple of float, optional
+            Shaded band ``(lo, hi)`` in Hz.
+        fitted : mapping, optional
+            Fitted constants (SI), with ``NAME_std`` standard deviations.
+        ax : sequence of Axes, optional
+            Where to draw; a new figure when None.
+        measured : FRF, optional
+            A measured point FRF drawn on a second axis.
+
+        Returns
+        -------
+        Figure
+            The figure (see :func:`substructure.plot.plot_identification`).
+        """
         from ..plot import plot_identification
 
         return plot_identification(self, names=names, band=band, fitted=fitted, ax=ax, measured=measured)
@@ -141,6 +209,8 @@ def closed_form(coupled: FRF, side_a: FRF, side_b: FRF, *, at: str, at_a: str, a
     Returns
     -------
     ClosedFormResult
+        ``K = k + i omega c`` at every line (N/m, N, N/rad, N m/rad; c times s), with the
+        condition numbers of the inversions.
     """
     freq = coupled.frequency
     for name, frf in (("side_a", side_a), ("side_b", side_b)):
@@ -199,6 +269,20 @@ def joint_sides(assembly: Assembly, joint: str) -> tuple[Assembly, Assembly, str
     ``side_a`` holds the joint's first point (``between[0]``), ``side_b`` the
     second.  The joint must separate the assembly in two (a bridge of the
     graph); the joints, sensors and supports of each side stay with it.
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model.
+    joint : str
+        The joint's name.
+
+    Returns
+    -------
+    side_a, side_b : Assembly
+        The two sides.
+    at_a, at_b : str
+        The joint's point on each side.
     """
     j = assembly.joint(joint)
     rest = [x for x in assembly.joints if x.name != joint]

@@ -37,6 +37,35 @@ class IdentificationReport:
     values (standard deviation 0 for entries that were not fitted);
     ``measured``, ``initial`` and ``predicted`` are the first measured FRF and
     the model's FRF there before and after the fit.
+
+    Parameters
+    ----------
+    joint : str
+        The joint's name.
+    band : tuple of float
+        The band fitted, ``(lo, hi)`` in Hz.
+    k : dict
+        Stiffness entries ``yf, ym, tf, tm`` in N/m, N, N/rad and N m/rad.
+    c : dict
+        Damping entries in N s/m, N s, N s/rad and N m s/rad.
+    k_std : dict
+        Standard deviations of ``k``, same units (0 where not fitted).
+    c_std : dict
+        Standard deviations of ``c``, same units.
+    fitted : tuple of str
+        The parameters fitted (``k_yf``, ...).
+    warnings : tuple of str
+        Problems found (a non-passive result, a poor fit).
+    measured : FRF
+        The first measured FRF (m/N for H).
+    initial : FRF
+        The model's FRF there before the fit.
+    predicted : FRF
+        The model's FRF there after the fit.
+    residual_rms : float
+        Relative RMS of the fit's residual (dimensionless).
+    closed_form : ClosedFormResult or None
+        The closed form of thesis eq. 2.3, when the data allowed it.
     """
 
     joint: str
@@ -54,7 +83,14 @@ class IdentificationReport:
     closed_form: ClosedFormResult | None = None
 
     def to_json(self) -> dict:
-        """The JSON object of formats.md (SI units, Hz), plus a few added keys."""
+        """The JSON object of ``substructure identify --json`` (SI units, Hz).
+
+        Returns
+        -------
+        dict
+            ``joint``, ``band_hz``, ``k``, ``c``, ``k_std``, ``c_std`` (SI), ``warnings``,
+            ``fitted``, ``residual_rms``.
+        """
         return {
             "joint": self.joint,
             "band_hz": [self.band[0], self.band[1]],
@@ -68,7 +104,13 @@ class IdentificationReport:
         }
 
     def plot(self):
-        """Closed-form parameters with band and fit (when available), and the FRF before/after."""
+        """Closed-form parameters with band and fit (when available), and the FRF before/after.
+
+        Returns
+        -------
+        Figure
+            The figure (never shown by the library).
+        """
         import matplotlib.pyplot as plt
 
         names = ("k_yf", "c_yf") if self.closed_form is not None else ()
@@ -131,7 +173,32 @@ def _points_on(measurements, assembly: Assembly, components: set, removed=()) ->
 def identify_joint(assembly: Assembly, measurements, joint: str, band="auto",
                    parameters: Sequence[str] = ("k_yf", "k_tm", "c_yf", "c_tm"), bootstrap: int = 0,
                    random_state: int = 0) -> IdentificationReport:
-    """Identify a joint from a measurement set (see the module docstring)."""
+    """Identify a joint from a measurement set (see the module docstring).
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model, with the joint (its values are the start) and the sensors the
+        measurements list.
+    measurements : MeasurementSet or sequence of Measurement
+        The tap tests (receptances in m/N).
+    joint : str
+        The joint's name.
+    band : "auto" or tuple of float
+        The band ``(lo, hi)`` in Hz, or found from the model's sensitivity.
+    parameters : sequence of str
+        The joint parameters to fit (``k_yf``, ``k_tm``, ``c_yf``, ``c_tm``, ...).
+    bootstrap : int
+        Bootstrap refits for the standard deviations (0: from the Jacobian).
+    random_state : int
+        Seed of the bootstrap.
+
+    Returns
+    -------
+    IdentificationReport
+        The fitted values with standard deviations (SI), the closed form, the FRFs before and
+        after.
+    """
     if hasattr(measurements, "validate"):
         measurements.validate(assembly)
     ident = JointIdentifier(joint, parameters=parameters, band=band, bootstrap=bootstrap,

@@ -61,10 +61,7 @@ _MATRIX_KEYS = ("yf", "ym", "tf", "tm")
 _MISSING = object()
 _FIELD = re.compile(r"^([A-Za-z_][A-Za-z0-9_.\[\]]*): (.*)$", re.DOTALL)
 _HEADER = re.compile(r"^\s*(\[\[?)\s*([^\[\]#]+?)\s*\]\]?\s*(?:#.*)?$")
-_HEADER_COMMENT = (
-    "# substructure assembly file (format: docs/file-formats.md of substructure): "
-    "units on every dimensional value\n"
-)
+_HEADER_COMMENT = "# substructure assembly file (docs/file-formats.md): units on every dimensional value\n"
 _STANDARD_FIELDS = ("name", "segments", "description")
 
 
@@ -369,6 +366,11 @@ def loads_assembly(text: str, source: str = "<string>") -> Assembly:
         wrong units, non-physical values, unknown materials or component
         types and points that do not exist; the message starts with
         ``source`` and names the key path.
+
+    Returns
+    -------
+    Assembly
+        The assembly.
     """
     if not isinstance(text, str):
         raise FileFormatError(f"{source}: got {type(text).__name__}; expected the TOML text as a str")
@@ -383,7 +385,18 @@ def loads_assembly(text: str, source: str = "<string>") -> Assembly:
 
 
 def load_assembly(path: str | os.PathLike) -> Assembly:
-    """Read an assembly file (TOML); see :func:`loads_assembly`."""
+    """Read an assembly file (TOML); see :func:`loads_assembly`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+
+    Returns
+    -------
+    Assembly
+        The assembly; errors name the file and the key.
+    """
     name = os.fspath(path)
     text = read_text(path)
     return loads_assembly(text, source=name)
@@ -394,6 +407,11 @@ def default_assembly() -> Assembly:
 
     Read from ``substructure/data/default_assembly.toml``, which documents
     where its numbers come from.
+
+    Returns
+    -------
+    Assembly
+        The assembly, with its frequency grid (20 Hz to 5 kHz, 2 Hz).
     """
     resource = importlib.resources.files("substructure") / "data" / "default_assembly.toml"
     return loads_assembly(resource.read_text(encoding="utf-8"), source="default_assembly.toml")
@@ -592,6 +610,16 @@ def dumps_assembly(assembly: Assembly) -> str:
     Custom materials (the assembly's ``materials`` and any non-catalogue
     material its segments use) are written to ``[materials.NAME]`` tables; a
     component's material is written once when all its segments share it.
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The assembly.
+
+    Returns
+    -------
+    str
+        The TOML text, every dimensional value with its unit.
 
     Raises
     ------

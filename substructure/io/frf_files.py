@@ -129,6 +129,11 @@ def read_csv(
         wrong header, a row without three numbers, NaN or inf, a negative,
         repeated or decreasing frequency, fewer than two rows, or a dead
         channel (every value 0).
+
+    Returns
+    -------
+    FRF
+        Shape ``(n_freq, 1, 1)``: frequencies in Hz, values as in the file (SI).
     """
     from . import read_text
 
@@ -646,6 +651,11 @@ def read_uff(path: str | os.PathLike, record: int | None = None, quantity: str |
     abscissa labelled in rad/s is divided by 2 pi.  Labels come from the ID
     lines this module writes; records of other programs get
     ``"node<N>:y"`` / ``"node<N>:theta"`` (``dir<D>`` for other directions).
+
+    Returns
+    -------
+    FRF
+        Frequencies in Hz, values converted to SI units (m/N for a receptance y/f).
     """
     import pyuff
 

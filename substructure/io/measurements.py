@@ -285,7 +285,7 @@ def loads_measurements(text: str, base_dir: str | os.PathLike = ".", source: str
     -------
     MeasurementSet
         Measurements in the order of the ``[[frf]]`` tables, receptances.
-        :attr:`Measurement.quantity` is the quantity the file gave (for a
+        ``Measurement.quantity`` is the quantity the file gave (for a
         UFF record without ``quantity``: the one the record states, by
         default receptance).
 
@@ -311,7 +311,18 @@ def loads_measurements(text: str, base_dir: str | os.PathLike = ".", source: str
 
 
 def load_measurements(path: str | os.PathLike) -> MeasurementSet:
-    """Read a measurement file; data file paths are relative to it (see :func:`loads_measurements`)."""
+    """Read a measurement file; data file paths are relative to it (see :func:`loads_measurements`).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The measurement set file (TOML).
+
+    Returns
+    -------
+    MeasurementSet
+        The measurements, their FRFs read; errors name the file and the key.
+    """
     name = os.fspath(path)
     text = read_text(path)
     return loads_measurements(text, base_dir=Path(name).parent, source=name)

@@ -79,6 +79,11 @@ def as_speed_rpm(value: Any, field: str = "speeds") -> np.ndarray:
     InvalidValueError
         For speeds that are not finite, not positive or not strictly
         increasing.
+
+    Returns
+    -------
+    ndarray
+        The speeds in rpm, 1-D, strictly increasing.
     """
     if isinstance(value, str):
         try:
@@ -116,6 +121,11 @@ def spindle_speeds(start: Any, stop: Any, step: Any) -> pint.Quantity:
         E.g. ``"2000 rpm"``, ``"20000 rpm"``, ``"10 rpm"``.  Hz is refused
         (see :func:`as_speed_rpm`).
 
+    Returns
+    -------
+    pint.Quantity
+        The speeds, an array in rpm.
+
     Examples
     --------
     >>> spindle_speeds("1000 rpm", "1100 rpm", "50 rpm")
@@ -130,7 +140,20 @@ def spindle_speeds(start: Any, stop: Any, step: Any) -> pint.Quantity:
 
 
 def tooth_passing_hz(speed_rpm: Any, teeth: int) -> np.ndarray:
-    """Tooth-passing frequency in Hz: ``teeth * rpm / 60`` (revolutions, not radians)."""
+    """Tooth-passing frequency in Hz: ``teeth * rpm / 60`` (revolutions, not radians).
+
+    Parameters
+    ----------
+    speed_rpm : array_like
+        Spindle speeds in rpm (plain numbers).
+    teeth : int
+        Number of teeth.
+
+    Returns
+    -------
+    ndarray
+        Tooth-passing frequencies in Hz.
+    """
     return np.asarray(speed_rpm, dtype=float) * teeth / 60.0
 
 
@@ -273,17 +296,28 @@ class MillingCut:
 
         Parameters
         ----------
-        teeth, diameter, milling, kt
-            As in the class.
+        teeth : int
+            Number of teeth.
+        diameter : quantity or str
+            Tool diameter, a length (``"12 mm"``).
         radial_depth : quantity or str, optional
-            Radial depth of cut; or
+            Radial depth of cut, a length; or
         immersion : float, optional
             Radial immersion ratio ``a_e / D`` in ``(0, 1]``.
+        milling : {"up", "down"}
+            Up or down milling.
+        kt : quantity or str
+            Tangential cutting pressure (``"625 MPa"``).
         kn : quantity or str, optional
             Normal cutting pressure; or
         kr : float, optional
             The ratio ``Kn / Kt`` (dimensionless, >= 0).  A pressure given as
             ``kr`` is refused with a hint: give it as ``kn``.
+
+        Returns
+        -------
+        MillingCut
+            The cut.
         """
         if (radial_depth is None) == (immersion is None):
             raise InvalidValueError("radial_depth, immersion: give exactly one of them")
@@ -351,7 +385,13 @@ class MillingCut:
         return 2.0 * np.pi / self.teeth
 
     def describe(self) -> str:
-        """One line for summaries."""
+        """One line for summaries.
+
+        Returns
+        -------
+        str
+            The cut with its units.
+        """
         return (f"{self.milling} milling, {self.teeth} teeth, D = {self.diameter:~P}, "
                 f"a_e = {self.radial_depth:~P} (a_e/D = {self.immersion:.3g}), "
                 f"Kt = {self.kt:~P}, Kn = {self.kn:~P} (Kn/Kt = {self.kr:.3g})")
@@ -361,6 +401,16 @@ class MillingCut:
         """Instantaneous ``K(theta)`` in N/m^2 at angles ``theta`` of tooth 0, shape ``(..., 2, 2)``.
 
         The sum over the teeth in the cut; zero when none is.
+
+        Parameters
+        ----------
+        theta : array_like
+            Angles of tooth 0, in rad.
+
+        Returns
+        -------
+        ndarray
+            Shape ``theta.shape + (2, 2)``, in N/m^2 (force per unit depth and unit chip thickness).
         """
         theta = np.asarray(theta, dtype=float)
         st, ex = self.angles
@@ -374,8 +424,11 @@ class MillingCut:
     def period_arcs(self) -> list[tuple[float, float, bool]]:
         """The delay period ``[0, 2*pi/teeth)`` split where teeth enter or leave the cut.
 
-        Returns a list of ``(theta_a, theta_b, cutting)``: between these angles
-        of tooth 0, ``K`` is smooth, and zero when ``cutting`` is False.
+        Returns
+        -------
+        list of tuple
+            ``(theta_a, theta_b, cutting)`` with angles of tooth 0 in rad: between them
+            ``K`` is smooth, and zero when ``cutting`` is False.
         """
         p = self.period_angle
         cuts = {0.0, p}
@@ -402,6 +455,18 @@ class MillingCut:
         Each interval must lie inside one arc of :meth:`period_arcs`; the
         integral is exact (closed-form antiderivative of the trigonometric
         entries), which keeps low immersions accurate.
+
+        Parameters
+        ----------
+        theta_a : array_like
+            Start angles of tooth 0, in rad.
+        theta_b : array_like
+            End angles, in rad (same shape).
+
+        Returns
+        -------
+        ndarray
+            Shape ``(n, 2, 2)``, in N/m^2.
         """
         theta_a, theta_b = np.atleast_1d(np.asarray(theta_a, float)), np.atleast_1d(np.asarray(theta_b, float))
         out = np.zeros(theta_a.shape + (2, 2))
@@ -420,6 +485,11 @@ class MillingCut:
 
         Equal to ``teeth * Kt / (4 pi) * alpha`` with Altintas & Budak's
         directional coefficients ``alpha``.
+
+        Returns
+        -------
+        ndarray
+            Shape ``(2, 2)``, in N/m^2.
         """
         st, ex = self.angles
         integral = _force_antiderivative(np.array(ex), self.kr) - _force_antiderivative(np.array(st), self.kr)
@@ -478,7 +548,13 @@ class TurningCut:
         return 2.0 * np.pi
 
     def describe(self) -> str:
-        """One line for summaries."""
+        """One line for summaries.
+
+        Returns
+        -------
+        str
+            The cut with its units.
+        """
         return f"turning, Kf = {self.kf:~P}, orientation u = {self.orientation:g} along {self.direction}"
 
     def _matrix(self) -> np.ndarray:
@@ -488,19 +564,55 @@ class TurningCut:
         return out
 
     def force_matrix(self, theta: Any) -> np.ndarray:
-        """The constant force matrix in N/m^2 at any angle, shape ``(..., 2, 2)``."""
+        """The constant force matrix in N/m^2 at any angle, shape ``(..., 2, 2)``.
+
+        Parameters
+        ----------
+        theta : array_like
+            Angles in rad (the matrix does not depend on them).
+
+        Returns
+        -------
+        ndarray
+            Shape ``theta.shape + (2, 2)``, in N/m^2.
+        """
         theta = np.asarray(theta, dtype=float)
         return np.broadcast_to(self._matrix(), theta.shape + (2, 2)).copy()
 
     def period_arcs(self) -> list[tuple[float, float, bool]]:
-        """One arc, always cutting."""
+        """One arc, always cutting.
+
+        Returns
+        -------
+        list of tuple
+            ``[(0, 2 pi, True)]``, angles in rad.
+        """
         return [(0.0, 2.0 * np.pi, True)]
 
     def force_matrix_average(self, theta_a: Any, theta_b: Any) -> np.ndarray:
-        """The constant force matrix for each interval, shape ``(n, 2, 2)``."""
+        """The constant force matrix for each interval, shape ``(n, 2, 2)``.
+
+        Parameters
+        ----------
+        theta_a : array_like
+            Start angles of tooth 0, in rad.
+        theta_b : array_like
+            End angles, in rad (same shape).
+
+        Returns
+        -------
+        ndarray
+            Shape ``(n, 2, 2)``, in N/m^2.
+        """
         n = np.atleast_1d(np.asarray(theta_a, float)).size
         return np.broadcast_to(self._matrix(), (n, 2, 2)).copy()
 
     def mean_force_matrix(self) -> np.ndarray:
-        """``-Kf u`` in the oriented direction, N/m^2, shape (2, 2)."""
+        """``-Kf u`` in the oriented direction, N/m^2, shape (2, 2).
+
+        Returns
+        -------
+        ndarray
+            Shape ``(2, 2)``, in N/m^2.
+        """
         return self._matrix()

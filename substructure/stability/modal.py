@@ -33,6 +33,8 @@ from .structure import XY_LABELS, _one_entry, xy_receptance
 
 __all__ = ["Mode", "ModalModel", "ModalFitter", "fit_modes", "MODES_CSV_HEADER", "ModalFitWarning"]
 
+#: The header of a modes CSV file (:meth:`ModalModel.from_csv`): direction ``x`` or ``y``,
+#: natural frequency in Hz, damping ratio, modal stiffness in N/m.
 MODES_CSV_HEADER = "direction,frequency_hz,damping_ratio,stiffness_n_per_m"
 
 
@@ -70,6 +72,7 @@ class Mode:
     Parameters
     ----------
     direction : {"x", "y"}
+        The direction the mode acts in (x the feed direction).
     frequency : quantity or str
         Natural frequency, e.g. ``"922 Hz"``.
     damping_ratio : float
@@ -86,10 +89,12 @@ class Mode:
 
     @property
     def frequency_hz(self) -> float:
+        """Natural frequency in Hz (a float)."""
         return float(self.frequency.m_as("Hz"))
 
     @property
     def stiffness_n_per_m(self) -> float:
+        """Modal stiffness in N/m (a float)."""
         return float(self.stiffness.m_as("N/m"))
 
     @property
@@ -98,7 +103,18 @@ class Mode:
         return self.stiffness_n_per_m / (2.0 * np.pi * self.frequency_hz) ** 2
 
     def receptance(self, frequency_hz: Any) -> np.ndarray:
-        """``1 / (k (1 - r^2 + 2 i zeta r))`` at frequencies in Hz."""
+        """``1 / (k (1 - r^2 + 2 i zeta r))`` with ``r = f / f_n``.
+
+        Parameters
+        ----------
+        frequency_hz : array_like
+            Frequencies in Hz.
+
+        Returns
+        -------
+        ndarray
+            Complex receptance in m/N, one value per frequency.
+        """
         r = np.asarray(frequency_hz, dtype=float) / self.frequency_hz
         return 1.0 / (self.stiffness_n_per_m * (1.0 - r**2 + 2j * self.damping_ratio * r))
 
@@ -117,6 +133,11 @@ def _modes(value: Any) -> tuple[Mode, ...]:
 class ModalModel:
     """Modes of the tool point in x and y; a direction without modes is rigid.
 
+    Parameters
+    ----------
+    modes : sequence of Mode
+        At least one mode.
+
     Examples
     --------
     >>> model = ModalModel([Mode("x", "922 Hz", 0.011, "1.34e6 N/m")])
@@ -131,6 +152,16 @@ class ModalModel:
         """Read a file with the header ``direction,frequency_hz,damping_ratio,stiffness_n_per_m``.
 
         Numbers are in Hz and N/m; errors name the file and the line.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The CSV file.
+
+        Returns
+        -------
+        ModalModel
+            The modes of the file.
         """
         name = os.fspath(path)
         try:
@@ -162,7 +193,13 @@ class ModalModel:
         return cls(modes)
 
     def to_csv(self, path: Any) -> None:
-        """Write the modes in the format :meth:`from_csv` reads (full precision)."""
+        """Write the modes in the format :meth:`from_csv` reads (full precision).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The CSV file to write.
+        """
         with open(path, "w", encoding="utf-8", newline="") as fh:
             fh.write(MODES_CSV_HEADER + "\n")
             for m in self.modes:
@@ -170,7 +207,13 @@ class ModalModel:
 
     # -- arrays for the kernels ---------------------------------------------------
     def arrays(self) -> dict[str, np.ndarray]:
-        """``frequency_hz``, ``damping_ratio``, ``stiffness``, ``mass`` and ``direction`` (0 x, 1 y) per mode."""
+        """``frequency_hz``, ``damping_ratio``, ``stiffness``, ``mass`` and ``direction`` (0 x, 1 y) per mode.
+
+        Returns
+        -------
+        dict
+            Arrays over the modes: Hz, dimensionless, N/m, kg, and 0 or 1.
+        """
         return {
             "frequency_hz": np.array([m.frequency_hz for m in self.modes]),
             "damping_ratio": np.array([m.damping_ratio for m in self.modes]),
@@ -180,7 +223,13 @@ class ModalModel:
         }
 
     def default_frequency(self) -> Frequency:
-        """Lines from 0.3 f_min to 3 f_max, log-spaced at a relative step of zeta_min / 50."""
+        """Lines from 0.3 f_min to 3 f_max, log-spaced at a relative step of zeta_min / 50.
+
+        Returns
+        -------
+        Frequency
+            The lines, in Hz.
+        """
         a = self.arrays()
         lo, hi = 0.3 * a["frequency_hz"].min(), 3.0 * a["frequency_hz"].max()
         step = np.log1p(a["damping_ratio"].min() / 50.0)
@@ -188,7 +237,18 @@ class ModalModel:
         return Frequency.from_hz(np.geomspace(lo, hi, n))
 
     def receptance(self, frequency_hz: Any) -> np.ndarray:
-        """``(n, 2, 2)`` receptance matrix, x and y (no cross terms)."""
+        """``(n, 2, 2)`` receptance matrix, x and y (no cross terms).
+
+        Parameters
+        ----------
+        frequency_hz : array_like
+            Frequencies in Hz.
+
+        Returns
+        -------
+        ndarray
+            Complex, shape ``(n_freq, 2, 2)``, in m/N.
+        """
         f = np.asarray(frequency_hz, dtype=float)
         out = np.zeros((f.size, 2, 2), dtype=complex)
         for m in self.modes:
@@ -197,13 +257,31 @@ class ModalModel:
         return out
 
     def xy_frf(self, frequency: Frequency | None = None) -> FRF:
-        """Synthesised receptances as an FRF labelled ``x``/``y`` (default grid: :meth:`default_frequency`)."""
+        """Synthesised receptances as an FRF labelled ``x``/``y`` (default grid: :meth:`default_frequency`).
+
+        Parameters
+        ----------
+        frequency : Frequency, optional
+            The lines; default :meth:`default_frequency`.
+
+        Returns
+        -------
+        FRF
+            Shape ``(n_freq, 2, 2)``, in m/N.
+        """
         frequency = self.default_frequency() if frequency is None else frequency
         if not isinstance(frequency, Frequency):
             raise InvalidValueError(f"frequency: got {type(frequency).__name__}; expected a Frequency")
         return FRF(frequency, self.receptance(frequency.hz), XY_LABELS, XY_LABELS)
 
     def describe(self) -> str:
+        """One line: every mode with its direction, frequency, damping ratio and stiffness.
+
+        Returns
+        -------
+        str
+            The description, in Hz and N/m.
+        """
         return "; ".join(f"{m.direction}: {m.frequency_hz:.6g} Hz, zeta {m.damping_ratio:.4g}, "
                          f"k {m.stiffness_n_per_m:.4g} N/m" for m in self.modes)
 
@@ -264,7 +342,20 @@ class ModalFitter:
         self.residuals = residuals
 
     def fit(self, frf: FRF, direction: str = "x") -> ModalFitter:
-        """Fit the modes of ``frf`` (a one-entry receptance), acting in ``direction``."""
+        """Fit the modes of ``frf`` (a one-entry receptance), acting in ``direction``.
+
+        Parameters
+        ----------
+        frf : FRF
+            A one-entry receptance in m/N (tool point H).
+        direction : {"x", "y"}
+            The direction the fitted modes act in.
+
+        Returns
+        -------
+        ModalFitter
+            ``self``, with ``modes_``, ``model_`` and the fit's errors.
+        """
         from scipy.optimize import least_squares
         from scipy.signal import find_peaks
 
@@ -337,7 +428,18 @@ class ModalFitter:
         return self
 
     def predict(self, frequency: Frequency | None = None) -> FRF:
-        """The fitted receptance (modes and residual terms) as a one-entry FRF."""
+        """The fitted receptance (modes and residual terms) as a one-entry FRF.
+
+        Parameters
+        ----------
+        frequency : Frequency, optional
+            The lines; default those fitted.
+
+        Returns
+        -------
+        FRF
+            The receptance, in m/N.
+        """
         if not hasattr(self, "model_"):
             raise InvalidValueError("ModalFitter: call fit(frf) first")
         frequency = self.frequency_ if frequency is None else frequency
@@ -362,6 +464,11 @@ def fit_modes(structure: FRF, n_modes: int | None = None, band: tuple[float, flo
     max_error : float, default 0.2
         Warn (:class:`ModalFitWarning`) when the modes alone miss the data by
         more than this relative error.
+
+    Returns
+    -------
+    ModalModel
+        Modes in x and y (Hz, damping ratio, N/m).
 
     Notes
     -----

@@ -43,14 +43,18 @@ def _json_numbers(values: np.ndarray) -> list:
 class Lobes:
     """A stability lobe diagram.
 
-    Attributes
+    Parameters
     ----------
     method : {"zoa", "sdm"}
+        The method: zero-order approximation or semi-discretization.
     spindle_speed_rpm : ndarray
+        Spindle speeds in rpm, increasing.
     depth_limit_m : ndarray
         Limiting axial depth of cut at each speed (``inf``: no limit found).
     chatter_frequency_hz : ndarray
         Chatter frequency at the limit (``nan`` where there is none).
+    cut : MillingCut or TurningCut
+        The cut the lobes are for.
     absolute_limit_m : float or None
         Zero-order: the speed-independent limit (the lowest depth of every
         lobe); ``None`` for semi-discretization.
@@ -64,7 +68,6 @@ class Lobes:
         the tooth passing) or ``"flip"`` (period doubling) at each speed.
     discretisation : dict
         Semi-discretization: the scheme and the numbers that define it.
-    cut : MillingCut or TurningCut
     label : str or None
         Legend label.
     """
@@ -88,16 +91,51 @@ class Lobes:
                 raise InvalidValueError(f"{name}: expected {n} values, one per spindle speed")
 
     def with_label(self, label: str) -> Lobes:
-        """The same result with another legend label."""
+        """The same result with another legend label.
+
+        Parameters
+        ----------
+        label : str
+            The legend label.
+
+        Returns
+        -------
+        Lobes
+            A copy with the label.
+        """
         return attrs.evolve(self, label=label)
 
     # -- reading the diagram ----------------------------------------------------
     def limit_at(self, speed_rpm: Any) -> np.ndarray:
-        """Depth limit in m at speeds in rpm (plain numbers), linearly interpolated."""
+        """Depth limit in m at speeds in rpm (plain numbers), linearly interpolated.
+
+        Parameters
+        ----------
+        speed_rpm : float or array_like
+            Spindle speeds in rpm.
+
+        Returns
+        -------
+        ndarray
+            The depth limits in m.
+        """
         return np.interp(np.asarray(speed_rpm, float), self.spindle_speed_rpm, self.depth_limit_m)
 
     def is_stable(self, speed_rpm: Any, depth_m: Any) -> np.ndarray:
-        """Whether cuts at these speeds [rpm] and depths [m] are below the limit."""
+        """Whether cuts at these speeds [rpm] and depths [m] are below the limit.
+
+        Parameters
+        ----------
+        speed_rpm : float or array_like
+            Spindle speeds in rpm.
+        depth_m : float or array_like
+            Axial depths of cut in m.
+
+        Returns
+        -------
+        ndarray
+            Boolean: True where the cut is stable.
+        """
         return np.asarray(depth_m, float) < self.limit_at(speed_rpm)
 
     def best_speeds(self, count: int = 3) -> list[tuple[float, float]]:
@@ -105,6 +143,16 @@ class Lobes:
 
         A maximum at either end of the speed range counts only when the limit
         falls away from it (it may lie outside the range).
+
+        Parameters
+        ----------
+        count : int
+            How many speeds.
+
+        Returns
+        -------
+        list of tuple
+            ``(speed in rpm, depth limit in m)``, deepest first.
         """
         a = np.where(np.isfinite(self.depth_limit_m), self.depth_limit_m, np.nan)
         if a.size < 3 or np.all(np.isnan(a)):
@@ -122,7 +170,13 @@ class Lobes:
 
     # -- output -----------------------------------------------------------------
     def to_json(self) -> dict:
-        """The JSON object of ``substructure lobes --json`` (SI units, ``null`` for no limit)."""
+        """The JSON object of ``substructure lobes --json`` (SI units, ``null`` for no limit).
+
+        Returns
+        -------
+        dict
+            Speeds in rpm, depths in m, frequencies in Hz.
+        """
         out = {
             "method": self.method,
             "spindle_speed_rpm": self.spindle_speed_rpm.tolist(),
@@ -141,9 +195,21 @@ class Lobes:
         return out
 
     def plot(self, ax: Any = None, **kw: Any):
-        """Draw onto ``ax`` (new figure when None) with :func:`~substructure.stability.plotting.plot_lobes`.
+        """Draw onto ``ax`` (new figure when None) with ``substructure.stability.plotting.plot_lobes``.
 
         Call it again with the same ``ax`` to put several results on one plot.
+
+        Parameters
+        ----------
+        ax : Axes, optional
+            Where to draw; a new figure when None.
+        **kw
+            Passed to the plotting function (line styles, ``lobes=True`` for the single lobes).
+
+        Returns
+        -------
+        Figure
+            The figure: depth limit in mm against spindle speed in rpm.
         """
         from .plotting import plot_lobes
 
@@ -154,15 +220,20 @@ class Lobes:
 class LobesBand:
     """The spread of lobes computed from several FRFs (e.g. an FRF uncertainty band).
 
-    Attributes
+    Parameters
     ----------
     spindle_speed_rpm : ndarray
-    lower_m, upper_m : ndarray
+        Spindle speeds in rpm, common to the members.
+    lower_m : ndarray
+        The lowest and highest depth limit at each speed over the members.
+    upper_m : ndarray
         The lowest and highest depth limit at each speed over the members.
     nominal : Lobes or None
         The result drawn as a line within the band.
     members : tuple of Lobes
+        The results the band spans.
     label : str or None
+        Legend label.
     """
 
     spindle_speed_rpm: np.ndarray = attrs.field(converter=_array, eq=_eq)
@@ -173,12 +244,32 @@ class LobesBand:
     label: str | None = None
 
     def plot(self, ax: Any = None, **kw: Any):
-        """Shade the band and draw the nominal lobes (:func:`~substructure.stability.plotting.plot_band`)."""
+        """Shade the band and draw the nominal lobes (``substructure.stability.plotting.plot_band``).
+
+        Parameters
+        ----------
+        ax : Axes, optional
+            Where to draw; a new figure when None.
+        **kw
+            Passed to the plotting function (line styles, ``lobes=True`` for the single lobes).
+
+        Returns
+        -------
+        Figure
+            The figure: depth limit in mm against spindle speed in rpm.
+        """
         from .plotting import plot_band
 
         return plot_band(self, ax=ax, **kw)
 
     def to_json(self) -> dict:
+        """The band for JSON output.
+
+        Returns
+        -------
+        dict
+            ``spindle_speed_rpm`` (rpm), ``lower_m`` and ``upper_m`` (m, ``null`` for no limit).
+        """
         return {"spindle_speed_rpm": self.spindle_speed_rpm.tolist(), "lower_m": _json_numbers(self.lower_m),
                 "upper_m": _json_numbers(self.upper_m)}
 
@@ -194,6 +285,12 @@ def lobes_band(results: Sequence[Lobes], nominal: Lobes | None = None, label: st
     nominal : Lobes, optional
         The result drawn as a line; default: none.
     label : str, optional
+        Legend label.
+
+    Returns
+    -------
+    LobesBand
+        The lowest and highest depth limit (m) at each speed (rpm).
     """
     results = list(results)
     if not results or not all(isinstance(r, Lobes) for r in results):

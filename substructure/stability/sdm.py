@@ -88,7 +88,9 @@ def spectral_radius(modes: ModalModel, cut: Any, speeds: Any, depths: Any, *, in
     Parameters
     ----------
     modes : ModalModel
+        Modal parameters in x and y (Hz, damping ratio, N/m).
     cut : MillingCut or TurningCut
+        The cut (cutting pressures in Pa, tool and radial depth in m).
     speeds : pint.Quantity
         Spindle speeds in rpm (1-D).
     depths : pint.Quantity or str
@@ -108,6 +110,7 @@ def spectral_radius(modes: ModalModel, cut: Any, speeds: Any, depths: Any, *, in
     Returns
     -------
     ndarray, shape (n_speeds, n_depths)
+        The spectral radius (dimensionless) at each speed and depth.
     """
     model = _check_model(modes)
     n = as_speed_rpm(speeds)
@@ -273,6 +276,7 @@ def sdm(modes: ModalModel, cut: Any, speeds: Any, *, intervals: int | None = Non
         Modal parameters in x and y (fit them to FRF data with
         :func:`~substructure.stability.fit_modes`).
     cut : MillingCut or TurningCut
+        The cut (cutting pressures in Pa, tool and radial depth in m).
     speeds : pint.Quantity
         Spindle speeds in rpm, strictly increasing.
     intervals : int, optional
@@ -299,6 +303,7 @@ def sdm(modes: ModalModel, cut: Any, speeds: Any, *, intervals: int | None = Non
         reference depth the ladder steps by 2).  An unstable band narrower
         than a rung, below the first unstable rung, can be missed.
     label : str, optional
+        Legend label.
 
     Returns
     -------

@@ -132,6 +132,7 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
         given), a one-entry translational FRF (a symmetric tool: ``y = x``),
         or a :class:`~substructure.stability.ModalModel`.
     cut : MillingCut or TurningCut
+        The cut (cutting pressures in Pa, tool and radial depth in m).
     speeds : pint.Quantity
         Spindle speeds in rpm, strictly increasing
         (:func:`~substructure.stability.spindle_speeds`).

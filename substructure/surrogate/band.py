@@ -31,11 +31,16 @@ _ENTRIES = {"k_yf": ("k", "yf"), "k_tm": ("k", "tm"), "k_ym": ("k", "ym"), "k_tf
 class FRFBand:
     """The tool point FRF of a predicted joint: median and envelope of ``|H|`` over samples.
 
-    Attributes
+    Parameters
     ----------
     frequency : Frequency
-    median, lower, upper : ndarray
-        ``|H|`` (m/N for translations) per line.
+        The frequency lines, in Hz.
+    median : ndarray
+        Median of ``|H|`` over the samples (m/N for translations), per line.
+    lower : ndarray
+        Lowest ``|H|`` over the samples, per line.
+    upper : ndarray
+        Highest ``|H|`` over the samples, per line.
     nominal : FRF
         The FRF with the median parameters.
     samples : dict of str to ndarray
@@ -50,16 +55,51 @@ class FRFBand:
     samples: dict = attrs.field(eq=False)
 
     def contains(self, frf: FRF, rtol: float = 1e-9) -> np.ndarray:
-        """Lines where ``|frf|`` lies inside the band."""
+        """Lines where ``|frf|`` lies inside the band.
+
+        Parameters
+        ----------
+        frf : FRF
+            A one-entry FRF on the band's lines (m/N).
+        rtol : float
+            Relative tolerance on the envelope.
+
+        Returns
+        -------
+        ndarray
+            Boolean, one value per line.
+        """
         h = np.abs(frf.data[:, 0, 0])
         return (h >= self.lower * (1 - rtol)) & (h <= self.upper * (1 + rtol))
 
     def to_json(self) -> dict:
+        """The band for JSON output.
+
+        Returns
+        -------
+        dict
+            ``frequency_hz`` (Hz), ``magnitude_median``, ``magnitude_lower``, ``magnitude_upper``
+            (m/N), ``n_samples``.
+        """
         return {"frequency_hz": self.frequency.hz.tolist(), "magnitude_median": self.median.tolist(),
                 "magnitude_lower": self.lower.tolist(), "magnitude_upper": self.upper.tolist(),
                 "n_samples": int(len(next(iter(self.samples.values()))))}
 
     def plot(self, ax=None, label="predicted"):
+        """The envelope shaded and the FRF of the median joint, ``|H|`` on a log scale.
+
+        Parameters
+        ----------
+        ax : Axes, optional
+            Where to draw; a new figure when None.
+        label : str
+            Legend label.
+
+        Returns
+        -------
+        Figure
+            The figure: ``|H|`` in m/N against frequency in Hz.
+        """
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -90,8 +130,19 @@ def predict_frf_band(assembly: Assembly, joint: str, prediction, at: str = "tool
         From a surrogate's ``predict``; parameters named ``k_yf``, ``k_tm``, ``c_yf``, ...
     at, to : str
         Response and excitation DOFs (one FRF entry).
+    frequency : Frequency or array_like, optional
+        Frequency lines (plain numbers in Hz); default the assembly's grid.
     n_samples : int
         Stratified samples of the predictive distribution.
+    seed : int
+        Seed of the sampling.
+    index : int
+        Which feature set of the prediction.
+
+    Returns
+    -------
+    FRFBand
+        The median FRF and the envelope of ``|H|`` (m/N) over the samples.
     """
     if n_samples < 2:
         raise InvalidValueError(f"n_samples: got {n_samples!r}; expected at least 2")

@@ -50,6 +50,15 @@ class Prediction:
     mean and standard deviation of the natural logarithm of parameter ``p``
     (in ``units[p]``); ``value`` is the median ``exp(log_mean)`` and ``std``
     the standard deviation of the log-normal distribution.
+
+    Parameters
+    ----------
+    log_mean : dict
+        ``{parameter: ndarray}``: mean of ln(value in ``units[parameter]``) per feature set.
+    log_std : dict
+        ``{parameter: ndarray}``: standard deviation of that logarithm (dimensionless).
+    units : dict
+        ``{parameter: unit}``, e.g. ``{"k_yf": "N/m"}``.
     """
 
     log_mean: dict
@@ -57,14 +66,51 @@ class Prediction:
     units: dict
 
     def value(self, parameter: str) -> np.ndarray:
+        """The median prediction ``exp(log_mean)``.
+
+        Parameters
+        ----------
+        parameter : str
+            A predicted parameter, e.g. ``"k_yf"``.
+
+        Returns
+        -------
+        ndarray
+            One value per feature set, in ``units[parameter]``.
+        """
         return np.exp(self.log_mean[parameter])
 
     def std(self, parameter: str) -> np.ndarray:
+        """The standard deviation of the log-normal predictive distribution.
+
+        Parameters
+        ----------
+        parameter : str
+            A predicted parameter.
+
+        Returns
+        -------
+        ndarray
+            One value per feature set, in ``units[parameter]``.
+        """
         s = self.log_std[parameter]
         return self.value(parameter) * np.sqrt(np.expm1(s**2)) * np.exp(s**2 / 2)
 
     def interval(self, parameter: str, level: float = 0.95) -> tuple[np.ndarray, np.ndarray]:
-        """Central interval of probability ``level`` (lower, upper)."""
+        """Central interval of probability ``level`` (lower, upper).
+
+        Parameters
+        ----------
+        parameter : str
+            A predicted parameter.
+        level : float
+            Probability in (0, 1), e.g. 0.95.
+
+        Returns
+        -------
+        lower, upper : ndarray
+            One bound per feature set, in ``units[parameter]``.
+        """
         z = norm.ppf(0.5 + level / 2)
         m, s = self.log_mean[parameter], self.log_std[parameter]
         return np.exp(m - z * s), np.exp(m + z * s)
@@ -75,6 +121,20 @@ class Prediction:
         Latin-hypercube style: each parameter's probabilities are evenly
         spaced (then shuffled independently), so that a small ``n`` still
         covers its distribution from tail to tail.
+
+        Parameters
+        ----------
+        n : int
+            Number of samples.
+        rng : numpy.random.Generator or int or None
+            Random generator or seed (default 0: reproducible).
+        index : int
+            Which feature set.
+
+        Returns
+        -------
+        dict
+            ``{parameter: ndarray of n values}``, in ``units[parameter]``.
         """
         rng = np.random.default_rng(rng)
         p = (np.arange(n) + 0.5) / n
@@ -85,7 +145,18 @@ class Prediction:
         return out
 
     def to_json(self, index: int = 0) -> dict:
-        """``{name: {"value", "unit", "std", "interval_95"}}`` for feature set ``index``."""
+        """``{name: {"value", "unit", "std", "interval_95"}}`` for feature set ``index``.
+
+        Parameters
+        ----------
+        index : int
+            Which feature set.
+
+        Returns
+        -------
+        dict
+            Values in ``unit``; plain floats, ready for JSON.
+        """
         out = {}
         for p in self.log_mean:
             lo, hi = self.interval(p, 0.95)
@@ -179,7 +250,21 @@ class JointSurrogate(BaseEstimator):
     extrapolation_tolerance: float = 0.25
 
     def fit(self, table: JointTable, targets: Sequence[str] | str | None = None) -> "JointSurrogate":
-        """Fit one model per target parameter (default: every parameter of the table)."""
+        """Fit one model per target parameter (default: every parameter of the table).
+
+        Parameters
+        ----------
+        table : JointTable
+            At least 3 rows; the target values must be positive (logarithms are learnt).
+        targets : str or sequence of str, optional
+            Parameters to learn, e.g. ``"k_yf"``; default all of the table's.
+
+        Returns
+        -------
+        JointSurrogate
+            ``self``, fitted.
+        """
+        table.check_not_empty()
         if isinstance(targets, str):
             targets = [targets]
         targets = list(table.parameters) if targets is None else list(targets)
@@ -214,6 +299,17 @@ class JointSurrogate(BaseEstimator):
 
         Feature values are quantities or strings with units (``"14 mm"``),
         names for categorical features; every feature of the table is needed.
+
+        Parameters
+        ----------
+        features : mapping or sequence of mapping
+            ``{"tool_diameter": "12 mm", "gauge_length": "80 mm"}``, or a list of them.
+
+        Returns
+        -------
+        Prediction
+            Log-normal predictions, in the table's units; warns with
+            :class:`ExtrapolationWarning` far outside the training features.
         """
         if not hasattr(self, "models_"):
             raise InvalidValueError(f"{type(self).__name__} is not fitted yet: call fit(table) first")
@@ -236,13 +332,16 @@ class MLPSurrogate(JointSurrogate):
     Parameters
     ----------
     hidden_layer_sizes : tuple of int
+        Neurons per hidden layer (tanh activation).
     alpha : float
         L2 penalty.
     n_models : int
         Networks in the ensemble, each from another seed; their spread (plus
         the training residual) is the predictive standard deviation.
     max_iter : int
+        Largest number of L-BFGS iterations per network.
     random_state : int
+        Seed of the first network (the others take the next ones).
     """
 
     def __init__(self, hidden_layer_sizes=(6,), alpha=1.0, n_models=5, max_iter=2000, random_state=0):
@@ -289,7 +388,9 @@ class GPSurrogate(JointSurrogate):
     noise_level : float
         Initial white-noise variance (standardised log units).
     n_restarts_optimizer : int
+        Restarts of the kernel hyperparameter optimiser.
     random_state : int
+        Seed of the restarts.
     """
 
     def __init__(self, length_scale=2.0, min_length_scale=2.0, noise_level=0.1, n_restarts_optimizer=1, random_state=0):
@@ -318,7 +419,20 @@ class GPSurrogate(JointSurrogate):
 
 
 def make_surrogate(model: str, **kwargs) -> JointSurrogate:
-    """``"mlp"`` or ``"gp"`` as an unfitted surrogate."""
+    """``"mlp"`` or ``"gp"`` as an unfitted surrogate.
+
+    Parameters
+    ----------
+    model : {"mlp", "gp"}
+        The kind of surrogate.
+    **kwargs
+        Hyperparameters of :class:`MLPSurrogate` or :class:`GPSurrogate`.
+
+    Returns
+    -------
+    JointSurrogate
+        The unfitted surrogate.
+    """
     if model == "mlp":
         return MLPSurrogate(**kwargs)
     if model == "gp":

@@ -159,6 +159,8 @@ class JointTable:
         One array per parameter, per feature and (optional) per ``NAME_std``;
         numbers in the column's unit, NaN for an unknown standard deviation.
 
+    Notes
+    -----
     Use :meth:`from_rows`, :meth:`from_csv` or :func:`thesis_table_4_2` rather
     than this constructor.
     """
@@ -194,7 +196,20 @@ class JointTable:
 
     @classmethod
     def empty(cls, parameters: Mapping[str, str], features: Mapping[str, str | None]) -> "JointTable":
-        """A table without rows, with the given columns and units."""
+        """A table without rows, with the given columns and units.
+
+        Parameters
+        ----------
+        parameters : mapping of str to str
+            Parameter name to unit, e.g. ``{"k_yf": "N/m"}``.
+        features : mapping of str to str or None
+            Feature name to unit (``{"tool_diameter": "mm"}``), None for a categorical one.
+
+        Returns
+        -------
+        JointTable
+            The empty table.
+        """
         cols = {p: np.zeros(0) for p in parameters}
         cols.update({f: np.zeros(0) if u is not None else np.zeros(0, dtype=object) for f, u in features.items()})
         return cls(parameters, features, cols)
@@ -206,6 +221,18 @@ class JointTable:
         Parameters are the keys named like joint parameters (or ``parameters``);
         ``NAME_std`` keys are their standard deviations.  The units of the
         first row become the table's units.
+
+        Parameters
+        ----------
+        rows : sequence of mapping
+            ``{"tool_diameter": "12 mm", "gauge_length": "80 mm", "k_yf": "1.4e7 N/m"}`` per row.
+        parameters : sequence of str, optional
+            Which keys are parameters; default the keys named like joint parameters.
+
+        Returns
+        -------
+        JointTable
+            The table.
         """
         rows = list(rows)
         if not rows:
@@ -238,7 +265,20 @@ class JointTable:
 
     @classmethod
     def from_csv(cls, path: str | Path, parameters: Sequence[str] | None = None) -> "JointTable":
-        """Read a table written by :meth:`to_csv` (units in brackets in the header)."""
+        """Read a table written by :meth:`to_csv` (units in brackets in the header).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The CSV file.
+        parameters : sequence of str, optional
+            Which columns are parameters; default those named like joint parameters.
+
+        Returns
+        -------
+        JointTable
+            The table, in the units of the header.
+        """
         from ..io import read_text
 
         return cls._from_csv_text(read_text(path), str(path), parameters)
@@ -329,20 +369,54 @@ class JointTable:
 
     @property
     def n_rows(self) -> int:
+        """Number of rows (identified joints)."""
         return len(self)
 
     def values(self, parameter: str) -> np.ndarray:
-        """The column of ``parameter`` in its unit (:attr:`parameters`)."""
+        """The column of ``parameter`` in its unit (``parameters``).
+
+        Parameters
+        ----------
+        parameter : str
+            A parameter of the table, e.g. ``"k_yf"``.
+
+        Returns
+        -------
+        ndarray
+            One value per row, in the parameter's unit.
+        """
         self._check_parameter(parameter)
         return np.asarray(self.columns[parameter], dtype=float)
 
     def stds(self, parameter: str) -> np.ndarray:
-        """Standard deviations of ``parameter`` (NaN where unknown)."""
+        """Standard deviations of ``parameter`` (NaN where unknown).
+
+        Parameters
+        ----------
+        parameter : str
+            A parameter of the table.
+
+        Returns
+        -------
+        ndarray
+            One value per row, in the parameter's unit.
+        """
         self._check_parameter(parameter)
         return np.asarray(self.columns[parameter + "_std"], dtype=float)
 
     def feature(self, name: str) -> np.ndarray:
-        """The column of feature ``name`` (numbers in its unit, or strings)."""
+        """The column of feature ``name`` (numbers in its unit, or strings).
+
+        Parameters
+        ----------
+        name : str
+            A feature of the table.
+
+        Returns
+        -------
+        ndarray
+            One value per row: numbers in the feature's unit, or names for a categorical feature.
+        """
         if name not in self.features:
             raise InvalidValueError(f"feature {name!r} is not in the table; it has {', '.join(self.features) or 'none'}")
         return self.columns[name]
@@ -372,7 +446,17 @@ class JointTable:
     def feature_values(self, features: Mapping[str, Any], field: str = "features") -> dict[str, Any]:
         """Check one set of features against the table: every feature, in matching units.
 
-        Returns numbers in the table's units, strings for categorical features.
+        Parameters
+        ----------
+        features : mapping
+            ``{feature: quantity, string with a unit, or name}`` with every feature of the table.
+        field : str
+            Name of the argument, for error messages.
+
+        Returns
+        -------
+        dict
+            Numbers in the table's units, strings for categorical features.
         """
         missing = [f for f in self.features if f not in features]
         if missing:
@@ -399,7 +483,19 @@ class JointTable:
     # -- changes -----------------------------------------------------------------------------
 
     def append(self, row: Mapping[str, Any]) -> "JointTable":
-        """A new table with one more row (quantities for parameters and unit features)."""
+        """A new table with one more row (quantities for parameters and unit features).
+
+        Parameters
+        ----------
+        row : mapping
+            Every parameter and feature, values with units (``"1.4e7 N/m"``, ``"12 mm"``);
+            optional ``NAME_std`` standard deviations.
+
+        Returns
+        -------
+        JointTable
+            A new table; this one is unchanged.
+        """
         feats = self.feature_values({k: v for k, v in row.items() if k in self.features
                                      or not (k in self.parameters or k.endswith("_std") and k[:-4] in self.parameters)},
                                     field="row")
@@ -422,6 +518,18 @@ class JointTable:
 
         The report's values are SI (``k_yf`` in N/m, ...); every parameter of
         the table is taken from it, with its standard deviation when fitted.
+
+        Parameters
+        ----------
+        report : IdentificationReport
+            The identification of the joint.
+        features : mapping
+            The joint's features, with units (``{"tool_diameter": "12 mm", ...}``).
+
+        Returns
+        -------
+        JointTable
+            A new table; this one is unchanged.
         """
         row = dict(features)
         for p in self.parameters:
@@ -439,7 +547,18 @@ class JointTable:
     # -- output ------------------------------------------------------------------------------
 
     def to_csv(self, path: str | Path | None = None) -> str:
-        """Write the table as CSV (units in the header); returns the text."""
+        """Write the table as CSV (units in the header); returns the text.
+
+        Parameters
+        ----------
+        path : str or os.PathLike, optional
+            Where to write it; None only returns the text.
+
+        Returns
+        -------
+        str
+            The CSV text.
+        """
         header, keys = [], []
         for f, u in self.features.items():
             header.append(f"{f} [{u}]" if u else f)
@@ -472,6 +591,16 @@ class JointTable:
         """Write the table as TOML: a ``[[joints]]`` table per row, every value with its unit.
 
         :meth:`from_toml` reads it back to an equal table (units and values).
+
+        Parameters
+        ----------
+        path : str or os.PathLike, optional
+            Where to write it; None only returns the text.
+
+        Returns
+        -------
+        str
+            The TOML text.
         """
         import tomli_w
 
@@ -498,7 +627,18 @@ class JointTable:
 
     @classmethod
     def from_toml(cls, path: str | Path) -> "JointTable":
-        """Read a table written by :meth:`to_toml` (or by hand in that form)."""
+        """Read a table written by :meth:`to_toml` (or by hand in that form).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The TOML file.
+
+        Returns
+        -------
+        JointTable
+            The table.
+        """
         import tomllib
 
         from ..io import read_text
@@ -532,13 +672,25 @@ class JointTable:
         return table
 
     def describe(self) -> str:
-        """One line: rows, parameters and features."""
+        """One line: rows, parameters and features.
+
+        Returns
+        -------
+        str
+            The description, with units.
+        """
         feats = ", ".join(f"{f} [{u}]" if u else f"{f} (categorical)" for f, u in self.features.items())
         return f"{len(self)} joints; parameters {', '.join(self.parameters)}; features {feats}"
 
 
 def thesis_table_4_2() -> JointTable:
-    """Thesis Table 4.2 as a joint table: 13 holder-tool ``k_yf`` over diameter and gauge length."""
+    """Thesis Table 4.2 as a joint table: 13 holder-tool ``k_yf`` over diameter and gauge length.
+
+    Returns
+    -------
+    JointTable
+        Features ``tool_diameter`` and ``gauge_length`` in mm, parameter ``k_yf`` in N/m.
+    """
     from ..datasets import thesis_table
 
     rows = [

@@ -26,6 +26,19 @@ class CrossValidation:
 
     ``folds`` is a list of dicts ``held_out`` (row indices), ``true``,
     ``predicted``, ``std``, ``lower_68``, ``upper_68``, ``lower_95``, ``upper_95``.
+
+    Parameters
+    ----------
+    model : str
+        The surrogate's class name.
+    target : str
+        The parameter predicted (``k_yf``).
+    unit : str
+        Its unit (``N/m``).
+    scheme : str
+        ``"loo"`` or ``"group:FEATURE"``.
+    folds : list of dict
+        The held-out predictions, values in ``unit``.
     """
 
     model: str
@@ -39,23 +52,45 @@ class CrossValidation:
 
     @property
     def percent_errors(self) -> np.ndarray:
+        """Absolute errors of the held-out predictions, in % of the true values."""
         t = self._all("true")
         return 100.0 * np.abs(self._all("predicted") - t) / np.abs(t)
 
     @property
     def mean_abs_percent_error(self) -> float:
+        """Mean absolute percentage error, in %."""
         return float(np.mean(self.percent_errors))
 
     @property
     def max_abs_percent_error(self) -> float:
+        """Largest absolute percentage error, in %."""
         return float(np.max(self.percent_errors))
 
     def coverage(self, level: float) -> float:
+        """Share of the true values inside the held-out predictive intervals.
+
+        Parameters
+        ----------
+        level : {0.68, 0.95}
+            The interval's probability.
+
+        Returns
+        -------
+        float
+            The share, in [0, 1]; an honest surrogate covers about ``level``.
+        """
         key = {0.68: "68", 0.95: "95"}[level]
         t = self._all("true")
         return float(np.mean((t >= self._all("lower_" + key)) & (t <= self._all("upper_" + key))))
 
     def to_json(self) -> dict:
+        """The cross-validation for JSON output.
+
+        Returns
+        -------
+        dict
+            The folds (values in ``unit``), the errors in % and the coverages.
+        """
         return {
             "model": self.model, "target": self.target, "unit": self.unit, "scheme": self.scheme,
             "folds": [{k: [int(i) for i in f[k]] if k == "held_out" else [float(x) for x in f[k]]
@@ -67,7 +102,18 @@ class CrossValidation:
         }
 
     def plot(self, ax=None):
-        """Parity plot: predicted against true with 95 % error bars."""
+        """Parity plot: predicted against true with 95 % error bars.
+
+        Parameters
+        ----------
+        ax : Axes, optional
+            Where to draw; a new figure when None.
+
+        Returns
+        -------
+        Figure
+            The figure, both axes in ``unit``.
+        """
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -90,9 +136,20 @@ def cross_validate(surrogate: JointSurrogate, table: JointTable, target: str, sc
 
     Parameters
     ----------
+    surrogate : JointSurrogate
+        An unfitted surrogate (cloned for every fold).
+    table : JointTable
+        The joint table.
+    target : str
+        The parameter to predict (``k_yf``).
     scheme : str
         ``"loo"`` (leave one row out) or ``"group:FEATURE"`` (leave out every
         row of one value of FEATURE at a time, e.g. ``group:tool_diameter``).
+
+    Returns
+    -------
+    CrossValidation
+        The held-out predictions, in the table's unit of ``target``.
     """
     table.check_not_empty()
     table._check_parameter(target)
