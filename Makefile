@@ -32,7 +32,7 @@ examples: $(STAMP)
 # Warnings are errors: an unresolved reference or link, a docstring the numpydoc check
 # rejects, or an example that fails, prints nothing or draws nothing fails the build.
 # The examples run here (and only here in CI); see docs/writing-docs.md.
-$(DOCS_STAMP): $(STAMP)
+$(DOCS_STAMP): $(STAMP) pyproject.toml
 	$(BIN)/python -m pip install --quiet -e ".[test,docs]"
 	touch $(DOCS_STAMP)
 
