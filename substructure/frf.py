@@ -119,7 +119,7 @@ class Frequency:
         Returns
         -------
         Frequency
-            At least two lines and at most :data:`MAX_GRID_LINES`.
+            At least two lines and at most :data:`~substructure.frf.MAX_GRID_LINES`.
 
         Raises
         ------
@@ -128,7 +128,7 @@ class Frequency:
         InvalidValueError
             For ``start < 0``, ``step <= 0``, ``stop < start``, a grid of one
             line (a range needs ``stop >= start + step``) or more lines than
-            :data:`MAX_GRID_LINES`.
+            :data:`~substructure.frf.MAX_GRID_LINES`.
         """
         f0, f1, df = frequency_hz(start, "start"), frequency_hz(stop, "stop"), frequency_hz(step, "step")
         if f0 < 0:

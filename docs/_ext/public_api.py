@@ -97,6 +97,9 @@ def _candidate_modules(package: str = PACKAGE) -> list[str]:
                         packages.append(subname)
         elif hasattr(mod, "__all__"):
             (packages if info.ispkg else modules).append(full)
+            # a package may name submodules that are public API of their own
+            for sub in getattr(mod, "__public_submodules__", ()):
+                packages.append(f"{full}.{sub}")
     return [package] + packages + modules
 
 

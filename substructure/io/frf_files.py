@@ -626,8 +626,8 @@ def read_uff(path: str | os.PathLike, record: int | None = None, quantity: str |
     Returns
     -------
     FRF
-        The data converted to SI units (m/N, (m/s)/N, (m/s^2)/N, ...), with
-        the quantity the records hold.
+        Frequencies in Hz; the data converted to SI units (m/N, (m/s)/N,
+        (m/s^2)/N, ...), with the quantity the records hold.
 
     Raises
     ------
@@ -651,11 +651,6 @@ def read_uff(path: str | os.PathLike, record: int | None = None, quantity: str |
     abscissa labelled in rad/s is divided by 2 pi.  Labels come from the ID
     lines this module writes; records of other programs get
     ``"node<N>:y"`` / ``"node<N>:theta"`` (``dir<D>`` for other directions).
-
-    Returns
-    -------
-    FRF
-        Frequencies in Hz, values converted to SI units (m/N for a receptance y/f).
     """
     import pyuff
 
