@@ -1,0 +1,742 @@
+/* Compiled kernels of substructure (internal): Timoshenko segments, free-free
+ * chains and coupling updates, one loop over frequency lines each.
+ *
+ * Built by setuptools when the package is installed (a plain C extension: no
+ * compiler is needed at run time and nothing is compiled on first use).  The
+ * Python side is substructure/_kernels.py, which prepares C-contiguous arrays
+ * of fixed dtypes, splits the lines between threads and documents the
+ * mathematics; the formulas are those of docs/beams.md.
+ *
+ * Floating point: IEEE double arithmetic, no reassociation and no contraction
+ * into fused multiply-adds (setup flags -fno-fast-math -ffp-contract=off), so
+ * that the compensated determinant below is exact and results do not depend
+ * on the instruction set.  Complex numbers are pairs of doubles with the
+ * textbook product (ac - bd, ad + bc); reciprocals are written out so that a
+ * zero divisor gives inf/nan as in numpy instead of trapping.
+ *
+ * The kernels release the GIL: plain Python threads run them in parallel on
+ * disjoint ranges of lines.
+ */
+
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct {
+    double re, im;
+} cx;
+
+static inline cx mk(double re, double im) { cx z; z.re = re; z.im = im; return z; }
+static inline cx cadd(cx a, cx b) { return mk(a.re + b.re, a.im + b.im); }
+static inline cx csub(cx a, cx b) { return mk(a.re - b.re, a.im - b.im); }
+static inline cx cneg(cx a) { return mk(-a.re, -a.im); }
+static inline cx cmul(cx a, cx b) { return mk(a.re * b.re - a.im * b.im, a.re * b.im + a.im * b.re); }
+static inline cx cscale(double s, cx a) { return mk(s * a.re, s * a.im); }
+
+/* 1 / z by Smith's method; inf/nan for z = 0. */
+static inline cx cinv(cx z)
+{
+    double r, d;
+    if (fabs(z.re) >= fabs(z.im)) {
+        r = z.im / z.re;
+        d = z.re + z.im * r;
+        return mk(1.0 / d, -r / d);
+    }
+    r = z.re / z.im;
+    d = z.re * r + z.im;
+    return mk(r / d, -1.0 / d);
+}
+
+/* 1 / z = conj(z) / |z|^2 for z well inside the range of doubles, else Smith's. */
+static inline cx crecip(cx z)
+{
+    double d = z.re * z.re + z.im * z.im;
+    if (d > 1e-290 && d < 1e290) {
+        double f = 1.0 / d;
+        return mk(z.re * f, -z.im * f);
+    }
+    return cinv(z);
+}
+
+#define SPLIT 134217729.0 /* 2^27 + 1: Veltkamp's splitting */
+
+/* a1 b1 + a2 b2 + a3 b3 + a4 b4 as accurate as in twice the precision (Ogita, Rump and Oishi's Dot2). */
+static double dot4(const double a[4], const double b[4])
+{
+    double total = 0.0, err = 0.0;
+    for (int k = 0; k < 4; k++) {
+        double x = a[k], y = b[k];
+        double p = x * y;
+        double t = SPLIT * x;
+        double xh = t - (t - x);
+        double xl = x - xh;
+        t = SPLIT * y;
+        double yh = t - (t - y);
+        double yl = y - yh;
+        err += ((xh * yh - p) + xh * yl + xl * yh) + xl * yl;
+        double s = total + p;
+        double z = s - total;
+        err += (total - (s - z)) + (p - z);
+        total = s;
+    }
+    return total + err;
+}
+
+/* a d - b c, compensated where the two products cancel to less than 1e-3 of their size. */
+static inline cx det2(cx a, cx b, cx c, cx d)
+{
+    cx ad = cmul(a, d), bc = cmul(b, c);
+    cx det = csub(ad, bc);
+    double size = fabs(ad.re) + fabs(ad.im) + fabs(bc.re) + fabs(bc.im);
+    if (fabs(det.re) + fabs(det.im) > 1e-3 * size)
+        return det;
+    double x1[4] = {a.re, -a.im, -b.re, b.im}, y1[4] = {d.re, d.im, c.re, c.im};
+    double x2[4] = {a.re, a.im, -b.re, -b.im}, y2[4] = {d.im, d.re, c.im, c.re};
+    return mk(dot4(x1, y1), dot4(x2, y2));
+}
+
+/* Principal square root (Re >= 0, branch cut on the negative real axis, as numpy). */
+static inline cx csqrt_(cx z)
+{
+    double x = z.re, y = z.im;
+    if (x == 0.0 && y == 0.0)
+        return mk(0.0, y);
+    double r2 = x * x + y * y;
+    double r = (r2 > 0.0 && r2 < INFINITY) ? sqrt(r2) : hypot(x, y);
+    if (x >= 0.0) {
+        double t = sqrt(0.5 * (r + x));
+        return mk(t, 0.5 * y / t);
+    }
+    double t = sqrt(0.5 * (r - x));
+    return mk(0.5 * fabs(y) / t, copysign(t, y));
+}
+
+/* ------------------------------------------------------------------------ */
+/* Segments */
+
+#define SERIES_LIMIT2 0.25 /* |s L^2| < 0.5, squared (docs/beams.md) */
+static double inv_factorial[24];
+static double series_bound2[12]; /* |z|^2 up to which n terms suffice: |z|^n / (2n)! <= 1e-18 */
+
+/* Per-segment constants: a / w2, e / w2, rhoA / EI, 1 / EI, 1 / kGA. */
+static void coefficients(cx ei, cx kga, double rhoa, double rhoi, cx out[5])
+{
+    cx iei = cinv(ei), ikga = cinv(kga);
+    out[0] = cscale(-rhoa, ikga);
+    out[1] = cscale(-rhoi, iei);
+    out[2] = cscale(rhoa, iei);
+    out[3] = iei;
+    out[4] = ikga;
+}
+
+/* a, e (the diagonal of A^2) and the eigenvalues s1, s2 of A^2 at w2 = omega^2. */
+static inline void wavenumbers(const cx co[5], double w2, cx *a, cx *e, cx *s1, cx *s2)
+{
+    *a = cscale(w2, co[0]);
+    *e = cscale(w2, co[1]);
+    cx half = cscale(0.5, csub(*a, *e));
+    cx root = csqrt_(cadd(cmul(half, half), cscale(w2, co[2])));
+    cx mean = cscale(0.5, cadd(*a, *e));
+    *s1 = cadd(mean, root);
+    *s2 = csub(mean, root);
+}
+
+/* The 16 entries of T = exp(A L) of one segment at one line, row-major. */
+static void transfer(const cx co[5], double rhoa, double rhoi, double length, double w2, cx t[16])
+{
+    cx a, e, s1, s2;
+    wavenumbers(co, w2, &a, &e, &s1, &s2);
+    cx iei = co[3], ikga = co[4];
+    double l2 = length * length;
+    cx z1 = cscale(l2, s1), z2 = cscale(l2, s2);
+    double m1 = z1.re * z1.re + z1.im * z1.im, m2 = z2.re * z2.re + z2.im * z2.im;
+    double bound2 = m1 > m2 ? m1 : m2;
+    cx c0, c1, g0, g1;
+    if (bound2 < SERIES_LIMIT2) {
+        /* h_n: complete homogeneous symmetric polynomial of degree n in z1, z2; pow2 = z2^n */
+        int n_terms = 2;
+        while (bound2 > series_bound2[n_terms])
+            n_terms++;
+        cx sc = mk(1.0, 0.0), ss = mk(1.0, 0.0), dc = mk(0.0, 0.0), ds = mk(0.0, 0.0);
+        cx h = mk(1.0, 0.0), pow2 = mk(1.0, 0.0);
+        for (int n = 1; n <= n_terms; n++) {
+            double rc = inv_factorial[2 * n], rs = inv_factorial[2 * n + 1];
+            dc = cadd(dc, cscale(rc, h));
+            ds = cadd(ds, cscale(rs, h));
+            pow2 = cmul(pow2, z2);
+            sc = cadd(sc, cscale(rc, pow2));
+            ss = cadd(ss, cscale(rs, pow2));
+            h = cadd(cmul(z1, h), pow2);
+        }
+        c0 = sc;
+        c1 = cscale(l2, dc);
+        g0 = cscale(length, ss);
+        g1 = cscale(l2 * length, ds);
+    } else {
+        /* cosh and sinh from exp(r L) = e^x (cos y + i sin y); Re r >= 0 */
+        cx r1 = csqrt_(s1), r2 = csqrt_(s2);
+        double x1 = r1.re * length, y1 = r1.im * length;
+        double x2 = r2.re * length, y2 = r2.im * length;
+        double p1 = exp(x1), p2 = exp(x2);
+        double q1 = 1.0 / p1, q2 = 1.0 / p2;
+        double cy1 = cos(y1), sy1 = sin(y1), cy2 = cos(y2), sy2 = sin(y2);
+        cx ch1 = mk(0.5 * (p1 + q1) * cy1, 0.5 * (p1 - q1) * sy1);
+        cx ch2 = mk(0.5 * (p2 + q2) * cy2, 0.5 * (p2 - q2) * sy2);
+        cx sh1 = cmul(mk(0.5 * (p1 - q1) * cy1, 0.5 * (p1 + q1) * sy1), crecip(r1));
+        cx sh2 = cmul(mk(0.5 * (p2 - q2) * cy2, 0.5 * (p2 + q2) * sy2), crecip(r2));
+        cx ids = crecip(csub(s1, s2));
+        c0 = ch2;
+        c1 = cmul(csub(ch1, ch2), ids);
+        g0 = sh2;
+        g1 = cmul(csub(sh1, sh2), ids);
+    }
+    cx alpha = csub(c0, cmul(c1, s2));
+    cx beta = csub(g0, cmul(g1, s2));
+    cx gamma = c1, delta = g1;
+    double ma = w2 * rhoa, mi = w2 * rhoi;
+    /* T = alpha I + beta A + gamma A^2 + delta A^3, entry by entry */
+    cx d00 = cadd(alpha, cmul(gamma, a));
+    cx d11 = cadd(alpha, cmul(gamma, e));
+    t[0] = d00;
+    t[10] = d00;
+    t[5] = d11;
+    t[15] = d11;
+    t[1] = cadd(beta, cmul(delta, cadd(a, e)));
+    t[2] = cadd(cmul(beta, ikga), cmul(delta, csub(cmul(a, ikga), iei)));
+    cx g_ei = cmul(gamma, iei);
+    t[3] = g_ei;
+    t[6] = cneg(g_ei);
+    cx d_ma_ei = cmul(cscale(ma, delta), iei);
+    t[4] = d_ma_ei;
+    t[11] = cneg(d_ma_ei);
+    t[7] = cmul(cadd(beta, cmul(delta, e)), iei);
+    t[8] = cneg(cscale(ma, cadd(beta, cmul(delta, a))));
+    cx g_ma = cscale(ma, gamma);
+    t[12] = g_ma;
+    t[9] = cneg(g_ma);
+    t[13] = cadd(cscale(-mi, beta), cmul(delta, csub(mk(ma, 0.0), cscale(mi, e))));
+    t[14] = cadd(cneg(beta), cmul(delta, csub(cscale(mi, iei), a)));
+}
+
+/* ------------------------------------------------------------------------ */
+/* Chains */
+
+/* Free-free receptances of a chain at its nodes, one line, into out[:, :, q].
+ * tmat: the 4x4 transfer matrices (row-major) of the distinct segments. */
+static void chain_line(const cx *tmat, const int64_t *seg_of, Py_ssize_t n_int, const int64_t *nodes,
+                       const int64_t *place, Py_ssize_t m, cx *out, Py_ssize_t n_lines, Py_ssize_t q,
+                       cx *pre, cx *post)
+{
+    cx cols[8], rows[8], tmp[8]; /* cols 4x2, rows 2x4, row-major */
+    /* u-columns of T(0 -> x), carried from the base to the tip; pre[p] = P_p,uu */
+    {
+        Py_ssize_t p = 0;
+        int fresh = 1;
+        for (Py_ssize_t k = 0; k <= n_int; k++) {
+            if (p < m && nodes[p] == k) {
+                cx *d = pre + 4 * p;
+                if (fresh) {
+                    d[0] = mk(1.0, 0.0); d[1] = mk(0.0, 0.0); d[2] = mk(0.0, 0.0); d[3] = mk(1.0, 0.0);
+                } else {
+                    d[0] = cols[0]; d[1] = cols[1]; d[2] = cols[2]; d[3] = cols[3];
+                }
+                p++;
+            }
+            if (k == n_int)
+                break;
+            const cx *t = tmat + 16 * seg_of[k];
+            if (fresh) {
+                for (int r = 0; r < 4; r++) {
+                    cols[2 * r] = t[4 * r];
+                    cols[2 * r + 1] = t[4 * r + 1];
+                }
+                fresh = 0;
+            } else {
+                for (int r = 0; r < 4; r++)
+                    for (int c = 0; c < 2; c++)
+                        tmp[2 * r + c] = cadd(cadd(cadd(cmul(t[4 * r], cols[c]), cmul(t[4 * r + 1], cols[2 + c])),
+                                                   cmul(t[4 * r + 2], cols[4 + c])),
+                                              cmul(t[4 * r + 3], cols[6 + c]));
+                memcpy(cols, tmp, sizeof(cols));
+            }
+        }
+    }
+    /* F-rows of T(x -> L), carried from the tip to the base; post[p] = S_p,FF */
+    {
+        Py_ssize_t p = m - 1;
+        int fresh = 1;
+        for (Py_ssize_t k = n_int; k >= 0; k--) {
+            if (p >= 0 && nodes[p] == k) {
+                cx *d = post + 4 * p;
+                if (fresh) {
+                    d[0] = mk(1.0, 0.0); d[1] = mk(0.0, 0.0); d[2] = mk(0.0, 0.0); d[3] = mk(1.0, 0.0);
+                } else {
+                    d[0] = rows[2]; d[1] = rows[3]; d[2] = rows[6]; d[3] = rows[7];
+                }
+                p--;
+            }
+            if (k == 0 || p < 0)
+                break;
+            const cx *t = tmat + 16 * seg_of[k - 1];
+            if (fresh) {
+                for (int c = 0; c < 4; c++) {
+                    rows[c] = t[8 + c];
+                    rows[4 + c] = t[12 + c];
+                }
+                fresh = 0;
+            } else {
+                for (int r = 0; r < 2; r++)
+                    for (int c = 0; c < 4; c++)
+                        tmp[4 * r + c] = cadd(cadd(cadd(cmul(rows[4 * r], t[c]), cmul(rows[4 * r + 1], t[4 + c])),
+                                                   cmul(rows[4 * r + 2], t[8 + c])),
+                                              cmul(rows[4 * r + 3], t[12 + c]));
+                memcpy(rows, tmp, sizeof(rows));
+            }
+        }
+    }
+    /* M_Fu^-1 (M_Fu = cols[4:8]) */
+    cx idet = cinv(det2(cols[4], cols[5], cols[6], cols[7]));
+    cx i00 = cmul(cols[7], idet), i11 = cmul(cols[4], idet);
+    cx i01 = cmul(cneg(cols[5]), idet), i10 = cmul(cneg(cols[6]), idet);
+    Py_ssize_t w = 2 * m; /* out is (w, w, n_lines) */
+    for (Py_ssize_t i = 0; i < m; i++) {
+        const cx *pi_ = pre + 4 * i;
+        cx l00 = cadd(cmul(pi_[0], i00), cmul(pi_[1], i10));
+        cx l01 = cadd(cmul(pi_[0], i01), cmul(pi_[1], i11));
+        cx l10 = cadd(cmul(pi_[2], i00), cmul(pi_[3], i10));
+        cx l11 = cadd(cmul(pi_[2], i01), cmul(pi_[3], i11));
+        Py_ssize_t a = 2 * place[i];
+        for (Py_ssize_t j = i; j < m; j++) {
+            const cx *s = post + 4 * j;
+            Py_ssize_t b = 2 * place[j];
+            cx y00 = cadd(cmul(l00, s[0]), cmul(l01, s[2]));
+            cx y01 = cadd(cmul(l00, s[1]), cmul(l01, s[3]));
+            cx y10 = cadd(cmul(l10, s[0]), cmul(l11, s[2]));
+            cx y11 = cadd(cmul(l10, s[1]), cmul(l11, s[3]));
+            out[((a) * w + b) * n_lines + q] = y00;
+            out[((a) * w + b + 1) * n_lines + q] = y01;
+            out[((a + 1) * w + b) * n_lines + q] = y10;
+            out[((a + 1) * w + b + 1) * n_lines + q] = y11;
+            if (j > i) {
+                out[((b) * w + a) * n_lines + q] = y00;
+                out[((b + 1) * w + a) * n_lines + q] = y01;
+                out[((b) * w + a + 1) * n_lines + q] = y10;
+                out[((b + 1) * w + a + 1) * n_lines + q] = y11;
+            }
+        }
+    }
+}
+
+/* ------------------------------------------------------------------------ */
+/* Buffers */
+
+typedef struct {
+    Py_buffer view;
+    int held;
+} buf_t;
+
+static void release(buf_t *b, int n)
+{
+    for (int i = 0; i < n; i++)
+        if (b[i].held) {
+            PyBuffer_Release(&b[i].view);
+            b[i].held = 0;
+        }
+}
+
+/* A C-contiguous buffer of ``kind`` ('d' float64, 'Z' complex128, 'q' int64) with ``ndim`` dimensions. */
+static int get(PyObject *obj, buf_t *b, char kind, int ndim, int writable, const char *name)
+{
+    int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0);
+    if (PyObject_GetBuffer(obj, &b->view, flags) < 0) {
+        PyErr_Format(PyExc_TypeError, "%s: expected a C-contiguous%s array", name, writable ? ", writeable" : "");
+        return -1;
+    }
+    b->held = 1;
+    const char *f = b->view.format ? b->view.format : "B";
+    if (*f == '<' || *f == '=' || *f == '@')
+        f++;
+    int ok;
+    if (kind == 'd')
+        ok = strcmp(f, "d") == 0;
+    else if (kind == 'Z')
+        ok = strcmp(f, "Zd") == 0;
+    else
+        ok = (strcmp(f, "q") == 0 || strcmp(f, "l") == 0) && b->view.itemsize == 8;
+    if (!ok || b->view.ndim != ndim) {
+        PyErr_Format(PyExc_TypeError, "%s: expected a %d-dimensional %s array, got format %s with %d dimensions",
+                     name, ndim, kind == 'd' ? "float64" : kind == 'Z' ? "complex128" : "int64", f,
+                     (int)b->view.ndim);
+        return -1;
+    }
+    return 0;
+}
+
+#define SHAPE(b, k) ((b).view.shape[k])
+
+/* ------------------------------------------------------------------------ */
+/* segment_coefficients(ei, kga, rhoa, rhoi, omega_max, coef, k_max) */
+
+static PyObject *py_segment_coefficients(PyObject *self, PyObject *args)
+{
+    PyObject *o[7];
+    double omega_max;
+    if (!PyArg_ParseTuple(args, "OOOOdOO", &o[0], &o[1], &o[2], &o[3], &omega_max, &o[5], &o[6]))
+        return NULL;
+    buf_t b[6] = {{0}};
+    if (get(o[0], &b[0], 'Z', 2, 0, "ei") || get(o[1], &b[1], 'Z', 2, 0, "kga") ||
+        get(o[2], &b[2], 'd', 2, 0, "rhoa") || get(o[3], &b[3], 'd', 2, 0, "rhoi") ||
+        get(o[5], &b[4], 'Z', 3, 1, "coef") || get(o[6], &b[5], 'd', 2, 1, "k_max")) {
+        release(b, 6);
+        return NULL;
+    }
+    Py_ssize_t n_u = SHAPE(b[0], 0), n_c = SHAPE(b[0], 1);
+    for (int k = 1; k < 4; k++)
+        if (SHAPE(b[k], 0) != n_u || SHAPE(b[k], 1) != n_c)
+            goto shape;
+    if (SHAPE(b[4], 0) != n_u || SHAPE(b[4], 1) != n_c || SHAPE(b[4], 2) != 5 || SHAPE(b[5], 0) != n_u ||
+        SHAPE(b[5], 1) != n_c)
+        goto shape;
+    {
+        const cx *ei = b[0].view.buf, *kga = b[1].view.buf;
+        const double *rhoa = b[2].view.buf, *rhoi = b[3].view.buf;
+        cx *coef = b[4].view.buf;
+        double *k_max = b[5].view.buf;
+        double w2 = omega_max * omega_max;
+        for (Py_ssize_t k = 0; k < n_u * n_c; k++) {
+            cx *co = coef + 5 * k;
+            coefficients(ei[k], kga[k], rhoa[k], rhoi[k], co);
+            cx a, e, s1, s2;
+            wavenumbers(co, w2, &a, &e, &s1, &s2);
+            double m1 = hypot(s1.re, s1.im), m2 = hypot(s2.re, s2.im);
+            k_max[k] = sqrt(m1 > m2 ? m1 : m2);
+        }
+    }
+    release(b, 6);
+    Py_RETURN_NONE;
+shape:
+    release(b, 6);
+    PyErr_SetString(PyExc_ValueError, "segment_coefficients: inconsistent shapes");
+    return NULL;
+}
+
+/* ------------------------------------------------------------------------ */
+/* chain_lines(omega, coef, rhoa, rhoi, length, slot, table, seg_of, nodes, place, out, table_only, lo, hi) */
+
+static PyObject *py_chain_lines(PyObject *self, PyObject *args)
+{
+    PyObject *o[11];
+    int table_only;
+    Py_ssize_t lo, hi;
+    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOpnn", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5], &o[6], &o[7], &o[8],
+                          &o[9], &o[10], &table_only, &lo, &hi))
+        return NULL;
+    buf_t b[11] = {{0}};
+    if (get(o[0], &b[0], 'd', 1, 0, "omega") || get(o[1], &b[1], 'Z', 3, 0, "coef") ||
+        get(o[2], &b[2], 'd', 2, 0, "rhoa") || get(o[3], &b[3], 'd', 2, 0, "rhoi") ||
+        get(o[4], &b[4], 'd', 2, 0, "length") || get(o[5], &b[5], 'q', 1, 0, "slot") ||
+        get(o[6], &b[6], 'Z', 3, 1, "table") || get(o[7], &b[7], 'q', 1, 0, "seg_of") ||
+        get(o[8], &b[8], 'q', 1, 0, "nodes") || get(o[9], &b[9], 'q', 1, 0, "place") ||
+        get(o[10], &b[10], 'Z', 3, 1, "out")) {
+        release(b, 11);
+        return NULL;
+    }
+    Py_ssize_t n_f = SHAPE(b[0], 0), n_u = SHAPE(b[1], 0), n_c = SHAPE(b[1], 1);
+    Py_ssize_t n_int = SHAPE(b[7], 0), m = SHAPE(b[8], 0);
+    const int64_t *slot = b[5].view.buf, *seg_of = b[7].view.buf, *nodes = b[8].view.buf, *place = b[9].view.buf;
+    Py_ssize_t n_shared = 0;
+    const char *bad = NULL;
+    for (Py_ssize_t u = 0; u < n_u; u++)
+        if (slot[u] >= 0)
+            n_shared = slot[u] + 1 > n_shared ? slot[u] + 1 : n_shared;
+    if (SHAPE(b[1], 2) != 5 || SHAPE(b[5], 0) != n_u)
+        bad = "coef or slot";
+    for (int k = 2; k < 5; k++)
+        if (SHAPE(b[k], 0) != n_u || SHAPE(b[k], 1) != n_c)
+            bad = "rhoa, rhoi or length";
+    if (SHAPE(b[6], 1) != 4 || SHAPE(b[6], 2) != 4 || SHAPE(b[6], 0) < n_shared * n_f)
+        bad = "table";
+    if (SHAPE(b[9], 0) != m)
+        bad = "place";
+    for (Py_ssize_t k = 0; k < n_int && !bad; k++)
+        if (seg_of[k] < 0 || seg_of[k] >= n_u)
+            bad = "seg_of";
+    for (Py_ssize_t k = 0; k < m && !bad; k++)
+        if (nodes[k] < 0 || nodes[k] > n_int || (k > 0 && nodes[k] <= nodes[k - 1]) || place[k] < 0 ||
+            place[k] >= m)
+            bad = "nodes or place";
+    Py_ssize_t n_lines = table_only ? n_f : n_c * n_f;
+    if (!table_only && (SHAPE(b[10], 0) != 2 * m || SHAPE(b[10], 1) != 2 * m || SHAPE(b[10], 2) != n_lines))
+        bad = "out";
+    if (lo < 0 || hi > n_lines || lo > hi)
+        bad = "lo, hi";
+    if (bad) {
+        release(b, 11);
+        PyErr_Format(PyExc_ValueError, "chain_lines: inconsistent %s", bad);
+        return NULL;
+    }
+    const double *omega = b[0].view.buf, *rhoa = b[2].view.buf, *rhoi = b[3].view.buf, *length = b[4].view.buf;
+    const cx *coef = b[1].view.buf;
+    cx *table = b[6].view.buf, *out = b[10].view.buf;
+    cx *work = malloc(sizeof(cx) * (16 * (n_u > 0 ? n_u : 1) + 8 * (m > 0 ? m : 1)));
+    if (!work) {
+        release(b, 11);
+        return PyErr_NoMemory();
+    }
+    cx *tmat = work, *pre = work + 16 * (n_u > 0 ? n_u : 1), *post = pre + 4 * (m > 0 ? m : 1);
+    Py_BEGIN_ALLOW_THREADS
+    for (Py_ssize_t q = lo; q < hi; q++) {
+        Py_ssize_t c = table_only ? 0 : q / n_f;
+        Py_ssize_t i = q - c * n_f;
+        double w2 = omega[i] * omega[i];
+        for (Py_ssize_t u = 0; u < n_u; u++) {
+            int shared = slot[u] >= 0;
+            if (shared && !table_only) {
+                memcpy(tmat + 16 * u, table + 16 * (slot[u] * n_f + i), 16 * sizeof(cx));
+            } else if (shared || !table_only) {
+                Py_ssize_t k = u * n_c + c;
+                transfer(coef + 5 * k, rhoa[k], rhoi[k], length[k], w2, tmat + 16 * u);
+                if (table_only)
+                    memcpy(table + 16 * (slot[u] * n_f + i), tmat + 16 * u, 16 * sizeof(cx));
+            }
+        }
+        if (!table_only)
+            chain_line(tmat, seg_of, n_int, nodes, place, m, out, n_lines, q, pre, post);
+    }
+    Py_END_ALLOW_THREADS
+    free(work);
+    release(b, 11);
+    Py_RETURN_NONE;
+}
+
+/* ------------------------------------------------------------------------ */
+/* The coupling update */
+
+typedef struct {
+    const cx *ya, *yb;
+    Py_ssize_t wa, wb, n; /* ya is (wa, wa, n), yb (wb, wb, n) */
+} pair_t;
+
+/* Block (p, pq) of diag(ya, yb) at one line. */
+static inline void block(const pair_t *y, int64_t sp, int64_t p, int64_t sq, int64_t pq, Py_ssize_t line, cx v[4])
+{
+    if (sp != sq) {
+        v[0] = v[1] = v[2] = v[3] = mk(0.0, 0.0);
+        return;
+    }
+    const cx *base = sp == 0 ? y->ya : y->yb;
+    Py_ssize_t w = sp == 0 ? y->wa : y->wb;
+    Py_ssize_t r = 2 * p, c = 2 * pq, n = y->n;
+    v[0] = base[(r * w + c) * n + line];
+    v[1] = base[(r * w + c + 1) * n + line];
+    v[2] = base[((r + 1) * w + c) * n + line];
+    v[3] = base[((r + 1) * w + c + 1) * n + line];
+}
+
+/* couple_lines(ya, yb, a_src, a_idx, b_src, b_idx, src, idx, stiffness, rigid, out, lo, hi) -> bool */
+static PyObject *py_couple_lines(PyObject *self, PyObject *args)
+{
+    PyObject *o[7];
+    long long a_src, a_idx, b_src, b_idx;
+    int rigid;
+    Py_ssize_t lo, hi;
+    if (!PyArg_ParseTuple(args, "OOLLLLOOOpOnn", &o[0], &o[1], &a_src, &a_idx, &b_src, &b_idx, &o[2], &o[3], &o[4],
+                          &rigid, &o[5], &lo, &hi))
+        return NULL;
+    buf_t b[6] = {{0}};
+    if (get(o[0], &b[0], 'Z', 3, 0, "ya") || get(o[1], &b[1], 'Z', 3, 0, "yb") ||
+        get(o[2], &b[2], 'q', 1, 0, "src") || get(o[3], &b[3], 'q', 1, 0, "idx") ||
+        get(o[4], &b[4], 'Z', 3, 0, "stiffness") || get(o[5], &b[5], 'Z', 3, 1, "out")) {
+        release(b, 6);
+        return NULL;
+    }
+    pair_t y = {b[0].view.buf, b[1].view.buf, SHAPE(b[0], 0), SHAPE(b[1], 0), SHAPE(b[0], 2)};
+    Py_ssize_t m = SHAPE(b[2], 0), n = y.n, n_k = SHAPE(b[4], 2);
+    const int64_t *src = b[2].view.buf, *idx = b[3].view.buf;
+    int ground = b_src < 0;
+    const char *bad = NULL;
+    if (SHAPE(b[0], 1) != y.wa || SHAPE(b[1], 1) != y.wb || SHAPE(b[1], 2) != n)
+        bad = "ya or yb";
+    if (SHAPE(b[3], 0) != m || SHAPE(b[5], 0) != 2 * m || SHAPE(b[5], 1) != 2 * m || SHAPE(b[5], 2) != n)
+        bad = "src, idx or out";
+    if (SHAPE(b[4], 0) != 2 || SHAPE(b[4], 1) != 2 || (n_k != n && n_k != 1))
+        bad = "stiffness";
+    if (lo < 0 || hi > n || lo > hi)
+        bad = "lo, hi";
+#define CHECK_POINT(s, p)                                                            \
+    if ((s) == 0 ? ((p) < 0 || 2 * (p) + 1 >= y.wa) : (s) == 1 ? ((p) < 0 || 2 * (p) + 1 >= y.wb) : 1) \
+        bad = "point";
+    CHECK_POINT(a_src, a_idx)
+    if (!ground) {
+        CHECK_POINT(b_src, b_idx)
+    }
+    for (Py_ssize_t i = 0; i < m && !bad; i++) {
+        CHECK_POINT(src[i], idx[i])
+    }
+#undef CHECK_POINT
+    if (bad) {
+        release(b, 6);
+        PyErr_Format(PyExc_ValueError, "couple_lines: inconsistent %s", bad);
+        return NULL;
+    }
+    const cx *stiffness = b[4].view.buf;
+    cx *out = b[5].view.buf;
+    cx *uw = malloc(sizeof(cx) * 4 * (m > 0 ? m : 1));
+    if (!uw) {
+        release(b, 6);
+        return PyErr_NoMemory();
+    }
+    double bad_re = 0.0, bad_im = 0.0; /* stays 0 while every entry is finite */
+    Py_BEGIN_ALLOW_THREADS
+    for (Py_ssize_t q = lo; q < hi; q++) {
+        cx s[4], x[4], z[4], bb[4];
+        block(&y, a_src, a_idx, a_src, a_idx, q, s);
+        if (!ground) {
+            block(&y, b_src, b_idx, b_src, b_idx, q, bb);
+            block(&y, a_src, a_idx, b_src, b_idx, q, x);
+            block(&y, b_src, b_idx, a_src, a_idx, q, z);
+            for (int k = 0; k < 4; k++)
+                s[k] = csub(cadd(s[k], bb[k]), cadd(x[k], z[k]));
+        }
+        cx e00, e01, e10, e11, k00 = mk(0, 0), k01 = mk(0, 0), k10 = mk(0, 0), k11 = mk(0, 0);
+        if (rigid) {
+            e00 = s[0]; e01 = s[1]; e10 = s[2]; e11 = s[3];
+        } else {
+            Py_ssize_t kq = n_k == n ? q : 0;
+            k00 = stiffness[0 * n_k + kq];
+            k01 = stiffness[1 * n_k + kq];
+            k10 = stiffness[2 * n_k + kq];
+            k11 = stiffness[3 * n_k + kq];
+            e00 = cadd(cadd(mk(1.0, 0.0), cmul(s[0], k00)), cmul(s[1], k10));
+            e01 = cadd(cmul(s[0], k01), cmul(s[1], k11));
+            e10 = cadd(cmul(s[2], k00), cmul(s[3], k10));
+            e11 = cadd(cadd(mk(1.0, 0.0), cmul(s[2], k01)), cmul(s[3], k11));
+        }
+        cx idet = cinv(det2(e00, e01, e10, e11));
+        cx w00 = cmul(e11, idet), w01 = cmul(cneg(e01), idet), w10 = cmul(cneg(e10), idet), w11 = cmul(e00, idet);
+        if (!rigid) {
+            cx f00 = w00, f01 = w01, f10 = w10, f11 = w11;
+            w00 = cadd(cmul(k00, f00), cmul(k01, f10));
+            w01 = cadd(cmul(k00, f01), cmul(k01, f11));
+            w10 = cadd(cmul(k10, f00), cmul(k11, f10));
+            w11 = cadd(cmul(k10, f01), cmul(k11, f11));
+        }
+        for (Py_ssize_t i = 0; i < m; i++) {
+            cx u[4];
+            block(&y, src[i], idx[i], a_src, a_idx, q, u);
+            if (!ground) {
+                block(&y, src[i], idx[i], b_src, b_idx, q, x);
+                for (int k = 0; k < 4; k++)
+                    u[k] = csub(u[k], x[k]);
+            }
+            cx *row = uw + 4 * i;
+            row[0] = cadd(cmul(u[0], w00), cmul(u[1], w10));
+            row[1] = cadd(cmul(u[0], w01), cmul(u[1], w11));
+            row[2] = cadd(cmul(u[2], w00), cmul(u[3], w10));
+            row[3] = cadd(cmul(u[2], w01), cmul(u[3], w11));
+        }
+        Py_ssize_t w = 2 * m;
+        for (Py_ssize_t j = 0; j < m; j++) {
+            cx v[4];
+            block(&y, a_src, a_idx, src[j], idx[j], q, v);
+            if (!ground) {
+                block(&y, b_src, b_idx, src[j], idx[j], q, x);
+                for (int k = 0; k < 4; k++)
+                    v[k] = csub(v[k], x[k]);
+            }
+            for (Py_ssize_t i = 0; i < m; i++) {
+                cx yy[4];
+                const cx *row = uw + 4 * i;
+                block(&y, src[i], idx[i], src[j], idx[j], q, yy);
+                yy[0] = csub(yy[0], cadd(cmul(row[0], v[0]), cmul(row[1], v[2])));
+                yy[1] = csub(yy[1], cadd(cmul(row[0], v[1]), cmul(row[1], v[3])));
+                yy[2] = csub(yy[2], cadd(cmul(row[2], v[0]), cmul(row[3], v[2])));
+                yy[3] = csub(yy[3], cadd(cmul(row[2], v[1]), cmul(row[3], v[3])));
+                out[((2 * i) * w + 2 * j) * n + q] = yy[0];
+                out[((2 * i) * w + 2 * j + 1) * n + q] = yy[1];
+                out[((2 * i + 1) * w + 2 * j) * n + q] = yy[2];
+                out[((2 * i + 1) * w + 2 * j + 1) * n + q] = yy[3];
+                for (int k = 0; k < 4; k++) {
+                    bad_re += yy[k].re - yy[k].re;
+                    bad_im += yy[k].im - yy[k].im;
+                }
+            }
+        }
+    }
+    Py_END_ALLOW_THREADS
+    free(uw);
+    release(b, 6);
+    return PyBool_FromLong(bad_re == 0.0 && bad_im == 0.0);
+}
+
+/* ------------------------------------------------------------------------ */
+/* The floor of the beam kernel (benchmarks): the transcendental functions the
+ * closed form needs, exp(x) and cos(y), sin(y) of both wavenumbers of every
+ * segment and line, for the arguments x, y given. */
+
+static PyObject *py_transcendental_floor(PyObject *self, PyObject *args)
+{
+    PyObject *ox, *oy;
+    if (!PyArg_ParseTuple(args, "OO", &ox, &oy))
+        return NULL;
+    buf_t b[2] = {{0}};
+    if (get(ox, &b[0], 'd', 1, 0, "x") || get(oy, &b[1], 'd', 1, 0, "y")) {
+        release(b, 2);
+        return NULL;
+    }
+    if (SHAPE(b[0], 0) != SHAPE(b[1], 0)) {
+        release(b, 2);
+        PyErr_SetString(PyExc_ValueError, "x and y differ in size");
+        return NULL;
+    }
+    const double *x = b[0].view.buf, *y = b[1].view.buf;
+    Py_ssize_t n = SHAPE(b[0], 0);
+    double acc = 0.0;
+    Py_BEGIN_ALLOW_THREADS
+    for (Py_ssize_t i = 0; i < n; i++)
+        acc += exp(x[i]) + cos(y[i]) + sin(y[i]);
+    Py_END_ALLOW_THREADS
+    release(b, 2);
+    return PyFloat_FromDouble(acc);
+}
+
+/* ------------------------------------------------------------------------ */
+
+static PyMethodDef methods[] = {
+    {"segment_coefficients", py_segment_coefficients, METH_VARARGS,
+     "segment_coefficients(ei, kga, rhoa, rhoi, omega_max, coef, k_max): per-segment constants and largest wavenumber."},
+    {"chain_lines", py_chain_lines, METH_VARARGS,
+     "chain_lines(omega, coef, rhoa, rhoi, length, slot, table, seg_of, nodes, place, out, table_only, lo, hi)."},
+    {"couple_lines", py_couple_lines, METH_VARARGS,
+     "couple_lines(ya, yb, a_src, a_idx, b_src, b_idx, src, idx, stiffness, rigid, out, lo, hi) -> all finite."},
+    {"transcendental_floor", py_transcendental_floor, METH_VARARGS,
+     "transcendental_floor(x, y): sum of exp(x) + cos(y) + sin(y) (the beam kernel's floor, for benchmarks)."},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_ckernels",
+                                    "Compiled kernels of substructure (internal; see substructure._kernels).", -1,
+                                    methods};
+
+PyMODINIT_FUNC PyInit__ckernels(void)
+{
+    double f = 1.0;
+    for (int k = 0; k < 24; k++) {
+        if (k > 0)
+            f *= k;
+        inv_factorial[k] = 1.0 / f;
+    }
+    /* |z| <= (1e-18 (2n)!)^(1/n), squared */
+    series_bound2[0] = 0.0;
+    double fact = 1.0;
+    for (int n = 1; n < 12; n++) {
+        fact *= (2.0 * n - 1.0) * (2.0 * n);
+        double bound = pow(1e-18 * fact, 1.0 / n);
+        series_bound2[n] = bound * bound;
+    }
+    return PyModule_Create(&module);
+}
