@@ -116,6 +116,162 @@ static inline cx csqrt_(cx z)
 }
 
 /* ------------------------------------------------------------------------ */
+/* Lanes: four frequency lines at once
+ *
+ * The closed form and the chain run on blocks of VL = 4 lines of one
+ * configuration.  Each quantity is a vector over the lanes (GCC and Clang
+ * vector extensions): the compiler keeps it in registers and emits vector
+ * instructions (AVX2 where the processor has it, else SSE2 pairs; see
+ * KERNEL_CLONES).  Each lane computes exactly what a line on its own would:
+ * the same operations in the same order, branches as per-lane selections,
+ * and the rare special cases (a zero or huge argument of a square root, a
+ * determinant that cancels) redone lane by lane with the scalar functions
+ * above.  So a line's result does not depend on the lines it shares a block
+ * with, nor on how the lines are split between threads, nor on the
+ * instruction set.  The exponentials, cosines and sines are the C library's,
+ * called lane by lane. */
+
+#ifndef VL
+#define VL 4
+#endif
+#define AI static inline __attribute__((always_inline))
+
+typedef double vd __attribute__((vector_size(8 * VL)));
+typedef long long vm __attribute__((vector_size(8 * VL))); /* lane masks: all bits set or clear */
+typedef struct {
+    vd re, im;
+} cv;
+
+AI vd splat(double x)
+{
+    vd v;
+    for (int l = 0; l < VL; l++)
+        v[l] = x;
+    return v;
+}
+AI vm msplat(long long x)
+{
+    vm v;
+    for (int l = 0; l < VL; l++)
+        v[l] = x;
+    return v;
+}
+AI vd vsel(vm mask, vd a, vd b) { return (vd)(((vm)a & mask) | ((vm)b & ~mask)); }
+AI vd vabs(vd x)
+{
+    return (vd)((vm)x & msplat(INT64_MAX));
+}
+/* |mag| with the sign of sgn */
+AI vd vcopysign(vd mag, vd sgn)
+{
+    return (vd)(((vm)vabs(mag)) | ((vm)sgn & msplat(INT64_MIN)));
+}
+AI vd vsqrt(vd x)
+{
+    vd r;
+    for (int l = 0; l < VL; l++)
+        r[l] = sqrt(x[l]);
+    return r;
+}
+AI vd vmax(vd a, vd b) { return vsel(a > b, a, b); }
+AI int any(vm m)
+{
+    long long r = 0;
+    for (int l = 0; l < VL; l++)
+        r |= m[l];
+    return r != 0;
+}
+AI int all(vm m)
+{
+    long long r = -1;
+    for (int l = 0; l < VL; l++)
+        r &= m[l];
+    return r != 0;
+}
+
+AI cv V(vd re, vd im) { cv z; z.re = re; z.im = im; return z; }
+AI cv vc(cx z) { return V(splat(z.re), splat(z.im)); }
+AI cx lane(cv a, int l) { return mk(a.re[l], a.im[l]); }
+AI cv vadd(cv a, cv b) { return V(a.re + b.re, a.im + b.im); }
+AI cv vsub(cv a, cv b) { return V(a.re - b.re, a.im - b.im); }
+AI cv vneg(cv a) { return V(-a.re, -a.im); }
+AI cv vmul(cv a, cv b) { return V(a.re * b.re - a.im * b.im, a.re * b.im + a.im * b.re); }
+AI cv vmulc(cv a, cx b) { return V(a.re * b.re - a.im * b.im, a.re * b.im + a.im * b.re); }
+AI cv vscale(vd s, cv a) { return V(s * a.re, s * a.im); }
+/* a0 b0 + a1 b1 */
+AI cv vdot2(cv a0, cv b0, cv a1, cv b1) { return vadd(vmul(a0, b0), vmul(a1, b1)); }
+/* ((a0 b0 + a1 b1) + a2 b2) + a3 b3 */
+AI cv vdot4(cv a0, cv b0, cv a1, cv b1, cv a2, cv b2, cv a3, cv b3)
+{
+    return vadd(vadd(vadd(vmul(a0, b0), vmul(a1, b1)), vmul(a2, b2)), vmul(a3, b3));
+}
+
+/* Principal square root per lane, as csqrt_. */
+AI cv vcsqrt(cv z)
+{
+    vd x = z.re, y = z.im;
+    vd r2 = x * x + y * y;
+    vd t = vsqrt(splat(0.5) * (vsqrt(r2) + vabs(x)));
+    vd w = splat(0.5) * y / t;
+    vm pos = x >= splat(0.0);
+    cv r = V(vsel(pos, t, vabs(w)), vsel(pos, w, vcopysign(t, y)));
+    vm special = ~((r2 > splat(0.0)) & (r2 < splat(INFINITY)));
+    if (any(special))
+        for (int l = 0; l < VL; l++)
+            if (special[l]) {
+                cx s = csqrt_(lane(z, l));
+                r.re[l] = s.re;
+                r.im[l] = s.im;
+            }
+    return r;
+}
+
+/* 1 / z per lane, as crecip. */
+AI cv vrecip(cv z)
+{
+    vd d = z.re * z.re + z.im * z.im;
+    vd f = splat(1.0) / d;
+    cv r = V(z.re * f, -z.im * f);
+    vm special = ~((d > splat(1e-290)) & (d < splat(1e290)));
+    if (any(special))
+        for (int l = 0; l < VL; l++)
+            if (special[l]) {
+                cx s = cinv(lane(z, l));
+                r.re[l] = s.re;
+                r.im[l] = s.im;
+            }
+    return r;
+}
+
+/* 1 / z per lane by Smith's method, as cinv. */
+AI cv vinv(cv z)
+{
+    vm big = vabs(z.re) >= vabs(z.im);
+    vd p = vsel(big, z.im, z.re), q = vsel(big, z.re, z.im);
+    vd s = p / q;
+    vd d = q + p * s;
+    vd one = splat(1.0);
+    return V(vsel(big, one, s) / d, -vsel(big, s, one) / d);
+}
+
+/* a d - b c per lane, as det2. */
+AI cv vdet2(cv a, cv b, cv c, cv d)
+{
+    cv ad = vmul(a, d), bc = vmul(b, c);
+    cv det = vsub(ad, bc);
+    vd size = vabs(ad.re) + vabs(ad.im) + vabs(bc.re) + vabs(bc.im);
+    vm special = ~((vabs(det.re) + vabs(det.im)) > splat(1e-3) * size);
+    if (any(special))
+        for (int l = 0; l < VL; l++)
+            if (special[l]) {
+                cx s = det2(lane(a, l), lane(b, l), lane(c, l), lane(d, l));
+                det.re[l] = s.re;
+                det.im[l] = s.im;
+            }
+    return det;
+}
+
+/* ------------------------------------------------------------------------ */
 /* Segments */
 
 #define SERIES_LIMIT2 0.25 /* |s L^2| < 0.5, squared (docs/beams.md) */
@@ -133,7 +289,7 @@ static void coefficients(cx ei, cx kga, double rhoa, double rhoi, cx out[5])
     out[4] = ikga;
 }
 
-/* a, e (the diagonal of A^2) and the eigenvalues s1, s2 of A^2 at w2 = omega^2. */
+/* a, e (the diagonal of A^2) and the eigenvalues s1, s2 of A^2 at w2 = omega^2, one line. */
 static inline void wavenumbers(const cx co[5], double w2, cx *a, cx *e, cx *s1, cx *s2)
 {
     *a = cscale(w2, co[0]);
@@ -145,102 +301,154 @@ static inline void wavenumbers(const cx co[5], double w2, cx *a, cx *e, cx *s1, 
     *s2 = csub(mean, root);
 }
 
-/* The 16 entries of T = exp(A L) of one segment at one line, row-major. */
-static void transfer(const cx co[5], double rhoa, double rhoi, double length, double w2, cx t[16])
+/* The 16 entries (row-major) of T = exp(A L) of one segment on the lanes, w2 = omega^2 per lane.
+ *
+ * exp(A L) = C(A^2) + A S(A^2), C(s) = cosh(L sqrt s), S(s) = sinh(L sqrt s) / sqrt s, and
+ * g(A^2) = g(s2) I + g[s1, s2] (A^2 - s2 I).  The divided differences come from their power
+ * series where max |s L^2| < 0.5 (terms until |z|^n / (2n)! < 1e-18, counted per lane), else
+ * from one exponential per wavenumber.  T = alpha I + beta A + gamma A^2 + delta A^3. */
+AI void transfer(const cx co[5], double rhoa, double rhoi, double length, vd w2, cv *t)
 {
-    cx a, e, s1, s2;
-    wavenumbers(co, w2, &a, &e, &s1, &s2);
-    cx iei = co[3], ikga = co[4];
+    cv a = vscale(w2, vc(co[0])), e = vscale(w2, vc(co[1]));
+    cv half = vscale(splat(0.5), vsub(a, e));
+    cv root = vcsqrt(vadd(vmul(half, half), vscale(w2, vc(co[2]))));
+    cv mean = vscale(splat(0.5), vadd(a, e));
+    cv s1 = vadd(mean, root), s2 = vsub(mean, root);
     double l2 = length * length;
-    cx z1 = cscale(l2, s1), z2 = cscale(l2, s2);
-    double m1 = z1.re * z1.re + z1.im * z1.im, m2 = z2.re * z2.re + z2.im * z2.im;
-    double bound2 = m1 > m2 ? m1 : m2;
-    cx c0, c1, g0, g1;
-    if (bound2 < SERIES_LIMIT2) {
-        /* h_n: complete homogeneous symmetric polynomial of degree n in z1, z2; pow2 = z2^n */
-        int n_terms = 2;
-        while (bound2 > series_bound2[n_terms])
-            n_terms++;
-        cx sc = mk(1.0, 0.0), ss = mk(1.0, 0.0), dc = mk(0.0, 0.0), ds = mk(0.0, 0.0);
-        cx h = mk(1.0, 0.0), pow2 = mk(1.0, 0.0);
-        for (int n = 1; n <= n_terms; n++) {
-            double rc = inv_factorial[2 * n], rs = inv_factorial[2 * n + 1];
-            dc = cadd(dc, cscale(rc, h));
-            ds = cadd(ds, cscale(rs, h));
-            pow2 = cmul(pow2, z2);
-            sc = cadd(sc, cscale(rc, pow2));
-            ss = cadd(ss, cscale(rs, pow2));
-            h = cadd(cmul(z1, h), pow2);
+    cv z1 = vscale(splat(l2), s1), z2 = vscale(splat(l2), s2);
+    vd bound2 = vmax(z1.re * z1.re + z1.im * z1.im, z2.re * z2.re + z2.im * z2.im);
+    vm series = bound2 < splat(SERIES_LIMIT2);
+    cv c0, c1, g0, g1;
+    if (any(series)) {
+        /* h_n: complete homogeneous symmetric polynomial of degree n in z1, z2; pow2 = z2^n;
+         * lane l takes the terms n <= nt[l] */
+        vm nt = msplat(0);
+        long long nt_min = 99, nt_max = 0;
+        for (int l = 0; l < VL; l++)
+            if (series[l]) {
+                long long n = 2;
+                while (bound2[l] > series_bound2[n])
+                    n++;
+                nt[l] = n;
+                nt_max = n > nt_max ? n : nt_max;
+                nt_min = n < nt_min ? n : nt_min;
+            }
+        cv one = V(splat(1.0), splat(0.0)), zero = V(splat(0.0), splat(0.0));
+        cv sc = one, ss = one, dc = zero, ds = zero, h = one, pow2 = one;
+        /* the terms every series lane takes (exponential lanes are replaced below) */
+        for (long long n = 1; n <= nt_min; n++) {
+            vd rc = splat(inv_factorial[2 * n]), rs = splat(inv_factorial[2 * n + 1]);
+            dc = vadd(dc, vscale(rc, h));
+            ds = vadd(ds, vscale(rs, h));
+            pow2 = vmul(pow2, z2);
+            sc = vadd(sc, vscale(rc, pow2));
+            ss = vadd(ss, vscale(rs, pow2));
+            h = vadd(vmul(z1, h), pow2);
+        }
+        /* the terms only some lanes take */
+        for (long long n = nt_min + 1; n <= nt_max; n++) {
+            vd rc = splat(inv_factorial[2 * n]), rs = splat(inv_factorial[2 * n + 1]);
+            vm on = nt >= msplat(n);
+            cv ndc = vadd(dc, vscale(rc, h)), nds = vadd(ds, vscale(rs, h));
+            pow2 = vmul(pow2, z2);
+            cv nsc = vadd(sc, vscale(rc, pow2)), nss = vadd(ss, vscale(rs, pow2));
+            h = vadd(vmul(z1, h), pow2);
+            dc = V(vsel(on, ndc.re, dc.re), vsel(on, ndc.im, dc.im));
+            ds = V(vsel(on, nds.re, ds.re), vsel(on, nds.im, ds.im));
+            sc = V(vsel(on, nsc.re, sc.re), vsel(on, nsc.im, sc.im));
+            ss = V(vsel(on, nss.re, ss.re), vsel(on, nss.im, ss.im));
         }
         c0 = sc;
-        c1 = cscale(l2, dc);
-        g0 = cscale(length, ss);
-        g1 = cscale(l2 * length, ds);
-    } else {
-        /* cosh and sinh from exp(r L) = e^x (cos y + i sin y); Re r >= 0 */
-        cx r1 = csqrt_(s1), r2 = csqrt_(s2);
-        double x1 = r1.re * length, y1 = r1.im * length;
-        double x2 = r2.re * length, y2 = r2.im * length;
-        double p1 = exp(x1), p2 = exp(x2);
-        double q1 = 1.0 / p1, q2 = 1.0 / p2;
-        double cy1 = cos(y1), sy1 = sin(y1), cy2 = cos(y2), sy2 = sin(y2);
-        cx ch1 = mk(0.5 * (p1 + q1) * cy1, 0.5 * (p1 - q1) * sy1);
-        cx ch2 = mk(0.5 * (p2 + q2) * cy2, 0.5 * (p2 - q2) * sy2);
-        cx sh1 = cmul(mk(0.5 * (p1 - q1) * cy1, 0.5 * (p1 + q1) * sy1), crecip(r1));
-        cx sh2 = cmul(mk(0.5 * (p2 - q2) * cy2, 0.5 * (p2 + q2) * sy2), crecip(r2));
-        cx ids = crecip(csub(s1, s2));
-        c0 = ch2;
-        c1 = cmul(csub(ch1, ch2), ids);
-        g0 = sh2;
-        g1 = cmul(csub(sh1, sh2), ids);
+        c1 = vscale(splat(l2), dc);
+        g0 = vscale(splat(length), ss);
+        g1 = vscale(splat(l2 * length), ds);
     }
-    cx alpha = csub(c0, cmul(c1, s2));
-    cx beta = csub(g0, cmul(g1, s2));
-    cx gamma = c1, delta = g1;
-    double ma = w2 * rhoa, mi = w2 * rhoi;
-    /* T = alpha I + beta A + gamma A^2 + delta A^3, entry by entry */
-    cx d00 = cadd(alpha, cmul(gamma, a));
-    cx d11 = cadd(alpha, cmul(gamma, e));
+    if (!all(series)) {
+        /* cosh and sinh from exp(r L) = e^x (cos y + i sin y); Re r >= 0 */
+        cv r1 = vcsqrt(s1), r2 = vcsqrt(s2);
+        vd x1 = r1.re * length, y1 = r1.im * length, x2 = r2.re * length, y2 = r2.im * length;
+        vd p1, p2, cy1, sy1, cy2, sy2;
+        for (int l = 0; l < VL; l++) {
+            if (series[l]) { /* a series lane: not used */
+                p1[l] = p2[l] = cy1[l] = cy2[l] = 1.0;
+                sy1[l] = sy2[l] = 0.0;
+                continue;
+            }
+            p1[l] = exp(x1[l]);
+            p2[l] = exp(x2[l]);
+            cy1[l] = cos(y1[l]);
+            sy1[l] = sin(y1[l]);
+            cy2[l] = cos(y2[l]);
+            sy2[l] = sin(y2[l]);
+        }
+        vd half1 = splat(0.5);
+        vd q1 = splat(1.0) / p1, q2 = splat(1.0) / p2;
+        cv ch1 = V(half1 * (p1 + q1) * cy1, half1 * (p1 - q1) * sy1);
+        cv ch2 = V(half1 * (p2 + q2) * cy2, half1 * (p2 - q2) * sy2);
+        cv sh1 = vmul(V(half1 * (p1 - q1) * cy1, half1 * (p1 + q1) * sy1), vrecip(r1));
+        cv sh2 = vmul(V(half1 * (p2 - q2) * cy2, half1 * (p2 + q2) * sy2), vrecip(r2));
+        cv ids = vrecip(vsub(s1, s2));
+        cv ec1 = vmul(vsub(ch1, ch2), ids), eg1 = vmul(vsub(sh1, sh2), ids);
+        if (!any(series)) {
+            c0 = ch2; c1 = ec1; g0 = sh2; g1 = eg1;
+        } else {
+            c0 = V(vsel(series, c0.re, ch2.re), vsel(series, c0.im, ch2.im));
+            c1 = V(vsel(series, c1.re, ec1.re), vsel(series, c1.im, ec1.im));
+            g0 = V(vsel(series, g0.re, sh2.re), vsel(series, g0.im, sh2.im));
+            g1 = V(vsel(series, g1.re, eg1.re), vsel(series, g1.im, eg1.im));
+        }
+    }
+    cv alpha = vsub(c0, vmul(c1, s2)), beta = vsub(g0, vmul(g1, s2));
+    cv gamma = c1, delta = g1;
+    cx iei = co[3], ikga = co[4];
+    vd ma = w2 * rhoa, mi = w2 * rhoi;
+    cv d00 = vadd(alpha, vmul(gamma, a)), d11 = vadd(alpha, vmul(gamma, e));
     t[0] = d00;
     t[10] = d00;
     t[5] = d11;
     t[15] = d11;
-    t[1] = cadd(beta, cmul(delta, cadd(a, e)));
-    t[2] = cadd(cmul(beta, ikga), cmul(delta, csub(cmul(a, ikga), iei)));
-    cx g_ei = cmul(gamma, iei);
-    t[3] = g_ei;
-    t[6] = cneg(g_ei);
-    cx d_ma_ei = cmul(cscale(ma, delta), iei);
-    t[4] = d_ma_ei;
-    t[11] = cneg(d_ma_ei);
-    t[7] = cmul(cadd(beta, cmul(delta, e)), iei);
-    t[8] = cneg(cscale(ma, cadd(beta, cmul(delta, a))));
-    cx g_ma = cscale(ma, gamma);
-    t[12] = g_ma;
-    t[9] = cneg(g_ma);
-    t[13] = cadd(cscale(-mi, beta), cmul(delta, csub(mk(ma, 0.0), cscale(mi, e))));
-    t[14] = cadd(cneg(beta), cmul(delta, csub(cscale(mi, iei), a)));
+    t[1] = vadd(beta, vmul(delta, vadd(a, e)));
+    cv u = vmulc(a, ikga);
+    u = V(u.re - iei.re, u.im - iei.im);
+    t[2] = vadd(vmulc(beta, ikga), vmul(delta, u));
+    t[3] = vmulc(gamma, iei);
+    t[6] = vneg(t[3]);
+    t[4] = vmulc(vscale(ma, delta), iei);
+    t[11] = vneg(t[4]);
+    t[7] = vmulc(vadd(beta, vmul(delta, e)), iei);
+    t[8] = vneg(vscale(ma, vadd(beta, vmul(delta, a))));
+    t[12] = vscale(ma, gamma);
+    t[9] = vneg(t[12]);
+    /* t31 = -mi beta + delta (ma - mi e), t32 = -beta + delta (mi / EI - a) */
+    t[13] = vadd(vscale(-mi, beta), vmul(delta, V(ma - mi * e.re, splat(0.0) - mi * e.im)));
+    t[14] = vadd(vneg(beta), vmul(delta, V(mi * iei.re - a.re, mi * iei.im - a.im)));
 }
 
 /* ------------------------------------------------------------------------ */
 /* Chains */
 
-/* Free-free receptances of a chain at its nodes, one line, into out[:, :, q].
- * tmat: the 4x4 transfer matrices (row-major) of the distinct segments. */
-static void chain_line(const cx *tmat, const int64_t *seg_of, Py_ssize_t n_int, const int64_t *nodes,
-                       const int64_t *place, Py_ssize_t m, cx *out, Py_ssize_t n_lines, Py_ssize_t q,
-                       cx *pre, cx *post)
+/* Free-free receptances of a chain at its nodes on the lanes: lines q .. q + nb - 1 of out.
+ *
+ * Y_ij = P_i,uu M_Fu^-1 S_j,FF for x_i <= x_j, with P_i = T(0 -> x_i), S_j = T(x_j -> L),
+ * M = T(0 -> L) (state [u; F]); Y_ji = Y_ij^T (reciprocity: no cancelling second term).
+ * tmat: the 16 entries of each distinct segment's T.  Only the u-columns of T(0 -> x) (from
+ * the base) and the F-rows of T(x -> L) (from the tip) are multiplied. */
+AI void chain_block(const cv *tmat, const int64_t *seg_of, Py_ssize_t n_int, const int64_t *nodes,
+                    const int64_t *place, Py_ssize_t m, cx *out, Py_ssize_t n_lines, Py_ssize_t q, int nb, cv *pre,
+                    cv *post)
 {
-    cx cols[8], rows[8], tmp[8]; /* cols 4x2, rows 2x4, row-major */
-    /* u-columns of T(0 -> x), carried from the base to the tip; pre[p] = P_p,uu */
+    const cv one = V(splat(1.0), splat(0.0)), zero = V(splat(0.0), splat(0.0));
+    /* the products live in memory (two buffers each, swapped): few values in registers at once */
+    cv buf[32];
+    cv *cols = buf, *ncols = buf + 8; /* u-columns of T(0 -> x), 4x2 row-major */
     {
         Py_ssize_t p = 0;
         int fresh = 1;
         for (Py_ssize_t k = 0; k <= n_int; k++) {
             if (p < m && nodes[p] == k) {
-                cx *d = pre + 4 * p;
+                cv *d = pre + 4 * p;
                 if (fresh) {
-                    d[0] = mk(1.0, 0.0); d[1] = mk(0.0, 0.0); d[2] = mk(0.0, 0.0); d[3] = mk(1.0, 0.0);
+                    d[0] = one; d[1] = zero; d[2] = zero; d[3] = one;
                 } else {
                     d[0] = cols[0]; d[1] = cols[1]; d[2] = cols[2]; d[3] = cols[3];
                 }
@@ -248,7 +456,7 @@ static void chain_line(const cx *tmat, const int64_t *seg_of, Py_ssize_t n_int, 
             }
             if (k == n_int)
                 break;
-            const cx *t = tmat + 16 * seg_of[k];
+            const cv *t = tmat + 16 * seg_of[k];
             if (fresh) {
                 for (int r = 0; r < 4; r++) {
                     cols[2 * r] = t[4 * r];
@@ -258,22 +466,23 @@ static void chain_line(const cx *tmat, const int64_t *seg_of, Py_ssize_t n_int, 
             } else {
                 for (int r = 0; r < 4; r++)
                     for (int c = 0; c < 2; c++)
-                        tmp[2 * r + c] = cadd(cadd(cadd(cmul(t[4 * r], cols[c]), cmul(t[4 * r + 1], cols[2 + c])),
-                                                   cmul(t[4 * r + 2], cols[4 + c])),
-                                              cmul(t[4 * r + 3], cols[6 + c]));
-                memcpy(cols, tmp, sizeof(cols));
+                        ncols[2 * r + c] = vdot4(t[4 * r], cols[c], t[4 * r + 1], cols[2 + c], t[4 * r + 2],
+                                                 cols[4 + c], t[4 * r + 3], cols[6 + c]);
+                cv *swap = cols;
+                cols = ncols;
+                ncols = swap;
             }
         }
     }
-    /* F-rows of T(x -> L), carried from the tip to the base; post[p] = S_p,FF */
     {
+        cv *rows = buf + 16, *nrows = buf + 24; /* F-rows of T(x -> L), 2x4 row-major */
         Py_ssize_t p = m - 1;
         int fresh = 1;
         for (Py_ssize_t k = n_int; k >= 0; k--) {
             if (p >= 0 && nodes[p] == k) {
-                cx *d = post + 4 * p;
+                cv *d = post + 4 * p;
                 if (fresh) {
-                    d[0] = mk(1.0, 0.0); d[1] = mk(0.0, 0.0); d[2] = mk(0.0, 0.0); d[3] = mk(1.0, 0.0);
+                    d[0] = one; d[1] = zero; d[2] = zero; d[3] = one;
                 } else {
                     d[0] = rows[2]; d[1] = rows[3]; d[2] = rows[6]; d[3] = rows[7];
                 }
@@ -281,7 +490,7 @@ static void chain_line(const cx *tmat, const int64_t *seg_of, Py_ssize_t n_int, 
             }
             if (k == 0 || p < 0)
                 break;
-            const cx *t = tmat + 16 * seg_of[k - 1];
+            const cv *t = tmat + 16 * seg_of[k - 1];
             if (fresh) {
                 for (int c = 0; c < 4; c++) {
                     rows[c] = t[8 + c];
@@ -289,50 +498,125 @@ static void chain_line(const cx *tmat, const int64_t *seg_of, Py_ssize_t n_int, 
                 }
                 fresh = 0;
             } else {
+                /* the last product (reaching the first node) needs only the F-columns */
+                int c0 = (p == 0 && nodes[0] == k - 1) ? 2 : 0;
                 for (int r = 0; r < 2; r++)
-                    for (int c = 0; c < 4; c++)
-                        tmp[4 * r + c] = cadd(cadd(cadd(cmul(rows[4 * r], t[c]), cmul(rows[4 * r + 1], t[4 + c])),
-                                                   cmul(rows[4 * r + 2], t[8 + c])),
-                                              cmul(rows[4 * r + 3], t[12 + c]));
-                memcpy(rows, tmp, sizeof(rows));
+                    for (int c = c0; c < 4; c++)
+                        nrows[4 * r + c] = vdot4(rows[4 * r], t[c], rows[4 * r + 1], t[4 + c], rows[4 * r + 2],
+                                                 t[8 + c], rows[4 * r + 3], t[12 + c]);
+                cv *swap = rows;
+                rows = nrows;
+                nrows = swap;
             }
         }
     }
-    /* M_Fu^-1 (M_Fu = cols[4:8]) */
-    cx idet = cinv(det2(cols[4], cols[5], cols[6], cols[7]));
-    cx i00 = cmul(cols[7], idet), i11 = cmul(cols[4], idet);
-    cx i01 = cmul(cneg(cols[5]), idet), i10 = cmul(cneg(cols[6]), idet);
+    const cv c4 = cols[4], c5 = cols[5], c6 = cols[6], c7 = cols[7];
+    /* M_Fu^-1, M_Fu = [[c4, c5], [c6, c7]] */
+    cv idet = vinv(vdet2(c4, c5, c6, c7));
+    cv i00 = vmul(c7, idet), i11 = vmul(c4, idet), i01 = vmul(vneg(c5), idet), i10 = vmul(vneg(c6), idet);
     Py_ssize_t w = 2 * m; /* out is (w, w, n_lines) */
     for (Py_ssize_t i = 0; i < m; i++) {
-        const cx *pi_ = pre + 4 * i;
-        cx l00 = cadd(cmul(pi_[0], i00), cmul(pi_[1], i10));
-        cx l01 = cadd(cmul(pi_[0], i01), cmul(pi_[1], i11));
-        cx l10 = cadd(cmul(pi_[2], i00), cmul(pi_[3], i10));
-        cx l11 = cadd(cmul(pi_[2], i01), cmul(pi_[3], i11));
+        const cv *pi_ = pre + 4 * i;
+        cv l00 = vdot2(pi_[0], i00, pi_[1], i10), l01 = vdot2(pi_[0], i01, pi_[1], i11);
+        cv l10 = vdot2(pi_[2], i00, pi_[3], i10), l11 = vdot2(pi_[2], i01, pi_[3], i11);
         Py_ssize_t a = 2 * place[i];
         for (Py_ssize_t j = i; j < m; j++) {
-            const cx *s = post + 4 * j;
+            const cv *s = post + 4 * j;
             Py_ssize_t b = 2 * place[j];
-            cx y00 = cadd(cmul(l00, s[0]), cmul(l01, s[2]));
-            cx y01 = cadd(cmul(l00, s[1]), cmul(l01, s[3]));
-            cx y10 = cadd(cmul(l10, s[0]), cmul(l11, s[2]));
-            cx y11 = cadd(cmul(l10, s[1]), cmul(l11, s[3]));
-            out[((a) * w + b) * n_lines + q] = y00;
-            out[((a) * w + b + 1) * n_lines + q] = y01;
-            out[((a + 1) * w + b) * n_lines + q] = y10;
-            out[((a + 1) * w + b + 1) * n_lines + q] = y11;
-            if (j > i) {
-                out[((b) * w + a) * n_lines + q] = y00;
-                out[((b + 1) * w + a) * n_lines + q] = y01;
-                out[((b) * w + a + 1) * n_lines + q] = y10;
-                out[((b + 1) * w + a + 1) * n_lines + q] = y11;
+            cv y[4] = {vdot2(l00, s[0], l01, s[2]), vdot2(l00, s[1], l01, s[3]), vdot2(l10, s[0], l11, s[2]),
+                       vdot2(l10, s[1], l11, s[3])};
+            Py_ssize_t at[4] = {(a * w + b) * n_lines, (a * w + b + 1) * n_lines, ((a + 1) * w + b) * n_lines,
+                                ((a + 1) * w + b + 1) * n_lines};
+            Py_ssize_t tr[4] = {(b * w + a) * n_lines, ((b + 1) * w + a) * n_lines, (b * w + a + 1) * n_lines,
+                                ((b + 1) * w + a + 1) * n_lines};
+            for (int k = 0; k < 4; k++) {
+                for (int side = 0; side < (j > i ? 2 : 1); side++) {
+                    cx *o = out + (side ? tr[k] : at[k]) + q;
+                    if (nb == VL) {
+                        for (int l = 0; l < VL; l++) {
+                            o[l].re = y[k].re[l];
+                            o[l].im = y[k].im[l];
+                        }
+                    } else {
+                        for (int l = 0; l < nb; l++) {
+                            o[l].re = y[k].re[l];
+                            o[l].im = y[k].im[l];
+                        }
+                    }
+                }
             }
         }
     }
 }
 
+#if defined(__x86_64__) && defined(__GNUC__) && defined(__ELF__) && !defined(SUBSTRUCTURE_NO_CLONES)
+/* One version of the line loop per instruction set, chosen when the module loads. */
+#define KERNEL_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define KERNEL_CLONES
+#endif
+
+/* Lines lo .. hi - 1 (see py_chain_lines). */
+KERNEL_CLONES static void chain_range(const double *omega, Py_ssize_t n_f, const cx *coef, const double *rhoa,
+                                      const double *rhoi, const double *length, Py_ssize_t n_u, Py_ssize_t n_c,
+                                      const int64_t *slot, cx *table, const int64_t *seg_of, Py_ssize_t n_int,
+                                      const int64_t *nodes, const int64_t *place, Py_ssize_t m, cx *out,
+                                      int table_only, Py_ssize_t lo, Py_ssize_t hi, cv *tmat, cv *pre, cv *post)
+{
+    Py_ssize_t n_lines = table_only ? n_f : n_c * n_f;
+    for (Py_ssize_t q = lo; q < hi;) {
+        Py_ssize_t c = table_only ? 0 : q / n_f;
+        Py_ssize_t i = q - c * n_f;
+        Py_ssize_t left = hi - q < n_f - i ? hi - q : n_f - i;
+        int nb = left < VL ? (int)left : VL; /* lines of this block, all of configuration c */
+        vd w2;
+        for (int l = 0; l < VL; l++) {
+            double w = omega[i + (l < nb ? l : nb - 1)];
+            w2[l] = w * w;
+        }
+        for (Py_ssize_t u = 0; u < n_u; u++) {
+            int shared = slot[u] >= 0;
+            cv *t = tmat + 16 * u;
+            if (shared && !table_only) {
+                for (int k = 0; k < 16; k++) {
+                    const cx *src = table + (slot[u] * 16 + k) * n_f + i;
+                    for (int l = 0; l < VL; l++) {
+                        cx z = src[l < nb ? l : nb - 1];
+                        t[k].re[l] = z.re;
+                        t[k].im[l] = z.im;
+                    }
+                }
+            } else if (shared || !table_only) {
+                Py_ssize_t k = u * n_c + c;
+                transfer(coef + 5 * k, rhoa[k], rhoi[k], length[k], w2, t);
+                if (table_only)
+                    for (int e = 0; e < 16; e++) {
+                        cx *dst = table + (slot[u] * 16 + e) * n_f + i;
+                        for (int l = 0; l < nb; l++) {
+                            dst[l].re = t[e].re[l];
+                            dst[l].im = t[e].im[l];
+                        }
+                    }
+            }
+        }
+        if (!table_only)
+            chain_block(tmat, seg_of, n_int, nodes, place, m, out, n_lines, q, nb, pre, post);
+        q += nb;
+    }
+}
+
 /* ------------------------------------------------------------------------ */
 /* Buffers */
+
+/* Scratch memory aligned for the lane vectors. */
+static void *aligned_alloc_(size_t size)
+{
+    void *p = NULL;
+    if (posix_memalign(&p, 64, size ? size : 64) != 0)
+        return NULL;
+    return p;
+}
+static void aligned_free_(void *p) { free(p); }
 
 typedef struct {
     Py_buffer view;
@@ -425,7 +709,12 @@ shape:
 }
 
 /* ------------------------------------------------------------------------ */
-/* chain_lines(omega, coef, rhoa, rhoi, length, slot, table, seg_of, nodes, place, out, table_only, lo, hi) */
+/* chain_lines(omega, coef, rhoa, rhoi, length, slot, table, seg_of, nodes, place, out, table_only, lo, hi)
+ *
+ * Lines lo .. hi - 1 of the chains' receptances into out, line q = c * n_f + i for configuration c;
+ * with table_only, instead, the transfer matrices of the shared segments (slot[u] >= 0) at the
+ * frequency lines lo .. hi - 1 into table[slot[u], entry, i] (one function for both, so that the
+ * closed form has one implementation). */
 
 static PyObject *py_chain_lines(PyObject *self, PyObject *args)
 {
@@ -450,15 +739,15 @@ static PyObject *py_chain_lines(PyObject *self, PyObject *args)
     const int64_t *slot = b[5].view.buf, *seg_of = b[7].view.buf, *nodes = b[8].view.buf, *place = b[9].view.buf;
     Py_ssize_t n_shared = 0;
     const char *bad = NULL;
-    for (Py_ssize_t u = 0; u < n_u; u++)
-        if (slot[u] >= 0)
-            n_shared = slot[u] + 1 > n_shared ? slot[u] + 1 : n_shared;
     if (SHAPE(b[1], 2) != 5 || SHAPE(b[5], 0) != n_u)
         bad = "coef or slot";
     for (int k = 2; k < 5; k++)
         if (SHAPE(b[k], 0) != n_u || SHAPE(b[k], 1) != n_c)
             bad = "rhoa, rhoi or length";
-    if (SHAPE(b[6], 1) != 4 || SHAPE(b[6], 2) != 4 || SHAPE(b[6], 0) < n_shared * n_f)
+    for (Py_ssize_t u = 0; u < n_u && !bad; u++)
+        if (slot[u] >= n_shared)
+            n_shared = slot[u] + 1;
+    if (SHAPE(b[6], 0) < n_shared || SHAPE(b[6], 1) != 16 || (n_shared > 0 && SHAPE(b[6], 2) != n_f))
         bad = "table";
     if (SHAPE(b[9], 0) != m)
         bad = "place";
@@ -482,33 +771,17 @@ static PyObject *py_chain_lines(PyObject *self, PyObject *args)
     const double *omega = b[0].view.buf, *rhoa = b[2].view.buf, *rhoi = b[3].view.buf, *length = b[4].view.buf;
     const cx *coef = b[1].view.buf;
     cx *table = b[6].view.buf, *out = b[10].view.buf;
-    cx *work = malloc(sizeof(cx) * (16 * (n_u > 0 ? n_u : 1) + 8 * (m > 0 ? m : 1)));
+    Py_ssize_t nu1 = n_u > 0 ? n_u : 1, m1 = m > 0 ? m : 1;
+    cv *work = aligned_alloc_(sizeof(cv) * (16 * nu1 + 8 * m1));
     if (!work) {
         release(b, 11);
         return PyErr_NoMemory();
     }
-    cx *tmat = work, *pre = work + 16 * (n_u > 0 ? n_u : 1), *post = pre + 4 * (m > 0 ? m : 1);
     Py_BEGIN_ALLOW_THREADS
-    for (Py_ssize_t q = lo; q < hi; q++) {
-        Py_ssize_t c = table_only ? 0 : q / n_f;
-        Py_ssize_t i = q - c * n_f;
-        double w2 = omega[i] * omega[i];
-        for (Py_ssize_t u = 0; u < n_u; u++) {
-            int shared = slot[u] >= 0;
-            if (shared && !table_only) {
-                memcpy(tmat + 16 * u, table + 16 * (slot[u] * n_f + i), 16 * sizeof(cx));
-            } else if (shared || !table_only) {
-                Py_ssize_t k = u * n_c + c;
-                transfer(coef + 5 * k, rhoa[k], rhoi[k], length[k], w2, tmat + 16 * u);
-                if (table_only)
-                    memcpy(table + 16 * (slot[u] * n_f + i), tmat + 16 * u, 16 * sizeof(cx));
-            }
-        }
-        if (!table_only)
-            chain_line(tmat, seg_of, n_int, nodes, place, m, out, n_lines, q, pre, post);
-    }
+    chain_range(omega, n_f, coef, rhoa, rhoi, length, n_u, n_c, slot, table, seg_of, n_int, nodes, place, m, out,
+                table_only, lo, hi, work, work + 16 * nu1, work + 16 * nu1 + 4 * m1);
     Py_END_ALLOW_THREADS
-    free(work);
+    aligned_free_(work);
     release(b, 11);
     Py_RETURN_NONE;
 }
@@ -722,7 +995,7 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_ckernels",
                                     "Compiled kernels of substructure (internal; see substructure._kernels).", -1,
                                     methods};
 
-PyMODINIT_FUNC PyInit__ckernels(void)
+static void init_tables(void)
 {
     double f = 1.0;
     for (int k = 0; k < 24; k++) {
@@ -738,5 +1011,10 @@ PyMODINIT_FUNC PyInit__ckernels(void)
         double bound = pow(1e-18 * fact, 1.0 / n);
         series_bound2[n] = bound * bound;
     }
+}
+
+PyMODINIT_FUNC PyInit__ckernels(void)
+{
+    init_tables();
     return PyModule_Create(&module);
 }

@@ -209,13 +209,14 @@ transcendental_floor = _c.transcendental_floor
 
 _NO_NODES = np.zeros(0, dtype=np.int64)
 _NO_OUT = np.zeros((0, 0, 0), dtype=np.complex128)
+# the shared segments' transfer matrices: (n_shared, 16 entries row-major, n_f lines)
 
 
 def _shared_table(omega, coef, rhoa, rhoi, length, shared):
     """``slot`` (place of each shared segment in the table, else -1) and the table of their transfer matrices."""
     slot = np.full(shared.size, -1, dtype=np.int64)
     slot[shared] = np.arange(int(np.count_nonzero(shared)))
-    table = np.empty((int(np.count_nonzero(shared)) * omega.size, 4, 4), dtype=np.complex128)
+    table = np.empty((int(np.count_nonzero(shared)), 16, omega.size), dtype=np.complex128)
     if table.size:
         over_lines(chain_lines, omega.size, omega, coef, rhoa, rhoi, length, slot, table,
                    _NO_NODES, _NO_NODES, _NO_NODES, _NO_OUT, True)
@@ -243,7 +244,7 @@ def transfer_matrices(omega, ei, kga, rhoa, rhoi, length):
     rhoa, rhoi, length = (c_array(v, float) for v in (rhoa, rhoi, length))
     coef, _ = segment_coefficients(ei, kga, rhoa, rhoi, 0.0)
     _, table = _shared_table(omega, coef, rhoa, rhoi, length, np.ones(coef.shape[0], dtype=bool))
-    return table.reshape(coef.shape[0], omega.size, 4, 4)
+    return np.ascontiguousarray(np.moveaxis(table.reshape(coef.shape[0], 4, 4, omega.size), -1, 1))
 
 
 def chain_receptance(omega, ei, kga, rhoa, rhoi, length, shared, seg_of, nodes, place, out=None):

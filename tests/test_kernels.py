@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from substructure import Frequency, Segment, Sensor
+from substructure import Frequency, InvalidValueError, Segment, Sensor
 from substructure import _kernels as kernels
 from substructure.beams import segment_transfer_matrix, stepped_beam_receptance
 from substructure.io.assembly_toml import default_assembly
@@ -25,7 +25,8 @@ def test_threads_give_bit_identical_results(one_thread):
     assert np.array_equal(split, asm.frf(points, frequency=grid).data)
 
 
-def test_one_compiled_signature_per_kernel_even_for_read_only_inputs():
+def test_read_only_inputs_are_taken_and_bad_arrays_refused():
+    """The wrappers copy what the compiled code cannot take; the compiled code checks what it gets."""
     omega = np.linspace(1.0, 5000.0, 50)
     omega.flags.writeable = False
     sec = Segment("46 mm", "12 mm", material="carbide").section()
@@ -34,9 +35,44 @@ def test_one_compiled_signature_per_kernel_even_for_read_only_inputs():
     y.flags.writeable = False
     from substructure._engine import Link, couple_substructures
 
-    couple_substructures([([1, 2], y), ([3, 4], y)], [Link(2, 3, None)], [1, 4])
-    for kernel in (kernels.segment_coefficients, kernels.chain_lines, kernels.couple_lines):
-        assert len(kernel.signatures) == 1
+    coupled = couple_substructures([([1, 2], y), ([3, 4], y)], [Link(2, 3, None)], [1, 4])
+    assert np.all(np.isfinite(coupled))
+    # straight calls with arrays of the wrong dtype, dimension or size: an exception, never a read past the end
+    ei = np.array([[sec.EI]], dtype=complex)
+    coef = np.empty((1, 1, 5), dtype=complex)
+    k_max = np.empty((1, 1))
+    args = [ei, ei.copy(), np.array([[sec.rhoA]]), np.array([[sec.rhoI]]), 100.0, coef, k_max]
+    kernels._c.segment_coefficients(*args)
+    with pytest.raises(TypeError, match="k_max"):
+        kernels._c.segment_coefficients(*args[:6], k_max.astype(np.float32))
+    with pytest.raises(TypeError, match="coef"):
+        kernels._c.segment_coefficients(*args[:5], coef[0], k_max)
+    with pytest.raises(ValueError, match="inconsistent"):
+        kernels._c.segment_coefficients(*args[:5], np.empty((1, 1, 4), dtype=complex), k_max)
+    out = np.empty((2, 2, 10), dtype=complex)
+    good = [omega.copy(), coef, args[2], args[3], np.array([[0.046]]), np.full(1, -1, dtype=np.int64),
+            np.zeros((0, 16, 10), dtype=complex), np.zeros(1, dtype=np.int64), np.array([1], dtype=np.int64),
+            np.zeros(1, dtype=np.int64), out, False, 0, 10]
+    with pytest.raises(ValueError, match="inconsistent"):
+        kernels._c.chain_lines(*good)  # omega has 50 lines, out 10
+    good[0] = omega[:10].copy()
+    kernels._c.chain_lines(*good)
+    for bad_nodes in ([2], [-1]):  # beyond the chain's one interval
+        with pytest.raises(ValueError, match="nodes"):
+            kernels._c.chain_lines(*good[:8], np.array(bad_nodes, dtype=np.int64), *good[9:])
+    with pytest.raises(ValueError, match="lo, hi"):
+        kernels._c.chain_lines(*good[:12], 0, 11)
+
+
+def test_thread_count_from_the_environment(monkeypatch):
+    monkeypatch.setenv(kernels.THREADS_VARIABLE, "3")
+    assert kernels.threads() == 3
+    for bad in ("0", "-2", "many", "1.5"):
+        monkeypatch.setenv(kernels.THREADS_VARIABLE, bad)
+        with pytest.raises(InvalidValueError, match=kernels.THREADS_VARIABLE):
+            kernels.threads()
+    monkeypatch.delenv(kernels.THREADS_VARIABLE)
+    assert kernels.threads() >= 1
 
 
 def test_blocks_between_points_are_exact_transposes():
@@ -59,3 +95,14 @@ def test_lines_next_to_a_pole_stay_finite():
     f = f0 * (1.0 + np.arange(-50, 51) * 2.2e-16)
     y = stepped_beam_receptance(segs, [length], f)
     assert np.all(np.isfinite(y))
+
+
+def test_a_line_does_not_depend_on_the_lines_computed_with_it():
+    """Lines are computed four at a time; each must come out as if computed alone (any grid, any split)."""
+    segs = [Segment("16 mm", "63 mm"), Segment("10 mm", "40 mm"), Segment("140 mm", "40 mm", "12 mm")]
+    length = sum(s.length_m for s in segs)
+    f = np.linspace(10.0, 9000.0, 103)  # power series at the low lines, exponentials above
+    full = stepped_beam_receptance(segs, [0.0, 0.05, length], f)
+    for start, n in ((1, 37), (2, 1), (3, 6), (50, 53)):
+        part = stepped_beam_receptance(segs, [0.0, 0.05, length], f[start : start + n])
+        assert np.array_equal(part, full[..., start : start + n])
