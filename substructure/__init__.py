@@ -9,42 +9,42 @@ The public names most users need are importable from here::
 
     from substructure import (Assembly, Spindle, Holder, Tool, Segment, Insert,
                               Flutes, Joint, Sensor, Support, FRF, Frequency)
+
+They are imported on first use (PEP 562), so that ``import substructure``,
+and a command that needs only part of the library, stay fast.
 """
 
-from .assembly import Assembly
-from .beams import Flutes, Insert, Segment, shear_coefficient
-from .components import (
-    COMPONENT_TYPES,
-    Beam,
-    Holder,
-    MeasuredComponent,
-    Spindle,
-    Tool,
-    register_component,
-)
-from .coupling import add_mass, decouple, modify, remove_mass
-from .errors import (
-    AssemblyError,
-    FileFormatError,
-    FrequencyAxisMismatchError,
-    IllConditionedWarning,
-    InvalidValueError,
-    NonPassiveJointWarning,
-    NonReciprocalWarning,
-    OutputExistsError,
-    SubstructureError,
-    SubstructureWarning,
-    UnitError,
-    UnknownPointError,
-)
-from .frf import FRF, Frequency
-from .joints import Joint, Sensor, Support
-from .materials import CATALOG, Material, get_material
-from .units import Q_, ureg
-from .io.assembly_toml import default_assembly, dumps_assembly, load_assembly, loads_assembly, save_assembly
-from .sweep import SweepResult, sweep
+from __future__ import annotations
+
+import importlib
+import sys
+import types
+from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
+
+# public name -> the module that defines it
+_EXPORTS = {
+    "Assembly": "assembly",
+    "Flutes": "beams", "Insert": "beams", "Segment": "beams", "shear_coefficient": "beams",
+    "COMPONENT_TYPES": "components", "Beam": "components", "Holder": "components",
+    "MeasuredComponent": "components", "Spindle": "components", "Tool": "components",
+    "register_component": "components",
+    "add_mass": "coupling", "decouple": "coupling", "modify": "coupling", "remove_mass": "coupling",
+    "AssemblyError": "errors", "FileFormatError": "errors", "FrequencyAxisMismatchError": "errors",
+    "IllConditionedWarning": "errors", "InvalidValueError": "errors", "NonPassiveJointWarning": "errors",
+    "NonReciprocalWarning": "errors", "OutputExistsError": "errors", "SubstructureError": "errors",
+    "SubstructureWarning": "errors",
+    "UnitError": "errors", "UnknownPointError": "errors",
+    "FRF": "frf", "Frequency": "frf",
+    "Joint": "joints", "Sensor": "joints", "Support": "joints",
+    "CATALOG": "materials", "Material": "materials", "get_material": "materials",
+    "Q_": "units", "ureg": "units",
+    "default_assembly": "io.assembly_toml", "dumps_assembly": "io.assembly_toml",
+    "load_assembly": "io.assembly_toml", "loads_assembly": "io.assembly_toml",
+    "save_assembly": "io.assembly_toml",
+    "SweepResult": "sweep", "sweep": "sweep",
+}
 
 __all__ = [
     "Assembly", "Beam", "Spindle", "Holder", "Tool", "MeasuredComponent", "Segment", "Insert",
@@ -56,3 +56,49 @@ __all__ = [
     "NonReciprocalWarning", "IllConditionedWarning", "load_assembly", "loads_assembly", "save_assembly",
     "dumps_assembly", "default_assembly", "sweep", "SweepResult",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    globals()[name] = value  # next time without this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
+
+
+class _Package(types.ModuleType):
+    """The package module: ``substructure.sweep`` stays the function when its module is imported.
+
+    Importing a submodule sets it as an attribute of the package; for the one
+    public name that is also a module's name (``sweep``), the package keeps
+    the function, as it did when it imported everything at once.
+    """
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if isinstance(value, types.ModuleType) and _EXPORTS.get(name) == name:
+            value = getattr(value, name)
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package
+
+
+if TYPE_CHECKING:  # for type checkers and editors: the names as plain imports
+    from .assembly import Assembly
+    from .beams import Flutes, Insert, Segment, shear_coefficient
+    from .components import COMPONENT_TYPES, Beam, Holder, MeasuredComponent, Spindle, Tool, register_component
+    from .coupling import add_mass, decouple, modify, remove_mass
+    from .errors import (AssemblyError, FileFormatError, FrequencyAxisMismatchError, IllConditionedWarning,
+                         InvalidValueError, NonPassiveJointWarning, NonReciprocalWarning, OutputExistsError,
+                         SubstructureError, SubstructureWarning, UnitError, UnknownPointError)
+    from .frf import FRF, Frequency
+    from .io.assembly_toml import default_assembly, dumps_assembly, load_assembly, loads_assembly, save_assembly
+    from .joints import Joint, Sensor, Support
+    from .materials import CATALOG, Material, get_material
+    from .sweep import SweepResult, sweep
+    from .units import Q_, ureg

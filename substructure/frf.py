@@ -22,7 +22,7 @@ import numpy as np
 from .errors import FrequencyAxisMismatchError, InvalidValueError, NonReciprocalWarning, UnknownPointError
 from .units import frequency_hz
 
-__all__ = ["Frequency", "FRF", "QUANTITIES", "MAX_GRID_LINES"]
+__all__ = ["Frequency", "FRF", "QUANTITIES", "MAX_GRID_LINES", "local_maxima"]
 
 QUANTITIES = ("receptance", "mobility", "accelerance")
 """The quantities an FRF may hold: displacement, velocity or acceleration per load."""
@@ -81,6 +81,39 @@ def _check_hz(instance: Any, attribute: Any, hz: np.ndarray) -> None:
             f"hz: got {hz[i + 1]} Hz at index {i + 1} after {hz[i]} Hz; "
             "expected strictly increasing frequencies"
         )
+
+
+def local_maxima(values: np.ndarray) -> np.ndarray:
+    """Indices of the local maxima of a 1-D real array, ascending.
+
+    Parameters
+    ----------
+    values : ndarray
+        Real values, 1-D (e.g. ``|H|`` over the frequency lines).
+
+    Returns
+    -------
+    ndarray of int
+        A run of equal values (one value or more) that is higher than the
+        values just before and just after it gives one index, the middle of
+        the run (the left one of two middles); runs at either end of the
+        array give none.  The same peaks as ``scipy.signal.find_peaks``
+        without conditions, found with whole-array numpy operations.
+    """
+    x = np.asarray(values)
+    if x.ndim != 1:
+        raise InvalidValueError(f"values: got shape {x.shape}; expected a 1-D array")
+    if x.size < 3:
+        return np.zeros(0, dtype=np.intp)
+    change = np.flatnonzero(x[1:] != x[:-1])  # a new run starts after each of these
+    starts = np.concatenate(([0], change + 1))
+    ends = np.concatenate((change, [x.size - 1]))
+    level = x[starts]
+    higher = np.zeros(level.size, dtype=bool)
+    higher[1:] = level[1:] > level[:-1]  # rises into the run
+    higher[:-1] &= level[1:] < level[:-1]  # and falls after it
+    higher[-1] = False
+    return (starts[higher] + ends[higher]) // 2
 
 
 @attrs.frozen(repr=False)
@@ -656,20 +689,25 @@ class FRF:
             The entry; may be left out along a side with a single label.
         prominence : float, optional
             Keep only peaks whose prominence is at least this fraction of the
-            largest ``|FRF|`` of the entry (``scipy.signal.find_peaks``).
+            largest ``|FRF|`` of the entry (the prominences of
+            ``scipy.signal.peak_prominences``).
 
         Returns
         -------
         ndarray
-            Peak frequencies in Hz, ascending.
+            Frequencies of the peaks in Hz, ascending (empty when there is none).
 
         Notes
         -----
-        A maximum at the first or last line is not a peak (it may be outside
+        A line is a peak when it is higher than both neighbours; a run of
+        equal values counts as one peak at its middle line (the left one of
+        the two middle lines), where it rises before and falls after.  A
+        maximum at the first or last line is not a peak (it may be outside
         the band).  The resolution is the grid's: no sub-line refinement.
+        These are the rules of ``scipy.signal.find_peaks``; the search is
+        done here with numpy alone, so that a plain peak search does not
+        load ``scipy.signal``.
         """
-        from scipy.signal import find_peaks
-
         chosen = []
         for label, have, which in ((output, self.outputs, "output"), (input, self.inputs, "input")):
             if label is None and len(have) != 1:
@@ -683,8 +721,11 @@ class FRF:
                 raise InvalidValueError(
                     f"prominence: got {prominence!r}; expected a fraction of the largest |FRF| in [0, 1]"
                 )
-            prominence = prominence * magnitude.max()
-        index, _ = find_peaks(magnitude, prominence=prominence)
+        index = local_maxima(magnitude)
+        if prominence is not None and index.size:
+            from scipy.signal import peak_prominences
+
+            index = index[peak_prominences(magnitude, index)[0] >= prominence * magnitude.max()]
         return self.frequency.hz[index].copy()
 
     def reciprocity_error(self) -> float:

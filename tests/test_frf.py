@@ -575,3 +575,29 @@ def test_plot_titles_wrap_and_overlays_keep_one_note():
     lo, hi = fig.axes[0].get_ylim()
     rest = (np.abs(frf.data[:, 0, 0]) * 1e6)[frf.frequency.hz > 100]
     assert hi >= 2 * rest.max()   # the overlay's larger values are inside the new limits
+
+
+def test_local_maxima_are_those_of_scipy_find_peaks():
+    """The numpy peak search against scipy.signal.find_peaks (plateaus, ends, noise, prominence)."""
+    from scipy.signal import find_peaks
+
+    from substructure.frf import local_maxima
+
+    rng = np.random.default_rng(7)
+    cases = [np.array([]), np.array([1.0]), np.array([1.0, 2.0]), np.array([1.0, 2.0, 1.0]),
+             np.array([3.0, 1.0, 3.0]), np.array([1.0, 2.0, 2.0, 1.0]), np.array([1.0, 2.0, 2.0, 2.0, 1.0]),
+             np.array([1.0, 2.0, 2.0, 3.0, 1.0]), np.array([2.0, 2.0, 1.0, 2.0, 2.0]), np.ones(6)]
+    for _ in range(300):
+        n = int(rng.integers(3, 60))
+        cases.append(rng.integers(0, 4, size=n).astype(float))  # many plateaus and ties
+        cases.append(rng.normal(size=n))
+    for x in cases:
+        expected, _ = find_peaks(x)
+        np.testing.assert_array_equal(local_maxima(x), expected)
+    # and as FRF.peaks with a prominence, on a noisy FRF with many small peaks
+    f = Frequency.from_range("10 Hz", "3000 Hz", "1 Hz")
+    values = sdof(f.hz, 4e7, 1.0, 0.03) * (1.0 + 0.05 * rng.normal(size=f.n))
+    frf = FRF.single(f, values)
+    for p in (None, 0.0, 0.01, 0.3):
+        kw = {} if p is None else {"prominence": p * np.abs(values).max()}
+        np.testing.assert_array_equal(frf.peaks(prominence=p), f.hz[find_peaks(np.abs(values), **kw)[0]])

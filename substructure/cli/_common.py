@@ -1,4 +1,9 @@
-"""What the subcommands share: the parser that raises, option types, strict JSON, figures and output files."""
+"""What the subcommands share: the parser that raises, option types, strict JSON, figures and output files.
+
+Imported by the parser of every command: it loads only light modules itself;
+the library's numerical and unit modules (and numpy) are imported inside the
+functions that need them, so that a command pays for what it uses.
+"""
 
 from __future__ import annotations
 
@@ -8,14 +13,12 @@ import math
 import os
 import re
 from pathlib import Path
-from typing import Any, Callable, Iterable
-
-import attrs
-import numpy as np
+from typing import TYPE_CHECKING, Any, Callable, Iterable
 
 from ..errors import SubstructureError
-from ..frf import FRF, Frequency
-from ..points import parse_point
+
+if TYPE_CHECKING:
+    from ..frf import FRF, Frequency
 
 PROG = "substructure"
 
@@ -67,12 +70,16 @@ def one_line(text: str) -> str:
 
 def strict(value: Any) -> Any:
     """``value`` made of JSON types only: NaN and infinities become ``null``, numpy values plain ones."""
+    import numpy as np
+
     if isinstance(value, dict):
         return {str(k): strict(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [strict(v) for v in value]
     if isinstance(value, np.ndarray):
-        return [strict(v) for v in value.tolist()]
+        value = value.tolist()
+    if isinstance(value, (list, tuple)):
+        if all(type(v) is float for v in value):  # a long list of numbers (an FRF): one pass
+            return [v if math.isfinite(v) else None for v in value]
+        return [strict(v) for v in value]
     if isinstance(value, (bool, np.bool_)):
         return bool(value)
     if isinstance(value, (int, np.integer)):
@@ -126,17 +133,25 @@ def range_arg(text: str, unit: str, build: Callable, example: str):
 
 def grid_arg(text: str) -> Frequency:
     """``START:STOP:STEP`` in Hz, or with units (``"20 Hz:5 kHz:2 Hz"``)."""
+    from ..frf import Frequency
+
     return range_arg(text, "Hz", Frequency.from_range, "20:5000:2 (Hz) or '20 Hz:5 kHz:2 Hz'")
 
 
 def point_arg(text: str) -> str:
     """A point name with its DOF, ``y`` when none is given."""
+    import attrs
+
+    from ..points import parse_point
+
     ref = parse_point(text)
     return str(attrs.evolve(ref, dof=ref.dof or "y"))
 
 
 def peak_table(frf: FRF) -> list[tuple[float, float]]:
     """``(frequency in Hz, |FRF|)`` of the peaks of a one-entry FRF, ascending."""
+    import numpy as np
+
     peaks = frf.peaks()
     magnitude = np.abs(frf.data[:, 0, 0])
     index = np.searchsorted(frf.frequency.hz, peaks)

@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 import attrs
 
-from ..frf import FRF
-from ..io.assembly_toml import default_assembly
 from ._common import figures, grid_text, peak_table, print_json, save_figure, save_plot
+
+if TYPE_CHECKING:
+    from ..frf import FRF
 
 TOOL_POINT = "tool.tip:y"
 """The tool point of the built-in assembly."""
@@ -41,6 +42,8 @@ class DemoState:
 
 
 def _demo_load(state: DemoState) -> None:
+    from ..io.assembly_toml import default_assembly
+
     state.assembly = default_assembly()
     state.lines.append(state.assembly.describe())
     state.results["components"] = [c.name for c in state.assembly.components]

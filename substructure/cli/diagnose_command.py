@@ -6,7 +6,6 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..io.assembly_toml import load_assembly
 from ._common import (
     PROG,
     UsageError,
@@ -23,6 +22,8 @@ FIGURES = ("where_it_fails.png", "error_fall.png", "after_refinement.png")
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..io.assembly_toml import load_assembly
+
     from ..diagnose import diagnose
     from ..io.assembly_toml import save_assembly
     from ..io.measurements import load_measurements

@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..io.assembly_toml import load_assembly
 from ._common import (
     UsageError,
     check_outputs,
@@ -22,6 +21,8 @@ from ._common import (
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..io.assembly_toml import load_assembly
+
     if args.out and Path(args.out).suffix.lower() not in (".csv", ".uff", ".unv"):
         raise UsageError(f"argument --out: {args.out!r}: expected a .csv or .uff file")
     check_plot(args.plot)

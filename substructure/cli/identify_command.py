@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-from ..io.assembly_toml import load_assembly
 from ._common import (
     band_arg,
     check_outputs,
@@ -18,6 +17,8 @@ from ._common import (
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..io.assembly_toml import load_assembly
+
     from ..identify import identify_joint
     from ..io.measurements import load_measurements
 

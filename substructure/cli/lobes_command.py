@@ -5,11 +5,7 @@ from __future__ import annotations
 import argparse
 import warnings
 
-import numpy as np
-
 from ..errors import SubstructureError
-from ..frf import FRF
-from ..io.assembly_toml import load_assembly
 from ._common import (
     UsageError,
     band_range_arg,
@@ -64,6 +60,8 @@ def _lobes_cut(args: argparse.Namespace):
 
 def _lobes_structure(args: argparse.Namespace):
     """The structure and a line describing it: an FRF (labelled x/y) or a ModalModel."""
+    from ..frf import FRF
+    from ..io.assembly_toml import load_assembly
     from ..stability import ModalModel, xy_frf
 
     sources = [name for name, value in (("--assembly", args.assembly), ("--frf", args.frf), ("--modes", args.modes))
@@ -100,6 +98,9 @@ def _lobes_structure(args: argparse.Namespace):
 
 
 def run(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from ..frf import FRF
     from ..stability import ModalFitter, ModalFitWarning, ModalModel, sdm, zoa
 
     check_plot(args.plot)

@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..io.assembly_toml import load_assembly
 from ._common import UsageError, check_outputs, check_plot, count_arg, figures, point_arg, print_json, save_figure
 
 
@@ -22,6 +21,8 @@ def _features(text: str) -> dict[str, str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..io.assembly_toml import load_assembly
+
     from ..surrogate import JointTable, cross_validate, make_surrogate
 
     check_plot(args.plot)
