@@ -47,7 +47,7 @@ from . import _blocks as bk
 from ._engine import Link, couple_substructures
 from .errors import InvalidValueError
 from .materials import Material, get_material
-from .units import dimensionless, quantity
+from .units import dimensionless, magnitude_in, quantity, ureg
 
 __all__ = [
     "Insert",
@@ -71,6 +71,16 @@ def _length(field: str, *, allow_zero: bool = False):
         return q
 
     return convert
+
+
+_METRE = ureg.Unit("m")
+
+
+def _metres(value, field: str) -> pint.Quantity:
+    """A float in metres as a quantity (no text parsed); bare numbers only."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+        raise InvalidValueError(f"{field}: got {value!r}; expected a number of metres")
+    return ureg.Quantity(float(value), _METRE)
 
 
 def _material(value) -> Material:
@@ -173,12 +183,25 @@ class Insert:
     od: pint.Quantity = attrs.field(converter=_length("insert.od"))
     material: Material = attrs.field(converter=_material)
     id: pint.Quantity = attrs.field(default="0 mm", converter=_length("insert.id", allow_zero=True))
+    _si: tuple = attrs.field(init=False, eq=False, repr=False)
 
     def __attrs_post_init__(self) -> None:
-        if self.id >= self.od:
+        od, id_ = magnitude_in(self.od, "m"), magnitude_in(self.id, "m")
+        if id_ >= od:
             raise InvalidValueError(
                 f"insert.id: got {self.id:~P} with insert.od {self.od:~P}; expected id < od"
             )
+        object.__setattr__(self, "_si", (od, id_))
+
+    @property
+    def od_m(self) -> float:
+        """Outer diameter in metres."""
+        return self._si[0]
+
+    @property
+    def id_m(self) -> float:
+        """Inner diameter in metres."""
+        return self._si[1]
 
 
 def _ratio(value) -> float:
@@ -279,21 +302,22 @@ class Segment:
     _taper: tuple | None = attrs.field(init=False, eq=False, repr=False, default=None)
 
     def __attrs_post_init__(self) -> None:
-        if self.id >= self.od:
+        length, od, id_ = (magnitude_in(q, "m") for q in (self.length, self.od, self.id))
+        if id_ >= od:
             raise InvalidValueError(f"id: got {self.id:~P} with od {self.od:~P}; expected id < od")
         if self.insert is not None:
             if not isinstance(self.insert, Insert):
                 raise InvalidValueError(f"insert: got {self.insert!r}; expected an Insert")
-            if self.id.magnitude == 0:
+            if id_ == 0:
                 raise InvalidValueError("insert: the segment is solid (id = 0); an insert needs a bore")
-            if self.insert.od > self.id:
+            if self.insert.od_m > id_:
                 raise InvalidValueError(
                     f"insert.od: got {self.insert.od:~P}, larger than the bore id {self.id:~P}"
                 )
         if self.flutes is not None:
             if not isinstance(self.flutes, Flutes):
                 raise InvalidValueError(f"flutes: got {self.flutes!r}; expected Flutes")
-            if self.flutes.diameter_ratio * self.od <= self.id:
+            if self.flutes.diameter_ratio * od <= id_:
                 raise InvalidValueError(
                     "flutes.diameter_ratio: the equivalent diameter "
                     f"{self.flutes.diameter_ratio} * {self.od:~P} is not larger than the bore {self.id:~P}"
@@ -303,16 +327,40 @@ class Segment:
 
             ends = check_taper(self)
             if ends is not None:  # tapered: no single section
-                object.__setattr__(self, "_si", (float(self.length.m_as("m")), None))
+                object.__setattr__(self, "_si", (length, None))
                 object.__setattr__(self, "_taper", ends)
                 return
-        od = self.od.m_as("m")
         if self.flutes is not None:
             od = od * self.flutes.diameter_ratio
-        sec = Section.ring(od, self.id.m_as("m"), self.material)
+        sec = Section.ring(od, id_, self.material)
         if self.insert is not None:
-            sec = sec + Section.ring(self.insert.od.m_as("m"), self.insert.id.m_as("m"), self.insert.material)
-        object.__setattr__(self, "_si", (float(self.length.m_as("m")), sec))
+            sec = sec + Section.ring(self.insert.od_m, self.insert.id_m, self.insert.material)
+        object.__setattr__(self, "_si", (length, sec))
+
+    @classmethod
+    def from_si(cls, length: float, od: float, id: float = 0.0, material="steel",
+                insert: Insert | None = None, flutes: Flutes | None = None) -> "Segment":
+        """A segment from its dimensions in metres: the fast way to build many variants.
+
+        Parameters
+        ----------
+        length, od : float
+            Length and outer diameter [m].
+        id : float, default 0
+            Inner diameter [m].
+        material : Material or str, default "steel"
+        insert : Insert, optional
+        flutes : Flutes, optional
+
+        Returns
+        -------
+        Segment
+            The same segment as ``Segment(f"{length} m", f"{od} m", ...)``,
+            with the same checks, built without reading any text: a sweep
+            over thousands of geometries spends its time in the computation,
+            not in parsing units.
+        """
+        return cls(_metres(length, "length"), _metres(od, "od"), _metres(id, "id"), material, insert, flutes)
 
     @property
     def length_m(self) -> float:

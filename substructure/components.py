@@ -25,6 +25,17 @@ The protocol a component satisfies (duck-typed, nothing to inherit):
     The receptances between the points, shape ``(2p, 2p, n_freq)``
     (frequency last), DOFs ``(y, theta)`` per point.
 
+One optional member lets batched computations take a shortcut:
+
+``plain_beam`` (bool, default False)
+    True when the receptances are exactly those of the stepped beam of the
+    component's ``segments`` between its ends (``base``, ``tip``): a sweep
+    then evaluates many such components in one call of the beam kernel from
+    their segments, without calling ``receptance_matrix``.  :class:`Beam`
+    says True; a subclass that overrides ``receptance_matrix`` or
+    ``position`` says False unless it sets ``plain_beam = True`` itself (see
+    :func:`is_plain_beam`).
+
 New component types are registered with :func:`register_component` so that
 assembly files can name them by their ``type``.
 """
@@ -52,6 +63,7 @@ __all__ = [
     "register_component",
     "as_frequency",
     "dof_labels",
+    "is_plain_beam",
 ]
 
 COMPONENT_TYPES: dict[str, type] = {}
@@ -181,6 +193,33 @@ def _text(field: str):
     return check
 
 
+_BEAM_METHODS = ("receptance_matrix", "position")
+"""Methods whose override makes a Beam subclass something else than its segments (plain_beam False)."""
+
+
+def is_plain_beam(component: Any) -> bool:
+    """Whether a component's receptances are those of its ``segments`` alone (the ``plain_beam`` member).
+
+    Parameters
+    ----------
+    component : object
+        Any component.
+
+    Returns
+    -------
+    bool
+        True only when the component says so with ``plain_beam = True`` and
+        has a sequence of :class:`~substructure.beams.Segment` as
+        ``segments``; batched paths (sweeps) may then compute it from the
+        segments.  Everything else is computed through its
+        ``receptance_matrix``.
+    """
+    if getattr(component, "plain_beam", False) is not True:
+        return False
+    segments = getattr(component, "segments", None)
+    return isinstance(segments, tuple) and bool(segments) and all(isinstance(s, Segment) for s in segments)
+
+
 @register_component("beam")
 @attrs.frozen
 class Beam:
@@ -207,10 +246,23 @@ class Beam:
     """
 
     kind: ClassVar[str] = "beam"
+    plain_beam: ClassVar[bool] = True
+    """The receptances are those of ``segments`` alone (see :func:`is_plain_beam`).
+
+    A subclass that overrides ``receptance_matrix`` or ``position`` (a
+    lumped mass, a different point layout) gets False, so that sweeps call
+    its own ``receptance_matrix``; it may set ``plain_beam = True`` in its
+    class body when its receptances are still exactly the segments'.
+    """
 
     name: str = attrs.field(converter=check_name)
     segments: tuple[Segment, ...] = attrs.field(converter=_segments)
     description: str = attrs.field(default="", kw_only=True, validator=_text("description"))
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        if "plain_beam" not in cls.__dict__ and any(m in cls.__dict__ for m in _BEAM_METHODS):
+            cls.plain_beam = False
 
     @property
     def component_names(self) -> frozenset[str]:

@@ -78,6 +78,14 @@ class Material:
     nu: float = attrs.field(converter=_poisson)
     rho: pint.Quantity = attrs.field(converter=_density)
     loss_factor: float = attrs.field(default=0.0, converter=_loss)
+    # SI values, derived once (every section of every beam variant needs them)
+    _si: tuple = attrs.field(init=False, eq=False, repr=False)
+
+    def __attrs_post_init__(self) -> None:
+        damping = 1.0 + 1j * self.loss_factor
+        object.__setattr__(
+            self, "_si", (self.E.m_as("Pa") * damping, self.G.m_as("Pa") * damping, self.rho.m_as("kg/m^3"))
+        )
 
     @property
     def G(self) -> pint.Quantity:
@@ -87,17 +95,17 @@ class Material:
     @property
     def E_si(self) -> complex:
         """Complex Young's modulus ``E (1 + i eta)`` in Pa."""
-        return self.E.m_as("Pa") * (1.0 + 1j * self.loss_factor)
+        return self._si[0]
 
     @property
     def G_si(self) -> complex:
         """Complex shear modulus ``G (1 + i eta)`` in Pa."""
-        return self.G.m_as("Pa") * (1.0 + 1j * self.loss_factor)
+        return self._si[1]
 
     @property
     def rho_si(self) -> float:
         """Density in kg/m^3."""
-        return self.rho.m_as("kg/m^3")
+        return self._si[2]
 
     @classmethod
     def from_catalog(cls, name: str) -> "Material":

@@ -30,7 +30,7 @@ import numpy as np
 
 from .assembly import Assembly, expand_points
 from .beams import stepped_beam_receptance_batch
-from .components import Beam
+from .components import is_plain_beam
 from .coupling import Link, couple_substructures
 from .errors import InvalidValueError
 from .frf import FRF, Frequency
@@ -182,7 +182,10 @@ def sweep(
         ]
         shared_block = (needed, couple_substructures(blocks0, links_s, needed)) if needed else None
 
-    all_beams = {gi: all(isinstance(o, Beam) for o in owners_of[gi]) for gi in range(len(groups0))}
+    # the batched beam kernel only for components that say they are plain stepped beams
+    # (component protocol: anything else, e.g. a Beam subclass with a lumped mass in its
+    # receptance_matrix, is asked for its own receptances)
+    all_beams = {gi: all(is_plain_beam(o) for o in owners_of[gi]) for gi in range(len(groups0))}
     per_chunk = max(1, chunk_lines // n_f)
     data = np.empty((n_var, n_f, len(rows), len(cols)), dtype=complex)
     constant_links: dict[int, np.ndarray] = {}
