@@ -1,5 +1,9 @@
 # Quick start: `make demo` and `make test` work on a fresh machine with only
-# Python >= 3.11 and make: the virtual environment is created when missing.
+# Python >= 3.11, make and a C compiler (the kernels are compiled when the
+# package is installed): the virtual environment is created when missing.
+# After installing, `python -m substructure._prepare` checks the compiled
+# kernels, builds the unit registry's cache and compiles the modules, so that
+# the first run is as fast as the next ones (docs/performance.md).
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
@@ -11,9 +15,10 @@ DOCS_STAMP := $(VENV)/.installed-docs
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 
-$(STAMP): $(BIN)/python pyproject.toml
+$(STAMP): $(BIN)/python pyproject.toml setup.py substructure/_ckernels.c
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e ".[test]"
+	$(BIN)/python -m substructure._prepare
 	touch $(STAMP)
 
 demo: $(STAMP)
@@ -41,4 +46,4 @@ docs: $(DOCS_STAMP)
 	@echo "docs: open docs/_build/html/index.html"
 
 clean:
-	rm -rf $(VENV) out .pytest_cache docs/_build docs/api docs/auto_examples
+	rm -rf $(VENV) out .pytest_cache build docs/_build docs/api docs/auto_examples substructure/_ckernels*.so

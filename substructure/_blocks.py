@@ -21,24 +21,43 @@ import numpy as np
 
 __all__ = ["mul2", "inv2", "inv", "to_front", "to_back", "CHUNK_LINES", "by_chunks"]
 
-CHUNK_LINES = 65536
+CHUNK_LINES = 16384
 """Frequency lines evaluated at once by an assembly (bounds the memory of intermediates).
 
 The compiled kernels (:mod:`substructure._kernels`) work line by line and
 need no chunking for speed; chunks only bound the size of the components'
-receptance matrices and joint stiffnesses held at once (a few tens of MB at
-this size).  The former vectorised numpy kernels needed chunks of 2,500
-lines, below the C allocator's threshold for memory-mapped blocks.
+receptance matrices, joint stiffnesses and coupling intermediates held at
+once: about 1 kB per line for a spindle, holder and tool, so some 16 MB at
+this size, whatever the number of lines.
 """
 
 
 def by_chunks(compute, frequency_hz: np.ndarray) -> np.ndarray:
-    """``compute(f)`` over chunks of at most :data:`CHUNK_LINES` lines, joined on the last axis."""
+    """``compute(f)`` over chunks of at most :data:`CHUNK_LINES` lines, joined on the last axis.
+
+    Parameters
+    ----------
+    compute : callable
+        ``compute(f)`` returns an array ``(..., f.size)`` for frequency lines ``f`` in Hz.
+    frequency_hz : ndarray
+        All the lines [Hz].
+
+    Returns
+    -------
+    ndarray
+        ``(..., n)``: each chunk is written into one array allocated once
+        (no list of parts joined at the end, which would hold the result twice).
+    """
     f = np.asarray(frequency_hz, dtype=float)
     if f.size <= CHUNK_LINES:
         return compute(f)
-    parts = [compute(f[i : i + CHUNK_LINES]) for i in range(0, f.size, CHUNK_LINES)]
-    return np.concatenate(parts, axis=-1)
+    out = None
+    for i in range(0, f.size, CHUNK_LINES):
+        part = compute(f[i : i + CHUNK_LINES])
+        if out is None:
+            out = np.empty(part.shape[:-1] + (f.size,), dtype=part.dtype)
+        out[..., i : i + part.shape[-1]] = part
+    return out
 
 
 def mul2(a: np.ndarray, b: np.ndarray) -> np.ndarray:

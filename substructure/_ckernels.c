@@ -1013,8 +1013,20 @@ static void init_tables(void)
     }
 }
 
+#ifndef KERNELS_SOURCE_SHA256
+#define KERNELS_SOURCE_SHA256 "unknown"
+#endif
+
 PyMODINIT_FUNC PyInit__ckernels(void)
 {
     init_tables();
-    return PyModule_Create(&module);
+    PyObject *m = PyModule_Create(&module);
+    if (m == NULL)
+        return NULL;
+    /* the SHA-256 of this file when it was compiled (setup.py): a checkout can tell a stale build */
+    if (PyModule_AddStringConstant(m, "SOURCE_SHA256", KERNELS_SOURCE_SHA256) < 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
+    return m;
 }

@@ -46,6 +46,25 @@ except ImportError as exc:  # pragma: no cover - an installation problem, not a 
         "checkout, or `python -m pip install -e .` (a C compiler and the Python headers are needed)"
     ) from exc
 
+def _check_build() -> None:
+    """In a checkout (the C source next to this file), refuse a build older than the source."""
+    import hashlib
+
+    source = os.path.join(os.path.dirname(__file__), "_ckernels.c")
+    try:
+        with open(source, "rb") as fh:
+            digest = hashlib.sha256(fh.read()).hexdigest()
+    except OSError:  # an installed package ships the compiled module only
+        return
+    if digest != getattr(_c, "SOURCE_SHA256", None):
+        raise SubstructureError(
+            f"the compiled kernels (substructure._ckernels) were built from another version of {source}; "
+            "rebuild them: `make .venv/.installed` in the checkout, or `python -m pip install -e .`"
+        )
+
+
+_check_build()
+
 __all__ = [
     "transfer_matrices",
     "segment_coefficients",

@@ -627,11 +627,20 @@ class Assembly:
 
         out_labels, out_idx, out_refs = expand_points(outputs)
         in_labels, in_idx, in_refs = expand_points(inputs)
-        refs = out_refs + in_refs
-        y = self.receptance_matrix(refs, freq.hz)
-        rows = [2 * i + d for i, d in out_idx]
-        cols = [2 * (len(out_refs) + i) + d for i, d in in_idx]
-        data = np.moveaxis(y[np.ix_(rows, cols)], -1, 0)
+        groups, keys, links = self._plan(out_refs + in_refs)
+        # each physical point once (a point receptance names its point twice), and only the
+        # requested entries kept from each chunk of lines: the memory is the result's
+        unique = list(dict.fromkeys(keys))
+        slot = [unique.index(k) for k in keys]
+        rows = [2 * slot[i] + d for i, d in out_idx]
+        cols = [2 * slot[len(out_refs) + i] + d for i, d in in_idx]
+        f = freq.hz
+        data = np.empty((f.size, len(rows), len(cols)), dtype=complex)
+        for start in range(0, f.size, CHUNK_LINES):
+            stop = min(f.size, start + CHUNK_LINES)
+            y = self._compute(groups, unique, links, f[start:stop])
+            data[start:stop] = np.moveaxis(y[np.ix_(rows, cols)], -1, 0)
+        data.flags.writeable = False  # handed to the FRF without a copy
         return FRF(freq, data, tuple(out_labels), tuple(in_labels))
 
     def receptance(self, at: str, to: str | None = None, frequency=None) -> FRF:

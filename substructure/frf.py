@@ -313,6 +313,11 @@ def _labels(field: str):
 
 
 def _complex_array(value: Any) -> np.ndarray:
+    if (isinstance(value, np.ndarray) and value.dtype == np.complex128 and value.base is None
+            and not value.flags.writeable):
+        # owned by no other array and read-only: kept as it is (a copy would double the
+        # memory of a large FRF); nobody can change it without re-enabling writes on purpose
+        return value
     try:
         return _readonly(np.array(value, dtype=np.complex128, copy=True))
     except (TypeError, ValueError):
