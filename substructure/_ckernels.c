@@ -516,15 +516,26 @@ AI void chain_block(const cv *tmat, const int64_t *seg_of, Py_ssize_t n_int, con
     cv i00 = vmul(c7, idet), i11 = vmul(c4, idet), i01 = vmul(vneg(c5), idet), i10 = vmul(vneg(c6), idet);
     Py_ssize_t w = 2 * m; /* out is (w, w, n_lines) */
     for (Py_ssize_t i = 0; i < m; i++) {
-        const cv *pi_ = pre + 4 * i;
-        cv l00 = vdot2(pi_[0], i00, pi_[1], i10), l01 = vdot2(pi_[0], i01, pi_[1], i11);
-        cv l10 = vdot2(pi_[2], i00, pi_[3], i10), l11 = vdot2(pi_[2], i01, pi_[3], i11);
+        /* left = P_i,uu M_Fu^-1; P = I at the base (a product with I would change only signs of zeros) */
+        cv l00 = i00, l01 = i01, l10 = i10, l11 = i11;
+        if (nodes[i] != 0) {
+            const cv *pi_ = pre + 4 * i;
+            l00 = vdot2(pi_[0], i00, pi_[1], i10);
+            l01 = vdot2(pi_[0], i01, pi_[1], i11);
+            l10 = vdot2(pi_[2], i00, pi_[3], i10);
+            l11 = vdot2(pi_[2], i01, pi_[3], i11);
+        }
         Py_ssize_t a = 2 * place[i];
         for (Py_ssize_t j = i; j < m; j++) {
-            const cv *s = post + 4 * j;
             Py_ssize_t b = 2 * place[j];
-            cv y[4] = {vdot2(l00, s[0], l01, s[2]), vdot2(l00, s[1], l01, s[3]), vdot2(l10, s[0], l11, s[2]),
-                       vdot2(l10, s[1], l11, s[3])};
+            cv y[4] = {l00, l01, l10, l11}; /* S_j,FF = I at the tip */
+            if (nodes[j] != n_int) {
+                const cv *s = post + 4 * j;
+                y[0] = vdot2(l00, s[0], l01, s[2]);
+                y[1] = vdot2(l00, s[1], l01, s[3]);
+                y[2] = vdot2(l10, s[0], l11, s[2]);
+                y[3] = vdot2(l10, s[1], l11, s[3]);
+            }
             Py_ssize_t at[4] = {(a * w + b) * n_lines, (a * w + b + 1) * n_lines, ((a + 1) * w + b) * n_lines,
                                 ((a + 1) * w + b + 1) * n_lines};
             Py_ssize_t tr[4] = {(b * w + a) * n_lines, ((b + 1) * w + a) * n_lines, (b * w + a + 1) * n_lines,
