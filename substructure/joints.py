@@ -25,7 +25,7 @@ import pint
 
 from .errors import InvalidValueError, NonPassiveJointWarning, NonReciprocalWarning
 from .points import check_name, parse_point
-from .units import format_quantity, quantity
+from .units import format_quantity, magnitude_in, quantity
 
 __all__ = ["JointMatrix", "Joint", "Support", "Sensor", "STIFFNESS_UNITS", "DAMPING_UNITS"]
 
@@ -116,7 +116,7 @@ class JointMatrix:
         units = STIFFNESS_UNITS if self.kind == "stiffness" else DAMPING_UNITS
         for k, q in self.entries:
             if k == key:
-                return float(q.m_as(units[key]))
+                return magnitude_in(q, units[key])
         return 0.0
 
     @property
@@ -385,12 +385,12 @@ class Sensor:
     @property
     def mass_kg(self) -> float:
         """The mass in kg (a float)."""
-        return float(self.mass.m_as("kg"))
+        return magnitude_in(self.mass, "kg")
 
     @property
     def inertia_si(self) -> float:
         """The rotary inertia in kg m^2 (a float)."""
-        return float(self.inertia.m_as("kg*m^2"))
+        return magnitude_in(self.inertia, "kg*m^2")
 
     def dynamic_stiffness(self, frequency_hz: np.ndarray) -> np.ndarray:
         """``-omega^2 diag(m, J)`` (thesis eq. 5.2, with the rotary inertia J).
