@@ -349,8 +349,11 @@ class Segment:
         id : float, default 0
             Inner diameter [m].
         material : Material or str, default "steel"
+            The segment's material (a catalogue name or a :class:`Material`).
         insert : Insert, optional
+            A body of another material filling the bore.
         flutes : Flutes, optional
+            Fluted section (tools).
 
         Returns
         -------
