@@ -519,11 +519,12 @@ class Segment:
 # Closed-form segment transfer matrices
 #
 # The closed form of the module docstring (and docs/beams.md) is evaluated by
-# the compiled kernels of substructure._kernels, one frequency line at a time:
-# the squared wavenumbers s1, s2 of A^2, C and S and their divided differences
-# (power series where |s L^2| < 0.5, exponentials elsewhere), and
+# the compiled kernels of substructure._kernels (a C extension built when the
+# package is installed), four frequency lines at a time: the squared
+# wavenumbers s1, s2 of A^2, C and S and their divided differences (power
+# series where |s L^2| < 0.5, exponentials elsewhere), and
 # T = alpha I + beta A + gamma A^2 + delta A^3.  The kernels are imported on
-# first use, so that numba is loaded only when something is computed.
+# first use, so that a program loads them only when something is computed.
 
 
 def segment_transfer_matrix(sec: Section, length: float, omega: np.ndarray) -> np.ndarray:
