@@ -35,9 +35,12 @@ import pint
 from ..errors import InvalidValueError, UnitError
 from ..units import Q_, dimensionless, quantity, ureg
 
-__all__ = ["MillingCut", "TurningCut", "spindle_speeds", "as_speed_rpm", "tooth_passing_hz"]
+__all__ = ["MillingCut", "TurningCut", "spindle_speeds", "as_speed_rpm", "tooth_passing_hz", "MAX_SPEEDS"]
 
 MILLING_MODES = ("up", "down")
+
+MAX_SPEEDS = 100_000
+"""Most spindle speeds of one grid (:func:`spindle_speeds`)."""
 
 # -- spindle speeds -----------------------------------------------------------
 
@@ -135,6 +138,10 @@ def spindle_speeds(start: Any, stop: Any, step: Any) -> pint.Quantity:
     if hi < lo:
         raise InvalidValueError(f"stop: got {stop!r} below start {start!r}")
     count = (hi - lo) / dn
+    if count + 1 > MAX_SPEEDS:
+        raise InvalidValueError(
+            f"step: {start!r} to {stop!r} in steps of {step!r} is {count + 1:.4g} speeds, more than the limit "
+            f"MAX_SPEEDS = {MAX_SPEEDS:,}; use a coarser step")
     k = round(count) if abs(count - round(count)) <= 1e-9 * max(1.0, count) else math.floor(count)
     return Q_(lo + dn * np.arange(k + 1), "rpm")
 
