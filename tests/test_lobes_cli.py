@@ -104,10 +104,26 @@ def test_assembly_and_point_with_band_and_plot(capsys, tmp_path):
     assert "y = x" in out
 
 
-def test_free_free_assembly_without_band_warns(capsys):
-    status, _, err = run(capsys, "lobes", "--assembly", ASSEMBLY, "--at", "tool.tip", *THESIS_CUT, "--json")
-    assert status == 0
-    assert "warning" in err and "band" in err
+def test_free_free_assembly_leaves_out_the_rigid_body_lines_and_says_so(capsys):
+    status, out, err = run(capsys, "lobes", "--assembly", ASSEMBLY, "--at", "tool.tip", *THESIS_CUT, "--json")
+    assert status == 0 and err == ""
+    result = json.loads(out)
+    band = result["structure_band"]
+    assert band["kind"] == "free-free" and 150 < band["lo_hz"] < 250 and band["excluded_hz"][0] == 20
+    chatter = [f for f in result["chatter_frequency_hz"] if f is not None]
+    assert min(chatter) >= band["lo_hz"]
+    assert result["recommended"]["chatter_frequency_hz"] >= band["lo_hz"]
+    # the same limit as cropping by hand above the antiresonance
+    _, out2, _ = run(capsys, "lobes", "--assembly", ASSEMBLY, "--at", "tool.tip", *THESIS_CUT, "--json",
+                     "--band", f"{band['lo_hz']}:5000")
+    assert json.loads(out2)["absolute_limit_m"] == pytest.approx(result["absolute_limit_m"])
+    _, human, _ = run(capsys, "lobes", "--assembly", ASSEMBLY, "--at", "tool.tip", *THESIS_CUT)
+    assert "rigid-body mass line" in human and "left out" in human
+    # --band all keeps the old behaviour: a limit at the first line, with the warning
+    status, out3, err3 = run(capsys, "lobes", "--assembly", ASSEMBLY, "--at", "tool.tip", *THESIS_CUT, "--json",
+                             "--band", "all")
+    assert status == 0 and "warning" in err3 and "first line" in err3
+    assert json.loads(out3)["absolute_limit_m"] < 0.5 * result["absolute_limit_m"]
 
 
 def test_sdm_from_frf_data_fits_modes(capsys, frf_files):

@@ -140,7 +140,7 @@ def spindle_speeds(start: Any, stop: Any, step: Any) -> pint.Quantity:
     count = (hi - lo) / dn
     if count + 1 > MAX_SPEEDS:
         raise InvalidValueError(
-            f"step: {start!r} to {stop!r} in steps of {step!r} is {count + 1:.4g} speeds, more than the limit "
+            f"step: {lo:g} to {hi:g} rpm in steps of {dn:g} rpm is {count + 1:.4g} speeds, more than the limit "
             f"MAX_SPEEDS = {MAX_SPEEDS:,}; use a coarser step")
     k = round(count) if abs(count - round(count)) <= 1e-9 * max(1.0, count) else math.floor(count)
     return Q_(lo + dn * np.arange(k + 1), "rpm")

@@ -265,14 +265,15 @@ class Lobes:
 
         Parameters
         ----------
-        ax : Axes, optional
+        ax : Axes or Figure, optional
             Where to draw; a new figure when None.
         **kw
-            Passed to the plotting function (line styles, ``lobes=True`` for the single lobes).
+            ``lobes``, ``recommendation``, ``title``, ``ylim_factor`` and line
+            options, as in :func:`~substructure.stability.plotting.plot_lobes`.
 
         Returns
         -------
-        Figure
+        matplotlib.figure.Figure
             The figure: depth limit in mm against spindle speed in rpm.
         """
         from .plotting import plot_lobes
