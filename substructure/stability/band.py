@@ -28,7 +28,9 @@ The rules, each tied to the physics of a driving-point receptance
 * **Model.**  An assembly without supports is free-free: the mass-line rule.
   An assembly with supports is compared with itself without them: a mode of
   the supported model below the free-free model's first antiresonance is the
-  body moving rigidly on its supports (a suspension mode); modes above it
+  body moving rigidly on its supports (a suspension mode), and so is the
+  region below it when the supports change the FRF above it by less than
+  10 % of its largest value (damped suspension modes leave no clear peak); modes above it
   deform the structure (a spindle on its bearings) and are kept.
 
 The rules can be wrong for measured data (a machine's column mode far below
@@ -295,16 +297,24 @@ def assembly_structure(assembly: Any, at: str, frequency: Any = None) -> tuple[F
         fa = f[ff["start"]]
         low = peaks[f[peaks] < fa]
         higher = peaks[f[peaks] >= fa]
+        above = f >= fa
+        change = float(np.max(np.abs(h[above] - hf[above])) / np.max(np.abs(hf[above])))
+        start = None
         if low.size and higher.size:
             start = _valley_between(mag, valleys, int(low[-1]), int(higher[0]))
-            if f[start] > band.lo_hz:
-                listed = ", ".join(f"{f[p]:.4g}" for p in low)
-                band = FlexibleBand(
-                    float(f[start]), float(f[-1]), "suspended", (float(f[0]), float(f[start])),
-                    tuple(float(f[p]) for p in low), ff["mass"],
-                    f"suspension modes at {listed} Hz (below the free-free model's first antiresonance at "
-                    f"{fa:.5g} Hz: the body moving rigidly on its supports) left out, up to the antiresonance at "
-                    f"{f[start]:.5g} Hz")
+        elif change < 0.1 and higher.size:  # damped suspension modes without a clear peak
+            start = _valley_between(mag, valleys, int(np.searchsorted(f, fa / 2)), int(higher[0]))
+        if start is not None and f[start] > band.lo_hz:
+            if low.size:
+                what = "suspension modes at " + ", ".join(f"{f[p]:.4g}" for p in low) + " Hz"
+            else:
+                what = (f"damped suspension modes (no clear peak; the supports change the FRF above {fa:.5g} Hz "
+                        f"by at most {change:.1%} of its peak)")
+            band = FlexibleBand(
+                float(f[start]), float(f[-1]), "suspended", (float(f[0]), float(f[start])),
+                tuple(float(f[p]) for p in low), ff["mass"],
+                f"{what}, below the free-free model's first antiresonance at {fa:.5g} Hz (the body moving "
+                f"rigidly on its supports), left out up to the antiresonance at {f[start]:.5g} Hz")
     if band.kind == "flexible":
         band = attrs.evolve(band, kind="supported",
                             reason="model on its supports: no rigid-body or suspension mode; the whole FRF is used")
