@@ -170,9 +170,9 @@ def _lobes_structure(args: argparse.Namespace):
         y = FRF.from_csv(args.frf_y) if args.frf_y else None
         frf = xy_frf(x, y)
         what = f"FRF from {args.frf}" + (f" (x) and {args.frf_y} (y)" if args.frf_y else ", y = x (a symmetric tool)")
-    from ..stability.zoa import _structure_band
+    from ..stability import choose_band
 
-    frf, band = _structure_band(frf, band)
+    frf, band = choose_band(frf, band)
     return frf, f"{what}, {grid_text(frf.frequency)}", band, tool
 
 

@@ -37,7 +37,7 @@ Examples
 0.2981
 """
 
-from .band import FlexibleBand, assembly_structure, flexible_band
+from .band import FlexibleBand, assembly_structure, choose_band, flexible_band
 from .cutting import MillingCut, TurningCut, as_speed_rpm, spindle_speeds, tooth_passing_hz
 from .machine import MachineLimits, SpeedCurve, cut_power, cut_torque, removal_rate
 from .modal import MODES_CSV_HEADER, ModalFitter, ModalFitWarning, ModalModel, Mode, fit_modes
@@ -53,7 +53,7 @@ __all__ = [
     "Mode", "ModalModel", "ModalFitter", "fit_modes", "ModalFitWarning", "MODES_CSV_HEADER",
     "xy_frf", "XY_LABELS", "zoa", "sdm", "spectral_radius",
     "Lobes", "LobesBand", "lobes_band", "StabilityWarning",
-    "FlexibleBand", "flexible_band", "assembly_structure",
+    "FlexibleBand", "flexible_band", "choose_band", "assembly_structure",
     "MachineLimits", "SpeedCurve", "cut_power", "cut_torque", "removal_rate",
     "Recommendation", "recommend", "RECOMMENDATION_KEYS",
     "Workpiece", "workpiece", "workpieces", "load_workpieces",

@@ -48,7 +48,7 @@ import numpy as np
 from ..errors import InvalidValueError
 from ..frf import FRF
 
-__all__ = ["FlexibleBand", "flexible_band", "assembly_structure", "MASS_LINE_PHASE_DEG", "SUSPENSION_RATIO"]
+__all__ = ["FlexibleBand", "flexible_band", "choose_band", "assembly_structure", "MASS_LINE_PHASE_DEG", "SUSPENSION_RATIO"]
 
 MASS_LINE_PHASE_DEG = 30.0
 """A line is mass-like when its phase is within this many degrees of -180."""
@@ -108,12 +108,29 @@ class FlexibleBand:
         return frf.crop(self.lo_hz, self.hi_hz)
 
     def contains(self, frequency_hz: Any) -> np.ndarray:
-        """Whether frequencies [Hz] lie in the band (``nan`` is not)."""
+        """Whether frequencies lie in the band.
+
+        Parameters
+        ----------
+        frequency_hz : array_like
+            Frequencies in Hz (``nan`` is not in the band).
+
+        Returns
+        -------
+        ndarray of bool
+        """
         f = np.asarray(frequency_hz, dtype=float)
         return (f >= self.lo_hz * (1 - 1e-12)) & (f <= self.hi_hz * (1 + 1e-12))
 
     def to_json(self) -> dict:
-        """The ``structure_band`` object of ``substructure lobes --json``."""
+        """The ``structure_band`` object of ``substructure lobes --json``.
+
+        Returns
+        -------
+        dict
+            ``lo_hz``, ``hi_hz``, ``kind``, ``excluded_hz``, ``suspension_hz``,
+            ``apparent_mass_kg``, ``reason``.
+        """
         return {
             "lo_hz": self.lo_hz,
             "hi_hz": self.hi_hz,
@@ -239,6 +256,47 @@ def flexible_band(frf: FRF) -> FlexibleBand:
                   f"antiresonance at {f[start]:.5g} Hz")
     return FlexibleBand(float(f[start]), float(f[-1]), worst["kind"], excluded, worst["suspension"],
                         worst["mass"], reason)
+
+
+def choose_band(structure: Any, band: Any = "auto") -> tuple[Any, FlexibleBand | None]:
+    """Apply a band choice to a structure: the lines stability will use, and the record of the choice.
+
+    Parameters
+    ----------
+    structure : FRF or ModalModel
+        Tool point receptances, or modes (used as they are).
+    band : "auto", "all", (lo_hz, hi_hz) or FlexibleBand, default "auto"
+        ``"auto"``: :func:`flexible_band`; ``"all"`` (or None): every line;
+        a pair: that band in Hz; a :class:`FlexibleBand`: applied as it is.
+
+    Returns
+    -------
+    (structure, FlexibleBand or None)
+        The cropped FRF and the band (``None`` for modes).
+    """
+    if not isinstance(structure, FRF):
+        if band not in ("auto", "all", None):
+            raise InvalidValueError("band: modal parameters are used as they are; band applies to FRF data")
+        return structure, None
+    if isinstance(band, FlexibleBand):
+        return band.crop(structure), band
+    if band == "auto":
+        found = flexible_band(structure)
+        return found.crop(structure), found
+    hz = structure.frequency.hz
+    if band in ("all", None):
+        return structure, FlexibleBand(float(hz[0]), float(hz[-1]), "all",
+                                       reason="the whole FRF is used (rigid-body detection switched off)")
+    try:
+        lo, hi = (float(v) for v in band)
+    except (TypeError, ValueError):
+        raise InvalidValueError(
+            f"band: got {band!r}; expected 'auto', 'all', (lo_hz, hi_hz) or a FlexibleBand") from None
+    cropped = structure.crop(lo, hi)
+    f = cropped.frequency.hz
+    excluded = (float(hz[0]), float(f[0])) if f[0] > hz[0] else None
+    return cropped, FlexibleBand(float(f[0]), float(f[-1]), "user", excluded,
+                                 reason=f"band {lo:g}..{hi:g} Hz given by the user")
 
 
 # -- models ----------------------------------------------------------------------------

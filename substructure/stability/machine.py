@@ -63,7 +63,19 @@ class SpeedCurve:
     value: pint.Quantity
 
     def at(self, speed_rpm: Any, unit: str) -> np.ndarray:
-        """Values in ``unit`` at speeds [rpm] (0 outside the curve's range)."""
+        """Values at speeds, linear between the curve's points, 0 outside its range.
+
+        Parameters
+        ----------
+        speed_rpm : array_like
+            Spindle speeds in rpm.
+        unit : str
+            Unit of the values returned (e.g. ``"W"``).
+
+        Returns
+        -------
+        ndarray
+        """
         n = np.asarray(speed_rpm, dtype=float)
         v = self.value.m_as(unit)
         inside = (n >= self.speed_rpm[0] * (1 - 1e-12)) & (n <= self.speed_rpm[-1] * (1 + 1e-12))
@@ -161,20 +173,60 @@ class MachineLimits:
         return np.inf if self.max_depth is None else float(self.max_depth.m_as("m"))
 
     def power_w(self, speed_rpm: Any) -> np.ndarray:
-        """Rated power [W] at speeds [rpm] (``inf`` without a power limit)."""
+        """Rated power [W] at speeds [rpm] (``inf`` without a power limit).
+
+        Parameters
+        ----------
+        speed_rpm : array_like
+            Spindle speeds in rpm.
+
+        Returns
+        -------
+        ndarray
+        """
         return _value_at(self.power, speed_rpm, "W")
 
     def torque_nm(self, speed_rpm: Any) -> np.ndarray:
-        """Rated torque [N m] at speeds [rpm] (``inf`` without a torque limit)."""
+        """Rated torque [N m] at speeds [rpm] (``inf`` without a torque limit).
+
+        Parameters
+        ----------
+        speed_rpm : array_like
+            Spindle speeds in rpm.
+
+        Returns
+        -------
+        ndarray
+        """
         return _value_at(self.torque, speed_rpm, "N*m")
 
     def available_power_w(self, speed_rpm: Any) -> np.ndarray:
-        """``min(P(n), T(n) omega)`` [W] at speeds [rpm]."""
+        """``min(P(n), T(n) omega)`` [W] at speeds [rpm].
+
+        Parameters
+        ----------
+        speed_rpm : array_like
+            Spindle speeds in rpm.
+
+        Returns
+        -------
+        ndarray
+        """
         n = np.asarray(speed_rpm, dtype=float)
         return np.minimum(self.power_w(n), self.torque_nm(n) * 2.0 * np.pi * n / 60.0)
 
     def speed_ok(self, speed_rpm: Any) -> np.ndarray:
-        """Whether speeds [rpm] lie in ``[min_speed, max_speed]``."""
+        """Whether speeds [rpm] lie in ``[min_speed, max_speed]``.
+
+        Parameters
+        ----------
+        speed_rpm : array_like
+            Spindle speeds in rpm.
+
+        Returns
+        -------
+        ndarray
+        """
         n = np.asarray(speed_rpm, dtype=float)
         ok = np.ones(n.shape, dtype=bool)
         if self.max_speed is not None:
@@ -184,7 +236,13 @@ class MachineLimits:
         return ok
 
     def to_json(self) -> dict:
-        """The limits in SI numbers (curves as lists of points)."""
+        """The limits in SI numbers (curves as lists of points).
+
+        Returns
+        -------
+        dict
+            ``max_speed_rpm``, ``min_speed_rpm``, ``power_w``, ``torque_n_m``, ``max_depth_m``.
+        """
         def value(v, unit):
             if v is None:
                 return None
@@ -267,7 +325,20 @@ def cut_power(cut: Any, depth_m: Any, speed_rpm: Any) -> np.ndarray:
 
 
 def cut_torque(cut: Any, depth_m: Any, speed_rpm: Any) -> np.ndarray:
-    """Average spindle torque [N m] of the cut: power / (2 pi n / 60)."""
+    """Average spindle torque of the cut: power / (2 pi n / 60).
+
+    Parameters
+    ----------
+    cut : MillingCut
+        With ``feed_per_tooth``.
+    depth_m, speed_rpm : array_like
+        Axial depths [m] and spindle speeds [rpm] (broadcast).
+
+    Returns
+    -------
+    ndarray
+        Torque in N m.
+    """
     n = np.asarray(speed_rpm, dtype=float)
     return cut_power(cut, depth_m, n) / (2.0 * np.pi * n / 60.0)
 

@@ -56,7 +56,17 @@ def _finish(ax: Axes) -> None:
 
 
 def wrap_title(ax: Axes, text: str, width: int = 95, **kw: Any) -> None:
-    """Set a title wrapped to lines of at most ``width`` characters (nothing is cut off)."""
+    """Set a title wrapped to lines of at most ``width`` characters (nothing is cut off).
+
+    Parameters
+    ----------
+    ax : Axes
+    text : str
+    width : int, default 95
+        Characters per line.
+    **kw
+        Passed to ``Axes.set_title``.
+    """
     ax.set_title("\n".join(textwrap.wrap(" ".join(str(text).split()), width)), fontsize="small", **kw)
 
 

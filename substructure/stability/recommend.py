@@ -144,7 +144,12 @@ class Recommendation:
         return out
 
     def describe(self) -> list[str]:
-        """Lines for the human output, in rpm and mm."""
+        """Lines for the human output, in rpm and mm.
+
+        Returns
+        -------
+        list of str
+        """
         lo, hi = self.window_rpm
         lines = [f"{self.spindle_speed_rpm:.0f} rpm, axial depth {self.depth_m * 1e3:.3g} mm"
                  + (f", removal rate {self.mrr_m3_per_s * 6e7:.4g} cm^3/min" if self.mrr_m3_per_s is not None else "")]
@@ -276,9 +281,11 @@ def recommend(lobes: Any, cut: Any, limits: MachineLimits | None = None, *, marg
 
     order = np.flatnonzero(eligible)
     bound = depth_of(coarse[order], order) * speeds[order]
-    if not np.isfinite(bound).all() and limits.max_depth is None:
-        raise InvalidValueError("lobes: no stability limit found at some speeds and no largest depth given; "
-                                "give limits=MachineLimits(max_depth=...)")
+    finite = np.isfinite(bound)
+    if not finite.any():
+        raise InvalidValueError("lobes: no stability limit found in any speed window and no largest depth, power "
+                                "or torque limit given; give limits=MachineLimits(max_depth=...)")
+    order, bound = order[finite], bound[finite]  # no limit at all there: nothing to recommend
     order = order[np.argsort(-bound, kind="stable")]
     bound = np.sort(bound)[::-1]
     pockets = _pockets(lobes.depth_limit_m)

@@ -341,10 +341,23 @@ class LobesBand:
 
 def sampled_window_minimum(evaluate, lo: np.ndarray, hi: np.ndarray, speeds: np.ndarray | None = None,
                            count: int = 33) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Window minima by evaluating ``evaluate(speeds) -> (depth, chatter)`` on samples of each window.
+    """Window minima by evaluating a limit on samples of each window.
 
-    Each window gets ``count`` evenly spaced speeds (its ends included) and,
-    when ``speeds`` is given, every one of those speeds inside it.
+    Parameters
+    ----------
+    evaluate : callable
+        ``evaluate(speeds_rpm) -> (depth_m, chatter_hz)``.
+    lo, hi : ndarray
+        Window ends in rpm.
+    speeds : ndarray, optional
+        Computed speeds [rpm]; those inside a window are evaluated too.
+    count : int, default 33
+        Evenly spaced speeds per window, its ends included.
+
+    Returns
+    -------
+    (depth_m, speed_rpm, chatter_hz) : ndarrays
+        Per window: the lowest sampled limit, where, and its chatter frequency.
     """
     t = np.linspace(0.0, 1.0, count)
     grid = lo[:, None] + (hi - lo)[:, None] * t[None, :]

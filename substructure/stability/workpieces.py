@@ -144,7 +144,18 @@ class Workpiece:
         return {"kt": kt.to("MPa"), "kn": None, "kte": zero, "kne": zero}
 
     def tangential_force_per_depth(self, chip_thickness_m: Any):
-        """Tangential force per unit depth [N/m] at chip thicknesses [m] (the force law itself)."""
+        """The tangential force law itself: force per unit depth at chip thicknesses.
+
+        Parameters
+        ----------
+        chip_thickness_m : array_like
+            Chip thicknesses in m.
+
+        Returns
+        -------
+        ndarray
+            N per m of axial depth.
+        """
         import numpy as np
 
         h = np.asarray(chip_thickness_m, dtype=float)
@@ -154,7 +165,12 @@ class Workpiece:
         return self.kc11.m_as("Pa") * h * (np.maximum(h, 0.0) / 1e-3) ** (-self.mc)
 
     def describe(self) -> str:
-        """One line: the name, the values and the source."""
+        """One line: the name, the values and the source.
+
+        Returns
+        -------
+        str
+        """
         if self.model == "linear":
             values = f"Kt = {self.kt.to('MPa'):.5g~P}"
             for label, q in (("Kr", self.kr), ("Kte", self.kte), ("Kre", self.kre)):
@@ -165,7 +181,15 @@ class Workpiece:
         return f"{self.name} ({self.material}): {values}; source: {self.short_source}"
 
     def to_json(self) -> dict:
-        """The entry with SI numbers (Pa, N/m) and its texts."""
+        """The entry with SI numbers (Pa, N/m) and its texts.
+
+        Returns
+        -------
+        dict
+            ``name``, ``model``, ``material``, ``source`` and the values the
+            entry has (``kt_pa``, ``kr_pa``, ``kte_n_per_m``, ``kre_n_per_m``,
+            ``kc11_pa``, ``mc``).
+        """
         out = {"name": self.name, "model": self.model, "material": self.material, "source": " ".join(self.source.split())}
         for key, unit in (("kt", "Pa"), ("kr", "Pa"), ("kte", "N/m"), ("kre", "N/m"), ("kc11", "Pa")):
             q = getattr(self, key)
@@ -244,7 +268,12 @@ def load_workpieces(path: Any) -> tuple[Workpiece, ...]:
 
 
 def workpieces() -> tuple[Workpiece, ...]:
-    """The project's table (``substructure/data/cutting_coefficients.toml``)."""
+    """The project's table (``substructure/data/cutting_coefficients.toml``).
+
+    Returns
+    -------
+    tuple of Workpiece
+    """
     resource = importlib.resources.files("substructure") / "data" / "cutting_coefficients.toml"
     return _parse(resource.read_text(encoding="utf-8"), "cutting_coefficients.toml")
 

@@ -31,7 +31,7 @@ import numpy as np
 
 from ..errors import InvalidValueError
 from ..frf import FRF, Frequency
-from .band import FlexibleBand, flexible_band
+from .band import choose_band
 from .cutting import as_speed_rpm
 from .result import Lobes, StabilityWarning
 from .structure import xy_receptance
@@ -171,32 +171,6 @@ class _ZoaEnvelope:
         return d, at, fc
 
 
-def _structure_band(structure: Any, band: Any) -> tuple[Any, FlexibleBand | None]:
-    """Apply the ``band`` argument of :func:`zoa` to FRF data."""
-    if not isinstance(structure, FRF):
-        if band not in ("auto", "all", None):
-            raise InvalidValueError("band: modal parameters are used as they are; band applies to FRF data")
-        return structure, None
-    if isinstance(band, FlexibleBand):
-        return band.crop(structure), band
-    if band == "auto":
-        found = flexible_band(structure)
-        return found.crop(structure), found
-    hz = structure.frequency.hz
-    if band in ("all", None):
-        return structure, FlexibleBand(float(hz[0]), float(hz[-1]), "all",
-                                       reason="the whole FRF is used (rigid-body detection switched off)")
-    try:
-        lo, hi = (float(v) for v in band)
-    except (TypeError, ValueError):
-        raise InvalidValueError(f"band: got {band!r}; expected 'auto', 'all', (lo_hz, hi_hz) or a FlexibleBand") from None
-    cropped = structure.crop(lo, hi)
-    f = cropped.frequency.hz
-    excluded = (float(hz[0]), float(f[0])) if f[0] > hz[0] else None
-    return cropped, FlexibleBand(float(f[0]), float(f[-1]), "user", excluded,
-                                 reason=f"band {lo:g}..{hi:g} Hz given by the user")
-
-
 def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = None,
         label: str | None = None, band: Any = "auto") -> Lobes:
     """Stability lobes by the zero-order approximation.
@@ -246,7 +220,7 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
         region of a free-free model); crop or extend it.
     """
     speeds_rpm = as_speed_rpm(speeds)
-    structure, used = _structure_band(structure, band)
+    structure, used = choose_band(structure, band)
     f, g = xy_receptance(structure, frequency)
     k0 = cut.mean_force_matrix()
     lam = zoa_eigenvalues(k0, g)  # (m, 2)
