@@ -63,7 +63,7 @@ _PEAK_PROMINENCE = np.log(1.25)  # a peak or valley of |H| stands out by 25 % (i
 class FlexibleBand:
     """The lines of a tool point FRF that stability may use, and why.
 
-    Attributes
+    Parameters
     ----------
     lo_hz, hi_hz : float
         First and last frequency [Hz] used.
@@ -104,6 +104,7 @@ class FlexibleBand:
         Returns
         -------
         FRF
+            The lines from ``lo_hz`` to ``hi_hz``.
         """
         return frf.crop(self.lo_hz, self.hi_hz)
 
@@ -118,6 +119,7 @@ class FlexibleBand:
         Returns
         -------
         ndarray of bool
+            True where a frequency lies in ``lo_hz .. hi_hz``.
         """
         f = np.asarray(frequency_hz, dtype=float)
         return (f >= self.lo_hz * (1 - 1e-12)) & (f <= self.hi_hz * (1 + 1e-12))

@@ -387,10 +387,18 @@ class MillingCut:
 
         Parameters
         ----------
-        teeth, diameter, radial_depth, immersion, milling
-            As in :meth:`from_spec`.
+        teeth : int
+            Number of teeth.
+        diameter : str or pint.Quantity
+            Tool diameter, a length.
         workpiece : Workpiece or str
             An entry of the table or its name (:func:`~substructure.stability.workpiece`).
+        radial_depth : str or pint.Quantity, optional
+            Radial depth of cut, a length; or
+        immersion : float, optional
+            ``a_e / D`` in (0, 1].
+        milling : {"up", "down"}
+            Up (default) or down milling.
         feed_per_tooth : quantity or str, optional
             Needed for a Kienzle entry (its coefficient depends on the chip
             thickness) and for power and removal rate.

@@ -48,10 +48,10 @@ class SpeedCurve:
 
     Parameters
     ----------
-    speed : quantity (array)
-        Spindle speeds, strictly increasing (rpm or another angular speed).
-    value : quantity (array)
-        The values at these speeds (e.g. power in kW, torque in N m).
+    speed_rpm : ndarray
+        Spindle speeds in rpm, increasing (0 allowed).
+    value : pint.Quantity
+        The values at these speeds (e.g. power in kW, torque in N m), an array.
 
     Notes
     -----
@@ -75,6 +75,7 @@ class SpeedCurve:
         Returns
         -------
         ndarray
+            The values in ``unit``.
         """
         n = np.asarray(speed_rpm, dtype=float)
         v = self.value.m_as(unit)
@@ -183,6 +184,7 @@ class MachineLimits:
         Returns
         -------
         ndarray
+            Rated power in W (``inf`` without a limit).
         """
         return _value_at(self.power, speed_rpm, "W")
 
@@ -197,6 +199,7 @@ class MachineLimits:
         Returns
         -------
         ndarray
+            Rated torque in N m (``inf`` without a limit).
         """
         return _value_at(self.torque, speed_rpm, "N*m")
 
@@ -211,6 +214,7 @@ class MachineLimits:
         Returns
         -------
         ndarray
+            Available power in W.
         """
         n = np.asarray(speed_rpm, dtype=float)
         return np.minimum(self.power_w(n), self.torque_nm(n) * 2.0 * np.pi * n / 60.0)
@@ -226,6 +230,7 @@ class MachineLimits:
         Returns
         -------
         ndarray
+            True where the speed is allowed.
         """
         n = np.asarray(speed_rpm, dtype=float)
         ok = np.ones(n.shape, dtype=bool)
@@ -356,6 +361,7 @@ def removal_rate(cut: Any, depth_m: Any, speed_rpm: Any) -> np.ndarray:
     Returns
     -------
     ndarray
+        Removal rate in m^3/s.
     """
     c = _feed(cut)
     return (np.asarray(depth_m, dtype=float) * float(cut.radial_depth.m_as("m")) * cut.teeth * c

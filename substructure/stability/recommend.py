@@ -39,6 +39,8 @@ from .machine import MachineLimits, cut_power, cut_torque, removal_rate
 
 __all__ = ["Recommendation", "recommend", "RECOMMENDATION_KEYS"]
 
+#: The keys of ``Recommendation.to_json()`` that the ``recommended`` object of
+#: ``substructure lobes --json`` always has.
 RECOMMENDATION_KEYS = ("spindle_speed_rpm", "depth_m", "limit_depth_m", "margin", "mrr_m3_per_s",
                        "chatter_frequency_hz")
 
@@ -47,7 +49,7 @@ RECOMMENDATION_KEYS = ("spindle_speed_rpm", "depth_m", "limit_depth_m", "margin"
 class Recommendation:
     """A recommended operating point.
 
-    Attributes
+    Parameters
     ----------
     spindle_speed_rpm : float
         The speed [rpm].
@@ -149,6 +151,7 @@ class Recommendation:
         Returns
         -------
         list of str
+            The recommendation, its limit and margin, the chatter frequency, the power.
         """
         lo, hi = self.window_rpm
         lines = [f"{self.spindle_speed_rpm:.0f} rpm, axial depth {self.depth_m * 1e3:.3g} mm"
@@ -223,6 +226,7 @@ def recommend(lobes: Any, cut: Any, limits: MachineLimits | None = None, *, marg
     Returns
     -------
     Recommendation
+        The best speed and depth, with its runners-up.
 
     Raises
     ------

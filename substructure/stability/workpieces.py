@@ -170,6 +170,7 @@ class Workpiece:
         Returns
         -------
         str
+            E.g. ``"aluminium-7075 (...): Kt = 767.01 MPa, ...; source: ..."``.
         """
         if self.model == "linear":
             values = f"Kt = {self.kt.to('MPa'):.5g~P}"
@@ -246,10 +247,12 @@ def load_workpieces(path: Any) -> tuple[Workpiece, ...]:
     Parameters
     ----------
     path : str or path-like
+        The TOML file.
 
     Returns
     -------
     tuple of Workpiece
+        Its entries, in file order.
 
     Raises
     ------
@@ -273,6 +276,7 @@ def workpieces() -> tuple[Workpiece, ...]:
     Returns
     -------
     tuple of Workpiece
+        Every entry of the project's table.
     """
     resource = importlib.resources.files("substructure") / "data" / "cutting_coefficients.toml"
     return _parse(resource.read_text(encoding="utf-8"), "cutting_coefficients.toml")
@@ -291,6 +295,7 @@ def workpiece(name: str, table: Any = None) -> Workpiece:
     Returns
     -------
     Workpiece
+        The first entry answering to the name.
     """
     entries: list[Workpiece] = []
     if table is not None:
