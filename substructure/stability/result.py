@@ -268,8 +268,8 @@ class Lobes:
         ax : Axes or Figure, optional
             Where to draw; a new figure when None.
         **kw
-            ``lobes``, ``recommendation``, ``title``, ``ylim_factor`` and line
-            options, as in :func:`~substructure.stability.plotting.plot_lobes`.
+            ``lobes`` (draw the single lobes), ``recommendation`` (mark it and
+            its safe window), ``title``, ``ylim_factor`` and line options.
 
         Returns
         -------

@@ -208,7 +208,7 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
     Raises
     ------
     InvalidValueError
-        When the lobes would need more than :data:`MAX_LOBE_POINTS` points
+        When the lobes would need more than ``MAX_LOBE_POINTS`` (5,000,000) points
         (FRF lines x lobes x 2): crop or thin the FRF, or raise the lowest
         speed.
 
