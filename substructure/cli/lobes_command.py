@@ -14,6 +14,7 @@ from ..frf import FRF
 from ..io.assembly_toml import load_assembly
 from ._common import (
     UsageError,
+    band_arg,
     check_outputs,
     check_plot,
     figures,
@@ -33,17 +34,13 @@ def _speeds(text: str):
 
 
 def _band(text: str):
-    """``--band``: ``auto`` (default), ``all`` or ``LO:HI`` in Hz."""
-    if text in ("auto", "all"):
-        return text
-    parts = text.split(":")
+    """``--band``: ``auto`` (default), ``all`` or ``LO:HI`` (Hz, or frequencies with units)."""
+    if text.strip() == "all":
+        return "all"
     try:
-        lo, hi = (float(p) for p in parts)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"got {text!r}; expected auto, all or LO:HI in Hz, e.g. 500:5000") from None
-    if not (np.isfinite(lo) and np.isfinite(hi) and 0 <= lo < hi):
-        raise argparse.ArgumentTypeError(f"got {text!r}; expected 0 <= LO < HI in Hz")
-    return (lo, hi)
+        return band_arg(text)
+    except argparse.ArgumentTypeError as exc:
+        raise argparse.ArgumentTypeError(str(exc).replace("expected auto or LO:HI", "expected auto, all or LO:HI"))
 
 
 def _curve(text: str, unit: str):
