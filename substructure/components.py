@@ -473,6 +473,47 @@ class Holder(Beam):
         return design(entry, **parameters).holder(name, cls)
 
 
+def _tool_teeth(value):
+    if value is None:
+        return None
+    if isinstance(value, bool) or not (isinstance(value, (int, np.integer)) or (
+            isinstance(value, float) and value.is_integer())):
+        raise InvalidValueError(f"teeth: got {value!r}; expected a whole number of teeth (flutes) >= 1")
+    if value < 1:
+        raise InvalidValueError(f"teeth: got {value!r}; expected a whole number of teeth (flutes) >= 1")
+    return int(value)
+
+
+def _tool_helix(value):
+    if value is None:
+        return None
+    from .errors import UnitError
+    from .units import Q_, ureg
+
+    try:
+        q = Q_(value) if isinstance(value, str) else value
+    except Exception:
+        q = None
+    if not isinstance(q, pint.Quantity) or q.units == ureg.dimensionless or not q.dimensionless \
+            or np.ndim(q.magnitude) != 0:
+        raise UnitError(f"helix: got {value!r}; expected the helix angle with its unit, e.g. '30 deg'")
+    deg = float(q.m_as("deg"))
+    if not 0.0 <= deg < 90.0:
+        raise InvalidValueError(f"helix: got {value!r}; expected a helix angle in [0, 90) deg")
+    return q.to("deg")
+
+
+def _tool_diameter(value):
+    if value is None:
+        return None
+    from .units import quantity
+
+    q = quantity(value, "diameter", "[length]")
+    if not q.magnitude > 0:
+        raise InvalidValueError(f"diameter: got {value!r}; expected a positive cutting diameter")
+    return q
+
+
 @register_component("tool")
 @attrs.frozen
 class Tool(Beam):
@@ -486,7 +527,34 @@ class Tool(Beam):
         Base to tip.
     description : str, optional
         What the component is and where its numbers come from (keyword only).
+    teeth : int, optional
+        Number of teeth (flutes); stability lobes take it from the tool.
+    helix : quantity or str, optional
+        Helix angle, e.g. ``"30 deg"`` (recorded; the straight-tooth
+        stability models do not use it).
+    diameter : quantity or str, optional
+        Cutting diameter; default: the outer diameter of the tip segment
+        (:attr:`cutting_diameter`).
     """
+
+    teeth: int | None = attrs.field(default=None, kw_only=True, converter=_tool_teeth)
+    helix: pint.Quantity | None = attrs.field(default=None, kw_only=True, converter=_tool_helix)
+    diameter: pint.Quantity | None = attrs.field(default=None, kw_only=True, converter=_tool_diameter)
+
+    @property
+    def cutting_diameter(self) -> pint.Quantity:
+        """The cutting diameter: ``diameter`` when given, else the tip segment's outer diameter."""
+        return self.diameter if self.diameter is not None else self.segments[-1].od
+
+    @property
+    def flute_length(self) -> pint.Quantity | None:
+        """Length of the fluted segments at the tip (``None`` when none is fluted)."""
+        total = None
+        for seg in reversed(self.segments):
+            if seg.flutes is None:
+                break
+            total = seg.length if total is None else total + seg.length
+        return total
 
     @classmethod
     def end_mill(
@@ -498,6 +566,8 @@ class Tool(Beam):
         material="carbide",
         diameter_ratio: float = 0.8,
         name: str = "tool",
+        teeth: int | None = None,
+        helix=None,
     ) -> "Tool":
         """An end mill sticking out of its holder by ``overhang``.
 
@@ -521,6 +591,10 @@ class Tool(Beam):
             (dimensionless); default 0.8.
         name : str
             Component name; default ``"tool"``.
+        teeth : int, optional
+            Number of teeth (flutes).
+        helix : str or pint.Quantity, optional
+            Helix angle, e.g. ``"30 deg"``.
 
         Returns
         -------
@@ -532,8 +606,9 @@ class Tool(Beam):
         d = quantity(diameter, "diameter", "[length]")
         total = quantity(overhang, "overhang", "[length]")
         flutes = None if flute_length is None else quantity(flute_length, "flute_length", "[length]")
+        extra = {"teeth": teeth, "helix": helix}
         if flutes is None or flutes.magnitude == 0:
-            return cls(name, [Segment(total, d, material=material)])
+            return cls(name, [Segment(total, d, material=material)], **extra)
         if flutes > total:
             raise InvalidValueError(
                 f"flute_length: got {flutes:~P}, longer than the overhang {total:~P}"
@@ -542,7 +617,7 @@ class Tool(Beam):
         segs = [Segment(flutes, d, material=material, flutes=Flutes(diameter_ratio))]
         if shank.magnitude > 0:
             segs.insert(0, Segment(shank, d, material=material))
-        return cls(name, segs)
+        return cls(name, segs, **extra)
 
 
 def _measured_frf(value) -> FRF:

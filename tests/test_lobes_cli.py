@@ -7,6 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import attrs
 import numpy as np
 import pytest
 
@@ -104,10 +105,26 @@ def test_assembly_and_point_with_band_and_plot(capsys, tmp_path):
     assert "y = x" in out
 
 
-def test_free_free_assembly_without_band_warns(capsys):
-    status, _, err = run(capsys, "lobes", "--assembly", ASSEMBLY, "--at", "tool.tip", *THESIS_CUT, "--json")
-    assert status == 0
-    assert "warning" in err and "band" in err
+def test_free_free_assembly_leaves_out_the_rigid_body_lines_and_says_so(capsys):
+    status, out, err = run(capsys, "lobes", "--assembly", ASSEMBLY, "--at", "tool.tip", *THESIS_CUT, "--json")
+    assert status == 0 and err == ""
+    result = json.loads(out)
+    band = result["structure_band"]
+    assert band["kind"] == "free-free" and 150 < band["lo_hz"] < 250 and band["excluded_hz"][0] == 20
+    chatter = [f for f in result["chatter_frequency_hz"] if f is not None]
+    assert min(chatter) >= band["lo_hz"]
+    assert result["recommended"]["chatter_frequency_hz"] >= band["lo_hz"]
+    # the same limit as cropping by hand above the antiresonance
+    _, out2, _ = run(capsys, "lobes", "--assembly", ASSEMBLY, "--at", "tool.tip", *THESIS_CUT, "--json",
+                     "--band", f"{band['lo_hz']}:5000")
+    assert json.loads(out2)["absolute_limit_m"] == pytest.approx(result["absolute_limit_m"])
+    _, human, _ = run(capsys, "lobes", "--assembly", ASSEMBLY, "--at", "tool.tip", *THESIS_CUT)
+    assert "rigid-body mass line" in human and "left out" in human
+    # --band all keeps the old behaviour: a limit at the first line, with the warning
+    status, out3, err3 = run(capsys, "lobes", "--assembly", ASSEMBLY, "--at", "tool.tip", *THESIS_CUT, "--json",
+                             "--band", "all")
+    assert status == 0 and "warning" in err3 and "first line" in err3
+    assert json.loads(out3)["absolute_limit_m"] < 0.5 * result["absolute_limit_m"]
 
 
 def test_sdm_from_frf_data_fits_modes(capsys, frf_files):
@@ -173,3 +190,91 @@ def test_the_installed_command_prints_one_json_object(frf_files):
                            "--speeds", "5000:6000:500", "--json"], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert set(json.loads(done.stdout)) >= KEYS
+
+
+# -- the machinist's recommendation (issue 11) ------------------------------------------------------
+
+REC_KEYS = {"spindle_speed_rpm", "depth_m", "limit_depth_m", "margin", "mrr_m3_per_s", "chatter_frequency_hz"}
+NO_TEETH_CUT = ["--radial-depth", "3 mm", "--milling", "up", "--kt", "625 MPa", "--kn", "100 MPa"]
+
+
+def test_the_recommendation_in_json_and_in_mm_and_rpm(capsys):
+    argv = ["lobes", "--assembly", ASSEMBLY, "--at", "tool.tip", *THESIS_CUT, "--feed-per-tooth", "0.05 mm",
+            "--max-speed", "20000", "--power", "5 kW", "--margin", "0.25", "--speed-tolerance", "0.04"]
+    status, out, err = run(capsys, *argv, "--json")
+    assert status == 0 and err == ""
+    result = json.loads(out)
+    rec = result["recommended"]
+    assert REC_KEYS <= set(rec) and rec["margin"] == 0.25 and rec["speed_tolerance"] == 0.04
+    assert rec["spindle_speed_rpm"] <= 20000 and rec["depth_m"] == pytest.approx(0.75 * rec["limit_depth_m"])
+    assert rec["mrr_m3_per_s"] == pytest.approx(rec["depth_m"] * 3e-3 * 4 * 0.05e-3 * rec["spindle_speed_rpm"] / 60)
+    assert rec["power_w"] == pytest.approx(625e6 * rec["mrr_m3_per_s"], rel=1e-9)  # Kt * MRR, no edge force
+    assert result["machine"]["power_w"] == 5000 and len(rec["runners_up"]) == 2
+    status, human, _ = run(capsys, *argv)
+    line = next(t for t in human.splitlines() if t.startswith("recommended:"))
+    assert f"{rec['spindle_speed_rpm']:.0f} rpm" in line and f"{rec['depth_m'] * 1e3:.3g} mm" in line
+    assert "margin 25%" in human and "runner-up 1" in human and "cm^3/min" in human
+
+
+def test_the_tooth_count_and_diameter_flow_from_the_assembly_file(capsys, tmp_path):
+    from substructure.io.assembly_toml import load_assembly, save_assembly
+
+    assembly = load_assembly(ASSEMBLY)
+    tool = assembly.component("tool")
+    three = tmp_path / "three.toml"
+    save_assembly(assembly.with_component(attrs.evolve(tool, teeth=3, helix="35 deg")), three)
+    assert load_assembly(three).component("tool").teeth == 3
+    _, out, _ = run(capsys, "lobes", "--assembly", three, "--at", "tool.tip", *NO_TEETH_CUT, "--json")
+    from_file = json.loads(out)
+    assert from_file["cut"]["teeth"] == 3 and from_file["cut"]["diameter_m"] == pytest.approx(0.012)
+    assert any("3 from the tool" in n for n in from_file["notes"])
+    _, out, _ = run(capsys, "lobes", "--assembly", three, "--at", "tool.tip", *NO_TEETH_CUT, "--teeth", "3",
+                    "--diameter", "12 mm", "--json")
+    assert json.loads(out)["depth_limit_m"] == from_file["depth_limit_m"]
+    _, out, _ = run(capsys, "lobes", "--assembly", three, "--at", "tool.tip", *NO_TEETH_CUT, "--teeth", "2", "--json")
+    overridden = json.loads(out)
+    assert overridden["cut"]["teeth"] == 2 and any("overrides" in n for n in overridden["notes"])
+    # the built-in assembly carries the thesis's 4 teeth; without teeth anywhere it is asked for
+    _, out, _ = run(capsys, "lobes", "--assembly", ASSEMBLY, "--at", "tool.tip", *NO_TEETH_CUT, "--json")
+    assert json.loads(out)["cut"]["teeth"] == 4
+    bare = tmp_path / "bare.toml"
+    save_assembly(assembly.with_component(attrs.evolve(tool, teeth=None)), bare)
+    code, _, err = run(capsys, "lobes", "--assembly", bare, "--at", "tool.tip", *NO_TEETH_CUT)
+    assert code == 2 and "--teeth" in err
+
+
+def test_workpiece_by_name_and_from_a_user_table(capsys, tmp_path):
+    base = ["lobes", "--assembly", ASSEMBLY, "--at", "tool.tip", "--radial-depth", "3 mm", "--json"]
+    _, out, _ = run(capsys, *base, "--workpiece", "aluminium-7075")
+    result = json.loads(out)
+    assert result["cut"]["kt_pa"] == pytest.approx(767.01e6) and result["cut"]["kn_pa"] == pytest.approx(168.8e6)
+    assert "doi" in result["workpiece"]["source"]
+    code, _, err = run(capsys, *base, "--workpiece", "steel-1045", "--feed-per-tooth", "0.1 mm")
+    assert code == 1 and "radial" in err and "kr" in err
+    code, out, _ = run(capsys, *base, "--workpiece", "steel-1045", "--feed-per-tooth", "0.1 mm", "--kr", "0.3")
+    assert code == 0 and json.loads(out)["workpiece"]["model"] == "kienzle"
+    table = tmp_path / "mine.toml"
+    table.write_text('[[workpiece]]\nname = "shop-7075"\nmodel = "linear"\nkt = "700 MPa"\nkr = "200 MPa"\n'
+                     'source = "our calibration cuts, 2025"\n', encoding="utf-8")
+    _, out, _ = run(capsys, *base, "--workpiece", "shop-7075", "--workpiece-table", table)
+    assert json.loads(out)["cut"]["kt_pa"] == pytest.approx(700e6)
+    code, _, err = run(capsys, *base, "--workpiece", "unobtainium")
+    assert code == 1 and "known" in err and "aluminium-7075" in err
+    code, _, err = run(capsys, *base, "--workpiece", "aluminium-7075", "--kt", "600 MPa")
+    assert code == 2 and "not both" in err
+
+
+@pytest.mark.parametrize("speeds, message", [
+    ("-2000:24000:50", "positive"),
+    ("2000:-24000:50", "positive"),
+    ("2000:24000:1e-4", "MAX_SPEEDS"),
+])
+def test_bad_speed_grids_get_a_clear_message(capsys, frf_files, speeds, message):
+    code, out, err = run(capsys, "lobes", "--frf", frf_files[0], *THESIS_CUT, "--speeds", speeds)
+    assert code == 2 and out == "" and message in err and "expected one argument" not in err
+
+
+def test_too_many_intervals_is_refused_by_name(capsys, modes_file):
+    code, _, err = run(capsys, "lobes", "--modes", modes_file, *BENCH_CUT, "--method", "sdm", "--intervals", "100000",
+                       "--speeds", "10000:11000:500")
+    assert code == 1 and "MAX_INTERVALS" in err

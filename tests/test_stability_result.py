@@ -56,7 +56,7 @@ def test_several_results_on_one_plot():
     b.plot(ax=fig.axes[0], ls="--")
     ax = fig.axes[0]
     labels = [line.get_label() for line in ax.lines if not line.get_label().startswith("_")]
-    assert labels == ["measured", "model"]
+    assert labels == ["measured", "stable at every speed", "model"]  # plain words for the absolute limit
     assert ax.get_xlabel() == "spindle speed [rpm]" and "mm" in ax.get_ylabel()
     assert len(ax.lines) > 2 + len(a.lobes) - 1  # individual lobes drawn faintly
     plt.close(fig)

@@ -177,15 +177,31 @@ def test_speeds_in_hz_are_an_error():
         zoa(benchmark_model(), benchmark_cut(1.0), np.linspace(5000, 20000, 50))
 
 
-def test_a_limit_at_the_edge_of_the_band_warns():
+def test_a_limit_at_the_edge_of_the_band_warns_when_detection_is_off():
     assembly = default_assembly()  # free-free: rigid-body motion at the lowest lines
     h = assembly.receptance("tool.tip:y", frequency=Frequency.from_range("20 Hz", "5000 Hz", "10 Hz"))
     cut = MillingCut(4, "12 mm", "3 mm", kt="625 MPa", kn="100 MPa")
     with pytest.warns(StabilityWarning, match="first line"):
-        zoa(h, cut, SPEEDS)
+        zoa(h, cut, SPEEDS, band="all")
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         zoa(h.crop("500 Hz", "5000 Hz"), cut, SPEEDS)
+
+
+def test_by_default_the_rigid_body_mass_line_is_left_out():
+    assembly = default_assembly()
+    h = assembly.receptance("tool.tip:y", frequency=Frequency.from_range("20 Hz", "5000 Hz", "10 Hz"))
+    cut = MillingCut(4, "12 mm", "3 mm", kt="625 MPa", kn="100 MPa")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lobes = zoa(h, cut, SPEEDS)
+    assert lobes.band.kind == "free-free" and 150 <= lobes.band.lo_hz <= 250
+    finite = np.isfinite(lobes.chatter_frequency_hz)
+    assert np.all(lobes.chatter_frequency_hz[finite] >= lobes.band.lo_hz)
+    # the same as cropping by hand above the antiresonance
+    by_hand = zoa(h.crop(lobes.band.lo_hz, None), cut, SPEEDS, band="all")
+    np.testing.assert_allclose(lobes.depth_limit_m, by_hand.depth_limit_m)
+    assert lobes.absolute_limit_m == pytest.approx(by_hand.absolute_limit_m)
 
 
 def test_no_chatter_possible_gives_no_limit():

@@ -530,7 +530,10 @@ def _component_table(component) -> dict:
         if shared:
             table["material"] = component.segments[0].material.name
         table["segments"] = [_segment_table(s, not shared) for s in component.segments]
+    defaults = {f.name: f.default for f in attrs.fields(cls)} if attrs.has(cls) else {}
     for field in _extra_fields(cls):
+        if getattr(component, field) is None and defaults.get(field, attrs.NOTHING) is None:
+            continue  # an optional field left unset (e.g. a tool's teeth): the default reads back
         if field in table:
             raise InvalidValueError(
                 f"components: {component.name!r} ({kind}) has a field {field!r} that clashes with the key of "

@@ -16,6 +16,13 @@ best speeds, and how much the lobes move when the FRF changes.
   low radial immersion where the zero order is not.
 * :class:`Lobes`, :func:`lobes_band`: results, several on one plot, and a
   band from an FRF uncertainty band.
+* :func:`flexible_band`, :func:`assembly_structure`: the part of a tool point
+  FRF stability may use (no rigid-body or suspension lines).
+* :func:`recommend`, :class:`MachineLimits`, :class:`Recommendation`: the
+  spindle speed and depth of cut to use, with a stated margin, within the
+  machine's speed, power, torque and depth.
+* :func:`workpiece`, :class:`Workpiece`: published cutting coefficients of
+  common work materials, by name.
 
 Spindle speeds are in rpm (:func:`spindle_speeds`), depths in m, frequencies
 in Hz; see ``docs/stability.md``.
@@ -30,11 +37,15 @@ Examples
 0.2981
 """
 
+from .band import FlexibleBand, assembly_structure, choose_band, flexible_band
 from .cutting import MillingCut, TurningCut, as_speed_rpm, spindle_speeds, tooth_passing_hz
+from .machine import MachineLimits, SpeedCurve, cut_power, cut_torque, removal_rate
 from .modal import MODES_CSV_HEADER, ModalFitter, ModalFitWarning, ModalModel, Mode, fit_modes
 from .result import Lobes, LobesBand, StabilityWarning, lobes_band
 from .sdm import sdm, spectral_radius
 from .structure import XY_LABELS, xy_frf
+from .recommend import RECOMMENDATION_KEYS, Recommendation, recommend
+from .workpieces import Workpiece, load_workpieces, workpiece, workpieces
 from .zoa import zoa
 
 __all__ = [
@@ -42,4 +53,8 @@ __all__ = [
     "Mode", "ModalModel", "ModalFitter", "fit_modes", "ModalFitWarning", "MODES_CSV_HEADER",
     "xy_frf", "XY_LABELS", "zoa", "sdm", "spectral_radius",
     "Lobes", "LobesBand", "lobes_band", "StabilityWarning",
+    "FlexibleBand", "flexible_band", "choose_band", "assembly_structure",
+    "MachineLimits", "SpeedCurve", "cut_power", "cut_torque", "removal_rate",
+    "Recommendation", "recommend", "RECOMMENDATION_KEYS",
+    "Workpiece", "workpiece", "workpieces", "load_workpieces",
 ]

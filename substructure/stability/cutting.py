@@ -35,9 +35,12 @@ import pint
 from ..errors import InvalidValueError, UnitError
 from ..units import Q_, dimensionless, quantity, ureg
 
-__all__ = ["MillingCut", "TurningCut", "spindle_speeds", "as_speed_rpm", "tooth_passing_hz"]
+__all__ = ["MillingCut", "TurningCut", "spindle_speeds", "as_speed_rpm", "tooth_passing_hz", "MAX_SPEEDS"]
 
 MILLING_MODES = ("up", "down")
+
+MAX_SPEEDS = 100_000
+"""Most spindle speeds of one grid (:func:`spindle_speeds`)."""
 
 # -- spindle speeds -----------------------------------------------------------
 
@@ -135,6 +138,10 @@ def spindle_speeds(start: Any, stop: Any, step: Any) -> pint.Quantity:
     if hi < lo:
         raise InvalidValueError(f"stop: got {stop!r} below start {start!r}")
     count = (hi - lo) / dn
+    if count + 1 > MAX_SPEEDS:
+        raise InvalidValueError(
+            f"step: {lo:g} to {hi:g} rpm in steps of {dn:g} rpm is {count + 1:.4g} speeds, more than the limit "
+            f"MAX_SPEEDS = {MAX_SPEEDS:,}; use a coarser step")
     k = round(count) if abs(count - round(count)) <= 1e-9 * max(1.0, count) else math.floor(count)
     return Q_(lo + dn * np.arange(k + 1), "rpm")
 
@@ -192,6 +199,16 @@ def _pressure(field: str, allow_zero: bool):
         if q.magnitude < 0 or (q.magnitude == 0 and not allow_zero):
             need = ">= 0" if allow_zero else "> 0"
             raise InvalidValueError(f"{field}: got {value!r}; expected a cutting coefficient {need} (a pressure)")
+        return q
+
+    return convert
+
+
+def _edge(field: str):
+    def convert(value: Any) -> pint.Quantity:
+        q = quantity(value, field, "[mass] / [time] ** 2")
+        if not q.magnitude >= 0:
+            raise InvalidValueError(f"{field}: got {value!r}; expected an edge force per length >= 0 (e.g. '20 N/mm')")
         return q
 
     return convert
@@ -258,6 +275,16 @@ class MillingCut:
     milling : {"up", "down"}
         Up (conventional) milling: the tooth enters at zero chip thickness;
         down (climb) milling: it leaves at zero chip thickness.
+    feed_per_tooth : quantity or str, optional
+        Feed per tooth (chip load), e.g. ``"0.1 mm"``.  Stability does not use
+        it (the linear model has no static chip); the material removal rate
+        and the cutting power do (:func:`~substructure.stability.recommend`).
+    kte, kne : quantity or str, default "0 N/m"
+        Edge (ploughing) force per unit length of cutting edge, tangential and
+        normal (``"27.7 N/mm"``).  They add power, not regeneration.
+    workpiece : Workpiece, optional
+        Where the coefficients came from (:func:`~substructure.stability.workpiece`);
+        a Kienzle entry also sets the force law used for the power.
 
     Notes
     -----
@@ -280,6 +307,11 @@ class MillingCut:
     kt: pint.Quantity = attrs.field(kw_only=True, converter=_pressure("kt", allow_zero=False))
     kn: pint.Quantity = attrs.field(kw_only=True, converter=_pressure("kn", allow_zero=True))
     milling: str = attrs.field(default="up", kw_only=True, validator=lambda i, a, v: _milling(v))
+    feed_per_tooth: pint.Quantity | None = attrs.field(default=None, kw_only=True, converter=attrs.converters.optional(
+        _length("feed_per_tooth")))
+    kte: pint.Quantity = attrs.field(default="0 N/m", kw_only=True, converter=_edge("kte"))
+    kne: pint.Quantity = attrs.field(default="0 N/m", kw_only=True, converter=_edge("kne"))
+    workpiece: Any = attrs.field(default=None, kw_only=True, eq=False, repr=False)
 
     def __attrs_post_init__(self) -> None:
         d, ae = self.diameter.m_as("m"), self.radial_depth.m_as("m")
@@ -291,7 +323,7 @@ class MillingCut:
 
     @classmethod
     def from_spec(cls, teeth: Any, diameter: Any, *, radial_depth: Any = None, immersion: Any = None,
-                  milling: str = "up", kt: Any, kn: Any = None, kr: Any = None) -> MillingCut:
+                  milling: str = "up", kt: Any, kn: Any = None, kr: Any = None, **extra: Any) -> MillingCut:
         """A cut from the alternatives users meet: radial depth or immersion, Kn or Kr.
 
         Parameters
@@ -313,6 +345,8 @@ class MillingCut:
         kr : float, optional
             The ratio ``Kn / Kt`` (dimensionless, >= 0).  A pressure given as
             ``kr`` is refused with a hint: give it as ``kn``.
+        **extra
+            ``feed_per_tooth``, ``kte``, ``kne``, ``workpiece`` as in the class.
 
         Returns
         -------
@@ -343,7 +377,73 @@ class MillingCut:
             if ratio < 0:
                 raise InvalidValueError(f"kr: got {kr!r}; expected a ratio Kn/Kt >= 0")
             kn = kt * ratio
-        return cls(teeth, diameter, radial_depth, kt=kt, kn=kn, milling=milling)
+        return cls(teeth, diameter, radial_depth, kt=kt, kn=kn, milling=milling, **extra)
+
+    @classmethod
+    def for_workpiece(cls, teeth: Any, diameter: Any, workpiece: Any, *, radial_depth: Any = None,
+                      immersion: Any = None, milling: str = "up", feed_per_tooth: Any = None, kn: Any = None,
+                      kr: Any = None) -> MillingCut:
+        """A cut whose coefficients come from the workpiece table.
+
+        Parameters
+        ----------
+        teeth : int
+            Number of teeth.
+        diameter : str or pint.Quantity
+            Tool diameter, a length.
+        workpiece : Workpiece or str
+            An entry of the table or its name (:func:`~substructure.stability.workpiece`).
+        radial_depth : str or pint.Quantity, optional
+            Radial depth of cut, a length; or
+        immersion : float, optional
+            ``a_e / D`` in (0, 1].
+        milling : {"up", "down"}
+            Up (default) or down milling.
+        feed_per_tooth : quantity or str, optional
+            Needed for a Kienzle entry (its coefficient depends on the chip
+            thickness) and for power and removal rate.
+        kn, kr : optional
+            The normal coefficient (pressure) or ratio ``Kn/Kt``, where the
+            entry has none (or to replace its value).
+
+        Returns
+        -------
+        MillingCut
+        """
+        from .workpieces import workpiece as lookup
+
+        entry = lookup(workpiece) if isinstance(workpiece, str) else workpiece
+        probe = cls.from_spec(teeth, diameter, radial_depth=radial_depth, immersion=immersion, milling=milling,
+                              kt="1 Pa", kr=0.0)
+        coeff = entry.coefficients(probe.mean_chip_thickness(feed_per_tooth))
+        if kn is None and kr is None:
+            if coeff["kn"] is None:
+                raise InvalidValueError(
+                    f"workpiece {entry.name!r}: the table has no radial (normal) coefficient for it "
+                    f"({entry.model} entry from {entry.short_source}); give kn (a pressure) or kr (the ratio Kn/Kt)")
+            kn = coeff["kn"]
+        return cls.from_spec(teeth, diameter, radial_depth=probe.radial_depth, milling=milling, kt=coeff["kt"],
+                             kn=kn, kr=kr, feed_per_tooth=feed_per_tooth, kte=coeff["kte"], kne=coeff["kne"],
+                             workpiece=entry)
+
+    def mean_chip_thickness(self, feed_per_tooth: Any = None) -> pint.Quantity | None:
+        """Average chip thickness over the engagement, ``c (cos phi_st - cos phi_ex) / (phi_ex - phi_st)``.
+
+        Parameters
+        ----------
+        feed_per_tooth : quantity or str, optional
+            Default: the cut's own.
+
+        Returns
+        -------
+        pint.Quantity or None
+            ``None`` without a feed per tooth.
+        """
+        c = self.feed_per_tooth if feed_per_tooth is None else _length("feed_per_tooth")(feed_per_tooth)
+        if c is None:
+            return None
+        st, ex = self.angles
+        return (c * (np.cos(st) - np.cos(ex)) / (ex - st)).to(c.units)
 
     # -- derived values ---------------------------------------------------------
     @property
@@ -392,9 +492,14 @@ class MillingCut:
         str
             The cut with its units.
         """
-        return (f"{self.milling} milling, {self.teeth} teeth, D = {self.diameter:~P}, "
+        text = (f"{self.milling} milling, {self.teeth} teeth, D = {self.diameter:~P}, "
                 f"a_e = {self.radial_depth:~P} (a_e/D = {self.immersion:.3g}), "
-                f"Kt = {self.kt:~P}, Kn = {self.kn:~P} (Kn/Kt = {self.kr:.3g})")
+                f"Kt = {self.kt.to('MPa'):.4g~P}, Kn = {self.kn.to('MPa'):.4g~P} (Kn/Kt = {self.kr:.3g})")
+        if self.feed_per_tooth is not None:
+            text += f", feed {self.feed_per_tooth.to('mm'):.4g~P}/tooth"
+        if self.workpiece is not None:
+            text += f", workpiece {self.workpiece.name}"
+        return text
 
     # -- what the methods use -----------------------------------------------------
     def force_matrix(self, theta: Any) -> np.ndarray:

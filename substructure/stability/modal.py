@@ -33,6 +33,9 @@ from .structure import XY_LABELS, _one_entry, xy_receptance
 
 __all__ = ["Mode", "ModalModel", "ModalFitter", "fit_modes", "MODES_CSV_HEADER", "ModalFitWarning"]
 
+#: Most lines of a modal model's default grid (about 64 MB of 2x2 complex receptances).
+MAX_DEFAULT_LINES = 2_000_000
+
 #: The header of a modes CSV file (:meth:`ModalModel.from_csv`): direction ``x`` or ``y``,
 #: natural frequency in Hz, damping ratio, modal stiffness in N/m.
 MODES_CSV_HEADER = "direction,frequency_hz,damping_ratio,stiffness_n_per_m"
@@ -233,7 +236,13 @@ class ModalModel:
         a = self.arrays()
         lo, hi = 0.3 * a["frequency_hz"].min(), 3.0 * a["frequency_hz"].max()
         step = np.log1p(a["damping_ratio"].min() / 50.0)
-        n = int(np.ceil(np.log(hi / lo) / step)) + 1
+        count = np.log(hi / lo) / step + 1
+        if count > MAX_DEFAULT_LINES:
+            raise InvalidValueError(
+                f"modes: the default grid for damping ratio {a['damping_ratio'].min():.3g} needs {count:.3g} lines "
+                f"(a relative step of zeta/50 from 0.3 f_min to 3 f_max), more than MAX_DEFAULT_LINES = "
+                f"{MAX_DEFAULT_LINES:.3g}; give the lines yourself (frequency=Frequency(...)), or check the damping")
+        n = int(np.ceil(count))
         return Frequency.from_hz(np.geomspace(lo, hi, n))
 
     def receptance(self, frequency_hz: Any) -> np.ndarray:

@@ -3,14 +3,19 @@
 :func:`plot_lobes` draws the depth limit (mm) against spindle speed (rpm) for
 one or several results on one axes, so that lobes from different FRFs (a
 measurement and a model, with and without a sensor) can be compared;
-:func:`plot_band` shades the spread of a :class:`~substructure.stability.result.LobesBand`.
-Depths below a curve are stable.
+:func:`plot_band` shades the spread of a :class:`~substructure.stability.result.LobesBand`;
+:func:`plot_recommendation` marks a recommended speed and depth with its
+safe window.  Depths below a curve are stable.  Labels are plain language
+("zero-order", "semi-discretization"), with the technical name in a small
+note; titles wrap; the depth axis always shows the recommendation.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from typing import Any
+
+import textwrap
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -19,7 +24,13 @@ from matplotlib.figure import Figure
 
 from ..errors import InvalidValueError
 
-__all__ = ["plot_lobes", "plot_band"]
+__all__ = ["plot_lobes", "plot_band", "plot_recommendation", "METHOD_NAMES"]
+
+METHOD_NAMES = {
+    "zoa": ("zero-order", "zero-order approximation (Altintas & Budak 1995), 'zoa'"),
+    "sdm": ("semi-discretization", "semi-discretization (Insperger & Stepan 2004), 'sdm'"),
+}
+"""Plain-language legend name and the technical note of each method."""
 
 
 def _axes(ax: Any) -> Axes:
@@ -37,15 +48,34 @@ def _axes(ax: Any) -> Axes:
 
 def _finish(ax: Axes) -> None:
     ax.set_xlabel("spindle speed [rpm]")
-    ax.set_ylabel("axial depth of cut limit [mm]")
+    ax.set_ylabel("axial depth of cut [mm]\n(stable below the curve)")
     ax.set_ylim(bottom=0.0)
     ax.grid(True, alpha=0.3)
     if any(not str(line.get_label()).startswith("_") for line in ax.lines + ax.collections):
         ax.legend(fontsize="small")
 
 
+def wrap_title(ax: Axes, text: str, width: int = 95, **kw: Any) -> None:
+    """Set a title wrapped to lines of at most ``width`` characters (nothing is cut off).
+
+    Parameters
+    ----------
+    ax : Axes
+    text : str
+    width : int, default 95
+        Characters per line.
+    **kw
+        Passed to ``Axes.set_title``.
+    """
+    ax.set_title("\n".join(textwrap.wrap(" ".join(str(text).split()), width)), fontsize="small", **kw)
+
+
+def _label(r: Any) -> str:
+    return r.label or METHOD_NAMES.get(r.method, (r.method, ""))[0]
+
+
 def plot_lobes(results: Sequence[Any], ax: Any = None, lobes: bool = False, ylim_factor: float = 3.0,
-               **line_kw: Any) -> Figure:
+               recommendation: Any = None, title: str | None = None, **line_kw: Any) -> Figure:
     """Depth limit against spindle speed for one or more :class:`Lobes`.
 
     Parameters
@@ -57,7 +87,12 @@ def plot_lobes(results: Sequence[Any], ax: Any = None, lobes: bool = False, ylim
         Also draw the individual zero-order lobes, thin and faint.
     ylim_factor : float, default 3.0
         The depth axis ends at this multiple of the median finite limit, so
-        that the near-vertical lobe flanks do not flatten the plot.
+        that the near-vertical lobe flanks do not flatten the plot; it is
+        raised to show the recommendation and its window.
+    recommendation : Recommendation, optional
+        Mark it with its safe window (:func:`plot_recommendation`).
+    title : str, optional
+        Wrapped to the width of the figure.
     **line_kw
         Passed to ``Axes.plot`` for every result (``color``, ``linestyle``).
 
@@ -71,12 +106,13 @@ def plot_lobes(results: Sequence[Any], ax: Any = None, lobes: bool = False, ylim
     left, right = ax.get_xlim() if overlay else (np.inf, -np.inf)
     for r in results:
         depth = np.where(np.isfinite(r.depth_limit_m), r.depth_limit_m, np.nan) * 1e3
-        (line,) = ax.plot(r.spindle_speed_rpm, depth, label=r.label or r.method, **line_kw)
+        (line,) = ax.plot(r.spindle_speed_rpm, depth, label=_label(r), **line_kw)
         if lobes:
             for n, a in r.lobes:
                 ax.plot(n, a * 1e3, lw=0.5, alpha=0.35, color=line.get_color(), label="_lobe")
         if r.absolute_limit_m is not None and np.isfinite(r.absolute_limit_m):
-            ax.axhline(r.absolute_limit_m * 1e3, lw=0.8, ls=":", color=line.get_color(), label="_absolute")
+            ax.axhline(r.absolute_limit_m * 1e3, lw=0.8, ls=":", color=line.get_color(),
+                       label="stable at every speed" if not overlay and r is results[0] else "_absolute")
         finite = depth[np.isfinite(depth)]
         if finite.size:
             top = max(top, ylim_factor * float(np.median(finite)))
@@ -84,6 +120,64 @@ def plot_lobes(results: Sequence[Any], ax: Any = None, lobes: bool = False, ylim
                 max([right] + [r.spindle_speed_rpm[-1] for r in results]))
     if top > 0:
         ax.set_ylim(0.0, top)
+    notes = sorted({METHOD_NAMES[r.method][1] for r in results if r.method in METHOD_NAMES})
+    bands = [r.band for r in results if getattr(r, "band", None) is not None and r.band.excluded_hz is not None]
+    if bands:
+        notes.append(f"FRF lines below {bands[0].lo_hz:.4g} Hz ({bands[0].kind}: rigid-body/suspension) left out")
+    if notes and not overlay:
+        ax.text(0.0, -0.2, "; ".join(notes), transform=ax.transAxes, fontsize="x-small", color="0.35",
+                va="top", wrap=True)
+    if recommendation is not None:
+        plot_recommendation(recommendation, ax=ax)
+    if title is not None:
+        wrap_title(ax, title)
+    _finish(ax)
+    return ax.figure
+
+
+def plot_recommendation(recommendation: Any, ax: Any = None, runners_up: bool = True) -> Figure:
+    """Mark a recommended speed and depth, its speed window and the limit it keeps a margin from.
+
+    Parameters
+    ----------
+    recommendation : Recommendation
+    ax : Axes or Figure, optional
+        Usually the axes of :func:`plot_lobes`.
+    runners_up : bool, default True
+        Also mark the runners-up (smaller, numbered).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The depth axis is raised, where needed, so that the point, its window
+        and the limit are inside it.
+    """
+    ax = _axes(ax)
+    r = recommendation
+    n, a = r.spindle_speed_rpm, r.depth_m * 1e3
+    lo, hi = r.window_rpm
+    ax.fill_between([lo, hi], 0.0, a, color="tab:green", alpha=0.18, lw=0,
+                    label=f"safe window: +-{r.speed_tolerance:.0%} speed, {r.margin:.0%} depth margin")
+    if np.isfinite(r.limit_depth_m):
+        ax.plot([lo, hi], [r.limit_depth_m * 1e3] * 2, color="tab:green", lw=1.0, ls="--", label="_limit")
+    ax.plot([n], [a], marker="*", ms=14, color="tab:green", mec="k", ls="none",
+            label=f"recommended: {n:,.0f} rpm, {a:.3g} mm")
+    top = a
+    if runners_up:
+        for k, other in enumerate(r.runners_up, 1):
+            ax.plot([other.spindle_speed_rpm], [other.depth_m * 1e3], marker="o", ms=6, color="tab:olive",
+                    mec="k", ls="none", label="runners-up" if k == 1 else "_runner")
+            ax.annotate(str(k), (other.spindle_speed_rpm, other.depth_m * 1e3), textcoords="offset points",
+                        xytext=(5, 5), fontsize="x-small")
+            top = max(top, other.depth_m * 1e3)
+    limit = r.limit_depth_m * 1e3 if np.isfinite(r.limit_depth_m) else a
+    needed = 1.25 * max(top, limit, r.limit_at_speed_m * 1e3 if np.isfinite(r.limit_at_speed_m) else 0.0)
+    bottom, current = ax.get_ylim()
+    if needed > current:
+        ax.set_ylim(0.0, needed)
+    left, right = ax.get_xlim()
+    if lo < left or hi > right:
+        ax.set_xlim(min(left, lo), max(right, hi))
     _finish(ax)
     return ax.figure
 

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import InvalidValueError, SubstructureWarning
 
-__all__ = ["Lobes", "LobesBand", "lobes_band", "StabilityWarning"]
+__all__ = ["Lobes", "LobesBand", "lobes_band", "StabilityWarning", "sampled_window_minimum"]
 
 
 class StabilityWarning(SubstructureWarning):
@@ -70,6 +70,13 @@ class Lobes:
         Semi-discretization: the scheme and the numbers that define it.
     label : str or None
         Legend label.
+    band : FlexibleBand or None
+        The part of the FRF that was used (rigid-body and suspension lines
+        left out, :mod:`~substructure.stability.band`); ``None`` for modes.
+    source : object or None
+        What computed the result, able to evaluate it at other speeds
+        (:meth:`limit_on`, :meth:`window_minimum`); ``None`` for results
+        built by hand, which are then read by interpolation.
     """
 
     method: str
@@ -83,6 +90,8 @@ class Lobes:
     bifurcation: tuple = attrs.field(default=(), converter=tuple, repr=False)
     discretisation: dict = attrs.field(factory=dict, eq=False)
     label: str | None = None
+    band: Any = attrs.field(default=None, eq=False)
+    source: Any = attrs.field(default=None, eq=False, repr=False)
 
     def __attrs_post_init__(self) -> None:
         n = self.spindle_speed_rpm.size
@@ -163,6 +172,59 @@ class Lobes:
         index = index[np.argsort(-fill[index])][:count]
         return [(float(self.spindle_speed_rpm[i]), float(a[i])) for i in index]
 
+    def limit_on(self, speed_rpm: Any) -> tuple[np.ndarray, np.ndarray]:
+        """Depth limit [m] and chatter frequency [Hz] computed at other speeds [rpm].
+
+        Parameters
+        ----------
+        speed_rpm : array_like
+            Spindle speeds in rpm (plain numbers) within the computed range.
+
+        Returns
+        -------
+        (ndarray, ndarray)
+            Zero order: exactly what :func:`~substructure.stability.zoa` gives
+            on these speeds (from the stored lobes, no new eigenvalues);
+            semi-discretization: a new run on these speeds; results without a
+            source: linear interpolation.
+        """
+        n = np.atleast_1d(np.asarray(speed_rpm, dtype=float))
+        lo, hi = self.spindle_speed_rpm[0], self.spindle_speed_rpm[-1]
+        if np.any(n < lo * (1 - 1e-12)) or np.any(n > hi * (1 + 1e-12)):
+            raise InvalidValueError(f"speed_rpm: expected speeds within the computed range {lo:g}..{hi:g} rpm")
+        if self.source is not None:
+            return self.source.limit(n)
+        return self.limit_at(n), np.interp(n, self.spindle_speed_rpm, self.chatter_frequency_hz)
+
+    def window_minimum(self, lo_rpm: Any, hi_rpm: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The lowest depth limit over speed windows ``[lo, hi]`` [rpm].
+
+        Parameters
+        ----------
+        lo_rpm, hi_rpm : array_like
+            Window ends in rpm, within the computed range (same shapes).
+
+        Returns
+        -------
+        (depth_m, speed_rpm, chatter_hz) : ndarrays
+            Per window: the lowest limit, the speed where it is, and the
+            chatter frequency there.  Zero order: exact for the lobes of the
+            FRF lines (the envelope is piecewise linear between lines; its
+            minimum over a window lies at an end or at a vertex of a lobe that
+            is a local minimum of that lobe, and all of those are evaluated).
+            Semi-discretization: the minimum over 33 speeds per window, each
+            a new run.  Without a source: the computed speeds in the window
+            and its interpolated ends.
+        """
+        lo = np.atleast_1d(np.asarray(lo_rpm, dtype=float))
+        hi = np.atleast_1d(np.asarray(hi_rpm, dtype=float))
+        if lo.shape != hi.shape or np.any(hi < lo):
+            raise InvalidValueError("lo_rpm, hi_rpm: expected windows with lo <= hi, of the same shape")
+        self.limit_on(np.concatenate([lo, hi]))  # range check
+        if self.source is not None and hasattr(self.source, "window_minimum"):
+            return self.source.window_minimum(lo, hi)
+        return sampled_window_minimum(self.limit_on, lo, hi, self.spindle_speed_rpm)
+
     @property
     def min_limit_m(self) -> float:
         """The lowest depth limit over the speeds computed."""
@@ -191,6 +253,8 @@ class Lobes:
             out["bifurcation"] = list(self.bifurcation)
         if self.discretisation:
             out["discretisation"] = dict(self.discretisation)
+        if self.band is not None:
+            out["structure_band"] = self.band.to_json()
         out["best_speeds"] = [{"spindle_speed_rpm": n, "depth_limit_m": a} for n, a in self.best_speeds()]
         return out
 
@@ -201,14 +265,15 @@ class Lobes:
 
         Parameters
         ----------
-        ax : Axes, optional
+        ax : Axes or Figure, optional
             Where to draw; a new figure when None.
         **kw
-            Passed to the plotting function (line styles, ``lobes=True`` for the single lobes).
+            ``lobes`` (draw the single lobes), ``recommendation`` (mark it and
+            its safe window), ``title``, ``ylim_factor`` and line options.
 
         Returns
         -------
-        Figure
+        matplotlib.figure.Figure
             The figure: depth limit in mm against spindle speed in rpm.
         """
         from .plotting import plot_lobes
@@ -272,6 +337,43 @@ class LobesBand:
         """
         return {"spindle_speed_rpm": self.spindle_speed_rpm.tolist(), "lower_m": _json_numbers(self.lower_m),
                 "upper_m": _json_numbers(self.upper_m)}
+
+
+def sampled_window_minimum(evaluate, lo: np.ndarray, hi: np.ndarray, speeds: np.ndarray | None = None,
+                           count: int = 33) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Window minima by evaluating a limit on samples of each window.
+
+    Parameters
+    ----------
+    evaluate : callable
+        ``evaluate(speeds_rpm) -> (depth_m, chatter_hz)``.
+    lo, hi : ndarray
+        Window ends in rpm.
+    speeds : ndarray, optional
+        Computed speeds [rpm]; those inside a window are evaluated too.
+    count : int, default 33
+        Evenly spaced speeds per window, its ends included.
+
+    Returns
+    -------
+    (depth_m, speed_rpm, chatter_hz) : ndarrays
+        Per window: the lowest sampled limit, where, and its chatter frequency.
+    """
+    t = np.linspace(0.0, 1.0, count)
+    grid = lo[:, None] + (hi - lo)[:, None] * t[None, :]
+    if speeds is not None:
+        extra = [np.sort(np.concatenate([g, speeds[(speeds > a) & (speeds < b)]])) for g, a, b in zip(grid, lo, hi)]
+    else:
+        extra = list(grid)
+    flat = np.concatenate(extra)
+    depth, chatter = evaluate(flat)
+    bounds = np.cumsum([0] + [e.size for e in extra])
+    out = np.empty(lo.size), np.empty(lo.size), np.empty(lo.size)
+    for w in range(lo.size):
+        d = depth[bounds[w]:bounds[w + 1]]
+        k = int(np.argmin(d))
+        out[0][w], out[1][w], out[2][w] = d[k], flat[bounds[w] + k], chatter[bounds[w] + k]
+    return out
 
 
 def lobes_band(results: Sequence[Lobes], nominal: Lobes | None = None, label: str | None = None) -> LobesBand:

@@ -54,7 +54,10 @@ from .result import Lobes
 from .structure import xy_receptance
 from .zoa import zoa_eigenvalues
 
-__all__ = ["sdm", "spectral_radius", "expm_batch", "SCHEME"]
+__all__ = ["sdm", "spectral_radius", "expm_batch", "SCHEME", "MAX_INTERVALS"]
+
+MAX_INTERVALS = 2000
+"""Most intervals per delay period: the monodromy matrix grows with them (``2 d + K p`` square)."""
 
 SCHEME = ("updated first-order semi-discretization (Insperger & Stepan 2004), "
           "grid aligned with tooth entry and exit, one step per free-vibration stretch")
@@ -67,6 +70,15 @@ def _check_model(modes: Any) -> ModalModel:
             "or fit one to FRF data with fit_modes(frf) (zero-order works on FRF data directly)"
         )
     return modes
+
+
+def _check_intervals(intervals: Any) -> None:
+    if intervals is not None and isinstance(intervals, (int, np.integer)) and not isinstance(intervals, bool) \
+            and intervals > MAX_INTERVALS:
+        raise InvalidValueError(
+            f"intervals: got {intervals}; the limit is MAX_INTERVALS = {MAX_INTERVALS} per delay period (the "
+            "monodromy matrix grows with the square of the count, the work with its cube); the default "
+            "(intervals=None) chooses the count from the modes")
 
 
 def _depths_m(depths: Any) -> np.ndarray:
@@ -115,6 +127,7 @@ def spectral_radius(modes: ModalModel, cut: Any, speeds: Any, depths: Any, *, in
     model = _check_model(modes)
     n = as_speed_rpm(speeds)
     a = _depths_m(depths)
+    _check_intervals(intervals)
     nn, aa = np.meshgrid(n, a, indexing="ij")
     plan = _Plan(model, cut, intervals, min_intervals, max_phase_step)
     rho, _ = _critical(model, plan, nn.ravel(), aa.ravel())
@@ -316,7 +329,14 @@ def sdm(modes: ModalModel, cut: Any, speeds: Any, *, intervals: int | None = Non
         raise InvalidValueError(f"rtol: got {rtol!r}; expected a relative tolerance in (0, 0.5)")
     if not coarse_ratio > 1.0:
         raise InvalidValueError(f"coarse_ratio: got {coarse_ratio!r}; expected a ratio > 1")
+    _check_intervals(intervals)
     plan = _Plan(model, cut, intervals, min_intervals, max_phase_step)
+    need = int(plan.intervals_for(speeds_rpm).max())
+    if need > MAX_INTERVALS:
+        raise InvalidValueError(
+            f"speeds: the lowest speed {speeds_rpm[0]:g} rpm needs {need} intervals per delay period for a phase "
+            f"step of {max_phase_step:g} rad at {plan.reference_hz:.4g} Hz, more than MAX_INTERVALS = "
+            f"{MAX_INTERVALS}; raise the lowest speed or max_phase_step")
     if depth_range is None:
         ref = _reference_depth(model, cut)
         lo, hi = ref / 4.0, ref * 64.0
@@ -353,5 +373,27 @@ def sdm(modes: ModalModel, cut: Any, speeds: Any, *, intervals: int | None = Non
         "coarse_ratio": coarse_ratio,
         "evaluations_per_speed": round(evaluations / ns, 2),
     }
-    return Lobes("sdm", speeds_rpm, limit, chatter, cut=cut, bifurcation=kinds, discretisation=info, label=label)
+    source = _SdmSource(model, cut, dict(intervals=intervals, min_intervals=min_intervals,
+                                          max_phase_step=max_phase_step, rtol=rtol, depth_range=depth_range,
+                                          coarse_ratio=coarse_ratio))
+    return Lobes("sdm", speeds_rpm, limit, chatter, cut=cut, bifurcation=kinds, discretisation=info, label=label,
+                 source=source)
+
+
+class _SdmSource:
+    """Re-runs semi-discretization with the same model, cut and settings at other speeds."""
+
+    def __init__(self, model: ModalModel, cut: Any, settings: dict) -> None:
+        self.model, self.cut, self.settings = model, cut, settings
+
+    def limit(self, speeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        from ..units import Q_
+
+        order = np.argsort(speeds)
+        unique, inverse = np.unique(speeds[order], return_inverse=True)
+        result = sdm(self.model, self.cut, Q_(unique, "rpm"), **self.settings)
+        depth, chatter = np.empty(speeds.size), np.empty(speeds.size)
+        depth[order] = result.depth_limit_m[inverse]
+        chatter[order] = result.chatter_frequency_hz[inverse]
+        return depth, chatter
 

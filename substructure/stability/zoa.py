@@ -29,12 +29,17 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import InvalidValueError
 from ..frf import FRF, Frequency
+from .band import choose_band
 from .cutting import as_speed_rpm
 from .result import Lobes, StabilityWarning
 from .structure import xy_receptance
 
-__all__ = ["zoa", "zoa_eigenvalues"]
+__all__ = ["zoa", "zoa_eigenvalues", "MAX_LOBE_POINTS"]
+
+MAX_LOBE_POINTS = 5_000_000
+"""Most points (FRF lines x lobes x 2 branches) the zero order builds, about 40 MB per array."""
 
 
 def zoa_eigenvalues(k0: np.ndarray, g: np.ndarray) -> np.ndarray:
@@ -120,8 +125,54 @@ def _lobes_on_speeds(speeds: np.ndarray, n: np.ndarray, a: np.ndarray, f: np.nda
     return depth, freq
 
 
+class _ZoaEnvelope:
+    """Every lobe of a zero-order result, to evaluate its envelope at any speed exactly.
+
+    ``n``, ``a``, ``f``: (L, m) speed [rpm], depth [m] and chatter frequency
+    [Hz] of L lobes at the m FRF lines; ``ok``: (L, m-1) the segments that
+    belong to a lobe.
+    """
+
+    def __init__(self, n: np.ndarray, a: np.ndarray, f: np.ndarray, ok: np.ndarray) -> None:
+        self.n, self.a, self.f, self.ok = n, a, f, ok
+        # vertices where the minimum of a window can lie: local minima of a lobe and lobe ends
+        seg_l = np.concatenate([np.zeros((ok.shape[0], 1), bool), ok], axis=1)  # segment to the left exists
+        seg_r = np.concatenate([ok, np.zeros((ok.shape[0], 1), bool)], axis=1)
+        a_l = np.concatenate([np.full((a.shape[0], 1), np.inf), a[:, :-1]], axis=1)
+        a_r = np.concatenate([a[:, 1:], np.full((a.shape[0], 1), np.inf)], axis=1)
+        low = (~seg_l | (a <= a_l)) & (~seg_r | (a <= a_r)) & (seg_l | seg_r) & np.isfinite(a)
+        self.critical = np.unique(n[low])
+
+    def limit(self, speeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        order = np.argsort(speeds)
+        depth, chatter = _lobes_on_speeds(speeds[order], self.n, self.a, self.f, self.ok)
+        out_d, out_f = np.empty_like(depth), np.empty_like(chatter)
+        out_d[order], out_f[order] = depth, chatter
+        return out_d, out_f
+
+    def window_minimum(self, lo: np.ndarray, hi: np.ndarray):
+        crit = self.critical[(self.critical >= lo.min()) & (self.critical <= hi.max())]
+        speeds = np.concatenate([lo, hi, crit])
+        depth, chatter = self.limit(speeds)
+        w = lo.size
+        best = np.where(depth[:w] <= depth[w:2 * w], 0, 1)
+        rows = np.arange(w)
+        d = np.where(best == 0, depth[:w], depth[w:2 * w])
+        at = np.where(best == 0, lo, hi)
+        fc = np.where(best == 0, chatter[:w], chatter[w:2 * w])
+        if crit.size:
+            cd, cf = depth[2 * w:], chatter[2 * w:]
+            start = np.searchsorted(crit, lo, side="left")
+            stop = np.searchsorted(crit, hi, side="right")
+            for i in rows[stop > start]:  # windows holding a lobe bottom (a few per window)
+                k = start[i] + int(np.argmin(cd[start[i]:stop[i]]))
+                if cd[k] < d[i]:
+                    d[i], at[i], fc[i] = cd[k], crit[k], cf[k]
+        return d, at, fc
+
+
 def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = None,
-        label: str | None = None) -> Lobes:
+        label: str | None = None, band: Any = "auto") -> Lobes:
     """Stability lobes by the zero-order approximation.
 
     Parameters
@@ -141,11 +192,25 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
         around every mode).
     label : str, optional
         Legend label of the result.
+    band : "auto", "all", (lo_hz, hi_hz) or FlexibleBand, default "auto"
+        FRF data only: which lines to use.  ``"auto"`` leaves out a
+        rigid-body mass line and suspension modes
+        (:func:`~substructure.stability.flexible_band`); ``"all"`` uses every
+        line; a pair crops to that band; a :class:`FlexibleBand` (e.g. from
+        :func:`~substructure.stability.assembly_structure`) is applied as it
+        is.  The choice is kept in ``Lobes.band``.
 
     Returns
     -------
     Lobes
-        With the absolute limit and the individual lobes.
+        With the absolute limit, the individual lobes and the band used.
+
+    Raises
+    ------
+    InvalidValueError
+        When the lobes would need more than ``MAX_LOBE_POINTS`` (5,000,000) points
+        (FRF lines x lobes x 2): crop or thin the FRF, or raise the lowest
+        speed.
 
     Warns
     -----
@@ -155,6 +220,7 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
         region of a free-free model); crop or extend it.
     """
     speeds_rpm = as_speed_rpm(speeds)
+    structure, used = choose_band(structure, band)
     f, g = xy_receptance(structure, frequency)
     k0 = cut.mean_force_matrix()
     lam = zoa_eigenvalues(k0, g)  # (m, 2)
@@ -165,13 +231,13 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
         theta = np.pi + 2.0 * np.angle(lam)  # in (0, 2 pi) where valid
     if not valid.any():
         return Lobes("zoa", speeds_rpm, np.full(speeds_rpm.size, np.inf), np.full(speeds_rpm.size, np.nan),
-                     cut=cut, absolute_limit_m=float("inf"), label=label)
+                     cut=cut, absolute_limit_m=float("inf"), label=label, band=used)
     # absolute limit
     flat = np.argmin(a, axis=None)
     i, branch = np.unravel_index(flat, a.shape)
     if isinstance(structure, FRF):
         a_abs, f_abs = _refine_data(f, a[:, branch], i)
-        if i in (0, f.size - 1):
+        if i in (0, f.size - 1) and not (i == 0 and used is not None and used.excluded_hz is not None):
             warnings.warn(
                 f"zoa: the absolute limit is at the {'first' if i == 0 else 'last'} line of the FRF "
                 f"({f[i]:g} Hz); the FRF band may leave out what limits the cut (a free-free model's "
@@ -181,6 +247,12 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
         a_abs, f_abs = _refine_model(structure, k0, f, i, branch)
     # lobes: n = 60 f / (N (theta / 2 pi + k)), k = 0 .. k_max over both branches
     k_max = int(np.ceil(60.0 * f[valid.any(axis=1)].max() / (teeth * speeds_rpm[0])))
+    points = 2 * (k_max + 1) * f.size
+    if points > MAX_LOBE_POINTS:
+        raise InvalidValueError(
+            f"zoa: {f.size} FRF lines x {k_max + 1} lobes x 2 = {points:.3g} lobe points, more than the limit "
+            f"MAX_LOBE_POINTS = {MAX_LOBE_POINTS:.3g} (about 40 MB per array); crop the FRF to the band that "
+            "matters, use fewer lines, or raise the lowest spindle speed (fewer lobes)")
     k = np.arange(k_max + 1)
     phase = theta.T[:, None, :] / (2.0 * np.pi) + k[None, :, None]  # (2, K, m)
     with np.errstate(divide="ignore"):
@@ -191,7 +263,8 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
     shape = (n.shape[0] * n.shape[1], n.shape[2])
     aa = np.broadcast_to(a.T[:, None, :], n.shape).reshape(shape)
     ff = np.broadcast_to(f[None, None, :], n.shape).reshape(shape)
-    depth, chatter = _lobes_on_speeds(speeds_rpm, n.reshape(shape), aa, ff, ok.reshape(shape[0], -1))
+    envelope = _ZoaEnvelope(n.reshape(shape), aa, ff, ok.reshape(shape[0], -1))
+    depth, chatter = envelope.limit(speeds_rpm)
     # the individual lobes, for plots: within the speed range and below a few times the deepest limit
     finite = depth[np.isfinite(depth)]
     cap = 5.0 * (finite.max() if finite.size else a_abs)
@@ -201,4 +274,4 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
         if show.sum() > 1:
             curves.append((np.where(show, row_n, np.nan), np.where(show, row_a, np.nan)))
     return Lobes("zoa", speeds_rpm, depth, chatter, cut=cut, absolute_limit_m=a_abs,
-                 absolute_limit_frequency_hz=f_abs, lobes=tuple(curves), label=label)
+                 absolute_limit_frequency_hz=f_abs, lobes=tuple(curves), label=label, band=used, source=envelope)
