@@ -153,7 +153,7 @@ def magnitude_in(q: pint.Quantity, unit: str) -> float:
     Parameters
     ----------
     q : pint.Quantity
-        A scalar quantity of :data:`ureg` with the dimension of ``unit``.
+        A scalar quantity of :data:`~substructure.ureg` with the dimension of ``unit``.
     unit : str
         The unit wanted, e.g. ``"m"``.
 
