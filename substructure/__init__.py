@@ -37,7 +37,7 @@ _EXPORTS = {
     "SubstructureWarning": "errors",
     "UnitError": "errors", "UnknownPointError": "errors",
     "FRF": "frf", "Frequency": "frf",
-    "Joint": "joints", "Sensor": "joints", "Support": "joints",
+    "Joint": "joints", "Sensor": "joints", "Support": "joints", "Mass": "joints",
     "CATALOG": "materials", "Material": "materials", "get_material": "materials",
     "Q_": "units", "ureg": "units",
     "default_assembly": "io.assembly_toml", "dumps_assembly": "io.assembly_toml",
@@ -48,7 +48,7 @@ _EXPORTS = {
 
 __all__ = [
     "Assembly", "Beam", "Spindle", "Holder", "Tool", "MeasuredComponent", "Segment", "Insert",
-    "Flutes", "Joint", "Sensor", "Support", "FRF", "Frequency", "Material", "CATALOG",
+    "Flutes", "Joint", "Sensor", "Support", "Mass", "FRF", "Frequency", "Material", "CATALOG",
     "get_material", "COMPONENT_TYPES", "register_component", "shear_coefficient", "add_mass",
     "remove_mass", "modify", "decouple", "ureg", "Q_", "SubstructureError", "UnitError",
     "InvalidValueError", "FrequencyAxisMismatchError", "UnknownPointError", "AssemblyError",
@@ -98,7 +98,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as plain imports
                          SubstructureError, SubstructureWarning, UnitError, UnknownPointError)
     from .frf import FRF, Frequency
     from .io.assembly_toml import default_assembly, dumps_assembly, load_assembly, loads_assembly, save_assembly
-    from .joints import Joint, Sensor, Support
+    from .joints import Joint, Mass, Sensor, Support
     from .materials import CATALOG, Material, get_material
     from .sweep import SweepResult, sweep
     from .units import Q_, ureg

@@ -40,7 +40,7 @@ from ._blocks import CHUNK_LINES, by_chunks
 from .coupling import Link, couple_substructures
 from .errors import AssemblyError, InvalidValueError, UnknownPointError
 from .frf import FRF, Frequency
-from .joints import Joint, Sensor, Support
+from .joints import Joint, Mass, Sensor, Support
 from .materials import Material
 from .points import DOFS, PointRef, parse_point
 
@@ -140,6 +140,9 @@ class Assembly:
         Default frequency grid of the computations and commands.
     materials : sequence of Material
         Custom materials this assembly was defined with (kept for saving).
+    masses : sequence of Mass
+        Bodies permanently on the structure (clamping nuts, balancing rings):
+        unlike sensors, they act in every test and in every prediction.
     """
 
     name: str = attrs.field(default="assembly")
@@ -149,6 +152,7 @@ class Assembly:
     sensors: tuple[Sensor, ...] = attrs.field(default=(), converter=_tuple(Sensor))
     frequency: Frequency | None = attrs.field(default=None)
     materials: tuple[Material, ...] = attrs.field(default=(), converter=_tuple(Material))
+    masses: tuple[Mass, ...] = attrs.field(default=(), converter=_tuple(Mass))
 
     def __attrs_post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.strip():
@@ -165,7 +169,8 @@ class Assembly:
                     )
                 seen[n] = comp.name
         named_supports = tuple(s for s in self.supports if s.name is not None)
-        for kind, items in (("joint", self.joints), ("sensor", self.sensors), ("support", named_supports)):
+        for kind, items in (("joint", self.joints), ("sensor", self.sensors), ("support", named_supports),
+                            ("mass", self.masses)):
             names = [i.name for i in items]
             dup = {n for n in names if names.count(n) > 1}
             if dup:
@@ -177,6 +182,8 @@ class Assembly:
             self._resolve(s.at, f"sensor {s.name!r}")
         for s in self.supports:
             self._resolve(s.at, "support")
+        for m in self.masses:
+            self._resolve(m.at, f"mass {m.name!r}")
 
     # -- lookup -----------------------------------------------------------
 
@@ -256,6 +263,30 @@ class Assembly:
                 return j
         known = ", ".join(j.name for j in self.joints) or "none"
         raise UnknownPointError(f"no joint {name!r} in assembly {self.name!r} (joints: {known})")
+
+    def mass(self, name: str) -> Mass:
+        """The permanent body (:class:`Mass`) called ``name``.
+
+        Parameters
+        ----------
+        name : str
+            Its name.
+
+        Returns
+        -------
+        Mass
+            The body.
+
+        Raises
+        ------
+        UnknownPointError
+            When there is none of that name.
+        """
+        for m in self.masses:
+            if m.name == name:
+                return m
+        known = ", ".join(m.name for m in self.masses) or "none"
+        raise UnknownPointError(f"no mass {name!r} in assembly {self.name!r} (masses: {known})")
 
     def sensor(self, name: str) -> Sensor:
         """The sensor called ``name``.
@@ -341,20 +372,22 @@ class Assembly:
             joint = Joint(label, (a, b), k=k, c=c, rigid=rigid or (k is None and c is None))
         return attrs.evolve(self, joints=self.joints + (joint,))
 
-    def attach(self, *sensors: Sensor) -> "Assembly":
-        """Put sensors on the structure.
+    def attach(self, *sensors: Sensor | Mass) -> "Assembly":
+        """Put sensors (or permanent bodies, :class:`Mass`) on the structure.
 
         Parameters
         ----------
-        *sensors : Sensor
-            The sensors (their mass in kg and rotary inertia act on the model).
+        *sensors : Sensor or Mass
+            The bodies; masses go to ``masses``, sensors to ``sensors``.
 
         Returns
         -------
         Assembly
             A new assembly; this one is unchanged.
         """
-        return attrs.evolve(self, sensors=self.sensors + sensors)
+        masses = tuple(s for s in sensors if isinstance(s, Mass))
+        others = tuple(s for s in sensors if not isinstance(s, Mass))
+        return attrs.evolve(self, sensors=self.sensors + others, masses=self.masses + masses)
 
     def support(self, at: str | Support, k=None, c=None) -> "Assembly":
         """Add springs/dampers to the ground at a point: ``support(Support(...))`` or ``support(at, k, c)``.
@@ -483,6 +516,7 @@ class Assembly:
             joints=tuple(j for j in self.joints if not any(on_removed(p) for p in j.between)),
             sensors=tuple(s for s in self.sensors if not on_removed(s.at)),
             supports=tuple(s for s in self.supports if not on_removed(s.at)),
+            masses=tuple(m for m in self.masses if not on_removed(m.at)),
         )
 
     # -- computing ---------------------------------------------------------
@@ -518,6 +552,8 @@ class Assembly:
         links = []
         for s in self.sensors:
             links.append((node(s.at), None, s, f"sensor {s.name!r}"))
+        for m in self.masses:
+            links.append((node(m.at), None, m, f"mass {m.name!r}"))
         for s in self.supports:
             links.append((node(s.at), None, s, s.name or f"support at {s.at}"))
         for j in self.joints:
@@ -684,6 +720,8 @@ class Assembly:
             lines.append(f"  support at {s.at}: " + ", ".join(f"k_{k}={v}" for k, v in s.k.as_dict().items()))
         for s in self.sensors:
             lines.append(f"  sensor {s.name} at {s.at}: {s.mass:~P}")
+        for m in self.masses:
+            lines.append(f"  mass {m.name} at {m.at}: {m.mass:~P}")
         return "\n".join(lines)
 
 
@@ -725,6 +763,8 @@ class PreparedFRF:
         self._cols = [2 * (len(out_refs) + i) + d for i, d in in_idx]
 
     def _replacement(self, obj, joints, sensors, supports):
+        if isinstance(obj, Mass):
+            return obj
         if isinstance(obj, Sensor):
             new = sensors.get(obj.name, obj)
             where = (obj.at, new.at)
@@ -777,7 +817,7 @@ class PreparedFRF:
                 i = names[name]
                 refs = [ref for _, ref in self._groups[i][1]]
                 blocks_all[i] = (blocks_all[i][0], by_chunks(lambda ff: comp.receptance_matrix(refs, ff), f_all))
-        known = {o.name for _, _, o, _ in self._links if not isinstance(o, (Sensor, Support))}
+        known = {o.name for _, _, o, _ in self._links if not isinstance(o, (Sensor, Support, Mass))}
         unknown = set(joints) - known
         if unknown:
             raise UnknownPointError(f"prepared FRF: no joint {sorted(unknown)} (joints: {sorted(known)})")

@@ -58,6 +58,7 @@ __all__ = [
     "segment_dynamic_stiffness",
     "stepped_beam_receptance",
     "stepped_beam_receptance_batch",
+    "stepped_beam_receptance_si",
 ]
 
 
@@ -750,6 +751,62 @@ def stepped_beam_receptance(
         intervals.append((sections[k], float(x1 - x0)))
     nodes = [int(i) for i in np.searchsorted(cuts, sorted_pos)]
     return _chain_receptance(intervals, nodes, omega, place=[int(i) for i in order])
+
+
+def stepped_beam_receptance_si(
+    ei: np.ndarray, kga: np.ndarray, rhoa: np.ndarray, rhoi: np.ndarray, lengths: np.ndarray,
+    positions: Sequence[float], frequency_hz: np.ndarray,
+) -> np.ndarray:
+    """Free-free receptances of a stepped beam given by SI arrays (no Segment objects).
+
+    The same closed form as :func:`stepped_beam_receptance`, for callers that
+    change section properties many times (model updating): no units are
+    parsed and no value objects are built.
+
+    Parameters
+    ----------
+    ei, kga : ndarray of complex, shape (n_seg,)
+        Bending stiffness [N m^2] and shear stiffness ``kappa G A`` [N] of each
+        segment, base to tip (complex with a loss factor).
+    rhoa, rhoi : ndarray of float, shape (n_seg,)
+        Mass per length [kg/m] and rotary inertia per length [kg m].
+    lengths : ndarray of float, shape (n_seg,)
+        Segment lengths [m], all > 0.
+    positions : sequence of float
+        Distinct positions from the base [m], within ``[0, sum(lengths)]``.
+    frequency_hz : ndarray
+        Frequency lines [Hz], all > 0.
+
+    Returns
+    -------
+    ndarray, shape (2p, 2p, n_freq)
+        Frequency-last receptances; DOFs ``(y, theta)`` per position in the
+        order given.
+    """
+    pos = np.asarray(positions, dtype=float)
+    order = np.argsort(pos)
+    sorted_pos = pos[order]
+    if np.any(np.diff(sorted_pos) <= 0):
+        raise InvalidValueError("positions: expected distinct positions")
+    lengths = np.asarray(lengths, dtype=float)
+    sections = [Section(complex(a), complex(b), float(c), float(d)) for a, b, c, d in zip(ei, kga, rhoa, rhoi)]
+    ends = np.concatenate([[0.0], np.cumsum(lengths)])
+    cuts = np.unique(np.concatenate([ends, sorted_pos]))
+    omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float).reshape(-1)
+    from . import _kernels
+
+    _, k_max = _kernels.segment_coefficients(  # every segment's largest wavenumber, in one call
+        _kernels.c_array(np.asarray(ei, complex).reshape(1, -1), complex),
+        _kernels.c_array(np.asarray(kga, complex).reshape(1, -1), complex),
+        _kernels.c_array(np.asarray(rhoa, float).reshape(1, -1), float),
+        _kernels.c_array(np.asarray(rhoi, float).reshape(1, -1), float), float(np.max(omega)) if omega.size else 0.0)
+    intervals, phases = [], []
+    for x0, x1 in zip(cuts[:-1], cuts[1:]):
+        k = int(np.clip(np.searchsorted(ends, 0.5 * (x0 + x1)) - 1, 0, len(sections) - 1))
+        intervals.append((sections[k], float(x1 - x0)))
+        phases.append(float(k_max[0, k]) * float(x1 - x0))
+    nodes = [int(i) for i in np.searchsorted(cuts, sorted_pos)]
+    return _chain_receptance(intervals, nodes, omega, phases, place=[int(i) for i in order])
 
 
 def _stack_sections(sections: Sequence[Section]) -> Section:

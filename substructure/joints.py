@@ -5,9 +5,11 @@
   acting on ``[y_a - y_b, theta_a - theta_b]`` (thesis eq. 2.5).
 * :class:`Support` is the same matrix between a point and the ground
   (bearings, suspension bands).
-* :class:`Sensor` is a rigid body on a point: mass and rotary inertia, i.e.
-  the dynamic stiffness ``-omega^2 diag(m, J)`` (thesis eq. 5.2); a massless
-  sensor stands for a laser vibrometer.
+* :class:`Sensor` is a rigid body on a point during a test: mass and rotary
+  inertia, i.e. the dynamic stiffness ``-omega^2 diag(m, J)`` (thesis eq.
+  5.2); a massless sensor stands for a laser vibrometer.
+* :class:`Mass` is the same rigid body permanently on the structure (a
+  clamping nut, a balancing ring): on in every test and in the cut.
 
 All three give their dynamic stiffness as an array ``(2, 2, n_freq)``, which is
 all the coupling engine asks of them: a new joint model is a class with
@@ -27,7 +29,7 @@ from .errors import InvalidValueError, NonPassiveJointWarning, NonReciprocalWarn
 from .points import check_name, parse_point
 from .units import format_quantity, magnitude_in, quantity
 
-__all__ = ["JointMatrix", "Joint", "Support", "Sensor", "STIFFNESS_UNITS", "DAMPING_UNITS"]
+__all__ = ["JointMatrix", "Joint", "Support", "Sensor", "Mass", "STIFFNESS_UNITS", "DAMPING_UNITS"]
 
 ENTRIES = ("yf", "ym", "tf", "tm")
 #: The SI unit of each stiffness entry: ``yf`` force per displacement, ``ym`` moment per
@@ -350,19 +352,29 @@ class Sensor:
     Parameters
     ----------
     name : str
-        The sensor's name (``"accelerometer"``).
+        Name of the sensor (measurement records list it by this name).
     at : str
         The point, e.g. ``"tool.tip"``.
     mass : quantity or str
         ``"0 g"`` for a non-contact sensor (laser vibrometer).
     inertia : quantity or str, default "0 kg*m^2"
         Rotary inertia about the bending axis.
+    always_on : bool, default False
+        On the structure in every test, whether a measurement record lists
+        it or not (a body the records do not mention, e.g. one found by a
+        diagnosis).  Still a sensor: ``Assembly.without_sensors()`` takes it
+        off for predictions of the machine in the cut.
     """
 
     name: str = attrs.field(converter=check_name)
     at: str = attrs.field(converter=_point)
     mass: pint.Quantity = attrs.field(converter=_mass)
     inertia: pint.Quantity = attrs.field(default="0 kg*m^2", converter=_inertia)
+    always_on: bool = attrs.field(default=False)
+
+    def __attrs_post_init__(self) -> None:
+        if not isinstance(self.always_on, bool):
+            raise InvalidValueError(f"always_on: got {self.always_on!r}; expected true or false")
 
     @classmethod
     def laser(cls, name: str, at: str) -> "Sensor":
@@ -404,6 +416,61 @@ class Sensor:
         -------
         ndarray
             Complex, shape ``(2, 2, n_freq)``: N/m on y, N m/rad on theta.
+        """
+        w2 = (2.0 * np.pi * np.asarray(frequency_hz, dtype=float)) ** 2
+        out = np.zeros((2, 2, w2.size), dtype=complex)
+        out[0, 0] = -w2 * self.mass_kg
+        out[1, 1] = -w2 * self.inertia_si
+        return out
+
+
+@attrs.frozen
+class Mass:
+    """A rigid body permanently on the structure: a clamping nut, a balancing ring.
+
+    Unlike a :class:`Sensor`, which is on the structure only in the tests
+    that list it, a mass is part of the machine: it acts in every test and in
+    every prediction.  Its dynamic stiffness is ``-omega^2 diag(m, J)``.
+
+    Parameters
+    ----------
+    name : str
+        Name of the body.
+    at : str
+        The point, e.g. ``"holder@50 mm"``.
+    mass : quantity or str
+        Its mass, e.g. ``"120 g"``.
+    inertia : quantity or str, default "0 kg*m^2"
+        Rotary inertia about the bending axis.
+    """
+
+    name: str = attrs.field(converter=check_name)
+    at: str = attrs.field(converter=_point)
+    mass: pint.Quantity = attrs.field(converter=_mass)
+    inertia: pint.Quantity = attrs.field(default="0 kg*m^2", converter=_inertia)
+
+    @property
+    def mass_kg(self) -> float:
+        """Mass in kg."""
+        return float(self.mass.m_as("kg"))
+
+    @property
+    def inertia_si(self) -> float:
+        """Rotary inertia in kg m^2."""
+        return float(self.inertia.m_as("kg*m^2"))
+
+    def dynamic_stiffness(self, frequency_hz: np.ndarray) -> np.ndarray:
+        """``-omega^2 diag(m, J)``, shape ``(2, 2, n_freq)``.
+
+        Parameters
+        ----------
+        frequency_hz : ndarray
+            Frequency lines [Hz].
+
+        Returns
+        -------
+        ndarray, shape (2, 2, n_freq)
+            The dynamic stiffness [N/m, N m/rad].
         """
         w2 = (2.0 * np.pi * np.asarray(frequency_hz, dtype=float)) ** 2
         out = np.zeros((2, 2, w2.size), dtype=complex)

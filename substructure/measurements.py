@@ -24,7 +24,8 @@ from .errors import FrequencyAxisMismatchError, InvalidValueError, SubstructureE
 from .frf import FRF, QUANTITIES, Frequency
 from .points import check_name, parse_point
 
-__all__ = ["Measurement", "MeasurementSet", "MeasurementSetError", "MissingMeasurementError", "dof_label"]
+__all__ = ["Measurement", "MeasurementSet", "MeasurementSetError", "MissingMeasurementError", "dof_label",
+           "model_of_measurement"]
 
 Configuration = tuple[tuple[str, ...], tuple[str, ...]]
 
@@ -517,3 +518,32 @@ class MeasurementSet:
             f"MeasurementSet({self.name!r}, {len(self.measurements)} FRFs, "
             f"{len(self.configurations())} configuration(s), {self.frequency!r})"
         )
+
+
+def model_of_measurement(assembly: Any, measurement: Any) -> Any:
+    """The model of the structure as it was measured: removed components off, sensors on.
+
+    The sensors the measurement lists are put on, and those declared
+    ``always_on`` (bodies the records do not mention); the assembly's other
+    sensors are taken off.  Permanent bodies (``Assembly.masses``) stay.
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model with every sensor the tests used declared.
+    measurement : Measurement or object with ``sensors`` and ``removed``
+        The test (an FRF without them stands for the assembly as given, with
+        its ``always_on`` sensors only).
+
+    Returns
+    -------
+    Assembly
+        The configured model.
+    """
+    removed = tuple(getattr(measurement, "removed", ()) or ())
+    listed = tuple(getattr(measurement, "sensors", ()) or ())
+    model = assembly.without(*removed) if removed else assembly
+    kept = {s.name for s in model.sensors}
+    on = [assembly.sensor(name) for name in listed]
+    on += [s for s in assembly.sensors if getattr(s, "always_on", False) and s.name not in listed and s.name in kept]
+    return model.without_sensors().attach(*on)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Sequence
+from typing import NamedTuple, Sequence
 
 import numpy as np
 import tomli_w
@@ -20,10 +20,15 @@ import tomli_w
 from .assembly import Assembly
 from .errors import InvalidValueError
 from .frf import FRF
-from .measurements import Measurement, MeasurementSet
+from .measurements import Measurement, MeasurementSet, model_of_measurement
 from .points import parse_point
 
 __all__ = ["simulate", "write_measurement_set"]
+
+
+class _Configuration(NamedTuple):
+    sensors: tuple
+    removed: tuple
 
 
 def simulate(assembly: Assembly, points: Sequence[str], excitation: str | None = None, *, frequency=None,
@@ -57,8 +62,7 @@ def simulate(assembly: Assembly, points: Sequence[str], excitation: str | None =
     """
     if noise < 0:
         raise InvalidValueError(f"noise: got {noise!r}; expected a level >= 0")
-    model = assembly.without(*removed) if removed else assembly
-    model = model.without_sensors().attach(*[assembly.sensor(s) for s in sensors])
+    model = model_of_measurement(assembly, _Configuration(tuple(sensors), tuple(removed)))
     excitation = excitation or points[0]
     rng = np.random.default_rng(seed)
     out = []

@@ -39,14 +39,14 @@ from ..beams import Flutes, Insert, Segment
 from ..components import COMPONENT_TYPES, Beam
 from ..errors import FileFormatError, InvalidValueError, SubstructureError
 from ..frf import Frequency
-from ..joints import Joint, Sensor, Support
+from ..joints import Joint, Mass, Sensor, Support
 from ..materials import CATALOG, Material
 from ..points import parse_point
 from ..units import Q_, format_quantity
 
 __all__ = ["load_assembly", "loads_assembly", "save_assembly", "dumps_assembly", "default_assembly"]
 
-_TOP_KEYS = ("name", "frequency", "materials", "components", "joints", "supports", "sensors")
+_TOP_KEYS = ("name", "frequency", "materials", "components", "joints", "supports", "sensors", "masses")
 _FREQUENCY_KEYS = ("start", "stop", "step")
 _MATERIAL_KEYS = ("E", "nu", "rho", "loss_factor")
 _COMPONENT_KEYS = ("name", "type", "material", "segments", "description")
@@ -56,7 +56,8 @@ _INSERT_KEYS = ("od", "material", "id")
 _FLUTES_KEYS = ("diameter_ratio",)
 _JOINT_KEYS = ("name", "between", "k", "c", "rigid")
 _SUPPORT_KEYS = ("name", "at", "k", "c")
-_SENSOR_KEYS = ("name", "at", "mass", "inertia")
+_SENSOR_KEYS = ("name", "at", "mass", "inertia", "always_on")
+_MASS_KEYS = ("name", "at", "mass", "inertia")
 _MATRIX_KEYS = ("yf", "ym", "tf", "tm")
 _MISSING = object()
 _FIELD = re.compile(r"^([A-Za-z_][A-Za-z0-9_.\[\]]*): (.*)$", re.DOTALL)
@@ -218,7 +219,7 @@ class _Reader:
             custom.append(self.call(parts, Material, name, **table))
             self.materials[name] = custom[-1]
         items = {key: self.array(data.get(key, []), [key], f"[[{key}]] tables")
-                 for key in ("components", "joints", "supports", "sensors")}
+                 for key in ("components", "joints", "supports", "sensors", "masses")}
         components = self.unique([self.component(c, ["components", i]) for i, c in enumerate(items["components"])],
                                  "components")
         base = self.call([], Assembly, data["name"], components, frequency=frequency, materials=custom)
@@ -227,7 +228,9 @@ class _Reader:
         self.unique([s for s in supports if s.name is not None], "supports")
         sensors = self.unique([self.sensor(s, ["sensors", i], base) for i, s in enumerate(items["sensors"])],
                               "sensors")
-        return self.call([], Assembly, data["name"], components, joints, supports, sensors, frequency, custom)
+        masses = self.unique([self.mass(m, ["masses", i], base) for i, m in enumerate(items["masses"])], "masses")
+        return self.call([], Assembly, data["name"], components, joints, supports, sensors, frequency, custom,
+                         masses)
 
     def unique(self, items: list, section: str) -> list:
         seen: dict[str, int] = {}
@@ -337,7 +340,15 @@ class _Reader:
         table = self.table(table, parts, _SENSOR_KEYS, ("name", "at", "mass"))
         at = self.point(table["at"], parts + ["at"], base)
         extra = {"inertia": table["inertia"]} if "inertia" in table else {}
+        if "always_on" in table:
+            extra["always_on"] = table["always_on"]
         return self.call(parts, Sensor, table["name"], at, table["mass"], **extra)
+
+    def mass(self, table, parts, base: Assembly) -> Mass:
+        table = self.table(table, parts, _MASS_KEYS, ("name", "at", "mass"))
+        at = self.point(table["at"], parts + ["at"], base)
+        extra = {"inertia": table["inertia"]} if "inertia" in table else {}
+        return self.call(parts, Mass, table["name"], at, table["mass"], **extra)
 
 
 def _init_fields(cls) -> tuple[str, ...]:
@@ -660,8 +671,15 @@ def dumps_assembly(assembly: Assembly) -> str:
     if assembly.sensors:
         doc["sensors"] = [
             {"name": s.name, "at": s.at, "mass": format_quantity(s.mass),
-             **({"inertia": format_quantity(s.inertia)} if s.inertia.magnitude != 0 else {})}
+             **({"inertia": format_quantity(s.inertia)} if s.inertia.magnitude != 0 else {}),
+             **({"always_on": True} if s.always_on else {})}
             for s in assembly.sensors
+        ]
+    if assembly.masses:
+        doc["masses"] = [
+            {"name": m.name, "at": m.at, "mass": format_quantity(m.mass),
+             **({"inertia": format_quantity(m.inertia)} if m.inertia.magnitude != 0 else {})}
+            for m in assembly.masses
         ]
     text = _HEADER_COMMENT + _emit(doc)
     _check_round_trip(assembly, text)
@@ -717,7 +735,7 @@ def _check_round_trip(assembly: Assembly, text: str) -> None:
     if not declared:
         raise InvalidValueError("materials: would not read back equal from an assembly file; refusing to "
                                 "write a file that loses a value")
-    for what in ("frequency", "joints", "supports", "sensors", "name"):
+    for what in ("frequency", "joints", "supports", "sensors", "masses", "name"):
         if not _equal(getattr(assembly, what), getattr(back, what)):
             raise InvalidValueError(f"{what}: would not read back equal from an assembly file; refusing to "
                                     "write a file that loses a value")

@@ -1,0 +1,391 @@
+"""Elements a model may lack, at fitted places: bodies, springs to the ground, changes of section.
+
+Each is a :class:`~substructure.updating.parameters.Change` on one beam
+component with its position fitted along it:
+
+* :class:`AddedMass` (``added-mass``): a rigid body, mass and rotary
+  inertia, at a fitted position: a clamping nut, a balancing ring, a sensor
+  nobody wrote down.  Written back as a permanent body (``[[masses]]``).
+* :class:`GroundSpring` (``ground-spring``): a translational spring to the
+  ground at a fitted position: a suspension band, a fixture, a bearing the
+  model lacks.  Written back as a ``[[supports]]`` entry.
+* :class:`SectionChange` (``section-change``): the outer diameter scaled
+  over a fitted length at a fitted position: a neck, a groove, a collar.
+  Written back as the component's segments split where it begins and ends.
+
+The helper :func:`split_beam` cuts a beam's arrays at positions and scales a
+range of it, shared with the diagnosis catalogue's fluted section.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import UnknownPointError
+from ..joints import Mass, Support
+from ..units import Q_, format_quantity
+from .parameters import Change, ParamSpec
+from .structure import LinkSI
+
+__all__ = ["AddedMass", "GroundSpring", "SectionChange", "split_beam", "split_segments", "unique_name"]
+
+
+def _si(value: float, unit: str) -> str:
+    return format_quantity(Q_(float(value), unit))
+
+
+def _mm(x: float) -> str:
+    return f"{x * 1e3:.4g} mm"
+
+
+def unique_name(taken, base: str) -> str:
+    """``base``, or ``base-2``, ``base-3``, ... : the first not in ``taken``.
+
+    Parameters
+    ----------
+    taken : iterable of str
+        Names in use.
+    base : str
+        The wanted name.
+
+    Returns
+    -------
+    str
+        A free name.
+    """
+    taken = set(taken)
+    name, n = base, 2
+    while name in taken:
+        name, n = f"{base}-{n}", n + 1
+    return name
+
+
+class _OnComponent(Change):
+    def __init__(self, component: str, length: float):
+        self.component = component
+        self.where = component
+        self.length = float(length)
+
+    def place(self, values) -> str:
+        """Where it sits with these values.
+
+        Parameters
+        ----------
+        values : mapping of str to float
+                The change's values by parameter name (SI).
+
+        Returns
+        -------
+        str
+            A point (or range) name such as ``holder@55 mm``.
+        """
+        return f"{self.component}@{_mm(values['position'])}"
+
+
+class AddedMass(_OnComponent):
+    """A rigid body at a fitted position along a beam component.
+
+    Parameters
+    ----------
+    component : str
+        The component's name.
+    length : float
+        Its length [m] (the position's bound).
+    mass_max : float
+        Upper bound of the mass [kg].
+    """
+
+    effect = "added-mass"
+    explanation = ("a body on the structure (a clamping nut, a balancing ring, a sensor) lowers the modes in "
+                   "proportion to the square of their motion where it sits: the modes that move most there drop most")
+
+    def __init__(self, component: str, length: float, mass_max: float):
+        super().__init__(component, length)
+        self.specs = (
+            ParamSpec("mass", "kg", 1e-4, float(mass_max), min(0.01, float(mass_max))),
+            ParamSpec("inertia", "kg*m^2", 1e-10, 1e-3, 1e-8),
+            ParamSpec("position", "m", 0.0, self.length, 0.5 * self.length, log=False),
+        )
+
+    def apply_si(self, structure, values):
+        """The structure with the body as a mass link at its position.
+
+        Parameters
+        ----------
+        structure : Structure
+            The SI form of one test configuration.
+        values : mapping of str to float
+                The change's values by parameter name (SI).
+
+        Returns
+        -------
+        Structure
+            The changed structure.
+        """
+        link = LinkSI(("added", f"mass-{self.component}-{len(structure.links)}"),
+                      (self.component, float(values["position"])),
+                      M=np.diag([values["mass"], values["inertia"]]))
+        return structure.add_link(link)
+
+    def apply(self, assembly, values):
+        """The assembly with the body as a permanent :class:`~substructure.joints.Mass`.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        values : mapping of str to float
+                The change's values by parameter name (SI).
+
+        Returns
+        -------
+        Assembly
+            A new assembly.
+
+        Raises
+        ------
+        UnknownPointError
+            When the component is not in this assembly.
+        """
+        if self.component not in assembly.component_names:
+            raise UnknownPointError(f"no component {self.component!r}")
+        name = unique_name([m.name for m in assembly.masses], f"diagnosed-{self.component}-mass")
+        return assembly.attach(Mass(name, f"{self.component}@{_si(values['position'], 'm')}",
+                                    _si(values["mass"], "kg"), _si(values["inertia"], "kg*m^2")))
+
+
+class GroundSpring(_OnComponent):
+    """A translational spring to the ground at a fitted position along a beam component.
+
+    Parameters
+    ----------
+    component : str
+        The component's name.
+    length : float
+        Its length [m].
+    """
+
+    effect = "ground-spring"
+    explanation = ("a spring to the ground (a suspension band, a fixture, a bearing) holds the structure: "
+                   "rigid-body motion becomes low modes, and modes with motion at the spring rise")
+
+    def __init__(self, component: str, length: float):
+        super().__init__(component, length)
+        self.specs = (
+            ParamSpec("k_yf", "N/m", 1.0, 1e10, 1e5),
+            ParamSpec("position", "m", 0.0, self.length, 0.5 * self.length, log=False),
+        )
+
+    def apply_si(self, structure, values):
+        """The structure with the spring as a link to the ground.
+
+        Parameters
+        ----------
+        structure : Structure
+            The SI form of one test configuration.
+        values : mapping of str to float
+                The change's values by parameter name (SI).
+
+        Returns
+        -------
+        Structure
+            The changed structure.
+        """
+        link = LinkSI(("added", f"spring-{self.component}-{len(structure.links)}"),
+                      (self.component, float(values["position"])), K=np.diag([values["k_yf"], 0.0]))
+        return structure.add_link(link)
+
+    def apply(self, assembly, values):
+        """The assembly with the spring as a :class:`~substructure.joints.Support`.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        values : mapping of str to float
+                The change's values by parameter name (SI).
+
+        Returns
+        -------
+        Assembly
+            A new assembly.
+
+        Raises
+        ------
+        UnknownPointError
+            When the component is not in this assembly.
+        """
+        if self.component not in assembly.component_names:
+            raise UnknownPointError(f"no component {self.component!r}")
+        name = unique_name([s.name for s in assembly.supports if s.name], f"diagnosed-{self.component}-spring")
+        return assembly.support(Support(f"{self.component}@{_si(values['position'], 'm')}",
+                                        k={"yf": _si(values["k_yf"], "N/m")}, name=name))
+
+
+def split_beam(beam, start: float, stop: float, od_factor: float = 1.0, flutes: float | None = None):
+    """A beam's arrays cut at ``start`` and ``stop`` [m], the part between changed.
+
+    Parameters
+    ----------
+    beam : BeamArrays
+        The beam.
+    start, stop : float
+        The range [m from the base], ``0 <= start < stop <= length``.
+    od_factor : float
+        The outer diameter in the range is multiplied by this.
+    flutes : float, optional
+        The flutes' diameter ratio in the range (replacing any).
+
+    Returns
+    -------
+    BeamArrays
+        The changed beam.
+    """
+    ends = np.concatenate([[0.0], np.cumsum(beam.length)])
+    total = ends[-1]
+    start, stop = max(0.0, float(start)), min(total, float(stop))
+    cuts = np.unique(np.concatenate([ends, [start, stop]]))
+    cuts = cuts[np.concatenate([[True], np.diff(cuts) > 1e-12 * total])]
+    idx, lengths, inside = [], [], []
+    for x0, x1 in zip(cuts[:-1], cuts[1:]):
+        k = int(np.clip(np.searchsorted(ends, 0.5 * (x0 + x1)) - 1, 0, beam.length.size - 1))
+        idx.append(k)
+        lengths.append(x1 - x0)
+        inside.append(start - 1e-12 <= 0.5 * (x0 + x1) <= stop + 1e-12)
+    idx, inside = np.array(idx), np.array(inside)
+    od = beam.od[idx] * np.where(inside, od_factor, 1.0)
+    ratio = beam.ratio[idx].copy()
+    if flutes is not None:
+        ratio[inside] = flutes
+    bore = beam.id[idx]
+    od = np.maximum(od, bore * 1.0001 / ratio)
+    return beam.evolve(length=np.array(lengths), od=od, id=bore, ratio=ratio, material=beam.material[idx],
+                       material_names=[beam.material_names[i] for i in idx], insert=beam.insert[idx],
+                       insert_names=[beam.insert_names[i] for i in idx])
+
+
+def split_segments(component, start: float, stop: float, change):
+    """A beam component with its segments cut at ``start`` and ``stop`` [m], ``change(segment)`` between.
+
+    Parameters
+    ----------
+    component : Beam
+        The component.
+    start, stop : float
+        The range [m from the base].
+    change : callable
+        Returns the changed segment for a piece inside the range.
+
+    Returns
+    -------
+    Beam
+        A new component (segments as value objects, for files).
+    """
+    import attrs
+
+    segments, x = [], 0.0
+    for seg in component.segments:
+        x0, x1 = x, x + seg.length_m
+        x = x1
+        pieces = [p for p in (x0, max(x0, min(x1, start)), max(x0, min(x1, stop)), x1)]
+        for a, b in zip(pieces[:-1], pieces[1:]):
+            if b - a <= 1e-12 * max(x1, 1e-3):
+                continue
+            piece = seg if (a, b) == (x0, x1) else attrs.evolve(seg, length=_si(b - a, "m"))
+            segments.append(change(piece) if start - 1e-12 <= 0.5 * (a + b) <= stop + 1e-12 else piece)
+    return attrs.evolve(component, segments=segments)
+
+
+class SectionChange(_OnComponent):
+    """The outer diameter scaled over a fitted range of a beam component (a neck, a collar).
+
+    Parameters
+    ----------
+    component : str
+        The component's name.
+    length : float
+        Its length [m].
+    """
+
+    effect = "section-change"
+    explanation = ("a part of the component is thinner (a neck, a groove) or thicker (a collar) than the model: "
+                   "the bending stiffness there changes with the fourth power of the diameter, the mass with "
+                   "its square, so the modes that bend that part move most")
+
+    def __init__(self, component: str, length: float):
+        super().__init__(component, length)
+        self.specs = (
+            ParamSpec("diameter_ratio", "dimensionless", 0.4, 1.5, 1.0, log=False),
+            ParamSpec("start", "m", 0.0, self.length, 0.25 * self.length, log=False),
+            ParamSpec("length", "m", 0.02 * self.length, self.length, 0.25 * self.length),
+        )
+
+    def place(self, values) -> str:
+        """Where it sits with these values.
+
+        Parameters
+        ----------
+        values : mapping of str to float
+                The change's values by parameter name (SI).
+
+        Returns
+        -------
+        str
+            A point (or range) name such as ``holder@55 mm``.
+        """
+        stop = min(self.length, values["start"] + values["length"])
+        return f"{self.component}@{_mm(values['start'])}-{_mm(stop)}"
+
+    def apply_si(self, structure, values):
+        """The structure with the beam's section scaled over the range.
+
+        Parameters
+        ----------
+        structure : Structure
+            The SI form of one test configuration.
+        values : mapping of str to float
+                The change's values by parameter name (SI).
+
+        Returns
+        -------
+        Structure
+            The changed structure.
+        """
+        beam = structure.beam(self.component)
+        start = float(values["start"])
+        return structure.with_beam(split_beam(beam, start, start + float(values["length"]),
+                                              od_factor=float(values["diameter_ratio"])))
+
+    def apply(self, assembly, values):
+        """The assembly with the component's segments split and the range's diameter scaled.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        values : mapping of str to float
+                The change's values by parameter name (SI).
+
+        Returns
+        -------
+        Assembly
+            A new assembly.
+
+        Raises
+        ------
+        UnknownPointError
+            When the component is not in this assembly.
+        """
+        import attrs
+
+        comp = assembly.component(self.component)
+        start = float(values["start"])
+        ratio = float(values["diameter_ratio"])
+
+        def thinner(seg):
+            od = seg.od.m_as("m") * ratio
+            if seg.flutes is not None:
+                od = max(od, 1.0001 * seg.id.m_as("m") / seg.flutes.diameter_ratio)
+            return attrs.evolve(seg, od=_si(max(od, 1.0001 * seg.id.m_as("m")), "m"))
+
+        return assembly.with_component(split_segments(comp, start, start + float(values["length"]), thinner))

@@ -1,0 +1,248 @@
+"""Weighted nonlinear least squares on whitened residuals, with standard deviations.
+
+:func:`fit` minimises ``chi^2`` of a :class:`~substructure.updating.likelihood.Likelihood`
+over the parameters of a list of changes with scipy's bounded
+trust-region reflective method.  Parameters that span decades are fitted as
+logarithms (``u = ln v``), the others scaled to order one
+(``u = v / s``, ``s`` a tenth of their range).
+
+Standard deviations and correlations come from the Jacobian ``J`` of the
+whitened residual at the optimum: ``Cov(u) = s^2 (J^T J)^-1`` with
+``s^2 = max(1, chi^2 / (n - p))``.  When the residual is consistent with the
+noise ``s^2`` is about one and the covariance is the Cramer-Rao bound; when
+it is not (the model misses something), the covariance is inflated by the
+misfit, as if the noise were that much larger (the quasi-likelihood
+correction), so that a wrong model does not report tight values.  Values
+follow by the delta method: ``std(v) = v std(u)`` on the log scale.
+"""
+
+from __future__ import annotations
+
+from typing import Callable, Sequence
+
+import attrs
+import numpy as np
+from scipy.optimize import least_squares
+
+from ..errors import InvalidValueError
+from .parameters import Change, ParamSpec
+
+__all__ = ["Fit", "fit", "scan", "FTOL", "XTOL"]
+
+FTOL = 1e-7
+"""Relative change of ``chi^2`` at which a fit stops: well below one unit of ``chi^2`` for any data set
+of fewer than ten million residuals, so that likelihood ratios are not blurred by unconverged fits."""
+XTOL = 1e-7
+"""Relative change of the fitted variables at which a fit stops."""
+
+
+def _scale(spec: ParamSpec) -> float:
+    return max((spec.upper - spec.lower) / 10.0, 1e-300)
+
+
+def to_u(spec: ParamSpec, value: float) -> float:
+    """The fitted variable of a value: ``ln v`` on a log scale, ``v / s`` on a linear one.
+
+    Parameters
+    ----------
+    spec : ParamSpec
+        The parameter.
+    value : float
+        Its value (SI).
+
+    Returns
+    -------
+    float
+        The fitted variable.
+    """
+    return float(np.log(value)) if spec.log else float(value) / _scale(spec)
+
+
+def from_u(spec: ParamSpec, u: float) -> float:
+    """The value of a fitted variable, within the parameter's bounds.
+
+    Parameters
+    ----------
+    spec : ParamSpec
+        The parameter.
+    u : float
+        The fitted variable.
+
+    Returns
+    -------
+    float
+        The value (SI).
+    """
+    if spec.log:
+        v = float(np.exp(np.clip(u, np.log(spec.lower), np.log(spec.upper))))
+    else:
+        v = float(u) * _scale(spec)
+    return float(np.clip(v, spec.lower, spec.upper))
+
+
+def _bounds_u(spec: ParamSpec) -> tuple[float, float]:
+    if spec.log:
+        if spec.lower <= 0:
+            raise InvalidValueError(f"parameter {spec.name}: a log-scale parameter needs lower > 0, got {spec.lower}")
+        return float(np.log(spec.lower)), float(np.log(spec.upper))
+    return spec.lower / _scale(spec), spec.upper / _scale(spec)
+
+
+@attrs.frozen
+class Fit:
+    """The result of :func:`fit`.
+
+    Parameters
+    ----------
+    changes : tuple of (Change, dict)
+        The changes with their fitted values (SI, by parameter name).
+    std : tuple of dict
+        Standard deviations per change and parameter (inflated by the misfit).
+    correlation : ndarray
+        Correlations between all fitted parameters, in the order of ``names``.
+    names : tuple of (int, str)
+        ``(change index, parameter name)`` of each fitted parameter.
+    chi2 : float
+        ``chi^2`` at the optimum.
+    n : int
+        Number of residuals.
+    nfev : int
+        Model evaluations used.
+    at_bound : tuple of bool
+        Per fitted parameter, whether it ended on a bound.
+    """
+
+    changes: tuple = attrs.field(eq=False)
+    std: tuple
+    correlation: np.ndarray = attrs.field(eq=False, repr=False)
+    names: tuple
+    chi2: float
+    n: int
+    nfev: int
+    at_bound: tuple
+
+    @property
+    def p(self) -> int:
+        """Number of fitted parameters."""
+        return len(self.names)
+
+    @property
+    def dof(self) -> int:
+        """Degrees of freedom ``n - p``."""
+        return max(self.n - self.p, 1)
+
+    @property
+    def chi2_reduced(self) -> float:
+        """``chi^2 / (n - p)``: about 1 when the residual is noise."""
+        return self.chi2 / self.dof
+
+
+def fit(likelihood, changes: Sequence[tuple], free: Sequence[bool] | None = None, max_nfev: int | None = None,
+        progress: Callable[[str], None] | None = None) -> Fit:
+    """Fit the parameters of changes to the data of a likelihood.
+
+    Parameters
+    ----------
+    likelihood : Likelihood
+        The data and the model evaluation.
+    changes : sequence of (Change, dict)
+        The changes in the order they apply, each with its starting values
+        (SI, by parameter name; missing ones start at the spec's ``start``).
+    free : sequence of bool, optional
+        Which changes are fitted (default all); the others keep their values.
+    max_nfev : int, optional
+        Most residual evaluations of the optimiser (default ``30 (p + 1)``).
+    progress : callable, optional
+        Called with a line of text when the fit ends.
+
+    Returns
+    -------
+    Fit
+        Values, standard deviations (inflated by the misfit), correlations.
+    """
+    changes = [(c, dict(v)) for c, v in changes]
+    free = [True] * len(changes) if free is None else list(free)
+    slots = []  # (change index, spec)
+    for i, ((change, values), is_free) in enumerate(zip(changes, free)):
+        for spec in change.specs:
+            if spec.name not in values:
+                values[spec.name] = spec.start
+            values[spec.name] = float(np.clip(values[spec.name], spec.lower, spec.upper))
+            if is_free:
+                slots.append((i, spec))
+
+    def model_of(u):
+        current = [(c, dict(v)) for c, v in changes]
+        for (i, spec), ui in zip(slots, u):
+            current[i][1][spec.name] = from_u(spec, ui)
+        return current
+
+    def residual(u):
+        return likelihood.residual(model_of(u))
+
+    if not slots:
+        r = likelihood.residual(changes)
+        return Fit(tuple(changes), tuple({} for _ in changes), np.zeros((0, 0)), (), float(r @ r), r.size, 1, ())
+    bounds = np.array([_bounds_u(s) for _, s in slots])
+    lo, hi = bounds[:, 0], bounds[:, 1]
+    u0 = np.array([to_u(s, changes[i][1][s.name]) for i, s in slots])
+    span = np.maximum(hi - lo, 1e-12)
+    u0 = np.clip(u0, lo + 1e-9 * span, hi - 1e-9 * span)
+    result = least_squares(residual, u0, bounds=(lo, hi), method="trf", x_scale=1.0, diff_step=1e-6,
+                           ftol=FTOL, xtol=XTOL, max_nfev=max_nfev or 30 * (len(slots) + 1))
+    u = result.x
+    f0 = result.fun
+    jac = result.jac
+    chi2 = float(f0 @ f0)
+    n, p = f0.size, len(slots)
+    s2 = max(1.0, chi2 / max(n - p, 1))
+    cov = s2 * np.linalg.pinv(jac.T @ jac)
+    sd_u = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        corr = cov / np.outer(sd_u, sd_u)
+    corr = np.where(np.isfinite(corr), corr, 0.0)
+    final = model_of(u)
+    std = [dict() for _ in changes]
+    at_bound = []
+    for (i, spec), ui, sd in zip(slots, u, sd_u):
+        v = final[i][1][spec.name]
+        std[i][spec.name] = float(abs(v) * sd) if spec.log else float(_scale(spec) * sd)
+        width = 1e-6 * (hi - lo)[len(at_bound)]
+        at_bound.append(bool(ui <= lo[len(at_bound)] + width or ui >= hi[len(at_bound)] - width))
+    if progress:
+        progress(f"fitted {', '.join(f'{c.effect} at {c.where}' for c, _ in final)}: chi^2/n = {chi2 / n:.4g}")
+    return Fit(tuple(final), tuple(std), corr, tuple((i, s.name) for i, s in slots), chi2, n,
+               int(result.nfev) + int(result.njev) * p, tuple(at_bound))
+
+
+def scan(likelihood, fixed: Sequence[tuple], change: Change, values: dict, name: str,
+         grid: Sequence[float]) -> tuple[float, float]:
+    """The best value of one parameter on a grid, others held: ``(chi2, value)``.
+
+    Parameters
+    ----------
+    likelihood : Likelihood
+        The data.
+    fixed : sequence of (Change, dict)
+        Changes applied first, with their values.
+    change : Change
+        The change scanned.
+    values : dict
+        Its other parameters' values.
+    name : str
+        The parameter scanned.
+    grid : sequence of float
+        Values to try.
+
+    Returns
+    -------
+    (float, float)
+        The lowest ``chi^2`` and its value.
+    """
+    best = (np.inf, float(values.get(name, np.nan)))
+    for v in grid:
+        trial = {**values, name: float(v)}
+        chi2 = likelihood.chi2(list(fixed) + [(change, trial)])
+        if chi2 < best[0]:
+            best = (chi2, float(v))
+    return best

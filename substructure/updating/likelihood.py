@@ -1,0 +1,310 @@
+"""The likelihood of a model given measured FRFs: whitened complex log ratios.
+
+For measured FRFs ``H_j`` with the per-line noise of
+:mod:`substructure.updating.noise` and a model ``M_j(theta)`` of the same
+entries, the residual of line ``k`` of FRF ``j`` is
+``r_jk = ln(M_jk / H_jk)`` and, the noise being Gaussian in ``ln H`` with
+variances ``v_re,jk`` and ``v_im,jk``,
+
+``-2 ln L(theta) = chi^2(theta) + const,
+chi^2 = sum_jk [ Re(r_jk)^2 / v_re,jk + Im(r_jk)^2 / v_im,jk ]``.
+
+:class:`Likelihood` evaluates the whitened residual vector (whose sum of
+squares is ``chi^2``) for a model given as the assembly plus a list of
+changes (:class:`~substructure.updating.parameters.Change` with values),
+each measured FRF in its own configuration (sensors on, components off, as
+its measurement says).  Every configuration is evaluated once per model on
+the SI form of the structure; changes that have an SI form are applied
+there, others (registered effects without one) on the assembly.
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import attrs
+import numpy as np
+
+from ..errors import InvalidValueError, UnknownPointError
+from ..frf import FRF
+from ..measurements import model_of_measurement
+from .noise import NoiseModel, estimate_noise
+from .parameters import Change
+from .structure import Evaluator, Structure
+
+__all__ = ["Measured", "Likelihood", "measured_frfs", "LOG_RATIO_PENALTY"]
+
+LOG_RATIO_PENALTY = 10.0
+"""The log ratio used where a model value is zero or not finite [-]."""
+
+
+@attrs.frozen
+class Measured:
+    """One measured FRF entry with its noise and its test configuration.
+
+    Parameters
+    ----------
+    label : str
+        ``"response / excitation"``, for messages.
+    frf : FRF
+        The receptance (one entry), on the band analysed.
+    noise : NoiseModel
+        Its per-line noise.
+    measurement : object
+        The measurement (with ``sensors`` and ``removed``) or the FRF itself.
+    """
+
+    label: str
+    frf: FRF = attrs.field(eq=False)
+    noise: NoiseModel = attrs.field(eq=False)
+    measurement: object = attrs.field(eq=False)
+
+    @property
+    def configuration(self) -> tuple:
+        """``(sensors, removed)`` sorted: measurements alike share one evaluation."""
+        return (tuple(sorted(getattr(self.measurement, "sensors", ()) or ())),
+                tuple(sorted(getattr(self.measurement, "removed", ()) or ())))
+
+
+def measured_frfs(measurements, band=None) -> tuple[list[Measured], tuple[float, float]]:
+    """Measured FRFs (one entry each) cropped to a band, with their noise estimated on the whole record.
+
+    Parameters
+    ----------
+    measurements : MeasurementSet, or sequence of measurements or FRFs
+        The data; an FRF with several entries counts as one per entry.
+    band : (float, float), optional
+        Lines ``lo <= f <= hi`` [Hz]; default all.
+
+    Returns
+    -------
+    (list of Measured, (lo, hi))
+        The data and the band used.
+
+    Raises
+    ------
+    InvalidValueError
+        For no data, a band not within the data (saying which part is
+        outside), fewer than 10 lines in the band, or an FRF that is zero on
+        every line (named).
+    """
+    items = []
+    for m in measurements:
+        frf = m if isinstance(m, FRF) else getattr(m, "frf", None)
+        if not isinstance(frf, FRF):
+            raise InvalidValueError(f"measurements: got {m!r}; expected FRFs or measurements")
+        frf = frf.to_receptance()
+        for i, out in enumerate(frf.outputs):
+            for j, inp in enumerate(frf.inputs):
+                items.append((m, frf.select([out], [inp]) if frf.shape[1:] != (1, 1) else frf))
+    if not items:
+        raise InvalidValueError("measurements: got none")
+    f0 = items[0][1].frequency
+    full = (float(f0.hz[0]), float(f0.hz[-1]))
+    lo, hi = full if band is None else band
+    try:
+        lo, hi = float(lo), float(hi)
+    except (TypeError, ValueError):
+        raise InvalidValueError(f"band: got {band!r}; expected (lo, hi) in Hz") from None
+    if not lo < hi:
+        raise InvalidValueError(f"band: got {lo:g}-{hi:g} Hz; expected lo < hi")
+    tol = 1e-9 * max(abs(full[1]), 1.0)
+    if hi < full[0] or lo > full[1]:
+        raise InvalidValueError(f"band: {lo:g}-{hi:g} Hz is outside the measured data ({full[0]:g}-{full[1]:g} Hz)")
+    if lo < full[0] - tol or hi > full[1] + tol:
+        part = (f"starts at {lo:g} Hz, below the first measured line ({full[0]:g} Hz)" if lo < full[0] - tol
+                else f"ends at {hi:g} Hz, above the last measured line ({full[1]:g} Hz)")
+        raise InvalidValueError(f"band: {lo:g}-{hi:g} Hz {part}; the data cover {full[0]:g}-{full[1]:g} Hz: "
+                                "give a band within them")
+    out = []
+    for m, frf in items:
+        label = f"{frf.outputs[0]} / {frf.inputs[0]}"
+        h = frf.data[:, 0, 0]
+        if not np.any(np.isfinite(h) & (np.abs(h) > 0)):
+            where = getattr(m, "describe", lambda: label)()
+            raise InvalidValueError(f"measured FRF {where}: zero (or not finite) on every line: a dead channel? "
+                                    "Leave it out of the measurement set")
+        noise = estimate_noise(frf)
+        mask = frf.frequency.band_mask(lo, hi)
+        if mask.sum() < 10:
+            raise InvalidValueError(f"band: {lo:g}-{hi:g} Hz holds {int(mask.sum())} lines of {label}; "
+                                    "at least 10 are needed")
+        out.append(Measured(label, frf.crop(lo, hi), noise.select(mask), m))
+    return out, (lo, hi)
+
+
+def _has_si(change) -> bool:
+    return type(change).apply_si is not Change.apply_si
+
+
+class _Group:
+    """The measured FRFs of one configuration: one evaluation gives all of them."""
+
+    def __init__(self, assembly, items: list[tuple[int, Measured]], lines: np.ndarray):
+        first = items[0][1]
+        self.indices = [i for i, _ in items]
+        self.assembly = model_of_measurement(assembly, first.measurement)
+        self.structure = Structure.from_assembly(self.assembly)
+        outputs = list(dict.fromkeys(m.frf.outputs[0] for _, m in items))
+        inputs = list(dict.fromkeys(m.frf.inputs[0] for _, m in items))
+        self.entries = [(outputs.index(m.frf.outputs[0]), inputs.index(m.frf.inputs[0])) for _, m in items]
+        self.evaluator = Evaluator(outputs, inputs, first.frf.frequency.hz[lines])
+
+    def structure_with(self, changes: Sequence[tuple]) -> Structure:
+        if all(_has_si(c) for c, _ in changes):
+            s = self.structure
+            for change, values in changes:
+                try:
+                    s = change.apply_si(s, values)
+                except UnknownPointError:  # no place for it in this configuration
+                    continue
+            return s
+        a = self.assembly
+        for change, values in changes:
+            try:
+                a = change.apply(a, values)
+            except UnknownPointError:
+                continue
+        return Structure.from_assembly(a, like=self.structure)
+
+    def predict(self, changes) -> list[np.ndarray]:
+        y = self.evaluator(self.structure_with(changes))
+        return [y[:, i, j] for i, j in self.entries]
+
+
+class Likelihood:
+    """``chi^2`` of models (the assembly with changes) against measured FRFs.
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model as given (sensors declared; each measurement's
+        configuration is set from it).
+    measured : sequence of Measured
+        The data (:func:`measured_frfs`).
+    lines : ndarray of int, optional
+        Indices of the lines to use (default all): a subsample for screening.
+    """
+
+    def __init__(self, assembly, measured: Sequence[Measured], lines: np.ndarray | None = None):
+        self.assembly = assembly
+        self.measured = list(measured)
+        n = self.measured[0].frf.frequency.n
+        self.lines = np.arange(n) if lines is None else np.asarray(lines)
+        groups: dict[tuple, list] = {}
+        for i, m in enumerate(self.measured):
+            groups.setdefault(m.configuration, []).append((i, m))
+        self.groups = [_Group(assembly, items, self.lines) for items in groups.values()]
+        self.data = [m.frf.data[self.lines, 0, 0] for m in self.measured]
+        self.w_re = [1.0 / np.sqrt(m.noise.var_re[self.lines]) for m in self.measured]
+        self.w_im = [1.0 / np.sqrt(m.noise.var_im[self.lines]) for m in self.measured]
+        self.n = 2 * sum(d.size for d in self.data)
+        self.evaluations = 0
+
+    def subsample(self, step: int) -> "Likelihood":
+        """The same likelihood on every ``step``-th line (for cheap screening).
+
+        Parameters
+        ----------
+        step : int
+            Keep every this-many-th line.
+
+        Returns
+        -------
+        Likelihood
+            The subsampled likelihood (the same noise per line).
+        """
+        return Likelihood(self.assembly, self.measured, self.lines[:: max(1, int(step))])
+
+    def predict(self, changes: Sequence[tuple] = ()) -> list[np.ndarray]:
+        """Model values per measured FRF on the lines used.
+
+        Parameters
+        ----------
+        changes : sequence of (Change, dict)
+            The changes with their values (SI), applied in order.
+
+        Returns
+        -------
+        list of ndarray
+            Complex receptances, one array per measured FRF.
+        """
+        self.evaluations += 1
+        out: list = [None] * len(self.measured)
+        for g in self.groups:
+            for i, y in zip(g.indices, g.predict(changes)):
+                out[i] = y
+        return out
+
+    def log_ratios(self, changes: Sequence[tuple] = ()) -> list[np.ndarray]:
+        """``ln(model / measured)`` per measured FRF (non-finite values replaced by a penalty).
+
+        Parameters
+        ----------
+        changes : sequence of (Change, dict)
+            The changes with their values (SI), applied in order.
+
+        Returns
+        -------
+        list of ndarray
+            Complex log ratios, one array per measured FRF.
+        """
+        out = []
+        for model, data in zip(self.predict(changes), self.data):
+            with np.errstate(divide="ignore", invalid="ignore"):
+                r = np.log(model / data)
+            bad = ~np.isfinite(r)
+            if bad.any():
+                r = np.where(bad, LOG_RATIO_PENALTY * (1 + 1j), r)
+            out.append(r)
+        return out
+
+    def whiten(self, ratios: Sequence[np.ndarray]) -> np.ndarray:
+        """The whitened residual vector of log ratios (real parts, then imaginary parts, per FRF).
+
+        Parameters
+        ----------
+        ratios : sequence of ndarray
+            Log ratios per measured FRF (:meth:`log_ratios`).
+
+        Returns
+        -------
+        ndarray
+            Each part divided by its standard deviation.
+        """
+        parts = []
+        for r, wr, wi in zip(ratios, self.w_re, self.w_im):
+            parts.append(r.real * wr)
+            parts.append(r.imag * wi)
+        return np.concatenate(parts)
+
+    def residual(self, changes: Sequence[tuple] = ()) -> np.ndarray:
+        """The whitened residual vector; its sum of squares is ``chi^2``.
+
+        Parameters
+        ----------
+        changes : sequence of (Change, dict)
+            The changes with their values (SI), applied in order.
+
+        Returns
+        -------
+        ndarray
+            The residuals.
+        """
+        return self.whiten(self.log_ratios(changes))
+
+    def chi2(self, changes: Sequence[tuple] = ()) -> float:
+        """``chi^2`` of the model (``-2 ln L`` up to a constant).
+
+        Parameters
+        ----------
+        changes : sequence of (Change, dict)
+            The changes with their values (SI), applied in order.
+
+        Returns
+        -------
+        float
+            The sum of squared whitened residuals.
+        """
+        r = self.residual(changes)
+        return float(r @ r)

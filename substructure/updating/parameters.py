@@ -1,0 +1,615 @@
+"""Every number of an assembly by its path in the assembly file, and changes that fit them.
+
+A model parameter is named by where it sits in the assembly file:
+
+=============================================  ==========================================
+path                                           value (SI)
+=============================================  ==========================================
+``components.C.segments.I.length|od|id``       a segment's length or diameter [m]
+``components.C.segments.I.insert.od|id``       the insert's diameters [m]
+``components.C.segments.I.flutes.diameter_ratio``  the flutes' equivalent diameter ratio
+``materials.M.E|rho|nu|loss_factor``           a material, in every part made of it
+``joints.J.k.yf|ym|tm``, ``joints.J.c.yf|ym|tm``   a joint entry (``ym`` sets ``tf`` too)
+``supports.I.k.E``, ``supports.I.c.E``         a support entry (``I``: index in the file)
+``supports.I.at``                              a support's position along its component [m]
+``sensors.S.mass|inertia``                     a sensor [kg, kg m^2]
+``masses.S.mass|inertia|at``                   a permanent body
+=============================================  ==========================================
+
+and a few *linked* parameters that move several numbers as one thing a user
+thinks of: ``components.C.overhang`` (a tool's length out of the holder [m]:
+the first segment at the shank end changes, the fluted length stays),
+``components.C.E|rho|loss_factor`` (that component's own material only, as
+a factor: "this component is stiffer"; materials are shared between
+components, so ``materials.M.E`` is another candidate),
+``joints.J.k`` and ``joints.J.c`` (every entry of a joint's stiffness or
+damping, as a factor) and ``components.C.supports.k`` (the stiffness of
+every support on a component, as a factor: a bearing preload).
+
+:func:`model_parameters` lists them with physical bounds per kind,
+:func:`get_parameter` and :func:`set_parameters` read and change them on an
+:class:`~substructure.assembly.Assembly` (the result saves normally), and
+:class:`ParameterChange` applies one to the SI form of a structure
+(:mod:`substructure.updating.structure`) for fits.  :class:`Change` is the
+protocol every fitted change follows (a parameter correction, an added
+element, an effect of the diagnosis catalogue).
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Mapping
+
+import attrs
+import numpy as np
+
+from ..components import Tool
+from ..errors import InvalidValueError, NonPassiveJointWarning, UnknownPointError
+from ..joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint
+from ..materials import Material
+from ..units import Q_, format_quantity
+from .changes import Change, ParamSpec
+from .paths import apply_path_si
+
+__all__ = ["ParamSpec", "Change", "ModelParameter", "ParameterChange", "ParameterSet", "model_parameters",
+           "get_parameter", "set_parameters", "apply_path_si"]
+
+
+@attrs.frozen
+class ModelParameter:
+    """A number of an assembly that a fit may correct.
+
+    Parameters
+    ----------
+    path : str
+        Where it sits in the assembly file (see the module docstring).
+    unit : str
+        SI unit (``dimensionless`` for the factors of linked parameters).
+    nominal : float
+        Its value in the assembly.
+    lower, upper : float
+        Physical bounds.
+    log : bool
+        Fitted on a log scale.
+    description : str
+        What it is, in words.
+    linked : bool
+        Several numbers moved as one (an overhang, a component's material, a
+        joint's whole stiffness, a set of supports).
+    """
+
+    path: str
+    unit: str
+    nominal: float
+    lower: float
+    upper: float
+    log: bool
+    description: str
+    linked: bool = False
+
+    def spec(self) -> ParamSpec:
+        """The fitted parameter ``value``, starting at the nominal value.
+
+        Returns
+        -------
+        ParamSpec
+            Bounds, scale and the nominal value.
+        """
+        start = float(np.clip(self.nominal, self.lower, self.upper))
+        return ParamSpec("value", self.unit, self.lower, self.upper, start, self.log, self.nominal)
+
+
+def _si(value: float, unit: str) -> str:
+    return format_quantity(Q_(float(value), unit))
+
+
+def _plain(component) -> bool:
+    from .structure import si_beam
+
+    return si_beam(component)
+
+
+def _log(path, unit, nominal, lo, hi, text) -> ModelParameter:
+    return ModelParameter(path, unit, float(nominal), float(lo), float(hi), True, text)
+
+
+def _lin(path, unit, nominal, lo, hi, text) -> ModelParameter:
+    return ModelParameter(path, unit, float(nominal), float(lo), float(hi), False, text)
+
+
+def _linked(path, unit, nominal, lo, hi, text) -> ModelParameter:
+    return ModelParameter(path, unit, float(nominal), float(lo), float(hi), True, text, True)
+
+
+_C_DEFAULT = {"yf": (1e-2, 1e5), "tm": (1e-4, 1e3)}
+
+
+def _matrix_parameters(prefix: str, owner, what: str) -> list[ModelParameter]:
+    out = []
+    k, c = owner.k.values, owner.c.values
+    for kind, m, units in (("k", k, STIFFNESS_UNITS), ("c", c, DAMPING_UNITS)):
+        for entry, (i, j) in (("yf", (0, 0)), ("tm", (1, 1))):
+            v = m[i, j]
+            if v > 0:
+                out.append(_log(f"{prefix}.{kind}.{entry}", units[entry], v, 1e-3 * v, 1e3 * v,
+                                f"{what} {kind}_{entry}"))
+            elif kind == "c" and k[i, j] > 0:
+                lo, hi = _C_DEFAULT[entry]
+                out.append(ModelParameter(f"{prefix}.c.{entry}", units[entry], 0.0, lo, hi, True,
+                                          f"{what} c_{entry}"))
+        limit = 0.999 * np.sqrt(max(m[0, 0] * m[1, 1], 0.0))
+        if limit > 0:
+            out.append(_lin(f"{prefix}.{kind}.ym", units["ym"], m[0, 1], -limit, limit,
+                            f"{what} {kind}_ym = {kind}_tf (cross-coupling)"))
+    return out
+
+
+def model_parameters(assembly) -> list[ModelParameter]:
+    """Every number of ``assembly`` a fit may correct, with physical bounds.
+
+    Bounds per kind: lengths 0.5 to 2 times nominal; outer diameters 0.5 to
+    1.5 times (and above the bore); bores and inserts within the section;
+    flutes' ratio 0.5 to 1; ``E`` and ``rho`` 0.25 to 4 times; ``nu`` 0 to
+    0.49; loss factors 1e-5 to 0.2; joint and support entries 1e-3 to 1e3
+    times (cross terms within passivity, ``k_ym^2 < k_yf k_tm``); positions
+    within the component; sensor and body masses 0.1 to 10 times; linked
+    factors 0.25 to 4 (a tool's overhang: 0.5 to 1.5 times).
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model.
+
+    Returns
+    -------
+    list of ModelParameter
+        Components first, then materials, joints, supports, sensors, masses.
+    """
+    out: list[ModelParameter] = []
+    materials: dict[str, Material] = {}
+    for comp in assembly.components:
+        if not _plain(comp):
+            continue
+        base = f"components.{comp.name}"
+        for i, seg in enumerate(comp.segments):
+            p = f"{base}.segments.{i}"
+            L, od, id_ = seg.length_m, seg.od.m_as("m"), seg.id.m_as("m")
+            out.append(_log(f"{p}.length", "m", L, 0.5 * L, 2.0 * L, f"length of segment {i} of {comp.name}"))
+            low = max(0.5 * od, 1.02 * id_ / (seg.flutes.diameter_ratio if seg.flutes else 1.0))
+            out.append(_log(f"{p}.od", "m", od, low, 1.5 * od, f"outer diameter of segment {i} of {comp.name}"))
+            if seg.insert is None:
+                out.append(_lin(f"{p}.id", "m", id_, 0.0, 0.9 * od * (seg.flutes.diameter_ratio if seg.flutes else 1.0),
+                                f"bore of segment {i} of {comp.name}"))
+            else:
+                iod = seg.insert.od.m_as("m")
+                out.append(_log(f"{p}.insert.od", "m", iod, max(0.5 * iod, 1.02 * seg.insert.id.m_as("m")), id_,
+                                f"insert diameter in segment {i} of {comp.name}"))
+                materials.setdefault(seg.insert.material.name, seg.insert.material)
+            if seg.flutes is not None:
+                low = max(0.5, 1.02 * id_ / od)
+                out.append(_lin(f"{p}.flutes.diameter_ratio", "dimensionless", seg.flutes.diameter_ratio, low, 1.0,
+                                f"flutes' diameter ratio of segment {i} of {comp.name}"))
+            materials.setdefault(seg.material.name, seg.material)
+        if isinstance(comp, Tool) and _overhang_segment(comp) is not None:
+            total = comp.length_m
+            fixed = total - comp.segments[_overhang_segment(comp)].length_m
+            out.append(_linked(f"{base}.overhang", "m", total, max(0.5 * total, fixed + 0.1 * (total - fixed)),
+                               1.5 * total, f"overhang of {comp.name} (its fluted length kept)"))
+        for prop, text in (("E", "stiffness (E)"), ("rho", "density"), ("loss_factor", "material damping")):
+            out.append(_linked(f"{base}.{prop}", "dimensionless", 1.0, 0.25 if prop != "loss_factor" else 0.05,
+                               4.0 if prop != "loss_factor" else 20.0, f"{text} of {comp.name} only, as a factor"))
+    for name, m in materials.items():
+        p = f"materials.{name}"
+        E, rho = m.E.m_as("Pa"), m.rho_si
+        out.append(_log(f"{p}.E", "Pa", E, 0.25 * E, 4.0 * E, f"Young's modulus of {name}"))
+        out.append(_log(f"{p}.rho", "kg/m^3", rho, 0.25 * rho, 4.0 * rho, f"density of {name}"))
+        out.append(_lin(f"{p}.nu", "dimensionless", m.nu, 0.0, 0.49, f"Poisson ratio of {name}"))
+        out.append(ModelParameter(f"{p}.loss_factor", "dimensionless", m.loss_factor, 1e-5, 0.2, True,
+                                  f"loss factor of {name}"))
+    for j in assembly.joints:
+        if type(j) is not Joint or j.rigid:
+            continue
+        p = f"joints.{j.name}"
+        out += _matrix_parameters(p, j, f"joint {j.name}")
+        out.append(_linked(f"{p}.k", "dimensionless", 1.0, 1e-3, 1e3, f"stiffness of joint {j.name}, as a factor"))
+        if j.c:
+            out.append(_linked(f"{p}.c", "dimensionless", 1.0, 1e-3, 1e3, f"damping of joint {j.name}, as a factor"))
+    per_component: dict[str, list] = {}
+    for i, s in enumerate(assembly.supports):
+        p = f"supports.{i}"
+        out += [m for m in _matrix_parameters(p, s, f"support {s.name or i} at {s.at}")]
+        comp, x, length = _on_beam(assembly, s.at)
+        if comp is not None:
+            out.append(_lin(f"{p}.at", "m", x, 0.0, length, f"position of support {s.name or i} along {comp}"))
+            if s.k:
+                per_component.setdefault(comp, []).append((x, i))
+    for comp, found in per_component.items():
+        if len(found) >= 2:
+            out.append(_linked(f"components.{comp}.supports.k", "dimensionless", 1.0, 1e-2, 1e2,
+                               f"stiffness of every support on {comp}, as a factor"))
+        order = [i for _, i in sorted(found)]
+        if len(order) >= 3:
+            for a, b in zip(order[:-1], order[1:]):  # neighbours: a bearing pair
+                out.append(_linked(f"supports.{a}+{b}.k", "dimensionless", 1.0, 1e-2, 1e2,
+                                   f"stiffness of the neighbouring supports {a} and {b} on {comp}, as a factor"))
+    for kind, items in (("sensors", assembly.sensors), ("masses", assembly.masses)):
+        for s in items:
+            p = f"{kind}.{s.name}"
+            if s.mass_kg > 0:
+                out.append(_log(f"{p}.mass", "kg", s.mass_kg, 0.1 * s.mass_kg, 10 * s.mass_kg, f"mass of {s.name}"))
+            if s.inertia_si > 0:
+                out.append(_log(f"{p}.inertia", "kg*m^2", s.inertia_si, 0.1 * s.inertia_si, 10 * s.inertia_si,
+                                f"rotary inertia of {s.name}"))
+            if kind == "masses":
+                comp, x, length = _on_beam(assembly, s.at)
+                if comp is not None:
+                    out.append(_lin(f"{p}.at", "m", x, 0.0, length, f"position of {s.name} along {comp}"))
+    return out
+
+
+def _overhang_segment(tool) -> int | None:
+    """The segment whose length a tool's overhang changes: the first without flutes."""
+    for i, seg in enumerate(tool.segments):
+        if seg.flutes is None:
+            return i
+    return None
+
+
+def _on_beam(assembly, point: str):
+    from ..points import parse_point
+
+    ref = parse_point(point)
+    try:
+        comp = assembly.component(ref.component)
+    except UnknownPointError:
+        return None, 0.0, 0.0
+    if not _plain(comp):
+        return None, 0.0, 0.0
+    return comp.name, comp.position(ref), comp.length_m
+
+
+# ---------------------------------------------------------------------------
+# Reading and writing values on an assembly
+
+
+def _parts(path: str) -> list[str]:
+    if not isinstance(path, str) or not path.strip():
+        raise InvalidValueError(f"path: got {path!r}; expected a parameter path such as 'joints.holder-tool.k.yf'")
+    return path.strip().split(".")
+
+
+def _unknown(path: str, why: str) -> UnknownPointError:
+    return UnknownPointError(f"parameter {path!r}: {why}")
+
+
+def get_parameter(assembly, path: str) -> float:
+    """The value of a parameter of ``assembly`` (SI; linked factors are 1).
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model.
+    path : str
+        A path of :func:`model_parameters` (e.g. ``"components.tool.segments.0.length"``).
+
+    Returns
+    -------
+    float
+        The value in SI units.
+
+    Raises
+    ------
+    UnknownPointError
+        When the path names nothing in the assembly.
+    """
+    for p in model_parameters(assembly):
+        if p.path == path:
+            return p.nominal
+    raise _unknown(path, "not a parameter of this assembly (see model_parameters)")
+
+
+def _quiet(build):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NonPassiveJointWarning)
+        return build()
+
+
+def _scaled_matrix(matrix, factor: float, units) -> dict:
+    return {e: _si(matrix.get(e) * factor, units[e]) for e in ("yf", "ym", "tf", "tm") if matrix.get(e) != 0}
+
+
+def _set_matrix(owner, kind: str, entry: str, value: float):
+    units = STIFFNESS_UNITS if kind == "k" else DAMPING_UNITS
+    entries = ("ym", "tf") if entry == "ym" else (entry,)
+    update = {e: _si(value, units[e]) for e in entries}
+    k, c = owner.k.as_dict(), owner.c.as_dict()
+    (k if kind == "k" else c).update(update)
+    return _quiet(lambda: attrs.evolve(owner, k=k, c=c))
+
+
+def _with_material(seg, material, insert: bool):
+    if insert:
+        return attrs.evolve(seg, insert=attrs.evolve(seg.insert, material=material))
+    return attrs.evolve(seg, material=material)
+
+
+def _material_value(material: Material, prop: str, value: float) -> Material:
+    if prop == "E":
+        return attrs.evolve(material, E=_si(value, "Pa"))
+    if prop == "rho":
+        return attrs.evolve(material, rho=_si(value, "kg/m^3"))
+    if prop == "nu":
+        return attrs.evolve(material, nu=float(value))
+    return attrs.evolve(material, loss_factor=float(value))
+
+
+def _set_one(assembly, path: str, value: float):
+    parts = _parts(path)
+    head = parts[0]
+    value = float(value)
+    if head == "components" and len(parts) >= 3:
+        comp = assembly.component(parts[1])
+        if not _plain(comp):
+            raise _unknown(path, f"{parts[1]!r} is not a stepped beam")
+        rest = parts[2:]
+        segs = list(comp.segments)
+        if rest[0] == "segments" and len(rest) >= 3:
+            i = int(rest[1])
+            seg = segs[i]
+            what = ".".join(rest[2:])
+            if what in ("length", "od", "id"):
+                segs[i] = attrs.evolve(seg, **{what: _si(value, "m")})
+            elif what in ("insert.od", "insert.id"):
+                segs[i] = attrs.evolve(seg, insert=attrs.evolve(seg.insert, **{what[7:]: _si(value, "m")}))
+            elif what == "flutes.diameter_ratio":
+                segs[i] = attrs.evolve(seg, flutes=attrs.evolve(seg.flutes, diameter_ratio=value))
+            else:
+                raise _unknown(path, f"unknown segment value {what!r}")
+            return assembly.with_component(attrs.evolve(comp, segments=segs))
+        if rest == ["overhang"]:
+            i = _overhang_segment(comp)
+            seg = segs[i]
+            segs[i] = attrs.evolve(seg, length=_si(seg.length_m + value - comp.length_m, "m"))
+            return assembly.with_component(attrs.evolve(comp, segments=segs))
+        if rest in (["E"], ["rho"], ["loss_factor"]):
+            prop = rest[0]
+            renamed = {}
+            for i, seg in enumerate(segs):
+                m = seg.material
+                if m.name not in renamed:
+                    current = {"E": m.E.m_as("Pa"), "rho": m.rho_si, "loss_factor": m.loss_factor}[prop]
+                    new = _material_value(m, prop, current * value)
+                    renamed[m.name] = attrs.evolve(new, name=f"{m.name}-{comp.name}")
+                segs[i] = attrs.evolve(seg, material=renamed[m.name])
+            return assembly.with_component(attrs.evolve(comp, segments=segs))
+        if rest == ["supports", "k"]:
+            supports = list(assembly.supports)
+            for i, s in enumerate(supports):
+                if _on_beam(assembly, s.at)[0] == comp.name:
+                    supports[i] = _quiet(lambda s=s: attrs.evolve(s, k=_scaled_matrix(s.k, value, STIFFNESS_UNITS)))
+            return attrs.evolve(assembly, supports=tuple(supports))
+    if head == "materials" and len(parts) >= 3:
+        name, prop = ".".join(parts[1:-1]), parts[-1]
+        comps = []
+        found = False
+        for comp in assembly.components:
+            if not _plain(comp):
+                comps.append(comp)
+                continue
+            segs = list(comp.segments)
+            for i, seg in enumerate(segs):
+                if seg.material.name == name:
+                    segs[i] = _with_material(segs[i], _material_value(seg.material, prop, value), False)
+                    found = True
+                if seg.insert is not None and seg.insert.material.name == name:
+                    segs[i] = _with_material(segs[i], _material_value(seg.insert.material, prop, value), True)
+                    found = True
+            comps.append(attrs.evolve(comp, segments=segs))
+        if not found:
+            raise _unknown(path, f"no part is made of {name!r}")
+        mats = tuple(_material_value(m, prop, value) if m.name == name else m for m in assembly.materials)
+        return attrs.evolve(assembly, components=tuple(comps), materials=mats)
+    if head == "joints" and len(parts) in (3, 4):
+        joint = assembly.joint(parts[1])
+        if len(parts) == 3:
+            units = STIFFNESS_UNITS if parts[2] == "k" else DAMPING_UNITS
+            matrix = joint.k if parts[2] == "k" else joint.c
+            new = _quiet(lambda: attrs.evolve(joint, **{parts[2]: _scaled_matrix(matrix, value, units)}))
+        else:
+            new = _set_matrix(joint, parts[2], parts[3], value)
+        return assembly.with_joint(new)
+    if head == "supports" and len(parts) == 3 and "+" in parts[1]:
+        supports = list(assembly.supports)
+        for i in (int(x) for x in parts[1].split("+")):
+            s = supports[i]
+            supports[i] = _quiet(lambda s=s: attrs.evolve(s, k=_scaled_matrix(s.k, value, STIFFNESS_UNITS)))
+        return attrs.evolve(assembly, supports=tuple(supports))
+    if head == "supports" and len(parts) in (3, 4):
+        i = int(parts[1])
+        supports = list(assembly.supports)
+        s = supports[i]
+        if parts[2] == "at":
+            comp, _, _ = _on_beam(assembly, s.at)
+            supports[i] = attrs.evolve(s, at=f"{comp}@{_si(value, 'm')}")
+        else:
+            supports[i] = _set_matrix(s, parts[2], parts[3], value)
+        return attrs.evolve(assembly, supports=tuple(supports))
+    if head in ("sensors", "masses") and len(parts) == 3:
+        items = list(getattr(assembly, head))
+        names = [s.name for s in items]
+        if parts[1] not in names:
+            raise _unknown(path, f"no {head[:-1]} {parts[1]!r}")
+        i = names.index(parts[1])
+        s = items[i]
+        if parts[2] == "mass":
+            items[i] = attrs.evolve(s, mass=_si(value, "kg"))
+        elif parts[2] == "inertia":
+            items[i] = attrs.evolve(s, inertia=_si(value, "kg*m^2"))
+        elif parts[2] == "at" and head == "masses":
+            comp, _, _ = _on_beam(assembly, s.at)
+            items[i] = attrs.evolve(s, at=f"{comp}@{_si(value, 'm')}")
+        else:
+            raise _unknown(path, f"unknown value {parts[2]!r}")
+        return attrs.evolve(assembly, **{head: tuple(items)})
+    raise _unknown(path, "not a parameter path (see substructure.updating.parameters)")
+
+
+def set_parameters(assembly, values: Mapping[str, float]):
+    """The assembly with parameters set (SI values by path; linked parameters as factors).
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model.
+    values : mapping of str to float
+        New values by path.
+
+    Returns
+    -------
+    Assembly
+        A new assembly, which :func:`substructure.save_assembly` writes normally
+        (a changed material under its own name, a component's own material as
+        ``NAME-COMPONENT``).
+
+    Raises
+    ------
+    UnknownPointError
+        When a path names nothing in the assembly.
+    """
+    for path, value in values.items():
+        try:
+            assembly = _set_one(assembly, path, value)
+        except (IndexError, ValueError, AttributeError) as exc:
+            if isinstance(exc, InvalidValueError):
+                raise
+            raise _unknown(path, f"cannot be set ({exc})") from None
+    return assembly
+
+
+# ---------------------------------------------------------------------------
+# The same on the SI form
+
+
+class ParameterChange(Change):
+    """A correction of one model parameter (effect ``model-parameter``, ``where`` its path).
+
+    Parameters
+    ----------
+    parameter : ModelParameter
+        The parameter, with its bounds.
+    """
+
+    effect = "model-parameter"
+    explanation = "a number of the model is off: the fit corrects it"
+
+    def __init__(self, parameter: ModelParameter):
+        self.parameter = parameter
+        self.where = parameter.path
+        self.specs = (parameter.spec(),)
+
+    def apply(self, assembly, values):
+        """The assembly with the parameter set to ``values['value']``.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        values : mapping of str to float
+                The change's values by parameter name (SI).
+
+        Returns
+        -------
+        Assembly
+            A new assembly.
+
+        Raises
+        ------
+        UnknownPointError
+            When the component is not in this assembly.
+        """
+        return set_parameters(assembly, {self.where: values["value"]})
+
+    def apply_si(self, structure, values):
+        """The structure with the parameter set to ``values['value']``.
+
+        Parameters
+        ----------
+        structure : Structure
+            The SI form of one test configuration.
+        values : mapping of str to float
+                The change's values by parameter name (SI).
+
+        Returns
+        -------
+        Structure
+            The changed structure.
+        """
+        return apply_path_si(structure, self.where, float(values["value"]))
+
+
+class ParameterSet(Change):
+    """Several model parameters fitted together, each under a short name (e.g. a joint's entries).
+
+    Parameters
+    ----------
+    effect : str
+        A name for reports.
+    where : str
+        What it acts on.
+    paths : mapping of str to str
+        Short name -> parameter path (see :func:`model_parameters`).
+    specs : sequence of ParamSpec
+        One per short name, with bounds and start.
+    """
+
+    def __init__(self, effect: str, where: str, paths: Mapping[str, str], specs):
+        self.effect = effect
+        self.where = where
+        self.paths = dict(paths)
+        self.specs = tuple(specs)
+        unknown = [s.name for s in self.specs if s.name not in self.paths]
+        if unknown:
+            raise InvalidValueError(f"parameters {unknown} have no path")
+
+    def apply(self, assembly, values):
+        """The assembly with every parameter set.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        values : mapping of str to float
+                The change's values by parameter name (SI).
+
+        Returns
+        -------
+        Assembly
+            A new assembly.
+
+        Raises
+        ------
+        UnknownPointError
+            When the component is not in this assembly.
+        """
+        return set_parameters(assembly, {self.paths[k]: v for k, v in values.items()})
+
+    def apply_si(self, structure, values):
+        """The structure with every parameter set.
+
+        Parameters
+        ----------
+        structure : Structure
+            The SI form of one test configuration.
+        values : mapping of str to float
+                The change's values by parameter name (SI).
+
+        Returns
+        -------
+        Structure
+            The changed structure.
+        """
+        for k, v in values.items():
+            structure = apply_path_si(structure, self.paths[k], float(v))
+        return structure
+
+

@@ -1,0 +1,254 @@
+"""Model selection by significance: is the residual noise, does a change earn its parameters.
+
+Three decisions, each a documented test on the ``chi^2`` of
+:mod:`substructure.updating.likelihood` (``n`` residuals, ``p`` fitted
+parameters, ``nu = n - p``):
+
+**Consistent with noise** (:func:`consistency`).  A model explains the data
+when its whitened residual is what the noise model predicts, globally and
+in every band:
+
+* globally, ``chi^2 / nu <= 1 + z sqrt(2 / nu + e^2)``, ``z = 3.09``
+  (one-sided 0.1 %), where ``e`` is the relative standard error of the
+  noise variance estimated from the data (:attr:`NoiseModel.scale_error`);
+* in each block of lines (2 % of the band, at least 20 lines, per FRF), the
+  mean of the squared whitened residual stays below the upper
+  ``0.001 / M`` quantile of its chi-square distribution (Bonferroni over the
+  ``M`` blocks), times the local noise scale where the smoothing residual
+  shows the noise larger there than the model says.
+
+**Significance of a change** (:func:`significance`).  A change with ``k``
+parameters that lowers ``chi^2`` from ``chi2_0`` to ``chi2_1`` enters only
+when the likelihood ratio, scaled by the misfit of the larger model
+``s^2 = max(1, chi2_1 / nu_1)`` (quasi-likelihood: a model that misses
+something has a larger effective noise), exceeds both the BIC penalty
+``k ln n`` and the chi-square quantile ``chi2_k(1 - 0.01 / M)`` for ``M``
+candidates tried (Bonferroni: searching many candidates must not let noise
+through).
+
+**Indifference** (:func:`indifferent`).  Two explanations with ``chi2_a``,
+``k_a`` and ``chi2_b``, ``k_b`` differ by
+``Delta BIC = (chi2_b - chi2_a) / s^2 + (k_b - k_a) ln n``; within
+``|Delta BIC| <= 10`` (a Bayes factor below ``e^5``, not "very strong"
+evidence in Kass and Raftery's scale, J. Am. Stat. Assoc. 90, 1995) the
+data cannot tell them apart: both are reported, with the measurement that
+would separate them.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Sequence
+
+import attrs
+import numpy as np
+from scipy.stats import chi2 as chi2_dist
+
+__all__ = ["Consistency", "consistency", "Significance", "significance", "indifferent", "bic",
+           "INDIFFERENCE", "CONSISTENCY_ALPHA"]
+
+CONSISTENCY_ALPHA = 0.001
+"""Level of the consistency tests (global and, Bonferroni-corrected, per band)."""
+SIGNIFICANCE_ALPHA = 0.01
+"""Level of the likelihood-ratio test of a change, before the Bonferroni correction."""
+INDIFFERENCE = 10.0
+"""Largest ``|Delta BIC|`` of two explanations the data cannot tell apart."""
+_Z = 3.090232306167813  # one-sided 0.1 %
+
+
+@attrs.frozen
+class Band:
+    """A block of lines where the residual is larger than the noise allows.
+
+    Parameters
+    ----------
+    item : int
+        Index of the measured FRF.
+    lo_hz, hi_hz : float
+        Its frequency range.
+    ratio : float
+        Mean squared whitened residual over the block (1 for noise).
+    threshold : float
+        What the test allows there.
+    share : float
+        The block's share of the excess ``chi^2`` over the noise.
+    """
+
+    item: int
+    lo_hz: float
+    hi_hz: float
+    ratio: float
+    threshold: float
+    share: float
+
+
+@attrs.frozen
+class Consistency:
+    """Whether a model's residual is consistent with the noise (see the module docstring).
+
+    Parameters
+    ----------
+    consistent : bool
+        Both tests pass.
+    chi2_reduced : float
+        ``chi^2 / nu``.
+    threshold : float
+        The global test's bound on ``chi2_reduced``.
+    bands : tuple of Band
+        Blocks failing the band test, largest excess first.
+    """
+
+    consistent: bool
+    chi2_reduced: float
+    threshold: float
+    bands: tuple
+
+
+def consistency(likelihood, ratios: Sequence[np.ndarray], p: int) -> Consistency:
+    """Test a model's residual against the noise, globally and band by band.
+
+    Parameters
+    ----------
+    likelihood : Likelihood
+        The data and noise (its ``measured`` items and lines).
+    ratios : sequence of ndarray
+        ``ln(model / measured)`` per measured FRF (:meth:`Likelihood.log_ratios`).
+    p : int
+        Number of fitted parameters.
+
+    Returns
+    -------
+    Consistency
+        The verdict and where the residual is too large.
+    """
+    z2 = []
+    for r, wr, wi in zip(ratios, likelihood.w_re, likelihood.w_im):
+        z2.append(0.5 * ((r.real * wr) ** 2 + (r.imag * wi) ** 2))
+    n = 2 * sum(z.size for z in z2)
+    nu = max(n - p, 1)
+    chi2 = 2.0 * sum(float(z.sum()) for z in z2)
+    sizes = np.array([z.size for z in z2], dtype=float)
+    errs = np.array([m.noise.scale_error for m in likelihood.measured])
+    e = float(np.sqrt(np.sum((sizes * errs) ** 2)) / sizes.sum())
+    threshold = 1.0 + _Z * math.sqrt(2.0 / nu + e * e)
+    reduced = chi2 / nu
+    blocks = []
+    for item, (z, m) in enumerate(zip(z2, likelihood.measured)):
+        size = max(20, int(round(0.02 * z.size)))
+        f = m.frf.frequency.hz[likelihood.lines]
+        starts = list(range(0, z.size, size))
+        if len(starts) > 1 and z.size - starts[-1] < size // 2:  # a short last block joins the one before
+            starts.pop()
+        for k, start in enumerate(starts):
+            stop = starts[k + 1] if k + 1 < len(starts) else z.size
+            blocks.append((item, slice(start, stop), f))
+    m_blocks = max(len(blocks), 1)
+    excess_total = max(chi2 - nu, 1e-300)
+    failing = []
+    for item, sl, f in blocks:
+        z = z2[item][sl]
+        k = 2 * z.size
+        local = likelihood.measured[item].noise.scatter[likelihood.lines][sl]
+        local = local[np.isfinite(local)]
+        scale = max(1.0, float(np.mean(local))) if local.size else 1.0
+        bound = scale * float(chi2_dist.isf(CONSISTENCY_ALPHA / m_blocks, k)) / k
+        ratio = float(z.mean())
+        if ratio > bound:
+            failing.append(Band(item, float(f[sl][0]), float(f[sl][-1]), ratio, bound,
+                                float(max(2 * z.sum() - k, 0.0) / excess_total)))
+    failing.sort(key=lambda b: -b.share)
+    return Consistency(bool(reduced <= threshold and not failing), reduced, threshold, tuple(failing))
+
+
+@attrs.frozen
+class Significance:
+    """The test of one change against the model without it.
+
+    Parameters
+    ----------
+    statistic : float
+        The scaled likelihood ratio ``(chi2_0 - chi2_1) / s^2``.
+    threshold : float
+        ``max(k ln n, chi2_k quantile)``.
+    significant : bool
+        ``statistic > threshold``.
+    """
+
+    statistic: float
+    threshold: float
+    significant: bool
+
+
+def significance(chi2_0: float, chi2_1: float, k: int, n: int, p1: int, candidates: int = 1) -> Significance:
+    """Does a change with ``k`` parameters earn them (see the module docstring)?
+
+    Parameters
+    ----------
+    chi2_0, chi2_1 : float
+        ``chi^2`` without and with the change (refitted).
+    k : int
+        Parameters the change adds.
+    n : int
+        Number of residuals.
+    p1 : int
+        Parameters of the larger model.
+    candidates : int
+        How many changes were tried for this one (Bonferroni).
+
+    Returns
+    -------
+    Significance
+        The statistic, the threshold and the verdict.
+    """
+    s2 = max(1.0, chi2_1 / max(n - p1, 1))
+    stat = (chi2_0 - chi2_1) / s2
+    threshold = max(k * math.log(n), float(chi2_dist.isf(SIGNIFICANCE_ALPHA / max(candidates, 1), max(k, 1))))
+    return Significance(float(stat), float(threshold), bool(stat > threshold))
+
+
+def bic(chi2: float, k: int, n: int, s2: float = 1.0) -> float:
+    """``chi2 / s2 + k ln n``: the Bayesian information criterion with a misfit scale.
+
+    Parameters
+    ----------
+    chi2 : float
+        The model's ``chi^2``.
+    k : int
+        Its number of fitted parameters.
+    n : int
+        Number of residuals.
+    s2 : float
+        Misfit scale (``max(1, chi^2 / nu)`` of the best model compared).
+
+    Returns
+    -------
+    float
+        The criterion (lower is better).
+    """
+    return chi2 / s2 + k * math.log(n)
+
+
+def indifferent(chi2_a: float, k_a: int, chi2_b: float, k_b: int, n: int, s2: float = 1.0) -> bool:
+    """True when the data cannot tell two explanations apart: ``|Delta BIC| <= 10``.
+
+    Parameters
+    ----------
+    chi2_a : float
+        ``chi^2`` of the first explanation.
+    k_a : int
+        Its number of fitted parameters.
+    chi2_b : float
+        ``chi^2`` of the second explanation.
+    k_b : int
+        Its number of fitted parameters.
+    n : int
+        Number of residuals.
+    s2 : float
+        Misfit scale of the better one.
+
+    Returns
+    -------
+    bool
+        Whether they are inside the indifference region.
+    """
+    return abs(bic(chi2_b, k_b, n, s2) - bic(chi2_a, k_a, n, s2)) <= INDIFFERENCE

@@ -1,0 +1,639 @@
+"""The SI form of an assembly, and its fast evaluation for model updating.
+
+A fit evaluates one model hundreds of times with a few numbers changed.
+:class:`Structure` holds an assembly as plain SI arrays: per beam component
+its segments' geometry and material constants (from which the section
+properties ``EI``, ``kappa G A``, ``rho A``, ``rho I`` follow), and per link
+(joint, support, sensor, permanent mass, or an element a fit adds) its
+stiffness, damping and mass matrices.  Changing a number returns a new
+structure that shares every array it did not change; no units are parsed
+and no value objects are rebuilt.
+
+:class:`Evaluator` computes the receptances between fixed outputs and
+inputs on fixed frequency lines for any structure of the same assembly: the
+receptances of components that did not change are reused (identified by the
+arrays object they hold), the others are computed by
+:func:`substructure.beams.stepped_beam_receptance_si`, and the coupling runs
+in the engine of :mod:`substructure.coupling`.  Components that are not
+plain stepped beams (measured components, subassemblies, subclasses with
+their own receptances) take part unchanged through their own
+``receptance_matrix``.
+"""
+
+from __future__ import annotations
+
+import functools
+import itertools
+import math
+from collections import OrderedDict
+from typing import Sequence
+
+import numpy as np
+
+from ..beams import Segment, shear_coefficient, stepped_beam_receptance_si
+from ..components import Beam, is_plain_beam
+from ..coupling import Link, couple_substructures
+from ..errors import AssemblyError, InvalidValueError, UnknownPointError
+from ..joints import Joint
+from ..points import DOFS, parse_point
+
+__all__ = ["BeamArrays", "LinkSI", "Structure", "Evaluator", "si_beam"]
+
+_TOKENS = itertools.count(1)
+
+
+@functools.lru_cache(maxsize=4096)
+def _parse(point: str):
+    """Point names parsed once (parsing a distance goes through the unit registry)."""
+    return parse_point(point)
+
+
+@functools.lru_cache(maxsize=4096)
+def _distance_m(point: str) -> float:
+    ref = _parse(point)
+    return 0.0 if ref.distance is None else float(ref.distance.m_as("m"))
+
+
+def _ring(od, id_, E, nu, rho, eta):
+    """Section properties of rings (arrays over segments), as ``beams.Section.ring``."""
+    area = math.pi / 4.0 * (od**2 - id_**2)
+    inertia = math.pi / 64.0 * (od**4 - id_**4)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(od > 0, id_ / np.where(od > 0, od, 1.0), 0.0)
+    kappa = np.array([shear_coefficient(float(n), float(m)) for n, m in zip(np.atleast_1d(nu), np.atleast_1d(ratio))])
+    damp = 1.0 + 1j * eta
+    return E * damp * inertia, kappa * (E / (2.0 * (1.0 + nu))) * damp * area, rho * area, rho * inertia
+
+
+class BeamArrays:
+    """A plain stepped beam as SI arrays over its segments (base to tip).
+
+    Attributes
+    ----------
+    name : str
+        The component's name.
+    length, od, id, ratio : ndarray, shape (n_seg,)
+        Lengths, outer and inner diameters [m], and the flutes' diameter
+        ratio (1 where a segment has no flutes).
+    material : ndarray, shape (n_seg, 4)
+        ``E`` [Pa], ``nu``, ``rho`` [kg/m^3], loss factor of each segment.
+    material_names : tuple of str
+        The segments' material names.
+    insert : ndarray, shape (n_seg, 6)
+        ``od``, ``id`` [m], ``E``, ``nu``, ``rho``, loss factor of each
+        segment's insert (``od = 0``: none).
+    insert_names : tuple of str or None
+        The inserts' material names.
+    token : int
+        Identifies the arrays: a changed beam gets a new token, so that the
+        evaluator recomputes only what changed.
+    """
+
+    __slots__ = ("name", "length", "od", "id", "ratio", "material", "material_names", "insert", "insert_names",
+                 "token", "_sections")
+
+    def __init__(self, name, length, od, id, ratio, material, material_names, insert, insert_names):
+        self.name = name
+        self.length = np.asarray(length, dtype=float)
+        self.od = np.asarray(od, dtype=float)
+        self.id = np.asarray(id, dtype=float)
+        self.ratio = np.asarray(ratio, dtype=float)
+        self.material = np.asarray(material, dtype=float)
+        self.material_names = tuple(material_names)
+        self.insert = np.asarray(insert, dtype=float)
+        self.insert_names = tuple(insert_names)
+        self.token = next(_TOKENS)
+        self._sections = None
+
+    @classmethod
+    def from_beam(cls, beam: Beam) -> "BeamArrays":
+        """The arrays of a :class:`~substructure.components.Beam` whose segments are plain ``Segment``.
+
+        Parameters
+        ----------
+        beam : Beam
+            The component.
+
+        Returns
+        -------
+        BeamArrays
+            Its segments as SI arrays.
+        """
+        segs = beam.segments
+        mat = [(s.material.E.m_as("Pa"), s.material.nu, s.material.rho_si, s.material.loss_factor) for s in segs]
+        ins, ins_names = [], []
+        for s in segs:
+            if s.insert is None:
+                ins.append((0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+                ins_names.append(None)
+            else:
+                m = s.insert.material
+                ins.append((s.insert.od.m_as("m"), s.insert.id.m_as("m"), m.E.m_as("Pa"), m.nu, m.rho_si,
+                            m.loss_factor))
+                ins_names.append(m.name)
+        return cls(beam.name, [s.length_m for s in segs], [s.od.m_as("m") for s in segs],
+                   [s.id.m_as("m") for s in segs],
+                   [1.0 if s.flutes is None else s.flutes.diameter_ratio for s in segs],
+                   mat, [s.material.name for s in segs], ins, ins_names)
+
+    def evolve(self, **changes) -> "BeamArrays":
+        """A copy with some arrays replaced (a new token).
+
+        Parameters
+        ----------
+        **changes
+            Fields to replace (``length``, ``od``, ``material``, ...).
+
+        Returns
+        -------
+        BeamArrays
+            The changed beam.
+        """
+        fields = {k: getattr(self, k) for k in ("name", "length", "od", "id", "ratio", "material", "material_names",
+                                               "insert", "insert_names")}
+        fields.update(changes)
+        return BeamArrays(**fields)
+
+    @property
+    def total_length(self) -> float:
+        """Length of the beam [m]."""
+        return float(self.length.sum())
+
+    def sections(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(EI, kGA, rhoA, rhoI)`` per segment, layers (inserts) summed.
+
+        Returns
+        -------
+        tuple of ndarray
+            Complex ``EI`` [N m^2] and ``kappa G A`` [N], ``rho A`` [kg/m], ``rho I`` [kg m].
+        """
+        if self._sections is None:
+            E, nu, rho, eta = self.material.T
+            parts = _ring(self.od * self.ratio, self.id, E, nu, rho, eta)
+            has = self.insert[:, 0] > 0
+            if has.any():
+                io, ii, iE, inu, irho, ieta = self.insert.T
+                safe_od = np.where(has, io, 1.0)
+                extra = _ring(safe_od, np.where(has, ii, 0.0), iE, np.where(has, inu, 0.3), irho, ieta)
+                parts = tuple(p + np.where(has, e, 0.0) for p, e in zip(parts, extra))
+            self._sections = (np.asarray(parts[0], complex), np.asarray(parts[1], complex),
+                              np.asarray(parts[2], float), np.asarray(parts[3], float))
+        return self._sections
+
+    def mass(self) -> float:
+        """Mass of the beam.
+
+        Returns
+        -------
+        float
+            [kg].
+        """
+        return float(np.sum(self.sections()[2] * self.length))
+
+    def receptance(self, positions: Sequence[float], frequency_hz: np.ndarray) -> np.ndarray:
+        """Free-free receptances between positions.
+
+        Parameters
+        ----------
+        positions : sequence of float
+            Distinct positions [m from the base].
+        frequency_hz : ndarray
+            Frequency lines [Hz], > 0.
+
+        Returns
+        -------
+        ndarray, shape (2p, 2p, n)
+            Frequency-last receptances, DOFs ``(y, theta)`` per position.
+        """
+        ei, kga, rhoa, rhoi = self.sections()
+        return stepped_beam_receptance_si(ei, kga, rhoa, rhoi, self.length, positions, frequency_hz)
+
+
+class LinkSI:
+    """A joint, support, body or added element, as SI matrices.
+
+    Attributes
+    ----------
+    key : tuple
+        What it is in the assembly: ``("joints", name)``, ``("supports", i)``,
+        ``("sensors", name)``, ``("masses", name)`` or ``("added", label)``.
+    a, b : str
+        Its points (``b`` None for a link to the ground or a body).
+    K, C, M : ndarray, shape (2, 2)
+        Stiffness, damping and mass matrices (SI); the dynamic stiffness is
+        ``K + i omega C - omega^2 M``.
+    rigid : bool
+        A rigid joint (no matrices).
+    custom : object or None
+        A joint model with its own ``dynamic_stiffness`` (used as is).
+    """
+
+    __slots__ = ("key", "a", "b", "K", "C", "M", "rigid", "custom")
+
+    def __init__(self, key, a, b=None, K=None, C=None, M=None, rigid=False, custom=None):
+        self.key, self.a, self.b = key, a, b
+        z = np.zeros((2, 2))
+        self.K = z if K is None else np.asarray(K, dtype=float)
+        self.C = z if C is None else np.asarray(C, dtype=float)
+        self.M = z if M is None else np.asarray(M, dtype=float)
+        self.rigid, self.custom = rigid, custom
+
+    def evolve(self, **changes) -> "LinkSI":
+        """A copy with some fields replaced.
+
+        Parameters
+        ----------
+        **changes
+            Fields to replace (``K``, ``C``, ``M``, ``a``, ``rigid``, ...).
+
+        Returns
+        -------
+        LinkSI
+            The changed link.
+        """
+        fields = {k: getattr(self, k) for k in self.__slots__}
+        fields.update(changes)
+        return LinkSI(**fields)
+
+    def dynamic_stiffness(self, frequency_hz: np.ndarray) -> np.ndarray | None:
+        """``K + i omega C - omega^2 M``, frequency last.
+
+        Parameters
+        ----------
+        frequency_hz : ndarray
+            Frequency lines [Hz].
+
+        Returns
+        -------
+        ndarray or None
+            ``(2, 2, n)``; None for a rigid joint.
+        """
+        if self.rigid:
+            return None
+        if self.custom is not None:
+            return self.custom.dynamic_stiffness(frequency_hz)
+        w = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
+        return self.K[:, :, None] + 1j * w * self.C[:, :, None] - (w * w) * self.M[:, :, None]
+
+
+def si_beam(component) -> bool:
+    """Whether a component can be held as SI arrays: a plain beam of uniform segments.
+
+    Parameters
+    ----------
+    component : object
+        Any component.
+
+    Returns
+    -------
+    bool
+        True for a component whose receptances are those of its segments
+        (:func:`substructure.components.is_plain_beam`) when no segment is
+        tapered; other components take part through their own methods.
+    """
+    return (is_plain_beam(component) and isinstance(component, Beam)
+            and all(type(s) is Segment and not s.is_tapered for s in component.segments))
+
+
+class Structure:
+    """An assembly as SI arrays (one test configuration), changed without rebuilding objects.
+
+    Build it with :meth:`from_assembly`; :meth:`with_beam`, :meth:`with_link`
+    and :meth:`add_link` return changed copies.
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The assembly it was made from (the configuration, before any change).
+    beams : dict of str to BeamArrays
+        The plain stepped beams as arrays, by name.
+    opaque : dict of str to object
+        The other components (used through their own ``receptance_matrix``).
+    links : tuple of LinkSI
+        Joints, supports, sensors, masses and added elements, in order.
+    order : tuple of str
+        The components' names in the assembly's order.
+    sources : dict of str to object, optional
+        The component objects the beams were made from (to share arrays).
+    """
+
+    __slots__ = ("assembly", "beams", "opaque", "links", "order", "sources")
+
+    def __init__(self, assembly, beams: dict, opaque: dict, links: tuple, order: tuple, sources: dict | None = None):
+        self.assembly = assembly
+        self.beams = beams
+        self.opaque = opaque
+        self.links = links
+        self.order = order
+        self.sources = sources or {}
+
+    @classmethod
+    def from_assembly(cls, assembly, like: "Structure | None" = None) -> "Structure":
+        """The SI form of an assembly (plain beams as arrays, everything else as given).
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The configuration.
+        like : Structure, optional
+            A structure of the same assembly: the arrays of components that
+            are the same objects in both are shared (so that their
+            receptances are not computed again).
+
+        Returns
+        -------
+        Structure
+            The SI form.
+        """
+        beams, opaque, order, sources = {}, {}, [], {}
+        for comp in assembly.components:
+            order.append(comp.name)
+            sources[comp.name] = comp
+            if like is not None and like.sources.get(comp.name) is comp and comp.name in like.beams:
+                beams[comp.name] = like.beams[comp.name]
+            elif si_beam(comp):
+                beams[comp.name] = BeamArrays.from_beam(comp)
+            else:
+                opaque[comp.name] = comp
+        links = []
+        for s in assembly.sensors:
+            links.append(LinkSI(("sensors", s.name), s.at, M=np.diag([s.mass_kg, s.inertia_si])))
+        for m in assembly.masses:
+            links.append(LinkSI(("masses", m.name), m.at, M=np.diag([m.mass_kg, m.inertia_si])))
+        for i, s in enumerate(assembly.supports):
+            links.append(LinkSI(("supports", i), s.at, K=s.k.values, C=s.c.values))
+        for j in assembly.joints:
+            if type(j) is Joint:
+                link = (LinkSI(("joints", j.name), j.between[0], j.between[1], rigid=True) if j.rigid else
+                        LinkSI(("joints", j.name), j.between[0], j.between[1], K=j.k.values, C=j.c.values))
+            else:
+                link = LinkSI(("joints", j.name), j.between[0], j.between[1], rigid=bool(getattr(j, "rigid", False)),
+                              custom=j)
+            links.append(link)
+        return cls(assembly, beams, opaque, tuple(links), tuple(order), sources)
+
+    # -- lookup and changes --------------------------------------------------------
+
+    def has_component(self, name: str) -> bool:
+        """True when a component of that name takes part.
+
+        Parameters
+        ----------
+        name : str
+            The component's name.
+
+        Returns
+        -------
+        bool
+            Whether it is in this configuration.
+        """
+        return name in self.beams or any(name in getattr(c, "component_names", ()) for c in self.opaque.values())
+
+    def beam(self, name: str) -> BeamArrays:
+        """The arrays of a plain beam.
+
+        Parameters
+        ----------
+        name : str
+            The component's name.
+
+        Returns
+        -------
+        BeamArrays
+            Its arrays.
+
+        Raises
+        ------
+        UnknownPointError
+            When it is not a plain beam of this configuration.
+        """
+        try:
+            return self.beams[name]
+        except KeyError:
+            raise UnknownPointError(f"no plain beam {name!r} in this configuration") from None
+
+    def link(self, key: tuple) -> tuple[int, LinkSI]:
+        """The link with a key.
+
+        Parameters
+        ----------
+        key : tuple
+            E.g. ``("joints", "holder-tool")`` or ``("supports", 2)``.
+
+        Returns
+        -------
+        (int, LinkSI)
+            Its index and the link.
+
+        Raises
+        ------
+        UnknownPointError
+            When there is none in this configuration.
+        """
+        for i, link in enumerate(self.links):
+            if link.key == key:
+                return i, link
+        raise UnknownPointError(f"no {key[0][:-1]} {key[1]!r} in this configuration")
+
+    def with_beam(self, beam: BeamArrays) -> "Structure":
+        """The structure with one beam's arrays replaced (by name).
+
+        Parameters
+        ----------
+        beam : BeamArrays
+            The new arrays.
+
+        Returns
+        -------
+        Structure
+            A new structure sharing everything else.
+        """
+        self.beam(beam.name)
+        sources = {k: v for k, v in self.sources.items() if k != beam.name}
+        return Structure(self.assembly, {**self.beams, beam.name: beam}, self.opaque, self.links, self.order, sources)
+
+    def with_link(self, index: int, link: LinkSI) -> "Structure":
+        """The structure with one link replaced.
+
+        Parameters
+        ----------
+        index : int
+            Its index.
+        link : LinkSI
+            The new link.
+
+        Returns
+        -------
+        Structure
+            A new structure sharing everything else.
+        """
+        links = list(self.links)
+        links[index] = link
+        return Structure(self.assembly, self.beams, self.opaque, tuple(links), self.order, self.sources)
+
+    def add_link(self, link: LinkSI) -> "Structure":
+        """The structure with one more link (applied after the others).
+
+        Parameters
+        ----------
+        link : LinkSI
+            The link (its point must exist).
+
+        Returns
+        -------
+        Structure
+            A new structure.
+        """
+        self.position(link.a)
+        return Structure(self.assembly, self.beams, self.opaque, self.links + (link,), self.order, self.sources)
+
+    def position(self, point) -> tuple[str, float | None]:
+        """``(component, x)`` of a point: ``x`` in metres from the base on a plain beam, else None.
+
+        Parameters
+        ----------
+        point : str or (str, float)
+            A point name, or ``(component, x)`` on a plain beam.
+
+        Returns
+        -------
+        (str, float or None)
+            The component's name and the position.
+
+        Raises
+        ------
+        UnknownPointError
+            When the point is not on a component of this configuration.
+        """
+        if isinstance(point, tuple):
+            comp, x = point
+            beam = self.beam(comp)
+            total = beam.total_length
+            if not -1e-9 * total <= x <= total * (1 + 1e-9):
+                raise UnknownPointError(f"point {comp}@{x} m: lies outside {comp!r} ({total * 1e3:.6g} mm long)")
+            return comp, min(max(float(x), 0.0), total)
+        ref = _parse(point)
+        if ref.component in self.beams:
+            beam = self.beams[ref.component]
+            total = beam.total_length
+            if ref.where == "base":
+                x = 0.0
+            elif ref.where == "tip":
+                x = total
+            elif ref.where == "at":
+                x = _distance_m(point)
+            elif ref.where == "from_tip":
+                x = total - _distance_m(point)
+            else:
+                raise UnknownPointError(f"point {ref}: {ref.component!r} has points base, tip, @X and tip-X")
+            if x < -1e-9 * total or x > total * (1 + 1e-9):
+                raise UnknownPointError(f"point {ref}: lies outside {ref.component!r} ({total * 1e3:.6g} mm long)")
+            return ref.component, min(max(x, 0.0), total)
+        for comp in self.opaque.values():
+            if ref.component in getattr(comp, "component_names", ()):
+                comp.node_key(ref.point)
+                return comp.name, None
+        raise UnknownPointError(f"point {ref}: there is no component {ref.component!r} in this configuration")
+
+
+class Evaluator:
+    """Receptances between fixed points on fixed lines, for structures of one assembly.
+
+    Parameters
+    ----------
+    outputs, inputs : sequence of str
+        DOF labels (``"tool.tip:y"``); a label without a DOF stands for ``y``.
+    frequency_hz : ndarray
+        The frequency lines [Hz].
+    cache : int
+        How many changed component receptances to keep (besides those of
+        the first structure evaluated, which are always kept).
+    """
+
+    def __init__(self, outputs: Sequence[str], inputs: Sequence[str], frequency_hz: np.ndarray, cache: int = 12):
+        self.outputs = tuple(outputs)
+        self.inputs = tuple(inputs)
+        self.f = np.asarray(frequency_hz, dtype=float)
+        if self.f.size == 0 or np.any(self.f <= 0):
+            raise InvalidValueError("frequency: a model evaluation needs lines above 0 Hz (free-free components "
+                                    "have no static receptance); crop the data, e.g. from 1 Hz")
+        refs = [_parse(p) for p in self.outputs + self.inputs]
+        self._points = []
+        self._dofs = []
+        for r in refs:
+            point = str(r.point)
+            if point not in self._points:
+                self._points.append(point)
+            self._dofs.append((self._points.index(point), DOFS.index(r.dof or "y")))
+        self._n_out = len(self.outputs)
+        self._pinned: dict = {}
+        self._lru: OrderedDict = OrderedDict()
+        self._size = cache
+
+    def _store(self, key, compute, pin: bool):
+        if key in self._pinned:
+            return self._pinned[key]
+        if key in self._lru:
+            self._lru.move_to_end(key)
+            return self._lru[key]
+        y = compute()
+        if pin:
+            self._pinned[key] = y
+        else:
+            self._lru[key] = y
+            while len(self._lru) > self._size:
+                self._lru.popitem(last=False)
+        return y
+
+    def _receptance(self, structure: Structure, name: str, nodes: list, pin: bool) -> np.ndarray:
+        if name in structure.beams:
+            beam = structure.beams[name]
+            xs = [x for x, _ in nodes]
+            return self._store((beam.token, tuple(xs)), lambda: beam.receptance(xs, self.f), pin)
+        comp = structure.opaque[name]
+        refs = [r for _, r in nodes]
+        return self._store((id(comp), tuple(str(r) for r in refs)), lambda: comp.receptance_matrix(refs, self.f),
+                           True)
+
+    def __call__(self, structure: Structure) -> np.ndarray:
+        """The receptances ``(n_freq, n_out, n_in)`` of ``structure``."""
+        pin = not self._pinned  # the first structure's components are kept for good
+        nodes: dict[str, dict] = {}
+        keys = {}
+
+        def node(point):
+            if not isinstance(point, tuple) and point in keys:
+                return keys[point]
+            comp, x = structure.position(point)
+            if x is None:
+                ref = _parse(point).point
+                owner = structure.opaque[comp]
+                k = (comp, owner.node_key(ref))
+                nodes.setdefault(comp, {}).setdefault(k, (None, ref))
+            else:
+                k = (comp, round(x, 12))
+                nodes.setdefault(comp, {}).setdefault(k, (x, None))
+            if not isinstance(point, tuple):
+                keys[point] = k
+            return k
+
+        out_keys = [node(p) for p in self._points]
+        links = []
+        for link in structure.links:
+            ka = node(link.a)
+            kb = None if link.b is None else node(link.b)
+            if ka == kb:
+                raise AssemblyError(f"{link.key[0][:-1]} {link.key[1]!r} connects a point to itself")
+            links.append((ka, kb, link))
+        blocks = []
+        for comp in structure.order:
+            if comp not in nodes:
+                continue
+            items = sorted(nodes[comp].items(), key=lambda kv: (kv[1][0] is None, kv[1][0] or 0.0, str(kv[0])))
+            blocks.append(([k for k, _ in items], self._receptance(structure, comp, [v for _, v in items], pin)))
+        coupling = [Link(ka, kb, link.dynamic_stiffness(self.f), f"{link.key[0][:-1]} {link.key[1]!r}")
+                    for ka, kb, link in links]
+        y = couple_substructures(blocks, coupling, out_keys)
+        rows = [2 * p + d for p, d in self._dofs[: self._n_out]]
+        cols = [2 * p + d for p, d in self._dofs[self._n_out:]]
+        return np.moveaxis(y[np.ix_(rows, cols)], -1, 0)
