@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ._common import (
+    UsageError,
     band_arg,
     check_outputs,
     check_plot,
@@ -27,7 +28,10 @@ def run(args: argparse.Namespace) -> int:
     check_outputs([("--plot", args.plot)], [args.assembly, *measurement_inputs(args.measurements)], args.overwrite)
     assembly = load_assembly(args.assembly)
     measurements = load_measurements(args.measurements)
-    parameters = tuple(p.strip() for p in args.parameters.split(",") if p.strip())
+    parameters = "auto" if args.parameters.strip() == "auto" else tuple(
+        p.strip() for p in args.parameters.split(",") if p.strip())
+    if not parameters:
+        raise UsageError("argument --parameters: got an empty list; give 'auto' or names such as k_yf,k_tm")
     report = identify_joint(assembly, measurements, args.joint, band=args.band, parameters=parameters,
                             bootstrap=args.bootstrap)
     if args.plot:
@@ -38,7 +42,11 @@ def run(args: argparse.Namespace) -> int:
         return print_json(report.to_json())
     lo, hi = report.band
     print(f"joint {report.joint!r} of {assembly.name}")
-    print(f"band {lo:.0f}-{hi:.0f} Hz, {len(measurements)} measured FRFs, relative residual {report.residual_rms:.3f}")
+    if not report.consistent:
+        print("warning: the model does not fit the data within their noise: it misses something; the values "
+              "below are uncertain (run `substructure diagnose` to find what is missing)")
+    print(f"band {lo:.0f}-{hi:.0f} Hz, {len(measurements)} measured FRFs, relative residual {report.residual_rms:.3f}, "
+          f"chi^2/nu {report.chi2_reduced:.3g}; joint model: {report.model}")
     units = {"k": ("N/m", "N", "N/rad", "N*m/rad"), "c": ("N*s/m", "N*s", "N*s/rad", "N*m*s/rad")}
     for kind, values, stds in (("k", report.k, report.k_std), ("c", report.c, report.c_std)):
         for (entry, value), unit in zip(values.items(), units[kind]):
@@ -60,8 +68,9 @@ def add_parser(commands) -> None:
     ident.add_argument("--joint", required=True, metavar="NAME", help="name of the joint to identify")
     ident.add_argument("--band", type=band_arg, default="auto", metavar="auto|LO:HI",
                        help="frequency band in Hz (default auto: the mode the joint dominates)")
-    ident.add_argument("--parameters", default="k_yf,k_tm,c_yf,c_tm", metavar="NAMES",
-                       help="parameters to fit, of k_yf,k_ym,k_tm,c_yf,c_ym,c_tm (k_ym stands for k_ym = k_tf)")
+    ident.add_argument("--parameters", default="auto", metavar="auto|NAMES",
+                       help="parameters to fit, of k_yf,k_ym,k_tm,c_yf,c_ym,c_tm (k_ym stands for k_ym = k_tf); "
+                            "default auto: the diagonal joint, with the cross terms when they are significant")
     ident.add_argument("--bootstrap", type=int, default=0, metavar="N",
                        help="bootstrap refits for the standard deviations (default 0: from the Jacobian)")
     ident.add_argument("--plot", metavar="FILE.png", help="plot the closed form, the band, the fit and the FRFs")

@@ -1,11 +1,20 @@
-"""Robust band identification: constant joint stiffness and damping fitted to measured FRFs.
+"""Band identification: constant joint stiffness and damping fitted to measured FRFs, by likelihood.
 
 The thesis's future work asks for an identification that no noisy matrix
-inversion drives.  :class:`JointIdentifier` fits constant ``k`` and ``c`` by
-least squares to the measured translational FRFs directly, over the band
-where the joint is observable (the mode it dominates, found from the model's
-sensitivity to the joint, :func:`auto_band`), with standard deviations from
-the fit's Jacobian and optionally a bootstrap over the residuals.
+inversion drives.  :class:`JointIdentifier` fits constant ``k`` and ``c`` to
+the measured translational FRFs directly, over the band where the joint is
+observable (the mode it dominates, found from the model's sensitivity to
+the joint, :func:`auto_band`), with the likelihood of the model-updating
+core (:mod:`substructure.updating`): complex log ratios of model to
+measurement weighted by the noise of each line, estimated from the data.
+
+The joint model is chosen by the same significance test as the diagnosis:
+the diagonal joint of thesis eq. 2.4 (``k_yf, k_tm, c_yf, c_tm``) and, when
+the cross terms ``k_ym = k_tf``, ``c_ym = c_tf`` of eq. 2.5 lower ``chi^2``
+significantly, the full one.  Standard deviations and correlations come
+from the Jacobian, inflated by the misfit when the residual is not
+consistent with the noise; then a warning says that the model misses
+something (run ``substructure diagnose``) instead of reporting tight values.
 """
 
 from __future__ import annotations
@@ -15,44 +24,28 @@ from typing import Mapping, Sequence
 
 import attrs
 import numpy as np
-from scipy.optimize import least_squares
 
 from ..assembly import Assembly
 from ..errors import InvalidValueError, NonPassiveJointWarning
 from ..frf import FRF
 from ..joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint
+from ..measurements import model_of_measurement
 from ..points import parse_point
+from ..updating.fit import fit
+from ..updating.likelihood import Likelihood, measured_frfs
+from ..updating.parameters import ParameterSet, ParamSpec
+from ..updating.selection import consistency, significance
 from .closed_form import PARAMETERS
 
-__all__ = ["JointIdentifier", "auto_band", "model_of_measurement"]
+__all__ = ["JointIdentifier", "auto_band", "model_of_measurement", "DIAGONAL", "CROSS"]
 
-def model_of_measurement(assembly: Assembly, measurement) -> Assembly:
-    """The model of the structure as it was measured: removed components, sensors on.
+DIAGONAL = ("k_yf", "k_tm", "c_yf", "c_tm")
+"""The diagonal joint of thesis eq. 2.4."""
+CROSS = ("k_ym", "c_ym")
+"""The cross terms of eq. 2.5 (``k_ym = k_tf``, ``c_ym = c_tf``)."""
 
-    Parameters
-    ----------
-    assembly : Assembly
-        The model, with every sensor the measurements name declared in it.
-    measurement : Measurement or FRF
-        A measurement with ``.sensors`` and ``.removed`` (a bare FRF has neither).
-
-    Returns
-    -------
-    Assembly
-        The model without the removed components, with exactly the listed sensors on.
-    """
-    removed = tuple(getattr(measurement, "removed", ()) or ())
-    sensors = tuple(getattr(measurement, "sensors", ()) or ())
-    model = assembly.without(*removed) if removed else assembly
-    on = [assembly.sensor(name) for name in sensors]
-    return model.without_sensors().attach(*on)
-
-
-def _frf_of(measurement) -> FRF:
-    frf = measurement if isinstance(measurement, FRF) else measurement.frf
-    if not isinstance(frf, FRF):
-        raise InvalidValueError(f"measurements: got {measurement!r}; expected FRFs or measurements with .frf")
-    return frf.to_receptance()
+_UNITS = {"k_yf": STIFFNESS_UNITS["yf"], "k_ym": STIFFNESS_UNITS["ym"], "k_tm": STIFFNESS_UNITS["tm"],
+          "c_yf": DAMPING_UNITS["yf"], "c_ym": DAMPING_UNITS["ym"], "c_tm": DAMPING_UNITS["tm"]}
 
 
 def _set_parameter(k: dict, c: dict, name: str, value: float) -> None:
@@ -63,32 +56,18 @@ def _set_parameter(k: dict, c: dict, name: str, value: float) -> None:
         target[e] = f"{float(value)!r} {units[e]}"
 
 
-@attrs.frozen
-class _MatrixJoint:
-    """A joint given by SI matrices, for fast model evaluations inside fits."""
-
-    name: str
-    between: tuple[str, str]
-    k: np.ndarray
-    c: np.ndarray
-    rigid: bool = False
-
-    @classmethod
-    def from_values(cls, template, values: Mapping[str, float]) -> "_MatrixJoint":
-        k = np.array([[values["k_yf"], values["k_ym"]], [values["k_ym"], values["k_tm"]]], dtype=float)
-        c = np.array([[values["c_yf"], values["c_ym"]], [values["c_ym"], values["c_tm"]]], dtype=float)
-        return cls(template.name, tuple(template.between), k, c)
-
-    def dynamic_stiffness(self, frequency_hz: np.ndarray) -> np.ndarray:
-        omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
-        return self.k[:, :, None] + 1j * omega * self.c[:, :, None]
-
-
 def _joint_values(joint: Joint) -> dict[str, float]:
     return {
         name: (joint.k if name[0] == "k" else joint.c).get(name.split("_", 1)[1])
         for name in PARAMETERS
     }
+
+
+def _frf_of(measurement) -> FRF:
+    frf = measurement if isinstance(measurement, FRF) else measurement.frf
+    if not isinstance(frf, FRF):
+        raise InvalidValueError(f"measurements: got {measurement!r}; expected FRFs or measurements with .frf")
+    return frf.to_receptance()
 
 
 def auto_band(prepared, joint: Joint, parameter: str = "k_yf", factor: float = 1.2) -> tuple[float, float]:
@@ -135,8 +114,6 @@ def auto_band(prepared, joint: Joint, parameter: str = "k_yf", factor: float = 1
     for p in peaks:
         window = (f > 0.8 * p) & (f < 1.25 * p)
         f1 = f[window][np.argmax(h1[window])]
-        # relative shift; a mode weaker than 2 % of the strongest sits near the
-        # noise floor of a tap test and is not considered
         strong = h0[np.searchsorted(f, p)] >= 0.02 * top
         scores.append(abs(f1 - p) / p if strong else -1.0)
     peak = peaks[int(np.argmax(scores))]
@@ -157,11 +134,13 @@ class JointIdentifier:
     ----------
     joint : str
         Name of the joint in the assembly.
-    parameters : sequence of str
-        Which of :data:`PARAMETERS` to fit; the others keep the assembly's
-        values.  Default: ``k_yf``, ``k_tm``, ``c_yf``, ``c_tm`` (the diagonal
-        joint of thesis eq. 2.4); add ``k_ym`` (= ``k_tf``) and ``c_ym`` for the
-        fully populated joint of eq. 2.5.
+    parameters : "auto" or sequence of str
+        ``"auto"`` (default): the diagonal joint (``k_yf, k_tm, c_yf, c_tm``,
+        thesis eq. 2.4), with the cross terms ``k_ym`` (= ``k_tf``) and
+        ``c_ym`` of eq. 2.5 added when they lower ``chi^2`` significantly
+        (:func:`substructure.updating.selection.significance`).  Or which of
+        :data:`~substructure.identify.closed_form.PARAMETERS` to fit; the
+        others keep the assembly's values.
     band : "auto" or (lo, hi)
         Frequency band in Hz; ``"auto"``: the mode the joint dominates
         (:func:`auto_band`).
@@ -179,54 +158,82 @@ class JointIdentifier:
     joint_ : Joint
         The fitted joint.
     values_, std_ : dict of str to float
-        Fitted parameters and their standard deviations (SI units).
+        Fitted parameters and their standard deviations (SI units; inflated
+        by the misfit when the residual is not consistent with the noise).
+    correlation_ : ndarray
+        Correlations of the fitted parameters (order of ``fitted_``).
+    fitted_ : tuple of str
+        The parameters fitted.
+    model_ : str
+        ``"diagonal"``, ``"full"`` (with cross terms) or ``"given"``.
     band_ : (float, float)
     cost_ : float
-        Final sum of squared relative residuals.
+        ``chi^2`` at the optimum.
+    chi2_reduced_ : float
+        ``chi^2 / (n - p)``: about 1 when the residual is noise.
+    consistent_ : bool
+        The residual is consistent with the noise
+        (:func:`substructure.updating.selection.consistency`).
     residual_rms_ : float
-        RMS of the relative complex residual over the band.
+        RMS of the complex log ratio of model to measurement over the band.
     warnings_ : list of str
-        Passivity and reciprocity findings on the fitted joint.
+        Misfit, passivity and reciprocity findings.
     n_lines_ : int
         Number of frequency lines (over all FRFs) in the fit.
-
-    Notes
-    -----
-    Residuals are ``(H_model - H_measured) / |H_measured|`` (real and
-    imaginary parts) at every line of the band for every measured FRF of a
-    configuration in which the joint exists, so that multiplicative noise is
-    weighted evenly.  Positive parameters are fitted as logarithms; the
-    standard deviations come from ``s^2 (J^T J)^-1`` with ``s^2`` the residual
-    variance, mapped back by the delta method.
     """
 
-    def __init__(self, joint: str, parameters: Sequence[str] = ("k_yf", "k_tm", "c_yf", "c_tm"),
-                 band="auto", bootstrap: int = 0, random_state: int = 0, initial: Mapping | None = None):
+    def __init__(self, joint: str, parameters: str | Sequence[str] = "auto", band="auto", bootstrap: int = 0,
+                 random_state: int = 0, initial: Mapping | None = None):
         self.joint = joint
-        self.parameters = tuple(parameters)
+        self.parameters = parameters if isinstance(parameters, str) else tuple(parameters)
         self.band = band
         self.bootstrap = bootstrap
         self.random_state = random_state
         self.initial = dict(initial or {})
 
-    # -- helpers -----------------------------------------------------------------
-
     def _check(self) -> None:
+        if isinstance(self.parameters, str):
+            if self.parameters != "auto":
+                raise InvalidValueError(f"parameters: got {self.parameters!r}; expected 'auto' or some of "
+                                        f"{', '.join(PARAMETERS)}")
+            return
         unknown = [p for p in self.parameters if p not in PARAMETERS]
         if unknown or not self.parameters:
             raise InvalidValueError(
-                f"parameters: got {list(self.parameters)}; expected some of {', '.join(PARAMETERS)}"
+                f"parameters: got {list(self.parameters)}; expected 'auto' or some of {', '.join(PARAMETERS)}"
             )
         if not (isinstance(self.bootstrap, int) and self.bootstrap >= 0):
             raise InvalidValueError(f"bootstrap: got {self.bootstrap!r}; expected an integer >= 0")
 
     def _joint(self, template: Joint, values: Mapping[str, float]) -> Joint:
-        k, c = template.k.as_dict() if not template.rigid else {}, template.c.as_dict() if not template.rigid else {}
+        k, c = (template.k.as_dict(), template.c.as_dict()) if not template.rigid else ({}, {})
         for name, value in values.items():
             _set_parameter(k, c, name, value)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", (NonPassiveJointWarning,))
             return Joint(template.name, template.between, k=k, c=c)
+
+    def _specs(self, names, start: Mapping[str, float]) -> list[ParamSpec]:
+        specs = []
+        for name in names:
+            v = float(start[name])
+            if name in CROSS:
+                diag = ("k_yf", "k_tm") if name == "k_ym" else ("c_yf", "c_tm")
+                scale = max(np.sqrt(abs(start[diag[0]] * start[diag[1]])), 1e-12)
+                specs.append(ParamSpec(name, _UNITS[name], -3 * scale, 3 * scale, v, False))
+            else:
+                specs.append(ParamSpec(name, _UNITS[name], v / 1e3, v * 1e3, v, True))
+        return specs
+
+    def _fit(self, lik, template, names, start):
+        paths = {n: f"joints.{template.name}.{n[0]}.{n.split('_', 1)[1]}" for n in names}
+        change = ParameterSet("joint", template.name, paths, self._specs(names, start))
+        values = {n: start[n] for n in names}
+        if "k_yf" in names:  # a scan of the main stiffness first, against local minima
+            trials = [(lik.chi2([(change, {**values, "k_yf": start["k_yf"] * f})]), f)
+                      for f in np.geomspace(0.1, 10.0, 41)]
+            values["k_yf"] = start["k_yf"] * min(trials)[1]
+        return fit(lik, [(change, values)])
 
     def fit(self, assembly: Assembly, measurements: Sequence) -> "JointIdentifier":
         """Fit the joint to the measurements; returns ``self``.
@@ -251,21 +258,22 @@ class JointIdentifier:
         template = assembly.joint(self.joint)
         nominal = _joint_values(template) if not template.rigid else {p: 0.0 for p in PARAMETERS}
         nominal.update(self.initial)
-        missing = [p for p in self.parameters if p in ("k_yf", "k_tm", "c_yf", "c_tm") and nominal[p] <= 0]
+        names = DIAGONAL if self.parameters == "auto" else self.parameters
+        missing = [p for p in names if p not in CROSS and nominal[p] <= 0]
         if missing:
             raise InvalidValueError(
                 f"initial: the assembly gives no starting value for {', '.join(missing)} of joint "
                 f"{self.joint!r}; pass initial={{...}} in SI units"
             )
+        start_joint = self._joint(template, {p: nominal[p] for p in PARAMETERS if nominal[p] != 0 or p in CROSS})
+        model = assembly.with_joint(start_joint)
         cases = []
         points = [parse_point(p).component for p in template.between]
         for m in measurements:
             removed = set(getattr(m, "removed", ()) or ())
             if any(any(pt in assembly.component(r).component_names for pt in points) for r in removed):
                 continue
-            frf = _frf_of(m)
-            prepared = model_of_measurement(assembly, m).prepare(list(frf.outputs), list(frf.inputs), frf.frequency)
-            cases.append((prepared, frf))
+            cases.append(m)
         if not cases:
             have = sorted({f"{getattr(m, 'response', '?')} with {list(getattr(m, 'removed', ()))} removed"
                            for m in measurements})
@@ -273,9 +281,12 @@ class JointIdentifier:
                 f"measurements: the fit of joint {self.joint!r} needs at least one FRF measured with the joint "
                 f"in place (neither {' nor '.join(points)} removed); the set has only: {'; '.join(have) or 'nothing'}"
             )
+        first = _frf_of(cases[0])
+        prepared = model_of_measurement(model, cases[0]).prepare(list(first.outputs), list(first.inputs),
+                                                                 first.frequency)
         auto = self.band == "auto"
         if auto:
-            band = auto_band(cases[0][0], self._joint(template, nominal))
+            band = auto_band(prepared, start_joint)
         else:
             try:
                 lo, hi = (float(x) for x in self.band)
@@ -285,109 +296,82 @@ class JointIdentifier:
                 raise InvalidValueError(f"band: got {self.band!r}; expected lo < hi")
             band = (lo, hi)
         for attempt in range(2 if auto else 1):
-            fit, data, values, positive, start, linear_scale, bounds, x0, residual = self._fit_band(
-                template, nominal, cases, band
-            )
+            lik = self._likelihood(model, cases, band, len(names))
+            result = self._fit(lik, start_joint, names, nominal)
             if not auto:
                 break
-            # The band came from the starting model; once fitted, look again.
-            new_band = auto_band(cases[0][0], self._joint(template, values(fit.x)))
+            new_band = auto_band(prepared, self._joint(template, {**nominal, **result.changes[0][1]}))
             if abs(new_band[0] - band[0]) + abs(new_band[1] - band[1]) < 0.02 * (band[1] - band[0]):
                 break
             band = new_band
-        m, n = fit.fun.size, fit.x.size
-        s2 = float(np.sum(fit.fun**2)) / max(m - n, 1)
-        jtj = fit.jac.T @ fit.jac
-        cov = s2 * np.linalg.pinv(jtj)
-        best = values(fit.x)
-        std = {}
-        for name, pos, var in zip(self.parameters, positive, np.diag(cov)):
-            sd = float(np.sqrt(max(var, 0.0)))
-            std[name] = best[name] * sd if pos else sd * linear_scale[name]
+        self.model_ = "given" if self.parameters != "auto" else "diagonal"
+        notes = []
+        if self.parameters == "auto":
+            best = {**nominal, **result.changes[0][1]}
+            full = self._fit(lik, start_joint, DIAGONAL + CROSS, best)
+            test = significance(result.chi2, full.chi2, len(CROSS), lik.n, full.p)
+            if test.significant:
+                result, self.model_ = full, "full"
+                notes.append(f"the cross terms k_ym = k_tf and c_ym = c_tf are significant (likelihood ratio "
+                             f"{test.statistic:.3g} > {test.threshold:.3g}): the joint is fitted with them (eq. 2.5)")
+        values = {**nominal, **result.changes[0][1]}
+        self.fitted_ = tuple(result.changes[0][1])
+        self.joint_ = self._joint(template, {p: values[p] for p in self.fitted_} if not template.rigid else values)
+        self.values_ = {p: float(result.changes[0][1][p]) for p in self.fitted_}
+        self.std_ = dict(result.std[0])
+        self.correlation_ = result.correlation
+        ratios = lik.log_ratios(result.changes)
+        test = consistency(lik, ratios, result.p)
+        self.consistent_ = test.consistent
+        self.chi2_reduced_ = result.chi2_reduced
+        if not test.consistent:
+            notes.append(f"the model does not fit the data within their noise (chi^2/nu = {result.chi2_reduced:.3g}, "
+                         f"the noise allows {test.threshold:.3g}): it misses something (a sensor, flutes, another "
+                         "joint term...), so the values are uncertain and their standard deviations are inflated "
+                         "by the misfit; run `substructure diagnose` to find what is missing")
         if self.bootstrap:
-            std = self._bootstrap(template, data, fit, residual, values, bounds, x0, std)
-        self.joint_ = self._joint(template, best)
-        self.values_ = {p: float(best[p]) for p in self.parameters}
-        self.std_ = std
+            self.std_ = self._bootstrap(lik, result)
         self.band_ = band
-        self.cost_ = float(np.sum(fit.fun**2))
-        self.residual_rms_ = float(np.sqrt(np.mean(fit.fun**2) * 2))
-        self.warnings_ = _passivity(self.joint_)
-        self.n_lines_ = int(sum(d[1].shape[0] for d in data))
+        self.cost_ = float(result.chi2)
+        self.residual_rms_ = float(np.sqrt(np.mean(np.concatenate([np.abs(r) ** 2 for r in ratios]))))
+        self.warnings_ = notes + _passivity(self.joint_)
+        self.n_lines_ = int(sum(m.frf.frequency.n for m in lik.measured))
         return self
 
-    def _fit_band(self, template, nominal, cases, band):
-        data = []
-        for prepared, frf in cases:
+    def _likelihood(self, model, cases, band, n_par):
+        self._enough(cases, band, n_par)
+        measured, _ = measured_frfs(cases, band)
+        return Likelihood(model, measured)
+
+    @staticmethod
+    def _enough(cases, band, n_par) -> None:
+        for m in cases:
+            frf = _frf_of(m)
             mask = frf.frequency.band_mask(*band)
-            if mask.sum() < len(self.parameters) + 2:
+            if mask.sum() < max(n_par + 2, 10):
                 raise InvalidValueError(
                     f"band: {band[0]:.0f}-{band[1]:.0f} Hz holds {int(mask.sum())} lines of the data "
                     f"({frf.frequency.start:.0f}-{frf.frequency.stop:.0f} Hz); too few to fit"
                 )
-            sub = prepared.frequency.crop(*band)
-            small = type(prepared)(prepared.assembly, _points(frf.outputs), _points(frf.inputs), sub)
-            data.append((small, frf.data[mask]))
 
-        positive = [p not in ("k_ym", "c_ym") for p in self.parameters]
-        start = np.array([nominal[p] for p in self.parameters], dtype=float)
-        linear_scale = {
-            "k_ym": max(abs(nominal["k_yf"] * nominal["k_tm"]) ** 0.5, 1.0),
-            "c_ym": max(abs(nominal["c_yf"] * nominal["c_tm"]) ** 0.5, 1e-6),
-        }
-
-        def values(x):
-            out = dict(nominal)
-            for name, xi, pos, s0 in zip(self.parameters, x, positive, start):
-                out[name] = s0 * np.exp(xi) if pos else s0 + xi * linear_scale[name]
-            return out
-
-        def residual(x, data=data):
-            joint = _MatrixJoint.from_values(template, values(x))
-            parts = []
-            for prepared, measured in data:
-                model = prepared.evaluate(joints={self.joint: joint}).data
-                r = (model - measured) / np.abs(measured)
-                parts.append(r.real.ravel())
-                parts.append(r.imag.ravel())
-            return np.concatenate(parts)
-
-        # A scan over the main stiffness first (one decade either way), against
-        # local minima; then bounded least squares: positive parameters within a
-        # factor 100 of their start, linear ones within +-10 scales.
-        x0 = np.zeros(len(self.parameters))
-        if "k_yf" in self.parameters:
-            i = self.parameters.index("k_yf")
-            trial = []
-            for factor in np.geomspace(0.1, 10.0, 41):
-                x = x0.copy()
-                x[i] = np.log(factor)
-                trial.append((float(np.sum(residual(x) ** 2)), factor))
-            x0[i] = np.log(min(trial)[1])
-        limit = np.where(positive, np.log(100.0), 10.0)
-        bounds = (x0 - limit, x0 + limit)
-        fit = least_squares(residual, x0, bounds=bounds, method="trf", x_scale=1.0, max_nfev=200 * len(x0))
-        return fit, data, values, positive, start, linear_scale, bounds, x0, residual
-
-    def _bootstrap(self, template, data, fit, residual, values, bounds, x0, std):
-        """Standard deviations from refits on the model plus resampled relative residuals."""
+    def _bootstrap(self, lik, result):
+        """Standard deviations from refits on the model plus resampled log-ratio residuals."""
         rng = np.random.default_rng(self.random_state)
-        best = values(fit.x)
-        joint = _MatrixJoint.from_values(template, best)
-        model_data = [prepared.evaluate(joints={self.joint: joint}).data for prepared, _ in data]
-        rel = [(meas - mod) / np.abs(meas) for (_, meas), mod in zip(data, model_data)]
+        change, best = result.changes[0]
+        model = lik.predict(result.changes)
+        ratios = lik.log_ratios(result.changes)
         samples = []
         for _ in range(self.bootstrap):
             boot = []
-            for (prepared, _), mod, r in zip(data, model_data, rel):
-                flat = r.ravel()
-                pick = flat[rng.integers(0, flat.size, flat.size)].reshape(r.shape)
-                boot.append((prepared, mod * (1 + pick)))
-            refit = least_squares(lambda x: residual(x, boot), fit.x, bounds=bounds, method="trf",
-                                  x_scale=1.0, max_nfev=50 * len(x0))
-            samples.append([values(refit.x)[p] for p in self.parameters])
+            for m, y, r in zip(lik.measured, model, ratios):
+                pick = r[rng.integers(0, r.size, r.size)]
+                data = m.frf.data.copy()
+                data[lik.lines, 0, 0] = y / np.exp(pick)
+                boot.append(attrs.evolve(m, frf=FRF(m.frf.frequency, data, m.frf.outputs, m.frf.inputs)))
+            refit = fit(Likelihood(lik.assembly, boot, lik.lines), [(change, best)], max_nfev=50 * len(best))
+            samples.append([refit.changes[0][1][p] for p in best])
         spread = np.std(np.array(samples), axis=0, ddof=1)
-        return {p: float(max(std[p], s)) for p, s in zip(self.parameters, spread)}
+        return {p: float(max(result.std[0][p], s)) for p, s in zip(best, spread)}
 
     def predict(self, assembly: Assembly, outputs, inputs=None, frequency=None) -> FRF:
         """The assembly's FRF with the fitted joint.
@@ -409,10 +393,6 @@ class JointIdentifier:
             The receptances with the fitted joint (m/N, ...).
         """
         return assembly.with_joint(self.joint_).frf(outputs, inputs, frequency)
-
-
-def _points(labels) -> list[str]:
-    return list(labels)
 
 
 def _passivity(joint: Joint) -> list[str]:

@@ -21,12 +21,17 @@ from ..errors import SubstructureError
 from ..frf import FRF
 from ..points import parse_point
 from ..rdof import estimate_rotational, positions_from
-from .band_fit import JointIdentifier, model_of_measurement
+from .band_fit import _UNITS, JointIdentifier, model_of_measurement
 from .closed_form import ClosedFormResult, closed_form, joint_sides
 
 __all__ = ["IdentificationReport", "identify_joint"]
 
 _ENTRIES = ("yf", "ym", "tf", "tm")
+
+
+def _finite(x):
+    x = float(x)
+    return x if np.isfinite(x) else None
 
 
 @attrs.frozen
@@ -63,9 +68,17 @@ class IdentificationReport:
     predicted : FRF
         The model's FRF there after the fit.
     residual_rms : float
-        Relative RMS of the fit's residual (dimensionless).
+        RMS of the complex log ratio of model to measurement over the band (dimensionless).
     closed_form : ClosedFormResult or None
         The closed form of thesis eq. 2.3, when the data allowed it.
+    model : str
+        The joint model chosen: ``diagonal``, ``full`` (with the cross terms) or ``given``.
+    consistent : bool
+        Whether the residual is consistent with the noise of the data.
+    chi2_reduced : float
+        ``chi^2`` per degree of freedom (about 1 when the model fits; dimensionless).
+    correlation : tuple of tuple of float
+        Correlations of the fitted parameters, in the order of ``fitted``.
     """
 
     joint: str
@@ -81,27 +94,45 @@ class IdentificationReport:
     predicted: FRF
     residual_rms: float
     closed_form: ClosedFormResult | None = None
+    model: str = "given"
+    consistent: bool = True
+    chi2_reduced: float = float("nan")
+    correlation: tuple = ()
 
     def to_json(self) -> dict:
-        """The JSON object of ``substructure identify --json`` (SI units, Hz).
+        """The JSON object of docs/file-formats.md (SI units, Hz; strict JSON), plus a few added keys.
 
         Returns
         -------
         dict
-            ``joint``, ``band_hz``, ``k``, ``c``, ``k_std``, ``c_std`` (SI), ``warnings``,
-            ``fitted``, ``residual_rms``.
+            ``joint``, ``band_hz``, ``k``, ``c``, ``k_std``, ``c_std``, ``warnings``, ``fitted``,
+            ``residual_rms``, ``model``, ``consistent``, ``chi2_reduced``, ``parameters``, ``correlation``.
         """
         return {
             "joint": self.joint,
             "band_hz": [self.band[0], self.band[1]],
-            "k": dict(self.k),
-            "c": dict(self.c),
-            "k_std": dict(self.k_std),
-            "c_std": dict(self.c_std),
+            "k": {e: _finite(v) for e, v in self.k.items()},
+            "c": {e: _finite(v) for e, v in self.c.items()},
+            "k_std": {e: _finite(v) for e, v in self.k_std.items()},
+            "c_std": {e: _finite(v) for e, v in self.c_std.items()},
             "warnings": list(self.warnings),
             "fitted": list(self.fitted),
-            "residual_rms": self.residual_rms,
+            "residual_rms": _finite(self.residual_rms),
+            "model": self.model,
+            "consistent": bool(self.consistent),
+            "chi2_reduced": _finite(self.chi2_reduced),
+            "parameters": {name: {"value": _finite(self._value(name)), "unit": _UNITS[name],
+                                  "std": _finite(self._std(name))} for name in self.fitted},
+            "correlation": [[_finite(x) for x in row] for row in self.correlation],
         }
+
+    def _value(self, name: str) -> float:
+        kind, entry = name.split("_", 1)
+        return (self.k if kind == "k" else self.c)[entry]
+
+    def _std(self, name: str) -> float:
+        kind, entry = name.split("_", 1)
+        return (self.k_std if kind == "k" else self.c_std)[entry]
 
     def plot(self):
         """Closed-form parameters with band and fit (when available), and the FRF before/after.
@@ -171,23 +202,22 @@ def _points_on(measurements, assembly: Assembly, components: set, removed=()) ->
 
 
 def identify_joint(assembly: Assembly, measurements, joint: str, band="auto",
-                   parameters: Sequence[str] = ("k_yf", "k_tm", "c_yf", "c_tm"), bootstrap: int = 0,
+                   parameters: str | Sequence[str] = "auto", bootstrap: int = 0,
                    random_state: int = 0) -> IdentificationReport:
     """Identify a joint from a measurement set (see the module docstring).
 
     Parameters
     ----------
     assembly : Assembly
-        The model, with the joint (its values are the start) and the sensors the
-        measurements list.
-    measurements : MeasurementSet or sequence of Measurement
-        The tap tests (receptances in m/N).
+        The model with the joint (its values start the fit).
+    measurements : MeasurementSet or sequence of measurements
+        The data.
     joint : str
         The joint's name.
-    band : "auto" or tuple of float
-        The band ``(lo, hi)`` in Hz, or found from the model's sensitivity.
-    parameters : sequence of str
-        The joint parameters to fit (``k_yf``, ``k_tm``, ``c_yf``, ``c_tm``, ...).
+    band : "auto" or (lo, hi)
+        The band [Hz].
+    parameters : "auto" or sequence of str
+        ``"auto"``: the diagonal joint, with cross terms when significant.
     bootstrap : int
         Bootstrap refits for the standard deviations (0: from the Jacobian).
     random_state : int
@@ -227,9 +257,10 @@ def identify_joint(assembly: Assembly, measurements, joint: str, band="auto",
         for e in (("ym", "tf") if entry == "ym" else (entry,)):
             target[e] = float(sd)
     return IdentificationReport(
-        joint=joint, band=ident.band_, k=k, c=c, k_std=k_std, c_std=c_std, fitted=tuple(parameters),
+        joint=joint, band=ident.band_, k=k, c=c, k_std=k_std, c_std=c_std, fitted=tuple(ident.fitted_),
         warnings=tuple(notes), measured=first.frf, initial=initial, predicted=predicted,
-        residual_rms=ident.residual_rms_, closed_form=result,
+        residual_rms=ident.residual_rms_, closed_form=result, model=ident.model_, consistent=ident.consistent_,
+        chi2_reduced=ident.chi2_reduced_, correlation=tuple(tuple(float(x) for x in row) for row in ident.correlation_),
     )
 
 
