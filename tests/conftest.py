@@ -95,3 +95,16 @@ def rel_err(a, b) -> float:
     """max |a - b| / max |b| (normwise relative error)."""
     a, b = np.asarray(a), np.asarray(b)
     return float(np.abs(a - b).max() / np.abs(b).max())
+
+
+@pytest.fixture(autouse=True)
+def _restore_registries():
+    """Registrations made by a test (effects, component types) do not outlive it."""
+    from substructure.components import COMPONENT_TYPES
+    from substructure.diagnose.effects import EFFECTS
+
+    saved = dict(EFFECTS), dict(COMPONENT_TYPES)
+    yield
+    for registry, before in zip((EFFECTS, COMPONENT_TYPES), saved):
+        registry.clear()
+        registry.update(before)

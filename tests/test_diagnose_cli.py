@@ -74,3 +74,19 @@ def test_demo_runs_the_diagnosis_on_built_in_data(capsys, tmp_path):
     assert diagnosis["refinement"][-1]["error"] <= 1.5 * diagnosis["noise_floor"]
     for name in ("where_it_fails.png", "error_fall.png", "improved_assembly.toml", "tool_point_frf.png"):
         assert (tmp_path / name).stat().st_size > 0
+
+
+def test_an_empty_effect_list_a_band_half_outside_and_a_dead_channel_say_what_is_wrong(files, capsys, tmp_path):
+    assert _run(files, "--effects", "") == 2
+    assert "--effects: got an empty list" in capsys.readouterr().err
+    assert _run(files, "--band", "1000:9000") == 1
+    err = capsys.readouterr().err
+    assert "ends at 9000 Hz, above the last measured line" in err and "outside the data" not in err
+    dead = tmp_path / "dead"
+    frf = hd.measure(sensor_kg=0.002, seed=3)[0]
+    zero = type(frf)(frf.frequency, 0 * frf.data, frf.outputs, frf.inputs)
+    write_measurement_set(MeasurementSet("dead", (Measurement.from_frf(zero, "tool.tip", "tool.tip"),)), dead)
+    assert main(["diagnose", str(files / "model.toml"), str(dead / "measurements.toml"), "--quiet", "--json"]) == 1
+    captured = capsys.readouterr()
+    assert "tool.tip:y / tool.tip:y" in captured.err and "dead channel" in captured.err
+    assert captured.out == "" and "Traceback" not in captured.err

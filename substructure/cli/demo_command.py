@@ -111,9 +111,11 @@ def _demo_diagnose(state: DemoState) -> None:
 
     result = diagnose(state.assembly, state.taps)
     state.results["diagnosis"] = result.to_json()
+    verdict = ("explained: the final error is at the noise floor" if result.explained else
+               "not explained: " + (result.report[0] if result.report else "the residual is not noise"))
     state.lines.append(f"diagnosis: error {result.baseline_error:.3f} against a noise floor of "
                        f"{result.noise_floor:.3f}; missing effect: {result.missing_effect} at "
-                       f"{result.missing_where}")
+                       f"{result.missing_where} ({verdict})")
     for step in result.refinement:
         what = "model as given" if step.added is None else f"+ {step.added.name} at {step.added.where}"
         state.lines.append(f"  step {step.step}: {what:45s} error {step.error:.4f}")

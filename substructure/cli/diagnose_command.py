@@ -1,4 +1,4 @@
-"""The ``substructure diagnose`` command: model against measurement, the missing effect, the error falling."""
+"""The ``substructure diagnose`` command: model against measurement, what is missing, an honest verdict."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ from ._common import (
     UsageError,
     band_range_arg,
     check_outputs,
+    count_arg,
     figures,
     measurement_inputs,
     print_json,
@@ -21,13 +22,68 @@ FIGURES = ("where_it_fails.png", "error_fall.png", "after_refinement.png")
 """The figures ``--plot DIR`` writes."""
 
 
-def run(args: argparse.Namespace) -> int:
-    from ..io.assembly_toml import load_assembly
+def _values(found) -> str:
+    parts = []
+    for name, spec in found.parameters_json().items():
+        unit = "" if spec["unit"] == "dimensionless" else f" {spec['unit']}"
+        std = f" +- {spec['std']:.2g}" if spec.get("std") is not None else ""
+        nominal = f" (model: {spec['nominal']:.4g})" if spec.get("nominal") is not None else ""
+        parts.append(f"{name} = {spec['value']:.4g}{std}{unit}{nominal}")
+    return ", ".join(parts)
 
+
+def _summary(result, assembly, measurements) -> list[str]:
+    floor = result.noise_floor
+    lines = []
+    if not result.explained:
+        lines += list(result.report)
+    lines.append(f"model {assembly.name!r} against {len(measurements)} measured FRF(s), "
+                 f"{result.band[0]:.0f}-{result.band[1]:.0f} Hz")
+    lines.append(f"error ({result.metric}): {result.baseline_error:.4f}; noise floor of the data: {floor:.4f}")
+    base = result.baseline[0]
+    for m in [m for m in base.modes if m.model_hz is not None][:12]:
+        lines.append(f"  mode at {m.measured_hz:7.0f} Hz measured, {m.model_hz:7.0f} Hz in the model "
+                     f"({m.shift_hz:+.0f} Hz), peak x{m.amplitude_ratio:.2f}")
+    if base.bands:
+        lines.append("  most of the error is in " + ", ".join(f"{lo:.0f}-{hi:.0f} Hz ({share:.0%})"
+                                                           for lo, hi, share in base.bands))
+    if result.missing_effect is None:
+        if result.explained:
+            lines.append("the model is as good as the data allow: nothing is missing")
+        else:
+            lines.append("no candidate explains the difference significantly")
+    else:
+        label = "missing effect" if result.explained else "best partial explanation (partial)"
+        for i, e in enumerate(result.effects):
+            lines.append(f"{label if i == 0 else 'and'}: {e.name} at {e.where}")
+            lines.append(f"  {_values(e)}")
+            lines.append(f"  why: {e.explanation}")
+        if result.ambiguous:
+            alts = "; ".join(f"{a.name} at {a.where} ({_values(a)})" for a, _ in result.ambiguous[:3])
+            lines.append(f"  equally possible: {alts}")
+            if result.suggestion:
+                lines.append(f"  to tell them apart: {result.suggestion}")
+    if len(result.refinement) > 1:
+        lines.append("refinement (watch the error fall):")
+        for step in result.refinement:
+            what = "model as given" if step.added is None else f"+ {step.added.name} at {step.added.where}"
+            lines.append(f"  step {step.step}: {what:50s} error {step.error:.4f}  chi^2/nu {step.chi2_reduced:.4g}")
+    cons = result.consistency
+    verdict = "explained" if result.explained else "not explained"
+    lines.append(f"verdict: {verdict}: final error {result.final_error:.4f} ({result.final_error / floor:.2f} x the "
+                 f"noise floor), chi^2/nu = {cons.chi2_reduced:.4g} (consistent with the noise up to "
+                 f"{cons.threshold:.4g})")
+    return lines
+
+
+def run(args: argparse.Namespace) -> int:
     from ..diagnose import diagnose
-    from ..io.assembly_toml import save_assembly
+    from ..io.assembly_toml import load_assembly, save_assembly
     from ..io.measurements import load_measurements
 
+    if not args.effects.strip():
+        raise UsageError("argument --effects: got an empty list; give 'all' or effect names separated by commas")
+    count_arg("--max-steps", args.max_steps, minimum=1)
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise UsageError(f"argument --plot: {args.plot} is a file; expected a directory for the figures")
     # figures go into DIR (created if missing): the ones there already are checked like any output
@@ -37,10 +93,9 @@ def run(args: argparse.Namespace) -> int:
                   [args.assembly, *measurement_inputs(args.measurements)], args.overwrite)
     assembly = load_assembly(args.assembly)
     measurements = load_measurements(args.measurements)
-    effects = "all" if args.effects == "all" else [e.strip() for e in args.effects.split(",") if e.strip()]
-    band = None if args.band is None else args.band
     progress = None if args.quiet else (lambda text: print(f"{PROG}: {text}", file=sys.stderr, flush=True))
-    result = diagnose(assembly, measurements, effects=effects, band=band, progress=progress or False)
+    result = diagnose(assembly, measurements, effects=args.effects, band=args.band, progress=progress or False,
+                      max_steps=args.max_steps, open_world=not args.catalogue_only)
     written = []
     if args.plot:
         figures()
@@ -59,38 +114,7 @@ def run(args: argparse.Namespace) -> int:
         written.append(args.save_model)
     if args.json:
         return print_json(result.to_json())
-    floor = result.noise_floor
-    print(f"model {assembly.name!r} against {len(measurements)} measured FRF(s), "
-          f"{result.band[0]:.0f}-{result.band[1]:.0f} Hz")
-    print(f"error ({result.metric}): {result.baseline_error:.4f}; noise floor of the data: {floor:.4f}")
-    base = result.baseline[0]
-    for m in base.modes[:12]:
-        if m.model_hz is not None:
-            print(f"  mode at {m.measured_hz:7.0f} Hz measured, {m.model_hz:7.0f} Hz in the model "
-                  f"({m.shift_hz:+.0f} Hz), peak x{m.amplitude_ratio:.2f}")
-        else:
-            print(f"  mode at {m.measured_hz:7.0f} Hz measured, none in the model")
-    if base.bands:
-        print("  most of the error is in " + ", ".join(f"{lo:.0f}-{hi:.0f} Hz ({share:.0%})"
-                                                        for lo, hi, share in base.bands))
-    if result.missing_effect is None:
-        if result.baseline_error <= 1.5 * floor:
-            print("the model is as good as the data allow: nothing is missing")
-        else:
-            print("no effect of the catalogue explains the difference convincingly")
-    else:
-        best = result.candidates[0]
-        print(f"missing effect: {best.name} at {best.where}")
-        for name, spec in best.effect.parameters_json().items():
-            print(f"  {name} = {spec['value']:.4g} {spec['unit']}")
-        print(f"  why: {best.effect.explanation}")
-        if result.ambiguous_with:
-            print(f"  equally possible: {', '.join(result.ambiguous_with)}; to tell them apart: {result.suggestion}")
-    if len(result.refinement) > 1:
-        print("refinement (watch the error fall):")
-        for step in result.refinement:
-            what = "model as given" if step.added is None else f"+ {step.added.name} at {step.added.where}"
-            print(f"  step {step.step}: {what:45s} error {step.error:.4f}")
+    print("\n".join(_summary(result, assembly, measurements)))
     for path in written:
         print(f"wrote {path}")
     return 0
@@ -98,14 +122,18 @@ def run(args: argparse.Namespace) -> int:
 
 def add_parser(commands) -> None:
     """Add the ``diagnose`` subcommand to the subparsers ``commands``."""
-    diag = commands.add_parser("diagnose", help="which physical effect the model misses against measurements")
+    diag = commands.add_parser("diagnose", help="what the model misses against measurements, with an honest verdict")
     diag.add_argument("assembly", metavar="ASSEMBLY.toml", help="assembly file (docs/file-formats.md)")
     diag.add_argument("measurements", metavar="MEASUREMENTS.toml", help="measurement set (docs/file-formats.md)")
     diag.add_argument("--effects", default="all", metavar="all|NAME,...",
-                      help="effects to consider (default all registered effects)")
+                      help="effects of the catalogue to consider (default all registered effects)")
+    diag.add_argument("--catalogue-only", action="store_true",
+                      help="consider only the catalogue's effects, not every model parameter and added element")
+    diag.add_argument("--max-steps", type=int, default=4, metavar="N",
+                      help="most changes the refinement adds (default 4)")
     diag.add_argument("--band", type=band_range_arg, metavar="LO:HI", help="frequency band in Hz (default: all data)")
     diag.add_argument("--plot", metavar="DIR", help="write the figures (where it fails, error fall) to DIR")
-    diag.add_argument("--save-model", metavar="FILE.toml", help="write the model with the effects found")
+    diag.add_argument("--save-model", metavar="FILE.toml", help="write the model with the changes found")
     diag.add_argument("--overwrite", action="store_true",
                       help="let --save-model and --plot replace existing files (never an input)")
     diag.add_argument("--quiet", action="store_true", help="no progress on standard error")

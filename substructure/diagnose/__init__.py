@@ -11,10 +11,11 @@
 """
 
 from .compare import METRIC, Comparison, compare, error, frac, noise_floor, pair_modes
-from .diagnosis import Candidate, Diagnosis, Step, diagnose
-from .effects import EFFECTS, Effect, Parameter, get_effect, register_effect
+from .diagnosis import Candidate, Diagnosis, Found, Step, diagnose
+from .effects import EFFECTS, Effect, Parameter, get_effect, register_effect, registered, registry
 
 __all__ = [
     "METRIC", "Comparison", "compare", "error", "frac", "noise_floor", "pair_modes", "Candidate",
-    "Diagnosis", "Step", "diagnose", "EFFECTS", "Effect", "Parameter", "get_effect", "register_effect",
+    "Diagnosis", "Found", "Step", "diagnose", "EFFECTS", "Effect", "Parameter", "get_effect", "register_effect",
+    "registered", "registry",
 ]

@@ -11,18 +11,18 @@ the band alike whatever the FRF's level (resonances and antiresonances
 count as much as the flanks), is symmetric in model and measurement, and a
 relative error of 1 % on every line gives ``e = 0.01``.
 
-The noise floor is estimated from the measurement alone: the measured FRF
-is smoothed by a Savitzky-Golay filter, and the log ratio of the data to its
-smoothed version has the scatter of the noise; corrected for the share of
-the noise the filter keeps, its RMS is the error a perfect model would still
-show (:func:`noise_floor`).
+The noise floor is estimated from the measurement alone, line by line
+(:mod:`substructure.updating.noise`): the measured FRF is smoothed by a
+Savitzky-Golay filter, and the log ratio of the data to its smoothed
+version has the scatter of the noise, a relative part plus an additive part
+that grows where ``|H|`` is small; the RMS of the per-line standard
+deviations is the error a perfect model would still show (:func:`noise_floor`).
 """
 
 from __future__ import annotations
 
 import attrs
 import numpy as np
-from scipy.signal import savgol_coeffs
 
 from ..errors import FrequencyAxisMismatchError, InvalidValueError
 from ..frf import FRF
@@ -56,7 +56,20 @@ def _check(model: FRF, measured: FRF) -> None:
 
 
 def log_ratio(model: FRF, measured: FRF) -> np.ndarray:
-    """``ln(H_model / H_measured)`` per line and entry, shape ``(n_freq, n_out, n_in)``."""
+    """``ln(H_model / H_measured)`` per line and entry.
+
+    Parameters
+    ----------
+    model : FRF
+        The model on the measured grid (same entries).
+    measured : FRF
+        The measurement.
+
+    Returns
+    -------
+    ndarray, shape (n_freq, n_out, n_in)
+        Complex log ratios.
+    """
     _check(model, measured)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.log(model.data / measured.data)
@@ -68,16 +81,16 @@ def error(model: FRF, measured: FRF, mask: np.ndarray | None = None) -> float:
     Parameters
     ----------
     model : FRF
-        The model's FRF (m/N for a tool point H).
+        The model on the measured grid (same entries).
     measured : FRF
-        The measured FRF, on the same lines and labels.
+        The measurement.
     mask : ndarray of bool, optional
-        The lines to use (``(n_freq,)``); default all.
+        Lines to use.
 
     Returns
     -------
     float
-        ``sqrt(mean |ln(model / measured)|^2)``: dimensionless, 0.01 for 1 % off on every line.
+        ``sqrt(mean |ln(H_model / H_measured)|^2)``.
     """
     r = log_ratio(model, measured)
     if mask is not None:
@@ -104,41 +117,34 @@ def _window(measured: FRF, polyorder: int = 3) -> int:
 def noise_floor(measured: FRF, window: int | None = None, polyorder: int = 3) -> float:
     """The error a perfect model would show on these data, estimated from the data.
 
-    ``r = ln(H / S(H))`` with ``S`` a Savitzky-Golay smoother of window ``w``:
-    for white relative noise of RMS ``sigma`` the filter keeps the share
-    ``h0`` (its central coefficient) of each line's noise, so
-    ``var(r) = sigma^2 (1 - 2 h0 + sum(h^2)) = sigma^2 (1 - h0)``.  The scatter
-    of ``r`` is taken robustly (1.4826 times the median absolute deviation, of
-    the real and imaginary parts), so that the few lines where the smoother
-    cannot follow the FRF (very sharp resonances, antiresonances in a noise
-    floor) do not inflate it; the floor is ``sigma``.
+    The per-line noise model of :func:`substructure.updating.noise.estimate_noise`
+    (relative noise plus an additive floor that dominates where ``|H|`` is
+    small, estimated from the scatter of the data about a Savitzky-Golay
+    smoothing) gives the variances ``v_re``, ``v_im`` of the real and
+    imaginary parts of ``ln H`` at every line; the floor is
+    ``sqrt(mean(v_re + v_im))``, the expected :func:`error` of a perfect
+    model.  With several entries, the RMS of their floors.
 
     Parameters
     ----------
     measured : FRF
-        The measured FRF.
+        The measurement, on a uniform grid.
     window : int, optional
-        Odd window of the smoother, in lines; default chosen from the narrowest resonance.
-    polyorder : int
-        Order of the smoother's polynomial.
+        Smoothing window in lines (chosen from the sharpest resonance when
+        not given).
+    polyorder : int, default 3
+        Order of the smoother.
 
     Returns
     -------
     float
-        The floor, on the scale of the error measure (dimensionless).
+        The noise floor (same scale as :func:`error`).
     """
-    w = window or _window(measured, polyorder)
-    smoothed = smooth(measured, window=w, polyorder=polyorder)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        r = np.log(measured.data / smoothed.data)
-    r = r[w // 2 : -(w // 2) or None]  # the filter's edges are less reliable
-    r = r[np.isfinite(r)]
-    h0 = float(savgol_coeffs(w, polyorder)[w // 2])
+    from ..updating.noise import estimate_noise
 
-    def mad(x):
-        return 1.4826 * np.median(np.abs(x - np.median(x)))
-
-    return float(np.sqrt((mad(r.real) ** 2 + mad(r.imag) ** 2) / (1.0 - h0)))
+    floors = [estimate_noise(measured.select([o], [i]), window, polyorder).floor ** 2
+              for o in measured.outputs for i in measured.inputs]
+    return float(np.sqrt(np.mean(floors)))
 
 
 def frac(model: FRF, measured: FRF) -> float:
@@ -147,14 +153,14 @@ def frac(model: FRF, measured: FRF) -> float:
     Parameters
     ----------
     model : FRF
-        The model's FRF (m/N for a tool point H).
+        The model on the measured grid (same entries).
     measured : FRF
-        The measured FRF, on the same lines and labels.
+        The measurement.
 
     Returns
     -------
     float
-        The criterion, in [0, 1].
+        FRAC over all lines and entries.
     """
     _check(model, measured)
     a, b = model.data.ravel(), measured.data.ravel()
@@ -172,11 +178,12 @@ class ModePair:
 
     @property
     def shift_hz(self) -> float | None:
-        """Model minus measurement, Hz."""
+        """Model minus measurement [Hz] (None when unpaired)."""
         return None if self.model_hz is None else self.model_hz - self.measured_hz
 
     @property
     def amplitude_ratio(self) -> float | None:
+        """Model peak over measured peak (None when unpaired)."""
         return None if self.model_amplitude is None else self.model_amplitude / self.measured_amplitude
 
 
@@ -208,18 +215,18 @@ def pair_modes(model: FRF, measured: FRF, floor: float = 0.02, window: int | Non
     Parameters
     ----------
     model : FRF
-        The model's FRF (m/N for a tool point H).
+        The model on the measured grid (same entries).
     measured : FRF
-        The measured FRF, on the same lines and labels.
+        The measurement.
     floor : float
-        Peaks below this fraction of the highest one are ignored.
+        Peaks below this share of the highest are left out.
     window : int, optional
-        Smoothing window in lines; default chosen from the data.
+        Smoothing window [lines].
 
     Returns
     -------
     list of ModePair
-        One per measured peak, with the model's frequency (Hz) when paired.
+        One per measured resonance.
     """
     _check(model, measured)
     w = window or _window(measured)
@@ -252,7 +259,25 @@ def error_bands(model: FRF, measured: FRF, share: float = 0.5, width_hz: float |
     band), is cut into contiguous regions above its median and above twice
     the noise ``floor`` (noise is not a failure of the model); the regions are
     ranked by their share of the total and returned until ``share`` of the
-    error is covered.  None when the model is within the noise everywhere.
+    error is covered.
+
+    Parameters
+    ----------
+    model : FRF
+        The model on the measured grid (same entries).
+    measured : FRF
+        The measurement.
+    share : float
+        Share of the error to cover.
+    width_hz : float, optional
+        Smoothing width [Hz].
+    floor : float
+        The noise floor.
+
+    Returns
+    -------
+    list of (float, float, float)
+        ``(lo_hz, hi_hz, share)``, largest share first.
     """
     r2 = np.mean(np.abs(log_ratio(model, measured)) ** 2, axis=(1, 2))
     f = model.frequency.hz
@@ -323,13 +348,13 @@ class Comparison:
 
         Parameters
         ----------
-        ax : sequence of Axes, optional
-            Where to draw; a new figure when None.
+        ax : sequence of three Axes, optional
+            Where to draw (default: a new figure).
 
         Returns
         -------
-        Figure
-            The figure (never shown by the library).
+        matplotlib.figure.Figure
+            The figure (never shown).
         """
         from .plots import plot_comparison
 
@@ -342,14 +367,14 @@ def compare(model: FRF, measured: FRF) -> Comparison:
     Parameters
     ----------
     model : FRF
-        The model's FRF (m/N for a tool point H).
+        The model on the measured grid (same entries).
     measured : FRF
-        The measured FRF, on the same lines and labels.
+        The measurement.
 
     Returns
     -------
     Comparison
-        The error, the noise floor, FRAC, paired modes and error bands.
+        Error, noise floor, FRAC, modes and error bands.
     """
     floor = noise_floor(measured)
     return Comparison(

@@ -1,187 +1,303 @@
-"""Diagnosis: which physical effect is the model missing, and the refinement that adds it.
+"""Diagnosis: what the model is missing, decided by statistics, and an honest verdict.
 
-For every registered effect at every place it proposes, its few parameters
-are fitted to the measurements by bounded least squares on the complex log
-ratio of model to measurement (the error measure of
-:mod:`substructure.diagnose.compare`), starting from a scan of the main
-parameter; the candidates are ranked by their error after the fit.  The best
-is declared the ``missing_effect`` only when
-
-* the model is not already as good as the data (baseline error above 1.5
-  times the noise floor), and
-* the fit improves the error clearly beyond what noise allows: by more than
-  half the noise floor and by more than a tenth of the excess over the floor.
-
-Effects whose fitted error is nearly as low (within 0.3 times the noise
-floor, plus a tenth of the best error's excess over the floor) are
-``ambiguous_with`` it, with a suggestion of a measurement that would tell
-them apart.
-
-The refinement adds the best effect, fits all added effects together, and
-diagnoses again, until nothing beats the noise floor; its history is the
-"watch the error fall" table.
+:func:`diagnose` compares an assembly with measured FRFs through the
+likelihood of :mod:`substructure.updating.likelihood` (complex log ratios
+weighted by the noise of each line, estimated from the data), searches the
+open world of candidates of :mod:`substructure.diagnose.search` (every model
+parameter, bodies, springs and section changes at fitted positions, the
+catalogue of effects) by forward selection with the significance test of
+:mod:`substructure.updating.selection`, refits everything added at every
+step, drops at the end what no longer earns its parameters, and says
+``explained`` only when the final residual is consistent with the noise
+(and, as a plain check, its RMS error within 1.5 times the noise floor).
+When it is not, the report says so first, with where the remaining error
+lives and what kind of effect has that signature
+(:mod:`substructure.diagnose.report`).  Explanations the data cannot tell
+apart are reported together, with the measurement that would separate them.
 """
 
 from __future__ import annotations
 
+import math
 import sys
 from typing import Callable, Sequence
 
 import attrs
 import numpy as np
-from scipy.optimize import least_squares
 
 from ..assembly import Assembly
-from ..errors import InvalidValueError, UnknownPointError
+from ..errors import InvalidValueError
 from ..frf import FRF
-from ..identify.band_fit import model_of_measurement
-from .compare import METRIC, Comparison, compare, noise_floor
-from .effects import EFFECTS, Effect, get_effect
+from ..updating.likelihood import Likelihood, measured_frfs
+from ..updating.selection import consistency
+from .compare import METRIC, Comparison, frac, pair_modes, error_bands
+from .effects import Effect, registry
+from .refine import refine as refine_model
+from .search import SCREEN_LINES, candidates
 
-__all__ = ["Candidate", "Step", "Diagnosis", "diagnose", "SUGGESTIONS", "REFIT_TOP"]
-
-REFIT_TOP = 3
-"""In refinement steps after the first, the best this many candidates are refitted together with
-the effects already added (the others keep their fit with those effects held)."""
-
-SUGGESTIONS = {
-    frozenset({"sensor-mass", "joint-stiffness"}): "measure once more with a laser vibrometer (or with a "
-    "second, different sensor mass): a sensor's effect changes with its mass, a joint's does not",
-    frozenset({"joint-stiffness", "joint-cross-coupling"}): "measure cross FRFs at a second point on the tool "
-    "(finite-difference rotations): cross-coupling changes the tool's rotation, a stiffness change "
-    "mostly its translation",
-    frozenset({"sensor-mass", "fluted-section"}): "measure with a laser vibrometer: flutes stay, a sensor's "
-    "mass goes",
-    frozenset({"fluted-section", "joint-stiffness"}): "measure a second tool overhang: the joint stays, the "
-    "fluted length moves with the tool",
-    frozenset({"support-springs", "joint-stiffness"}): "extend the measurement down to a few Hz, or soften "
-    "the suspension: support modes move with the suspension, joint modes do not",
-}
+__all__ = ["Found", "Candidate", "Step", "Diagnosis", "diagnose", "strict"]
 
 
-def _suggestion(a: str, b: str) -> str:
-    return SUGGESTIONS.get(frozenset({a, b}), "measure at another point, or in another configuration "
-                           f"(with a component removed), where {a} and {b} act differently")
+def _finite(x):
+    """A JSON-safe number: None for NaN and infinities."""
+    if x is None:
+        return None
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def strict(value):
+    """A JSON-ready copy with every NaN or infinity replaced by None (numpy numbers made plain).
+
+    Parameters
+    ----------
+    value : object
+        Dicts, lists, tuples, numbers, strings.
+
+    Returns
+    -------
+    object
+        The same structure, safe for ``json.dumps(..., allow_nan=False)``.
+    """
+    if isinstance(value, dict):
+        return {str(k): strict(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [strict(v) for v in value]
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return _finite(value)
+    return value
+
+
+class Found:
+    """A change with fitted values: what a candidate or a refinement step reports.
+
+    It has the interface of an :class:`~substructure.diagnose.effects.Effect`
+    instance (``name``, ``where``, ``values``, ``explanation``,
+    ``parameters_json()``, ``apply(assembly)``), so that
+    ``assembly.with_effect(found)`` works, plus ``std`` and ``nominal``.
+
+    Parameters
+    ----------
+    change : Change
+        The change.
+    values : dict
+        Fitted values (SI).
+    std : dict, optional
+        Standard deviations (SI).
+    """
+
+    def __init__(self, change, values: dict, std: dict | None = None):
+        self.change = change
+        self.values = {k: float(v) for k, v in values.items()}
+        self.std = {k: float(v) for k, v in (std or {}).items()}
+
+    @property
+    def name(self) -> str:
+        """The effect's name (``model-parameter``, ``added-mass``, ``sensor-mass``, ...)."""
+        return self.change.effect
+
+    @property
+    def where(self) -> str:
+        """Where it acts (a path, a point, a joint, a component)."""
+        return self.change.place(self.values)
+
+    @property
+    def explanation(self) -> str:
+        """Its signature in the FRF, in words."""
+        return self.change.explanation
+
+    @property
+    def nominal(self) -> dict:
+        """The model's values before a correction (parameters that have one)."""
+        return {s.name: s.nominal for s in self.change.specs if s.nominal is not None}
+
+    def parameters_json(self) -> dict:
+        """``{name: {"value", "unit", "std"[, "nominal"]}}`` (SI, strict JSON).
+
+        Returns
+        -------
+        dict
+            One entry per parameter.
+        """
+        out = {}
+        for s in self.change.specs:
+            entry = {"value": _finite(self.values.get(s.name)), "unit": s.unit,
+                     "std": _finite(self.std.get(s.name)) if s.name in self.std else None}
+            if s.nominal is not None:
+                entry["nominal"] = _finite(s.nominal)
+            out[s.name] = entry
+        return out
+
+    def apply(self, assembly: Assembly) -> Assembly:
+        """The assembly with this change (a normal assembly that saves as usual).
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+
+        Returns
+        -------
+        Assembly
+            The changed model.
+        """
+        return self.change.apply(assembly, self.values)
+
+    def __repr__(self) -> str:
+        vals = ", ".join(f"{k}={v:.4g}" for k, v in self.values.items())
+        return f"{self.name}(where={self.where!r}, {vals})"
 
 
 @attrs.frozen
 class Candidate:
-    """One effect at one place, fitted: its error after the fit.
+    """One candidate of the first round, fitted: its error and ``chi^2`` after the fit.
 
     Parameters
     ----------
-    effect : Effect
-        The effect with its fitted values (SI units of its parameters).
+    effect : Found
+        The change with its values.
     error : float
-        The error measure after the fit (dimensionless, :data:`METRIC`).
+        The error measure after the fit (dimensionless).
+    chi2 : float
+        ``chi^2`` after the fit.
+    fitted : bool
+        Fitted on all lines (else its values are the screening's).
     nfev : int
-        Model evaluations the fit took.
-    added : tuple of Effect
-        Effects added earlier in the refinement, refitted with this one.
+        Model evaluations of its fit.
     """
 
-    effect: Effect = attrs.field(eq=False)
+    effect: Found = attrs.field(eq=False)
     error: float
+    chi2: float = 0.0
+    fitted: bool = True
     nfev: int = 0
-    added: tuple = attrs.field(default=(), eq=False)  # earlier effects, refitted with this one
 
     @property
     def name(self) -> str:
-        """The effect's name (``"sensor_mass"``)."""
+        """The effect's name."""
         return self.effect.name
 
     @property
     def where(self) -> str:
-        """Where the effect acts: a point or a joint name."""
+        """Where it acts."""
         return self.effect.where
 
     def to_json(self) -> dict:
-        """The candidate as in ``substructure diagnose --json``.
+        """The candidate's JSON object.
 
         Returns
         -------
         dict
-            ``effect``, ``where``, ``parameters`` (values with their SI units), ``error``,
-            ``explanation``.
+            ``effect``, ``where``, ``parameters``, ``error``, ``chi2``, ``fitted``, ``explanation``.
         """
         return {"effect": self.name, "where": self.where, "parameters": self.effect.parameters_json(),
-                "error": self.error, "explanation": self.effect.explanation}
+                "error": _finite(self.error), "chi2": _finite(self.chi2), "fitted": self.fitted,
+                "explanation": self.effect.explanation}
 
 
 @attrs.frozen
 class Step:
-    """One step of the refinement: the effect added (None at step 0), with its values as fitted at
-    that step, and the error after it (earlier effects refitted with it).
+    """One refinement step: the change added (None at step 0), its values when added, the error after.
 
     Parameters
     ----------
     step : int
-        The step number, 0 for the model as given.
-    added : Effect or None
-        The effect added at this step, with its values then (None at step 0).
+        Its number (0: the model as given).
+    added : Found or None
+        The change added, with its values at this step.
     error : float
-        The error measure after the step (dimensionless).
+        The error measure after the step.
+    chi2_reduced : float
+        ``chi^2 / nu`` after the step.
+    statistic : float or None
+        The significance test's likelihood ratio that admitted it.
+    threshold : float or None
+        The test's threshold.
     """
 
     step: int
-    added: Effect | None = attrs.field(eq=False)
+    added: Found | None = attrs.field(eq=False)
     error: float
+    chi2_reduced: float = float("nan")
+    statistic: float | None = None
+    threshold: float | None = None
 
     def to_json(self) -> dict:
-        """The step as in ``substructure diagnose --json``.
+        """The step's JSON object.
 
         Returns
         -------
         dict
-            ``step``, ``added`` (a name or None), ``error``; ``where`` and ``parameters``
-            (values with their SI units) when an effect was added.
+            ``step``, ``added``, ``error``, ``chi2_reduced`` and, for a change, ``where``, ``parameters``,
+            ``significance``.
         """
         out = {"step": self.step, "added": None if self.added is None else self.added.name, "error": self.error}
         if self.added is not None:
             out["where"] = self.added.where
             out["parameters"] = self.added.parameters_json()
+            out["significance"] = {"statistic": _finite(self.statistic), "threshold": _finite(self.threshold)}
+        out["chi2_reduced"] = _finite(self.chi2_reduced)
         return out
 
 
 @attrs.frozen
 class Diagnosis:
-    """What :func:`diagnose` found.  ``to_json`` gives the JSON of ``substructure diagnose --json``.
+    """What :func:`diagnose` found.  ``to_json`` gives the JSON of docs/file-formats.md.
 
     Parameters
     ----------
     metric : str
-        The error measure's name, :data:`METRIC`.
+        ``"rms_log_ratio"``.
     baseline_error : float
         The error of the model as given (dimensionless).
     noise_floor : float
-        The error a perfect model would show, estimated from the data.
+        The error a perfect model would show, from the data's own noise.
+    explained : bool
+        The final residual is consistent with the noise (and within 1.5 floors).
     missing_effect : str or None
-        The name of the effect found missing; None when nothing beats the noise floor.
+        The first change of the refinement.
     missing_where : str or None
-        Where it acts (a point or a joint name).
+        Where it acts.
     ambiguous_with : tuple of str
-        Other effects that fit as well (the data cannot tell them apart).
+        Names of the alternatives inside the indifference region.
     suggestion : str or None
-        How to tell the ambiguous effects apart.
+        The measurement that would tell the first change from its first alternative.
     candidates : tuple of Candidate
-        Every effect at every place, fitted, the best first.
+        The first step's candidates, best first.
     refinement : tuple of Step
-        The refinement's steps: the error falling as effects are added.
+        Step 0 (the model as given), then one per change kept.
     band : tuple of float
-        The frequency band compared, ``(lo, hi)`` in Hz.
+        The band used ``(lo, hi)`` [Hz].
     baseline : tuple of Comparison
-        The model as given against each measurement.
+        Every measurement against the model as given.
     final : tuple of Comparison
-        The refined model against each measurement.
+        Every measurement against the final model.
     refined_assembly : Assembly
-        The model with the effects added.
-    final_effects : tuple of Effect
-        The effects added, with their final (jointly refitted) values.
+        The model with the changes kept.
+    final_effects : tuple of Found
+        The changes kept, with their final values and standard deviations.
+    consistency : Consistency
+        The test of the final model.
+    ambiguous : tuple of (Found, float)
+        The alternatives with their errors.
+    separation : dict or None
+        ``response``, ``excitation``, ``non_contact``, ``chi2``, ``text``.
+    report : tuple of str
+        The verdict's lines when the data are not explained.
+    correlation : dict
+        ``parameters`` and ``matrix`` of the final fit's correlations.
+    final_error : float
+        The error of the final model.
     """
 
     metric: str
     baseline_error: float
     noise_floor: float
+    explained: bool
     missing_effect: str | None
     missing_where: str | None
     ambiguous_with: tuple[str, ...]
@@ -193,24 +309,35 @@ class Diagnosis:
     final: tuple[Comparison, ...] = attrs.field(eq=False)
     refined_assembly: Assembly = attrs.field(eq=False)
     final_effects: tuple = attrs.field(default=(), eq=False)
+    consistency: object = attrs.field(default=None, eq=False)
+    ambiguous: tuple = attrs.field(default=(), eq=False)
+    separation: dict | None = attrs.field(default=None, eq=False)
+    report: tuple[str, ...] = ()
+    correlation: dict = attrs.field(factory=dict, eq=False)
+    final_error: float = float("nan")
 
     @property
-    def effects(self) -> list[Effect]:
-        """The effects the refinement added, in order, with their final values (refitted together)."""
+    def effects(self) -> list[Found]:
+        """The changes the refinement kept, with their final values (refitted together)."""
         return list(self.final_effects)
 
     def to_json(self) -> dict:
-        """The JSON object of ``substructure diagnose --json`` (SI units, frequencies in Hz).
+        """One JSON object (strict JSON: no NaN or infinities); see docs/file-formats.md.
 
         Returns
         -------
         dict
-            The diagnosis: errors, candidates, refinement, modes and error bands.
+            The keys of the contract and the added ones.
         """
+        return strict(self._json())
+
+    def _json(self) -> dict:
+        cons = self.consistency
         return {
             "metric": self.metric,
-            "baseline_error": self.baseline_error,
-            "noise_floor": self.noise_floor,
+            "baseline_error": _finite(self.baseline_error),
+            "noise_floor": _finite(self.noise_floor),
+            "explained": bool(self.explained),
             "missing_effect": self.missing_effect,
             "ambiguous_with": list(self.ambiguous_with),
             "candidates": [c.to_json() for c in self.candidates],
@@ -218,9 +345,19 @@ class Diagnosis:
             "missing_where": self.missing_where,
             "suggestion": self.suggestion,
             "band_hz": list(self.band),
-            "final_error": self.refinement[-1].error,
+            "final_error": _finite(self.final_error),
             "final_effects": [{"effect": e.name, "where": e.where, "parameters": e.parameters_json()}
                               for e in self.final_effects],
+            "correlation": self.correlation,
+            "consistency": None if cons is None else {
+                "chi2_reduced": _finite(cons.chi2_reduced), "threshold": _finite(cons.threshold),
+                "bands_hz": [{"frf": self.final[b.item].measured.outputs[0] + " / " + self.final[b.item].measured.inputs[0],
+                              "lo": b.lo_hz, "hi": b.hi_hz, "ratio": _finite(b.ratio), "share": _finite(b.share)}
+                             for b in cons.bands]},
+            "ambiguous": [{"effect": a.name, "where": a.where, "parameters": a.parameters_json(),
+                           "error": _finite(err)} for a, err in self.ambiguous],
+            "separation": self.separation,
+            "report": list(self.report),
             "modes": [
                 {"measured_hz": m.measured_hz, "model_hz": m.model_hz, "shift_hz": m.shift_hz,
                  "amplitude_ratio": m.amplitude_ratio}
@@ -234,13 +371,13 @@ class Diagnosis:
 
         Parameters
         ----------
-        ax : Axes or sequence of Axes, optional
-            Where to draw; a new figure when None.
+        ax : sequence of three Axes, optional
+            Where to draw.
 
         Returns
         -------
-        Figure
-            The figure (never shown by the library).
+        matplotlib.figure.Figure
+            The figure.
         """
         return self.baseline[0].plot(ax=ax)
 
@@ -249,179 +386,76 @@ class Diagnosis:
 
         Parameters
         ----------
-        ax : Axes or sequence of Axes, optional
-            Where to draw; a new figure when None.
+        ax : Axes, optional
+            Where to draw.
 
         Returns
         -------
-        Figure
-            The figure (never shown by the library).
+        matplotlib.figure.Figure
+            The figure.
         """
         from .plots import plot_history
 
         return plot_history(self, ax=ax)
 
 
-# ---------------------------------------------------------------------------
-# The data and the model
-
-
-@attrs.frozen
-class _Data:
-    """Measured FRFs (cropped to the band) and the configuration of each."""
-
-    items: tuple  # of (measurement, FRF cropped)
-
-    def residual(self, models: Sequence[np.ndarray]) -> np.ndarray:
-        parts = []
-        for (_, frf), model in zip(self.items, models):
-            with np.errstate(divide="ignore", invalid="ignore"):
-                r = np.log(model / frf.data)
-            parts.append(r.real.ravel())
-            parts.append(r.imag.ravel())
-        out = np.concatenate(parts)
-        return np.where(np.isfinite(out), out, 10.0)
-
-    def error(self, models) -> float:
-        r = self.residual(models)
-        return float(np.sqrt(np.mean(r**2) * 2))
-
-
-def _measurements(measurements, band) -> tuple[_Data, tuple[float, float]]:
-    items = []
-    for m in measurements:
-        frf = m if isinstance(m, FRF) else m.frf
-        if not isinstance(frf, FRF):
-            raise InvalidValueError(f"measurements: got {m!r}; expected FRFs or measurements")
-        items.append((m, frf.to_receptance()))
-    if not items:
-        raise InvalidValueError("measurements: got none")
-    f0 = items[0][1].frequency
-    full = (float(f0.hz[0]), float(f0.hz[-1]))
-    if band is None:
-        band = full
-    lo, hi = (float(x) for x in band)
-    if not lo < hi:
-        raise InvalidValueError(f"band: got {band!r}; expected lo < hi")
-    if hi < full[0] or lo > full[1] or lo < full[0] - 1e-9 * full[1] or hi > full[1] * (1 + 1e-12):
-        raise InvalidValueError(
-            f"band: {lo:g}-{hi:g} Hz is outside the measured data ({full[0]:g}-{full[1]:g} Hz)"
-        )
-    cropped = []
-    for m, frf in items:
-        c = frf.crop(lo, hi)
-        if len(c.frequency) < 10:
-            raise InvalidValueError(f"band: {lo:g}-{hi:g} Hz holds {len(c.frequency)} lines; too few")
-        cropped.append((m, c))
-    return _Data(tuple(cropped)), (lo, hi)
-
-
-def _diff(old: Assembly, new: Assembly) -> dict:
-    """What a modification changed, as replacements by name (for PreparedFRF.evaluate)."""
-    changes: dict = {"joints": {}, "sensors": {}, "supports": {}, "components": {}}
-    for kind, attr in (("joints", "joints"), ("sensors", "sensors"), ("supports", "supports")):
-        before = {getattr(o, "name", None) or f"support at {o.at}": o for o in getattr(old, attr)}
-        for o in getattr(new, attr):
-            key = getattr(o, "name", None) or f"support at {o.at}"
-            if key not in before or before[key] is not o:
-                changes[kind][key] = o
-    before = {c.name: c for c in old.components}
-    for c in new.components:
-        if before.get(c.name) is not c:
-            changes["components"][c.name] = c
-    return changes
-
-
-def _apply_all(model: Assembly, effects: Sequence[Effect]) -> Assembly:
-    """Apply effects in order; one whose place is not in this configuration is skipped."""
+def _catalogue(effects) -> dict:
+    """The effects of a call: a snapshot of the registry, or the names or classes given."""
+    known = registry()
+    if isinstance(effects, str):
+        if effects == "all":
+            return known
+        effects = [e.strip() for e in effects.split(",") if e.strip()]
+        if not effects:
+            raise InvalidValueError("effects: got an empty list; give 'all' or effect names "
+                                    f"({', '.join(known)})")
+    effects = list(effects)
+    if not effects:
+        raise InvalidValueError("effects: got an empty list; give 'all' or effect names "
+                                f"({', '.join(known)})")
+    out = {}
     for e in effects:
-        try:
-            model = e.apply(model)
-        except UnknownPointError:
-            continue
-    return model
+        if isinstance(e, type) and issubclass(e, Effect):
+            out[e.name] = e
+        elif isinstance(e, str) and e in known:
+            out[e] = known[e]
+        else:
+            raise InvalidValueError(f"effect: unknown effect {e!r}; known: {', '.join(known)}")
+    return out
 
 
-class _Model:
-    """Fast evaluation of the assembly with a list of effects applied, per measurement.
-
-    Each measurement's configuration (its sensors on, its components off) is
-    set first, then the effects are applied: a diagnosed effect acts in every
-    test where its place exists.
-    """
-
-    def __init__(self, assembly: Assembly, effects: Sequence[Effect], data: _Data):
-        self.data = data
-        self.configurations = [model_of_measurement(assembly, m) for m, _ in data.items]
-        self.references = [_apply_all(c, effects) for c in self.configurations]
-        self.prepared = [
-            ref.prepare(list(frf.outputs), list(frf.inputs), frf.frequency)
-            for ref, (_, frf) in zip(self.references, data.items)
-        ]
-
-    def evaluate(self, effects: Sequence[Effect]) -> list[np.ndarray]:
-        out = []
-        for config, ref, prepared, (_, frf) in zip(self.configurations, self.references, self.prepared,
-                                                   self.data.items):
-            modified = _apply_all(config, effects)
-            changes = _diff(ref, modified)
-            try:
-                out.append(prepared.evaluate(joints=changes["joints"], sensors=changes["sensors"],
-                                             supports=changes["supports"], components=changes["components"]).data)
-            except InvalidValueError:  # the effect moved a point (e.g. a spring's position): compute anew
-                out.append(modified.frf(list(frf.outputs), list(frf.inputs), frf.frequency).data)
-        return out
+def _comparisons(lik: Likelihood, ratios, floors) -> tuple[Comparison, ...]:
+    out = []
+    for m, r, floor in zip(lik.measured, ratios, floors):
+        measured = m.frf
+        model = FRF(measured.frequency, (measured.data[:, 0, 0] * np.exp(r))[:, None, None], measured.outputs,
+                    measured.inputs)
+        out.append(Comparison(model=model, measured=measured, error=float(np.sqrt(np.mean(np.abs(r) ** 2))),
+                              noise_floor=floor, frac=frac(model, measured), modes=pair_modes(model, measured),
+                              bands=error_bands(model, measured, floor=floor)))
+    return tuple(out)
 
 
-def _fit(assembly: Assembly, data: _Data, fixed: Sequence[Effect], free: Sequence[tuple[type, str, dict]],
-         scan: bool = True) -> tuple[list[Effect], float, int]:
-    """Fit the parameters of the ``free`` effects (class, where, start) with ``fixed`` applied first."""
-    specs = []  # (effect index, parameter, lower, upper)
-    for i, (cls, where, start) in enumerate(free):
-        bounds = cls.bounds(assembly, where)
-        for p in cls.parameters:
-            lo, hi = max(bounds[p.name][0], p.lower), min(bounds[p.name][1], p.upper)
-            specs.append((i, p, lo, hi, float(np.clip(start[p.name], lo, hi))))
-    starts = [cls(where, **start) for cls, where, start in free]
-    model = _Model(assembly, list(fixed) + starts, data)
+def _rms(ratios) -> float:
+    return float(np.sqrt(np.mean(np.concatenate([np.abs(r) ** 2 for r in ratios]))))
 
-    def to_values(x):
-        values = [dict(s) for _, _, s in free]
-        for (i, p, lo, hi, s0), xi in zip(specs, x):
-            values[i][p.name] = float(np.clip(np.exp(xi) if p.log else xi, lo, hi))
-        return values
 
-    def effects_of(x):
-        return [cls(where, **v) for (cls, where, _), v in zip(free, to_values(x))]
-
-    def residual(x):
-        return data.residual(model.evaluate(list(fixed) + effects_of(x)))
-
-    x0 = np.array([np.log(s0) if p.log else s0 for (_, p, _, _, s0) in specs])
-    lower = np.array([np.log(lo) if p.log else lo for (_, p, lo, _, _) in specs])
-    upper = np.array([np.log(hi) if p.log else hi for (_, p, _, hi, _) in specs])
-    nfev = 0
-    if scan and specs:
-        best = (float(np.sum(residual(x0) ** 2)), x0)
-        for v in np.linspace(lower[0], upper[0], 13)[1:-1]:
-            x = x0.copy()
-            x[0] = v
-            cost = float(np.sum(residual(x) ** 2))
-            nfev += 1
-            if cost < best[0]:
-                best = (cost, x)
-        x0 = best[1]
-    x0 = np.clip(x0, lower + 1e-12 * np.abs(lower), upper - 1e-12 * np.abs(upper))
-    scale = np.where([p.log for (_, p, _, _, _) in specs], 1.0, np.maximum(upper - lower, 1e-30) / 10)
-    fit = least_squares(residual, x0, bounds=(lower, upper), x_scale=scale, method="trf",
-                        max_nfev=25 * len(x0) + 20)
-    nfev += fit.nfev
-    err = float(np.sqrt(np.mean(fit.fun**2) * 2))
-    return effects_of(fit.x), err, nfev
+def _passive(lik: Likelihood, changes) -> bool:
+    """Every joint, support and body of the changed model is passive (PSD matrices, masses >= 0)."""
+    for g in lik.groups:
+        s = g.structure_with(changes)
+        for link in s.links:
+            if link.rigid or link.custom is not None:
+                continue
+            for m in (link.K, link.C, link.M):
+                sym = 0.5 * (m + m.T)
+                scale = max(abs(sym).max(), 1e-300)
+                if np.linalg.eigvalsh(sym).min() < -1e-9 * scale:
+                    return False
+    return True
 
 
 def _main_shift(comparison: Comparison) -> float:
-    """Relative shift (model / measured - 1) of the strongest paired mode that moved most."""
     pairs = [m for m in comparison.modes if m.model_hz is not None]
     if not pairs:
         return 0.0
@@ -431,143 +465,119 @@ def _main_shift(comparison: Comparison) -> float:
     return float(best.model_hz / best.measured_hz - 1)
 
 
-def _significant(e0: float, e1: float, floor: float) -> bool:
-    return e0 > 1.5 * floor and (e0 - e1) > 0.5 * floor and (e0 - e1) > 0.1 * (e0 - floor)
-
-
-def _candidates(assembly, data, added, names, exclude, progress, shift: float = 0.0) -> list[Candidate]:
-    """Every effect at every place, fitted; with ``added`` effects refitted together with it."""
-    points = []
-    for m, frf in data.items:
-        points += list(frf.outputs) + list(frf.inputs)
-    todo = []
-    for name in names:
-        cls = get_effect(name)
-        for where in cls.places(assembly, points):
-            if (name, where) not in exclude:
-                todo.append((cls, where))
-    out = []
-    for n, (cls, where) in enumerate(todo, start=1):
-        if progress:
-            progress(f"fitting {cls.name} at {where} ({n}/{len(todo)})")
-        start = cls.starting_values(assembly, where, shift)
-        try:
-            effects, err, nfev = _fit(assembly, data, list(added), [(cls, where, start)])
-        except InvalidValueError as exc:  # the effect cannot act here (e.g. out of its bounds)
-            if progress:
-                progress(f"  skipped {cls.name} at {where}: {exc}")
-            continue
-        out.append(Candidate(effects[0], err, nfev, tuple(added)))
-    out.sort(key=lambda c: c.error)
-    if added:
-        # The earlier effects were fitted without this one and may be biased by
-        # it: refit them together with each of the best few candidates.
-        refined = []
-        for c in out[:REFIT_TOP]:
-            if progress:
-                progress(f"refitting {c.name} at {c.where} with the effects added so far")
-            free = [(type(c.effect), c.where, c.effect.values)] + [(type(e), e.where, e.values) for e in added]
-            effects, err, nfev = _fit(assembly, data, [], free, scan=False)
-            refined.append(Candidate(effects[0], err, c.nfev + nfev, tuple(effects[1:])))
-        out = sorted(refined, key=lambda c: c.error) + out[REFIT_TOP:]
-    return out
-
-
-def _comparisons(assembly, effects, data) -> tuple[Comparison, ...]:
-    model = _Model(assembly, effects, data)
-    values = model.evaluate(list(effects))
-    return tuple(compare(FRF(frf.frequency, v, frf.outputs, frf.inputs), frf) for (m, frf), v in zip(data.items, values))
-
-
-def diagnose(assembly: Assembly, measurements, effects: str | Sequence[str] = "all", band=None,
-             refine: bool = True, max_steps: int = 3,
-             progress: bool | Callable[[str], None] = False) -> Diagnosis:
-    """Diagnose which physical effect an assembly model is missing against measurements.
+def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", band=None,
+             refine: bool = True, max_steps: int = 4, progress: bool | Callable[[str], None] = False,
+             open_world: bool = True) -> Diagnosis:
+    """Diagnose what an assembly model is missing against measurements.
 
     Parameters
     ----------
     assembly : Assembly
-        The model (sensors declared in it are applied as each measurement says).
+        The model (sensors declared in it are applied as each measurement
+        says; ``always_on`` sensors and permanent masses in every test).
     measurements : MeasurementSet, or sequence of measurements or FRFs
-        The tap tests (receptances in m/N).
-    effects : "all" or sequence of str
-        Names of registered effects to consider.
+        The data.
+    effects : "all", or sequence of names or Effect classes
+        The catalogue effects to consider (default: a snapshot of every
+        registered effect); classes given here need no registration.
     band : (lo, hi), optional
         Frequency band in Hz (default: all measured lines).
     refine : bool
-        Run the greedy refinement after the first diagnosis.
+        Run the forward selection to the end (else one step).
     max_steps : int
-        Most effects the refinement adds.
+        Most changes the refinement adds.
     progress : bool or callable
         Report progress (to standard error when True).
+    open_world : bool
+        Consider every model parameter and the elements at fitted
+        positions besides the catalogue (default True).
 
     Returns
     -------
     Diagnosis
-        The missing effect with its fitted values (SI), the candidates, and the refinement.
+        The verdict, the candidates, the refinement and the refined model.
     """
-    if effects == "all":
-        names = list(EFFECTS)
-    else:
-        names = [effects] if isinstance(effects, str) else list(effects)
-        for n in names:
-            get_effect(n)
+    from .report import separation, unexplained_report
+
+    catalogue = _catalogue(effects)
     if progress is True:
         def progress(text):  # noqa: F811 - a printer when asked for
             print(f"diagnose: {text}", file=sys.stderr, flush=True)
+    say = progress or None
     if hasattr(measurements, "validate"):
         measurements.validate(assembly)
-    data, band = _measurements(measurements, band)
-    floor = float(np.sqrt(np.mean([noise_floor(frf) ** 2 for _, frf in data.items])))
-    base_model = _Model(assembly, [], data)
-    e0 = data.error(base_model.evaluate([]))
-    baseline = _comparisons(assembly, [], data)
-    shift = _main_shift(baseline[0])
-    first = _candidates(assembly, data, [], names, set(), progress, shift)
-    best = first[0] if first else None
-    missing = best is not None and _significant(e0, best.error, floor)
-    ambiguous, suggestion = [], None
-    if missing:
-        margin = 0.3 * floor + 0.1 * max(best.error - floor, 0.0)
-        for c in first[1:]:
-            if c.error <= best.error + margin and c.name != best.name and c.name not in ambiguous:
-                ambiguous.append(c.name)
-        if ambiguous:
-            suggestion = _suggestion(best.name, ambiguous[0])
-    steps = [Step(0, None, e0)]
-    added: list[Effect] = []
-    current_error = e0
-    if refine and missing:
-        candidates = first
-        while len(added) < max_steps:
-            choice = candidates[0] if candidates else None
-            if choice is None or not _significant(current_error, choice.error, floor):
-                break
-            added = list(choice.added) + [choice.effect]
-            current_error = choice.error
-            if progress:
-                progress(f"step {len(added)}: added {choice.name} at {choice.where}, error {current_error:.4g}")
-            steps.append(Step(len(added), choice.effect, current_error))
-            if current_error <= 1.5 * floor:
-                break
-            exclude = {(e.name, e.where) for e in added}
-            candidates = _candidates(assembly, data, added, names, exclude, progress, shift)
+    measured, band = measured_frfs(measurements, band)
+    lik = Likelihood(assembly, measured)
+    floors = [m.noise.floor for m in measured]
+    floor = float(np.sqrt(np.mean(np.concatenate([m.noise.var_re + m.noise.var_im for m in measured]))))
+    base_ratios = lik.log_ratios([])
+    e0 = _rms(base_ratios)
+    chi2_now = float(lik.whiten(base_ratios) @ lik.whiten(base_ratios))
+    n = lik.n
+    cons = consistency(lik, base_ratios, 0)
+    baseline = _comparisons(lik, base_ratios, floors)
+    if say:
+        say(f"baseline error {e0:.4g} (noise floor {floor:.4g}), chi^2/n = {chi2_now / n:.4g}"
+            f"{': consistent with the noise' if cons.consistent else ''}")
+    points = [lbl for m in measured for lbl in (m.frf.outputs[0], m.frf.inputs[0])]
+    cands = candidates(assembly, points, catalogue, open_world, _main_shift(baseline[0]), say)
+    screen_lik = lik.subsample(max(1, lik.lines.size // SCREEN_LINES))
+    limit = 0 if cons.consistent else (max_steps if refine else 1)
+    outcome = refine_model(lik, screen_lik, cands, limit, lambda changes: _passive(lik, changes), say)
+    current = outcome.current
+    p_now = sum(len(c.specs) for c, _ in current)
+    steps = [Step(0, None, e0, chi2_now / n)]
+    for k, (result, added, stat, threshold) in enumerate(outcome.history, start=1):
+        values = next(v for c, v in result.changes if c is added)
+        steps.append(Step(k, Found(added, values, _std_of(result, added)), _rms(lik.log_ratios(result.changes)),
+                          result.chi2_reduced, stat, threshold))
+    first = [Candidate(Found(s.change, s.values, s.fit.std[-1]), _rms(lik.log_ratios(s.fit.changes)), s.chi2, True,
+                       s.fit.nfev) for s in outcome.first_fitted]
+    done = {s.change.key for s in outcome.first_fitted}
+    for s in outcome.first_scored:
+        if s.change.key not in done:
+            r = lik.log_ratios([(s.change, s.values)])
+            w = lik.whiten(r)
+            first.append(Candidate(Found(s.change, s.values), _rms(r), float(w @ w), False))
+    final_fit = outcome.fit
+    final_ratios = lik.log_ratios(current)
+    cons = consistency(lik, final_ratios, p_now)
+    final_error = _rms(final_ratios)
+    explained = bool(cons.consistent and final_error <= 1.5 * floor)
+    final_effects = tuple(Found(c, v, final_fit.std[i] if final_fit else {}) for i, (c, v) in enumerate(current))
     refined = assembly
-    for e in added:
-        refined = e.apply(refined)
+    for c, v in current:
+        refined = c.apply(refined, v)
+    missing = steps[1].added if len(steps) > 1 else None
+    ambiguous = []
+    if missing is not None:
+        for c, v, chi2 in outcome.alternatives.get(missing.change.key, []):
+            alt = [(c, v) if x is missing.change else (x, y) for x, y in current]
+            ambiguous.append((Found(c, v), _rms(lik.log_ratios(alt))))
+    names = tuple(dict.fromkeys(a.name for a, _ in ambiguous))
+    sep = None
+    if missing is not None and ambiguous:
+        sep = separation(assembly, measured, missing, ambiguous[0][0], say)
+    correlation = {}
+    if final_fit is not None and final_fit.p > 1:
+        labels = [f"{current[i][0].effect}@{current[i][0].where}:{name}" for i, name in final_fit.names]
+        correlation = {"parameters": labels, "matrix": [[_finite(x) for x in row] for row in final_fit.correlation]}
+    final = _comparisons(lik, final_ratios, floors)
+    report = unexplained_report(lik, assembly, current, baseline, cons, final_error, floor, explained, say) \
+        if not explained else ()
     return Diagnosis(
-        metric=METRIC,
-        baseline_error=e0,
-        noise_floor=floor,
-        missing_effect=best.name if missing else None,
-        missing_where=best.where if missing else None,
-        ambiguous_with=tuple(ambiguous),
-        suggestion=suggestion,
-        candidates=tuple(first),
-        refinement=tuple(steps),
-        band=band,
-        baseline=baseline,
-        final=_comparisons(assembly, added, data),
-        refined_assembly=refined,
-        final_effects=tuple(added),
+        metric=METRIC, baseline_error=e0, noise_floor=floor, explained=explained,
+        missing_effect=None if missing is None else missing.name,
+        missing_where=None if missing is None else missing.where,
+        ambiguous_with=names, suggestion=None if sep is None else sep["text"],
+        candidates=tuple(first), refinement=tuple(steps), band=band, baseline=baseline, final=final,
+        refined_assembly=refined, final_effects=final_effects, consistency=cons, ambiguous=tuple(ambiguous),
+        separation=sep, report=tuple(report), correlation=correlation, final_error=final_error,
     )
+
+
+def _std_of(result, change) -> dict:
+    for i, (c, _) in enumerate(result.changes):
+        if c is change:
+            return result.std[i]
+    return {}

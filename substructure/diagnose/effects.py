@@ -21,11 +21,19 @@ without touching the core::
             return assembly.attach(Sensor("nut", self.where, f"{self.values['mass']} kg"))
 
 The diagnosis (:mod:`substructure.diagnose.diagnosis`) fits every registered
-effect at every place it proposes.
+effect at every place it proposes, next to every parameter of the model and
+the elements of :mod:`substructure.updating.elements`.  An effect may also
+give ``apply_si(structure)``, the same change on the SI form of the model
+(:mod:`substructure.updating.structure`), so that fits need not rebuild
+objects; the built-in effects do.  :class:`EffectChange` makes an effect at a
+place a :class:`~substructure.updating.parameters.Change` of the updating
+core.  :func:`registry` snapshots the registry for one diagnosis, and
+:func:`registered` registers effects for a ``with`` block only.
 """
 
 from __future__ import annotations
 
+import contextlib
 import warnings
 from typing import ClassVar, Sequence
 
@@ -39,8 +47,12 @@ from ..errors import InvalidValueError, NonPassiveJointWarning, UnknownPointErro
 from ..joints import Joint, Sensor, Support
 from ..points import parse_point
 from ..units import format_quantity, ureg
+from ..updating.elements import split_beam
+from ..updating.parameters import Change, ParamSpec
+from ..updating.structure import LinkSI
 
-__all__ = ["Parameter", "Effect", "EFFECTS", "register_effect", "get_effect"]
+__all__ = ["Parameter", "Effect", "EFFECTS", "register_effect", "get_effect", "EffectChange", "registry",
+           "registered"]
 
 EFFECTS: dict[str, type] = {}
 """Registered effects by name."""
@@ -54,7 +66,12 @@ def register_effect(cls):
     Returns
     -------
     type
-        The class, unchanged, now in :data:`EFFECTS`.
+        The class, registered.
+
+    Raises
+    ------
+    InvalidValueError
+        Without a ``name``, or with the name of another registered effect.
     """
     if not isinstance(getattr(cls, "name", None), str):
         raise InvalidValueError(f"effect {cls.__name__}: needs a class attribute `name`")
@@ -72,16 +89,56 @@ def get_effect(name: str) -> type:
     Parameters
     ----------
     name : str
-        A registered name (``"sensor_mass"``).
+        The effect's name.
 
     Returns
     -------
     type
-        The subclass of :class:`Effect`.
+        The class.
+
+    Raises
+    ------
+    InvalidValueError
+        For an unknown name (the message lists the known ones).
     """
     if name not in EFFECTS:
         raise InvalidValueError(f"effect: unknown effect {name!r}; known: {', '.join(EFFECTS)}")
     return EFFECTS[name]
+
+
+def registry() -> dict[str, type]:
+    """A snapshot of the registered effects (a diagnosis works on its own copy).
+
+    Returns
+    -------
+    dict of str to type
+        Effect classes by name.
+    """
+    return dict(EFFECTS)
+
+
+@contextlib.contextmanager
+def registered(*classes):
+    """Register effect classes for the ``with`` block only; the registry is restored after.
+
+    Parameters
+    ----------
+    *classes : type
+        :class:`Effect` subclasses.
+
+    Yields
+    ------
+    dict
+        The registry inside the block.
+    """
+    saved = dict(EFFECTS)
+    try:
+        for cls in classes:
+            register_effect(cls)
+        yield EFFECTS
+    finally:
+        EFFECTS.clear()
+        EFFECTS.update(saved)
 
 
 @attrs.frozen
@@ -112,17 +169,17 @@ class Parameter:
     log: bool = True
 
     def quantity(self, value: float):
-        """A value of the parameter with its unit.
+        """The value as a quantity of this parameter's unit.
 
         Parameters
         ----------
         value : float
-            The value in ``unit``.
+            The value (SI).
 
         Returns
         -------
         pint.Quantity
-            The quantity.
+            With its unit.
         """
         return ureg.Quantity(value, self.unit)
 
@@ -170,25 +227,25 @@ class Effect:
 
     @classmethod
     def places(cls, assembly: Assembly, measured_points: Sequence[str]) -> list[str]:
-        """Where this effect may act in an assembly (subclasses say; none by default).
+        """Where it may act.
 
         Parameters
         ----------
         assembly : Assembly
             The model.
         measured_points : sequence of str
-            The points the measurements respond or are excited at.
+            The measured DOF labels.
 
         Returns
         -------
         list of str
-            Points or joint names.
+            Places (points, joint or component names).
         """
         return []
 
     @classmethod
     def starting_values(cls, assembly: Assembly, where: str, shift: float) -> dict[str, float]:
-        """Starting values of the fit at a place (default: each parameter's ``start``).
+        """Starting values at a place.
 
         Parameters
         ----------
@@ -197,18 +254,18 @@ class Effect:
         where : str
             The place.
         shift : float
-            Relative shift of the main mode, measured / model - 1 (dimensionless).
+            Relative shift of the main mode, ``f_model / f_measured - 1``.
 
         Returns
         -------
         dict of str to float
-            Values in the parameters' SI units.
+            A value per parameter (SI).
         """
         return {p.name: p.start for p in cls.parameters}
 
     @classmethod
     def bounds(cls, assembly: Assembly, where: str) -> dict[str, tuple[float, float]]:
-        """Bounds of each parameter at this place (default: the class's).
+        """Bounds of each parameter at this place.
 
         Parameters
         ----------
@@ -219,35 +276,167 @@ class Effect:
 
         Returns
         -------
-        dict of str to tuple
-            ``{name: (lower, upper)}`` in the parameters' SI units.
+        dict of str to (float, float)
+            ``(lower, upper)`` per parameter, within the class's.
         """
         return {p.name: (p.lower, p.upper) for p in cls.parameters}
 
     def apply(self, assembly: Assembly) -> Assembly:
-        """The assembly with this effect added (subclasses implement it).
+        """The assembly with the effect applied (a new assembly in normal form).
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model (or one test configuration of it).
+
+        Returns
+        -------
+        Assembly
+            The changed model.
+        """
+        raise NotImplementedError
+
+    def apply_si(self, structure):
+        """The same change on the SI form of the model (optional; fits use it when given).
+
+        Parameters
+        ----------
+        structure : Structure
+            The SI form of one test configuration.
+
+        Returns
+        -------
+        Structure
+            The changed structure.
+        """
+        raise NotImplementedError
+
+    def parameters_json(self) -> dict:
+        """``{name: {"value", "unit"}}`` of this instance (SI).
+
+        Returns
+        -------
+        dict
+            One entry per parameter.
+        """
+        return {p.name: {"value": self.values[p.name], "unit": p.unit} for p in self.parameters}
+
+
+class EffectChange(Change):
+    """An effect of the catalogue at one place, as a change of the updating core.
+
+    Parameters
+    ----------
+    cls : type
+        The :class:`Effect` subclass.
+    where : str
+        The place.
+    assembly : Assembly
+        The model (for the place's bounds and starting values).
+    shift : float
+        Relative shift of the main mode, for the starting values.
+    """
+
+    def __init__(self, cls: type, where: str, assembly: Assembly, shift: float = 0.0):
+        self.cls = cls
+        self.effect = cls.name
+        self.explanation = cls.explanation
+        self.where = where
+        self.test_only = cls is SensorMass
+        bounds = cls.bounds(assembly, where)
+        start = cls.starting_values(assembly, where, shift)
+        specs = []
+        for p in cls.parameters:
+            lo, hi = max(bounds[p.name][0], p.lower), min(bounds[p.name][1], p.upper)
+            if not lo <= hi:
+                raise InvalidValueError(f"effect {cls.name!r} at {where}: {p.name} has no room ({lo:g} > {hi:g})")
+            specs.append(ParamSpec(p.name, p.unit, lo, hi, float(np.clip(start.get(p.name, p.start), lo, hi)),
+                                   p.log and lo > 0))
+        self.specs = tuple(specs)
+
+    def instance(self, values) -> Effect:
+        """The effect with these values.
+
+        Parameters
+        ----------
+        values : mapping of str to float
+            The effect's values (SI).
+
+        Returns
+        -------
+        Effect
+            An instance at this change's place.
+        """
+        return self.cls(self.where, **{k: float(v) for k, v in values.items()})
+
+    def apply(self, assembly, values):
+        """The assembly with the effect applied.
 
         Parameters
         ----------
         assembly : Assembly
             The model.
+        values : mapping of str to float
+            The effect's values (SI).
 
         Returns
         -------
         Assembly
-            A new assembly: a sensor, a joint value, flutes or a support added or changed.
+            The changed model.
         """
-        raise NotImplementedError
+        return self.instance(values).apply(assembly)
 
-    def parameters_json(self) -> dict:
-        """The values with their units, for JSON.
+    def apply_si(self, structure, values):
+        """The SI structure with the effect applied (the effect's ``apply_si``).
+
+        Parameters
+        ----------
+        structure : Structure
+            The SI form of one test configuration.
+        values : mapping of str to float
+            The effect's values (SI).
 
         Returns
         -------
-        dict
-            ``{name: {"value": float, "unit": SI unit}}``.
+        Structure
+            The changed structure.
         """
-        return {p.name: {"value": self.values[p.name], "unit": p.unit} for p in self.parameters}
+        return self.instance(values).apply_si(structure)
+
+
+def _has_si(cls) -> bool:
+    return getattr(cls, "apply_si", None) is not None and cls.apply_si is not Effect.apply_si
+
+
+def effect_change(cls: type, where: str, assembly: Assembly, shift: float = 0.0) -> Change:
+    """An :class:`EffectChange`, or one fitted through ``apply`` when the effect has no SI form.
+
+    Parameters
+    ----------
+    cls : type
+        The effect class.
+    where : str
+        Its place.
+    assembly : Assembly
+        The model.
+    shift : float
+        Relative shift of the main mode.
+
+    Returns
+    -------
+    Change
+        The change.
+    """
+    change = EffectChange(cls, where, assembly, shift)
+    if not _has_si(cls):
+        change.__class__ = _AssemblyOnlyEffect
+    return change
+
+
+class _AssemblyOnlyEffect(EffectChange):
+    """An effect without an SI form: fits apply it to the assembly (slower)."""
+
+    apply_si = Change.apply_si
 
 
 def _quiet_joint(joint: Joint, **kw) -> Joint:
@@ -266,6 +455,12 @@ def _si(value: float, unit: str) -> str:
 
 @register_effect
 class SensorMass(Effect):
+    """A body on a measured point (an accelerometer, a magnet) that the model lacks: ``mass``, ``inertia``.
+
+    Written back as a sensor ``diagnosed-<point>`` that is on in every test (``always_on``), since the
+    records the diagnosis was fitted on do not list it.
+    """
+
     name = "sensor-mass"
     parameters = (
         Parameter("mass", "kg", 1e-4, 0.2, 2e-3),
@@ -279,11 +474,45 @@ class SensorMass(Effect):
 
     @classmethod
     def places(cls, assembly, measured_points):
+        """Where it may act.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        measured_points : sequence of str
+            The measured DOF labels.
+
+        Returns
+        -------
+        list of str
+            Places (points, joint or component names).
+        """
         return list(dict.fromkeys(str(parse_point(p).point) for p in measured_points))
 
     @classmethod
     def starting_values(cls, assembly, where, shift):
-        """From the main mode's relative shift (model above measurement: a tip mass)."""
+        """Starting values at a place.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        where : str
+            The place.
+        shift : float
+            Relative shift of the main mode, ``f_model / f_measured - 1``.
+
+        Returns
+        -------
+        dict of str to float
+            A value per parameter (SI).
+
+        Notes
+        -----
+        From the main mode's relative shift: a tip mode drops as ``sqrt(1 + dm / m_eff)``
+        with a quarter of the component's mass moving (model above measurement: a tip mass).
+        """
         out = {p.name: p.start for p in cls.parameters}
         try:
             body = assembly.component(parse_point(where).component)
@@ -295,13 +524,42 @@ class SensorMass(Effect):
         return out
 
     def apply(self, assembly):
+        """The assembly with the effect applied (a new assembly in normal form).
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model (or one test configuration of it).
+
+        Returns
+        -------
+        Assembly
+            The changed model.
+        """
         base = f"diagnosed-{self.where.replace('.', '-').replace('@', '-at-').replace(' ', '')}"
         taken = {s.name for s in assembly.sensors}
         name, n = base, 2
         while name in taken:  # a model improved before may carry one already
             name, n = f"{base}-{n}", n + 1
-        sensor = Sensor(name, self.where, _si(self.values["mass"], "kg"), _si(self.values["inertia"], "kg*m^2"))
+        sensor = Sensor(name, self.where, _si(self.values["mass"], "kg"), _si(self.values["inertia"], "kg*m^2"),
+                        always_on=True)
         return assembly.attach(sensor)
+
+    def apply_si(self, structure):
+        """The same change on the SI form of the model (optional; fits use it when given).
+
+        Parameters
+        ----------
+        structure : Structure
+            The SI form of one test configuration.
+
+        Returns
+        -------
+        Structure
+            The changed structure.
+        """
+        return structure.add_link(LinkSI(("added", f"sensor-mass-{self.where}"), self.where,
+                                         M=np.diag([self.values["mass"], self.values["inertia"]])))
 
 
 class _JointEffect(Effect):
@@ -310,10 +568,40 @@ class _JointEffect(Effect):
 
     @classmethod
     def places(cls, assembly, measured_points):
+        """Where it may act.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        measured_points : sequence of str
+            The measured DOF labels.
+
+        Returns
+        -------
+        list of str
+            Places (points, joint or component names).
+        """
         return _elastic_joints(assembly)
 
     @classmethod
     def starting_values(cls, assembly, where, shift):
+        """Starting values at a place.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        where : str
+            The place.
+        shift : float
+            Relative shift of the main mode, ``f_model / f_measured - 1``.
+
+        Returns
+        -------
+        dict of str to float
+            A value per parameter (SI).
+        """
         joint = assembly.joint(where)
         out = {}
         for p in cls.parameters:
@@ -323,6 +611,18 @@ class _JointEffect(Effect):
         return out
 
     def apply(self, assembly):
+        """The assembly with the effect applied (a new assembly in normal form).
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model (or one test configuration of it).
+
+        Returns
+        -------
+        Assembly
+            The changed model.
+        """
         joint = assembly.joint(self.where)
         k, c = {}, {}
         for name, value in self.values.items():
@@ -334,9 +634,37 @@ class _JointEffect(Effect):
                 target[e] = _si(value, unit)
         return assembly.with_joint(_quiet_joint(joint, k=k, c=c))
 
+    def apply_si(self, structure):
+        """The same change on the SI form of the model (optional; fits use it when given).
+
+        Parameters
+        ----------
+        structure : Structure
+            The SI form of one test configuration.
+
+        Returns
+        -------
+        Structure
+            The changed structure.
+        """
+        i, link = structure.link(("joints", self.where))
+        if link.rigid or link.custom is not None:
+            raise UnknownPointError(f"joint {self.where!r} has no stiffness matrix here")
+        K, C = link.K.copy(), link.C.copy()
+        for name, value in self.values.items():
+            kind, entry = name.split("_", 1)
+            m = K if kind == "k" else C
+            if entry == "ym":
+                m[0, 1] = m[1, 0] = value
+            else:
+                m[(0, 1)[entry == "tm"], (0, 1)[entry == "tm"]] = value
+        return structure.with_link(i, link.evolve(K=K, C=C))
+
 
 @register_effect
 class JointStiffness(_JointEffect):
+    """A joint's stiffness ``k_yf``, ``k_tm`` off."""
+
     name = "joint-stiffness"
     parameters = (
         Parameter("k_yf", "N/m", 1e4, 1e11, 1e7),
@@ -350,6 +678,8 @@ class JointStiffness(_JointEffect):
 
 @register_effect
 class JointDamping(_JointEffect):
+    """A joint's damping ``c_yf``, ``c_tm`` off."""
+
     name = "joint-damping"
     parameters = (
         Parameter("c_yf", "N*s/m", 1e-2, 1e5, 50.0),
@@ -363,6 +693,8 @@ class JointDamping(_JointEffect):
 
 @register_effect
 class JointCrossCoupling(_JointEffect):
+    """A joint's cross terms ``k_ym = k_tf`` and ``c_ym = c_tf`` missing (within passivity)."""
+
     name = "joint-cross-coupling"
     parameters = (
         Parameter("k_ym", "N", -1e9, 1e9, 0.0, log=False),
@@ -376,13 +708,46 @@ class JointCrossCoupling(_JointEffect):
 
     @classmethod
     def starting_values(cls, assembly, where, shift):
+        """Starting values at a place.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        where : str
+            The place.
+        shift : float
+            Relative shift of the main mode, ``f_model / f_measured - 1``.
+
+        Returns
+        -------
+        dict of str to float
+            A value per parameter (SI).
+        """
         joint = assembly.joint(where)
         scale = np.sqrt(max(joint.k.get("yf") * joint.k.get("tm"), 1.0))
         return {"k_ym": 0.3 * scale * (-1 if shift < 0 else 1), "c_ym": 0.0}
 
     @classmethod
     def bounds(cls, assembly, where):
-        """Passive cross terms: ``k_ym^2 < k_yf k_tm`` and ``c_ym^2 < c_yf c_tm``."""
+        """Bounds of each parameter at this place.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        where : str
+            The place.
+
+        Returns
+        -------
+        dict of str to (float, float)
+            ``(lower, upper)`` per parameter, within the class's.
+
+        Notes
+        -----
+        Passive cross terms: ``k_ym^2 < k_yf k_tm`` and ``c_ym^2 < c_yf c_tm``.
+        """
         joint = assembly.joint(where)
         k = 0.999 * np.sqrt(max(joint.k.get("yf") * joint.k.get("tm"), 0.0))
         c = 0.999 * np.sqrt(max(joint.c.get("yf") * joint.c.get("tm"), 0.0))
@@ -391,6 +756,8 @@ class JointCrossCoupling(_JointEffect):
 
 @register_effect
 class RigidJointFlexibility(_JointEffect):
+    """A joint modelled as rigid is elastic: ``k_yf``, ``k_tm``."""
+
     name = "rigid-joint-flexibility"
     parameters = (
         Parameter("k_yf", "N/m", 1e4, 1e12, 1e8),
@@ -403,17 +770,77 @@ class RigidJointFlexibility(_JointEffect):
 
     @classmethod
     def places(cls, assembly, measured_points):
+        """Where it may act.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        measured_points : sequence of str
+            The measured DOF labels.
+
+        Returns
+        -------
+        list of str
+            Places (points, joint or component names).
+        """
         return [j.name for j in assembly.joints if getattr(j, "rigid", False)]
 
     @classmethod
     def starting_values(cls, assembly, where, shift):
+        """Starting values at a place.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        where : str
+            The place.
+        shift : float
+            Relative shift of the main mode, ``f_model / f_measured - 1``.
+
+        Returns
+        -------
+        dict of str to float
+            A value per parameter (SI).
+        """
         return {p.name: p.start for p in cls.parameters}
 
     def apply(self, assembly):
+        """The assembly with the effect applied (a new assembly in normal form).
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model (or one test configuration of it).
+
+        Returns
+        -------
+        Assembly
+            The changed model.
+        """
         joint = assembly.joint(self.where)
         elastic = Joint(joint.name, joint.between, k={"yf": _si(self.values["k_yf"], "N/m"),
                                                       "tm": _si(self.values["k_tm"], "N*m/rad")})
         return assembly.with_joint(elastic)
+
+    def apply_si(self, structure):
+        """The same change on the SI form of the model (optional; fits use it when given).
+
+        Parameters
+        ----------
+        structure : Structure
+            The SI form of one test configuration.
+
+        Returns
+        -------
+        Structure
+            The changed structure.
+        """
+        i, link = structure.link(("joints", self.where))
+        return structure.with_link(i, link.evolve(rigid=False, custom=None,
+                                                  K=np.diag([self.values["k_yf"], self.values["k_tm"]]),
+                                                  C=np.zeros((2, 2))))
 
 
 def _tools(assembly: Assembly) -> list[Beam]:
@@ -422,6 +849,8 @@ def _tools(assembly: Assembly) -> list[Beam]:
 
 @register_effect
 class FlutedSection(Effect):
+    """A tool's last ``length`` fluted, at ``diameter_ratio`` (equivalent diameter)."""
+
     name = "fluted-section"
     parameters = (
         Parameter("diameter_ratio", "dimensionless", 0.5, 1.0, 0.8, log=False),
@@ -434,25 +863,114 @@ class FlutedSection(Effect):
 
     @classmethod
     def places(cls, assembly, measured_points):
+        """Where it may act.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        measured_points : sequence of str
+            The measured DOF labels.
+
+        Returns
+        -------
+        list of str
+            Places (points, joint or component names).
+        """
         return [t.name for t in _tools(assembly) if not any(s.flutes for s in t.segments)]
 
     @classmethod
     def starting_values(cls, assembly, where, shift):
+        """Starting values at a place.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        where : str
+            The place.
+        shift : float
+            Relative shift of the main mode, ``f_model / f_measured - 1``.
+
+        Returns
+        -------
+        dict of str to float
+            A value per parameter (SI).
+        """
         tool = assembly.component(where)
         return {"diameter_ratio": 0.8, "length": min(0.03, 0.5 * tool.length_m)}
 
     @classmethod
     def bounds(cls, assembly, where):
+        """Bounds of each parameter at this place.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        where : str
+            The place.
+
+        Returns
+        -------
+        dict of str to (float, float)
+            ``(lower, upper)`` per parameter, within the class's.
+        """
         tool = assembly.component(where)
         return {"diameter_ratio": (0.5, 1.0), "length": (1e-3, tool.length_m)}
 
     def apply(self, assembly):
+        """The assembly with the effect applied (a new assembly in normal form).
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model (or one test configuration of it).
+
+        Returns
+        -------
+        Assembly
+            The changed model.
+        """
         tool = assembly.component(self.where)
         return assembly.with_component(flute_tip(tool, self.values["length"], self.values["diameter_ratio"]))
 
+    def apply_si(self, structure):
+        """The same change on the SI form of the model (optional; fits use it when given).
+
+        Parameters
+        ----------
+        structure : Structure
+            The SI form of one test configuration.
+
+        Returns
+        -------
+        Structure
+            The changed structure.
+        """
+        beam = structure.beam(self.where)
+        total = beam.total_length
+        return structure.with_beam(split_beam(beam, total - min(self.values["length"], total), total,
+                                              flutes=self.values["diameter_ratio"]))
+
 
 def flute_tip(tool: Beam, length_m: float, ratio: float) -> Beam:
-    """The tool with its last ``length_m`` fluted at ``ratio`` (segments split as needed)."""
+    """The tool with its last ``length_m`` fluted at ``ratio`` (segments split as needed).
+
+    Parameters
+    ----------
+    tool : Beam
+        The tool.
+    length_m : float
+        Fluted length [m] (at most the tool's).
+    ratio : float
+        The flutes' diameter ratio.
+
+    Returns
+    -------
+    Beam
+        A new tool.
+    """
     total = tool.length_m
     length_m = min(length_m, total)
     start = total - length_m
@@ -472,6 +990,8 @@ def flute_tip(tool: Beam, length_m: float, ratio: float) -> Beam:
 
 @register_effect
 class SupportSprings(Effect):
+    """Springs to the ground near both ends of the heaviest component: ``k_yf`` per spring, ``inset``."""
+
     name = "support-springs"
     parameters = (
         Parameter("k_yf", "N/m", 1e1, 1e8, 1e5),
@@ -485,6 +1005,20 @@ class SupportSprings(Effect):
 
     @classmethod
     def places(cls, assembly, measured_points):
+        """Where it may act.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        measured_points : sequence of str
+            The measured DOF labels.
+
+        Returns
+        -------
+        list of str
+            Places (points, joint or component names).
+        """
         beams = [c for c in assembly.components if isinstance(c, Beam)]
         if not beams:
             return []
@@ -492,8 +1026,23 @@ class SupportSprings(Effect):
         return [f"{heaviest.name}.base,{heaviest.name}.tip"]
 
     def apply(self, assembly):
-        """Two equal springs (k_yf each) near the two points of ``where`` (the ends of a
-        component, ``"spindle.base,spindle.tip"``), ``inset`` of its length in from each."""
+        """The assembly with the effect applied (a new assembly in normal form).
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model (or one test configuration of it).
+
+        Returns
+        -------
+        Assembly
+            The changed model.
+
+        Notes
+        -----
+        Two equal springs (``k_yf`` each) near the two points of ``where`` (the ends of a component,
+        ``"spindle.base,spindle.tip"``), ``inset`` of its length in from each.
+        """
         points = [parse_point(p.strip()) for p in self.where.split(",")]
         if len({p.component for p in points}) != 1 or {p.where for p in points} != {"base", "tip"}:
             raise InvalidValueError(
@@ -507,3 +1056,25 @@ class SupportSprings(Effect):
         far = f"{comp.name}@{_si(comp.length_m - inset, 'm')}"
         return assembly.support(Support(near, k={"yf": k}, name=f"diagnosed-{comp.name}-1")).support(
             Support(far, k={"yf": k}, name=f"diagnosed-{comp.name}-2"))
+
+    def apply_si(self, structure):
+        """The same change on the SI form of the model (optional; fits use it when given).
+
+        Parameters
+        ----------
+        structure : Structure
+            The SI form of one test configuration.
+
+        Returns
+        -------
+        Structure
+            The changed structure.
+        """
+        points = [parse_point(p.strip()) for p in self.where.split(",")]
+        name = points[0].component
+        total = structure.beam(name).total_length
+        inset = self.values["inset"] * total
+        k = np.diag([self.values["k_yf"], 0.0])
+        near = LinkSI(("added", f"springs-{name}-1"), (name, inset), K=k)
+        far = LinkSI(("added", f"springs-{name}-2"), (name, total - inset), K=k)
+        return structure.add_link(near).add_link(far)

@@ -9,10 +9,22 @@ __all__ = ["plot_comparison", "plot_history"]
 
 
 def plot_comparison(comparison, ax=None):
-    """Measured and model |H| and phase overlaid, the log-ratio residual below.
+    """Measured and model ``|H|`` and phase overlaid, the log-ratio residual below.
 
     The bands that carry most of the error are shaded and the paired modes
     annotated with their shifts (model minus measurement).
+
+    Parameters
+    ----------
+    comparison : Comparison
+        What to draw.
+    ax : sequence of three Axes, optional
+        Where to draw (default: a new figure).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
     """
     if ax is None:
         fig, axes = plt.subplots(3, 1, sharex=True, figsize=(8.0, 7.5), layout="constrained",
@@ -60,7 +72,20 @@ def plot_comparison(comparison, ax=None):
 
 
 def plot_history(diagnosis, ax=None):
-    """The refinement's error after each step, with the noise floor."""
+    """The refinement's error after each step, with the noise floor.
+
+    Parameters
+    ----------
+    diagnosis : Diagnosis
+        What to draw.
+    ax : Axes, optional
+        Where to draw (default: a new figure).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     if ax is None:
         fig, ax = plt.subplots(figsize=(6.5, 3.8), layout="constrained")
     else:

@@ -1,0 +1,248 @@
+"""The refinement of a diagnosis: forward selection, backward elimination, review, the history.
+
+:func:`refine` runs the steps of :mod:`substructure.diagnose.search` until
+no candidate passes the significance test (or ``max_steps``), refitting
+every change added at every step; a model consistent with the noise before
+any change is left alone.  Then
+
+* backward elimination drops a change whose removal (the others refitted)
+  is not significant: an early change that a later one made redundant;
+* the review tries, for each change kept, the other candidates fitted at
+  the step it was added and the changes dropped, in place of it with the
+  others refitted: one
+  inside the indifference region is an alternative explanation (reported
+  as ambiguous), and replaces it when it is preferred (a named effect of
+  the catalogue before a linked parameter, before a single parameter,
+  before an element; :func:`~substructure.diagnose.search.preference`);
+* the history is rebuilt from the changes kept, in the order that lowers
+  ``chi^2`` most at each step, so that the "error fall" shows the final
+  explanation.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import attrs
+
+from ..updating.fit import Fit, fit
+from ..updating.selection import INDIFFERENCE, significance
+from ..updating.likelihood import Likelihood
+from .modes import mode_starts
+from .search import Scored, _places as places, choose, full_fits, physical, preference, rank, screen, shortlist
+
+__all__ = ["Outcome", "refine"]
+
+
+@attrs.define
+class Outcome:
+    """What :func:`refine` gives the diagnosis.
+
+    Attributes
+    ----------
+    current : list of (Change, dict)
+        The changes kept, with their final values.
+    fit : Fit or None
+        The final joint fit of those changes.
+    history : list of tuple
+        Per step ``(fit of the changes so far, the change added, statistic, threshold)``.
+    first_scored, first_fitted : list of Scored
+        The first step's screened and fully fitted candidates.
+    alternatives : dict
+        Per kept change's key, the alternatives inside the indifference
+        region: ``[(change, values, chi2), ...]``.
+    """
+
+    current: list
+    fit: Fit | None
+    history: list
+    first_scored: list
+    first_fitted: list
+    alternatives: dict
+
+
+def _p(changes) -> int:
+    return sum(len(c.specs) for c, _ in changes)
+
+
+def _prune(lik, current, chi2_now, say):
+    n = lik.n
+    dropped: list = []
+    while len(current) > 1:
+        p = _p(current)
+        worst = None
+        for i in range(len(current)):
+            refit = fit(lik, current[:i] + current[i + 1:])
+            sig = significance(refit.chi2, chi2_now, len(current[i][0].specs), n, p, 1)
+            if not sig.significant and (worst is None or sig.statistic < worst[0]):
+                worst = (sig.statistic, i, refit)
+        if worst is None:
+            break
+        _, i, refit = worst
+        if say:
+            say(f"dropped {current[i][0].effect} at {current[i][0].where}: no longer significant")
+        dropped.append(Scored(current[i][0], dict(current[i][1]), chi2_now, start=None))
+        current, chi2_now = [(c, dict(v)) for c, v in refit.changes], refit.chi2
+    return current, chi2_now, dropped
+
+
+def _review(lik, current, chi2_now, steps_fitted, steps_inside, dropped, passive, say):
+    """Alternatives of each kept change; preferred ones replace it (see the module docstring)."""
+    n = lik.n
+    alternatives: dict = {}
+    for i in range(len(current)):
+        change = current[i][0]
+        keys = {c.key for c, _ in current}
+        # the candidates fitted when it was added that the report would prefer (refitting costs)
+        pool = [s for s in steps_fitted.get(change.key, []) + dropped if s.change.key not in keys
+                and preference(s.change) < preference(change)]
+        pool.sort(key=lambda s: (preference(s.change), s.chi2))
+        found = []
+        for s in pool[:3]:
+            trial = current[:i] + [(s.change, s.values)] + current[i + 1:]
+            if s.fit is None and s.start is not None:  # screened only: with the values it screened at
+                trial = [(c, dict(v)) for c, v in s.start[:i]] + [(s.change, s.values)] + current[i + 1:]
+            try:
+                result = fit(lik, trial)
+            except (ValueError, ArithmeticError):
+                continue
+            if not (physical(s.change, result.changes[i][1]) and passive(result.changes)):
+                continue
+            s2 = max(1.0, min(result.chi2, chi2_now) / max(n - _p(current), 1))
+            if abs(result.chi2 - chi2_now) / s2 <= INDIFFERENCE:
+                found.append((result, s))
+        best = None
+        for result, s in found:
+            if preference(s.change) < preference(change) and (best is None or result.chi2 < best[0].chi2):
+                best = (result, s)
+        if best is not None:
+            result, s = best
+            if say:
+                say(f"review: {s.change.effect} at {s.change.where} explains as well as {change.effect} at "
+                    f"{change.where} and is preferred")
+            old = (change, current[i][1], chi2_now)
+            current, chi2_now = [(c, dict(v)) for c, v in result.changes], result.chi2
+            found = [(r, t) for r, t in found if t is not s]
+            alternatives[current[i][0].key] = [old] + [(t.change, r.changes[i][1], r.chi2) for r, t in found]
+        else:
+            alternatives[change.key] = [(t.change, r.changes[i][1], r.chi2) for r, t in found]
+        # and those that were inside the indifference region when it was added
+        for s in steps_inside.get(current[i][0].key, []):
+            if s.change.key not in {c.key for c, _ in current} and \
+                    s.change.key not in {a[0].key for a in alternatives[current[i][0].key]}:
+                alternatives[current[i][0].key].append((s.change, s.fit.changes[-1][1], s.fit.chi2))
+    return current, chi2_now, alternatives
+
+
+def _history(lik, current, final: Fit, tried: int):
+    """The steps rebuilt from the kept changes: at each step the one that lowers chi^2 most."""
+    n = lik.n
+    order, rest, history = [], list(current), []
+    chi2_prev = lik.chi2([])
+    while rest:
+        if len(rest) == 1:
+            result = final
+            pick = rest[0]
+        else:
+            trials = []
+            chosen = {id(x) for x in order}
+            for c in rest:
+                subset = [x for x in current if id(x) in chosen or x is c]
+                trials.append((fit(lik, subset), c))
+            result, pick = min(trials, key=lambda t: t[0].chi2)
+        order.append(pick)
+        rest = [c for c in rest if c is not pick]
+        sig = significance(chi2_prev, result.chi2, len(pick[0].specs), n, _p(order), tried)
+        history.append((result, pick[0], sig.statistic, sig.threshold))
+        chi2_prev = result.chi2
+    return history
+
+
+def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None) -> Outcome:
+    """Forward selection, then elimination, review and history (see the module docstring).
+
+    Parameters
+    ----------
+    lik : Likelihood
+        All lines.
+    screen_lik : Likelihood
+        The screening subsample.
+    cands : list of Change
+        The candidates.
+    max_steps : int
+        Most forward steps.
+    passive : callable
+        ``passive(changes) -> bool``: the changed model is passive.
+    say : callable, optional
+        Progress.
+
+    Returns
+    -------
+    Outcome
+        The changes kept and what the report needs.
+    """
+    n = lik.n
+    current: list = []
+    chi2_now = lik.chi2([])
+    first_scored, first_fitted = [], []
+    lik0 = Likelihood(lik.assembly, lik.measured[:1])
+    steps_fitted: dict = {}
+    steps_inside: dict = {}
+    path: list = []
+    tried = len(cands)
+    while len(current) < max_steps:
+        keys = {c.key for c, _ in current}
+        remaining = [c for c in cands if c.key not in keys]
+        if say:
+            say(f"step {len(current) + 1}: screening {len(remaining)} candidates on "
+                f"{screen_lik.lines.size} of {lik.lines.size} lines")
+        # the current changes refitted on the subsample too: candidates are compared with that
+        chi2_s = fit(screen_lik, current).chi2 if current else screen_lik.chi2([])
+        extra = mode_starts(lik0, current, remaining, places)
+        scored = screen(screen_lik, current, remaining, chi2_s, n, say, extra)
+        chosen = []
+        for s in shortlist(scored, chi2_s, screen_lik.n, n, _p(current)):
+            # the screened values checked on all lines (noise fitted on the subsample does not carry over)
+            chi2_all = lik.chi2(list(s.start if s.start is not None else current) + [(s.change, s.values)])
+            if significance(chi2_now, chi2_all, s.k, n, _p(current) + s.k).significant:
+                chosen.append(s)
+        fitted = [s for s in full_fits(lik, current, chosen, say)
+                  if physical(s.change, s.values) and passive(s.fit.changes)]
+        ranked = rank(fitted, n, _p(current))
+        if not first_scored:
+            first_scored, first_fitted = scored, ranked
+        if not ranked:
+            break
+        best, inside, _ = choose(ranked, n, _p(current))
+        sig = significance(chi2_now, best.chi2, best.k, n, _p(current) + best.k, len(remaining))
+        if not sig.significant:
+            if say:
+                say(f"best candidate {best.change.effect} at {best.change.where} is not significant "
+                    f"({sig.statistic:.4g} <= {sig.threshold:.4g}): stop")
+            break
+        # the review's pool: what was fitted, and what screened nearly as well as the choice
+        winner = next((x for x in scored if x.change.key == best.change.key), None)
+        near = [x for x in scored if winner is not None and x.change.key not in {r.change.key for r in ranked}
+                and chi2_s - x.chi2 >= 0.9 * (chi2_s - winner.chi2)]
+        steps_fitted[best.change.key] = [s for s in ranked if s is not best] + near
+        steps_inside[best.change.key] = inside
+        path.append((best.fit, best.change, sig.statistic, sig.threshold))
+        current = [(c, dict(v)) for c, v in best.fit.changes]
+        chi2_now = best.chi2
+        if say:
+            say(f"step {len(current)}: added {best.change.effect} at {best.change.place(best.values)}, "
+                f"chi^2/nu = {chi2_now / max(n - _p(current), 1):.4g}")
+    dropped: list = []
+    if len(current) > 1:
+        current, chi2_now, dropped = _prune(lik, current, chi2_now, say)
+    alternatives: dict = {}
+    if current:
+        current, chi2_now, alternatives = _review(lik, current, chi2_now, steps_fitted, steps_inside, dropped,
+                                                  passive, say)
+    kept = [c.key for c, _ in current]
+    unchanged = kept == [change.key for _, change, _, _ in path]
+    final = path[-1][0] if unchanged and path else (fit(lik, current) if current else None)
+    if final is not None:
+        current = [(c, dict(v)) for c, v in final.changes]
+    history = path if unchanged else (_history(lik, current, final, tried) if current else [])
+    return Outcome(current, final, history, first_scored, first_fitted, alternatives)

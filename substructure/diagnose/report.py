@@ -1,0 +1,320 @@
+"""What a diagnosis says when nothing explains the data, and which measurement separates two explanations.
+
+:func:`unexplained_report` writes the lines of an honest verdict: that no
+candidate explains the data (with the error against the noise floor and
+the test), where the remaining error lives (bands of lines and FRFs, from
+the band test of :func:`substructure.updating.selection.consistency`), the
+best partial explanation labelled partial, how the modes of the model as
+given sit against the measured ones, and the *signature*: which kind of
+change would move the modes as the measurement has them.  The signature
+compares the measured relative mode shifts ``d_i = ln(f_measured / f_model)``
+with the sensitivities ``s_ij = d ln f_i / d ln theta_j`` of the model's
+modes to the stiffness and the mass of each component, each joint's
+stiffness and each component's supports (finite differences of 5 %); the
+knob ``j`` whose pattern ``a s_j`` fits ``d`` best (largest share of
+``|d|^2`` explained) names the kind of effect, and each mode is named after
+the component whose stiffness moves it most.
+
+:func:`separation` ranks candidate measurements (point and cross FRFs at
+the ends, quarter points and middle of every beam component; with a
+non-contact sensor when one explanation belongs to the test) by how much
+two explanations differ there relative to the noise of the data.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..updating.structure import si_beam
+from ..errors import SubstructureError
+from ..measurements import model_of_measurement
+from ..updating.parameters import set_parameters
+from ..updating.selection import INDIFFERENCE
+
+__all__ = ["unexplained_report", "separation", "signature"]
+
+
+def _plain_beams(assembly):
+    return [c for c in assembly.components if si_beam(c)]
+
+
+def _peak(f: np.ndarray, h: np.ndarray, near: float) -> float | None:
+    """The resonance of ``|h|`` nearest ``near`` (within 15 %), by a parabola through the top three lines."""
+    window = np.flatnonzero((f > 0.85 * near) & (f < 1.15 * near))
+    if window.size < 3:
+        return None
+    a = np.log(np.abs(h[window]))
+    i = int(np.argmax(a))
+    if i == 0 or i == window.size - 1:
+        return None
+    y0, y1, y2 = a[i - 1], a[i], a[i + 1]
+    den = y0 - 2 * y1 + y2
+    shift = 0.0 if den == 0 else 0.5 * (y0 - y2) / den
+    df = f[window[1]] - f[window[0]]
+    return float(f[window[i]] + shift * df)
+
+
+def _knobs(assembly) -> list[tuple[str, str, str]]:
+    """``(path, kind, description)`` of the knobs of the signature analysis."""
+    out = []
+    for comp in _plain_beams(assembly):
+        out.append((f"components.{comp.name}.E", "stiffness", f"the stiffness of the {comp.name}"))
+        out.append((f"components.{comp.name}.rho", "mass", f"the mass of the {comp.name}"))
+    for j in assembly.joints:
+        if getattr(j, "rigid", True) is False and getattr(j, "k", None):
+            out.append((f"joints.{j.name}.k", "stiffness", f"the stiffness of the joint {j.name}"))
+    comps = {}
+    for s in assembly.supports:
+        comps.setdefault(s.at.split("@")[0].split(".")[0], 0)
+        comps[s.at.split("@")[0].split(".")[0]] += 1
+    for comp, count in comps.items():
+        out.append((f"components.{comp}.supports.k", "stiffness", f"the stiffness of the supports of the {comp}"))
+    return out
+
+
+def signature(model, measured_frf, pairs) -> tuple[list[str], dict]:
+    """Name the modes and the kind of change their shifts point to.
+
+    Parameters
+    ----------
+    model : Assembly
+        The best model (in the configuration of ``measured_frf``).
+    measured_frf : FRF
+        One measured entry.
+    pairs : list of ModePair
+        Measured modes paired with the model's.
+
+    Returns
+    -------
+    (list of str, dict)
+        Report lines and the numbers (``modes``: names and shifts,
+        ``knob``: the best-matching change and its share).
+    """
+    f = measured_frf.frequency.hz
+    out, inp = list(measured_frf.outputs), list(measured_frf.inputs)
+    paired = [p for p in pairs if p.model_hz is not None]
+    if not paired:
+        return [], {}
+    base = model.frf(out, inp, measured_frf.frequency).data[:, 0, 0]
+    f0 = [_peak(f, base, p.model_hz) for p in paired]
+    keep = [i for i, v in enumerate(f0) if v is not None]
+    if not keep:
+        return [], {}
+    paired = [paired[i] for i in keep]
+    f0 = np.array([f0[i] for i in keep])
+    d = np.log(np.array([p.measured_hz for p in paired]) / f0)
+    sens, names = [], []
+    for path, kind, text in _knobs(model):
+        try:
+            changed = set_parameters(model, {path: 1.05})
+            h = changed.frf(out, inp, measured_frf.frequency).data[:, 0, 0]
+        except (SubstructureError, ValueError):
+            continue
+        f1 = np.array([_peak(f, h, v) or v for v in f0])
+        sens.append(np.log(f1 / f0) / np.log(1.05))
+        names.append((path, kind, text))
+    if not sens:
+        return [], {}
+    s = np.array(sens)
+    lines = []
+    step = float(f[1] - f[0]) if f.size > 1 else 1.0
+    mode_names = []
+    for i, p in enumerate(paired):
+        # strain energy share of a stiffness: 2 d ln f / d ln k; kinetic energy share of a mass: -2 d ln f / d ln m
+        strain = [(s[j, i], names[j][2].replace("the stiffness of the ", "")) for j in range(len(names))
+                  if names[j][1] == "stiffness"]
+        motion = [(-s[j, i], names[j][2].replace("the mass of the ", "")) for j in range(len(names))
+                  if names[j][1] == "mass"]
+        where_strain = max(strain)[1] if strain else "?"
+        where_motion = max(motion)[1] if motion else "?"
+        mode_names.append(where_strain)
+        rel = d[i]
+        state = "within two lines" if abs(p.measured_hz - f0[i]) < 2 * step else \
+            f"{abs(rel):.1%} {'lower' if rel < 0 else 'higher'} in the measurement"
+        lines.append(f"mode at {f0[i]:.0f} Hz in the model (strain mostly in the {where_strain}, motion mostly "
+                     f"in the {where_motion}): {state}")
+    moved = np.abs(np.array([p.measured_hz for p in paired]) - f0) >= 2 * step
+    if not moved.any():
+        return lines, {"modes": [{"model_hz": float(v), "measured_hz": float(p.measured_hz), "strain": n}
+                                 for v, p, n in zip(f0, paired, mode_names)]}
+    dd = float(d @ d)
+    best = None
+    if dd > 0:
+        for j, (path, kind, text) in enumerate(names):
+            ss = float(s[j] @ s[j])
+            if ss <= 0:
+                continue
+            a = float(s[j] @ d) / ss
+            share = 1.0 - float(np.sum((d - a * s[j]) ** 2)) / dd
+            if best is None or share > best[0]:
+                best = (share, a, path, kind, text)
+    info = {"modes": [{"model_hz": float(v), "measured_hz": float(p.measured_hz), "strain": n}
+                      for v, p, n in zip(f0, paired, mode_names)]}
+    if best is not None and best[0] > 0.5:
+        share, a, path, kind, text = best
+        if kind == "stiffness":
+            what = f"{text} {'lower' if a < 0 else 'higher'} than the model"
+            alt = " (or mass added where that part moves)" if a < 0 else ""
+        else:
+            what = f"{text} {'higher' if a > 0 else 'lower'} than the model"
+            alt = f" (or softness near the {text.replace('the mass of the ', '')})" if a > 0 else ""
+        lower = [f"{f0[i]:.0f} Hz" for i in range(len(f0)) if moved[i] and d[i] < 0]
+        higher = [f"{f0[i]:.0f} Hz" for i in range(len(f0)) if moved[i] and d[i] > 0]
+        pattern = "; ".join(x for x in (f"lower in the measurement: {', '.join(lower)}" if lower else "",
+                                        f"higher: {', '.join(higher)}" if higher else "") if x)
+        lines.append(f"signature: {pattern}; this pattern matches {what}{alt}, which accounts for {share:.0%} "
+                     "of the mode shifts")
+        info["knob"] = {"path": path, "kind": kind, "factor": float(np.exp(a)), "share": share}
+    return lines, info
+
+
+def unexplained_report(lik, assembly, current, baseline, cons, final_error: float, floor: float,
+                       explained: bool, say=None) -> list[str]:
+    """The lines of the verdict when the data are not explained (see the module docstring).
+
+    Parameters
+    ----------
+    lik : Likelihood
+        The data.
+    assembly : Assembly
+        The model as given.
+    current : list of (Change, dict)
+        The best (partial) model's changes.
+    baseline : sequence of Comparison
+        The model as given against each measured FRF (its modes give the signature).
+    cons : Consistency
+        The test of the best model.
+    final_error : float
+        Its error.
+    floor : float
+        The noise floor.
+    explained : bool
+        The verdict.
+    say : callable, optional
+        Progress.
+
+    Returns
+    -------
+    list of str
+        The report, the verdict first.
+    """
+    lines = [f"unexplained: no candidate explains the data; the best model found leaves an error of "
+             f"{final_error:.4g}, {final_error / floor:.2g} times the noise floor ({floor:.4g}); "
+             f"chi^2/nu = {cons.chi2_reduced:.4g} where the noise allows {cons.threshold:.4g}"]
+    merged = []
+    for b in cons.bands:
+        label = lik.measured[b.item].label
+        for i, (lab, lo, hi, share) in enumerate(merged):
+            if lab == label and (b.lo_hz <= hi * 1.05 and b.hi_hz >= lo * 0.95):
+                merged[i] = (lab, min(lo, b.lo_hz), max(hi, b.hi_hz), share + b.share)
+                break
+        else:
+            merged.append((label, b.lo_hz, b.hi_hz, b.share))
+    merged.sort(key=lambda m: -m[3])
+    if merged:
+        lines.append("the remaining error lives in: " + "; ".join(
+            f"{lab} {lo:.0f}-{hi:.0f} Hz ({share:.0%})" for lab, lo, hi, share in merged[:5]))
+    elif cons.chi2_reduced > cons.threshold:
+        lines.append("the remaining error is spread over the band (no single band stands out)")
+    if current:
+        parts = []
+        for c, v in current:
+            vals = ", ".join(f"{s.name} = {v[s.name]:.4g} {s.unit}".replace(" dimensionless", "") for s in c.specs)
+            parts.append(f"{c.effect} at {c.place(v)} ({vals})")
+        lines.append("best partial explanation (partial): " + "; ".join(parts))
+    else:
+        lines.append("no candidate improves the model significantly")
+    try:  # the signature of the data against the model as given: what kind of change is missing
+        first = lik.measured[0]
+        sig_lines, _ = signature(model_of_measurement(assembly, first.measurement), first.frf, baseline[0].modes)
+        lines += sig_lines
+    except (SubstructureError, ValueError) as exc:
+        if say:
+            say(f"signature skipped: {exc}")
+    return lines
+
+
+def _measurement_points(assembly) -> list[str]:
+    points = []
+    for comp in _plain_beams(assembly):
+        L = comp.length_m
+        points += [f"{comp.name}.base", f"{comp.name}@{0.25 * L * 1e3:.4g} mm", f"{comp.name}@{0.5 * L * 1e3:.4g} mm",
+                   f"{comp.name}@{0.75 * L * 1e3:.4g} mm", f"{comp.name}.tip"]
+    return points
+
+
+def separation(assembly, measured, a, b, say=None) -> dict | None:
+    """The measurement that best tells two explanations apart.
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model as given.
+    measured : sequence of Measured
+        The data (the first one's configuration and excitation are used).
+    a, b : Found
+        The two explanations.
+    say : callable, optional
+        Progress.
+
+    Returns
+    -------
+    dict or None
+        ``response``, ``excitation``, ``non_contact`` (bool), ``chi2`` (the
+        difference of the two predictions relative to the noise, over the
+        band), ``text``; None when nothing can be computed.
+    """
+    first = measured[0]
+    f = first.frf.frequency
+    sub = f.hz[::4]
+    config = model_of_measurement(assembly, first.measurement)
+    v_typ = float(np.median(0.5 * (first.noise.var_re + first.noise.var_im)))
+    excitation = str(first.frf.inputs[0]).split(":")[0]
+    done = {(str(m.frf.outputs[0]).split(":")[0], str(m.frf.inputs[0]).split(":")[0]) for m in measured}
+    points = list(dict.fromkeys(_measurement_points(config) + [p for pair in done for p in pair]))
+    variants = [False] + ([True] if (a.change.test_only or b.change.test_only) else [])
+    best = None
+    for non_contact in variants:
+        models = []
+        for e in (a, b):
+            if non_contact and e.change.test_only:
+                models.append(config)
+            else:
+                try:
+                    models.append(e.apply(config))
+                except SubstructureError:
+                    models.append(config)
+        try:
+            ha = models[0].frf([p + ":y" for p in points], [p + ":y" for p in points], sub).data
+            hb = models[1].frf([p + ":y" for p in points], [p + ":y" for p in points], sub).data
+        except (SubstructureError, ValueError) as exc:
+            if say:
+                say(f"separating measurement skipped: {exc}")
+            return None
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r = np.log(ha / hb)
+        score = np.nansum(np.where(np.isfinite(r), np.abs(r) ** 2, 0.0), axis=0) / (2 * v_typ) * (f.n / sub.size)
+        for i, resp in enumerate(points):
+            for j, exc in enumerate(points):
+                if j != i and exc != excitation:
+                    continue
+                if (resp, exc) in done and not non_contact:
+                    continue
+                if non_contact and (resp, exc) not in done:  # the same test again, without the sensor
+                    continue
+                value = float(score[i, j])
+                if best is None or value > best[0]:
+                    best = (value, resp, exc, non_contact)
+    if best is None:
+        return None
+    value, resp, exc, non_contact = best
+    kind = "point FRF" if resp == exc else "cross FRF"
+    how = " with a non-contact sensor (laser vibrometer)" if non_contact else ""
+    if value <= INDIFFERENCE:
+        text = (f"no measurement at the ends, quarter points and middles of the components tells {a.name} at "
+                f"{a.where} from {b.name} at {b.where}: they are equivalent descriptions of these data")
+    else:
+        text = (f"measure the {kind} {resp} / {exc}{how}: {a.name} at {a.where} and {b.name} at {b.where} "
+                f"differ there by chi^2 = {value:.3g} over the band (above {INDIFFERENCE:g} tells them apart)")
+    return {"response": f"{resp}:y", "excitation": f"{exc}:y", "non_contact": non_contact, "chi2": value,
+            "text": text}

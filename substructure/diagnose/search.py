@@ -1,0 +1,555 @@
+"""The open-world search: candidates, cheap screening, full fits, forward selection.
+
+The candidates of one diagnosis are
+
+(a) every parameter of the model and the linked ones
+    (:func:`substructure.updating.parameters.model_parameters`), each a
+    ``model-parameter`` correction;
+(b) elements the model may lack, on every plain beam component, at a fitted
+    position: ``added-mass``, ``ground-spring``, ``section-change``
+    (:mod:`substructure.updating.elements`);
+(c) every registered effect of the catalogue at every place it proposes
+    (:mod:`substructure.diagnose.effects`).
+
+Each step of the forward selection screens every candidate on a subsample
+of the lines (every ``k``-th, about 250 per FRF): a coarse scan of its main
+parameter (with its position, for elements) and a short local fit with the
+effects already added held; then every candidate whose screened improvement
+is at least a quarter of the best one is fitted on all lines together with
+the effects already added (all refitted).  The best by BIC is added when it
+passes the significance test of :mod:`substructure.updating.selection`;
+the search stops when the model is consistent with the noise, when nothing
+passes, or after ``max_steps``.  Which candidates get full fits depends on
+each one's own screened improvement, never on a count, so a registered
+effect can only add a candidate, not push a built-in one out.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable, Sequence
+
+import attrs
+import numpy as np
+
+from ..errors import SubstructureError
+from ..updating.elements import AddedMass, GroundSpring, SectionChange
+from ..updating.fit import Fit, fit, from_u, to_u
+from ..updating.parameters import Change, ParameterChange, model_parameters
+from ..updating.structure import si_beam
+from ..updating.selection import INDIFFERENCE, bic, significance
+from .effects import EffectChange, effect_change
+
+__all__ = ["Scored", "candidates", "screen", "full_fits", "SCREEN_LINES", "SHORTLIST_SHARE"]
+
+SCREEN_LINES = 250
+"""Lines per FRF in the screening subsample (about)."""
+SHORTLIST_SHARE = 0.25
+"""A candidate gets a full fit when its screened improvement is at least this share of the best one."""
+
+
+def _plain(component) -> bool:
+    return si_beam(component)
+
+
+def candidates(assembly, measured_points: Sequence[str], effects: dict, open_world: bool = True,
+               shift: float = 0.0, progress: Callable | None = None) -> list[Change]:
+    """Every candidate change of a diagnosis (see the module docstring).
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model.
+    measured_points : sequence of str
+        The measured DOF labels (places of ``sensor-mass``).
+    effects : dict of str to type
+        The effects of the catalogue to consider.
+    open_world : bool
+        Include the model's parameters and the elements.
+    shift : float
+        Relative shift of the main mode (starting values of effects).
+    progress : callable, optional
+        Told about effects that cannot act at a place.
+
+    Returns
+    -------
+    list of Change
+        The candidates.
+    """
+    out: list[Change] = []
+    if open_world:
+        out += [ParameterChange(p) for p in model_parameters(assembly)]
+        for comp in assembly.components:
+            if not _plain(comp):
+                continue
+            out.append(AddedMass(comp.name, comp.length_m, max(2.0 * comp.mass(), 1e-3)))
+            out.append(GroundSpring(comp.name, comp.length_m))
+            out.append(SectionChange(comp.name, comp.length_m))
+    for name, cls in effects.items():
+        try:
+            places = cls.places(assembly, list(measured_points))
+        except SubstructureError as exc:
+            if progress:
+                progress(f"  {name}: no places ({exc})")
+            continue
+        for where in places:
+            try:
+                out.append(effect_change(cls, where, assembly, shift))
+            except (SubstructureError, ValueError) as exc:
+                if progress:
+                    progress(f"  skipped {name} at {where}: {exc}")
+    return out
+
+
+@attrs.frozen
+class Scored:
+    """A candidate after screening (and possibly a full fit).
+
+    Attributes
+    ----------
+    change : Change
+        The candidate.
+    values : dict
+        Its values (screened, or fitted on all lines).
+    chi2 : float
+        ``chi^2`` of the model with it (on the lines of the fit).
+    fit : Fit or None
+        The full fit (the effects already added refitted with it).
+    """
+
+    change: Change = attrs.field(eq=False)
+    values: dict = attrs.field(eq=False)
+    chi2: float
+    fit: Fit | None = attrs.field(default=None, eq=False)
+    start: list | None = attrs.field(default=None, eq=False)
+
+    @property
+    def k(self) -> int:
+        """Parameters the candidate adds."""
+        return len(self.change.specs)
+
+
+def _grid(spec, count: int) -> np.ndarray:
+    if spec.log:
+        return np.geomspace(spec.lower, spec.upper, count)
+    return np.linspace(spec.lower, spec.upper, count)
+
+
+def _places(change: Change) -> list[dict]:
+    """Where an element may sit, for screening: positions (and ranges) along its component."""
+    base = {s.name: s.start for s in change.specs}
+    if isinstance(change, SectionChange):
+        L = change.length
+        return [{**base, "start": float(start), "length": float(length)}
+                for length in (0.12 * L, 0.3 * L, 0.6 * L) for start in np.linspace(0.0, L - length, 5)]
+    position = next((s for s in change.specs if s.name == "position"), None)
+    if position is not None:
+        return [{**base, "position": float(x)} for x in np.linspace(position.lower, position.upper, 9)]
+    return [base]
+
+
+def _trials(change: Change) -> list[dict]:
+    """Starting points of the screening scan: the main parameter over its range (at each place), and
+    for effects of several log-scale parameters, all of them scaled together."""
+    main = change.specs[0]
+    count = 5 if len(_places(change)) > 1 else 9
+    values = list(_grid(main, count))
+    if main.nominal is not None:
+        values.append(float(np.clip(main.nominal, main.lower, main.upper)))
+    values.append(main.start)
+    values = list(dict.fromkeys(float(v) for v in values))
+    if isinstance(change, SectionChange):
+        values = [0.7, 0.85, 1.2]
+    out = [{**place, main.name: v} for place in _places(change) for v in values]
+    logs = [s for s in change.specs if s.log]
+    if len(logs) >= 2 and len(_places(change)) == 1:  # all log parameters scaled together too
+        for factor in np.geomspace(0.01, 100.0, 9):
+            trial = dict(_places(change)[0])
+            for spec in logs:
+                trial[spec.name] = float(np.clip(spec.start * factor, spec.lower, spec.upper))
+            out.append(trial)
+    return out
+
+
+def _places(change: Change) -> list[dict]:
+    """Where an element may sit, for screening: positions (and ranges) along its component."""
+    base = {s.name: s.start for s in change.specs}
+    if isinstance(change, SectionChange):
+        L = change.length
+        return [{**base, "start": float(start), "length": float(length)}
+                for length in (0.12 * L, 0.3 * L, 0.6 * L) for start in np.linspace(0.0, L - length, 5)]
+    position = next((s for s in change.specs if s.name == "position"), None)
+    if position is not None:
+        return [{**base, "position": float(x)} for x in np.linspace(position.lower, position.upper, 9)]
+    return [base]
+
+
+def _trials(change: Change) -> list[dict]:
+    """Starting points of the screening scan: the main parameter over its range (at each place), and
+    for effects of several log-scale parameters, all of them scaled together."""
+    main = change.specs[0]
+    count = 5 if len(_places(change)) > 1 else 9
+    values = list(_grid(main, count))
+    if main.nominal is not None:
+        values.append(float(np.clip(main.nominal, main.lower, main.upper)))
+    values.append(main.start)
+    values = list(dict.fromkeys(float(v) for v in values))
+    if isinstance(change, SectionChange):
+        values = [0.7, 0.85, 1.2]
+    out = [{**place, main.name: v} for place in _places(change) for v in values]
+    logs = [s for s in change.specs if s.log]
+    if len(logs) >= 2 and len(_places(change)) == 1:  # all log parameters scaled together too
+        for factor in np.geomspace(0.01, 100.0, 9):
+            trial = dict(_places(change)[0])
+            for spec in logs:
+                trial[spec.name] = float(np.clip(spec.start * factor, spec.lower, spec.upper))
+            out.append(trial)
+    return out
+
+
+def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2_now: float,
+           progress: Callable | None = None) -> list[Scored]:
+    """Screen candidates on a (subsampled) likelihood: scan, then a short local fit.
+
+    Parameters
+    ----------
+    likelihood : Likelihood
+        Usually a subsample of the lines.
+    current : sequence of (Change, dict)
+        The effects already added, held at their values.
+    changes : sequence of Change
+        The candidates.
+    chi2_now : float
+        ``chi^2`` of the current model on these lines.
+    progress : callable, optional
+        Progress lines.
+
+    Returns
+    -------
+    list of Scored
+        Every candidate that could be evaluated, best first.
+    """
+    out = []
+    for n, change in enumerate(changes, start=1):
+        if progress and (n % 20 == 0 or n == len(changes)):
+            progress(f"screened {n}/{len(changes)} candidates")
+        best_chi2, best = math.inf, None
+        try:
+            for trial in _trials(change):
+                chi2 = likelihood.chi2(list(current) + [(change, trial)])
+                if chi2 < best_chi2:
+                    best_chi2, best = chi2, trial
+            if best is None or not best_chi2 < chi2_now:
+                continue
+            p = len(change.specs) + sum(len(c.specs) for c, _ in current)
+            local = fit(likelihood, list(current) + [(change, best)], max_nfev=6 * (p + 1))
+        except (SubstructureError, ValueError, FloatingPointError) as exc:
+            if progress:
+                progress(f"  skipped {change.effect} at {change.where}: {exc}")
+            continue
+        moved = list(current)
+        if local.chi2 < best_chi2:
+            best_chi2, best = local.chi2, local.changes[-1][1]
+            moved = [(c, dict(v)) for c, v in local.changes[:-1]]
+        out.append(Scored(change, dict(best), float(best_chi2), start=moved))
+    out.sort(key=lambda s: s.chi2)
+    return out
+
+
+def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2_now: float, n_full: int,
+           progress: Callable | None = None, extra: dict | None = None) -> list[Scored]:
+    """Screen candidates on a subsample: a scan with the changes already added held, then local fits.
+
+    Every candidate's main parameter is scanned over its range (at each
+    place, for elements); the changes already added are refitted to first
+    order at every trial (the residual is projected out of the span of
+    their Jacobian, computed once), since their values may compensate for
+    the candidate.  The candidates that pass :func:`shortlist` get a short
+    local fit on the subsample with the current changes refitted too; their
+    values (and the current changes' moved values) start the full fits.
+
+    Parameters
+    ----------
+    likelihood : Likelihood
+        Usually a subsample of the lines.
+    current : sequence of (Change, dict)
+        The changes already added.
+    changes : sequence of Change
+        The candidates.
+    chi2_now : float
+        ``chi^2`` of the current model on these lines.
+    n_full : int
+        Residuals of the full data (to scale improvements for the tests).
+    progress : callable, optional
+        Progress lines.
+    extra : dict, optional
+        More trials per candidate key (from :func:`substructure.diagnose.modes.mode_starts`).
+
+    Returns
+    -------
+    list of Scored
+        The candidates that improve the model, best first (local fits first).
+    """
+    basis = _basis(likelihood, current)
+
+    def chi2_of(changes_now) -> float:
+        w = likelihood.residual(changes_now)
+        if basis is not None:  # the changes already added, refitted to first order
+            w = w - basis @ (basis.T @ w)
+        return float(w @ w)
+
+    scanned = []
+    for n, change in enumerate(changes, start=1):
+        if progress and (n % 25 == 0 or n == len(changes)):
+            progress(f"scanned {n}/{len(changes)} candidates")
+        best_chi2, best = math.inf, None
+        try:
+            for trial in _trials(change) + list((extra or {}).get(change.key, ())):
+                chi2 = chi2_of(list(current) + [(change, trial)])
+                if chi2 < best_chi2:
+                    best_chi2, best = chi2, trial
+        except (SubstructureError, ValueError, FloatingPointError) as exc:
+            if progress:
+                progress(f"  skipped {change.effect} at {change.where}: {exc}")
+            continue
+        if best is not None and best_chi2 < chi2_now:
+            scanned.append(Scored(change, dict(best), float(best_chi2), start=list(current)))
+    scanned.sort(key=lambda s: s.chi2)
+    local = []
+    p_now = sum(len(c.specs) for c, _ in current)
+    for s in shortlist(scanned, chi2_now, likelihood.n, n_full, p_now):
+        try:
+            result = fit(likelihood, list(current) + [(s.change, s.values)], max_nfev=5 * (p_now + s.k + 1))
+        except (SubstructureError, ValueError, FloatingPointError):
+            continue
+        if result.chi2 < s.chi2:
+            s = Scored(s.change, dict(result.changes[-1][1]), float(result.chi2),
+                       start=[(c, dict(v)) for c, v in result.changes[:-1]])
+        local.append(s)
+    local.sort(key=lambda s: s.chi2)
+    done = {s.change.key for s in local}
+    return [s for s in local + [s for s in scanned if s.change.key not in done] if s.chi2 < chi2_now]
+
+
+def _basis(likelihood, current) -> np.ndarray | None:
+    """An orthonormal basis of the Jacobian of the changes already added (None without any)."""
+    if not current:
+        return None
+    w0 = likelihood.residual(current)
+    cols = []
+    for i, (c, v) in enumerate(current):
+        for spec in c.specs:
+            u = to_u(spec, v[spec.name])
+            h = 1e-4 * max(1.0, abs(u))
+            moved = [(x, dict(y)) for x, y in current]
+            moved[i][1][spec.name] = from_u(spec, u + h)
+            if moved[i][1][spec.name] == v[spec.name]:
+                moved[i][1][spec.name] = from_u(spec, u - h)
+            cols.append(likelihood.residual(moved) - w0)
+    q, r = np.linalg.qr(np.array(cols).T)
+    keep = np.abs(np.diag(r)) > 1e-12 * max(np.abs(np.diag(r)).max(), 1e-300)
+    return q[:, keep]
+
+
+SHORTLIST_MAX = 6
+"""Most candidates of one kind (built-in, or registered by users) fitted further in one step."""
+
+
+def shortlist(scored: Sequence[Scored], chi2_now: float, n_lines: int, n_full: int, p_now: int) -> list[Scored]:
+    """The screened candidates worth fitting further.
+
+    A candidate qualifies when its improvement is at least
+    :data:`SHORTLIST_SHARE` of the best one and, less the ``k`` that fitting
+    its ``k`` parameters to noise gains and scaled to all lines, could pass
+    the significance test; of those, at most :data:`SHORTLIST_MAX` of
+    the built-in candidates and as many of users' registered effects (so
+    that registering effects never pushes a built-in candidate out).
+
+    Parameters
+    ----------
+    scored : sequence of Scored
+        Screened candidates, best first.
+    chi2_now : float
+        ``chi^2`` of the current model on the screening lines.
+    n_lines : int
+        Residuals on the screening lines.
+    n_full : int
+        Residuals on all lines.
+    p_now : int
+        Parameters of the current model.
+
+    Returns
+    -------
+    list of Scored
+        The candidates to fit further, best first.
+    """
+    if not scored:
+        return []
+    scale = n_full / max(n_lines, 1)
+    gain = chi2_now - scored[0].chi2
+    out, counts = [], {True: 0, False: 0}
+    for s in _ties_by_preference(scored):
+        own = chi2_now - s.chi2
+        if own < SHORTLIST_SHARE * gain:
+            continue
+        # scaled to all lines, less what fitting k parameters to noise gains on the subsample
+        if not significance((chi2_now - s.k) * scale, s.chi2 * scale, s.k, n_full, p_now + s.k).significant:
+            continue
+        user = not _builtin(s.change)
+        if counts[user] >= SHORTLIST_MAX:
+            continue
+        counts[user] += 1
+        out.append(s)
+    return out
+
+
+def _ties_by_preference(scored: Sequence[Scored]) -> list[Scored]:
+    """Best first; candidates that screened alike (within one unit of chi^2) in order of preference."""
+    ordered = sorted(scored, key=lambda s: s.chi2)
+    out, i = [], 0
+    while i < len(ordered):
+        j = i + 1
+        while j < len(ordered) and ordered[j].chi2 - ordered[i].chi2 <= 1.0:
+            j += 1
+        out += sorted(ordered[i:j], key=lambda s: (preference(s.change), s.chi2))
+        i = j
+    return out
+
+
+def _builtin(change: Change) -> bool:
+    if isinstance(change, EffectChange):
+        return change.cls.__module__ == __name__.rsplit(".", 1)[0] + ".effects"
+    return True
+
+
+def full_fits(likelihood, current: Sequence[tuple], chosen: Sequence[Scored],
+              progress: Callable | None = None) -> list[Scored]:
+    """Fit each chosen candidate on all lines with the effects already added refitted.
+
+    Parameters
+    ----------
+    likelihood : Likelihood
+        All lines.
+    current : sequence of (Change, dict)
+        The effects already added (refitted with each candidate).
+    chosen : sequence of Scored
+        Candidates with their screened values as the start.
+    progress : callable, optional
+        Progress lines.
+
+    Returns
+    -------
+    list of Scored
+        With ``fit`` set, best ``chi^2`` first.
+    """
+    out = []
+    for s in chosen:
+        if progress:
+            progress(f"fitting {s.change.effect} at {s.change.where} with {len(current)} effect(s) added")
+        try:
+            result = fit(likelihood, list(s.start if s.start is not None else current) + [(s.change, s.values)])
+        except (SubstructureError, ValueError, FloatingPointError) as exc:
+            if progress:
+                progress(f"  skipped {s.change.effect} at {s.change.where}: {exc}")
+            continue
+        out.append(Scored(s.change, dict(result.changes[-1][1]), result.chi2, result))
+    out.sort(key=lambda s: s.chi2)
+    return out
+
+
+def rank(fitted: Sequence[Scored], n: int, p_now: int) -> list[Scored]:
+    """Candidates ordered by BIC (``chi^2`` plus ``k ln n``), best first.
+
+    Parameters
+    ----------
+    fitted : sequence of Scored
+        Fully fitted candidates.
+    n : int
+        Number of residuals.
+    p_now : int
+        Parameters of the model without the candidate.
+
+    Returns
+    -------
+    list of Scored
+        Best first.
+    """
+    return sorted(fitted, key=lambda s: bic(s.chi2, p_now + s.k, n))
+
+
+def preference(change: Change) -> int:
+    """Which of explanations the data cannot tell apart is reported first (lower first).
+
+    0: an effect of the catalogue (a named physical effect); 1: a linked
+    model parameter (an overhang, a component's material, a joint's whole
+    stiffness); 2: a single model parameter; 3: an element at a fitted place.
+
+    Parameters
+    ----------
+    change : Change
+        The candidate.
+
+    Returns
+    -------
+    int
+        Its class.
+    """
+    if isinstance(change, EffectChange):
+        return 0
+    if isinstance(change, ParameterChange):
+        return 1 if change.parameter.linked else 2
+    return 3
+
+
+def choose(ranked: Sequence[Scored], n: int, p_now: int) -> tuple[Scored, list[Scored], float]:
+    """The explanation to add among fitted candidates, and those indifferent to it.
+
+    The best by BIC sets the misfit scale ``s^2``; every candidate whose
+    ``chi^2`` is within :data:`~substructure.updating.selection.INDIFFERENCE`
+    of it (scaled) is indifferent; among those the one of lowest
+    :func:`preference`, then lowest BIC, is chosen.
+
+    Parameters
+    ----------
+    ranked : sequence of Scored
+        Fully fitted candidates, best BIC first.
+    n : int
+        Number of residuals.
+    p_now : int
+        Parameters of the current model.
+
+    Returns
+    -------
+    (Scored, list of Scored, float)
+        The choice, the others inside the indifference region, and ``s^2``.
+    """
+    best = ranked[0]
+    s2 = max(1.0, best.chi2 / max(n - p_now - best.k, 1))
+    inside = [s for s in ranked if abs(s.chi2 - best.chi2) / s2 <= INDIFFERENCE]
+    chosen = min(inside, key=lambda s: (preference(s.change), bic(s.chi2, p_now + s.k, n, s2)))
+    return chosen, [s for s in inside if s is not chosen], s2
+
+
+def physical(change: Change, values: dict) -> bool:
+    """A fitted candidate is physical: its values finite and inside their physical bounds.
+
+    Parameters
+    ----------
+    change : Change
+        The candidate.
+    values : dict
+        Its fitted values.
+
+    Returns
+    -------
+    bool
+        Whether every value is allowed.
+    """
+    for spec in change.specs:
+        v = values.get(spec.name)
+        if v is None or not np.isfinite(v) or v < spec.lower - 1e-12 * abs(spec.lower) or v > spec.upper * (1 + 1e-12) + 1e-300:
+            return False
+    return True
+
+
+__all__ += ["shortlist", "rank", "physical", "preference", "choose"]
