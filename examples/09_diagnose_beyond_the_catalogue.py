@@ -1,6 +1,6 @@
 """
-Diagnose beyond the catalogue: an effect nobody listed, an honest verdict, then your own effect
-=============================================================================================
+Diagnose beyond the catalogue: an effect nobody listed, an honest verdict, your own effect
+========================================================================================
 
 The catalogue of effects (a sensor, a joint's stiffness or damping, flutes,
 suspension springs, ...) does not know every way a model can be wrong. Here
@@ -12,8 +12,9 @@ lacks. We diagnose it three ways:
     change has that signature;
 (b) in the open world: every number of the model and bodies, springs and
     section changes at fitted positions are candidates; an ``added-mass`` on
-    the holder explains the data, with its mass, rotary inertia and position
-    and their standard deviations;
+    the holder (a rigid body coupled to the structure, the structural
+    modification of thesis eq. 5.1-5.3, at a fitted place) explains the data,
+    with its mass, rotary inertia and position and their standard deviations;
 (c) with an effect of our own, a clamping nut whose inertia follows from
     its mass and size (one parameter instead of three), passed to
     ``diagnose`` without registering it: the error falls to the noise floor

@@ -83,10 +83,12 @@ def test_an_empty_effect_list_a_band_half_outside_and_a_dead_channel_say_what_is
     err = capsys.readouterr().err
     assert "ends at 9000 Hz, above the last measured line" in err and "outside the data" not in err
     dead = tmp_path / "dead"
-    frf = hd.measure(sensor_kg=0.002, seed=3)[0]
-    zero = type(frf)(frf.frequency, 0 * frf.data, frf.outputs, frf.inputs)
-    write_measurement_set(MeasurementSet("dead", (Measurement.from_frf(zero, "tool.tip", "tool.tip"),)), dead)
+    dead.mkdir()
+    (dead / "measurements.toml").write_text((files / "measurements.toml").read_text())
+    rows = (files / "00_tool_tip__tool_tip.csv").read_text().splitlines()
+    zeros = [rows[0]] + [f"{row.split(',')[0]},0,0" for row in rows[1:]]
+    (dead / "00_tool_tip__tool_tip.csv").write_text("\n".join(zeros) + "\n")
     assert main(["diagnose", str(files / "model.toml"), str(dead / "measurements.toml"), "--quiet", "--json"]) == 1
     captured = capsys.readouterr()
-    assert "tool.tip:y / tool.tip:y" in captured.err and "dead channel" in captured.err
+    assert "00_tool_tip__tool_tip.csv" in captured.err and "dead channel" in captured.err
     assert captured.out == "" and "Traceback" not in captured.err
