@@ -1,6 +1,6 @@
 """
 Diagnose beyond the catalogue: an effect nobody listed, an honest verdict, your own effect
-========================================================================================
+==========================================================================================
 
 The catalogue of effects (a sensor, a joint's stiffness or damping, flutes,
 suspension springs, ...) does not know every way a model can be wrong. Here
