@@ -204,7 +204,8 @@ def _peaks(frf: FRF, floor: float, prominence: float) -> tuple[np.ndarray, np.nd
     return f[idx], h[idx]
 
 
-def pair_modes(model: FRF, measured: FRF, floor: float = 0.02, window: int | None = None) -> list[ModePair]:
+def pair_modes(model: FRF, measured: FRF, floor: float = 0.02, window: int | None = None,
+               noise: float | None = None) -> list[ModePair]:
     """Pair each measured resonance with the nearest model resonance (in log frequency).
 
     Measured peaks are taken on the smoothed data (so that noise ripples are
@@ -222,6 +223,8 @@ def pair_modes(model: FRF, measured: FRF, floor: float = 0.02, window: int | Non
         Peaks below this share of the highest are left out.
     window : int, optional
         Smoothing window [lines].
+    noise : float, optional
+        The measurement's noise floor when known (estimated from it otherwise).
 
     Returns
     -------
@@ -232,7 +235,7 @@ def pair_modes(model: FRF, measured: FRF, floor: float = 0.02, window: int | Non
     w = window or _window(measured)
     # a mode must stand out of the noise: a prominence of 0.1 in ln|H| (10 %) or
     # five times the noise floor, whichever is larger
-    prominence = max(0.1, 5.0 * noise_floor(measured, window=w))
+    prominence = max(0.1, 5.0 * (noise_floor(measured, window=w) if noise is None else noise))
     fm, hm = _peaks(smooth(measured, window=w), floor, prominence)
     fo, ho = _peaks(model, floor, 0.1)
     candidates = sorted(
@@ -383,6 +386,6 @@ def compare(model: FRF, measured: FRF) -> Comparison:
         error=error(model, measured),
         noise_floor=floor,
         frac=frac(model, measured),
-        modes=pair_modes(model, measured),
+        modes=pair_modes(model, measured, noise=floor),
         bands=error_bands(model, measured, floor=floor),
     )

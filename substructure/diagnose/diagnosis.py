@@ -431,7 +431,8 @@ def _comparisons(lik: Likelihood, ratios, floors) -> tuple[Comparison, ...]:
         model = FRF(measured.frequency, (measured.data[:, 0, 0] * np.exp(r))[:, None, None], measured.outputs,
                     measured.inputs)
         out.append(Comparison(model=model, measured=measured, error=float(np.sqrt(np.mean(np.abs(r) ** 2))),
-                              noise_floor=floor, frac=frac(model, measured), modes=pair_modes(model, measured),
+                              noise_floor=floor, frac=frac(model, measured),
+                              modes=pair_modes(model, measured, noise=floor),
                               bands=error_bands(model, measured, floor=floor)))
     return tuple(out)
 

@@ -108,7 +108,7 @@ def mode_starts(lik0, current, changes, places) -> dict:
     except SubstructureError:
         return {}
     model = FRF(measured.frequency, base[:, None, None], measured.outputs, measured.inputs)
-    pairs = [p for p in pair_modes(model, measured) if p.model_hz is not None]
+    pairs = [p for p in pair_modes(model, measured, noise=lik0.measured[0].noise.floor) if p.model_hz is not None]
     f0 = np.array([peak_near(f, base, p.model_hz, 0.02) or p.model_hz for p in pairs])
     if f0.size == 0:
         return {}

@@ -197,7 +197,7 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3)
 
     def solve(start, keep, nu=None):
         res = minimize(_nll, start, args=(q_re2[keep], q_im2[keep], g[keep], h0, nu), jac=True, method="L-BFGS-B",
-                       bounds=bounds)
+                       bounds=bounds, options={"maxiter": 80, "ftol": 1e-10})  # a negligible b is flat: stop
         return res.fun, res.x
 
     # a robust first fit (Student t, 4 dof: lines where the smoother cannot follow a very
