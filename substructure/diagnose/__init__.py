@@ -5,9 +5,13 @@
   from the data;
 * :mod:`~substructure.diagnose.effects`: the catalogue of physical effects
   (registered by name; users add their own);
-* :mod:`~substructure.diagnose.diagnosis`: fitting every effect at every
-  place, ranking, deciding, and the greedy refinement whose history shows the
-  error fall.
+* :mod:`~substructure.diagnose.diagnosis`: :func:`diagnose`, on the
+  model-updating core (:mod:`substructure.updating`): the candidates of the
+  open world (``search``: every model parameter, bodies, springs and section
+  changes at fitted positions, the catalogue; screening, full fits), starting
+  values from mode shifts (``modes``), the refinement by significance with
+  elimination and review (``refine``), and the verdict, the signature and the
+  separating measurement (``report``).
 """
 
 from .compare import METRIC, Comparison, compare, error, frac, noise_floor, pair_modes
