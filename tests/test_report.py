@@ -327,6 +327,15 @@ def test_report_checks_its_inputs(model):
         report(attrs.evolve(model, frequency=None))
     with pytest.raises(ValueError, match="two|tool components"):
         report(model.without("tool"))
+    with pytest.raises(ValueError, match="MeasurementSet"):
+        report(model, measurements=list(_taps(model)))
+    with pytest.raises(ValueError, match="MillingCut"):
+        report(model, cut="3 mm slot")
+    with pytest.raises(ValueError, match="rigid"):
+        report(model.connect("holder.tip", "tool@1 mm", name="glued"), _taps(model), identify=["glued"])
+    stranger = MeasurementSet("t", tuple(attrs.evolve(m, sensors=("nope",)) for m in _taps(model)))
+    with pytest.raises(ValueError, match="no sensor 'nope'"):
+        report(model, stranger)
     assert isinstance(report(model, at="holder.tip"), Report)
 
 

@@ -417,7 +417,9 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
     import substructure
 
     from ..assembly import Assembly
-    from ..stability import MachineLimits, assembly_structure, choose_band, recommend, spindle_speeds
+    from ..measurements import MeasurementSet
+    from ..stability import (MachineLimits, MillingCut, TurningCut, assembly_structure, choose_band, recommend,
+                             spindle_speeds)
 
     if progress is True:
         import sys
@@ -426,18 +428,26 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
             print(f"report: {text}", file=sys.stderr, flush=True)
     say = progress if callable(progress) else (lambda text: None)
     sources: list[tuple[str, str]] = []
-    if not isinstance(assembly, Assembly):
+    if isinstance(assembly, (str, os.PathLike)):
         from ..io.assembly_toml import load_assembly
 
         sources.append(("assembly", os.fspath(assembly)))
         assembly = load_assembly(assembly)
-    if measurements is not None and not hasattr(measurements, "validate"):
+    elif not isinstance(assembly, Assembly):
+        raise InvalidValueError(f"assembly: got {type(assembly).__name__}; expected an Assembly or the path of an "
+                                "assembly file")
+    if isinstance(measurements, (str, os.PathLike)):
         from ..io.measurements import load_measurements
 
         sources.append(("measurements", os.fspath(measurements)))
         measurements = load_measurements(measurements)
+    elif measurements is not None and not isinstance(measurements, MeasurementSet):
+        raise InvalidValueError(f"measurements: got {type(measurements).__name__}; expected a MeasurementSet or "
+                                "the path of a measurement file")
     if method not in ("zoa", "sdm"):
         raise InvalidValueError(f"method: got {method!r}; expected 'zoa' or 'sdm'")
+    if cut is not None and not isinstance(cut, (MillingCut, TurningCut)):
+        raise InvalidValueError(f"cut: got {type(cut).__name__}; expected a MillingCut or a TurningCut")
     if intervals is not None and method != "sdm":
         raise InvalidValueError("intervals: they set the semi-discretization; use them with method='sdm'")
     margin = _fraction(margin, "margin", 1.0)
@@ -447,6 +457,8 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
                                 "report computes the tool point receptance on it")
     at = tool_point(assembly, at)
     joints = _joints_to_identify(assembly, identify) if measurements is not None else []
+    if measurements is not None:
+        measurements.validate(assembly)  # every point, sensor and component it names: before any work
     notes = list(notes)
     say(f"tool point receptance at {at}")
     frf = assembly.receptance(at, frequency=assembly.frequency)

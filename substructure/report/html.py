@@ -227,9 +227,18 @@ def _model(report: Any) -> str:
              fixed(m.loss_factor, ".3g")] for m in materials.values()]
     out.append("<h3>Materials</h3>" + table(["Material", "Young's modulus E (GPa)", "Poisson's ratio",
                                               "Density (kg/m³)", "Loss factor"], rows))
-    rows = [[esc(j.name), esc(f"{j.between[0]} – {j.between[1]}"), "rigid" if getattr(j, "rigid", False)
-             else '<a href="#joints">elastic: values below</a>'] for j in a.joints]
-    out.append("<h3>Joints</h3>" + (table(["Joint", "Connects", "Kind"], rows) if rows else "<p>None.</p>"))
+    rows = []
+    for j in a.joints:
+        if getattr(j, "rigid", False) or not hasattr(j, "k"):
+            rows.append([esc(j.name), esc(f"{j.between[0]} – {j.between[1]}"), "rigid", "–"])
+            continue
+        rows.append([esc(j.name), esc(f"{j.between[0]} – {j.between[1]}"),
+                     "<br />".join(f"{tech('k_' + e)} {sci(j.k.get(e), 4)} {_K_UNITS[e]}" for e, _ in j.k.entries),
+                     "<br />".join(f"{tech('c_' + e)} {sci(j.c.get(e), 4)} {_C_UNITS[e]}" for e, _ in j.c.entries)
+                     or "none"])
+    out.append("<h3>Joints</h3>" + (table(["Joint", "Connects", "Stiffness", "Damping"], rows)
+                                    + note('Their uncertainty: <a href="#joints">the joints</a>.')
+                                    if rows else "<p>None.</p>"))
     if a.supports:
         rows = [[esc(s.name or "–"), esc(s.at),
                  ", ".join(f"{tech('k_' + e)} {sci(s.k.get(e))} {_K_UNITS[e]}" for e, _ in s.k.entries) or "–",
