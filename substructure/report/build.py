@@ -70,7 +70,7 @@ class ToolMode:
         return attrs.asdict(self)
 
 
-@attrs.frozen
+@attrs.frozen(eq=False)  # a container of results: compared by identity, never hashed by its arrays
 class Report:
     """What :func:`report` computed: the model, its tool point FRF, the diagnosis, the lobes, the joints.
 
