@@ -111,6 +111,7 @@ PRESSURES = ["600 MPa", "-1 MPa", "x", "600", "1e400 MPa", "600 m"]
 SPEEDS = ["2000:24000:500", "-2000:24000:50", "a:b:c", "100 Hz:300 Hz:1 Hz", "24000:2000:50", "2000:2000:1"]
 OUTPUT_NAMES = ["new.csv", "new.uff", "new.png", "new.pdf", "existing.csv", "existing.png", ".", "bad.xyz",
                 "noext", "missing_dir/x.csv"]
+REPORT_NAMES = ["new.html", "existing.html", "new.htm", ".", "new.csv", "noext", "missing_dir/x.html"]
 
 flag = st.booleans()
 
@@ -123,7 +124,7 @@ def pick(values):
 @st.composite
 def invocation(draw):
     """(argv with {pool}/{out} placeholders, the pool files this call reads)."""
-    command = draw(st.sampled_from(["frf", "identify", "diagnose", "lobes", "predict", "demo"]))
+    command = draw(st.sampled_from(["frf", "identify", "diagnose", "lobes", "predict", "report", "demo"]))
     argv, inputs = [command], []
 
     def pool_file(choices):
@@ -131,8 +132,8 @@ def invocation(draw):
         inputs.append(name)
         return f"{{pool}}/{name}"
 
-    def output(option):
-        choice = draw(st.one_of(pick(OUTPUT_NAMES), st.just("INPUT")))
+    def output(option, names=OUTPUT_NAMES):
+        choice = draw(st.one_of(pick(names), st.just("INPUT")))
         if choice == "INPUT" and inputs:
             return [option, f"{{pool}}/{draw(pick(inputs))}"]
         return [option, f"{{out}}/{choice if choice != 'INPUT' else 'new.csv'}"]
@@ -189,6 +190,25 @@ def invocation(draw):
                                               "tool_diameter=14 mm,gauge_length=100 mm"]))]
         if draw(flag):
             argv += output("--plot")
+    elif command == "report":
+        argv += [pool_file(ASSEMBLIES)]
+        if draw(flag):
+            argv += [pool_file(MEASUREMENTS), "--identify", draw(pick(["auto", "none", "nope", "holder-tool,x"]))]
+        argv += ["--quiet"] + output("--out", REPORT_NAMES)
+        if draw(flag):
+            argv += ["--radial-depth", draw(pick(QUANTITIES)), "--kt", draw(pick(PRESSURES)),
+                     "--kr", draw(pick(["0.3", "-0.3", "x"]))]
+            if draw(flag):
+                argv += ["--speeds=" + draw(pick(SPEEDS))]
+            if draw(flag):
+                argv += ["--max-speed", draw(pick(NUMBERS)), "--feed-per-tooth", draw(pick(QUANTITIES)),
+                         "--power", draw(pick(["5 kW", "-5 kW", "5"]))]
+        elif draw(flag):
+            argv += ["--max-depth", draw(pick(QUANTITIES))]  # machine options without a cut: refused
+        if draw(flag):
+            argv += ["--at", draw(pick(POINTS))]
+        if draw(flag):
+            argv += ["--band=" + draw(pick(BANDS))]
     else:  # demo: only where it must refuse before any work (a full run is tested elsewhere)
         argv += ["--out", draw(pick(["{out}", "{out}/existing.csv"]))]
     if command != "demo" and draw(flag):  # (demo --overwrite would run the whole demo: tested elsewhere)
@@ -207,7 +227,7 @@ counter = itertools.count()
 def test_no_command_line_ends_in_a_traceback_bad_json_or_a_changed_input(pool, tmp_path_factory, case, capsys):
     argv, _ = case
     out_dir = tmp_path_factory.mktemp(f"out{next(counter)}")
-    for name in ("existing.csv", "existing.png", "default_assembly.toml"):  # a user's files
+    for name in ("existing.csv", "existing.png", "existing.html", "default_assembly.toml"):  # a user's files
         (out_dir / name).write_bytes(b"a user's file\n")
     before, before_out = digest(pool), digest(out_dir)
     args = [a.replace("{pool}", str(pool)).replace("{out}", str(out_dir)) for a in argv]

@@ -1,10 +1,12 @@
 """The ``substructure`` command: the library's workflows without writing code.
 
 Each subcommand is a module of this package (``frf_command``, ``identify_command``,
-``diagnose_command``, ``lobes_command``, ``predict_command``, ``demo_command``) with
-``add_parser(commands)`` and ``run(args)``; the modules import the heavy parts of
-the library only when their command runs, so that a one-shot command loads what
-it needs and nothing more.  The options and JSON outputs are documented in
+``diagnose_command``, ``lobes_command``, ``predict_command``, ``report_command``,
+``demo_command``) with ``add_parser(commands)`` and ``run(args)``; the modules
+import the heavy parts of the library only when their command runs, so that a
+one-shot command loads what it needs and nothing more.  Options that several
+commands share live in ``_common`` (all of them) and ``_cutting`` (the cut, the
+machine and the lobes: ``lobes`` and ``report``).  The options and JSON outputs are documented in
 docs/cli.md and docs/file-formats.md.
 
 Every subcommand prints a human summary, or with ``--json`` exactly one strict
@@ -30,7 +32,7 @@ from ._common import EXIT_ERROR, EXIT_INTERNAL, EXIT_INTERRUPTED, EXIT_USAGE, PR
 
 __all__ = ["main", "DEMO_STEPS", "DemoState", "COMMANDS"]
 
-COMMANDS = ("frf", "identify", "diagnose", "lobes", "predict", "demo")
+COMMANDS = ("frf", "identify", "diagnose", "lobes", "predict", "report", "demo")
 """The subcommands, in the order of ``substructure --help``; each is the module ``<name>_command``."""
 
 
@@ -111,6 +113,7 @@ def main(argv: list[str] | None = None) -> int:
         try:
             _load_plugins()
             args = _parser().parse_args(argv)
+            args.argv = list(sys.argv[1:] if argv is None else argv)  # the command line, for reports
             if args.command is None:
                 raise UsageError(f"choose a command: {', '.join(COMMANDS)} (see substructure --help)")
             return args.run(args)

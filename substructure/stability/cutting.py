@@ -501,6 +501,21 @@ class MillingCut:
             text += f", workpiece {self.workpiece.name}"
         return text
 
+    def to_json(self) -> dict:
+        """The ``cut`` object of ``substructure lobes --json`` (SI units).
+
+        Returns
+        -------
+        dict
+            ``teeth``, ``diameter_m``, ``radial_depth_m``, ``milling``, ``kt_pa``,
+            ``kn_pa`` and ``feed_per_tooth_m`` (None when not given).
+        """
+        feed = self.feed_per_tooth
+        return {"teeth": self.teeth, "diameter_m": float(self.diameter.m_as("m")),
+                "radial_depth_m": float(self.radial_depth.m_as("m")), "milling": self.milling,
+                "kt_pa": self.kt_pa, "kn_pa": self.kn_pa,
+                "feed_per_tooth_m": None if feed is None else float(feed.m_as("m"))}
+
     # -- what the methods use -----------------------------------------------------
     def force_matrix(self, theta: Any) -> np.ndarray:
         """Instantaneous ``K(theta)`` in N/m^2 at angles ``theta`` of tooth 0, shape ``(..., 2, 2)``.
