@@ -58,6 +58,46 @@ __all__ = [
 ]
 
 
+class _PintWithoutDask:
+    """Import pint, once, without letting it import Dask.
+
+    pint imports ``dask.base`` (about 0.1 s) whenever Dask is installed, for
+    quantities that wrap Dask arrays, which this package never makes; with
+    the ``study`` extra installed (``substructure study`` runs on Dask) that
+    would slow every command.  This finder, first on ``sys.meta_path`` until
+    pint is imported, runs pint's import with ``sys.modules["dask"] = None``,
+    which ``importlib.util.find_spec`` reads as "not installed"; afterwards
+    Dask imports as usual.  When Dask was imported before pint (a notebook
+    with a Dask client), nothing is changed.
+    """
+
+    def find_spec(self, fullname, path=None, target=None):
+        if fullname != "pint":
+            return None
+        sys.meta_path[:] = [f for f in sys.meta_path if f is not self]
+        spec = importlib.util.find_spec(fullname)
+        if spec is None or spec.loader is None or "dask" in sys.modules or not hasattr(spec.loader, "exec_module"):
+            return spec
+        run = spec.loader.exec_module
+
+        def exec_module(module):
+            sys.modules["dask"] = None
+            try:
+                run(module)
+            finally:
+                if "dask" in sys.modules and sys.modules["dask"] is None:
+                    del sys.modules["dask"]
+
+        spec.loader.exec_module = exec_module
+        return spec
+
+
+if "pint" not in sys.modules:
+    import importlib.util
+
+    sys.meta_path.insert(0, _PintWithoutDask())
+
+
 def __getattr__(name: str) -> Any:
     module = _EXPORTS.get(name)
     if module is None:

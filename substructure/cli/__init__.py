@@ -2,7 +2,7 @@
 
 Each subcommand is a module of this package (``frf_command``, ``identify_command``,
 ``diagnose_command``, ``lobes_command``, ``predict_command``, ``report_command``,
-``demo_command``) with ``add_parser(commands)`` and ``run(args)``; the modules
+``study_command``, ``demo_command``) with ``add_parser(commands)`` and ``run(args)``; the modules
 import the heavy parts of the library only when their command runs, so that a
 one-shot command loads what it needs and nothing more.  Options that several
 commands share live in ``_common`` (all of them) and ``_cutting`` (the cut, the
@@ -32,7 +32,7 @@ from ._common import EXIT_ERROR, EXIT_INTERNAL, EXIT_INTERRUPTED, EXIT_USAGE, PR
 
 __all__ = ["main", "DEMO_STEPS", "DemoState", "COMMANDS"]
 
-COMMANDS = ("frf", "identify", "diagnose", "lobes", "predict", "report", "demo")
+COMMANDS = ("frf", "identify", "diagnose", "lobes", "predict", "report", "study", "demo")
 """The subcommands, in the order of ``substructure --help``; each is the module ``<name>_command``."""
 
 

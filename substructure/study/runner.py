@@ -1,0 +1,483 @@
+"""Running a study: tasks on Dask (or in this process), each result saved as it completes, progress, resume.
+
+* **Where the tasks run.**  ``processes:N``: a local Dask cluster of N
+  worker processes with one thread each (a crash of one loses one task);
+  ``local:N``: N worker threads in this process; an address: an existing
+  scheduler (``dask scheduler`` and ``dask worker`` on a cluster); a
+  ``dask.distributed.Client``: its cluster; ``serial``: this process,
+  without Dask.  A local cluster is made for the run and closed after it.
+* **Nothing lost.**  The worker returns plain data; this process writes the
+  combination's figure and FRF, then its result file
+  ``results/KEY.json`` (each atomically), as soon as the task completes.
+  The result file is written last, so a combination counts as finished only
+  when all its files are there.
+* **Nothing repeated.**  ``resume`` keeps every result whose fingerprint
+  (a hash of all its inputs) matches the task, and computes the others:
+  those never finished, those lost with a worker, and those whose inputs
+  changed.  The table is always assembled from the saved results, in the
+  study's order, so that a resumed study gives the same table as an
+  uninterrupted one.
+* **A bad combination fails its rows.**  :func:`~substructure.study.task.run_task`
+  turns every problem of a combination into failed rows with the message; a
+  worker that dies (killed, out of memory) is retried by Dask
+  (``distributed.scheduler.allowed-failures``) and then reported as
+  ``crashed`` rows.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from ..errors import InvalidValueError, OutputExistsError
+
+__all__ = ["run_study", "Progress", "parse_scheduler", "json_text", "RESULT_FORMAT"]
+
+#: The ``format`` of a combination's result file.
+RESULT_FORMAT = "substructure-study-result/1"
+_TABLE_FILES = ("table.parquet", "table.csv", "summary.png")
+_FOLDERS = ("results", "figures", "frf")
+
+
+def parse_scheduler(text: str) -> tuple[str, Any]:
+    """``processes:N``, ``local:N``, ``serial`` or a scheduler's address, checked.
+
+    Parameters
+    ----------
+    text : str
+        The scheduler as the command line or :meth:`Study.run` takes it;
+        ``processes`` and ``local`` alone use one worker per CPU.
+
+    Returns
+    -------
+    (str, object)
+        ``("processes", N)``, ``("local", N)``, ``("serial", None)`` or
+        ``("address", text)``.
+    """
+    if not isinstance(text, str) or not text.strip():
+        raise InvalidValueError(f"scheduler: got {text!r}; expected processes:N, local:N, serial or an address")
+    text = text.strip()
+    if text == "serial":
+        return "serial", None
+    kind, sep, count = text.partition(":")
+    if kind in ("processes", "local"):
+        if not sep:
+            return kind, _cpus()
+        try:
+            n = int(count)
+        except ValueError:
+            n = 0
+        if not 1 <= n <= 4096:
+            raise InvalidValueError(f"scheduler: got {text!r}; expected {kind}:N with N workers, 1 to 4096")
+        return kind, n
+    if re.fullmatch(r"[a-z]+://\S+", text) or re.fullmatch(r"[A-Za-z0-9.\-\[\]:]+:\d{2,5}", text):
+        return "address", text
+    raise InvalidValueError(f"scheduler: got {text!r}; expected processes:N, local:N, serial or a scheduler's "
+                            "address such as tcp://10.0.0.5:8786 or 10.0.0.5:8786")
+
+
+def _cpus() -> int:
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return max(1, os.cpu_count() or 1)
+
+
+class Progress:
+    """Progress lines: done / total, failures, the rate and the time left.
+
+    Parameters
+    ----------
+    stream : file-like or None
+        Where the lines go (``None``: nowhere).
+    total : int
+        Tasks in the study.
+    resumed : int
+        Tasks found finished before the run.
+    interval : float, default 2.0
+        Seconds between lines (the first and the last are always printed).
+    """
+
+    def __init__(self, stream: Any, total: int, resumed: int = 0, interval: float = 2.0):
+        self.stream, self.total, self.resumed, self.interval = stream, total, resumed, interval
+        self.done, self.failed, self.start, self.last = resumed, 0, time.perf_counter(), -1e9
+
+    def say(self, text: str) -> None:
+        """Print one line.
+
+        Parameters
+        ----------
+        text : str
+            The line, without the ``study:`` prefix.
+        """
+        if self.stream is not None:
+            print(f"study: {text}", file=self.stream, flush=True)
+
+    def update(self, failed_rows: int) -> None:
+        """Count one finished task.
+
+        Parameters
+        ----------
+        failed_rows : int
+            Rows of the task that failed.
+        """
+        self.done += 1
+        self.failed += failed_rows
+        now = time.perf_counter()
+        if now - self.last >= self.interval or self.done == self.total:
+            self.last = now
+            self.say(self.line(now))
+
+    def line(self, now: float | None = None) -> str:
+        """The progress line.
+
+        Parameters
+        ----------
+        now : float, optional
+            ``time.perf_counter()`` of the line.
+
+        Returns
+        -------
+        str
+            ``"37/200 done, 1 row failed; 3.1/s, about 53 s left"``.
+        """
+        now = time.perf_counter() if now is None else now
+        elapsed = max(now - self.start, 1e-9)
+        fresh = self.done - self.resumed
+        rate = fresh / elapsed
+        text = f"{self.done}/{self.total} done"
+        if self.failed:
+            text += f", {self.failed} row{'s' if self.failed > 1 else ''} failed"
+        if self.done == self.total:
+            return text + f" in {elapsed:.1f} s" + (f" ({rate:.3g} combinations/s)" if fresh else "")
+        left = (self.total - self.done) / rate if rate > 0 else float("nan")
+        return text + f"; {rate:.3g} combinations/s, about {_duration(left)} left"
+
+
+def _duration(seconds: float) -> str:
+    if seconds != seconds:
+        return "? s"
+    if seconds < 100:
+        return f"{seconds:.0f} s"
+    if seconds < 6000:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
+
+
+class _Store:
+    """The output directory: a result file per combination, its figure and FRF, the table."""
+
+    def __init__(self, out: Any, inputs: tuple):
+        self.root = Path(out)
+        self.inputs = {Path(os.path.abspath(p)).resolve(): os.fspath(p) for p in inputs}
+        if self.root.exists() and not self.root.is_dir():
+            raise InvalidValueError(f"out: {self.root} is a file; expected a directory (it is created if missing)")
+
+    def path(self, folder: str, key: str, suffix: str) -> Path:
+        return self.root / folder / f"{key}{suffix}"
+
+    def check(self, tasks: list[dict], resume: bool, overwrite: bool) -> None:
+        planned = [self.root / name for name in _TABLE_FILES]
+        planned += [self.path(f, t["key"], s) for t in tasks for f, s in (("results", ".json"),
+                                                                         ("figures", ".png"), ("frf", ".csv"))]
+        for p in planned:
+            where = Path(os.path.abspath(p)).resolve()
+            if where in self.inputs:
+                raise InvalidValueError(f"out: {p} would be written onto the input {self.inputs[where]}; choose "
+                                        "another output directory")
+        if resume or overwrite or not self.root.exists():
+            return
+        found = [p for p in planned if p.exists()]
+        if found:
+            raise OutputExistsError(f"{self.root}: holds the files of a study ({found[0].relative_to(self.root)}, "
+                                    f"{len(found)} in all); continue it with --resume (resume=True) or compute it "
+                                    "anew with --overwrite (overwrite=True)")
+
+    def load(self, task: dict) -> dict | None:
+        path = self.path("results", task["key"], ".json")
+        try:
+            data = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            return None
+        if (not isinstance(data, dict) or data.get("format") != RESULT_FORMAT
+                or data.get("fingerprint") != task["fingerprint"] or data.get("status") != "done"):
+            return None
+        return data
+
+    def save(self, result: dict) -> dict:
+        from ..io import write_bytes, write_text
+
+        key = result["key"]
+        for folder in _FOLDERS:
+            (self.root / folder).mkdir(parents=True, exist_ok=True)
+        record = {k: v for k, v in result.items() if k not in ("figure", "frf")}
+        record["format"] = RESULT_FORMAT
+        if result.get("figure") is not None:
+            write_bytes(self.path("figures", key, ".png"), result["figure"])
+            record["figure"] = f"figures/{key}.png"
+        if result.get("frf") is not None:
+            _write_frf(result["frf"], self.path("frf", key, ".csv"))
+            record["frf"] = f"frf/{key}.csv"
+        write_text(self.path("results", key, ".json"), json_text(record) + "\n")  # last: the combination is done
+        return record
+
+
+def _plain(value: Any) -> Any:
+    """JSON types only: non-finite floats as ``None``, numpy numbers as Python's."""
+    import math
+
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, bool) or value is None or isinstance(value, str):
+        return value
+    if hasattr(value, "item") and not isinstance(value, (int, float)):  # numpy scalars
+        value = value.item()
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    return value
+
+
+def json_text(value: Any) -> str:
+    """Strict JSON (no NaN or Infinity: ``null``) of plain data.
+
+    Parameters
+    ----------
+    value : object
+        Dicts, lists, strings, numbers, ``None``.
+
+    Returns
+    -------
+    str
+        The JSON text; floats keep every digit.
+    """
+    return json.dumps(_plain(value), allow_nan=False)
+
+
+def _write_frf(data: dict, path: Path) -> None:
+    import numpy as np
+
+    from ..frf import FRF, Frequency
+    from ..io.frf_files import write_csv
+
+    values = np.asarray(data["real"]) + 1j * np.asarray(data["imag"])
+    frf = FRF.single(Frequency.from_hz(np.asarray(data["frequency_hz"])), values, output=data["label"],
+                     input=data["label"])
+    write_csv(frf, path)
+
+
+def _crashed(task: dict, exc: BaseException) -> dict:
+    from .task import _failed_row
+
+    what = " ".join(str(exc).split())
+    message = (f"{task['where']}: the worker computing it was lost ({type(exc).__name__}"
+               + (f": {what}" if what else "") + "); --resume (resume=True) tries it again")
+    rows = [_failed_row(task, spec, message) for spec in (task["cuts"] or [None])]
+    for row in rows:
+        row["status"] = "crashed"
+    return {"key": task["key"], "fingerprint": task["fingerprint"], "status": "crashed", "rows": rows,
+            "figure": None, "frf": None, "elapsed_s": None}
+
+
+def _pending(task: dict) -> list[dict]:
+    from .task import _failed_row
+
+    rows = [_failed_row(task, spec, "") for spec in (task["cuts"] or [None])]
+    for row in rows:
+        row["status"] = "pending"
+    return rows
+
+
+def _serial(tasks: list[dict]):
+    from .task import run_task
+
+    for task in tasks:
+        yield task, run_task(task)
+
+
+def _on_dask(client, tasks: list[dict]):
+    from distributed import as_completed
+
+    from .task import run_task
+
+    futures = {client.submit(run_task, task, key=f"substructure-study-{task['fingerprint'][:24]}", pure=False): task
+               for task in tasks}
+    try:
+        for future in as_completed(list(futures), loop=client.loop):
+            task = futures.pop(future)
+            try:
+                result = future.result()
+            except Exception as exc:  # the worker died (KilledWorker), the task was cancelled, ...
+                result = _crashed(task, exc)
+            future.release()
+            yield task, result
+    finally:
+        if futures:
+            client.cancel(list(futures))
+
+
+def _local_cluster(kind: str, n: int, progress: Progress):
+    import importlib.util
+    import logging
+
+    from distributed import Client, LocalCluster
+
+    extra = {"env": {"SUBSTRUCTURE_NUM_THREADS": "1"}} if kind == "processes" else {}
+    if importlib.util.find_spec("bokeh") is not None:
+        extra["dashboard_address"] = _dashboard_address()
+    else:  # no dashboard; the scheduler's HTTP server (health, metrics) on any free port, not on a busy 8787
+        extra.update(dashboard_address=None, scheduler_kwargs={"dashboard_address": ":0"})
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=kind == "processes",
+                           silence_logs=logging.ERROR, **extra)
+    client = Client(cluster, set_as_default=False)
+    where = "worker processes" if kind == "processes" else "worker threads in this process"
+    progress.say(f"local Dask cluster: {n} {where}")
+    return cluster, client
+
+
+def _dashboard_address() -> str:
+    """Dask's usual port 8787 when it is free, else any free port (so that no warning is needed)."""
+    import socket
+
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        try:
+            probe.bind(("", 8787))
+        except OSError:
+            return ":0"
+    return ":8787"
+
+
+def _dashboard(client, progress: Progress) -> None:
+    link = getattr(client, "dashboard_link", None)
+    import importlib.util
+
+    if link and importlib.util.find_spec("bokeh") is not None:
+        progress.say(f"Dask dashboard: {link}")
+    else:
+        progress.say("Dask dashboard: not available here (it needs bokeh: pip install bokeh)")
+
+
+def run_study(study, client: Any = None, out: Any = None, scheduler: str | None = None, resume: bool = False,
+              overwrite: bool = False, progress: Any = True):
+    """Run a study (see :meth:`substructure.study.Study.run`).
+
+    Parameters
+    ----------
+    study : Study
+        The study.
+    client : dask.distributed.Client, optional
+        Its cluster runs the tasks.
+    out : str or path, optional
+        Output directory.
+    scheduler : str, optional
+        ``processes:N``, ``local:N``, an address or ``serial``.
+    resume : bool
+        Keep finished combinations of ``out``.
+    overwrite : bool
+        Replace a study's files in ``out``.
+    progress : bool or file
+        Progress lines on standard error, a file, or none.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The table.
+    """
+    if resume and overwrite:
+        raise InvalidValueError("resume and overwrite: choose one (resume keeps finished combinations, overwrite "
+                                "computes everything anew)")
+    if client is not None and scheduler is not None:
+        raise InvalidValueError("client and scheduler: give one")
+    stream = (sys.stderr if progress is True else None if progress in (False, None) else progress)
+    kind, count = parse_scheduler(scheduler) if scheduler is not None else (None, None)
+    tasks = study.tasks()
+    store = None if out is None else _Store(out, study.inputs)
+    finished: dict[str, dict] = {}
+    if store is not None:
+        store.check(tasks, resume, overwrite)
+        if resume:
+            for task in tasks:
+                record = store.load(task)
+                if record is not None:
+                    finished[task["key"]] = record
+        store.root.mkdir(parents=True, exist_ok=True)
+    todo = [t for t in tasks if t["key"] not in finished]
+    report = Progress(stream, len(tasks), resumed=len(finished))
+    report.say(f"{study.name!r}: {len(tasks)} combination{'s' if len(tasks) != 1 else ''} on their machines, "
+               f"{len(study.cuts)} cut{'s' if len(study.cuts) != 1 else ''}"
+               + (f"; {len(finished)} finished before, {len(todo)} to compute" if resume else ""))
+    cluster = own = None
+    try:
+        if todo:
+            if client is None and kind is None:
+                try:
+                    from distributed import default_client
+
+                    client = default_client()
+                except (ImportError, ValueError):
+                    kind, count = "processes", _cpus()
+            if kind == "serial":
+                results = _serial(todo)
+            else:
+                if client is None and kind in ("processes", "local"):
+                    cluster, own = _local_cluster(kind, count, report)
+                elif client is None:
+                    from distributed import Client
+
+                    try:
+                        own = Client(count, set_as_default=False)
+                    except (OSError, TimeoutError) as exc:
+                        raise InvalidValueError(f"scheduler: cannot reach the Dask scheduler at {count} ({exc})") from None
+                    report.say(f"Dask scheduler at {count}")
+                _dashboard(own or client, report)
+                results = _on_dask(own or client, todo)
+            for task, result in results:
+                record = store.save(result) if store is not None else {k: v for k, v in result.items()
+                                                                         if k not in ("figure", "frf")}
+                finished[task["key"]] = json.loads(json_text(record))
+                report.update(sum(row["status"] != "ok" for row in result["rows"]))
+        elif tasks:
+            report.say("every combination was finished before; assembling the table")
+    except KeyboardInterrupt:
+        if store is not None:  # a result saved just as the signal came is on disk, if not yet counted here
+            for task in tasks:
+                if task["key"] not in finished:
+                    record = store.load(task)
+                    if record is not None:
+                        finished[task["key"]] = record
+        report.say(f"interrupted: {len(finished)} of {len(tasks)} combinations are saved"
+                   + (f" in {store.root}; run again with --resume (resume=True) to finish" if store else ""))
+        if store is not None:
+            _assemble(study, tasks, finished, store)
+        raise
+    finally:
+        if own is not None:
+            own.close()
+        if cluster is not None:
+            cluster.close()
+    return _assemble(study, tasks, finished, store)
+
+
+def _assemble(study, tasks: list[dict], finished: dict, store: _Store | None):
+    from .table import make_table, summary_figure, write_table
+
+    rows = []
+    for task in tasks:
+        record = finished.get(task["key"])
+        rows += record["rows"] if record is not None else _pending(task)
+    table = make_table(rows)
+    if store is not None:
+        write_table(table, store.root / "table.parquet", store.root / "table.csv")
+        if rows:
+            from ..io import replacing
+
+            fig = summary_figure(table, title=f"{study.name}: combinations ranked")
+            with replacing(store.root / "summary.png") as temporary:
+                fig.savefig(temporary, format="png", dpi=100)
+    return table
