@@ -214,7 +214,8 @@ class _Store:
 
         key = result["key"]
         for folder in _FOLDERS:
-            (self.root / folder).mkdir(parents=True, exist_ok=True)
+            if folder == "results" or result.get(folder.rstrip("s")) is not None:
+                (self.root / folder).mkdir(parents=True, exist_ok=True)
         record = {k: v for k, v in result.items() if k not in ("figure", "frf")}
         record["format"] = RESULT_FORMAT
         if result.get("figure") is not None:

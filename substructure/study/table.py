@@ -202,6 +202,11 @@ def summary_figure(table, title: str = "", top: int = 25):
                                                                                   shown["machine"])]
         y = np.arange(len(shown))[::-1]
         ax.barh(y, shown["_v"], color=[colours[m] for m in shown["machine"]])
+        for yy, (_, r) in zip(y, shown.iterrows()):
+            what = (f" {r['spindle_speed_rpm']:,.0f} rpm, {r['depth_m'] * 1e3:.3g} mm"
+                    if r["spindle_speed_rpm"] == r["spindle_speed_rpm"] else f" {r['tool_mode_hz']:.0f} Hz")
+            ax.text(r["_v"], yy, what, va="center", fontsize="xx-small")
+        ax.margins(x=0.15)
         ax.set_yticks(y, names, fontsize="x-small")
         ax.set_xlabel(label, fontsize="small")
         ax.grid(True, axis="x", alpha=0.3)

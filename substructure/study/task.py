@@ -374,7 +374,7 @@ def _figure(task: dict, nominal: dict, members: list, envelope, cuts: list) -> b
     """The combination's figure: the tool point FRF (and its band) above the lobes of each cut."""
     from matplotlib.figure import Figure
 
-    from ..stability.plotting import wrap_title
+    from ..stability.plotting import plot_recommendation, wrap_title
 
     panels = 1 + len(cuts)
     fig = Figure(figsize=(8.0, 3.2 + 3.6 * len(cuts)), layout="constrained")
@@ -409,11 +409,15 @@ def _figure(task: dict, nominal: dict, members: list, envelope, cuts: list) -> b
             ax.text(0.5, 0.5, f"cut {spec['name']!r}: failed", transform=ax.transAxes, ha="center")
             ax.set_axis_off()
             continue
-        if lband is not None:
+        chosen = task["compute"]["recommend_method"]
+        if lband is not None:  # the band and its nominal lobes, then the other method, then the recommendation
             lband.plot(ax=ax, color="tab:blue", alpha=0.2)
         for k, (method, result) in enumerate(lobes.items()):
-            result.plot(ax=ax, recommendation=best if method == task["compute"]["recommend_method"] else None,
-                        color=f"C{k}")
+            if lband is None or method != chosen:
+                result.plot(ax=ax, recommendation=best if method == chosen and lband is None else None,
+                            color=f"C{k}")
+        if lband is not None and best is not None:
+            plot_recommendation(best, ax=ax)
         wrap_title(ax, f"cut {spec['name']!r}", width=80)
     buffer = io.BytesIO()
     with _FIGURE_LOCK:
