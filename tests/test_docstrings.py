@@ -25,7 +25,8 @@ public_api = sys.modules.setdefault("public_api", importlib.util.module_from_spe
 if not hasattr(public_api, "check_docstrings"):
     _spec.loader.exec_module(public_api)
 
-WORKFLOWS = ["substructure.identify", "substructure.diagnose", "substructure.stability", "substructure.surrogate"]
+WORKFLOWS = ["substructure.identify", "substructure.diagnose", "substructure.stability", "substructure.surrogate",
+             "substructure.study"]
 
 
 def test_every_public_name_is_documented_with_its_parameters():
