@@ -162,7 +162,8 @@ print("3. Predicted joints: tool mode with its 95 % band, and the recommendation
 alu_pr = table_pr[table_pr["cut"] == "aluminium finish"]
 for _, r in alu_pr.iterrows():
     print(f"    {r['combination']:12s} k_yf {r['joint_k_yf_n_per_m']:.3g} N/m "
-          f"[{r['joint_k_yf_lo_n_per_m']:.3g}, {r['joint_k_yf_hi_n_per_m']:.3g}]  tool mode {r['tool_mode_hz']:5.0f} Hz "
+          f"[{r['joint_k_yf_lo_n_per_m']:.3g}, {r['joint_k_yf_hi_n_per_m']:.3g}]  "
+          f"tool mode {r['tool_mode_hz']:5.0f} Hz "
           f"[{r['tool_mode_lo_hz']:.0f}, {r['tool_mode_hi_hz']:.0f}]  {r['spindle_speed_rpm']:6.0f} rpm "
           f"{r['depth_m'] * 1e3:5.2f} mm")
 # the study's own figures: the ranking, and one combination (FRF band, lobes and recommendation per cut)

@@ -24,8 +24,8 @@ from study_files import write_study  # noqa: E402
 
 from substructure import Frequency, Tool, default_assembly  # noqa: E402
 from substructure.errors import OutputExistsError  # noqa: E402
-from substructure.stability import (MachineLimits, MillingCut, assembly_structure, recommend, spindle_speeds,  # noqa: E402
-                                    xy_frf, zoa)
+from substructure.stability import (  # noqa: E402
+    MachineLimits, MillingCut, assembly_structure, recommend, spindle_speeds, xy_frf, zoa)
 from substructure.study import Combination, Compute, Cut, Machine, Study  # noqa: E402
 from substructure.study.task import joint_at_quantile  # noqa: E402
 

@@ -82,7 +82,8 @@ def test_an_existing_study_is_neither_replaced_nor_repeated_unasked(tmp_path):
 
 @pytest.mark.parametrize("edit, message", [
     (lambda t: t.replace('radial_depth = "3 mm"', 'radial_depth = "3 kg"'), "line 23: cuts[0].radial_depth:"),
-    (lambda t: t.replace('milling = "down"', 'milling = "down"\ndepth = "1 mm"'), "line 25: cuts[0].depth: unknown key"),
+    (lambda t: t.replace('milling = "down"', 'milling = "down"\ndepth = "1 mm"'),
+     "line 25: cuts[0].depth: unknown key"),
     (lambda t: t.replace('name = "bench"\n', ''), "machines[0].name: missing"),
     (lambda t: t.replace('lobes', 'lobes').replace('figures = false', 'figures = false\nlobes = ["fem"]'),
      "compute.lobes: got 'fem'"),
@@ -185,3 +186,35 @@ def test_neither_the_package_nor_the_parser_nor_frf_imports_dask_or_pandas():
     loaded = set(json.loads(done.stdout.strip().splitlines()[-1]))
     for name in ("dask", "distributed", "pandas", "pyarrow"):
         assert name not in loaded, name
+
+
+# -- the documentation's contract -------------------------------------------------------------
+
+
+def test_every_column_of_the_table_is_in_the_contract():
+    from substructure.study import COLUMNS
+
+    text = (ROOT / "docs" / "file-formats.md").read_text(encoding="utf-8")
+    section = text[text.index("### `substructure study`"):]
+    for name, kind, _ in COLUMNS:
+        assert f"| `{name}` | {kind} |" in section, name
+
+
+def test_the_study_file_of_the_contract_loads(tmp_path):
+    import re
+    import shutil
+
+    text = (ROOT / "docs" / "file-formats.md").read_text(encoding="utf-8")
+    section = text[text.index("**The study file (TOML)**"):]
+    toml = re.search(r"```toml\n(.*?)```", section, flags=re.DOTALL).group(1)
+    csv_block = re.search(r"```\n(name,.*?)```", section, flags=re.DOTALL).group(1)
+    (tmp_path / "study.toml").write_text(toml)
+    (tmp_path / "library.csv").write_text(csv_block)
+    shutil.copy(ROOT / "substructure" / "data" / "default_assembly.toml", tmp_path / "dmu50.toml")
+    from study_files import JOINTS
+
+    (tmp_path / "joints.csv").write_text(JOINTS)
+    study = Study.from_file(tmp_path / "study.toml")
+    assert [c.name for c in study.combinations] == ["T12 ER32 76", "T10-65", "T12-90"]
+    assert study.machines[0].limits.max_speed == 18000 and study.compute.quantiles == (0.025, 0.5, 0.975)
+    assert study.combinations[2].joint is None and study.combinations[1].joint == {"k": {"yf": "9.7e6 N/m"}}

@@ -35,8 +35,8 @@ def run(args: argparse.Namespace) -> int:
     check_outputs([("--out", out / n) for n in names if out.is_dir()], study.inputs, True)
     previous = signal.signal(signal.SIGTERM, _interrupt)
     try:
-        table = study.run(out=out, scheduler=args.scheduler, resume=args.resume, overwrite=args.overwrite,
-                          progress=not args.quiet)
+        table = study.run(out=out, scheduler=args.scheduler or "processes", resume=args.resume,
+                          overwrite=args.overwrite, progress=not args.quiet)
     finally:
         signal.signal(signal.SIGTERM, previous)
     return _report(args, study, table, out)

@@ -421,8 +421,8 @@ def run_study(study, client: Any = None, out: Any = None, scheduler: str | None 
                     from distributed import default_client
 
                     client = default_client()
-                except (ImportError, ValueError):
-                    kind, count = "processes", _cpus()
+                except (ImportError, ValueError):  # threads: safe in any script (processes need a main guard)
+                    kind, count = "local", _cpus()
             if kind == "serial":
                 results = _serial(todo)
             else:
@@ -434,7 +434,8 @@ def run_study(study, client: Any = None, out: Any = None, scheduler: str | None 
                     try:
                         own = Client(count, set_as_default=False)
                     except (OSError, TimeoutError) as exc:
-                        raise InvalidValueError(f"scheduler: cannot reach the Dask scheduler at {count} ({exc})") from None
+                        raise InvalidValueError(f"scheduler: cannot reach the Dask scheduler at {count} "
+                                                f"({exc})") from None
                     report.say(f"Dask scheduler at {count}")
                 _dashboard(own or client, report)
                 results = _on_dask(own or client, todo)

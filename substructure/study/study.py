@@ -32,8 +32,9 @@ def _tuple_of(cls, field: str):
         seen: dict[str, int] = {}
         for i, item in enumerate(items):
             if item.name in seen:
-                raise InvalidValueError(f"{field}[{i}].name: {item.name!r} is already the name of "
-                                        f"{field}[{seen[item.name]}]; names must be unique")
+                first = items[seen[item.name]]
+                raise InvalidValueError(f"{item.where or f'{field}[{i}]'}: name: {item.name!r} is already the name of "
+                                        f"{first.where or f'{field}[{seen[item.name]}]'}; names must be unique")
             seen[item.name] = i
         return items
 
@@ -315,7 +316,9 @@ class Study:
         client : dask.distributed.Client, optional
             Run on this client's cluster (a notebook's).  Without it: the
             ``scheduler``, else the current default client, else a local
-            cluster of one worker process per CPU for the run.
+            cluster of one worker thread per CPU in this process (worker
+            processes, ``scheduler="processes:N"``, need the ``if __name__
+            == "__main__":`` guard in a script).
         out : str or path, optional
             Output directory: each finished combination is written there as
             it completes (``results/``, ``figures/``, ``frf/``), then the
