@@ -304,3 +304,44 @@ def test_the_table_files_are_not_written_onto_an_input(tmp_path):
     with pytest.raises(ValueError, match="onto the input"):
         Study.from_file(path).run(scheduler="serial", out=out, overwrite=True, progress=False)
     assert os.path.getsize(tmp_path / "s" / "table.csv") > 10
+
+
+@pytest.mark.parametrize("build, message", [
+    (lambda: Compute(lobes=["fem"]), "lobes: got 'fem'"),
+    (lambda: Compute(recommend=True, lobes=[]), "a recommendation needs lobes"),
+    (lambda: Compute(quantiles=[0.9, 0.1]), "increasing probabilities"),
+    (lambda: Compute(at="tool.tip:theta"), "translational"),
+    (lambda: Machine("m", assembly="no-such-file.toml"), "no such file"),
+    (lambda: Machine("m", limits={"max_rpm": "1 rpm"}), "limits.max_rpm: unknown key"),
+    (lambda: Combination("c", tool={"diameter": "12 mm"}), "tool.overhang: missing"),
+    (lambda: Combination("c", tool={"diameter": "12 mm", "overhang": "70 mm", "colour": "red"}), "tool.colour"),
+    (lambda: Combination("c", holder={"catalog": "BT40 ER32", "segments": []}), "not both"),
+    (lambda: Combination("c", joint={"k": {"xx": "1 N/m"}}), "joint.k.xx: unknown entry"),
+    (lambda: Cut("c", radial_depth="3 mm"), "give workpiece"),
+    (lambda: Cut("c", kt="600 MPa", kn="100 MPa"), "radial_depth"),
+    (lambda: Cut("c", kt="600 MPa", kn="100 MPa", immersion=1.5), "immersion: got 1.5"),
+    (lambda: Cut("c", kt="600 N", kn="100 MPa", immersion=0.5), "kt"),
+    (lambda: Study("s", [], [Combination("c")]), "at least one machine"),
+    (lambda: Study("s", [Machine("m")], [Combination("c", cuts=["x"])]), "'x' is not a cut"),
+    (lambda: Study("s", [Machine("m")], [Combination("c")], joint="spindle-tool"), "no joint 'spindle-tool'"),
+])
+def test_bad_definitions_are_refused_where_they_enter(build, message):
+    with pytest.raises((ValueError, TypeError), match=message.replace("(", r"\(").replace(")", r"\)")):
+        build()
+
+
+def test_a_holder_that_cannot_take_the_tool_or_a_cut_too_wide_fails_only_its_rows():
+    machine = Machine("bench")
+    cuts = [Cut("narrow", kt="700 MPa", kr=0.3, radial_depth="3 mm"),
+            Cut("wide", kt="700 MPa", kr=0.3, radial_depth="14 mm")]
+    combos = [Combination("ok", tool={"diameter": "12 mm", "overhang": "70 mm", "teeth": 4},
+                          holder={"catalog": "BT40 ER32"}, joint={"k": {"yf": "1.4e7 N/m"}}),
+              Combination("16 mm in an ER16", tool={"diameter": "16 mm", "overhang": "70 mm", "teeth": 4},
+                          holder={"catalog": "BT40 ER16"}, joint={"k": {"yf": "2e7 N/m"}})]
+    table = Study("s", [machine], combos, cuts, Compute(figures=False)).run(scheduler="serial", progress=False)
+    status = dict(zip(zip(table["combination"], table["cut"]), table["status"]))
+    errors = dict(zip(zip(table["combination"], table["cut"]), table["error"]))
+    assert status == {("ok", "narrow"): "ok", ("ok", "wide"): "failed", ("16 mm in an ER16", "narrow"): "failed",
+                      ("16 mm in an ER16", "wide"): "failed"}
+    assert "holder: bore" in errors[("16 mm in an ER16", "narrow")] and "ER16" in errors[("16 mm in an ER16", "narrow")]
+    assert "cut 'wide'" in errors[("ok", "wide")] and "radial" in errors[("ok", "wide")]

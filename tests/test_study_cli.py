@@ -113,6 +113,7 @@ def test_errors_in_the_study_file_name_the_file_line_and_key(tmp_path, edit, mes
 
 @pytest.mark.parametrize("header, row, message", [
     ("name,tool.diameter [mm],tool.overhang [mm],tool.teeth", "A,12,x,4", "line 3: tool.overhang: got 'x'"),
+    ("name,tool.diameter [mm],tool.overhang [mm]", "A,12,nan", "expected a finite number"),
     ("name,tool.diameter [mm],tool.overhang [mm],tool.teeth", "A,12,70,four", "tool.teeth: got 'four'"),
     ("name,tool.diam [mm],tool.overhang [mm]", "A,12,70", "tool.diam: unknown key"),
     ("name,tool.diameter [mm],bogus", "A,12,x", "column 'bogus': unknown"),

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import csv
 import io
+import math
 import os
 import re
 import tomllib
@@ -256,9 +257,11 @@ _BOOL = ("holder.shank_taper",)
 def _csv_cell(column: str, unit: str | None, cell: str, where: str):
     if unit is not None:
         try:
-            float(cell)
+            finite = math.isfinite(float(cell))
         except ValueError:
-            raise FileFormatError(f"{where}: {column}: got {cell!r}; expected a number (in {unit})") from None
+            finite = False
+        if not finite:
+            raise FileFormatError(f"{where}: {column}: got {cell!r}; expected a finite number (in {unit})")
         return f"{cell} {unit}"
     if column in _INTEGER:
         try:

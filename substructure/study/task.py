@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import SubstructureError
+from ..errors import InvalidValueError, SubstructureError
 from .table import empty_row
 
 __all__ = ["run_task", "joint_at_quantile"]
@@ -71,9 +71,9 @@ def _component_from_table(kind: str, table: dict):
     try:
         return loads_assembly(tomli_w.dumps(doc), source="<study>").component(kind)
     except SubstructureError as exc:
-        raise _Failed(_MINI.sub("", " ".join(str(exc).split()))) from None
+        raise InvalidValueError(_MINI.sub("", " ".join(str(exc).split()))) from None
     except (TypeError, ValueError) as exc:  # a value tomli_w cannot write
-        raise _Failed(str(exc)) from None
+        raise InvalidValueError(str(exc)) from None
 
 
 def _tool(spec: dict | None, machine):
@@ -82,7 +82,7 @@ def _tool(spec: dict | None, machine):
     if spec is None:
         tool = machine.component("tool")
         if not isinstance(tool, Tool):
-            raise _Failed("the machine's component 'tool' is not a Tool; give the combination a tool")
+            raise InvalidValueError("the machine's component 'tool' is not a Tool; give the combination a tool")
         return tool
     if "segments" in spec:
         return _component_from_table("tool", spec)
@@ -213,7 +213,7 @@ def _cut(spec: dict, tool):
     from ..stability import MillingCut, workpiece
 
     if tool.teeth is None:
-        raise _Failed("tool.teeth: missing; the cut needs the tool's tooth count (teeth = 4)")
+        raise InvalidValueError("tool.teeth: missing; the cut needs the tool's tooth count (teeth = 4)")
     diameter = tool.cutting_diameter
     common = {"radial_depth": spec["radial_depth"], "immersion": spec["immersion"], "milling": spec["milling"]}
     if spec["workpiece"] is not None:
@@ -265,10 +265,12 @@ def _caught(record: list) -> list[str]:
     return out
 
 
-def _entry(matrix, entry: str) -> float:
+def _entry(joint, kind: str, entry: str) -> float | None:
     from ..units import Q_
 
-    value = matrix.as_dict().get(entry)
+    if joint.rigid:
+        return None
+    value = getattr(joint, kind).as_dict().get(entry)
     return 0.0 if value is None else float(Q_(value).to_base_units().magnitude)
 
 
@@ -286,10 +288,10 @@ def _combination_row(task: dict, tool, assembly, template, frf_band, tool_mode, 
     row["joint_source"] = ("explicit" if task["joint"] is not None else
                            "surrogate" if task["prediction"] is not None else "machine")
     joint = assembly.joint(task["joint_name"])
-    row["joint_k_yf_n_per_m"] = _entry(joint.k, "yf")
-    row["joint_k_tm_n_m_per_rad"] = _entry(joint.k, "tm")
-    row["joint_c_yf_n_s_per_m"] = _entry(joint.c, "yf")
-    row["joint_c_tm_n_m_s_per_rad"] = _entry(joint.c, "tm")
+    row["joint_k_yf_n_per_m"] = _entry(joint, "k", "yf")
+    row["joint_k_tm_n_m_per_rad"] = _entry(joint, "k", "tm")
+    row["joint_c_yf_n_s_per_m"] = _entry(joint, "c", "yf")
+    row["joint_c_tm_n_m_s_per_rad"] = _entry(joint, "c", "tm")
     prediction = task["prediction"]
     if row["joint_source"] == "surrogate" and "k_yf" in prediction["log_mean"]:
         m, s = prediction["log_mean"]["k_yf"], prediction["log_std"]["k_yf"]
