@@ -190,6 +190,8 @@ class _Store:
             if where in self.inputs:
                 raise InvalidValueError(f"out: {p} would be written onto the input {self.inputs[where]}; choose "
                                         "another output directory")
+        if resume or overwrite:
+            self.clean()
         if resume or overwrite or not self.root.exists():
             return
         found = [p for p in planned if p.exists()]
@@ -197,6 +199,15 @@ class _Store:
             raise OutputExistsError(f"{self.root}: holds the files of a study ({found[0].relative_to(self.root)}, "
                                     f"{len(found)} in all); continue it with --resume (resume=True) or compute it "
                                     "anew with --overwrite (overwrite=True)")
+
+    def clean(self) -> None:
+        """Remove temporary files of this study's that a killed run left (``.NAME.XXXX.part.SUFFIX``)."""
+        for folder in _FOLDERS:
+            for p in (self.root / folder).glob(".*.part.*") if (self.root / folder).is_dir() else ():
+                p.unlink(missing_ok=True)
+        for p in self.root.glob(".*.part.*") if self.root.is_dir() else ():
+            if any(p.name.startswith(f".{name}.") for name in _TABLE_FILES):
+                p.unlink(missing_ok=True)
 
     def load(self, task: dict) -> dict | None:
         path = self.path("results", task["key"], ".json")
@@ -398,6 +409,8 @@ def run_study(study, client: Any = None, out: Any = None, scheduler: str | None 
     stream = (sys.stderr if progress is True else None if progress in (False, None) else progress)
     kind, count = parse_scheduler(scheduler) if scheduler is not None else (None, None)
     tasks = study.tasks()
+    if out is None:  # nowhere to put figures and FRF files: not made (the rows do not depend on them)
+        tasks = [{**t, "compute": {**t["compute"], "figures": False, "frf_files": False}} for t in tasks]
     store = None if out is None else _Store(out, study.inputs)
     finished: dict[str, dict] = {}
     if store is not None:

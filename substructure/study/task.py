@@ -508,13 +508,15 @@ def _compute(task: dict, out: dict) -> list[dict]:
                                                      frequency)}
                 member["tool_mode"] = _tool_mode(*member["frf_band"], near=nominal["tool_mode"][0])
                 members.append(member)
-            if compute["figures"]:
-                from ..surrogate import Prediction, predict_frf_band
+    if banded and compute["figures"]:  # for the figure only: the rows do not depend on it
+        from ..surrogate import Prediction, predict_frf_band
 
-                p = Prediction({k: np.array([v]) for k, v in prediction["log_mean"].items()},
-                               {k: np.array([v]) for k, v in prediction["log_std"].items()}, prediction["units"])
-                envelope = _guard(where, "FRF envelope", predict_frf_band, assembly, task["joint_name"], p, at=point,
-                                  frequency=frequency, n_samples=compute["samples"], seed=task["seed"])
+        p = Prediction({k: np.array([v]) for k, v in prediction["log_mean"].items()},
+                       {k: np.array([v]) for k, v in prediction["log_std"].items()}, prediction["units"])
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            envelope = _guard(where, "FRF envelope", predict_frf_band, assembly, task["joint_name"], p, at=point,
+                              frequency=frequency, n_samples=compute["samples"], seed=task["seed"])
     common = _caught(record) + list(prediction.get("warnings", ()) if prediction else ())
     band = nominal["frf_band"][1]
     common.insert(0, f"structure band from {band.lo_hz:.5g} Hz ({band.kind})")
