@@ -73,7 +73,7 @@ machine = Machine("thesis spindle", "default",
                                                               ["24000 rpm", "11 kW"]]})
 cuts = [Cut("aluminium finish", workpiece="aluminium-7075", immersion=0.25, milling="down", feed_per_tooth="0.05 mm"),
         Cut("steel slot", workpiece="steel-1045", kr=0.35, immersion=1.0, milling="up", feed_per_tooth="0.08 mm")]
-speeds = ("3000 rpm", "24000 rpm", "50 rpm")
+speeds = ("3000 rpm", "24000 rpm", "100 rpm")
 from substructure.study import Grid  # noqa: E402
 
 grid = Grid(frequency=("100 Hz", "5000 Hz", "4 Hz"), speeds=speeds)
@@ -94,7 +94,7 @@ combinations_csv = "library.csv"
 
 [grid]
 frequency = { start = "100 Hz", stop = "5000 Hz", step = "4 Hz" }
-speeds = { start = "3000 rpm", stop = "24000 rpm", step = "50 rpm" }
+speeds = { start = "3000 rpm", stop = "24000 rpm", step = "100 rpm" }
 
 [compute]
 band = false
