@@ -22,7 +22,8 @@ Needs the ``study`` extra (dask[distributed], pandas, pyarrow), imported
 when a study runs.  See docs/study.md.
 """
 
-from .spec import FEATURE_SOURCES, METHODS, Combination, Compute, Cut, Grid, Machine, SurrogateSpec
+from .settings import METHODS, Compute, Grid
+from .spec import FEATURE_SOURCES, Combination, Cut, Machine, SurrogateSpec
 from .study import Study, task_key, task_seed
 from .table import COLUMNS
 

@@ -139,7 +139,8 @@ class _Reader:
 
     # -- sections ------------------------------------------------------------------
     def study(self):
-        from .spec import Compute, Grid, SurrogateSpec
+        from .settings import Compute, Grid
+        from .spec import SurrogateSpec
         from .study import Study
 
         data = self.table(self.data, [], TOP_KEYS, ("name",))

@@ -18,7 +18,8 @@ from typing import Any
 import attrs
 
 from ..errors import InvalidValueError
-from .spec import Combination, Compute, Cut, Grid, Machine, SurrogateSpec
+from .settings import Compute, Grid
+from .spec import Combination, Cut, Machine, SurrogateSpec
 
 __all__ = ["Study", "task_key", "task_seed"]
 
