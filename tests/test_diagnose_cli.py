@@ -1,4 +1,4 @@
-"""`substructure diagnose`: formats.md JSON, human output, figures, the improved model, bad input."""
+"""`substructure diagnose`: the JSON of docs/file-formats.md, human output, figures, the improved model, bad input."""
 
 import json
 
