@@ -54,7 +54,7 @@ def check_readable_file(path, what: str = "file") -> str:
 
 
 def read_text(path) -> str:
-    """The UTF-8 text of a file, without a leading byte-order mark.
+    """The text of a file, UTF-8 (or UTF-16 with its byte-order mark), without a leading byte-order mark.
 
     Parameters
     ----------
@@ -70,7 +70,7 @@ def read_text(path) -> str:
     ------
     FileFormatError
         Naming the file, for a missing file, a directory, an unreadable file
-        or bytes that are not UTF-8.
+        or bytes that are not UTF-8 (nor UTF-16 after a UTF-16 byte-order mark).
     """
     name = check_readable_file(path)
     try:
@@ -78,6 +78,12 @@ def read_text(path) -> str:
             data = fh.read()
     except OSError as exc:
         raise FileFormatError(f"{name}: cannot read the file ({exc.strerror or exc})") from None
+    if data[:2] in (b"\xff\xfe", b"\xfe\xff"):  # UTF-16 with its byte-order mark (Excel's "Unicode text")
+        try:
+            return data.decode("utf-16")
+        except UnicodeDecodeError as exc:
+            raise FileFormatError(f"{name}: starts with a UTF-16 byte-order mark but is not UTF-16 text "
+                                  f"(byte {exc.start}); save the file as UTF-8") from None
     try:
         return data.decode("utf-8-sig")  # a BOM (Windows editors write one) is not part of the text
     except UnicodeDecodeError as exc:

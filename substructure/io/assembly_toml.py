@@ -42,7 +42,7 @@ from ..frf import Frequency
 from ..joints import Joint, Mass, Sensor, Support
 from ..materials import CATALOG, Material
 from ..points import parse_point
-from ..units import Q_, format_quantity
+from ..units import Q_, format_quantity, to_si
 
 __all__ = ["load_assembly", "loads_assembly", "save_assembly", "dumps_assembly", "default_assembly"]
 
@@ -51,6 +51,12 @@ _FREQUENCY_KEYS = ("start", "stop", "step")
 _MATERIAL_KEYS = ("E", "nu", "rho", "loss_factor")
 _COMPONENT_KEYS = ("name", "type", "material", "segments", "description")
 _CATALOG_KEYS = ("name", "type", "catalog")  # and the catalogue holder's parameters
+SIZE_RANGE_M = (1e-6, 1e3)
+"""Lengths and diameters of segments an assembly file may give [m]: 1 um to 1 km (checked on reading)."""
+
+MAX_TAPER_STEPS = 10_000
+"""The most steps ``taper_steps`` may ask for (each is a beam element at every frequency line)."""
+
 _SEGMENT_KEYS = ("length", "od", "id", "material", "insert", "flutes", "od_tip", "id_tip", "taper_steps")
 _INSERT_KEYS = ("od", "material", "id")
 _FLUTES_KEYS = ("diameter_ratio",)
@@ -292,8 +298,28 @@ class _Reader:
         resolved = self.call(parts, design, entry, **params)
         return self.call(parts, resolved.holder, table["name"], cls)
 
+    def size(self, value, parts) -> None:
+        """Refuse a length outside the range the beam model is made for (a wrong unit, or a typo)."""
+        try:
+            metres = to_si(value, _path(parts), "m")
+        except SubstructureError:
+            return  # the constructor says what is wrong with it
+        if metres > 0 and not SIZE_RANGE_M[0] <= metres <= SIZE_RANGE_M[1]:
+            raise self.error(parts, f"got {value!r}; expected a length from 1 um to 1 km (the range of the "
+                             "beam model): check the unit")
+
     def segment(self, table, parts, material):
         table = self.table(table, parts, _SEGMENT_KEYS, ("length", "od"), "a segment table {length, od, ...}")
+        for key in ("length", "od", "id", "od_tip", "id_tip"):
+            if key in table:
+                self.size(table[key], parts + [key])
+        for key in ("od", "id"):
+            if isinstance(table.get("insert"), dict) and key in table["insert"]:
+                self.size(table["insert"][key], parts + ["insert", key])
+        steps = table.get("taper_steps")
+        if isinstance(steps, int) and not isinstance(steps, bool) and steps > MAX_TAPER_STEPS:
+            raise self.error(parts + ["taper_steps"], f"got {steps}; expected at most {MAX_TAPER_STEPS:,} steps "
+                             "(substructure.io.assembly_toml.MAX_TAPER_STEPS; the default bound needs far fewer)")
         kw = {k: table[k] for k in ("length", "od", "id", "od_tip", "id_tip", "taper_steps") if k in table}
         if "material" in table:
             kw["material"] = self.material(table["material"], parts + ["material"])

@@ -317,7 +317,7 @@ def _label(dset: dict, id_key: str, prefix: str, node_key: str, dir_key: str) ->
     text = str(dset.get(id_key, "")).strip()
     if text.startswith(prefix) and len(text) > len(prefix):
         return text[len(prefix):]
-    direction = int(dset.get(dir_key, 0))
+    direction = abs(int(dset.get(dir_key, 0)))  # -Y is read as +Y, the sign goes to the data (_parse_record)
     dof = _DIRECTION_NAME.get(direction, f"dir{direction}")
     return f"node{int(dset.get(node_key, 0))}:{dof}"
 
@@ -525,10 +525,17 @@ def _abscissa_hz(dset: dict, where: str) -> np.ndarray:
             "is a function of frequency"
         )
     hz = np.asarray(dset["x"], dtype=np.float64)
+    label = str(dset.get("abscissa_axis_units_lab") or "").strip()
     try:
-        unit = _unit_of_label(dset.get("abscissa_axis_units_lab"))
+        unit = _unit_of_label(label)
     except ValueError:
-        unit = None
+        try:  # labels in capitals: "HZ", "RPM", "RAD/S"
+            unit = _unit_of_label({"hz": "Hz", "khz": "kHz"}.get(label.lower(), label.lower()))
+        except ValueError:
+            raise FileFormatError(
+                f"{where}: cannot read the abscissa's unit label {label!r}; expected a frequency unit "
+                "(Hz, rad/s, rpm): convert the file, or export it with the frequency axis in Hz"
+            ) from None
     if unit is not None and unit.check("1 / [time]"):
         hz = np.asarray(cycles_per_second(hz * unit, "abscissa"), dtype=np.float64)
     elif unit is not None and not unit.dimensionless:
@@ -557,6 +564,8 @@ def _parse_record(dset: dict, name: str, number: int, quantity: str | None,
             f"{where}: its header announces {int(expected)} values but it holds {data.size}: the file is "
             "truncated or damaged; copy or export it again"
         )
+    if data.size < 2:
+        raise FileFormatError(f"{where}: {data.size} frequency line(s); an FRF needs at least 2")
     hz = _abscissa_hz(dset, where)
     grid = _GRID_LINE.match(str(dset.get("id4", "")).strip())
     if grid and int(grid[3]) == hz.size:
@@ -571,6 +580,9 @@ def _parse_record(dset: dict, name: str, number: int, quantity: str | None,
         k = int(np.argmax(~np.isfinite(data)))
         raise FileFormatError(f"{where}: the value at {hz[k]:g} Hz is {data[k]}; expected finite values")
     kind, factor = _record_quantity(dset, where, quantity, system)
+    # a negative direction code (-Y: the sensor or the hammer along -y) flips the sign of the FRF in +y
+    factor *= (-1.0 if int(dset.get("rsp_dir", 0) or 0) < 0 else 1.0) * \
+        (-1.0 if int(dset.get("ref_dir", 0) or 0) < 0 else 1.0)
     output = _label(dset, "id1", "response=", "rsp_node", "rsp_dir")
     input_ = _label(dset, "id2", "excitation=", "ref_node", "ref_dir")
     if not np.any(data):

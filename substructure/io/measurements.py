@@ -250,6 +250,7 @@ class _Reader:
     def check_set(self, measurements: list[Measurement]) -> None:
         first = measurements[0]
         seen: dict[tuple, int] = {}
+        sources: dict[tuple, int] = {}
         for i, m in enumerate(measurements):
             if m.frf.frequency != first.frf.frequency:
                 raise self.error(
@@ -267,6 +268,15 @@ class _Reader:
                     "(same sensors and removed components); keep one",
                 )
             seen[key] = i
+            source = (os.path.realpath(self.base_dir / m.file), m.record or 0)
+            if source in sources:
+                j = sources[source]
+                raise self.error(
+                    i, "record" if m.record is not None else "file",
+                    f"reads the same data as frf[{j}] ({m.file}{f', record {m.record}' if m.record else ''}); "
+                    "each [[frf]] table is a measurement of its own: check the file name and the record index",
+                )
+            sources[source] = i
 
 
 def loads_measurements(text: str, base_dir: str | os.PathLike = ".", source: str = "<string>") -> MeasurementSet:

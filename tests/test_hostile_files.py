@@ -1,0 +1,132 @@
+"""Second hostile round (issue 10 follow-up): files as acquisition systems and careless hands write them.
+
+Each test is an input that gave a wrong number, a hang, an internal error
+or an unhelpful refusal, with what must happen now.  References are the
+closed-form single-degree-of-freedom receptance of tests/test_uff_units.py
+and values written here by hand.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from substructure.cli import main
+from substructure.errors import FileFormatError
+from substructure.io.assembly_toml import load_assembly, loads_assembly
+from substructure.io.frf_files import read_uff
+from substructure.io.measurements import load_measurements
+
+from test_uff_units import G, assert_receptance, grid, measurement_set, read_set, receptance, record_58
+
+from pathlib import Path
+
+EXAMPLE = Path(__file__).parent / "data" / "formats_example.toml"
+EXAMPLE_TEXT = EXAMPLE.read_text(encoding="utf-8")
+TOOL_SEGMENT = '{ length = "30 mm", od = "12 mm" },'
+
+
+# -- universal files ------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("rsp, ref, sign", [(-3, 3, -1), (3, -3, -1), (-3, -3, 1), (-2, 2, -1)])
+def test_negative_direction_codes_flip_the_sign(tmp_path, rsp, ref, sign):
+    """A sensor mounted along -Z (LMS writes '-Z') measures -H in +Z: the reader gives +H, never -H."""
+    hz = grid(5.0)
+    (tmp_path / "tip.uff").write_text(
+        record_58(sign * receptance(hz), x0=5.0, num=(8, 1, 0, "m"), rsp=(1, rsp), ref=(1, ref)), encoding="ascii")
+    frf = read_uff(tmp_path / "tip.uff")
+    assert_receptance(frf)
+    assert frf.outputs[0].endswith(f"dir{abs(rsp)}") or frf.outputs[0].endswith(":y")
+    measurement, _ = read_set(measurement_set(tmp_path, "tip.uff"))
+    assert_receptance(measurement.frf)
+
+
+@pytest.mark.parametrize("label, scale", [("RPM", 60.0), ("HZ", 1.0), ("RAD/S", 2 * np.pi)])
+def test_abscissa_labels_in_capitals_are_read(tmp_path, label, scale):
+    hz = grid(5.0)
+    (tmp_path / "tip.uff").write_text(
+        record_58(receptance(hz), x0=5.0 * scale, dx=5.0 * scale, num=(8, 1, 0, "m"), abscissa=(18, label)),
+        encoding="ascii")
+    frf = read_uff(tmp_path / "tip.uff")
+    np.testing.assert_allclose(frf.frequency.hz, hz, rtol=1e-5)  # 6 digits of an E13.5 abscissa
+    assert_receptance(frf, rtol=1e-3)  # (the 6-digit abscissa moves a line by up to 5e-6 near the mode)
+
+
+def test_an_unreadable_abscissa_label_is_refused_not_taken_as_hz(tmp_path):
+    hz = grid(5.0)
+    (tmp_path / "tip.uff").write_text(
+        record_58(receptance(hz), x0=5.0, num=(8, 1, 0, "m"), abscissa=(18, "Umdrehungen")), encoding="ascii")
+    with pytest.raises(FileFormatError, match="abscissa's unit label 'Umdrehungen'.*Hz"):
+        read_uff(tmp_path / "tip.uff")
+
+
+def test_a_record_of_one_line_is_refused(tmp_path):
+    (tmp_path / "one.uff").write_text(record_58(receptance([100.0]), x0=100.0, num=(8, 1, 0, "m")),
+                                      encoding="ascii")
+    with pytest.raises(FileFormatError, match="1 frequency line"):
+        read_uff(tmp_path / "one.uff")
+
+
+def test_one_record_used_for_two_measurements_is_refused(tmp_path):
+    hz = grid(5.0)
+    (tmp_path / "two.uff").write_text(
+        record_58(receptance(hz), x0=5.0, num=(8, 1, 0, "m"))
+        + record_58(2 * receptance(hz), x0=5.0, num=(8, 1, 0, "m"), rsp=(2, 3)), encoding="ascii")
+    text = ('[[frf]]\nresponse = "tool.tip"\nexcitation = "tool.tip"\nfile = "two.uff"\nrecord = 1\n'
+            '[[frf]]\nresponse = "holder.tip"\nexcitation = "tool.tip"\nfile = "./two.uff"\nrecord = 1\n')
+    (tmp_path / "m.toml").write_text(text, encoding="utf-8")
+    with pytest.raises(FileFormatError, match=r"frf\[1\]\.record: reads the same data as frf\[0\]"):
+        load_measurements(tmp_path / "m.toml")
+    (tmp_path / "m.toml").write_text(text.replace("record = 1\n", "record = 0\n", 1), encoding="utf-8")
+    assert len(load_measurements(tmp_path / "m.toml")) == 2  # two records of one file are fine
+
+
+# -- text encodings ---------------------------------------------------------------------------------
+
+
+def test_utf16_text_with_its_byte_order_mark_is_read(tmp_path):
+    """Windows tools ("Unicode text") write UTF-16 with a byte-order mark: unambiguous, so read."""
+    (tmp_path / "a.toml").write_text(EXAMPLE_TEXT, encoding="utf-16")
+    assert load_assembly(tmp_path / "a.toml") == load_assembly(EXAMPLE)
+    (tmp_path / "b.toml").write_bytes(b"\xff\xfe" + b"\x00\xd8")  # a lone surrogate: not UTF-16
+    with pytest.raises(FileFormatError, match="not UTF-16 text"):
+        load_assembly(tmp_path / "b.toml")
+
+
+# -- assembly files: sizes the beam model cannot take -------------------------------------------------
+
+
+@pytest.mark.parametrize("segment", [
+    '{ length = "30 mm", od = "1e300 mm" },',        # was an OverflowError (internal error)
+    '{ length = "30 mm", od = "1e-300 mm" },',       # was a NaN in the beam chain (internal error)
+    '{ length = "5 m", od = "1e-12 m" },',           # hung
+    '{ length = "1e-30 mm", od = "12 mm" },',
+    '{ length = "30 mm", od = "12 mm", id = "1e-9 mm" },',
+    '{ length = "30 mm", od = "12 mm", od_tip = "2 km" },',
+])
+def test_sizes_outside_the_beam_models_range_are_refused_on_reading(segment):
+    text = EXAMPLE_TEXT.replace(TOOL_SEGMENT, segment, 1)
+    with pytest.raises(FileFormatError, match=r"components\[2\]\.segments\[0\]\.\w+: got .*1 um to 1 km"):
+        loads_assembly(text)
+
+
+def test_sizes_at_the_ends_of_the_range_are_accepted():
+    for segment in ('{ length = "1 um", od = "12 mm" },', '{ length = "30 mm", od = "12 mm", id = "0.001 mm" },'):
+        loads_assembly(EXAMPLE_TEXT.replace(TOOL_SEGMENT, segment, 1))
+
+
+def test_taper_steps_beyond_the_limit_are_refused_before_allocating():
+    text = EXAMPLE_TEXT.replace(TOOL_SEGMENT, '{ length = "30 mm", od = "12 mm", od_tip = "10 mm", '
+                                              'taper_steps = 1000000000 },', 1)
+    with pytest.raises(FileFormatError, match=r"taper_steps: got 1000000000; expected at most 10,000"):
+        loads_assembly(text)
+
+
+def test_the_command_refuses_a_huge_diameter_in_one_line(tmp_path, capsys):
+    (tmp_path / "a.toml").write_text(EXAMPLE_TEXT.replace(TOOL_SEGMENT, '{ length = "30 mm", od = "1e300 mm" },', 1),
+                                     encoding="utf-8")
+    status = main(["frf", str(tmp_path / "a.toml"), "--at", "tool.tip", "--grid", "100:200:50", "--json"])
+    out, err = capsys.readouterr()
+    assert status == 1 and out == ""
+    assert err.count("\n") == 1 and "internal error" not in err and "od: got '1e300 mm'" in err
