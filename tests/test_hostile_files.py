@@ -130,3 +130,74 @@ def test_the_command_refuses_a_huge_diameter_in_one_line(tmp_path, capsys):
     out, err = capsys.readouterr()
     assert status == 1 and out == ""
     assert err.count("\n") == 1 and "internal error" not in err and "od: got '1e300 mm'" in err
+
+
+# -- CSV exports of other programs --------------------------------------------------------------------
+
+HZ = np.arange(100.0, 1500.0, 10.0)
+H = receptance(HZ)
+W = 2 * np.pi * HZ
+
+
+def _export(tmp_path, header, columns, sep=",", decimal=".", prefix="", encoding="utf-8", newline="\n"):
+    rows = [sep.join(f"{v!r}".replace(".", decimal) for v in map(float, row)) for row in zip(*columns)]
+    path = tmp_path / "export.csv"
+    path.write_bytes((prefix + newline.join([header, *rows]) + newline).encode(encoding))
+    return path
+
+
+@pytest.mark.parametrize("header, columns, kw, quantity", [
+    ("Frequency [Hz];Real [m/N];Imag [m/N];", (HZ, H.real, H.imag, [""] * HZ.size), {"sep": ";", "decimal": ","},
+     "receptance"),
+    ('"Frequency (Hz)"\t"Re (mm/N)"\t"Im (mm/N)"', (HZ, 1e3 * H.real, 1e3 * H.imag), {"sep": "\t"}, "receptance"),
+    ("frequency [kHz],real [µm/N],imag [µm/N]", (HZ / 1e3, 1e6 * H.real, 1e6 * H.imag),
+     {"prefix": "# exported 2026-11-23\n# channel 3\n", "newline": "\r\n"}, "receptance"),
+    ("Frequency [Hz];Magnitude [g/N];Phase [deg]", (HZ, np.abs(W**2 * H) / G, np.degrees(np.angle(-(W**2) * H))),
+     {"sep": ";", "decimal": ",", "encoding": "utf-16"}, "accelerance"),
+    ("freq [rad/s],magnitude [(m/s^2)/N],phase [rad]", (W, np.abs(W**2 * H), np.angle(-(W**2) * H)), {},
+     "accelerance"),
+    ("frequency_hz,real [m/s/N],imag [m/s/N]", (HZ, (1j * W * H).real, (1j * W * H).imag), {}, "mobility"),
+])
+def test_exports_with_units_in_the_header_are_read_and_converted(tmp_path, header, columns, kw, quantity):
+    from substructure.io.frf_files import read_csv
+
+    path = _export(tmp_path, header, [c for c in columns if not isinstance(c, list)], **kw)
+    if len(columns) == 4:  # the trailing empty column of a spreadsheet
+        path.write_bytes(path.read_bytes().replace(b"\n", b";\n").replace(b"];;\n", b"];\n"))
+    frf = read_csv(path)
+    assert frf.quantity == quantity
+    np.testing.assert_allclose(frf.frequency.hz, HZ, rtol=1e-12)
+    np.testing.assert_allclose(frf.to_receptance().data[:, 0, 0], H, rtol=1e-9, atol=1e-9 * np.abs(H).max())
+    # a measurement set takes the quantity from the header and converts to a receptance
+    (tmp_path / "m.toml").write_text('[[frf]]\nresponse = "tool.tip"\nexcitation = "tool.tip"\n'
+                                     'file = "export.csv"\n', encoding="utf-8")
+    measurement = next(iter(load_measurements(tmp_path / "m.toml")))
+    assert measurement.quantity == quantity
+    np.testing.assert_allclose(measurement.frf.data[:, 0, 0], H, rtol=1e-9, atol=1e-9 * np.abs(H).max())
+
+
+@pytest.mark.parametrize("header, pattern", [
+    ("frequency_hz,magnitude_db,phase_deg", "dB of what"),
+    ("Frequency [Hz],Magnitude [dB],Phase [deg]", "dB of what"),
+    ("Frequency [Hz],Magnitude [m/N],Phase", "give the phase's unit"),
+    ("Frequency,Real [m/N],Imag [m/N]", "has no unit"),
+    ("Frequency [mm],Real [m/N],Imag [m/N]", "not a frequency unit"),
+    ("Frequency [Hz],Real [m/N],Imag [mm/N]", "different units"),
+    ("Frequency [Hz],Real [N/m],Imag [N/m]", "not that of a receptance"),
+    ("Frequency [Hz],Coherence,Imag", "column 'Coherence'"),
+    ("Frequency [Hz],Imag [m/N],Real [m/N]", "in this order"),
+])
+def test_ambiguous_exports_are_refused_with_what_to_give(tmp_path, header, pattern):
+    from substructure.io.frf_files import read_csv
+
+    path = _export(tmp_path, header, (HZ, H.real, H.imag))
+    with pytest.raises(FileFormatError, match=pattern):
+        read_csv(path)
+
+
+def test_an_export_whose_units_contradict_the_quantity_given_is_refused(tmp_path):
+    from substructure.io.frf_files import read_csv
+
+    path = _export(tmp_path, "Frequency [Hz],Real [g/N],Imag [g/N]", (HZ, H.real, H.imag))
+    with pytest.raises(FileFormatError, match="those of an accelerance, but the quantity given is receptance"):
+        read_csv(path, quantity="receptance")

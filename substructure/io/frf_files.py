@@ -109,7 +109,7 @@ def read_csv(
     path: str | os.PathLike,
     output: str = "response",
     input: str = "excitation",
-    quantity: str = "receptance",
+    quantity: str | None = None,
 ) -> FRF:
     """Read a CSV file ``frequency_hz,real,imag`` into a one-entry FRF.
 
@@ -117,10 +117,14 @@ def read_csv(
     ----------
     path : str or path-like
         The file.  Blank lines are ignored; a UTF-8 byte-order mark is allowed.
+        Other exports (``;`` or tab separators with decimal commas, comment
+        lines, units in the header, magnitude and phase) are read by
+        :func:`substructure.io.frf_exports.parse_export` when unambiguous.
     output, input : str
         Labels of the response and excitation DOFs, e.g. ``"tool.tip:y"``.
-    quantity : {"receptance", "mobility", "accelerance"}
-        What the file holds (the file itself does not say).
+    quantity : {"receptance", "mobility", "accelerance"}, optional
+        What the file holds; default: what the header's units say, else
+        receptance.  A quantity that contradicts the header's units is refused.
 
     Raises
     ------
@@ -143,11 +147,11 @@ def read_csv(
     if not numbered:
         raise FileFormatError(f"{name}: the file is empty; expected the header {CSV_HEADER!r}")
     first, header = numbered[0]
-    if header.replace(" ", "") != CSV_HEADER:
-        raise FileFormatError(
-            f"{name}, line {first}: header {header!r}; expected {CSV_HEADER!r} "
-            "(frequency in Hz, real and imaginary parts)"
-        )
+    if header.replace(" ", "") != CSV_HEADER:  # another program's export: read what is unambiguous
+        from .frf_exports import parse_export
+
+        table, lines_of, said = parse_export(numbered, name, quantity)
+        return _checked_csv(table, lines_of, name, output, input, quantity or said or "receptance")
     numbered = numbered[1:]
     if len(numbered) < 2:
         raise FileFormatError(
@@ -173,6 +177,14 @@ def read_csv(
                     ) from None
         raise  # pragma: no cover - numpy and float() disagree on a cell
     lines_of = np.array([number for number, _ in numbered])
+    return _checked_csv(table, lines_of, name, output, input, quantity or "receptance")
+
+
+def _checked_csv(table: np.ndarray, lines_of: np.ndarray, name: str, output: str, input: str,
+                 quantity: str) -> FRF:
+    """The FRF of a table ``frequency_hz, real, imag`` (SI) after the checks of every CSV file."""
+    if table.shape[0] < 2:
+        raise FileFormatError(f"{name}: {table.shape[0]} data row(s); an FRF needs at least 2 frequency lines")
     bad = ~np.isfinite(table)
     if bad.any():
         row, column = np.argwhere(bad)[0]

@@ -158,7 +158,7 @@ class _Reader:
             if suffix in _CSV:
                 if record is not None:
                     raise self.error(index, "record", f"a CSV file ({file}) holds one FRF; record is for UFF files")
-                frf = read_csv(path, output=response, input=excitation, quantity=quantity or "receptance")
+                frf = read_csv(path, output=response, input=excitation, quantity=quantity)
             else:
                 frf = self.uff(index, path, record, quantity, response, excitation)
             return frf
