@@ -79,7 +79,7 @@ GOOD = "frequency_hz,real,imag\n10,1e-6,-2e-7\n20,2e-6,-3e-7\n30,1e-6,-1e-7\n"
 @pytest.mark.parametrize(
     "content, match",
     [
-        ("freq,re,im\n10,1,2\n20,1,2\n", r"line 1: header 'freq,re,im'; expected 'frequency_hz,real,imag'"),
+        ("freq,re,im\n10,1,2\n20,1,2\n", r"line 1: column 'freq' has no unit; name it frequency_hz or give the unit"),
         ("", "empty"),
         (GOOD.replace("20,2e-6", "20,abc"), r"line 3: real is 'abc'; expected a number"),
         (GOOD.replace("-3e-7", ""), r"line 3: imag is ''; expected a number"),
