@@ -201,3 +201,16 @@ def test_an_export_whose_units_contradict_the_quantity_given_is_refused(tmp_path
     path = _export(tmp_path, "Frequency [Hz],Real [g/N],Imag [g/N]", (HZ, H.real, H.imag))
     with pytest.raises(FileFormatError, match="those of an accelerance, but the quantity given is receptance"):
         read_csv(path, quantity="receptance")
+
+
+def test_no_stability_limit_tells_a_command_line_user_the_option(tmp_path, capsys):
+    """A cutting coefficient of 1e-300 Pa leaves no finite limit: the message names --max-depth too."""
+    from substructure import Frequency
+    from substructure.io.frf_files import write_csv
+
+    frf = load_assembly(EXAMPLE).receptance("tool.tip:y", frequency=Frequency.from_range("200 Hz", "3000 Hz", "20 Hz"))
+    write_csv(frf, tmp_path / "tip.csv")
+    status = main(["lobes", "--frf", str(tmp_path / "tip.csv"), "--teeth", "4", "--diameter", "12 mm",
+                   "--immersion", "0.5", "--kt", "1e-300 MPa", "--kr", "0.3", "--speeds", "5000:8000:100", "--json"])
+    out, err = capsys.readouterr()
+    assert status == 1 and out == "" and "--max-depth" in err

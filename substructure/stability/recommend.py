@@ -288,7 +288,8 @@ def recommend(lobes: Any, cut: Any, limits: MachineLimits | None = None, *, marg
     finite = np.isfinite(bound)
     if not finite.any():
         raise InvalidValueError("lobes: no stability limit found in any speed window and no largest depth, power "
-                                "or torque limit given; give limits=MachineLimits(max_depth=...)")
+                                "or torque limit given; give limits=MachineLimits(max_depth=...) "
+                                "(--max-depth on the command line)")
     order, bound = order[finite], bound[finite]  # no limit at all there: nothing to recommend
     order = order[np.argsort(-bound, kind="stable")]
     bound = np.sort(bound)[::-1]
