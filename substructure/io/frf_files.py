@@ -119,7 +119,7 @@ def read_csv(
         The file.  Blank lines are ignored; a UTF-8 byte-order mark is allowed.
         Other exports (``;`` or tab separators with decimal commas, comment
         lines, units in the header, magnitude and phase) are read by
-        :func:`substructure.io.frf_exports.parse_export` when unambiguous.
+        ``substructure.io.frf_exports`` when unambiguous.
     output, input : str
         Labels of the response and excitation DOFs, e.g. ``"tool.tip:y"``.
     quantity : {"receptance", "mobility", "accelerance"}, optional
