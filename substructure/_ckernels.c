@@ -301,13 +301,31 @@ static inline void wavenumbers(const cx co[5], double w2, cx *a, cx *e, cx *s1, 
     *s2 = csub(mean, root);
 }
 
-/* The 16 entries (row-major) of T = exp(A L) of one segment on the lanes, w2 = omega^2 per lane.
+/* The transfer matrix of a segment, T = exp(A L), on the lanes, in three phases.
  *
  * exp(A L) = C(A^2) + A S(A^2), C(s) = cosh(L sqrt s), S(s) = sinh(L sqrt s) / sqrt s, and
  * g(A^2) = g(s2) I + g[s1, s2] (A^2 - s2 I).  The divided differences come from their power
  * series where max |s L^2| < 0.5 (terms until |z|^n / (2n)! < 1e-18, counted per lane), else
- * from one exponential per wavenumber.  T = alpha I + beta A + gamma A^2 + delta A^3. */
-AI void transfer(const cx co[5], double rhoa, double rhoi, double length, vd w2, cv *t)
+ * from one exponential per wavenumber.  T = alpha I + beta A + gamma A^2 + delta A^3.
+ *
+ * The phases run over all the segments of a block of lines in turn: the wavenumbers of every
+ * segment (waves), then the exponentials, cosines and sines of every segment (transcendentals:
+ * a plain loop of library calls, no vector value lives across a call), then the rest
+ * (transfer).  Each phase's work on one segment is independent of the other segments', so
+ * the processor overlaps the long chains of square roots and divisions of one segment with
+ * those of the next instead of waiting for each in turn between the calls. */
+
+typedef struct {
+    cv a, e, s1, s2, r1, r2; /* a, e: diagonal of A^2; s1, s2 its eigenvalues; r = sqrt(s) */
+    vd bound2;               /* max |s L^2|^2 */
+    vm series;               /* lanes on the power series */
+    int some_series, some_exp;
+    double x[2][VL], y[2][VL];      /* r L = x + i y of both wavenumbers, exponential lanes */
+    double p[2][VL], c[2][VL], s[2][VL]; /* exp(x), cos(y), sin(y) */
+} wave_t;
+
+/* Phase 1: wavenumbers, the choice series/exponential per lane, and r L where needed. */
+AI void waves(const cx co[5], double length, vd w2, wave_t *wv)
 {
     cv a = vscale(w2, vc(co[0])), e = vscale(w2, vc(co[1]));
     cv half = vscale(splat(0.5), vsub(a, e));
@@ -318,8 +336,66 @@ AI void transfer(const cx co[5], double rhoa, double rhoi, double length, vd w2,
     cv z1 = vscale(splat(l2), s1), z2 = vscale(splat(l2), s2);
     vd bound2 = vmax(z1.re * z1.re + z1.im * z1.im, z2.re * z2.re + z2.im * z2.im);
     vm series = bound2 < splat(SERIES_LIMIT2);
+    wv->a = a;
+    wv->e = e;
+    wv->s1 = s1;
+    wv->s2 = s2;
+    wv->bound2 = bound2;
+    wv->series = series;
+    wv->some_series = any(series);
+    wv->some_exp = !all(series);
+    if (wv->some_exp) {
+        cv r1 = vcsqrt(s1), r2 = vcsqrt(s2);
+        wv->r1 = r1;
+        wv->r2 = r2;
+        vd x1 = r1.re * length, y1 = r1.im * length, x2 = r2.re * length, y2 = r2.im * length;
+        for (int l = 0; l < VL; l++) {
+            wv->x[0][l] = x1[l];
+            wv->y[0][l] = y1[l];
+            wv->x[1][l] = x2[l];
+            wv->y[1][l] = y2[l];
+        }
+    }
+}
+
+/* Phase 2: exp(x), cos(y), sin(y) of both wavenumbers on the exponential lanes of n segments. */
+static inline void transcendentals(wave_t *wv, Py_ssize_t n)
+{
+    for (Py_ssize_t u = 0; u < n; u++) {
+        wave_t *w = wv + u;
+        if (!w->some_exp)
+            continue;
+        for (int l = 0; l < VL; l++)
+            for (int k = 0; k < 2; k++) {
+                if (w->series[l]) { /* a series lane: not used */
+                    w->p[k][l] = w->c[k][l] = 1.0;
+                    w->s[k][l] = 0.0;
+                    continue;
+                }
+                w->p[k][l] = exp(w->x[k][l]);
+                w->c[k][l] = cos(w->y[k][l]);
+                w->s[k][l] = sin(w->y[k][l]);
+            }
+    }
+}
+
+AI vd vload(const double *x)
+{
+    vd v;
+    memcpy(&v, x, sizeof v);
+    return v;
+}
+
+/* Phase 3: the 16 entries (row-major) of T on the lanes, w2 = omega^2 per lane. */
+AI void transfer(const cx co[5], double rhoa, double rhoi, double length, vd w2, const wave_t *wv, cv *t)
+{
+    cv a = wv->a, e = wv->e, s1 = wv->s1, s2 = wv->s2;
+    vm series = wv->series;
+    double l2 = length * length;
     cv c0, c1, g0, g1;
-    if (any(series)) {
+    if (wv->some_series) {
+        cv z1 = vscale(splat(l2), s1), z2 = vscale(splat(l2), s2);
+        vd bound2 = wv->bound2;
         /* h_n: complete homogeneous symmetric polynomial of degree n in z1, z2; pow2 = z2^n;
          * lane l takes the terms n <= nt[l] */
         vm nt = msplat(0);
@@ -363,24 +439,11 @@ AI void transfer(const cx co[5], double rhoa, double rhoi, double length, vd w2,
         g0 = vscale(splat(length), ss);
         g1 = vscale(splat(l2 * length), ds);
     }
-    if (!all(series)) {
+    if (wv->some_exp) {
         /* cosh and sinh from exp(r L) = e^x (cos y + i sin y); Re r >= 0 */
-        cv r1 = vcsqrt(s1), r2 = vcsqrt(s2);
-        vd x1 = r1.re * length, y1 = r1.im * length, x2 = r2.re * length, y2 = r2.im * length;
-        vd p1, p2, cy1, sy1, cy2, sy2;
-        for (int l = 0; l < VL; l++) {
-            if (series[l]) { /* a series lane: not used */
-                p1[l] = p2[l] = cy1[l] = cy2[l] = 1.0;
-                sy1[l] = sy2[l] = 0.0;
-                continue;
-            }
-            p1[l] = exp(x1[l]);
-            p2[l] = exp(x2[l]);
-            cy1[l] = cos(y1[l]);
-            sy1[l] = sin(y1[l]);
-            cy2[l] = cos(y2[l]);
-            sy2[l] = sin(y2[l]);
-        }
+        cv r1 = wv->r1, r2 = wv->r2;
+        vd p1 = vload(wv->p[0]), p2 = vload(wv->p[1]);
+        vd cy1 = vload(wv->c[0]), sy1 = vload(wv->s[0]), cy2 = vload(wv->c[1]), sy2 = vload(wv->s[1]);
         vd half1 = splat(0.5);
         vd q1 = splat(1.0) / p1, q2 = splat(1.0) / p2;
         cv ch1 = V(half1 * (p1 + q1) * cy1, half1 * (p1 - q1) * sy1);
@@ -389,7 +452,7 @@ AI void transfer(const cx co[5], double rhoa, double rhoi, double length, vd w2,
         cv sh2 = vmul(V(half1 * (p2 - q2) * cy2, half1 * (p2 + q2) * sy2), vrecip(r2));
         cv ids = vrecip(vsub(s1, s2));
         cv ec1 = vmul(vsub(ch1, ch2), ids), eg1 = vmul(vsub(sh1, sh2), ids);
-        if (!any(series)) {
+        if (!wv->some_series) {
             c0 = ch2; c1 = ec1; g0 = sh2; g1 = eg1;
         } else {
             c0 = V(vsel(series, c0.re, ch2.re), vsel(series, c0.im, ch2.im));
@@ -426,6 +489,40 @@ AI void transfer(const cx co[5], double rhoa, double rhoi, double length, vd w2,
 
 /* ------------------------------------------------------------------------ */
 /* Chains */
+
+/* The VL lanes of z to o[0 .. VL - 1] (complex numbers: re, im interleaved). */
+AI void store_lanes(cx *o, cv z)
+{
+#if VL == 4 && (defined(__clang__) || (defined(__GNUC__) && __GNUC__ >= 5))
+    /* two interleaving shuffles and two full-width stores instead of eight scalar ones */
+#if defined(__clang__)
+    vd lo = __builtin_shufflevector(z.re, z.im, 0, 4, 1, 5), hi = __builtin_shufflevector(z.re, z.im, 2, 6, 3, 7);
+#else
+    vd lo = __builtin_shuffle(z.re, z.im, (vm){0, 4, 1, 5}), hi = __builtin_shuffle(z.re, z.im, (vm){2, 6, 3, 7});
+#endif
+    memcpy(o, &lo, sizeof lo);
+    memcpy(o + 2, &hi, sizeof hi);
+#else
+    for (int l = 0; l < VL; l++)
+        o[l] = lane(z, l);
+#endif
+}
+
+/* y = t x: t 4x4, x and y 4x2 (row-major) */
+AI void times_columns(const cv *t, const cv *x, cv *y)
+{
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < 2; c++)
+            y[2 * r + c] = vdot4(t[4 * r], x[c], t[4 * r + 1], x[2 + c], t[4 * r + 2], x[4 + c], t[4 * r + 3], x[6 + c]);
+}
+
+/* columns c0 .. 3 of y = x t: x and y 2x4, t 4x4 (row-major); c0 a constant where inlined */
+AI void rows_times(const cv *x, const cv *t, cv *y, int c0)
+{
+    for (int r = 0; r < 2; r++)
+        for (int c = c0; c < 4; c++)
+            y[4 * r + c] = vdot4(x[4 * r], t[c], x[4 * r + 1], t[4 + c], x[4 * r + 2], t[8 + c], x[4 * r + 3], t[12 + c]);
+}
 
 /* Free-free receptances of a chain at its nodes on the lanes: lines q .. q + nb - 1 of out.
  *
@@ -464,10 +561,7 @@ AI void chain_block(const cv *tmat, const int64_t *seg_of, Py_ssize_t n_int, con
                 }
                 fresh = 0;
             } else {
-                for (int r = 0; r < 4; r++)
-                    for (int c = 0; c < 2; c++)
-                        ncols[2 * r + c] = vdot4(t[4 * r], cols[c], t[4 * r + 1], cols[2 + c], t[4 * r + 2],
-                                                 cols[4 + c], t[4 * r + 3], cols[6 + c]);
+                times_columns(t, cols, ncols);
                 cv *swap = cols;
                 cols = ncols;
                 ncols = swap;
@@ -499,11 +593,10 @@ AI void chain_block(const cv *tmat, const int64_t *seg_of, Py_ssize_t n_int, con
                 fresh = 0;
             } else {
                 /* the last product (reaching the first node) needs only the F-columns */
-                int c0 = (p == 0 && nodes[0] == k - 1) ? 2 : 0;
-                for (int r = 0; r < 2; r++)
-                    for (int c = c0; c < 4; c++)
-                        nrows[4 * r + c] = vdot4(rows[4 * r], t[c], rows[4 * r + 1], t[4 + c], rows[4 * r + 2],
-                                                 t[8 + c], rows[4 * r + 3], t[12 + c]);
+                if (p == 0 && nodes[0] == k - 1)
+                    rows_times(rows, t, nrows, 2);
+                else
+                    rows_times(rows, t, nrows, 0);
                 cv *swap = rows;
                 rows = nrows;
                 nrows = swap;
@@ -536,25 +629,30 @@ AI void chain_block(const cv *tmat, const int64_t *seg_of, Py_ssize_t n_int, con
                 y[2] = vdot2(l10, s[0], l11, s[2]);
                 y[3] = vdot2(l10, s[1], l11, s[3]);
             }
-            Py_ssize_t at[4] = {(a * w + b) * n_lines, (a * w + b + 1) * n_lines, ((a + 1) * w + b) * n_lines,
-                                ((a + 1) * w + b + 1) * n_lines};
-            Py_ssize_t tr[4] = {(b * w + a) * n_lines, ((b + 1) * w + a) * n_lines, (b * w + a + 1) * n_lines,
-                                ((b + 1) * w + a + 1) * n_lines};
-            for (int k = 0; k < 4; k++) {
-                for (int side = 0; side < (j > i ? 2 : 1); side++) {
-                    cx *o = out + (side ? tr[k] : at[k]) + q;
-                    if (nb == VL) {
-                        for (int l = 0; l < VL; l++) {
-                            o[l].re = y[k].re[l];
-                            o[l].im = y[k].im[l];
-                        }
-                    } else {
-                        for (int l = 0; l < nb; l++) {
-                            o[l].re = y[k].re[l];
-                            o[l].im = y[k].im[l];
-                        }
-                    }
+            cx *o = out + (a * w + b) * n_lines + q;
+            if (nb == VL) {
+                store_lanes(o, y[0]);
+                store_lanes(o + n_lines, y[1]);
+                store_lanes(o + w * n_lines, y[2]);
+                store_lanes(o + (w + 1) * n_lines, y[3]);
+                if (j > i) { /* Y_ji = Y_ij^T */
+                    o = out + (b * w + a) * n_lines + q;
+                    store_lanes(o, y[0]);
+                    store_lanes(o + n_lines, y[2]);
+                    store_lanes(o + w * n_lines, y[1]);
+                    store_lanes(o + (w + 1) * n_lines, y[3]);
                 }
+            } else {
+                Py_ssize_t at[4] = {(a * w + b) * n_lines, (a * w + b + 1) * n_lines, ((a + 1) * w + b) * n_lines,
+                                    ((a + 1) * w + b + 1) * n_lines};
+                Py_ssize_t tr[4] = {(b * w + a) * n_lines, ((b + 1) * w + a) * n_lines, (b * w + a + 1) * n_lines,
+                                    ((b + 1) * w + a + 1) * n_lines};
+                for (int k = 0; k < 4; k++)
+                    for (int side = 0; side < (j > i ? 2 : 1); side++) {
+                        cx *d = out + (side ? tr[k] : at[k]) + q;
+                        for (int l = 0; l < nb; l++)
+                            d[l] = lane(y[k], l);
+                    }
             }
         }
     }
@@ -572,7 +670,8 @@ KERNEL_CLONES static void chain_range(const double *omega, Py_ssize_t n_f, const
                                       const double *rhoi, const double *length, Py_ssize_t n_u, Py_ssize_t n_c,
                                       const int64_t *slot, cx *table, const int64_t *seg_of, Py_ssize_t n_int,
                                       const int64_t *nodes, const int64_t *place, Py_ssize_t m, cx *out,
-                                      int table_only, Py_ssize_t lo, Py_ssize_t hi, cv *tmat, cv *pre, cv *post)
+                                      int table_only, Py_ssize_t lo, Py_ssize_t hi, cv *tmat, cv *pre, cv *post,
+                                      wave_t *wv)
 {
     Py_ssize_t n_lines = table_only ? n_f : n_c * n_f;
     for (Py_ssize_t q = lo; q < hi;) {
@@ -585,6 +684,16 @@ KERNEL_CLONES static void chain_range(const double *omega, Py_ssize_t n_f, const
             double w = omega[i + (l < nb ? l : nb - 1)];
             w2[l] = w * w;
         }
+        /* the segments computed here (not read from the table): phases 1 to 3 of the closed form */
+        for (Py_ssize_t u = 0; u < n_u; u++) {
+            int shared = slot[u] >= 0;
+            if (shared ? table_only : !table_only) {
+                Py_ssize_t k = u * n_c + c;
+                waves(coef + 5 * k, length[k], w2, wv + u);
+            } else
+                wv[u].some_exp = 0;
+        }
+        transcendentals(wv, n_u);
         for (Py_ssize_t u = 0; u < n_u; u++) {
             int shared = slot[u] >= 0;
             cv *t = tmat + 16 * u;
@@ -599,7 +708,7 @@ KERNEL_CLONES static void chain_range(const double *omega, Py_ssize_t n_f, const
                 }
             } else if (shared || !table_only) {
                 Py_ssize_t k = u * n_c + c;
-                transfer(coef + 5 * k, rhoa[k], rhoi[k], length[k], w2, t);
+                transfer(coef + 5 * k, rhoa[k], rhoi[k], length[k], w2, wv + u, t);
                 if (table_only)
                     for (int e = 0; e < 16; e++) {
                         cx *dst = table + (slot[u] * 16 + e) * n_f + i;
@@ -783,14 +892,16 @@ static PyObject *py_chain_lines(PyObject *self, PyObject *args)
     const cx *coef = b[1].view.buf;
     cx *table = b[6].view.buf, *out = b[10].view.buf;
     Py_ssize_t nu1 = n_u > 0 ? n_u : 1, m1 = m > 0 ? m : 1;
-    cv *work = aligned_alloc_(sizeof(cv) * (16 * nu1 + 8 * m1));
+    /* the transfer matrices and the end products of a block (cv), then the segments' wave_t */
+    cv *work = aligned_alloc_(sizeof(cv) * (16 * nu1 + 8 * m1) + sizeof(wave_t) * nu1);
     if (!work) {
         release(b, 11);
         return PyErr_NoMemory();
     }
     Py_BEGIN_ALLOW_THREADS
     chain_range(omega, n_f, coef, rhoa, rhoi, length, n_u, n_c, slot, table, seg_of, n_int, nodes, place, m, out,
-                table_only, lo, hi, work, work + 16 * nu1, work + 16 * nu1 + 4 * m1);
+                table_only, lo, hi, work, work + 16 * nu1, work + 16 * nu1 + 4 * m1,
+                (wave_t *)(work + 16 * nu1 + 8 * m1));
     Py_END_ALLOW_THREADS
     aligned_free_(work);
     release(b, 11);
