@@ -508,12 +508,13 @@ AI void store_lanes(cx *o, cv z)
 #endif
 }
 
-/* y = t x: t 4x4, x and y 4x2 (row-major) */
-AI void times_columns(const cv *t, const cv *x, cv *y)
+/* y = t x: t 4x4, x and y 4x2 (row-major; x's rows xs apart, a constant where inlined) */
+AI void times_columns(const cv *t, const cv *x, int xs, cv *y)
 {
     for (int r = 0; r < 4; r++)
         for (int c = 0; c < 2; c++)
-            y[2 * r + c] = vdot4(t[4 * r], x[c], t[4 * r + 1], x[2 + c], t[4 * r + 2], x[4 + c], t[4 * r + 3], x[6 + c]);
+            y[2 * r + c] = vdot4(t[4 * r], x[c], t[4 * r + 1], x[xs + c], t[4 * r + 2], x[2 * xs + c], t[4 * r + 3],
+                                 x[3 * xs + c]);
 }
 
 /* columns c0 .. 3 of y = x t: x and y 2x4, t 4x4 (row-major); c0 a constant where inlined */
@@ -535,9 +536,11 @@ AI void chain_block(const cv *tmat, const int64_t *seg_of, Py_ssize_t n_int, con
                     cv *post)
 {
     const cv one = V(splat(1.0), splat(0.0)), zero = V(splat(0.0), splat(0.0));
-    /* the products live in memory (two buffers each, swapped): few values in registers at once */
+    /* the products live in memory (two buffers each, used in turn): few values in registers at once.
+     * The first segment's matrix is read where it is (no copy): cs is the stride between rows. */
     cv buf[32];
-    cv *cols = buf, *ncols = buf + 8; /* u-columns of T(0 -> x), 4x2 row-major */
+    const cv *cols = buf; /* u-columns of T(0 -> x), 4x2: entry (r, c) at cols[cs * r + c] */
+    int cs = 2;
     {
         Py_ssize_t p = 0;
         int fresh = 1;
@@ -547,7 +550,7 @@ AI void chain_block(const cv *tmat, const int64_t *seg_of, Py_ssize_t n_int, con
                 if (fresh) {
                     d[0] = one; d[1] = zero; d[2] = zero; d[3] = one;
                 } else {
-                    d[0] = cols[0]; d[1] = cols[1]; d[2] = cols[2]; d[3] = cols[3];
+                    d[0] = cols[0]; d[1] = cols[1]; d[2] = cols[cs]; d[3] = cols[cs + 1];
                 }
                 p++;
             }
@@ -555,21 +558,22 @@ AI void chain_block(const cv *tmat, const int64_t *seg_of, Py_ssize_t n_int, con
                 break;
             const cv *t = tmat + 16 * seg_of[k];
             if (fresh) {
-                for (int r = 0; r < 4; r++) {
-                    cols[2 * r] = t[4 * r];
-                    cols[2 * r + 1] = t[4 * r + 1];
-                }
+                cols = t;
+                cs = 4;
                 fresh = 0;
             } else {
-                times_columns(t, cols, ncols);
-                cv *swap = cols;
-                cols = ncols;
-                ncols = swap;
+                cv *next = cols == buf ? buf + 8 : buf;
+                if (cs == 4)
+                    times_columns(t, cols, 4, next);
+                else
+                    times_columns(t, cols, 2, next);
+                cols = next;
+                cs = 2;
             }
         }
     }
     {
-        cv *rows = buf + 16, *nrows = buf + 24; /* F-rows of T(x -> L), 2x4 row-major */
+        const cv *rows = buf + 16; /* F-rows of T(x -> L), 2x4 row-major */
         Py_ssize_t p = m - 1;
         int fresh = 1;
         for (Py_ssize_t k = n_int; k >= 0; k--) {
@@ -586,24 +590,20 @@ AI void chain_block(const cv *tmat, const int64_t *seg_of, Py_ssize_t n_int, con
                 break;
             const cv *t = tmat + 16 * seg_of[k - 1];
             if (fresh) {
-                for (int c = 0; c < 4; c++) {
-                    rows[c] = t[8 + c];
-                    rows[4 + c] = t[12 + c];
-                }
+                rows = t + 8;
                 fresh = 0;
             } else {
+                cv *next = rows == buf + 16 ? buf + 24 : buf + 16;
                 /* the last product (reaching the first node) needs only the F-columns */
                 if (p == 0 && nodes[0] == k - 1)
-                    rows_times(rows, t, nrows, 2);
+                    rows_times(rows, t, next, 2);
                 else
-                    rows_times(rows, t, nrows, 0);
-                cv *swap = rows;
-                rows = nrows;
-                nrows = swap;
+                    rows_times(rows, t, next, 0);
+                rows = next;
             }
         }
     }
-    const cv c4 = cols[4], c5 = cols[5], c6 = cols[6], c7 = cols[7];
+    const cv c4 = cols[2 * cs], c5 = cols[2 * cs + 1], c6 = cols[3 * cs], c7 = cols[3 * cs + 1];
     /* M_Fu^-1, M_Fu = [[c4, c5], [c6, c7]] */
     cv idet = vinv(vdet2(c4, c5, c6, c7));
     cv i00 = vmul(c7, idet), i11 = vmul(c4, idet), i01 = vmul(vneg(c5), idet), i10 = vmul(vneg(c6), idet);
