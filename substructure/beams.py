@@ -26,12 +26,10 @@ formula are evaluated by the compiled kernels of :mod:`substructure._kernels`,
 one frequency line at a time (and over configurations in sweeps); this
 module prepares their inputs.
 
-Shear coefficient: Cowper (1966) for a hollow circular section,
-``kappa = 6(1+nu)(1+m^2)^2 / ((7+6nu)(1+m^2)^2 + (20+12nu)m^2)``, ``m = id/od``
-(0.886 for a solid steel section).  A composite section (a bore filled by an
-``Insert``) sums ``EI``, ``kappa G A``, ``rho A`` and ``rho I`` over its
-layers, each with its own ``kappa``.  A fluted length is a solid section of
-the equivalent diameter ``diameter_ratio * od`` for both stiffness and mass.
+Sections (the shear coefficient, composite and fluted sections) live in
+``substructure.sections`` and the chain machinery (cutting long chains
+into well-conditioned pieces) in ``substructure._chains``; their public
+names are importable from here as before.
 """
 
 from __future__ import annotations
@@ -44,10 +42,10 @@ import numpy as np
 import pint
 
 from . import _blocks as bk
-from ._engine import Link, couple_substructures
+from ._chains import _CHUNK_KL, _chain_receptance, _chain_single, _is_shared, _phase, _stack_sections  # noqa: F401
 from .errors import InvalidValueError
-from .materials import Material, get_material
-from .units import dimensionless, magnitude_in, quantity, ureg
+from .sections import Flutes, Insert, Section, _length, _material, _metres, shear_coefficient
+from .units import magnitude_in, quantity
 
 __all__ = [
     "Insert",
@@ -60,174 +58,6 @@ __all__ = [
     "stepped_beam_receptance_batch",
     "stepped_beam_receptance_si",
 ]
-
-
-
-def _length(field: str, *, allow_zero: bool = False):
-    def convert(value) -> pint.Quantity:
-        q = quantity(value, field, "[length]")
-        if q.magnitude < 0 or (q.magnitude == 0 and not allow_zero):
-            expected = "a length >= 0" if allow_zero else "a positive length"
-            raise InvalidValueError(f"{field}: got {value!r}; expected {expected}")
-        return q
-
-    return convert
-
-
-_METRE = ureg.Unit("m")
-
-
-def _metres(value, field: str) -> pint.Quantity:
-    """A float in metres as a quantity (no text parsed); bare numbers only."""
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-        raise InvalidValueError(f"{field}: got {value!r}; expected a number of metres")
-    return ureg.Quantity(float(value), _METRE)
-
-
-def _material(value) -> Material:
-    if isinstance(value, Material):
-        return value
-    if isinstance(value, str):
-        return get_material(value)
-    raise InvalidValueError(
-        f"material: got {value!r}; expected a Material or a catalogue name (steel, carbide, aluminium)"
-    )
-
-
-def shear_coefficient(nu: float, ratio: float = 0.0) -> float:
-    """Cowper's (1966) shear coefficient of a hollow circular section.
-
-    Parameters
-    ----------
-    nu : float
-        Poisson ratio.
-    ratio : float
-        Inner to outer diameter, ``m = id / od`` (0 for a solid section).
-
-    Returns
-    -------
-    float
-        The shear coefficient kappa (dimensionless).
-    """
-    m2 = ratio * ratio
-    a = (1.0 + m2) ** 2
-    return 6.0 * (1.0 + nu) * a / ((7.0 + 6.0 * nu) * a + (20.0 + 12.0 * nu) * m2)
-
-
-@attrs.frozen
-class Section:
-    """Section properties of a segment in SI units (complex with loss factor).
-
-    Parameters
-    ----------
-    EI : complex
-        Bending stiffness [N m^2].
-    kGA : complex
-        Shear stiffness ``kappa G A`` [N].
-    rhoA : float
-        Mass per length [kg/m].
-    rhoI : float
-        Rotary inertia per length [kg m].
-    """
-
-    EI: complex
-    kGA: complex
-    rhoA: float
-    rhoI: float
-
-    def __add__(self, other: "Section") -> "Section":
-        return Section(self.EI + other.EI, self.kGA + other.kGA, self.rhoA + other.rhoA, self.rhoI + other.rhoI)
-
-    @classmethod
-    def ring(cls, od: float, id: float, material: Material) -> "Section":
-        """A circular ring of one material (``id = 0`` for a solid circle), SI inputs.
-
-        Parameters
-        ----------
-        od : float
-            Outer diameter in m.
-        id : float
-            Inner diameter in m (0 for a solid circle).
-        material : Material
-            The material.
-
-        Returns
-        -------
-        Section
-            The section properties, SI.
-        """
-        area = math.pi / 4.0 * (od**2 - id**2)
-        inertia = math.pi / 64.0 * (od**4 - id**4)
-        kappa = shear_coefficient(material.nu, id / od)
-        return cls(
-            EI=material.E_si * inertia,
-            kGA=kappa * material.G_si * area,
-            rhoA=material.rho_si * area,
-            rhoI=material.rho_si * inertia,
-        )
-
-
-@attrs.frozen
-class Insert:
-    """A concentric body filling a segment's bore, e.g. the tool shank in a holder.
-
-    Parameters
-    ----------
-    od : quantity or str
-        Outer diameter of the insert; at most the bore (``id``) of its segment.
-    material : Material or str
-        The insert's material (a catalogue name such as ``"carbide"``).
-    id : quantity or str, default "0 mm"
-        Inner diameter of the insert (0 for a solid shank).
-    """
-
-    od: pint.Quantity = attrs.field(converter=_length("insert.od"))
-    material: Material = attrs.field(converter=_material)
-    id: pint.Quantity = attrs.field(default="0 mm", converter=_length("insert.id", allow_zero=True))
-    _si: tuple = attrs.field(init=False, eq=False, repr=False)
-
-    def __attrs_post_init__(self) -> None:
-        od, id_ = magnitude_in(self.od, "m"), magnitude_in(self.id, "m")
-        if id_ >= od:
-            raise InvalidValueError(
-                f"insert.id: got {self.id:~P} with insert.od {self.od:~P}; expected id < od"
-            )
-        object.__setattr__(self, "_si", (od, id_))
-
-    @property
-    def od_m(self) -> float:
-        """Outer diameter in metres."""
-        return self._si[0]
-
-    @property
-    def id_m(self) -> float:
-        """Inner diameter in metres."""
-        return self._si[1]
-
-
-def _ratio(value) -> float:
-    r = dimensionless(value, "flutes.diameter_ratio")
-    if not 0.0 < r <= 1.0:
-        raise InvalidValueError(f"flutes.diameter_ratio: got {value!r}; expected a ratio in (0, 1]")
-    return r
-
-
-@attrs.frozen
-class Flutes:
-    """Fluted length of a tool, modelled by an equivalent solid diameter.
-
-    The fluted section is a circle of diameter ``diameter_ratio * od`` for
-    both its stiffness and its mass (0.8 is a common value for two- to
-    four-flute end mills).
-
-    Parameters
-    ----------
-    diameter_ratio : float
-        Equivalent diameter over the outer diameter, in (0, 1] (dimensionless).
-    """
-
-    diameter_ratio: float = attrs.field(converter=_ratio)
-
 
 def _optional_length(field: str, *, allow_zero: bool = False):
     convert = _length(field, allow_zero=allow_zero)
@@ -574,147 +404,6 @@ def segment_dynamic_stiffness(sec: Section, length: float, omega: np.ndarray):
     return d11, d12, d21, d22
 
 
-# ---------------------------------------------------------------------------
-# Chains of segments: free-free receptances by transfer matrices
-#
-# An interval is a pair ``(section, length)``.  In a batch of ``n_config``
-# configurations the fields of the section and the length are either scalars
-# (the same in every configuration) or arrays of ``n_config`` values.
-
-
-def _is_shared(sec: Section, length) -> bool:
-    return not any(isinstance(v, np.ndarray) for v in (sec.EI, sec.kGA, sec.rhoA, sec.rhoI, length))
-
-
-def _chain_single(intervals: list[tuple[Section, object]], nodes: list[int], omega: np.ndarray,
-                  n_config: int = 1, place: list[int] | None = None) -> np.ndarray:
-    """Free-free receptances of a chain of uniform intervals at some of its nodes.
-
-    ``intervals[k]`` spans node ``k`` to node ``k + 1``; ``nodes`` are sorted,
-    distinct node indices.  With the state ``z = [u; F]`` (``u = [w, psi]``,
-    ``F = [V, M]``) a load ``g`` at node ``j`` makes ``F`` jump by ``-g``; the
-    free ends give ``F = 0`` before the base and after the tip, so
-
-    ``Y_ij = P_i,uu M_Fu^-1 S_j,FF - [x_i > x_j] T_(j->i),uF``
-
-    with ``P_i = T(0 -> x_i)``, ``S_j = T(x_j -> L)`` and ``M = T(0 -> L)``.
-    ``M_Fu`` is singular only at the free-free natural frequencies, and its
-    ``omega^2`` factor carries the rigid-body modes exactly, so the result is
-    well conditioned down to the lowest frequency line.  The blocks with
-    ``x_i > x_j`` are taken from reciprocity, ``Y_ij = Y_ji^T``: evaluated
-    from their own formula, whose two terms grow like ``exp(k (x_i - x_j))``
-    and cancel, they would lose about ``exp(k L)`` more digits.
-
-    Computed line by line by :func:`substructure._kernels.chain_receptance`.
-    Intervals that are the same object (the equal pieces of a split segment)
-    are one segment for the kernel, computed once per line; in a batch, a
-    segment that is the same in every configuration is computed once per
-    frequency line for all of them.  Node ``nodes[i]`` is put at position
-    ``place[i]`` of the result (default: in order).  Returns
-    ``(2m, 2m, n_config * n_freq)``.
-    """
-    from . import _kernels
-
-    index: dict[tuple, int] = {}
-    unique: list[tuple[Section, object]] = []
-    seg_of = []
-    for sec, length in intervals:
-        key = (id(sec), id(length) if isinstance(length, np.ndarray) else length)
-        if key not in index:
-            index[key] = len(unique)
-            unique.append((sec, length))
-        seg_of.append(index[key])
-    n_u = len(unique)
-    ei = np.empty((n_u, n_config), dtype=complex)
-    kga = np.empty((n_u, n_config), dtype=complex)
-    rhoa = np.empty((n_u, n_config))
-    rhoi = np.empty((n_u, n_config))
-    lengths = np.empty((n_u, n_config))
-    shared = np.zeros(n_u, dtype=bool)
-    for u, (sec, length) in enumerate(unique):
-        ei[u], kga[u], rhoa[u], rhoi[u], lengths[u] = sec.EI, sec.kGA, sec.rhoA, sec.rhoI, length
-        shared[u] = n_config > 1 and _is_shared(sec, length)
-    return _kernels.chain_receptance(
-        _kernels.c_array(omega, float), ei, kga, rhoa, rhoi, lengths, shared,
-        np.array(seg_of, dtype=np.int64), np.array(nodes, dtype=np.int64),
-        np.arange(len(nodes), dtype=np.int64) if place is None else np.array(place, dtype=np.int64),
-    )
-
-
-_CHUNK_KL = 8.0  # largest k L of one transfer-matrix chain: rounding ~ 1e-16 exp(8) ~ 3e-13
-
-
-def _phase(sec: Section, length, omega_max: float) -> float:
-    """Largest ``k L`` of an interval at ``omega_max`` (over a batch: the maximum)."""
-    from . import _kernels
-
-    ei, kga, rhoa, rhoi, length = np.broadcast_arrays(
-        *(np.atleast_1d(v) for v in (sec.EI, sec.kGA, sec.rhoA, sec.rhoI, length))
-    )
-    _, k_max = _kernels.segment_coefficients(
-        _kernels.c_array(ei.reshape(1, -1), complex), _kernels.c_array(kga.reshape(1, -1), complex),
-        _kernels.c_array(rhoa.reshape(1, -1), float), _kernels.c_array(rhoi.reshape(1, -1), float),
-        float(omega_max),
-    )
-    return float(np.max(k_max[0] * length))
-
-
-def _chain_receptance(
-    intervals: list[tuple], nodes: list[int], omega: np.ndarray, phases: list[float] | None = None,
-    n_config: int = 1, place: list[int] | None = None,
-) -> np.ndarray:
-    """Free-free receptances of a chain at some of its nodes, for any length and frequency.
-
-    The transfer-matrix rounding grows like ``exp(k L)`` (``k`` the evanescent
-    bending wavenumber), so a chain with ``k L`` above 8 at the highest line is
-    cut into pieces of ``k L <= 8``: each piece's receptances come from
-    :func:`_chain_single` and the pieces are joined by rigid connections with
-    the coupling engine, which is exact and well conditioned.  Short chains
-    (the usual case) are one piece.  ``omega`` holds the frequency lines of
-    one configuration; the result has ``n_config * omega.size`` lines.
-    ``nodes`` are sorted; node ``nodes[i]`` is put at position ``place[i]``
-    of the result (default: in order).
-    """
-    omega_max = float(np.max(omega)) if omega.size else 0.0
-    if phases is None:
-        phases = [_phase(sec, length, omega_max) for sec, length in intervals]
-    refined, node_map, piece_phases = [], [0], []
-    for item, kl in zip(intervals, phases):
-        n_sub = max(1, math.ceil(kl / _CHUNK_KL))
-        piece = item if n_sub == 1 else (item[0], item[1] / n_sub)
-        refined.extend([piece] * n_sub)
-        piece_phases.extend([kl / n_sub] * n_sub)
-        node_map.append(node_map[-1] + n_sub)
-    phases = piece_phases
-    nodes = [node_map[i] for i in nodes]
-    bounds, acc = [0], 0.0
-    for i, kl in enumerate(phases):
-        if acc + kl > _CHUNK_KL and i > bounds[-1]:
-            bounds.append(i)
-            acc = 0.0
-        acc += kl
-    bounds.append(len(refined))
-    if len(bounds) == 2:
-        return _chain_single(refined, nodes, omega, n_config, place)
-    blocks, links = [], []
-    last = len(bounds) - 2
-    for c, (n0, n1) in enumerate(zip(bounds[:-1], bounds[1:])):
-        local = {nd for nd in nodes if n0 <= nd <= n1}
-        if c > 0:
-            local.add(n0)
-            links.append(Link((c - 1, n0), (c, n0), None, "a beam's own cross-section"))
-        if c < last:
-            local.add(n1)
-        local = sorted(local)
-        y = _chain_single(refined[n0:n1], [nd - n0 for nd in local], omega, n_config)
-        blocks.append(([(c, nd) for nd in local], y))
-    outputs = [None] * len(nodes)
-    for i, nd in enumerate(nodes):
-        c = next(c for c, (n0, n1) in enumerate(zip(bounds[:-1], bounds[1:])) if n0 <= nd <= n1)
-        outputs[i if place is None else place[i]] = (c, nd)
-    return couple_substructures(blocks, links, outputs)
-
-
 def stepped_beam_receptance(
     segments: Sequence[Segment], positions: Sequence[float], frequency_hz: np.ndarray
 ) -> np.ndarray:
@@ -807,16 +496,6 @@ def stepped_beam_receptance_si(
         phases.append(float(k_max[0, k]) * float(x1 - x0))
     nodes = [int(i) for i in np.searchsorted(cuts, sorted_pos)]
     return _chain_receptance(intervals, nodes, omega, phases, place=[int(i) for i in order])
-
-
-def _stack_sections(sections: Sequence[Section]) -> Section:
-    """One Section whose fields are arrays over configurations."""
-    return Section(
-        EI=np.array([s.EI for s in sections], dtype=complex),
-        kGA=np.array([s.kGA for s in sections], dtype=complex),
-        rhoA=np.array([s.rhoA for s in sections], dtype=float),
-        rhoI=np.array([s.rhoI for s in sections], dtype=float),
-    )
 
 
 def stepped_beam_receptance_batch(

@@ -41,7 +41,8 @@ from typing import Any
 import attrs
 import pint
 
-from .beams import Insert, Segment, _material
+from .beams import Segment
+from .sections import Insert, _material
 from .errors import InvalidValueError
 from .units import Q_, quantity
 

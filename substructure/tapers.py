@@ -34,7 +34,9 @@ from typing import Sequence
 import attrs
 import numpy as np
 
-from .beams import Section, Segment, _phase, _stack_sections, shear_coefficient
+from ._chains import _phase, _stack_sections
+from .beams import Segment
+from .sections import Section, shear_coefficient
 from .errors import InvalidValueError
 from .units import Q_, quantity
 
