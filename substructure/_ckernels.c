@@ -129,7 +129,8 @@ static inline cx csqrt_(cx z)
  * above.  So a line's result does not depend on the lines it shares a block
  * with, nor on how the lines are split between threads, nor on the
  * instruction set.  The exponentials, cosines and sines are the C library's,
- * called lane by lane. */
+ * called lane by lane in a loop of their own over all the segments of a block
+ * (see waves, transcendentals and transfer below). */
 
 #ifndef VL
 #define VL 4
