@@ -48,7 +48,7 @@ import numpy as np
 from ..errors import InvalidValueError
 from ..units import to_si
 from ._semidiscrete import _chatter, _critical, _Plan, expm_batch
-from .cutting import as_speed_rpm
+from .speeds import as_speed_rpm
 from .modal import ModalModel
 from .result import Lobes
 from .structure import xy_receptance
