@@ -5,7 +5,7 @@ points.  The assembly owns its bookkeeping (which DOF is where), checks its
 names and points on construction, and is immutable: ``add``, ``connect``,
 ``attach``, ``support`` and the ``with_*``/``without*`` methods return new
 assemblies.  Its receptances come from the plan and the coupling of
-:mod:`substructure.assembly.plan`; an assembly is itself a component.
+``substructure.assembly.plan``; an assembly is itself a component.
 """
 
 from __future__ import annotations

@@ -17,17 +17,37 @@ subclass uses the generic ``name``/``type``/``material``/``segments`` table,
 plus one key per further field of its class (quantities written with their
 unit).  Writing checks that the text reads back to an equal assembly and
 refuses, naming the component and the fields, what would not: a file never
+silently loses a value.
 
 The package holds the reading (``reader``: key paths and line numbers in
 errors), the writing (``writer``: the text, the round-trip check and the
-atomic save) and the keys both share (``_schema``); every name is imported
-from here.
+atomic save, imported on first use) and the keys both share (``_schema``);
+every name is imported from here.
 """
 
 from __future__ import annotations
 
+from typing import Any
+
 from ._schema import MAX_TAPER_STEPS, SIZE_RANGE_M  # noqa: F401 (the limits of reading, named in errors)
 from .reader import default_assembly, load_assembly, loads_assembly
-from .writer import dumps_assembly, save_assembly
 
 __all__ = ["load_assembly", "loads_assembly", "save_assembly", "dumps_assembly", "default_assembly"]
+
+_WRITER = ("dumps_assembly", "save_assembly")
+
+
+def __getattr__(name: str) -> Any:
+    # the writer (and tomli_w) is imported when an assembly is written, not by the commands
+    # that only read one (PEP 562)
+    if name in _WRITER:
+        from . import writer
+
+        value = getattr(writer, name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

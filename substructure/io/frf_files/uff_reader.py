@@ -1,7 +1,7 @@
 """Reading universal files: :func:`read_uff`, type-58 records into an FRF in SI units.
 
 Records that are not FRFs are skipped; the others are read with their
-labels, quantity and units (:mod:`substructure.io.frf_files.uff_units`),
+labels, quantity and units (``uff_units``),
 checked for a complete file, and assembled into one FRF when they share a
 grid and a quantity and form a full matrix.
 """
