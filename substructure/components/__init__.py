@@ -40,7 +40,7 @@ New component types are registered with :func:`register_component` so that
 assembly files can name them by their ``type``.
 
 The package holds one concept per module: ``protocol`` (the registry
-:data:`COMPONENT_TYPES`, :func:`register_component`, :func:`is_plain_beam`
+``COMPONENT_TYPES``, :func:`register_component`, :func:`is_plain_beam`
 and the helpers every component uses), ``beam`` (:class:`Beam`,
 :class:`Spindle`, :class:`Holder`), ``tool`` (:class:`Tool` and
 :meth:`Tool.end_mill`) and ``measured`` (:class:`MeasuredComponent`); every
