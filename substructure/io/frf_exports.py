@@ -54,7 +54,7 @@ def _column(cell: str, name: str, line: int) -> tuple[str, str | None]:
 
 def _value_unit(unit: str | None, cell: str, name: str, line: int):
     """``(quantity, factor to SI)`` of a value column's unit; ``(None, 1)`` without one."""
-    from .frf_files import _exponents, _unit_of_label
+    from .frf_files.uff_units import _exponents, _unit_of_label
 
     if unit is None:
         return None, 1.0

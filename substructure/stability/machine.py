@@ -28,7 +28,7 @@ import pint
 
 from ..errors import InvalidValueError
 from ..units import Q_, quantity
-from .cutting import as_speed_rpm
+from .speeds import as_speed_rpm
 
 __all__ = ["MachineLimits", "SpeedCurve", "cut_power", "removal_rate", "cut_torque"]
 

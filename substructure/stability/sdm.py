@@ -48,7 +48,7 @@ import numpy as np
 from ..errors import InvalidValueError
 from ..units import to_si
 from ._semidiscrete import _chatter, _critical, _Plan, expm_batch
-from .cutting import as_speed_rpm
+from .speeds import as_speed_rpm
 from .modal import ModalModel
 from .result import Lobes
 from .structure import xy_receptance
@@ -114,10 +114,7 @@ def spectral_radius(modes: ModalModel, cut: Any, speeds: Any, depths: Any, *, in
         Fewest intervals in the cut when they are chosen per speed.
     max_phase_step : float, default 0.2
         Largest ``omega_ref * dt`` [rad] of an interval when they are chosen
-        per speed (``omega_ref``: the highest natural frequency among the
-        dominant modes).  The first-order method's error on the limit is
-        about ``0.1 * max_phase_step**2`` (0.4 % at 0.2 rad on the
-        Insperger-Stepan benchmark).
+        per speed; as in ``sdm``, whose documentation gives its error.
 
     Returns
     -------

@@ -32,7 +32,7 @@ import numpy as np
 from ..errors import InvalidValueError
 from ..frf import FRF, Frequency
 from .band import choose_band
-from .cutting import as_speed_rpm
+from .speeds import as_speed_rpm
 from .result import Lobes, StabilityWarning
 from .structure import xy_receptance
 

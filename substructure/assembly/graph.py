@@ -1,122 +1,32 @@
-"""The assembly graph: components connected by joints, with sensors and supports.
+"""The assembly graph: :class:`Assembly`, components connected by joints, with bodies and supports.
 
-Nodes are components, edges are joints; sensors and supports hang on points.
-The assembly owns its bookkeeping (which DOF is where), so one component can
-sit in many assemblies and sweeps at once.  It is immutable: ``add``,
-``connect``, ``attach``, ``support`` and friends return new assemblies.
-
-The coupled receptance between any points is computed by the one generic
-engine of :mod:`substructure.coupling`: the free-free receptances of the
-components at the points that matter (outputs, joint ends, sensor and
-support points) are stacked block-diagonally, and every joint, support and
-sensor is applied as a connection.  Any number of components and any
-topology (chain, branch, loop) work the same way.
-
-An assembly is itself a component: it can be added to a larger assembly,
-which is how a spindle-holder subassembly (modelled or measured) is coupled
-to a tool (thesis eq. 2.2).
-
-Examples
---------
->>> from substructure import Assembly, Holder, Tool, Segment
->>> holder = Holder("holder", [Segment("60 mm", "40 mm")])
->>> tool = Tool("tool", [Segment("50 mm", "12 mm", material="carbide")])
->>> asm = (Assembly("demo").add(holder, tool)
-...        .connect("holder.tip", "tool.base", k={"yf": "4e7 N/m", "tm": "6e4 N*m/rad"}))
->>> frf = asm.receptance("tool.tip", frequency=[1000.0, 2000.0])
->>> frf.outputs
-('tool.tip:y', 'tool.tip:theta')
+Nodes are components, edges are joints; sensors, masses and supports hang on
+points.  The assembly owns its bookkeeping (which DOF is where), checks its
+names and points on construction, and is immutable: ``add``, ``connect``,
+``attach``, ``support`` and the ``with_*``/``without*`` methods return new
+assemblies.  Its receptances come from the plan and the coupling of
+``substructure.assembly.plan``; an assembly is itself a component.
 """
 
 from __future__ import annotations
 
-from typing import Any, Sequence
+from typing import Sequence
 
 import attrs
 import numpy as np
 
-from .components import as_frequency
-from ._blocks import CHUNK_LINES, by_chunks
-from .coupling import Link, couple_substructures
-from .errors import AssemblyError, InvalidValueError, UnknownPointError
-from .frf import FRF, Frequency
-from .joints import Joint, Mass, Sensor, Support
-from .materials import Material
-from .points import DOFS, PointRef, parse_point
+from .._blocks import CHUNK_LINES, by_chunks
+from ..components import as_frequency
+from ..errors import AssemblyError, InvalidValueError, UnknownPointError
+from ..frf import FRF, Frequency
+from ..joints import Joint, Mass, Sensor, Support
+from ..materials import Material
+from ..points import PointRef, parse_point
+from ._fields import _component_check, _joint_check, _tuple
+from .plan import couple, expand_points, plan
+from .prepared import PreparedFRF
 
-__all__ = ["Assembly", "PreparedFRF", "expand_points"]
-
-
-def expand_points(points: Sequence[str] | str):
-    """DOF labels of point names, and where they sit: ``(labels, [(point, dof)], refs)``.
-
-    A point without a DOF suffix stands for both of its DOFs ``(y, theta)``.
-
-    Parameters
-    ----------
-    points : str or sequence of str
-        Point names, with or without a DOF suffix (``"tool.tip"``, ``"tool.tip:y"``).
-
-    Returns
-    -------
-    labels : list of str
-        The DOF labels (``"tool.tip:y"``, ``"tool.tip:theta"``).
-    dof_index : list of tuple
-        For each label, ``(index of its point in refs, 0 for y or 1 for theta)``.
-    refs : list of PointRef
-        The points, in order.
-    """
-    points = [points] if isinstance(points, str) else list(points)
-    if not points:
-        raise InvalidValueError("expected at least one point")
-    labels, dof_index, refs = [], [], []
-    for p in points:
-        ref = parse_point(p)
-        refs.append(ref.point)
-        base = str(ref.point)
-        for d, name in enumerate(DOFS):
-            if ref.dof is None or ref.dof == name:
-                labels.append(f"{base}:{name}")
-                dof_index.append((len(refs) - 1, d))
-    return labels, dof_index, refs
-
-
-def _tuple(kind: type | None = None):
-    def convert(value) -> tuple:
-        if value is None:
-            return ()
-        items = tuple(value)
-        if kind is not None:
-            for i, item in enumerate(items):
-                if not isinstance(item, kind):
-                    raise InvalidValueError(f"got {item!r} at position {i}; expected a {kind.__name__}")
-        return items
-
-    return convert
-
-
-def _joint_check(items) -> tuple:
-    items = _tuple()(items)
-    for i, j in enumerate(items):
-        missing = [a for a in ("name", "between", "rigid", "dynamic_stiffness") if not hasattr(j, a)]
-        if missing:
-            raise InvalidValueError(
-                f"joints[{i}]: {j!r} is not a joint (it has no {', '.join(missing)}); expected a Joint "
-                "or an object with name, between, rigid and dynamic_stiffness(frequency_hz)"
-            )
-    return items
-
-
-def _component_check(items) -> tuple:
-    items = _tuple()(items)
-    for c in items:
-        for attr in ("name", "component_names", "node_key", "receptance_matrix"):
-            if not hasattr(c, attr):
-                raise InvalidValueError(
-                    f"components: {c!r} is not a component (it has no {attr!r}); see "
-                    "substructure.components for the protocol"
-                )
-    return items
+__all__ = ["Assembly"]
 
 
 @attrs.frozen
@@ -531,40 +441,8 @@ class Assembly:
         return as_frequency(frequency)
 
     def _plan(self, refs: Sequence[PointRef]):
-        """What a computation needs: the nodes per component and the links, in order.
-
-        Returns ``(groups, out_keys, links)``: ``groups`` is a list of
-        ``(owner, [(key, ref), ...])`` (every point that takes part, deduplicated
-        by physical node), ``links`` a list of ``(key_a, key_b or None, object,
-        label)`` for sensors, supports and joints.  Assemblies of the same
-        structure give plans that match item by item (used by sweeps).
-        """
-        nodes: dict[Any, tuple[Any, PointRef]] = {}
-        # component name -> component (names are unique in an assembly)
-        index = {n: c for c in self.components for n in c.component_names}
-
-        def node(point) -> Any:
-            ref, owner, key = self._resolve(point, index=index)
-            nodes.setdefault(key, (owner, ref.point))
-            return key
-
-        out_keys = [node(r) for r in refs]
-        links = []
-        for s in self.sensors:
-            links.append((node(s.at), None, s, f"sensor {s.name!r}"))
-        for m in self.masses:
-            links.append((node(m.at), None, m, f"mass {m.name!r}"))
-        for s in self.supports:
-            links.append((node(s.at), None, s, s.name or f"support at {s.at}"))
-        for j in self.joints:
-            ka, kb = node(j.between[0]), node(j.between[1])
-            if ka == kb:
-                raise AssemblyError(f"joint {j.name!r} connects a point to itself")
-            links.append((ka, kb, j, f"joint {j.name!r}"))
-        groups: dict[int, list] = {}
-        for k, (owner, ref) in nodes.items():
-            groups.setdefault(id(owner), [owner, []])[1].append((k, ref))
-        return [tuple(g) for g in groups.values()], out_keys, links
+        # what a computation needs (substructure.assembly.plan.plan); sweeps compare the plans
+        return plan(self, refs)
 
     def receptance_matrix(self, refs: Sequence[PointRef], frequency_hz: np.ndarray) -> np.ndarray:
         """Coupled receptances between points, frequency last (the component protocol).
@@ -585,17 +463,7 @@ class Assembly:
         groups, out_keys, links = self._plan(refs)
         return by_chunks(lambda f: self._compute(groups, out_keys, links, f), frequency_hz)
 
-    @staticmethod
-    def _compute(groups, out_keys, links, f: np.ndarray) -> np.ndarray:
-        blocks = [
-            ([k for k, _ in items], owner.receptance_matrix([ref for _, ref in items], f))
-            for owner, items in groups
-        ]
-        coupling_links = [
-            Link(ka, kb, None if getattr(obj, "rigid", False) else obj.dynamic_stiffness(f), label)
-            for ka, kb, obj, label in links
-        ]
-        return couple_substructures(blocks, coupling_links, out_keys)
+    _compute = staticmethod(couple)  # one chunk of lines (substructure.assembly.plan.couple)
 
     def prepare(self, outputs, inputs=None, frequency=None) -> "PreparedFRF":
         """The FRF from ``inputs`` to ``outputs``, ready to be re-evaluated fast.
@@ -709,7 +577,7 @@ class Assembly:
         str
             One line per component, joint, support and sensor, with units.
         """
-        from .components import component_info
+        from ..components import component_info
 
         lines = [f"{self.name}:"]
         lines += [f"  component {component_info(c)}" for c in self.components]
@@ -723,116 +591,3 @@ class Assembly:
         for m in self.masses:
             lines.append(f"  mass {m.name} at {m.at}: {m.mass:~P}")
         return "\n".join(lines)
-
-
-class PreparedFRF:
-    """An assembly's FRF at fixed points and frequency lines, for fast re-evaluation.
-
-    Built by :meth:`Assembly.prepare`.  :meth:`evaluate` accepts replacements
-    for joints (by name), sensors (by name) and supports (by name or label),
-    which must act on the same points as the ones they replace; everything
-    else (the components' free-free receptances) is reused.
-
-    Parameters
-    ----------
-    assembly : Assembly
-        The model.
-    outputs : str or sequence of str
-        Response points (``"tool.tip:y"``; without a DOF suffix, both DOFs).
-    inputs : str or sequence of str, optional
-        Excitation points; default ``outputs``.
-    frequency : Frequency or array_like, optional
-        Frequency lines (plain numbers in Hz); default the assembly's grid.
-    """
-
-    def __init__(self, assembly: Assembly, outputs, inputs=None, frequency=None):
-        self.assembly = assembly
-        self.frequency = assembly._frequency(frequency)
-        outputs = [outputs] if isinstance(outputs, str) else list(outputs)
-        inputs = outputs if inputs is None else ([inputs] if isinstance(inputs, str) else list(inputs))
-        self.outputs, out_idx, out_refs = expand_points(outputs)
-        self.inputs, in_idx, in_refs = expand_points(inputs)
-        groups, self._out_keys, self._links = assembly._plan(out_refs + in_refs)
-        f = self.frequency.hz
-        self._groups = groups
-        self._blocks = [
-            ([k for k, _ in items], by_chunks(lambda ff, o=owner, r=[ref for _, ref in items]: o.receptance_matrix(r, ff), f))
-            for owner, items in groups
-        ]
-        self._rows = [2 * i + d for i, d in out_idx]
-        self._cols = [2 * (len(out_refs) + i) + d for i, d in in_idx]
-
-    def _replacement(self, obj, joints, sensors, supports):
-        if isinstance(obj, Mass):
-            return obj
-        if isinstance(obj, Sensor):
-            new = sensors.get(obj.name, obj)
-            where = (obj.at, new.at)
-        elif isinstance(obj, Support):
-            new = supports.get(obj.name or f"support at {obj.at}", obj)
-            where = (obj.at, new.at)
-        else:
-            new = joints.get(obj.name, obj)
-            where = (tuple(obj.between), tuple(new.between))
-        if where[0] != where[1]:
-            raise InvalidValueError(
-                f"prepared FRF: a replacement must act on the same points ({where[0]}), got {where[1]}"
-            )
-        return new
-
-    def evaluate(self, joints=None, sensors=None, supports=None, components=None) -> FRF:
-        """The FRF with some joints, sensors, supports or components replaced (mappings by name).
-
-        A replaced component is recomputed at the same points (it must have
-        them); the others' receptances are reused.
-
-        Parameters
-        ----------
-        joints : mapping, optional
-            ``{joint name: Joint}``: joints acting between the same points.
-        sensors : mapping, optional
-            ``{sensor name: Sensor}``: sensors at the same points.
-        supports : mapping, optional
-            ``{support name or "support at POINT": Support}``.
-        components : mapping, optional
-            ``{component name: component}``, recomputed at the same points.
-
-        Returns
-        -------
-        FRF
-            The FRF at the prepared points and lines (m/N, m/(N m), rad/N, rad/(N m)).
-        """
-        joints, sensors, supports = dict(joints or {}), dict(sensors or {}), dict(supports or {})
-        components = dict(components or {})
-        blocks_all = self._blocks
-        if components:
-            f_all = self.frequency.hz
-            blocks_all = list(self._blocks)
-            names = {owner.name: i for i, (owner, _) in enumerate(self._groups)}
-            for name, comp in components.items():
-                if name not in names:
-                    raise UnknownPointError(
-                        f"prepared FRF: no component {name!r} takes part (components: {sorted(names)})"
-                    )
-                i = names[name]
-                refs = [ref for _, ref in self._groups[i][1]]
-                blocks_all[i] = (blocks_all[i][0], by_chunks(lambda ff: comp.receptance_matrix(refs, ff), f_all))
-        known = {o.name for _, _, o, _ in self._links if not isinstance(o, (Sensor, Support, Mass))}
-        unknown = set(joints) - known
-        if unknown:
-            raise UnknownPointError(f"prepared FRF: no joint {sorted(unknown)} (joints: {sorted(known)})")
-        objs = [self._replacement(obj, joints, sensors, supports) for _, _, obj, _ in self._links]
-        f = self.frequency.hz
-        n = f.size
-        parts = []
-        for start in range(0, n, CHUNK_LINES):
-            sl = slice(start, min(n, start + CHUNK_LINES))
-            blocks = [(keys, y[..., sl]) for keys, y in blocks_all]
-            links = [
-                Link(ka, kb, None if getattr(o, "rigid", False) else o.dynamic_stiffness(f[sl]), label)
-                for (ka, kb, _, label), o in zip(self._links, objs)
-            ]
-            parts.append(couple_substructures(blocks, links, self._out_keys))
-        y = np.concatenate(parts, axis=-1) if len(parts) > 1 else parts[0]
-        data = np.moveaxis(y[np.ix_(self._rows, self._cols)], -1, 0)
-        return FRF(self.frequency, data, tuple(self.outputs), tuple(self.inputs))

@@ -1,0 +1,48 @@
+"""The checks and conversions of an assembly's fields: sequences of joints, components, bodies.
+
+:class:`~substructure.assembly.Assembly` uses them as attrs converters; each
+refuses an item that is not what the field holds, naming the field and the
+position.
+"""
+
+from __future__ import annotations
+
+from ..errors import InvalidValueError
+
+
+def _tuple(kind: type | None = None):
+    def convert(value) -> tuple:
+        if value is None:
+            return ()
+        items = tuple(value)
+        if kind is not None:
+            for i, item in enumerate(items):
+                if not isinstance(item, kind):
+                    raise InvalidValueError(f"got {item!r} at position {i}; expected a {kind.__name__}")
+        return items
+
+    return convert
+
+
+def _joint_check(items) -> tuple:
+    items = _tuple()(items)
+    for i, j in enumerate(items):
+        missing = [a for a in ("name", "between", "rigid", "dynamic_stiffness") if not hasattr(j, a)]
+        if missing:
+            raise InvalidValueError(
+                f"joints[{i}]: {j!r} is not a joint (it has no {', '.join(missing)}); expected a Joint "
+                "or an object with name, between, rigid and dynamic_stiffness(frequency_hz)"
+            )
+    return items
+
+
+def _component_check(items) -> tuple:
+    items = _tuple()(items)
+    for c in items:
+        for attr in ("name", "component_names", "node_key", "receptance_matrix"):
+            if not hasattr(c, attr):
+                raise InvalidValueError(
+                    f"components: {c!r} is not a component (it has no {attr!r}); see "
+                    "substructure.components for the protocol"
+                )
+    return items

@@ -1,0 +1,136 @@
+"""The plan of a computation: which points take part, the links, and the coupling of a chunk.
+
+:func:`expand_points` turns point names into DOF labels; :func:`plan` finds,
+for an assembly and the requested points, the nodes of each component
+(deduplicated by physical node) and the links of its sensors, masses,
+supports and joints; :func:`couple` asks each component for its receptances
+at its nodes and runs the coupling engine on one chunk of frequency lines.
+:class:`~substructure.assembly.Assembly`, :class:`~substructure.assembly.PreparedFRF`
+and :func:`substructure.sweep.sweep` share them (assemblies of the same
+structure give plans that match item by item).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+import numpy as np
+
+from ..coupling import Link, couple_substructures
+from ..errors import AssemblyError, InvalidValueError
+from ..points import DOFS, PointRef, parse_point
+
+__all__ = ["expand_points", "plan", "couple"]
+
+
+def expand_points(points: Sequence[str] | str):
+    """DOF labels of point names, and where they sit: ``(labels, [(point, dof)], refs)``.
+
+    A point without a DOF suffix stands for both of its DOFs ``(y, theta)``.
+
+    Parameters
+    ----------
+    points : str or sequence of str
+        Point names, with or without a DOF suffix (``"tool.tip"``, ``"tool.tip:y"``).
+
+    Returns
+    -------
+    labels : list of str
+        The DOF labels (``"tool.tip:y"``, ``"tool.tip:theta"``).
+    dof_index : list of tuple
+        For each label, ``(index of its point in refs, 0 for y or 1 for theta)``.
+    refs : list of PointRef
+        The points, in order.
+    """
+    points = [points] if isinstance(points, str) else list(points)
+    if not points:
+        raise InvalidValueError("expected at least one point")
+    labels, dof_index, refs = [], [], []
+    for p in points:
+        ref = parse_point(p)
+        refs.append(ref.point)
+        base = str(ref.point)
+        for d, name in enumerate(DOFS):
+            if ref.dof is None or ref.dof == name:
+                labels.append(f"{base}:{name}")
+                dof_index.append((len(refs) - 1, d))
+    return labels, dof_index, refs
+
+
+def plan(assembly, refs: Sequence[PointRef]):
+    """What a computation needs: the nodes per component and the links, in order.
+
+    Assemblies of the same structure give plans that match item by item (used
+    by sweeps).
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model.
+    refs : sequence of PointRef
+        The requested points.
+
+    Returns
+    -------
+    groups : list of tuple
+        ``(owner, [(key, ref), ...])``: every point that takes part,
+        deduplicated by physical node, grouped by the component that owns it.
+    out_keys : list
+        The node key of each requested point.
+    links : list of tuple
+        ``(key_a, key_b or None, object, label)`` for sensors, masses,
+        supports and joints.
+    """
+    nodes: dict[Any, tuple[Any, PointRef]] = {}
+    # component name -> component (names are unique in an assembly)
+    index = {n: c for c in assembly.components for n in c.component_names}
+
+    def node(point) -> Any:
+        ref, owner, key = assembly._resolve(point, index=index)
+        nodes.setdefault(key, (owner, ref.point))
+        return key
+
+    out_keys = [node(r) for r in refs]
+    links = []
+    for s in assembly.sensors:
+        links.append((node(s.at), None, s, f"sensor {s.name!r}"))
+    for m in assembly.masses:
+        links.append((node(m.at), None, m, f"mass {m.name!r}"))
+    for s in assembly.supports:
+        links.append((node(s.at), None, s, s.name or f"support at {s.at}"))
+    for j in assembly.joints:
+        ka, kb = node(j.between[0]), node(j.between[1])
+        if ka == kb:
+            raise AssemblyError(f"joint {j.name!r} connects a point to itself")
+        links.append((ka, kb, j, f"joint {j.name!r}"))
+    groups: dict[int, list] = {}
+    for k, (owner, ref) in nodes.items():
+        groups.setdefault(id(owner), [owner, []])[1].append((k, ref))
+    return [tuple(g) for g in groups.values()], out_keys, links
+
+
+def couple(groups, out_keys, links, f: np.ndarray) -> np.ndarray:
+    """The coupled receptances of one chunk of lines, from a plan (frequency last).
+
+    Parameters
+    ----------
+    groups, out_keys, links
+        A plan, as :func:`plan` returns it.
+    f : ndarray
+        Frequencies in Hz.
+
+    Returns
+    -------
+    ndarray
+        Complex, shape ``(2k, 2k, f.size)`` for the k keys of ``out_keys``,
+        DOFs ``(y, theta)`` per key: m/N, m/(N m), rad/N and rad/(N m).
+    """
+    blocks = [
+        ([k for k, _ in items], owner.receptance_matrix([ref for _, ref in items], f))
+        for owner, items in groups
+    ]
+    coupling_links = [
+        Link(ka, kb, None if getattr(obj, "rigid", False) else obj.dynamic_stiffness(f), label)
+        for ka, kb, obj, label in links
+    ]
+    return couple_substructures(blocks, coupling_links, out_keys)

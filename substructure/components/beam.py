@@ -1,0 +1,314 @@
+"""Stepped Timoshenko beams as components: :class:`Beam` and its kinds :class:`Spindle` and :class:`Holder`.
+
+A beam is a name and its segments from base to tip; its points are the ends
+and positions along it (``tip-15 mm``), its receptances those of the stepped
+beam of :mod:`substructure.beams`.  :func:`component_info` writes the one
+line of a component in summaries.
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar, Sequence
+
+import attrs
+import numpy as np
+import pint
+
+from ..beams import Segment, stepped_beam_receptance
+from ..errors import InvalidValueError, UnknownPointError
+from ..frf import FRF
+from ..points import PointRef, check_name, parse_point
+from .protocol import _positive_frequencies, as_frequency, dof_labels, register_component
+
+__all__ = ["Beam", "Spindle", "Holder", "component_info"]
+
+
+def _segments(value) -> tuple[Segment, ...]:
+    if isinstance(value, Segment):
+        value = (value,)
+    try:
+        segs = tuple(value)
+    except TypeError:
+        raise InvalidValueError(f"segments: got {value!r}; expected a sequence of Segment") from None
+    if not segs:
+        raise InvalidValueError("segments: got none; expected at least one Segment (base to tip)")
+    for i, s in enumerate(segs):
+        if not isinstance(s, Segment):
+            raise InvalidValueError(f"segments[{i}]: got {s!r}; expected a Segment")
+    return segs
+
+
+def _text(field: str):
+    def check(instance, attribute, value) -> None:
+        if not isinstance(value, str):
+            raise InvalidValueError(f"{field}: got {value!r}; expected a text")
+
+    return check
+
+
+_BEAM_METHODS = ("receptance_matrix", "position")
+"""Methods whose override makes a Beam subclass something else than its segments (plain_beam False)."""
+
+
+@register_component("beam")
+@attrs.frozen
+class Beam:
+    """A free-free stepped Timoshenko beam (the base class of spindles, holders and tools).
+
+    Parameters
+    ----------
+    name : str
+        Name used in point names (``"tool"`` gives ``"tool.tip"``).
+    segments : sequence of Segment
+        Base to tip (lengths and diameters with units, see :class:`Segment`).
+    description : str, optional
+        What the component is and where its numbers come from (keyword only;
+        shown in summaries, kept in assembly files).  Catalogue holders say
+        here that their geometry is approximate.
+
+    Examples
+    --------
+    >>> from substructure import Tool, Segment
+    >>> tool = Tool("tool", [Segment("60 mm", "12 mm", material="carbide")])
+    >>> frf = tool.receptance([500.0, 1000.0], points=["tip"])
+    >>> frf.outputs
+    ('tool.tip:y', 'tool.tip:theta')
+    """
+
+    kind: ClassVar[str] = "beam"
+    plain_beam: ClassVar[bool] = True
+    """The receptances are those of ``segments`` alone (see :func:`is_plain_beam`).
+
+    A subclass that overrides ``receptance_matrix`` or ``position`` (a
+    lumped mass, a different point layout) gets False, so that sweeps call
+    its own ``receptance_matrix``; it may set ``plain_beam = True`` in its
+    class body when its receptances are still exactly the segments'.
+    """
+
+    name: str = attrs.field(converter=check_name)
+    segments: tuple[Segment, ...] = attrs.field(converter=_segments)
+    description: str = attrs.field(default="", kw_only=True, validator=_text("description"))
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        if "plain_beam" not in cls.__dict__ and any(m in cls.__dict__ for m in _BEAM_METHODS):
+            cls.plain_beam = False
+
+    @property
+    def component_names(self) -> frozenset[str]:
+        """The component names whose points this beam answers for: its own name."""
+        return frozenset({self.name})
+
+    @property
+    def length(self) -> pint.Quantity:
+        """Total length."""
+        total = self.segments[0].length
+        for s in self.segments[1:]:
+            total = total + s.length
+        return total.to(self.segments[0].length.units)
+
+    @property
+    def length_m(self) -> float:
+        """Total length in m (a float)."""
+        return float(sum(s.length_m for s in self.segments))
+
+    def mass(self) -> float:
+        """Total mass (inserts included).
+
+        Returns
+        -------
+        float
+            The mass in kg.
+        """
+        return float(sum(s.mass() for s in self.segments))
+
+    def position(self, ref: PointRef | str) -> float:
+        """Distance of a point from the base.
+
+        Parameters
+        ----------
+        ref : PointRef or str
+            A point of this beam: ``"tool.tip"``, ``"base"``, ``"@30 mm"``, ``"tip-15 mm"``.
+
+        Returns
+        -------
+        float
+            The distance from the base, in m.
+
+        Raises
+        ------
+        UnknownPointError
+            When the point is not on this beam or lies outside it.
+        """
+        if isinstance(ref, str):
+            ref = self._ref(ref)
+        if ref.component != self.name:
+            raise UnknownPointError(f"point {ref}: not on component {self.name!r}")
+        total = self.length_m
+        if ref.where == "base":
+            x = 0.0
+        elif ref.where == "tip":
+            x = total
+        elif ref.where == "at":
+            x = float(ref.distance.m_as("m"))
+        elif ref.where == "from_tip":
+            x = total - float(ref.distance.m_as("m"))
+        else:
+            raise UnknownPointError(
+                f"point {ref}: {self.name!r} has points base, tip, @X and tip-X, not {ref.where!r}"
+            )
+        tol = 1e-12 * total
+        if x < -tol or x > total + tol:
+            raise UnknownPointError(
+                f"point {ref}: lies outside {self.name!r}, whose length is {self.length:~P}"
+            )
+        return min(max(x, 0.0), total)
+
+    def node_key(self, ref: PointRef):
+        """A key of the physical point: two names of the same place give the same key.
+
+        Parameters
+        ----------
+        ref : PointRef
+            A point of this beam.
+
+        Returns
+        -------
+        tuple
+            ``(name, position in m rounded to 1e-12)``.
+        """
+        return (self.name, round(self.position(ref), 12))
+
+    def receptance_matrix(self, refs: Sequence[PointRef], frequency_hz: np.ndarray) -> np.ndarray:
+        """The free-free receptances between points, frequency last (the component protocol).
+
+        Parameters
+        ----------
+        refs : sequence of PointRef
+            The p points.
+        frequency_hz : ndarray
+            Frequencies in Hz, all > 0 (a free-free beam has no static receptance).
+
+        Returns
+        -------
+        ndarray
+            Complex, shape ``(2p, 2p, n_freq)``, DOFs ``(y, theta)`` per point: m/N, m/(N m),
+            rad/N and rad/(N m).
+        """
+        f = np.asarray(frequency_hz, dtype=float)
+        _positive_frequencies(f, f"component {self.name!r}")
+        return stepped_beam_receptance(self.segments, [self.position(r) for r in refs], f)
+
+    def _ref(self, point: str) -> PointRef:
+        text = point if point.startswith(self.name + ".") or point.startswith(self.name + "@") else (
+            f"{self.name}{point}" if point.startswith("@") else f"{self.name}.{point}"
+        )
+        return parse_point(text, allow_dof=False)
+
+    def receptance(self, frequency, points: Sequence[str] = ("tip",)) -> FRF:
+        """Free-free receptance matrix between points of this beam.
+
+        Parameters
+        ----------
+        frequency : Frequency or array_like
+            The frequency lines (plain numbers are in Hz), all > 0.
+        points : sequence of str
+            Point names, full (``"tool.tip"``) or local (``"tip"``, ``"base"``,
+            ``"@30 mm"``, ``"tip-15 mm"``).
+
+        Returns
+        -------
+        FRF
+            Outputs and inputs ``(p:y, p:theta)`` per point: H in m/N, L in m/(N m),
+            N in rad/N, P in rad/(N m).
+        """
+        freq = as_frequency(frequency)
+        refs = [self._ref(p) for p in points]
+        data = np.moveaxis(self.receptance_matrix(refs, freq.hz), -1, 0)
+        labels = dof_labels(str(r) for r in refs)
+        return FRF(freq, data, labels, labels)
+
+
+@register_component("spindle")
+@attrs.frozen
+class Spindle(Beam):
+    """A spindle: base at its rear end, tip at its nose.
+
+    Parameters
+    ----------
+    name : str
+        Name used in point names (``"spindle"`` gives ``"spindle.tip"``).
+    segments : sequence of Segment
+        Base to tip.
+    description : str, optional
+        What the component is and where its numbers come from (keyword only).
+    """
+
+
+@register_component("holder")
+@attrs.frozen
+class Holder(Beam):
+    """A tool holder: base at the taper end, tip at its face.
+
+    Parameters
+    ----------
+    name : str
+        Name used in point names (``"holder"`` gives ``"holder.tip"``).
+    segments : sequence of Segment
+        Base to tip.
+    description : str, optional
+        What the component is and where its numbers come from (keyword only).
+
+    Notes
+    -----
+    The part of the tool inside the holder is usually modelled as an
+    :class:`~substructure.beams.Insert` of the holder's bore segment
+    (thesis section 2.1).  Standard holders (BT40, CAT40, HSK-A63 with ER
+    collet chucks, shrink-fit or hydraulic noses) come from
+    :meth:`from_catalog`.
+    """
+
+    @classmethod
+    def from_catalog(cls, entry: str, *, name: str = "holder", **parameters) -> "Holder":
+        """A standard holder of approximate geometry from the catalogue, with overrides.
+
+        Parameters
+        ----------
+        entry : str
+            ``"<interface> <clamp>"``, e.g. ``"HSK-A63 shrink-fit"``, ``"BT40 ER32"``,
+            ``"CAT40 hydraulic"`` (:func:`substructure.holders.catalog_names`).
+        name : str
+            Component name.
+        **parameters
+            ``bore`` (the tool shank diameter, required), ``gauge_length``,
+            ``clamp_length``, ``material``, ``tool_material``, ``shank_taper``
+            and any geometric value of the catalogue by name, e.g.
+            ``nose_diameter="27 mm"`` (:func:`substructure.holders.design`).
+
+        Returns
+        -------
+        Holder
+            From the gauge line (its base, the spindle-holder joint) to the
+            nose, the tool shank as an insert over the clamped length; its
+            ``description`` says it is approximate and cites the sources.
+
+        Examples
+        --------
+        >>> h = Holder.from_catalog("BT40 ER32", bore="12 mm", gauge_length="70 mm", nut_diameter="48 mm")
+        >>> round(h.mass(), 2)
+        1.11
+        """
+        from ..holders import design
+
+        return design(entry, **parameters).holder(name, cls)
+
+
+def component_info(component: Any) -> str:
+    """One line describing a component, for summaries."""
+    kind = getattr(component, "kind", type(component).__name__)
+    if isinstance(component, Beam):
+        text = f"{component.name} ({kind}, {len(component.segments)} segments, {component.length:~P}, {component.mass():.3g} kg)"
+        if component.description:  # its first sentence: catalogue holders carry their sources after it
+            text += ": " + component.description.split(". ")[0].rstrip(".")
+        return text
+    return f"{component.name} ({kind})"

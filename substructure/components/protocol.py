@@ -1,0 +1,148 @@
+"""The component protocol's shared machinery: the registry of types and the helpers of every component.
+
+:data:`COMPONENT_TYPES` and :func:`register_component` name component
+classes for assembly files; :func:`as_frequency` and :func:`dof_labels` are
+what every component's ``receptance`` needs; :func:`is_plain_beam` tells
+batched computations when a component's receptances are those of its
+segments alone.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Iterable
+
+import numpy as np
+import pint
+
+from ..beams import Segment
+from ..errors import InvalidValueError
+from ..frf import FRF, Frequency
+from ..points import DOFS
+
+__all__ = ["COMPONENT_TYPES", "register_component", "as_frequency", "dof_labels", "is_plain_beam"]
+
+COMPONENT_TYPES: dict[str, type] = {}
+"""Registered component types by their ``type`` name in assembly files."""
+
+
+def register_component(kind: str):
+    """Class decorator registering a component type under ``kind``.
+
+    Parameters
+    ----------
+    kind : str
+        The name of the type in assembly files (``type = "shrink-fit-holder"``).
+
+    Returns
+    -------
+    callable
+        The decorator: it sets ``cls.kind``, adds the class to
+        :data:`COMPONENT_TYPES` and returns the class unchanged.
+
+    Raises
+    ------
+    InvalidValueError
+        When another class is already registered under ``kind``.
+
+    Examples
+    --------
+    >>> @register_component("shrink-fit-holder")          # doctest: +SKIP
+    ... @attrs.frozen
+    ... class ShrinkFitHolder(Holder): ...
+    """
+
+    def decorate(cls):
+        if kind in COMPONENT_TYPES and COMPONENT_TYPES[kind] is not cls:
+            raise InvalidValueError(f"component type {kind!r} is already registered")
+        cls.kind = kind
+        COMPONENT_TYPES[kind] = cls
+        return cls
+
+    return decorate
+
+
+def as_frequency(frequency) -> Frequency:
+    """A :class:`Frequency` from a Frequency, an FRF, an array of frequencies in Hz or a quantity.
+
+    A quantity in angular units is converted explicitly, as everywhere
+    (:func:`substructure.units.frequency_hz`): rad/s divided by ``2*pi``,
+    rpm by 60.
+
+    Parameters
+    ----------
+    frequency : Frequency, FRF, pint.Quantity or array_like
+        The frequency lines: a Frequency, the axis of an FRF, a quantity in Hz
+        (rad/s and rpm converted: divided by 2*pi and by 60), or plain numbers in Hz.
+
+    Returns
+    -------
+    Frequency
+        The frequency axis, in Hz.
+    """
+    if isinstance(frequency, Frequency):
+        return frequency
+    if isinstance(frequency, FRF):
+        return frequency.frequency
+    if isinstance(frequency, pint.Quantity):
+        from ..units import cycles_per_second, ureg
+
+        q = frequency if frequency._REGISTRY is ureg else ureg.Quantity(frequency.magnitude, str(frequency.units))
+        if not q.check("1 / [time]"):
+            raise InvalidValueError(
+                f"frequency: got a quantity in {q.units}; expected frequencies (Hz, or rad/s and rpm, "
+                "which are divided by 2*pi and by 60)"
+            )
+        return Frequency.from_hz(np.atleast_1d(np.asarray(cycles_per_second(q, "frequency"), dtype=float)))
+    if isinstance(frequency, str):
+        raise InvalidValueError(
+            f"frequency: got {frequency!r}; expected a Frequency (e.g. Frequency.from_range('20 Hz', "
+            "'5000 Hz', '2 Hz')) or an array of frequencies in Hz"
+        )
+    return Frequency.from_hz(np.atleast_1d(np.asarray(frequency, dtype=float)))
+
+
+def dof_labels(points: Iterable[str]) -> tuple[str, ...]:
+    """DOF labels ``("p:y", "p:theta", ...)`` of point names.
+
+    Parameters
+    ----------
+    points : iterable of str
+        Point names (``"tool.tip"``).
+
+    Returns
+    -------
+    tuple of str
+        Two labels per point: the displacement ``y`` (m) and the slope ``theta`` (rad).
+    """
+    return tuple(f"{p}:{d}" for p in points for d in DOFS)
+
+
+def _positive_frequencies(f: np.ndarray, who: str) -> None:
+    if np.any(f <= 0):
+        raise InvalidValueError(
+            f"frequency: {who} is free-free and has no static receptance; "
+            f"expected frequencies > 0 Hz, got {float(f.min())} Hz"
+        )
+
+
+def is_plain_beam(component: Any) -> bool:
+    """Whether a component's receptances are those of its ``segments`` alone (the ``plain_beam`` member).
+
+    Parameters
+    ----------
+    component : object
+        Any component.
+
+    Returns
+    -------
+    bool
+        True only when the component says so with ``plain_beam = True`` and
+        has a sequence of :class:`~substructure.beams.Segment` as
+        ``segments``; batched paths (sweeps) may then compute it from the
+        segments.  Everything else is computed through its
+        ``receptance_matrix``.
+    """
+    if getattr(component, "plain_beam", False) is not True:
+        return False
+    segments = getattr(component, "segments", None)
+    return isinstance(segments, tuple) and bool(segments) and all(isinstance(s, Segment) for s in segments)

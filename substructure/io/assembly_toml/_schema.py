@@ -1,0 +1,43 @@
+"""The keys of an assembly file, shared by the reader and the writer.
+
+The allowed keys of every table (top level, frequency, materials,
+components, segments, inserts, flutes, joints, supports, sensors, masses and
+the joint matrices), and the fields of a component class that its table
+holds: the generic ``name``/``segments``/``description`` plus one key per
+further init field of an attrs class.
+"""
+
+from __future__ import annotations
+
+import attrs
+
+_TOP_KEYS = ("name", "frequency", "materials", "components", "joints", "supports", "sensors", "masses")
+_FREQUENCY_KEYS = ("start", "stop", "step")
+_MATERIAL_KEYS = ("E", "nu", "rho", "loss_factor")
+_COMPONENT_KEYS = ("name", "type", "material", "segments", "description")
+_CATALOG_KEYS = ("name", "type", "catalog")  # and the catalogue holder's parameters
+SIZE_RANGE_M = (1e-6, 1e3)
+"""Lengths and diameters of segments an assembly file may give [m]: 1 um to 1 km (checked on reading)."""
+
+MAX_TAPER_STEPS = 10_000
+"""The most steps ``taper_steps`` may ask for (each is a beam element at every frequency line)."""
+
+_SEGMENT_KEYS = ("length", "od", "id", "material", "insert", "flutes", "od_tip", "id_tip", "taper_steps")
+_INSERT_KEYS = ("od", "material", "id")
+_FLUTES_KEYS = ("diameter_ratio",)
+_JOINT_KEYS = ("name", "between", "k", "c", "rigid")
+_SUPPORT_KEYS = ("name", "at", "k", "c")
+_SENSOR_KEYS = ("name", "at", "mass", "inertia", "always_on")
+_MASS_KEYS = ("name", "at", "mass", "inertia")
+_MATRIX_KEYS = ("yf", "ym", "tf", "tm")
+_STANDARD_FIELDS = ("name", "segments", "description")
+
+
+def _init_fields(cls) -> tuple[str, ...]:
+    return tuple(f.name for f in attrs.fields(cls) if f.init) if attrs.has(cls) else _STANDARD_FIELDS
+
+
+def _extra_fields(cls) -> tuple[str, ...]:
+    """The init fields of a Beam subclass beyond ``name`` and ``segments``: one key each in its table."""
+    return tuple(f for f in _init_fields(cls) if f not in _STANDARD_FIELDS)
+

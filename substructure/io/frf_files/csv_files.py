@@ -1,0 +1,168 @@
+"""CSV files of one FRF: :func:`write_csv` and :func:`read_csv`.
+
+One FRF per file, header ``frequency_hz,real,imag``, one line per frequency,
+receptance in m/N unless told otherwise; values are written with every
+digit (``repr``) so that a written file reads back to the same floats.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from ...errors import FileFormatError, InvalidValueError
+from ...frf import FRF, Frequency
+from ._common import _refuse_all_zero, _require_frf
+
+__all__ = ["write_csv", "read_csv"]
+
+CSV_HEADER = "frequency_hz,real,imag"
+
+
+def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True) -> None:
+    """Write a one-entry FRF to a CSV file ``frequency_hz,real,imag``.
+
+    Parameters
+    ----------
+    frf : FRF
+        Shape ``(n_freq, 1, 1)``; select one entry of a larger FRF first,
+        e.g. ``frf["tool.tip:y", "tool.tip:y"]``.  The data are written as
+        they are (the file does not record labels or quantity).
+    path : str or path-like
+        The file, written through a temporary file and an atomic rename
+        (:func:`substructure.io.replacing`).
+    overwrite : bool, default True
+        Whether an existing file may be replaced.
+
+    Raises
+    ------
+    InvalidValueError
+        For an FRF of more than one entry or of fewer than 2 lines (which
+        no reader takes).
+    """
+    from .. import write_text
+
+    frf = _require_frf(frf, "write_csv")
+    if frf.frequency.n < 2:
+        raise InvalidValueError(
+            f"frf: cannot write {os.fspath(path)}: an FRF file needs at least 2 frequency lines (readers refuse fewer)"
+        )
+    if frf.shape[1:] != (1, 1):
+        raise InvalidValueError(
+            f"frf: a CSV file holds one FRF, this one has {frf.shape[1]}x{frf.shape[2]} entries "
+            f"(outputs {list(frf.outputs)}, inputs {list(frf.inputs)}); select one entry first, "
+            f"e.g. frf[{frf.outputs[0]!r}, {frf.inputs[0]!r}]"
+        )
+    values = frf.data[:, 0, 0]
+    _refuse_all_zero(frf, os.fspath(path))
+    rows = zip(frf.frequency.hz.tolist(), values.real.tolist(), values.imag.tolist())
+    text = "".join(f"{f!r},{re_!r},{im!r}\n" for f, re_, im in rows)
+    write_text(path, CSV_HEADER + "\n" + text, overwrite=overwrite)
+
+
+def read_csv(
+    path: str | os.PathLike,
+    output: str = "response",
+    input: str = "excitation",
+    quantity: str | None = None,
+) -> FRF:
+    """Read a CSV file ``frequency_hz,real,imag`` into a one-entry FRF.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.  Blank lines are ignored; a UTF-8 byte-order mark is allowed.
+        Other exports (``;`` or tab separators with decimal commas, comment
+        lines, units in the header, magnitude and phase) are read by
+        ``substructure.io.frf_exports`` when unambiguous.
+    output, input : str
+        Labels of the response and excitation DOFs, e.g. ``"tool.tip:y"``.
+    quantity : {"receptance", "mobility", "accelerance"}, optional
+        What the file holds; default: what the header's units say, else
+        receptance.  A quantity that contradicts the header's units is refused.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the file and the line, for a missing file, a directory, a
+        wrong header, a row without three numbers, NaN or inf, a negative,
+        repeated or decreasing frequency, fewer than two rows, or a dead
+        channel (every value 0).
+
+    Returns
+    -------
+    FRF
+        Shape ``(n_freq, 1, 1)``: frequencies in Hz, values as in the file (SI).
+    """
+    from .. import read_text
+
+    name = os.fspath(path)
+    lines = read_text(path).splitlines()
+    numbered = [(k + 1, line) for k, line in enumerate(lines) if line.strip()]
+    if not numbered:
+        raise FileFormatError(f"{name}: the file is empty; expected the header {CSV_HEADER!r}")
+    first, header = numbered[0]
+    if header.replace(" ", "") != CSV_HEADER:  # another program's export: read what is unambiguous
+        from ..frf_exports import parse_export
+
+        table, lines_of, said = parse_export(numbered, name, quantity)
+        return _checked_csv(table, lines_of, name, output, input, quantity or said or "receptance")
+    numbered = numbered[1:]
+    if len(numbered) < 2:
+        raise FileFormatError(
+            f"{name}: {len(numbered)} data row(s); an FRF needs at least 2 frequency lines"
+        )
+    cells = [line.split(",") for _, line in numbered]
+    for (number, line), row in zip(numbered, cells):
+        if len(row) != 3:
+            raise FileFormatError(
+                f"{name}, line {number}: {line!r} has {len(row)} value(s); expected 3 "
+                "(frequency_hz, real, imag)"
+            )
+    try:
+        table = np.array(cells, dtype=np.float64)
+    except ValueError:
+        for (number, _), row in zip(numbered, cells):
+            for column, cell in zip(CSV_HEADER.split(","), row):
+                try:
+                    float(cell)
+                except ValueError:
+                    raise FileFormatError(
+                        f"{name}, line {number}: {column} is {cell.strip()!r}; expected a number"
+                    ) from None
+        raise  # pragma: no cover - numpy and float() disagree on a cell
+    lines_of = np.array([number for number, _ in numbered])
+    return _checked_csv(table, lines_of, name, output, input, quantity or "receptance")
+
+
+def _checked_csv(table: np.ndarray, lines_of: np.ndarray, name: str, output: str, input: str,
+                 quantity: str) -> FRF:
+    """The FRF of a table ``frequency_hz, real, imag`` (SI) after the checks of every CSV file."""
+    if table.shape[0] < 2:
+        raise FileFormatError(f"{name}: {table.shape[0]} data row(s); an FRF needs at least 2 frequency lines")
+    bad = ~np.isfinite(table)
+    if bad.any():
+        row, column = np.argwhere(bad)[0]
+        raise FileFormatError(
+            f"{name}, line {lines_of[row]}: {CSV_HEADER.split(',')[column]} is {table[row, column]}; "
+            "expected a finite number"
+        )
+    hz = table[:, 0]
+    if hz[0] < 0:
+        raise FileFormatError(f"{name}, line {lines_of[0]}: frequency {float(hz[0])!r} Hz is negative")
+    step_bad = np.diff(hz) <= 0
+    if step_bad.any():
+        k = int(np.argmax(step_bad)) + 1
+        raise FileFormatError(
+            f"{name}, line {lines_of[k]}: frequency {float(hz[k])!r} Hz does not exceed {float(hz[k - 1])!r} Hz "
+            f"of line {lines_of[k - 1]}; frequencies must be strictly increasing, without repeats"
+        )
+    values = table[:, 1] + 1j * table[:, 2]
+    if not np.any(values):
+        raise FileFormatError(
+            f"{name}: every value is 0, a dead channel (a sensor or the hammer not connected?); leave this "
+            "FRF out or measure it again"
+        )
+    return FRF.single(Frequency.from_hz(hz), values, output=output, input=input, quantity=quantity)
+
