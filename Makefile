@@ -25,7 +25,7 @@ demo: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/substructure demo --out out/demo --overwrite
 
 test: $(STAMP)
-	MPLBACKEND=Agg $(BIN)/python -m pytest -q
+	MPLBACKEND=Agg $(BIN)/python -m pytest -q -n 2 --dist loadfile
 
 # The report in a real browser: headless chromium renders `substructure report`'s page offline and
 # the check finds every figure on the screenshot (docs/report.md). Skipped, with the reason, where
