@@ -68,11 +68,18 @@ def _optional_length(field: str, *, allow_zero: bool = False):
     return optional
 
 
+MAX_TAPER_STEPS = 10_000
+"""The most steps ``taper_steps`` may ask for (each is a beam element at every frequency line)."""
+
+
 def _steps(value) -> int | None:
     if value is None:
         return None
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
         raise InvalidValueError(f"taper_steps: got {value!r}; expected a whole number of steps >= 1")
+    if value > MAX_TAPER_STEPS:
+        raise InvalidValueError(f"taper_steps: got {value!r}; expected at most {MAX_TAPER_STEPS:,} steps (each is a "
+                                "beam element at every frequency line; the default error bound needs far fewer)")
     return int(value)
 
 

@@ -29,12 +29,22 @@ from .units import dimensionless, magnitude_in, quantity, ureg
 __all__ = ["Section", "Insert", "Flutes", "shear_coefficient"]
 
 
+SIZE_RANGE_M = (1e-6, 1e3)
+"""Lengths and diameters of sections and segments [m]: 1 um to 1 km, the range the beam model is made
+for (outside it a wrong unit is far more likely than a real part, and the closed forms overflow)."""
+
+
 def _length(field: str, *, allow_zero: bool = False):
     def convert(value) -> pint.Quantity:
         q = quantity(value, field, "[length]")
-        if q.magnitude < 0 or (q.magnitude == 0 and not allow_zero):
+        if not np.isfinite(q.magnitude) or q.magnitude < 0 or (q.magnitude == 0 and not allow_zero):
             expected = "a length >= 0" if allow_zero else "a positive length"
             raise InvalidValueError(f"{field}: got {value!r}; expected {expected}")
+        if q.magnitude != 0:
+            metres = magnitude_in(q, "m")
+            if not SIZE_RANGE_M[0] <= metres <= SIZE_RANGE_M[1]:
+                raise InvalidValueError(f"{field}: got {value!r}; expected a length from 1 um to 1 km "
+                                        "(the range of the beam model): check the unit")
         return q
 
     return convert

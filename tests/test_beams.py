@@ -203,3 +203,25 @@ def test_end_mill_constructor():
     assert tool.length.m_as("mm") == pytest.approx(60)
     with pytest.raises(InvalidValueError, match="flute_length"):
         Tool.end_mill("12 mm", "60 mm", "70 mm")
+
+
+@pytest.mark.parametrize("field, kw", [("od", dict(od="1e300 mm")), ("od", dict(od="1e-300 mm")),
+                                       ("od", dict(length="5 m", od="1e-12 m")), ("length", dict(length="2 km")),
+                                       ("id", dict(id="1e-9 mm")), ("id", dict(od="40 mm", id="1e-7 m")),
+                                       ("od_tip", dict(od_tip="1e9 mm"))])
+def test_segment_dimensions_outside_the_beam_models_range_are_refused_by_name(field, kw):
+    # these once overflowed, gave NaN or hung in the chain kernel; the file reader refused them
+    # already, the Python API now does the same at the constructor
+    args = {"length": "10 mm", "od": "10 mm", **kw}
+    with pytest.raises(InvalidValueError, match=rf"^{field}: .*1 um to 1 km"):
+        Segment(**args)
+
+
+def test_segments_at_the_ends_of_the_range_give_finite_reciprocal_receptances():
+    for length, od in (("1 um", "1 um"), ("1 km", "1 m"), ("5 m", "1 mm")):
+        seg = Segment(length, od)
+        h = stepped_beam_receptance([seg], [0.0, seg.length_m], np.array([10.0, 1e3, 2e4]))
+        assert np.all(np.isfinite(h))
+        assert np.allclose(h, np.swapaxes(h, 0, 1), rtol=1e-6, atol=0)   # Maxwell reciprocity
+    with pytest.raises(InvalidValueError, match="taper_steps: .*at most 10,000"):
+        Segment("10 mm", "10 mm", od_tip="5 mm", taper_steps=10**9)

@@ -11,16 +11,14 @@ from __future__ import annotations
 
 import attrs
 
+from ...beams import MAX_TAPER_STEPS  # noqa: F401 (the limits of the beam model, named in the reader's errors)
+from ...sections import SIZE_RANGE_M  # noqa: F401
+
 _TOP_KEYS = ("name", "frequency", "materials", "components", "joints", "supports", "sensors", "masses")
 _FREQUENCY_KEYS = ("start", "stop", "step")
 _MATERIAL_KEYS = ("E", "nu", "rho", "loss_factor")
 _COMPONENT_KEYS = ("name", "type", "material", "segments", "description")
 _CATALOG_KEYS = ("name", "type", "catalog")  # and the catalogue holder's parameters
-SIZE_RANGE_M = (1e-6, 1e3)
-"""Lengths and diameters of segments an assembly file may give [m]: 1 um to 1 km (checked on reading)."""
-
-MAX_TAPER_STEPS = 10_000
-"""The most steps ``taper_steps`` may ask for (each is a beam element at every frequency line)."""
 
 _SEGMENT_KEYS = ("length", "od", "id", "material", "insert", "flutes", "od_tip", "id_tip", "taper_steps")
 _INSERT_KEYS = ("od", "material", "id")
