@@ -214,3 +214,17 @@ def test_no_stability_limit_tells_a_command_line_user_the_option(tmp_path, capsy
                    "--immersion", "0.5", "--kt", "1e-300 MPa", "--kr", "0.3", "--speeds", "5000:8000:100", "--json"])
     out, err = capsys.readouterr()
     assert status == 1 and out == "" and "--max-depth" in err
+
+
+def test_frf_from_csv_reads_the_quantity_from_the_header_as_read_csv_does(tmp_path):
+    # `lobes --frf` reads through FRF.from_csv: an export in g/N is an accelerance, converted, not
+    # taken as a receptance in m/N
+    from substructure import FRF
+
+    path = _export(tmp_path, "Frequency [Hz],Real [g/N],Imag [g/N]",
+                   (HZ, (-(W**2) * H).real / G, (-(W**2) * H).imag / G))
+    frf = FRF.from_csv(path)
+    assert frf.quantity == "accelerance"
+    np.testing.assert_allclose(frf.to_receptance().data[:, 0, 0], H, rtol=1e-9, atol=1e-9 * np.abs(H).max())
+    with pytest.raises(FileFormatError, match="quantity given is receptance"):
+        FRF.from_csv(path, quantity="receptance")

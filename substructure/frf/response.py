@@ -506,7 +506,7 @@ class FRF:
 
     @classmethod
     def from_csv(cls, path: Any, output: str = "response", input: str = "excitation",
-                 quantity: str = "receptance") -> FRF:
+                 quantity: str | None = None) -> FRF:
         """Read a CSV file (:func:`substructure.io.frf_files.read_csv`).
 
         Parameters
@@ -517,13 +517,14 @@ class FRF:
             Output label of the FRF read.
         input : str
             Input label.
-        quantity : {"receptance", "mobility", "accelerance"}
-            What the file holds.
+        quantity : {"receptance", "mobility", "accelerance"}, optional
+            What the file holds; default: what the header's units say (an export
+            with ``[g/N]`` is an accelerance, converted), else a receptance.
 
         Returns
         -------
         FRF
-            The FRF, shape ``(n_freq, 1, 1)``.
+            The FRF (a receptance in m/N), shape ``(n_freq, 1, 1)``.
         """
         from ..io.frf_files import read_csv
 
