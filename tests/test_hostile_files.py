@@ -228,3 +228,16 @@ def test_frf_from_csv_reads_the_quantity_from_the_header_as_read_csv_does(tmp_pa
     np.testing.assert_allclose(frf.to_receptance().data[:, 0, 0], H, rtol=1e-9, atol=1e-9 * np.abs(H).max())
     with pytest.raises(FileFormatError, match="quantity given is receptance"):
         FRF.from_csv(path, quantity="receptance")
+
+
+def test_a_record_without_its_closing_line_is_refused_not_merged(tmp_path):
+    # pyuff takes the next record's opening -1 as the closing one and the second record is lost
+    hz = grid(5.0)
+    first = record_58(receptance(hz), x0=hz[0], num=(8, 1, 0, "m"))
+    second = record_58(2 * receptance(hz), x0=hz[0], num=(8, 1, 0, "m"), rsp=(2, 3))
+    path = tmp_path / "two.uff"
+    path.write_text(first.rsplit("    -1\n", 1)[0] + second, encoding="ascii")
+    with pytest.raises(FileFormatError, match=r"line \d+: text outside any record .*closes the record before it"):
+        read_uff(path)
+    path.write_text(first + second, encoding="ascii")     # intact, both records are read
+    assert read_uff(path).shape[1:] == (2, 1)

@@ -85,6 +85,7 @@ def _check_complete(name: str) -> None:
             "'    -1' that opens a record)"
         )
     if re.search(rb"(?:^|\s)-1\s*$", tail):  # (binary 58b data end right before the closing "    -1")
+        _check_records_closed(name)
         return
     with open(name, "rb") as fh:
         starts = [n + 1 for n, line in enumerate(fh) if line.rstrip()[:6].strip() in (b"58", b"58b")]
@@ -93,6 +94,36 @@ def _check_complete(name: str) -> None:
         f"{name}: the file is truncated: it does not end with the '-1' line that closes a record{where}; "
         "copy or export it again"
     )
+
+
+def _check_records_closed(name: str) -> None:
+    """Every record of an ASCII universal file is closed by its ``-1`` line before the next opens.
+
+    Without the closing line of a record, the next record's opening ``-1``
+    closes it and the next record's lines fall outside any record: readers
+    then merge or drop them silently.  Files with binary records (``58b``)
+    are not scanned (their data may hold any bytes).
+    """
+    inside = False
+    opened = False
+    with open(name, "rb") as fh:
+        for number, raw in enumerate(fh, start=1):
+            line = raw.strip()
+            if opened:  # the line after an opening -1 names the record type
+                if line.lower().endswith(b"b") or b"b " in line[:8].lower():
+                    return  # a binary record: its data are not lines
+                opened = False
+                continue
+            if line == b"-1":
+                inside = not inside
+                opened = inside
+                continue
+            if not inside and line:
+                raise FileFormatError(
+                    f"{name}, line {number}: text outside any record ({line[:20].decode('latin-1')!r}); the "
+                    "'-1' line that closes the record before it is missing, so that record and this one "
+                    "cannot be told apart: export the file again"
+                )
 
 
 def read_uff(path: str | os.PathLike, record: int | None = None, quantity: str | None = None) -> FRF:
