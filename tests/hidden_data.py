@@ -87,9 +87,10 @@ def _offset(point: str, length: float) -> tuple[str, float]:
 
 def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
             springs: tuple[float, float, float] | None = None, ht_scale: float = 1.0, ht_cross: float = 0.0,
-            ht_damping: float = 1.0, sh_ktm_scale: float = 1.0, tool_length: float = TOOL_LENGTH,
+            ht_damping: float = 1.0, sh_ktm_scale: float = 1.0, sh_cross: float = 0.0, tool_length: float = TOOL_LENGTH,
             nut: tuple[float, float, float] | None = None, neck: tuple[float, float, float] | None = None,
-            bearings: tuple[float, float] | None = None, tool_E: float = 580e9, ht_loss: float = 0.0,
+            bearings: tuple[float, float] | None = None, tool_E: float = 580e9, tool_rho: float = 14500.0,
+            tool_nu: float = 0.22, ht_loss: float = 0.0,
             drawbar: bool = False, taper: float | None = None, seed: int = 0,
             points=("tool.tip",), excitation: str = "tool.tip", noise: float = 0.015, phase_deg: float = 0.5,
             floor: float = 1e-3) -> list[FRF]:
@@ -98,12 +99,14 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
     flutes: (length m, diameter ratio) at the tip; springs: (k N/m, x1 m, x2 m) on the spindle;
     nut: (mass kg, rotary inertia kg m^2, x m) on the holder; neck: (start m from the tool's base,
     length m, diameter m); bearings: (rear factor, front factor) on the stiffness of the bearing pairs
-    (None: free-free spindle).  Beyond every candidate of the diagnosis: ht_loss, a hysteretic loss
+    (None: free-free spindle); sh_cross: the spindle-holder cross term k_ym = k_tf [N]; tool_E, tool_rho,
+    tool_nu: the tool's material (carbide: 580e9 Pa, 14500 kg/m^3, 0.22; an HSS tool: about 210e9, 8100,
+    0.29).  Beyond every candidate of the diagnosis: ht_loss, a hysteretic loss
     factor of the holder-tool joint (``k (1 + i eta)``: damping that does not grow with frequency);
     drawbar, a 20 mm steel rod in the spindle's bore held at two points; taper, the tool's tip
     diameter [m] of a tool tapering linearly from 12 mm over its length.
     """
-    cb = fe.Material(tool_E, 0.22, 14500.0, 0.002)
+    cb = fe.Material(tool_E, tool_nu, tool_rho, 0.002)
     m = fe.Model()
     lengths = {"spindle": 0.33, "holder": 0.066, "tool": tool_length}
     wanted = {"spindle": [], "holder": [], "tool": []}
@@ -135,6 +138,7 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
     t = m.add_beam([pc for pc in pieces if pc[0] > 0], points=wanted["tool"])
     k_sh, c_sh = (np.array(x, dtype=float) for x in NOMINAL["sh"])
     k_sh[1, 1] *= sh_ktm_scale
+    k_sh[0, 1] = k_sh[1, 0] = sh_cross
     m.add_joint((s, 0.33), (h, 0.0), k_sh, c_sh)
     k_ht, c_ht = (np.array(x, dtype=float) for x in NOMINAL["ht"])
     k_ht[0, 0] *= ht_scale

@@ -129,9 +129,19 @@ class Scored:
         return len(self.change.specs)
 
 
+SIGNED_DECADES = 3.0
+"""A linear parameter whose range holds zero (a cross term) is scanned at both signs over this many decades
+below its largest magnitude: its physically typical values are small next to its passivity bound, and a
+start at zero (where the model is as given) hides it."""
+
+
 def _grid(spec, count: int) -> np.ndarray:
     if spec.log:
         return np.geomspace(spec.lower, spec.upper, count)
+    if spec.lower < 0.0 < spec.upper:  # sign-symmetric, log-spaced magnitudes
+        top = max(-spec.lower, spec.upper)
+        mags = np.geomspace(top * 10.0 ** -SIGNED_DECADES, top, max(count, 7))
+        return np.clip(np.concatenate([-mags[::-1], mags]), spec.lower, spec.upper)
     return np.linspace(spec.lower, spec.upper, count)
 
 
@@ -168,91 +178,6 @@ def _trials(change: Change) -> list[dict]:
             for spec in logs:
                 trial[spec.name] = float(np.clip(spec.start * factor, spec.lower, spec.upper))
             out.append(trial)
-    return out
-
-
-def _places(change: Change) -> list[dict]:
-    """Where an element may sit, for screening: positions (and ranges) along its component."""
-    base = {s.name: s.start for s in change.specs}
-    if isinstance(change, SectionChange):
-        L = change.length
-        return [{**base, "start": float(start), "length": float(length)}
-                for length in (0.12 * L, 0.3 * L, 0.6 * L) for start in np.linspace(0.0, L - length, 5)]
-    position = next((s for s in change.specs if s.name == "position"), None)
-    if position is not None:
-        return [{**base, "position": float(x)} for x in np.linspace(position.lower, position.upper, 9)]
-    return [base]
-
-
-def _trials(change: Change) -> list[dict]:
-    """Starting points of the screening scan: the main parameter over its range (at each place), and
-    for effects of several log-scale parameters, all of them scaled together."""
-    main = change.specs[0]
-    count = 5 if len(_places(change)) > 1 else 9
-    values = list(_grid(main, count))
-    if main.nominal is not None:
-        values.append(float(np.clip(main.nominal, main.lower, main.upper)))
-    values.append(main.start)
-    values = list(dict.fromkeys(float(v) for v in values))
-    if isinstance(change, SectionChange):
-        values = [0.7, 0.85, 1.2]
-    out = [{**place, main.name: v} for place in _places(change) for v in values]
-    logs = [s for s in change.specs if s.log]
-    if len(logs) >= 2 and len(_places(change)) == 1:  # all log parameters scaled together too
-        for factor in np.geomspace(0.01, 100.0, 9):
-            trial = dict(_places(change)[0])
-            for spec in logs:
-                trial[spec.name] = float(np.clip(spec.start * factor, spec.lower, spec.upper))
-            out.append(trial)
-    return out
-
-
-def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2_now: float,
-           progress: Callable | None = None) -> list[Scored]:
-    """Screen candidates on a (subsampled) likelihood: scan, then a short local fit.
-
-    Parameters
-    ----------
-    likelihood : Likelihood
-        Usually a subsample of the lines.
-    current : sequence of (Change, dict)
-        The effects already added, held at their values.
-    changes : sequence of Change
-        The candidates.
-    chi2_now : float
-        ``chi^2`` of the current model on these lines.
-    progress : callable, optional
-        Progress lines.
-
-    Returns
-    -------
-    list of Scored
-        Every candidate that could be evaluated, best first.
-    """
-    out = []
-    for n, change in enumerate(changes, start=1):
-        if progress and (n % 20 == 0 or n == len(changes)):
-            progress(f"screened {n}/{len(changes)} candidates")
-        best_chi2, best = math.inf, None
-        try:
-            for trial in _trials(change):
-                chi2 = likelihood.chi2(list(current) + [(change, trial)])
-                if chi2 < best_chi2:
-                    best_chi2, best = chi2, trial
-            if best is None or not best_chi2 < chi2_now:
-                continue
-            p = len(change.specs) + sum(len(c.specs) for c, _ in current)
-            local = fit(likelihood, list(current) + [(change, best)], max_nfev=6 * (p + 1))
-        except (SubstructureError, ValueError, FloatingPointError) as exc:
-            if progress:
-                progress(f"  skipped {change.effect} at {change.where}: {exc}")
-            continue
-        moved = list(current)
-        if local.chi2 < best_chi2:
-            best_chi2, best = local.chi2, local.changes[-1][1]
-            moved = [(c, dict(v)) for c, v in local.changes[:-1]]
-        out.append(Scored(change, dict(best), float(best_chi2), start=moved))
-    out.sort(key=lambda s: s.chi2)
     return out
 
 
