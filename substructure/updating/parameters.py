@@ -37,17 +37,15 @@ element, an effect of the diagnosis catalogue).
 
 from __future__ import annotations
 
-import warnings
 from typing import Mapping
 
 import attrs
 import numpy as np
 
 from ..components import Tool
-from ..errors import InvalidValueError, NonPassiveJointWarning, UnknownPointError
+from ..errors import InvalidValueError
 from ..joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint
 from ..materials import Material
-from ..units import Q_, format_quantity
 from .changes import Change, ParamSpec
 from .paths import apply_path_si
 
@@ -99,14 +97,8 @@ class ModelParameter:
         return ParamSpec("value", self.unit, self.lower, self.upper, start, self.log, self.nominal)
 
 
-def _si(value: float, unit: str) -> str:
-    return format_quantity(Q_(float(value), unit))
+from .paths import _on_beam, _overhang_segment, _plain, _unknown, set_parameters
 
-
-def _plain(component) -> bool:
-    from .structure import si_beam
-
-    return si_beam(component)
 
 
 def _log(path, unit, nominal, lo, hi, text) -> ModelParameter:
@@ -247,39 +239,9 @@ def model_parameters(assembly) -> list[ModelParameter]:
     return out
 
 
-def _overhang_segment(tool) -> int | None:
-    """The segment whose length a tool's overhang changes: the first without flutes."""
-    for i, seg in enumerate(tool.segments):
-        if seg.flutes is None:
-            return i
-    return None
-
-
-def _on_beam(assembly, point: str):
-    from ..points import parse_point
-
-    ref = parse_point(point)
-    try:
-        comp = assembly.component(ref.component)
-    except UnknownPointError:
-        return None, 0.0, 0.0
-    if not _plain(comp):
-        return None, 0.0, 0.0
-    return comp.name, comp.position(ref), comp.length_m
-
 
 # ---------------------------------------------------------------------------
-# Reading and writing values on an assembly
-
-
-def _parts(path: str) -> list[str]:
-    if not isinstance(path, str) or not path.strip():
-        raise InvalidValueError(f"path: got {path!r}; expected a parameter path such as 'joints.holder-tool.k.yf'")
-    return path.strip().split(".")
-
-
-def _unknown(path: str, why: str) -> UnknownPointError:
-    return UnknownPointError(f"parameter {path!r}: {why}")
+# Reading values on an assembly
 
 
 def get_parameter(assembly, path: str) -> float:
@@ -307,183 +269,6 @@ def get_parameter(assembly, path: str) -> float:
             return p.nominal
     raise _unknown(path, "not a parameter of this assembly (see model_parameters)")
 
-
-def _quiet(build):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", NonPassiveJointWarning)
-        return build()
-
-
-def _scaled_matrix(matrix, factor: float, units) -> dict:
-    return {e: _si(matrix.get(e) * factor, units[e]) for e in ("yf", "ym", "tf", "tm") if matrix.get(e) != 0}
-
-
-def _set_matrix(owner, kind: str, entry: str, value: float):
-    units = STIFFNESS_UNITS if kind == "k" else DAMPING_UNITS
-    entries = ("ym", "tf") if entry == "ym" else (entry,)
-    update = {e: _si(value, units[e]) for e in entries}
-    k, c = owner.k.as_dict(), owner.c.as_dict()
-    (k if kind == "k" else c).update(update)
-    return _quiet(lambda: attrs.evolve(owner, k=k, c=c))
-
-
-def _with_material(seg, material, insert: bool):
-    if insert:
-        return attrs.evolve(seg, insert=attrs.evolve(seg.insert, material=material))
-    return attrs.evolve(seg, material=material)
-
-
-def _material_value(material: Material, prop: str, value: float) -> Material:
-    if prop == "E":
-        return attrs.evolve(material, E=_si(value, "Pa"))
-    if prop == "rho":
-        return attrs.evolve(material, rho=_si(value, "kg/m^3"))
-    if prop == "nu":
-        return attrs.evolve(material, nu=float(value))
-    return attrs.evolve(material, loss_factor=float(value))
-
-
-def _set_one(assembly, path: str, value: float):
-    parts = _parts(path)
-    head = parts[0]
-    value = float(value)
-    if head == "components" and len(parts) >= 3:
-        comp = assembly.component(parts[1])
-        if not _plain(comp):
-            raise _unknown(path, f"{parts[1]!r} is not a stepped beam")
-        rest = parts[2:]
-        segs = list(comp.segments)
-        if rest[0] == "segments" and len(rest) >= 3:
-            i = int(rest[1])
-            seg = segs[i]
-            what = ".".join(rest[2:])
-            if what in ("length", "od", "id"):
-                segs[i] = attrs.evolve(seg, **{what: _si(value, "m")})
-            elif what in ("insert.od", "insert.id"):
-                segs[i] = attrs.evolve(seg, insert=attrs.evolve(seg.insert, **{what[7:]: _si(value, "m")}))
-            elif what == "flutes.diameter_ratio":
-                segs[i] = attrs.evolve(seg, flutes=attrs.evolve(seg.flutes, diameter_ratio=value))
-            else:
-                raise _unknown(path, f"unknown segment value {what!r}")
-            return assembly.with_component(attrs.evolve(comp, segments=segs))
-        if rest == ["overhang"]:
-            i = _overhang_segment(comp)
-            seg = segs[i]
-            segs[i] = attrs.evolve(seg, length=_si(seg.length_m + value - comp.length_m, "m"))
-            return assembly.with_component(attrs.evolve(comp, segments=segs))
-        if rest in (["E"], ["rho"], ["loss_factor"]):
-            prop = rest[0]
-            renamed = {}
-            for i, seg in enumerate(segs):
-                m = seg.material
-                if m.name not in renamed:
-                    current = {"E": m.E.m_as("Pa"), "rho": m.rho_si, "loss_factor": m.loss_factor}[prop]
-                    new = _material_value(m, prop, current * value)
-                    renamed[m.name] = attrs.evolve(new, name=f"{m.name}-{comp.name}")
-                segs[i] = attrs.evolve(seg, material=renamed[m.name])
-            return assembly.with_component(attrs.evolve(comp, segments=segs))
-        if rest == ["supports", "k"]:
-            supports = list(assembly.supports)
-            for i, s in enumerate(supports):
-                if _on_beam(assembly, s.at)[0] == comp.name:
-                    supports[i] = _quiet(lambda s=s: attrs.evolve(s, k=_scaled_matrix(s.k, value, STIFFNESS_UNITS)))
-            return attrs.evolve(assembly, supports=tuple(supports))
-    if head == "materials" and len(parts) >= 3:
-        name, prop = ".".join(parts[1:-1]), parts[-1]
-        comps = []
-        found = False
-        for comp in assembly.components:
-            if not _plain(comp):
-                comps.append(comp)
-                continue
-            segs = list(comp.segments)
-            for i, seg in enumerate(segs):
-                if seg.material.name == name:
-                    segs[i] = _with_material(segs[i], _material_value(seg.material, prop, value), False)
-                    found = True
-                if seg.insert is not None and seg.insert.material.name == name:
-                    segs[i] = _with_material(segs[i], _material_value(seg.insert.material, prop, value), True)
-                    found = True
-            comps.append(attrs.evolve(comp, segments=segs))
-        if not found:
-            raise _unknown(path, f"no part is made of {name!r}")
-        mats = tuple(_material_value(m, prop, value) if m.name == name else m for m in assembly.materials)
-        return attrs.evolve(assembly, components=tuple(comps), materials=mats)
-    if head == "joints" and len(parts) in (3, 4):
-        joint = assembly.joint(parts[1])
-        if len(parts) == 3:
-            units = STIFFNESS_UNITS if parts[2] == "k" else DAMPING_UNITS
-            matrix = joint.k if parts[2] == "k" else joint.c
-            new = _quiet(lambda: attrs.evolve(joint, **{parts[2]: _scaled_matrix(matrix, value, units)}))
-        else:
-            new = _set_matrix(joint, parts[2], parts[3], value)
-        return assembly.with_joint(new)
-    if head == "supports" and len(parts) == 3 and "+" in parts[1]:
-        supports = list(assembly.supports)
-        for i in (int(x) for x in parts[1].split("+")):
-            s = supports[i]
-            supports[i] = _quiet(lambda s=s: attrs.evolve(s, k=_scaled_matrix(s.k, value, STIFFNESS_UNITS)))
-        return attrs.evolve(assembly, supports=tuple(supports))
-    if head == "supports" and len(parts) in (3, 4):
-        i = int(parts[1])
-        supports = list(assembly.supports)
-        s = supports[i]
-        if parts[2] == "at":
-            comp, _, _ = _on_beam(assembly, s.at)
-            supports[i] = attrs.evolve(s, at=f"{comp}@{_si(value, 'm')}")
-        else:
-            supports[i] = _set_matrix(s, parts[2], parts[3], value)
-        return attrs.evolve(assembly, supports=tuple(supports))
-    if head in ("sensors", "masses") and len(parts) == 3:
-        items = list(getattr(assembly, head))
-        names = [s.name for s in items]
-        if parts[1] not in names:
-            raise _unknown(path, f"no {head[:-1]} {parts[1]!r}")
-        i = names.index(parts[1])
-        s = items[i]
-        if parts[2] == "mass":
-            items[i] = attrs.evolve(s, mass=_si(value, "kg"))
-        elif parts[2] == "inertia":
-            items[i] = attrs.evolve(s, inertia=_si(value, "kg*m^2"))
-        elif parts[2] == "at" and head == "masses":
-            comp, _, _ = _on_beam(assembly, s.at)
-            items[i] = attrs.evolve(s, at=f"{comp}@{_si(value, 'm')}")
-        else:
-            raise _unknown(path, f"unknown value {parts[2]!r}")
-        return attrs.evolve(assembly, **{head: tuple(items)})
-    raise _unknown(path, "not a parameter path (see substructure.updating.parameters)")
-
-
-def set_parameters(assembly, values: Mapping[str, float]):
-    """The assembly with parameters set (SI values by path; linked parameters as factors).
-
-    Parameters
-    ----------
-    assembly : Assembly
-        The model.
-    values : mapping of str to float
-        New values by path.
-
-    Returns
-    -------
-    Assembly
-        A new assembly, which :func:`substructure.save_assembly` writes normally
-        (a changed material under its own name, a component's own material as
-        ``NAME-COMPONENT``).
-
-    Raises
-    ------
-    UnknownPointError
-        When a path names nothing in the assembly.
-    """
-    for path, value in values.items():
-        try:
-            assembly = _set_one(assembly, path, value)
-        except (IndexError, ValueError, AttributeError) as exc:
-            if isinstance(exc, InvalidValueError):
-                raise
-            raise _unknown(path, f"cannot be set ({exc})") from None
-    return assembly
 
 
 # ---------------------------------------------------------------------------
