@@ -41,11 +41,13 @@ CARBIDE = fe.Material(580e9, 0.22, 14500.0, 0.002)
 
 
 def nominal_model(flutes: tuple[float, float] | None = None, bearings: bool = False,
-                  tool_length: float = TOOL_LENGTH) -> Assembly:
+                  tool_length: float = TOOL_LENGTH, taper: float | None = None) -> Assembly:
     """The library's model: the built-in geometry, joints nominal.
 
     flutes: (length m, diameter ratio) of a fluted tool tip; bearings: the
-    spindle held by four bearings (a machine) instead of free-free.
+    spindle held by four bearings (a machine) instead of free-free; taper:
+    the tool one conical segment from 12 mm at its base to this diameter [m]
+    at its tip (without flutes).
     """
     spindle = Spindle("spindle", [Segment("120 mm", "70 mm", "40 mm"), Segment("150 mm", "90 mm", "40 mm"),
                                   Segment("60 mm", "110 mm", "40 mm")])
@@ -55,6 +57,9 @@ def nominal_model(flutes: tuple[float, float] | None = None, bearings: bool = Fa
         length, ratio = flutes
         tool = Tool("tool", [Segment(f"{(tool_length - length) * 1e3!r} mm", "12 mm", material="carbide"),
                              Segment(f"{length * 1e3!r} mm", "12 mm", material="carbide", flutes=Flutes(ratio))])
+    elif taper:
+        tool = Tool("tool", [Segment(f"{tool_length * 1e3!r} mm", "12 mm", material="carbide",
+                                     od_tip=f"{taper * 1e3!r} mm")])
     else:
         tool = Tool("tool", [Segment(f"{(tool_length - 0.030) * 1e3!r} mm", "12 mm", material="carbide"),
                              Segment("30 mm", "12 mm", material="carbide")])
@@ -91,7 +96,7 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
             nut: tuple[float, float, float] | None = None, neck: tuple[float, float, float] | None = None,
             bearings: tuple[float, float] | None = None, tool_E: float = 580e9, tool_rho: float = 14500.0,
             tool_nu: float = 0.22, ht_loss: float = 0.0,
-            drawbar: bool = False, taper: float | None = None, seed: int = 0,
+            drawbar: bool = False, taper: float | None = None, taper_pieces: int = 8, seed: int = 0,
             points=("tool.tip",), excitation: str = "tool.tip", noise: float = 0.015, phase_deg: float = 0.5,
             floor: float = 1e-3) -> list[FRF]:
     """FRFs of the rig with the hidden effects, noisy (response at each point, hammer at ``excitation``).
@@ -104,7 +109,7 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
     0.29).  Beyond every candidate of the diagnosis: ht_loss, a hysteretic loss
     factor of the holder-tool joint (``k (1 + i eta)``: damping that does not grow with frequency);
     drawbar, a 20 mm steel rod in the spindle's bore held at two points; taper, the tool's tip
-    diameter [m] of a tool tapering linearly from 12 mm over its length.
+    diameter [m] of a tool tapering linearly from 12 mm over its length (``taper_pieces`` uniform pieces).
     """
     cb = fe.Material(tool_E, tool_nu, tool_rho, 0.002)
     m = fe.Model()
@@ -128,7 +133,7 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
         pieces = [(start, fe.section(0.012, 0, cb)), (length, fe.section(diameter, 0, cb)),
                   (tool_length - fl_len - start - length, fe.section(0.012, 0, cb))]
     elif taper:
-        n_t = 8
+        n_t = taper_pieces
         pieces = [(cuts[1] / n_t, fe.section(0.012 + (taper - 0.012) * (i + 0.5) * cuts[1] / n_t / tool_length, 0, cb))
                   for i in range(n_t)]
     else:

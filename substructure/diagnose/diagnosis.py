@@ -29,7 +29,7 @@ from ..assembly import Assembly
 from ..errors import InvalidValueError
 from ..frf import FRF
 from ..updating.likelihood import Likelihood, measured_frfs
-from ..updating.selection import consistency
+from ..updating.selection import INDIFFERENCE, consistency
 from .compare import METRIC, Comparison, frac, pair_modes, error_bands
 from .effects import Effect, registry
 from .refine import refine as refine_model
@@ -292,6 +292,14 @@ class Diagnosis:
         ``parameters`` and ``matrix`` of the final fit's correlations.
     final_error : float
         The error of the final model.
+    rivals : tuple of (Explanation, dict)
+        Whole explanations as good as the one reported (inside the
+        indifference region) that are different structures, each with the
+        measurement that separates it; when there are any, ``explained`` is
+        false.
+    search : dict
+        What the search did: ``candidates``, ``full_fits``, ``seconds``,
+        ``budget_s``, ``cut`` (the time budget stopped it).
     """
 
     metric: str
@@ -315,6 +323,8 @@ class Diagnosis:
     report: tuple[str, ...] = ()
     correlation: dict = attrs.field(factory=dict, eq=False)
     final_error: float = float("nan")
+    rivals: tuple = attrs.field(default=(), eq=False)
+    search: dict = attrs.field(factory=dict, eq=False)
 
     @property
     def effects(self) -> list[Found]:
@@ -357,6 +367,9 @@ class Diagnosis:
             "ambiguous": [{"effect": a.name, "where": a.where, "parameters": a.parameters_json(),
                            "error": _finite(err)} for a, err in self.ambiguous],
             "separation": self.separation,
+            "rivals": [{"effects": [{"effect": f.name, "where": f.where, "parameters": f.parameters_json()}
+                                    for f in r.founds], "separation": sep} for r, sep in self.rivals],
+            "search": dict(self.search),
             "report": list(self.report),
             "modes": [
                 {"measured_hz": m.measured_hz, "model_hz": m.model_hz, "shift_hz": m.shift_hz,
@@ -498,7 +511,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     Diagnosis
         The verdict, the candidates, the refinement and the refined model.
     """
-    from .report import separation, unexplained_report
+    from .report import Explanation, separation, unexplained_report
 
     catalogue = _catalogue(effects)
     if progress is True:
@@ -563,9 +576,21 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     if final_fit is not None and final_fit.p > 1:
         labels = [f"{current[i][0].effect}@{current[i][0].where}:{name}" for i, name in final_fit.names]
         correlation = {"parameters": labels, "matrix": [[_finite(x) for x in row] for row in final_fit.correlation]}
+    rivals = _distinct_rivals(assembly, measured, final_effects, outcome, say) if explained else []
     final = _comparisons(lik, final_ratios, floors)
     report = unexplained_report(lik, assembly, current, baseline, cons, final_error, floor, explained, say) \
         if not explained else ()
+    if rivals:  # consistent with the noise, but not uniquely: claim neither
+        explained = False
+        kept = Explanation(final_effects)
+        report = [f"unexplained: no candidate explains the data uniquely: {kept.name} at {kept.where} and "
+                  f"{rival.name} at {rival.where} both leave a residual consistent with the noise (their BIC "
+                  f"differ by at most {INDIFFERENCE:g}) but change different parts" for rival, _ in rivals[:1]]
+        report += [f"to tell them apart: {sep['text']}" for rival, sep in rivals]
+        report.append("the best (ambiguous) explanation is reported as partial: "
+                      + ", ".join(repr(e) for e in final_effects))
+        sep = sep or rivals[0][1]
+        names = tuple(dict.fromkeys(list(names) + [r.name for r, _ in rivals]))
     return Diagnosis(
         metric=METRIC, baseline_error=e0, noise_floor=floor, explained=explained,
         missing_effect=None if missing is None else missing.name,
@@ -574,7 +599,106 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         candidates=tuple(first), refinement=tuple(steps), band=band, baseline=baseline, final=final,
         refined_assembly=refined, final_effects=final_effects, consistency=cons, ambiguous=tuple(ambiguous),
         separation=sep, report=tuple(report), correlation=correlation, final_error=final_error,
+        rivals=tuple(rivals),
     )
+
+
+def sites(assembly, change, values) -> frozenset:
+    """The parts of the model a change acts on: joints by name, components by name.
+
+    A model parameter acts on the component, joint, support's component,
+    sensor's or body's component its path names (a material on every
+    component made of it); an element or an effect on the component or
+    joint its place names.
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model.
+    change : Change
+        The change.
+    values : dict
+        Its values (for places that depend on them).
+
+    Returns
+    -------
+    frozenset of str
+        ``"joint:NAME"`` and ``"component:NAME"`` entries.
+    """
+    joints = {j.name for j in assembly.joints}
+    comps = set(assembly.component_names)
+    where = change.where
+    parts = where.split(".")
+    if change.effect == "model-parameter":
+        head = parts[0]
+        if head == "components":
+            return frozenset({f"component:{parts[1]}"})
+        if head == "joints":
+            return frozenset({f"joint:{parts[1]}"})
+        if head == "materials":
+            name = ".".join(parts[1:-1])
+            return frozenset(f"component:{c.name}" for c in assembly.components
+                             if any(getattr(getattr(seg, "material", None), "name", None) == name
+                                    for seg in getattr(c, "segments", ())))
+        if head == "supports":
+            return frozenset(f"component:{assembly.supports[int(i)].at.split('.')[0].split('@')[0]}"
+                             for i in parts[1].split("+") if i.isdigit() and int(i) < len(assembly.supports))
+        if head in ("sensors", "masses"):
+            items = {x.name: x for x in getattr(assembly, head)}
+            if parts[1] in items:
+                return frozenset({f"component:{items[parts[1]].at.split('.')[0].split('@')[0]}"})
+        return frozenset({where})
+    if where in joints:
+        return frozenset({f"joint:{where}"})
+    out = set()
+    for piece in where.replace("+", ",").split(","):
+        name = piece.strip().split("@")[0].split(".")[0]
+        out.add(f"component:{name}" if name in comps else piece.strip())
+    return frozenset(out)
+
+
+RIVALS_CHECKED = 3
+"""Most rival explanations whose separation is computed for the verdict."""
+
+
+def _distinct_rivals(assembly, measured, final_effects, outcome, say) -> list:
+    """Rival explanations inside the indifference region that are different structures.
+
+    A rival is a whole explanation of the parsimony check
+    (:func:`substructure.diagnose.refine.refine`) or the kept one with one
+    change replaced by an alternative of its step.  It is a *different
+    structure* when some measurement with the test's sensors on (a point or
+    cross FRF at the ends, quarter points and middles of the components)
+    would tell the two apart (``chi^2 > INDIFFERENCE`` over the band);
+    otherwise it is an equivalent description (a joint's stiffness as a
+    named effect or as its matrix entry) and the preferred one stands.
+
+    Returns
+    -------
+    list of (Explanation, dict)
+        The distinct rivals with their separating measurement.
+    """
+    from .report import Explanation, separation
+
+    pool = [(chi2, [Found(c, v) for c, v in changes]) for changes, chi2, _ in outcome.rivals]
+    for i, found in enumerate(final_effects):
+        for c, v, chi2 in outcome.alternatives.get(found.change.key, []):
+            pool.append((chi2, [Found(c, v) if j == i else f for j, f in enumerate(final_effects)]))
+    pool.sort(key=lambda t: t[0])
+    kept = Explanation(final_effects)
+    kept_sites = frozenset().union(*(sites(assembly, f.change, f.values) for f in final_effects))
+    out = []
+    for _, founds in pool[:RIVALS_CHECKED]:
+        rival = Explanation(founds)
+        if frozenset().union(*(sites(assembly, f.change, f.values) for f in founds)) == kept_sites:
+            continue  # the same parts changed: an equivalent description
+        rival = Explanation(founds)
+        sep = separation(assembly, measured, kept, rival, say, contact_only=True)
+        if sep is not None and sep["chi2"] > INDIFFERENCE:
+            if say:
+                say(f"rival explanation {rival.name} at {rival.where}: {sep['text']}")
+            out.append((rival, sep))
+    return out
 
 
 def _std_of(result, change) -> dict:

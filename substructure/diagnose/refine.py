@@ -21,10 +21,12 @@ any change is left alone.  Then
 
 from __future__ import annotations
 
+import math
 from typing import Callable
 
 import attrs
 
+from ..errors import SubstructureError
 from ..updating.fit import Fit, fit
 from ..updating.selection import INDIFFERENCE, significance
 from ..updating.likelihood import Likelihood
@@ -51,6 +53,10 @@ class Outcome:
     alternatives : dict
         Per kept change's key, the alternatives inside the indifference
         region: ``[(change, values, chi2), ...]``.
+    rivals : list
+        Whole explanations (a single or a pair of changes fitted from fair
+        starts, or the forward path's) inside the indifference region of the
+        one kept: ``[(changes, chi2, bic), ...]``.
     """
 
     current: list
@@ -59,6 +65,7 @@ class Outcome:
     first_scored: list
     first_fitted: list
     alternatives: dict
+    rivals: list = attrs.field(factory=list)
 
 
 def _p(changes) -> int:
@@ -158,6 +165,73 @@ def _history(lik, current, final: Fit, tried: int):
     return history
 
 
+PAIR_POOL = 4
+"""Singles of the first step (best first) whose pairs are fitted from fair starts in the parsimony check."""
+
+
+def _bic(chi2: float, p: int, n: int, s2: float) -> float:
+    return chi2 / s2 + p * math.log(n)
+
+
+def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say):
+    """The kept explanation against the best single and best pair ones fitted from fair starts.
+
+    Forward selection extends its first choice; when that choice was wrong,
+    later steps compensate and the path ends at several changes that a
+    single or a pair of other changes explains as well.  Here every single
+    of the first step (fitted from its own scan on all lines) and every pair
+    of the :data:`PAIR_POOL` best of them (fitted from the two singles'
+    values, first on the screening lines, the best two on all lines) is
+    compared with the kept explanation by BIC (``chi^2 / s^2 + p ln n``,
+    ``s^2`` the misfit scale of the best of them).  The lowest BIC is kept;
+    the others within :data:`~substructure.updating.selection.INDIFFERENCE`
+    of it are its rivals.
+
+    Returns
+    -------
+    (list, float, list)
+        The explanation kept, its ``chi^2``, and the rivals ``[(changes, chi2, bic), ...]``.
+    """
+    n = lik.n
+    options = [([(c, dict(v)) for c, v in current], chi2_now)]
+    keys_now = sorted(c.key for c, _ in current)
+    singles = [s for s in first_fitted if s.fit is not None]
+    for s in singles:
+        if [s.change.key] != keys_now:
+            options.append(([(c, dict(v)) for c, v in s.fit.changes], s.fit.chi2))
+    if len(current) >= 3:
+        pool = singles[:PAIR_POOL]
+        trials = []
+        for i in range(len(pool)):
+            for j in range(i + 1, len(pool)):
+                a, b = pool[i], pool[j]
+                if sorted([a.change.key, b.change.key]) == keys_now:
+                    continue
+                pair = [(a.change, dict(a.values)), (b.change, dict(b.values))]
+                try:
+                    trials.append((fit(screen_lik, pair, max_nfev=40).chi2, pair))
+                except (ValueError, ArithmeticError, SubstructureError):
+                    continue
+        trials.sort(key=lambda t: t[0])
+        for _, pair in trials[:2]:
+            try:
+                result = fit(lik, pair)
+            except (ValueError, ArithmeticError, SubstructureError):
+                continue
+            if all(physical(c, v) for c, v in result.changes) and passive(result.changes):
+                options.append(([(c, dict(v)) for c, v in result.changes], result.chi2))
+    best_chi2 = min(chi2 for _, chi2 in options)
+    p_best = next(_p(ch) for ch, chi2 in options if chi2 == best_chi2)
+    s2 = max(1.0, best_chi2 / max(n - p_best, 1))
+    scored = sorted(((ch, chi2, _bic(chi2, _p(ch), n, s2)) for ch, chi2 in options), key=lambda t: (t[2], _p(t[0])))
+    kept, kept_chi2, kept_bic = scored[0]
+    if say and sorted(c.key for c, _ in kept) != keys_now:
+        say(f"parsimony: {', '.join(f'{c.effect} at {c.place(v)}' for c, v in kept)} explains as well with "
+            f"{_p(kept)} parameter(s) instead of {_p(current)} (BIC {kept_bic:.1f})")
+    rivals = [(ch, chi2, b) for ch, chi2, b in scored[1:] if b - kept_bic <= INDIFFERENCE]
+    return kept, kept_chi2, rivals
+
+
 def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None) -> Outcome:
     """Forward selection, then elimination, review and history (see the module docstring).
 
@@ -239,10 +313,16 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None) 
     if current:
         current, chi2_now, alternatives = _review(lik, current, chi2_now, steps_fitted, steps_inside, dropped,
                                                   passive, say)
+    rivals: list = []
+    if len(current) >= 2:
+        before = [c.key for c, _ in current]
+        current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say)
+        if [c.key for c, _ in current] != before:
+            alternatives = {c.key: [] for c, _ in current}
     kept = [c.key for c, _ in current]
     unchanged = kept == [change.key for _, change, _, _ in path]
     final = path[-1][0] if unchanged and path else (fit(lik, current) if current else None)
     if final is not None:
         current = [(c, dict(v)) for c, v in final.changes]
     history = path if unchanged else (_history(lik, current, final, tried) if current else [])
-    return Outcome(current, final, history, first_scored, first_fitted, alternatives)
+    return Outcome(current, final, history, first_scored, first_fitted, alternatives, rivals)

@@ -243,7 +243,41 @@ def _measurement_points(assembly) -> list[str]:
     return points
 
 
-def separation(assembly, measured, a, b, say=None) -> dict | None:
+class Explanation:
+    """Several fitted changes taken as one explanation (for :func:`separation`).
+
+    Parameters
+    ----------
+    founds : sequence of Found
+        The changes with their values.
+    """
+
+    def __init__(self, founds):
+        self.founds = list(founds)
+        self.name = " + ".join(f.name for f in self.founds) or "nothing"
+        self.where = " + ".join(f.where for f in self.founds)
+        self.test_only = any(f.change.test_only for f in self.founds)
+        self.change = self
+
+    def apply(self, assembly):
+        """The assembly with every change applied.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+
+        Returns
+        -------
+        Assembly
+            The changed model.
+        """
+        for f in self.founds:
+            assembly = f.apply(assembly)
+        return assembly
+
+
+def separation(assembly, measured, a, b, say=None, contact_only: bool = False) -> dict | None:
     """The measurement that best tells two explanations apart.
 
     Parameters
@@ -252,10 +286,13 @@ def separation(assembly, measured, a, b, say=None) -> dict | None:
         The model as given.
     measured : sequence of Measured
         The data (the first one's configuration and excitation are used).
-    a, b : Found
+    a, b : Found or Explanation
         The two explanations.
     say : callable, optional
         Progress.
+    contact_only : bool
+        Only measurements with the test's sensors on, as in the data (no
+        non-contact variant): do the two explanations differ as structures?
 
     Returns
     -------
@@ -272,7 +309,7 @@ def separation(assembly, measured, a, b, say=None) -> dict | None:
     excitation = str(first.frf.inputs[0]).split(":")[0]
     done = {(str(m.frf.outputs[0]).split(":")[0], str(m.frf.inputs[0]).split(":")[0]) for m in measured}
     points = list(dict.fromkeys(_measurement_points(config) + [p for pair in done for p in pair]))
-    variants = [False] + ([True] if (a.change.test_only or b.change.test_only) else [])
+    variants = [False] + ([True] if (a.change.test_only or b.change.test_only) and not contact_only else [])
     best = None
     for non_contact in variants:
         models = []

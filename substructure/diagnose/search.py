@@ -33,9 +33,9 @@ import attrs
 import numpy as np
 
 from ..errors import SubstructureError
-from ..updating.elements import AddedMass, GroundSpring, SectionChange
+from ..updating.elements import AddedMass, GroundSpring, SectionChange, body_bounds
 from ..updating.fit import Fit, fit, from_u, to_u
-from ..updating.parameters import Change, ParameterChange, model_parameters
+from ..updating.parameters import Change, ParameterChange, material_changes, model_parameters, parameter_change
 from ..updating.structure import si_beam
 from ..updating.selection import INDIFFERENCE, bic, significance
 from .effects import EffectChange, effect_change
@@ -78,11 +78,13 @@ def candidates(assembly, measured_points: Sequence[str], effects: dict, open_wor
     """
     out: list[Change] = []
     if open_world:
-        out += [ParameterChange(p) for p in model_parameters(assembly)]
+        out += [parameter_change(p) for p in model_parameters(assembly)]
+        out += material_changes(assembly)
         for comp in assembly.components:
             if not _plain(comp):
                 continue
-            out.append(AddedMass(comp.name, comp.length_m, max(2.0 * comp.mass(), 1e-3)))
+            lo, hi, mass_max = body_bounds(assembly, comp)
+            out.append(AddedMass(comp.name, comp.length_m, mass_max, (lo, hi)))
             out.append(GroundSpring(comp.name, comp.length_m))
             out.append(SectionChange(comp.name, comp.length_m))
     for name, cls in effects.items():
@@ -171,6 +173,7 @@ def _trials(change: Change) -> list[dict]:
     if isinstance(change, SectionChange):
         values = [0.7, 0.85, 1.2]
     out = [{**place, main.name: v} for place in _places(change) for v in values]
+    out += [{**_places(change)[0], **trial} for trial in getattr(change, "trials", ())]  # e.g. known materials
     logs = [s for s in change.specs if s.log]
     if len(logs) >= 2 and len(_places(change)) == 1:  # all log parameters scaled together too
         for factor in np.geomspace(0.01, 100.0, 9):
@@ -423,6 +426,8 @@ def preference(change: Change) -> int:
         return 0
     if isinstance(change, ParameterChange):
         return 1 if change.parameter.linked else 2
+    if getattr(change, "linked", False):
+        return 1
     return 3
 
 

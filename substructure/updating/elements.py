@@ -27,7 +27,8 @@ from ..units import Q_, format_quantity
 from .parameters import Change, ParamSpec
 from .structure import LinkSI
 
-__all__ = ["AddedMass", "GroundSpring", "SectionChange", "split_beam", "split_segments", "unique_name"]
+__all__ = ["AddedMass", "GroundSpring", "SectionChange", "split_beam", "split_segments", "unique_name", "body_bounds",
+           "STEEL_DENSITY"]
 
 
 def _si(value: float, unit: str) -> str:
@@ -36,6 +37,48 @@ def _si(value: float, unit: str) -> str:
 
 def _mm(x: float) -> str:
     return f"{x * 1e3:.4g} mm"
+
+
+STEEL_DENSITY = 7850.0
+"""Density of the steel a clamped body is assumed made of [kg/m^3] (for the bound on its mass)."""
+
+
+def body_bounds(assembly, component) -> tuple[float, float, float]:
+    """Where on a beam component a body the model lacks may sit, and its largest plausible mass.
+
+    A body nobody modelled is something clamped or glued on a part that can
+    be reached: a nut, a ring, a sensor.  Its mass is at most that of a steel
+    ring as long as the component's thickest section is wide, from that
+    diameter to twice it (a nut is about as long as it is wide), and at most
+    the component's own mass.  On a :class:`~substructure.components.Spindle`
+    only the nose can be reached (the shaft behind it runs inside the
+    housing): from the front-most support on it, or without supports, from
+    the start of its last segment, to its tip.
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model (for the supports on the component).
+    component : Beam
+        A plain beam component of it.
+
+    Returns
+    -------
+    (float, float, float)
+        Lowest and highest position [m from the base] and the largest mass [kg].
+    """
+    from ..components import Spindle
+    from .paths import _on_beam
+
+    supports = [x for name, x, _ in (_on_beam(assembly, s.at) for s in assembly.supports) if name == component.name]
+    length = float(component.length_m)
+    od = max(float(s.od.m_as("m")) for s in component.segments)
+    ring = STEEL_DENSITY * np.pi / 4.0 * ((2.0 * od) ** 2 - od ** 2) * od
+    mass_max = max(min(ring, float(component.mass())), 1e-3)
+    lo = 0.0
+    if isinstance(component, Spindle):
+        lo = max(supports) if len(supports) else length - float(component.segments[-1].length_m)
+    return float(lo), length, float(mass_max)
 
 
 def unique_name(taken, base: str) -> str:
@@ -92,19 +135,22 @@ class AddedMass(_OnComponent):
     length : float
         Its length [m] (the position's bound).
     mass_max : float
-        Upper bound of the mass [kg].
+        Upper bound of the mass [kg] (see :func:`body_bounds`).
+    position : (float, float), optional
+        Where it may sit [m from the base] (default the whole length).
     """
 
     effect = "added-mass"
     explanation = ("a body on the structure (a clamping nut, a balancing ring, a sensor) lowers the modes in "
                    "proportion to the square of their motion where it sits: the modes that move most there drop most")
 
-    def __init__(self, component: str, length: float, mass_max: float):
+    def __init__(self, component: str, length: float, mass_max: float, position: tuple[float, float] | None = None):
         super().__init__(component, length)
+        lo, hi = position if position is not None else (0.0, self.length)
         self.specs = (
             ParamSpec("mass", "kg", 1e-4, float(mass_max), min(0.01, float(mass_max))),
             ParamSpec("inertia", "kg*m^2", 1e-10, 1e-3, 1e-8),
-            ParamSpec("position", "m", 0.0, self.length, 0.5 * self.length, log=False),
+            ParamSpec("position", "m", float(lo), float(hi), 0.5 * (lo + hi), log=False),
         )
 
     def apply_si(self, structure, values):

@@ -6,6 +6,7 @@ A model parameter is named by where it sits in the assembly file:
 path                                           value (SI)
 =============================================  ==========================================
 ``components.C.segments.I.length|od|id``       a segment's length or diameter [m]
+``components.C.segments.I.od_tip|id_tip``      a tapered segment's diameters at its tip end [m]
 ``components.C.segments.I.insert.od|id``       the insert's diameters [m]
 ``components.C.segments.I.flutes.diameter_ratio``  the flutes' equivalent diameter ratio
 ``materials.M.E|rho|nu|loss_factor``           a material, in every part made of it
@@ -50,7 +51,8 @@ from .changes import Change, ParamSpec
 from .paths import apply_path_si
 
 __all__ = ["ParamSpec", "Change", "ModelParameter", "ParameterChange", "ParameterSet", "model_parameters",
-           "get_parameter", "set_parameters", "apply_path_si"]
+           "material_changes", "parameter_change", "AssemblyParameterChange", "get_parameter", "set_parameters", "apply_path_si", "LENGTH_FACTOR", "ENGINEERING_E",
+           "ENGINEERING_RHO"]
 
 
 @attrs.frozen
@@ -74,6 +76,9 @@ class ModelParameter:
     linked : bool
         Several numbers moved as one (an overhang, a component's material, a
         joint's whole stiffness, a set of supports).
+    si : bool
+        It can be set on the SI form of the model (False for the numbers of
+        a component with tapered segments, which fits set on the assembly).
     """
 
     path: str
@@ -84,6 +89,7 @@ class ModelParameter:
     log: bool
     description: str
     linked: bool = False
+    si: bool = True
 
     def spec(self) -> ParamSpec:
         """The fitted parameter ``value``, starting at the nominal value.
@@ -97,7 +103,7 @@ class ModelParameter:
         return ParamSpec("value", self.unit, self.lower, self.upper, start, self.log, self.nominal)
 
 
-from .paths import _on_beam, _overhang_segment, _plain, _unknown, set_parameters
+from .paths import _on_beam, _overhang_segment, _plain, _segmented, _unknown, set_parameters
 
 
 
@@ -114,6 +120,23 @@ def _linked(path, unit, nominal, lo, hi, text) -> ModelParameter:
 
 
 _C_DEFAULT = {"yf": (1e-2, 1e5), "tm": (1e-4, 1e3)}
+
+
+LENGTH_FACTOR = 1.5
+"""Lengths and diameters of the model are corrected within this factor of their nominal values (a drawing
+is not off by half a part, a tool is not clamped at half its length)."""
+ENGINEERING_E = (40e9, 700e9)
+"""Range of Young's modulus of the engineering materials a machine-tool part is made of [Pa]: from
+magnesium and aluminium alloys to cemented carbide."""
+ENGINEERING_RHO = (1500.0, 19300.0)
+"""Range of density of those materials [kg/m^3]: from magnesium alloys to heavy tungsten alloys."""
+
+
+def _within(nominal: float, factor_lo: float, factor_hi: float, allowed: tuple[float, float]) -> tuple[float, float]:
+    """Bounds ``factor_lo..factor_hi`` times nominal, cut to ``allowed`` but always holding the nominal value."""
+    lo = min(max(factor_lo * nominal, allowed[0]), nominal)
+    hi = max(min(factor_hi * nominal, allowed[1]), nominal)
+    return float(lo), float(hi)
 
 
 def _matrix_parameters(prefix: str, owner, what: str) -> list[ModelParameter]:
@@ -139,13 +162,16 @@ def _matrix_parameters(prefix: str, owner, what: str) -> list[ModelParameter]:
 def model_parameters(assembly) -> list[ModelParameter]:
     """Every number of ``assembly`` a fit may correct, with physical bounds.
 
-    Bounds per kind: lengths 0.5 to 2 times nominal; outer diameters 0.5 to
-    1.5 times (and above the bore); bores and inserts within the section;
-    flutes' ratio 0.5 to 1; ``E`` and ``rho`` 0.25 to 4 times; ``nu`` 0 to
+    Bounds per kind: lengths and outer diameters within
+    :data:`LENGTH_FACTOR` (1.5) times nominal either way (diameters above
+    the bore); bores and inserts within the section; flutes' ratio 0.5 to 1;
+    ``E`` and ``rho`` 0.25 to 4 times, within the range of engineering
+    materials (:data:`ENGINEERING_E`, :data:`ENGINEERING_RHO`); ``nu`` 0 to
     0.49; loss factors 1e-5 to 0.2; joint and support entries 1e-3 to 1e3
     times (cross terms within passivity, ``k_ym^2 < k_yf k_tm``); positions
     within the component; sensor and body masses 0.1 to 10 times; linked
-    factors 0.25 to 4 (a tool's overhang: 0.5 to 1.5 times).
+    factors 0.25 to 4 (a component's ``E`` and ``rho`` within the
+    engineering range too; a tool's overhang within 1.5 times).
 
     Parameters
     ----------
@@ -160,41 +186,63 @@ def model_parameters(assembly) -> list[ModelParameter]:
     out: list[ModelParameter] = []
     materials: dict[str, Material] = {}
     for comp in assembly.components:
-        if not _plain(comp):
+        si = _plain(comp)
+        if not si and not _segmented(comp):
             continue
+        first = len(out)
         base = f"components.{comp.name}"
         for i, seg in enumerate(comp.segments):
             p = f"{base}.segments.{i}"
             L, od, id_ = seg.length_m, seg.od.m_as("m"), seg.id.m_as("m")
-            out.append(_log(f"{p}.length", "m", L, 0.5 * L, 2.0 * L, f"length of segment {i} of {comp.name}"))
-            low = max(0.5 * od, 1.02 * id_ / (seg.flutes.diameter_ratio if seg.flutes else 1.0))
-            out.append(_log(f"{p}.od", "m", od, low, 1.5 * od, f"outer diameter of segment {i} of {comp.name}"))
+            out.append(_log(f"{p}.length", "m", L, L / LENGTH_FACTOR, LENGTH_FACTOR * L,
+                            f"length of segment {i} of {comp.name}"))
+            low = max(od / LENGTH_FACTOR, 1.02 * id_ / (seg.flutes.diameter_ratio if seg.flutes else 1.0))
+            out.append(_log(f"{p}.od", "m", od, low, LENGTH_FACTOR * od, f"outer diameter of segment {i} of {comp.name}"))
+            if seg.is_tapered:
+                od1, id1 = seg._od_tip.m_as("m"), seg._id_tip.m_as("m")
+                low = max(od1 / LENGTH_FACTOR, 1.02 * id1 / (seg.flutes.diameter_ratio if seg.flutes else 1.0))
+                out.append(_log(f"{p}.od_tip", "m", od1, low, LENGTH_FACTOR * od1,
+                                f"outer diameter at the tip end of tapered segment {i} of {comp.name}"))
+                if id1 > 0:
+                    out.append(_lin(f"{p}.id_tip", "m", id1, 0.0, 0.9 * od1, f"bore at the tip end of tapered segment "
+                                                                            f"{i} of {comp.name}"))
             if seg.insert is None:
-                out.append(_lin(f"{p}.id", "m", id_, 0.0, 0.9 * od * (seg.flutes.diameter_ratio if seg.flutes else 1.0),
+                narrow = min(od, seg._od_tip.m_as("m")) if seg.is_tapered else od
+                out.append(_lin(f"{p}.id", "m", id_, 0.0, 0.9 * narrow * (seg.flutes.diameter_ratio if seg.flutes else 1.0),
                                 f"bore of segment {i} of {comp.name}"))
             else:
                 iod = seg.insert.od.m_as("m")
                 out.append(_log(f"{p}.insert.od", "m", iod, max(0.5 * iod, 1.02 * seg.insert.id.m_as("m")), id_,
                                 f"insert diameter in segment {i} of {comp.name}"))
-                materials.setdefault(seg.insert.material.name, seg.insert.material)
+                if si:
+                    materials.setdefault(seg.insert.material.name, seg.insert.material)
             if seg.flutes is not None:
                 low = max(0.5, 1.02 * id_ / od)
                 out.append(_lin(f"{p}.flutes.diameter_ratio", "dimensionless", seg.flutes.diameter_ratio, low, 1.0,
                                 f"flutes' diameter ratio of segment {i} of {comp.name}"))
-            materials.setdefault(seg.material.name, seg.material)
+            if si:
+                materials.setdefault(seg.material.name, seg.material)
         if isinstance(comp, Tool) and _overhang_segment(comp) is not None:
             total = comp.length_m
             fixed = total - comp.segments[_overhang_segment(comp)].length_m
-            out.append(_linked(f"{base}.overhang", "m", total, max(0.5 * total, fixed + 0.1 * (total - fixed)),
-                               1.5 * total, f"overhang of {comp.name} (its fluted length kept)"))
+            out.append(_linked(f"{base}.overhang", "m", total,
+                               max(total / LENGTH_FACTOR, fixed + 0.1 * (total - fixed)),
+                               LENGTH_FACTOR * total, f"overhang of {comp.name} (its fluted length kept)"))
+        own = comp.segments[0].material
         for prop, text in (("E", "stiffness (E)"), ("rho", "density"), ("loss_factor", "material damping")):
-            out.append(_linked(f"{base}.{prop}", "dimensionless", 1.0, 0.25 if prop != "loss_factor" else 0.05,
-                               4.0 if prop != "loss_factor" else 20.0, f"{text} of {comp.name} only, as a factor"))
+            if prop == "loss_factor":
+                lo, hi = 0.05, 20.0
+            else:
+                value = own.E.m_as("Pa") if prop == "E" else own.rho_si
+                lo, hi = (x / value for x in _within(value, 0.25, 4.0, ENGINEERING_E if prop == "E" else ENGINEERING_RHO))
+            out.append(_linked(f"{base}.{prop}", "dimensionless", 1.0, lo, hi, f"{text} of {comp.name} only, as a factor"))
+        if not si:  # tapered segments: set on the assembly in fits
+            out[first:] = [attrs.evolve(x, si=False) for x in out[first:]]
     for name, m in materials.items():
         p = f"materials.{name}"
         E, rho = m.E.m_as("Pa"), m.rho_si
-        out.append(_log(f"{p}.E", "Pa", E, 0.25 * E, 4.0 * E, f"Young's modulus of {name}"))
-        out.append(_log(f"{p}.rho", "kg/m^3", rho, 0.25 * rho, 4.0 * rho, f"density of {name}"))
+        out.append(_log(f"{p}.E", "Pa", E, *_within(E, 0.25, 4.0, ENGINEERING_E), f"Young's modulus of {name}"))
+        out.append(_log(f"{p}.rho", "kg/m^3", rho, *_within(rho, 0.25, 4.0, ENGINEERING_RHO), f"density of {name}"))
         out.append(_lin(f"{p}.nu", "dimensionless", m.nu, 0.0, 0.49, f"Poisson ratio of {name}"))
         out.append(ModelParameter(f"{p}.loss_factor", "dimensionless", m.loss_factor, 1e-5, 0.2, True,
                                   f"loss factor of {name}"))
@@ -238,6 +286,55 @@ def model_parameters(assembly) -> list[ModelParameter]:
                     out.append(_lin(f"{p}.at", "m", x, 0.0, length, f"position of {s.name} along {comp}"))
     return out
 
+
+
+def material_changes(assembly, known=None) -> list["ParameterSet"]:
+    """Per beam component, "this part is made of another material": its ``E`` and ``rho`` fitted together.
+
+    The change is named ``components.C.material`` (effect
+    ``model-parameter``) with the parameters ``E`` [Pa] and ``rho``
+    [kg/m^3] of the component's own material (every segment of it; inserts
+    keep theirs), bounded by the range of engineering materials, starting at
+    the model's values; its extra starting points (``trials``) are the
+    materials the library and the assembly know, so that a fit reaches the
+    right one from where it is (a carbide tool that is HSS: steel's
+    ``E`` and ``rho``).
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model.
+    known : mapping of str to Material, optional
+        Materials to start from (default the library's catalogue and the assembly's own).
+
+    Returns
+    -------
+    list of ParameterSet
+        One change per plain beam component.
+    """
+    from ..materials import CATALOG
+
+    known = dict(known) if known is not None else {**CATALOG, **{m.name: m for m in assembly.materials}}
+    out = []
+    for comp in assembly.components:
+        if not _plain(comp):
+            continue
+        own = comp.segments[0].material
+        E, rho = own.E.m_as("Pa"), own.rho_si
+        e_lo, e_hi = _within(E, 0.0, np.inf, ENGINEERING_E)
+        r_lo, r_hi = _within(rho, 0.0, np.inf, ENGINEERING_RHO)
+        base = f"components.{comp.name}.material"
+        change = ParameterSet("model-parameter", base, {"E": f"{base}.E", "rho": f"{base}.rho"},
+                              (ParamSpec("E", "Pa", e_lo, e_hi, E, True, E),
+                               ParamSpec("rho", "kg/m^3", r_lo, r_hi, rho, True, rho)))
+        change.explanation = (f"{comp.name} is made of another material than the model says: E and rho move "
+                              "together (a stiffer and lighter material raises its modes, and so on)")
+        change.linked = True
+        change.trials = tuple({"E": float(np.clip(m.E.m_as("Pa"), e_lo, e_hi)),
+                               "rho": float(np.clip(m.rho_si, r_lo, r_hi))}
+                              for m in known.values() if (m.E.m_as("Pa"), m.rho_si) != (E, rho))
+        out.append(change)
+    return out
 
 
 # ---------------------------------------------------------------------------
@@ -330,6 +427,29 @@ class ParameterChange(Change):
             The changed structure.
         """
         return apply_path_si(structure, self.where, float(values["value"]))
+
+
+class AssemblyParameterChange(ParameterChange):
+    """A :class:`ParameterChange` of a number the SI form does not hold (a tapered segment's): fits set it
+    on the assembly and rebuild the changed component (slower, the same result)."""
+
+    apply_si = Change.apply_si
+
+
+def parameter_change(parameter: ModelParameter) -> ParameterChange:
+    """The change that corrects a model parameter: on the SI form when it can, else on the assembly.
+
+    Parameters
+    ----------
+    parameter : ModelParameter
+        The parameter.
+
+    Returns
+    -------
+    ParameterChange
+        A :class:`ParameterChange`, or an :class:`AssemblyParameterChange` when ``parameter.si`` is false.
+    """
+    return ParameterChange(parameter) if parameter.si else AssemblyParameterChange(parameter)
 
 
 class ParameterSet(Change):

@@ -73,6 +73,10 @@ def apply_path_si(structure, path: str, value: float):
             mat = beam.material.copy()
             mat[:, _MAT_COLUMN[rest[0]]] *= value
             return structure.with_beam(beam.evolve(material=mat))
+        if len(rest) == 2 and rest[0] == "material" and rest[1] in _MAT_COLUMN:
+            mat = beam.material.copy()
+            mat[:, _MAT_COLUMN[rest[1]]] = value
+            return structure.with_beam(beam.evolve(material=mat))
         if rest == ["supports", "k"]:
             out = structure
             for i, link in enumerate(structure.links):
@@ -150,6 +154,15 @@ def _plain(component) -> bool:
     return si_beam(component)
 
 
+def _segmented(component) -> bool:
+    """A beam of plain segments, tapered ones allowed (its numbers can be set on the assembly)."""
+    from ..beams import Segment
+    from ..components import Beam, is_plain_beam
+
+    return is_plain_beam(component) and isinstance(component, Beam) and all(type(s) is Segment
+                                                                             for s in component.segments)
+
+
 def _overhang_segment(tool) -> int | None:
     """The segment whose length a tool's overhang changes: the first without flutes."""
     for i, seg in enumerate(tool.segments):
@@ -225,7 +238,7 @@ def _set_one(assembly, path: str, value: float):
     value = float(value)
     if head == "components" and len(parts) >= 3:
         comp = assembly.component(parts[1])
-        if not _plain(comp):
+        if not _segmented(comp):
             raise _unknown(path, f"{parts[1]!r} is not a stepped beam")
         rest = parts[2:]
         segs = list(comp.segments)
@@ -233,7 +246,7 @@ def _set_one(assembly, path: str, value: float):
             i = int(rest[1])
             seg = segs[i]
             what = ".".join(rest[2:])
-            if what in ("length", "od", "id"):
+            if what in ("length", "od", "id", "od_tip", "id_tip"):
                 segs[i] = attrs.evolve(seg, **{what: _si(value, "m")})
             elif what in ("insert.od", "insert.id"):
                 segs[i] = attrs.evolve(seg, insert=attrs.evolve(seg.insert, **{what[7:]: _si(value, "m")}))
@@ -247,15 +260,17 @@ def _set_one(assembly, path: str, value: float):
             seg = segs[i]
             segs[i] = attrs.evolve(seg, length=_si(seg.length_m + value - comp.length_m, "m"))
             return assembly.with_component(attrs.evolve(comp, segments=segs))
-        if rest in (["E"], ["rho"], ["loss_factor"]):
-            prop = rest[0]
+        own = rest in (["E"], ["rho"], ["loss_factor"])
+        if own or (len(rest) == 2 and rest[0] == "material" and rest[1] in _MAT_COLUMN):
+            prop = rest[-1]
             renamed = {}
             for i, seg in enumerate(segs):
                 m = seg.material
                 if m.name not in renamed:
-                    current = {"E": m.E.m_as("Pa"), "rho": m.rho_si, "loss_factor": m.loss_factor}[prop]
-                    new = _material_value(m, prop, current * value)
-                    renamed[m.name] = attrs.evolve(new, name=f"{m.name}-{comp.name}")
+                    current = {"E": m.E.m_as("Pa"), "rho": m.rho_si, "nu": m.nu, "loss_factor": m.loss_factor}[prop]
+                    new = _material_value(m, prop, current * value if own else value)
+                    suffix = f"-{comp.name}"
+                    renamed[m.name] = attrs.evolve(new, name=m.name if m.name.endswith(suffix) else m.name + suffix)
                 segs[i] = attrs.evolve(seg, material=renamed[m.name])
             return assembly.with_component(attrs.evolve(comp, segments=segs))
         if rest == ["supports", "k"]:

@@ -592,8 +592,11 @@ class Evaluator:
             return self._store((beam.token, tuple(xs)), lambda: beam.receptance(xs, self.f), pin)
         comp = structure.opaque[name]
         refs = [r for _, r in nodes]
-        return self._store((id(comp), tuple(str(r) for r in refs)), lambda: comp.receptance_matrix(refs, self.f),
-                           True)
+        # keyed by the object's id, stored with the object itself so that the id cannot be reused while cached;
+        # pinned only for the first structure (a component changed by a fit is rebuilt at every evaluation)
+        kept = self._store((id(comp), tuple(str(r) for r in refs)),
+                           lambda: (comp, comp.receptance_matrix(refs, self.f)), pin)
+        return kept[1]
 
     def __call__(self, structure: Structure) -> np.ndarray:
         """The receptances ``(n_freq, n_out, n_in)`` of ``structure``."""
