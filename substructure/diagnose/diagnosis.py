@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 import sys
+import time
 from typing import Callable, Sequence
 
 import attrs
@@ -298,8 +299,9 @@ class Diagnosis:
         measurement that separates it; when there are any, ``explained`` is
         false.
     search : dict
-        What the search did: ``candidates``, ``full_fits``, ``seconds``,
-        ``budget_s``, ``cut`` (the time budget stopped it).
+        What the search did: ``candidates``, ``steps_screened``,
+        ``full_fits``, ``seconds``, ``budget_s``, ``cut`` (the time budget
+        stopped part of it) and ``cut_at`` (where).
     """
 
     metric: str
@@ -479,9 +481,14 @@ def _main_shift(comparison: Comparison) -> float:
     return float(best.model_hz / best.measured_hz - 1)
 
 
+BUDGET_S = 30.0
+"""Default time budget of the search [s]: past it no step is added, a step fits only its best candidate on all
+lines, and the parsimony check compares singles only; the JSON says so (``search.cut``)."""
+
+
 def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", band=None,
              refine: bool = True, max_steps: int = 4, progress: bool | Callable[[str], None] = False,
-             open_world: bool = True) -> Diagnosis:
+             open_world: bool = True, budget: float | None = BUDGET_S) -> Diagnosis:
     """Diagnose what an assembly model is missing against measurements.
 
     Parameters
@@ -505,6 +512,10 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     open_world : bool
         Consider every model parameter and the elements at fitted
         positions besides the catalogue (default True).
+    budget : float or None
+        Time budget of the search [s] (default :data:`BUDGET_S`; None: no
+        limit).  When it cuts the search, ``Diagnosis.search["cut"]`` is
+        true and, unless the data are explained, the report says so.
 
     Returns
     -------
@@ -513,6 +524,9 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     """
     from .report import Explanation, separation, unexplained_report
 
+    started = time.monotonic()
+    if budget is not None and not (isinstance(budget, (int, float)) and math.isfinite(budget) and budget > 0):
+        raise InvalidValueError(f"budget: got {budget!r}; expected a positive number of seconds (or None: no limit)")
     catalogue = _catalogue(effects)
     if progress is True:
         def progress(text):  # noqa: F811 - a printer when asked for
@@ -537,7 +551,8 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     cands = candidates(assembly, points, catalogue, open_world, _main_shift(baseline[0]), say)
     screen_lik = lik.subsample(max(1, lik.lines.size // SCREEN_LINES))
     limit = 0 if cons.consistent else (max_steps if refine else 1)
-    outcome = refine_model(lik, screen_lik, cands, limit, lambda changes: _passive(lik, changes), say)
+    outcome = refine_model(lik, screen_lik, cands, limit, lambda changes: _passive(lik, changes), say,
+                           None if budget is None else started + float(budget))
     current = outcome.current
     p_now = sum(len(c.specs) for c, _ in current)
     steps = [Step(0, None, e0, chi2_now / n)]
@@ -591,6 +606,10 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
                       + ", ".join(repr(e) for e in final_effects))
         sep = sep or rivals[0][1]
         names = tuple(dict.fromkeys(list(names) + [r.name for r, _ in rivals]))
+    search = {**outcome.search, "budget_s": budget, "seconds": round(time.monotonic() - started, 3)}
+    if search["cut"] and not explained:
+        report = list(report) + [f"the search was cut by its time budget ({budget:g} s): {search['cut_at']}; "
+                                 "a larger budget (--budget) may find more"]
     return Diagnosis(
         metric=METRIC, baseline_error=e0, noise_floor=floor, explained=explained,
         missing_effect=None if missing is None else missing.name,
@@ -599,7 +618,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         candidates=tuple(first), refinement=tuple(steps), band=band, baseline=baseline, final=final,
         refined_assembly=refined, final_effects=final_effects, consistency=cons, ambiguous=tuple(ambiguous),
         separation=sep, report=tuple(report), correlation=correlation, final_error=final_error,
-        rivals=tuple(rivals),
+        rivals=tuple(rivals), search=search,
     )
 
 

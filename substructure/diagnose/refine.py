@@ -22,6 +22,7 @@ any change is left alone.  Then
 from __future__ import annotations
 
 import math
+import time
 from typing import Callable
 
 import attrs
@@ -57,6 +58,9 @@ class Outcome:
         Whole explanations (a single or a pair of changes fitted from fair
         starts, or the forward path's) inside the indifference region of the
         one kept: ``[(changes, chi2, bic), ...]``.
+    search : dict
+        ``candidates``, ``steps_screened``, ``full_fits``, ``cut`` (the time
+        budget stopped part of the search) and ``cut_at`` (where).
     """
 
     current: list
@@ -66,6 +70,7 @@ class Outcome:
     first_fitted: list
     alternatives: dict
     rivals: list = attrs.field(factory=list)
+    search: dict = attrs.field(factory=dict)
 
 
 def _p(changes) -> int:
@@ -173,7 +178,7 @@ def _bic(chi2: float, p: int, n: int, s2: float) -> float:
     return chi2 / s2 + p * math.log(n)
 
 
-def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say):
+def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say, pairs: bool = True):
     """The kept explanation against the best single and best pair ones fitted from fair starts.
 
     Forward selection extends its first choice; when that choice was wrong,
@@ -199,7 +204,7 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say):
     for s in singles:
         if [s.change.key] != keys_now:
             options.append(([(c, dict(v)) for c, v in s.fit.changes], s.fit.chi2))
-    if len(current) >= 3:
+    if len(current) >= 3 and pairs:
         pool = singles[:PAIR_POOL]
         trials = []
         for i in range(len(pool)):
@@ -232,7 +237,12 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say):
     return kept, kept_chi2, rivals
 
 
-def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None) -> Outcome:
+def _late(deadline: float | None) -> bool:
+    return deadline is not None and time.monotonic() > deadline
+
+
+def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
+           deadline: float | None = None) -> Outcome:
     """Forward selection, then elimination, review and history (see the module docstring).
 
     Parameters
@@ -249,6 +259,10 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None) 
         ``passive(changes) -> bool``: the changed model is passive.
     say : callable, optional
         Progress.
+    deadline : float, optional
+        ``time.monotonic()`` after which the search adds no step, fits no
+        more candidates in a step than the first, and skips the pairs of the
+        parsimony check (recorded in ``Outcome.search``).
 
     Returns
     -------
@@ -256,6 +270,14 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None) 
         The changes kept and what the report needs.
     """
     n = lik.n
+    search = {"candidates": len(cands), "steps_screened": 0, "full_fits": 0, "cut": False, "cut_at": None}
+
+    def cut(where: str) -> None:
+        if not search["cut"]:
+            search["cut"], search["cut_at"] = True, where
+            if say:
+                say(f"time budget spent: {where}")
+
     current: list = []
     chi2_now = lik.chi2([])
     first_scored, first_fitted = [], []
@@ -265,6 +287,10 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None) 
     path: list = []
     tried = len(cands)
     while len(current) < max_steps:
+        if _late(deadline):
+            cut(f"no step {len(current) + 1} screened")
+            break
+        search["steps_screened"] += 1
         keys = {c.key for c, _ in current}
         remaining = [c for c in cands if c.key not in keys]
         if say:
@@ -280,8 +306,11 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None) 
             chi2_all = lik.chi2(list(s.start if s.start is not None else current) + [(s.change, s.values)])
             if significance(chi2_now, chi2_all, s.k, n, _p(current) + s.k).significant:
                 chosen.append(s)
-        fitted = [s for s in full_fits(lik, current, chosen, say)
-                  if physical(s.change, s.values) and passive(s.fit.changes)]
+        done = full_fits(lik, current, chosen, say, deadline)
+        search["full_fits"] += len(done)
+        if len(done) < len(chosen):
+            cut(f"step {len(current) + 1}: {len(done)} of {len(chosen)} shortlisted candidates fitted on all lines")
+        fitted = [s for s in done if physical(s.change, s.values) and passive(s.fit.changes)]
         ranked = rank(fitted, n, _p(current))
         if not first_scored:
             first_scored, first_fitted = scored, ranked
@@ -316,7 +345,10 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None) 
     rivals: list = []
     if len(current) >= 2:
         before = [c.key for c, _ in current]
-        current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say)
+        if _late(deadline) and len(current) >= 3:
+            cut("the parsimony check compared singles only (no pairs)")
+        current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
+                                               pairs=not _late(deadline))
         if [c.key for c, _ in current] != before:
             alternatives = {c.key: [] for c, _ in current}
     kept = [c.key for c, _ in current]
@@ -325,4 +357,4 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None) 
     if final is not None:
         current = [(c, dict(v)) for c, v in final.changes]
     history = path if unchanged else (_history(lik, current, final, tried) if current else [])
-    return Outcome(current, final, history, first_scored, first_fitted, alternatives, rivals)
+    return Outcome(current, final, history, first_scored, first_fitted, alternatives, rivals, search)

@@ -27,6 +27,7 @@ effect can only add a candidate, not push a built-in one out.
 from __future__ import annotations
 
 import math
+import time
 from typing import Callable, Sequence
 
 import attrs
@@ -351,7 +352,7 @@ def _builtin(change: Change) -> bool:
 
 
 def full_fits(likelihood, current: Sequence[tuple], chosen: Sequence[Scored],
-              progress: Callable | None = None) -> list[Scored]:
+              progress: Callable | None = None, deadline: float | None = None) -> list[Scored]:
     """Fit each chosen candidate on all lines with the effects already added refitted.
 
     Parameters
@@ -364,6 +365,9 @@ def full_fits(likelihood, current: Sequence[tuple], chosen: Sequence[Scored],
         Candidates with their screened values as the start.
     progress : callable, optional
         Progress lines.
+    deadline : float, optional
+        ``time.monotonic()`` after which no more candidates are fitted (the
+        first one always is; the shortlist is best first).
 
     Returns
     -------
@@ -371,7 +375,9 @@ def full_fits(likelihood, current: Sequence[tuple], chosen: Sequence[Scored],
         With ``fit`` set, best ``chi^2`` first.
     """
     out = []
-    for s in chosen:
+    for k, s in enumerate(chosen):
+        if k and deadline is not None and time.monotonic() > deadline:
+            break
         if progress:
             progress(f"fitting {s.change.effect} at {s.change.where} with {len(current)} effect(s) added")
         try:
