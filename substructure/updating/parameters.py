@@ -52,7 +52,7 @@ from .paths import apply_path_si
 
 __all__ = ["ParamSpec", "Change", "ModelParameter", "ParameterChange", "ParameterSet", "model_parameters",
            "material_changes", "parameter_change", "AssemblyParameterChange", "get_parameter", "set_parameters", "apply_path_si", "LENGTH_FACTOR", "ENGINEERING_E",
-           "ENGINEERING_RHO"]
+           "ENGINEERING_RHO", "ENGINEERING_NU"]
 
 
 @attrs.frozen
@@ -130,6 +130,8 @@ ENGINEERING_E = (40e9, 700e9)
 magnesium and aluminium alloys to cemented carbide."""
 ENGINEERING_RHO = (1500.0, 19300.0)
 """Range of density of those materials [kg/m^3]: from magnesium alloys to heavy tungsten alloys."""
+ENGINEERING_NU = (0.15, 0.40)
+"""Range of Poisson's ratio of those materials (ceramics and carbides about 0.2, metals about 0.3)."""
 
 
 def _within(nominal: float, factor_lo: float, factor_hi: float, allowed: tuple[float, float]) -> tuple[float, float]:
@@ -289,16 +291,17 @@ def model_parameters(assembly) -> list[ModelParameter]:
 
 
 def material_changes(assembly, known=None) -> list["ParameterSet"]:
-    """Per beam component, "this part is made of another material": its ``E`` and ``rho`` fitted together.
+    """Per beam component, "this part is made of another material": its ``E``, ``rho`` and ``nu`` fitted together.
 
     The change is named ``components.C.material`` (effect
-    ``model-parameter``) with the parameters ``E`` [Pa] and ``rho``
-    [kg/m^3] of the component's own material (every segment of it; inserts
-    keep theirs), bounded by the range of engineering materials, starting at
-    the model's values; its extra starting points (``trials``) are the
-    materials the library and the assembly know, so that a fit reaches the
-    right one from where it is (a carbide tool that is HSS: steel's
-    ``E`` and ``rho``).
+    ``model-parameter``) with the parameters ``E`` [Pa], ``rho`` [kg/m^3]
+    and ``nu`` of the component's own material (every segment of it;
+    inserts keep theirs), bounded by the range of engineering materials
+    (:data:`ENGINEERING_E`, :data:`ENGINEERING_RHO`,
+    :data:`ENGINEERING_NU`), starting at the model's values; its extra
+    starting points (``trials``) are the materials the library and the
+    assembly know, so that a fit reaches the right one from where it is (a
+    carbide tool that is HSS: steel's constants).
 
     Parameters
     ----------
@@ -324,14 +327,17 @@ def material_changes(assembly, known=None) -> list["ParameterSet"]:
         e_lo, e_hi = _within(E, 0.0, np.inf, ENGINEERING_E)
         r_lo, r_hi = _within(rho, 0.0, np.inf, ENGINEERING_RHO)
         base = f"components.{comp.name}.material"
-        change = ParameterSet("model-parameter", base, {"E": f"{base}.E", "rho": f"{base}.rho"},
+        nu = float(own.nu)
+        n_lo, n_hi = _within(nu, 0.0, np.inf, ENGINEERING_NU)
+        change = ParameterSet("model-parameter", base, {"E": f"{base}.E", "rho": f"{base}.rho", "nu": f"{base}.nu"},
                               (ParamSpec("E", "Pa", e_lo, e_hi, E, True, E),
-                               ParamSpec("rho", "kg/m^3", r_lo, r_hi, rho, True, rho)))
-        change.explanation = (f"{comp.name} is made of another material than the model says: E and rho move "
-                              "together (a stiffer and lighter material raises its modes, and so on)")
+                               ParamSpec("rho", "kg/m^3", r_lo, r_hi, rho, True, rho),
+                               ParamSpec("nu", "dimensionless", n_lo, n_hi, nu, False, nu)))
+        change.explanation = (f"{comp.name} is made of another material than the model says: E, rho and nu move "
+                              "together (a stiffer or lighter material raises the modes where it bends)")
         change.linked = True
         change.trials = tuple({"E": float(np.clip(m.E.m_as("Pa"), e_lo, e_hi)),
-                               "rho": float(np.clip(m.rho_si, r_lo, r_hi))}
+                               "rho": float(np.clip(m.rho_si, r_lo, r_hi)), "nu": float(np.clip(m.nu, n_lo, n_hi))}
                               for m in known.values() if (m.E.m_as("Pa"), m.rho_si) != (E, rho))
         out.append(change)
     return out

@@ -1,0 +1,397 @@
+"""What a diagnosis reports: the changes found, the candidates, the steps, and the :class:`Diagnosis`.
+
+:class:`Found` is a fitted change with its values, standard deviations and
+nominal values (the interface of an effect instance, so that
+``assembly.with_effect(found)`` works); :class:`Candidate` and :class:`Step`
+are the first step's candidates and the refinement's steps; :class:`Diagnosis`
+holds the verdict and writes the JSON of the project's file-format page
+(:func:`strict` keeps it strict JSON).  :func:`substructure.diagnose.diagnose`
+makes them.
+"""
+
+from __future__ import annotations
+
+import math
+
+import attrs
+import numpy as np
+
+from ..assembly import Assembly
+from .compare import Comparison
+
+__all__ = ["Found", "Candidate", "Step", "Diagnosis", "strict"]
+
+
+def _finite(x):
+    """A JSON-safe number: None for NaN and infinities."""
+    if x is None:
+        return None
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def strict(value):
+    """A JSON-ready copy with every NaN or infinity replaced by None (numpy numbers made plain).
+
+    Parameters
+    ----------
+    value : object
+        Dicts, lists, tuples, numbers, strings.
+
+    Returns
+    -------
+    object
+        The same structure, safe for ``json.dumps(..., allow_nan=False)``.
+    """
+    if isinstance(value, dict):
+        return {str(k): strict(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [strict(v) for v in value]
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return _finite(value)
+    return value
+
+
+class Found:
+    """A change with fitted values: what a candidate or a refinement step reports.
+
+    It has the interface of an :class:`~substructure.diagnose.effects.Effect`
+    instance (``name``, ``where``, ``values``, ``explanation``,
+    ``parameters_json()``, ``apply(assembly)``), so that
+    ``assembly.with_effect(found)`` works, plus ``std`` and ``nominal``.
+
+    Parameters
+    ----------
+    change : Change
+        The change.
+    values : dict
+        Fitted values (SI).
+    std : dict, optional
+        Standard deviations (SI).
+    """
+
+    def __init__(self, change, values: dict, std: dict | None = None):
+        self.change = change
+        self.values = {k: float(v) for k, v in values.items()}
+        self.std = {k: float(v) for k, v in (std or {}).items()}
+
+    @property
+    def name(self) -> str:
+        """The effect's name (``model-parameter``, ``added-mass``, ``sensor-mass``, ...)."""
+        return self.change.effect
+
+    @property
+    def where(self) -> str:
+        """Where it acts (a path, a point, a joint, a component)."""
+        return self.change.place(self.values)
+
+    @property
+    def explanation(self) -> str:
+        """Its signature in the FRF, in words."""
+        return self.change.explanation
+
+    @property
+    def nominal(self) -> dict:
+        """The model's values before a correction (parameters that have one)."""
+        return {s.name: s.nominal for s in self.change.specs if s.nominal is not None}
+
+    def parameters_json(self) -> dict:
+        """``{name: {"value", "unit", "std"[, "nominal"]}}`` (SI, strict JSON).
+
+        Returns
+        -------
+        dict
+            One entry per parameter.
+        """
+        out = {}
+        for s in self.change.specs:
+            entry = {"value": _finite(self.values.get(s.name)), "unit": s.unit,
+                     "std": _finite(self.std.get(s.name)) if s.name in self.std else None}
+            if s.nominal is not None:
+                entry["nominal"] = _finite(s.nominal)
+            out[s.name] = entry
+        return out
+
+    def apply(self, assembly: Assembly) -> Assembly:
+        """The assembly with this change (a normal assembly that saves as usual).
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+
+        Returns
+        -------
+        Assembly
+            The changed model.
+        """
+        return self.change.apply(assembly, self.values)
+
+    def __repr__(self) -> str:
+        vals = ", ".join(f"{k}={v:.4g}" for k, v in self.values.items())
+        return f"{self.name}(where={self.where!r}, {vals})"
+
+
+@attrs.frozen
+class Candidate:
+    """One candidate of the first round, fitted: its error and ``chi^2`` after the fit.
+
+    Parameters
+    ----------
+    effect : Found
+        The change with its values.
+    error : float
+        The error measure after the fit (dimensionless).
+    chi2 : float
+        ``chi^2`` after the fit.
+    fitted : bool
+        Fitted on all lines (else its values are the screening's).
+    nfev : int
+        Model evaluations of its fit.
+    """
+
+    effect: Found = attrs.field(eq=False)
+    error: float
+    chi2: float = 0.0
+    fitted: bool = True
+    nfev: int = 0
+
+    @property
+    def name(self) -> str:
+        """The effect's name."""
+        return self.effect.name
+
+    @property
+    def where(self) -> str:
+        """Where it acts."""
+        return self.effect.where
+
+    def to_json(self) -> dict:
+        """The candidate's JSON object.
+
+        Returns
+        -------
+        dict
+            ``effect``, ``where``, ``parameters``, ``error``, ``chi2``, ``fitted``, ``explanation``.
+        """
+        return {"effect": self.name, "where": self.where, "parameters": self.effect.parameters_json(),
+                "error": _finite(self.error), "chi2": _finite(self.chi2), "fitted": self.fitted,
+                "explanation": self.effect.explanation}
+
+
+@attrs.frozen
+class Step:
+    """One refinement step: the change added (None at step 0), its values when added, the error after.
+
+    Parameters
+    ----------
+    step : int
+        Its number (0: the model as given).
+    added : Found or None
+        The change added, with its values at this step.
+    error : float
+        The error measure after the step.
+    chi2_reduced : float
+        ``chi^2 / nu`` after the step.
+    statistic : float or None
+        The significance test's likelihood ratio that admitted it.
+    threshold : float or None
+        The test's threshold.
+    """
+
+    step: int
+    added: Found | None = attrs.field(eq=False)
+    error: float
+    chi2_reduced: float = float("nan")
+    statistic: float | None = None
+    threshold: float | None = None
+
+    def to_json(self) -> dict:
+        """The step's JSON object.
+
+        Returns
+        -------
+        dict
+            ``step``, ``added``, ``error``, ``chi2_reduced`` and, for a change, ``where``, ``parameters``,
+            ``significance``.
+        """
+        out = {"step": self.step, "added": None if self.added is None else self.added.name, "error": self.error}
+        if self.added is not None:
+            out["where"] = self.added.where
+            out["parameters"] = self.added.parameters_json()
+            out["significance"] = {"statistic": _finite(self.statistic), "threshold": _finite(self.threshold)}
+        out["chi2_reduced"] = _finite(self.chi2_reduced)
+        return out
+
+
+@attrs.frozen
+class Diagnosis:
+    """What :func:`diagnose` found.  ``to_json`` gives the JSON of docs/file-formats.md.
+
+    Parameters
+    ----------
+    metric : str
+        ``"rms_log_ratio"``.
+    baseline_error : float
+        The error of the model as given (dimensionless).
+    noise_floor : float
+        The error a perfect model would show, from the data's own noise.
+    explained : bool
+        The final residual is consistent with the noise (and within 1.5 floors).
+    missing_effect : str or None
+        The first change of the refinement.
+    missing_where : str or None
+        Where it acts.
+    ambiguous_with : tuple of str
+        Names of the alternatives inside the indifference region.
+    suggestion : str or None
+        The measurement that would tell the first change from its first alternative.
+    candidates : tuple of Candidate
+        The first step's candidates, best first.
+    refinement : tuple of Step
+        Step 0 (the model as given), then one per change kept.
+    band : tuple of float
+        The band used ``(lo, hi)`` [Hz].
+    baseline : tuple of Comparison
+        Every measurement against the model as given.
+    final : tuple of Comparison
+        Every measurement against the final model.
+    refined_assembly : Assembly
+        The model with the changes kept.
+    final_effects : tuple of Found
+        The changes kept, with their final values and standard deviations.
+    consistency : Consistency
+        The test of the final model.
+    ambiguous : tuple of (Found, float)
+        The alternatives with their errors.
+    separation : dict or None
+        ``response``, ``excitation``, ``non_contact``, ``chi2``, ``text``.
+    report : tuple of str
+        The verdict's lines when the data are not explained.
+    correlation : dict
+        ``parameters`` and ``matrix`` of the final fit's correlations.
+    final_error : float
+        The error of the final model.
+    rivals : tuple of (Explanation, dict)
+        Whole explanations as good as the one reported (inside the
+        indifference region) that are different structures, each with the
+        measurement that separates it; when there are any, ``explained`` is
+        false.
+    search : dict
+        What the search did: ``candidates``, ``steps_screened``,
+        ``full_fits``, ``seconds``, ``budget_s``, ``cut`` (the time budget
+        stopped part of it) and ``cut_at`` (where).
+    """
+
+    metric: str
+    baseline_error: float
+    noise_floor: float
+    explained: bool
+    missing_effect: str | None
+    missing_where: str | None
+    ambiguous_with: tuple[str, ...]
+    suggestion: str | None
+    candidates: tuple[Candidate, ...]
+    refinement: tuple[Step, ...]
+    band: tuple[float, float]
+    baseline: tuple[Comparison, ...] = attrs.field(eq=False)
+    final: tuple[Comparison, ...] = attrs.field(eq=False)
+    refined_assembly: Assembly = attrs.field(eq=False)
+    final_effects: tuple = attrs.field(default=(), eq=False)
+    consistency: object = attrs.field(default=None, eq=False)
+    ambiguous: tuple = attrs.field(default=(), eq=False)
+    separation: dict | None = attrs.field(default=None, eq=False)
+    report: tuple[str, ...] = ()
+    correlation: dict = attrs.field(factory=dict, eq=False)
+    final_error: float = float("nan")
+    rivals: tuple = attrs.field(default=(), eq=False)
+    search: dict = attrs.field(factory=dict, eq=False)
+
+    @property
+    def effects(self) -> list[Found]:
+        """The changes the refinement kept, with their final values (refitted together)."""
+        return list(self.final_effects)
+
+    def to_json(self) -> dict:
+        """One JSON object (strict JSON: no NaN or infinities); see docs/file-formats.md.
+
+        Returns
+        -------
+        dict
+            The keys of the contract and the added ones.
+        """
+        return strict(self._json())
+
+    def _json(self) -> dict:
+        cons = self.consistency
+        return {
+            "metric": self.metric,
+            "baseline_error": _finite(self.baseline_error),
+            "noise_floor": _finite(self.noise_floor),
+            "explained": bool(self.explained),
+            "missing_effect": self.missing_effect,
+            "ambiguous_with": list(self.ambiguous_with),
+            "candidates": [c.to_json() for c in self.candidates],
+            "refinement": [s.to_json() for s in self.refinement],
+            "missing_where": self.missing_where,
+            "suggestion": self.suggestion,
+            "band_hz": list(self.band),
+            "final_error": _finite(self.final_error),
+            "final_effects": [{"effect": e.name, "where": e.where, "parameters": e.parameters_json()}
+                              for e in self.final_effects],
+            "correlation": self.correlation,
+            "consistency": None if cons is None else {
+                "chi2_reduced": _finite(cons.chi2_reduced), "threshold": _finite(cons.threshold),
+                "bands_hz": [{"frf": self.final[b.item].measured.outputs[0] + " / " + self.final[b.item].measured.inputs[0],
+                              "lo": b.lo_hz, "hi": b.hi_hz, "ratio": _finite(b.ratio), "share": _finite(b.share)}
+                             for b in cons.bands]},
+            "ambiguous": [{"effect": a.name, "where": a.where, "parameters": a.parameters_json(),
+                           "error": _finite(err)} for a, err in self.ambiguous],
+            "separation": self.separation,
+            "rivals": [{"effects": [{"effect": f.name, "where": f.where, "parameters": f.parameters_json()}
+                                    for f in r.founds], "separation": sep} for r, sep in self.rivals],
+            "search": dict(self.search),
+            "report": list(self.report),
+            "modes": [
+                {"measured_hz": m.measured_hz, "model_hz": m.model_hz, "shift_hz": m.shift_hz,
+                 "amplitude_ratio": m.amplitude_ratio}
+                for m in self.baseline[0].modes
+            ],
+            "error_bands_hz": [[lo, hi, share] for lo, hi, share in self.baseline[0].bands],
+        }
+
+    def plot_where(self, ax=None):
+        """The baseline comparison: FRFs overlaid, residual, error bands, mode shifts.
+
+        Parameters
+        ----------
+        ax : sequence of three Axes, optional
+            Where to draw.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            The figure.
+        """
+        return self.baseline[0].plot(ax=ax)
+
+    def plot_history(self, ax=None):
+        """The error falling step by step, against the noise floor.
+
+        Parameters
+        ----------
+        ax : Axes, optional
+            Where to draw.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            The figure.
+        """
+        from .plots import plot_history
+
+        return plot_history(self, ax=ax)
