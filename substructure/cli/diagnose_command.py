@@ -85,8 +85,10 @@ def run(args: argparse.Namespace) -> int:
     if not args.effects.strip():
         raise UsageError("argument --effects: got an empty list; give 'all' or effect names separated by commas")
     count_arg("--max-steps", args.max_steps, minimum=1)
-    if args.budget is not None and not (math.isfinite(args.budget) and args.budget > 0):
-        raise UsageError(f"argument --budget: got {args.budget:g}; expected a positive number of seconds")
+    for option, value, what in (("--budget", args.budget, "model evaluations"), ("--time-limit", args.time_limit,
+                                                                               "seconds")):
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise UsageError(f"argument {option}: got {value:g}; expected a positive number of {what}")
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise UsageError(f"argument --plot: {args.plot} is a file; expected a directory for the figures")
     # figures go into DIR (created if missing): the ones there already are checked like any output
@@ -99,7 +101,7 @@ def run(args: argparse.Namespace) -> int:
     progress = None if args.quiet else (lambda text: print(f"{PROG}: {text}", file=sys.stderr, flush=True))
     result = diagnose(assembly, measurements, effects=args.effects, band=args.band, progress=progress or False,
                       max_steps=args.max_steps, open_world=not args.catalogue_only,
-                      **({} if args.budget is None else {"budget": args.budget}))
+                      time_limit=args.time_limit, **({} if args.budget is None else {"budget": args.budget}))
     written = []
     if args.plot:
         figures()
@@ -135,9 +137,11 @@ def add_parser(commands) -> None:
                       help="consider only the catalogue's effects, not every model parameter and added element")
     diag.add_argument("--max-steps", type=int, default=4, metavar="N",
                       help="most changes the refinement adds (default 4)")
-    diag.add_argument("--budget", type=float, default=None, metavar="SECONDS",
-                      help="time budget of the search in seconds (default 30); past it the search stops adding "
-                           "changes and says so")
+    diag.add_argument("--budget", type=float, default=None, metavar="N",
+                      help="budget of the search in model evaluations of all lines (default 3000); once spent the "
+                           "search stops adding changes and says so")
+    diag.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
+                      help="a limit in wall-clock seconds as well (default none)")
     diag.add_argument("--band", type=band_range_arg, metavar="LO:HI", help="frequency band in Hz (default: all data)")
     diag.add_argument("--plot", metavar="DIR", help="write the figures (where it fails, error fall) to DIR")
     diag.add_argument("--save-model", metavar="FILE.toml", help="write the model with the changes found")

@@ -22,7 +22,6 @@ any change is left alone.  Then
 from __future__ import annotations
 
 import math
-import time
 from typing import Callable
 
 import attrs
@@ -32,7 +31,7 @@ from ..updating.fit import Fit, fit
 from ..updating.selection import INDIFFERENCE, significance
 from ..updating.likelihood import Likelihood
 from .modes import mode_starts
-from .search import Scored, _places as places, choose, full_fits, physical, preference, rank, screen, shortlist
+from .search import Budget, Scored, _places as places, choose, full_fits, physical, preference, rank, screen, shortlist
 
 __all__ = ["Outcome", "refine"]
 
@@ -237,12 +236,8 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say, p
     return kept, kept_chi2, rivals
 
 
-def _late(deadline: float | None) -> bool:
-    return deadline is not None and time.monotonic() > deadline
-
-
 def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
-           deadline: float | None = None) -> Outcome:
+           budget: Budget | None = None) -> Outcome:
     """Forward selection, then elimination, review and history (see the module docstring).
 
     Parameters
@@ -259,10 +254,10 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
         ``passive(changes) -> bool``: the changed model is passive.
     say : callable, optional
         Progress.
-    deadline : float, optional
-        ``time.monotonic()`` after which the search adds no step, fits no
-        more candidates in a step than the first, and skips the pairs of the
-        parsimony check (recorded in ``Outcome.search``).
+    budget : Budget, optional
+        Once it is spent the search adds no step, fits no more candidates in
+        a step than the first, and skips the pairs of the parsimony check
+        (recorded in ``Outcome.search``).
 
     Returns
     -------
@@ -271,23 +266,28 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     """
     n = lik.n
     search = {"candidates": len(cands), "steps_screened": 0, "full_fits": 0, "cut": False, "cut_at": None}
+    lik0 = Likelihood(lik.assembly, lik.measured[:1])
+    if budget is not None:
+        budget.watch(lik, screen_lik, lik0)
+
+    def spent() -> bool:
+        return budget is not None and budget.spent()
 
     def cut(where: str) -> None:
         if not search["cut"]:
             search["cut"], search["cut_at"] = True, where
             if say:
-                say(f"time budget spent: {where}")
+                say(f"budget spent: {where}")
 
     current: list = []
     chi2_now = lik.chi2([])
     first_scored, first_fitted = [], []
-    lik0 = Likelihood(lik.assembly, lik.measured[:1])
     steps_fitted: dict = {}
     steps_inside: dict = {}
     path: list = []
     tried = len(cands)
     while len(current) < max_steps:
-        if _late(deadline):
+        if spent():
             cut(f"no step {len(current) + 1} screened")
             break
         search["steps_screened"] += 1
@@ -306,7 +306,7 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
             chi2_all = lik.chi2(list(s.start if s.start is not None else current) + [(s.change, s.values)])
             if significance(chi2_now, chi2_all, s.k, n, _p(current) + s.k).significant:
                 chosen.append(s)
-        done = full_fits(lik, current, chosen, say, deadline)
+        done = full_fits(lik, current, chosen, say, budget)
         search["full_fits"] += len(done)
         if len(done) < len(chosen):
             cut(f"step {len(current) + 1}: {len(done)} of {len(chosen)} shortlisted candidates fitted on all lines")
@@ -345,10 +345,10 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     rivals: list = []
     if len(current) >= 2:
         before = [c.key for c, _ in current]
-        if _late(deadline) and len(current) >= 3:
+        if spent() and len(current) >= 3:
             cut("the parsimony check compared singles only (no pairs)")
         current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
-                                               pairs=not _late(deadline))
+                                               pairs=not spent())
         if [c.key for c, _ in current] != before:
             alternatives = {c.key: [] for c, _ in current}
     kept = [c.key for c, _ in current]

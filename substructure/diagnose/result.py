@@ -283,7 +283,8 @@ class Diagnosis:
         false.
     search : dict
         What the search did: ``candidates``, ``steps_screened``,
-        ``full_fits``, ``seconds``, ``budget_s``, ``cut`` (the time budget
+        ``full_fits``, ``evaluations`` (model evaluations of all lines),
+        ``budget``, ``time_limit_s``, ``seconds``, ``cut`` (the budget
         stopped part of it) and ``cut_at`` (where).
     """
 

@@ -41,12 +41,80 @@ from ..updating.structure import si_beam
 from ..updating.selection import INDIFFERENCE, bic, significance
 from .effects import EffectChange, effect_change
 
-__all__ = ["Scored", "candidates", "screen", "full_fits", "SCREEN_LINES", "SHORTLIST_SHARE"]
+__all__ = ["Scored", "Budget", "candidates", "screen", "full_fits", "SCREEN_LINES", "SHORTLIST_SHARE"]
 
 SCREEN_LINES = 250
 """Lines per FRF in the screening subsample (about)."""
 SHORTLIST_SHARE = 0.25
 """A candidate gets a full fit when its screened improvement is at least this share of the best one."""
+
+
+class Budget:
+    """The work a search may do: model evaluations, and optionally seconds.
+
+    Evaluations are counted in evaluations of all lines of all measured
+    FRFs (one on the screening subsample of a tenth of the lines counts a
+    tenth), so that the same data and model give the same search on any
+    machine; a limit in seconds is there for users who want one (it makes
+    the result depend on the machine's speed).
+
+    Parameters
+    ----------
+    evaluations : float or None
+        Most evaluations (None: no limit).
+    seconds : float or None
+        Most wall-clock seconds (None: no limit).
+    """
+
+    def __init__(self, evaluations: float | None = None, seconds: float | None = None):
+        self.evaluations = evaluations
+        self.seconds = seconds
+        self.started = time.monotonic()
+        self.likelihoods: list = []
+        self.full = 1
+
+    def watch(self, *likelihoods) -> None:
+        """Count the evaluations of these likelihoods (the first one's lines are "all lines").
+
+        Parameters
+        ----------
+        *likelihoods : Likelihood
+            The likelihoods the search evaluates.
+        """
+        if not self.likelihoods and likelihoods:
+            self.full = max(likelihoods[0].n, 1)
+        self.likelihoods += [x for x in likelihoods if all(x is not y for y in self.likelihoods)]
+
+    def used(self) -> float:
+        """Evaluations so far, in evaluations of all lines.
+
+        Returns
+        -------
+        float
+            The work done.
+        """
+        return sum(x.evaluations * x.n for x in self.likelihoods) / self.full
+
+    def elapsed(self) -> float:
+        """Seconds since the budget was made.
+
+        Returns
+        -------
+        float
+            Wall-clock seconds.
+        """
+        return time.monotonic() - self.started
+
+    def spent(self) -> bool:
+        """Whether either limit is reached.
+
+        Returns
+        -------
+        bool
+            True once the search must stop adding work.
+        """
+        return bool((self.evaluations is not None and self.used() > self.evaluations)
+                    or (self.seconds is not None and self.elapsed() > self.seconds))
 
 
 def _plain(component) -> bool:
@@ -352,7 +420,7 @@ def _builtin(change: Change) -> bool:
 
 
 def full_fits(likelihood, current: Sequence[tuple], chosen: Sequence[Scored],
-              progress: Callable | None = None, deadline: float | None = None) -> list[Scored]:
+              progress: Callable | None = None, budget: Budget | None = None) -> list[Scored]:
     """Fit each chosen candidate on all lines with the effects already added refitted.
 
     Parameters
@@ -365,9 +433,9 @@ def full_fits(likelihood, current: Sequence[tuple], chosen: Sequence[Scored],
         Candidates with their screened values as the start.
     progress : callable, optional
         Progress lines.
-    deadline : float, optional
-        ``time.monotonic()`` after which no more candidates are fitted (the
-        first one always is; the shortlist is best first).
+    budget : Budget, optional
+        Once it is spent no more candidates are fitted (the first one always
+        is; the shortlist is best first).
 
     Returns
     -------
@@ -376,7 +444,7 @@ def full_fits(likelihood, current: Sequence[tuple], chosen: Sequence[Scored],
     """
     out = []
     for k, s in enumerate(chosen):
-        if k and deadline is not None and time.monotonic() > deadline:
+        if k and budget is not None and budget.spent():
             break
         if progress:
             progress(f"fitting {s.change.effect} at {s.change.where} with {len(current)} effect(s) added")
