@@ -38,6 +38,7 @@ def test_json_is_exactly_formats_md(files, capsys):
     assert best["parameters"]["mass"]["value"] == pytest.approx(0.002, rel=0.15)
     assert out["refinement"][1]["added"] == "sensor-mass" and out["refinement"][1]["where"] == "tool.tip"
     assert out["refinement"][-1]["error"] < out["baseline_error"] / 5
+    assert out["rivals"] == [] and out["search"]["budget"] == 3000 and not out["search"]["cut"]
 
 
 def test_human_output_figures_and_the_improved_model(files, capsys, tmp_path):
@@ -58,6 +59,9 @@ def test_bad_input(files, capsys, tmp_path):
     assert "unknown effect 'gremlins'" in capsys.readouterr().err
     assert _run(files, "--band", "6000:9000") == 1
     assert "outside the measured data" in capsys.readouterr().err
+    for option, value in (("--budget", "0"), ("--budget", "nan"), ("--time-limit", "-1")):
+        assert _run(files, option, value) == 2
+        assert f"argument {option}" in capsys.readouterr().err
     other = tmp_path / "other.toml"
     other.write_text((files / "measurements.toml").read_text().replace('"tool.tip:y"', '"drill.tip:y"', 1))
     (tmp_path / "00_tool_tip__tool_tip.csv").write_text((files / "00_tool_tip__tool_tip.csv").read_text())

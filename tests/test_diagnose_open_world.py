@@ -154,3 +154,31 @@ def test_sites_name_the_part_a_change_acts_on(results):
     assert all(sites(model, e.change, e.values) == frozenset({"joint:spindle-holder"}) for e in d.effects)
     hss_found = results["HSS tool modelled as carbide"].effects[0]
     assert sites(model, hss_found.change, hss_found.values) == frozenset({"component:tool"})
+
+
+def test_a_rival_that_changes_another_part_is_not_claimed():
+    """The rival rule on its own: the kept change against an alternative on the same part (an equivalent
+    description, the preferred one stands) and against one on another part that a measurement would tell apart."""
+    from substructure.diagnose.diagnosis import _distinct_rivals
+    from substructure.diagnose.refine import Outcome
+    from substructure.diagnose.result import Found
+    from substructure.updating.elements import AddedMass
+    from substructure.updating.likelihood import measured_frfs
+    from substructure.updating.parameters import parameter_change
+
+    model = hd.nominal_model()
+    measured, _ = measured_frfs(hd.measure(seed=6, ht_scale=0.8), None)
+    params = {p.path: p for p in model_parameters(model)}
+    kept = parameter_change(params["joints.holder-tool.k.yf"])
+    same = parameter_change(params["joints.holder-tool.k"])  # the joint's whole stiffness: the same part
+    other = AddedMass("holder", 0.066, 0.5)  # a body on the holder: another part
+    final = (Found(kept, {"value": 1.144e7}),)
+
+    def outcome(alternatives):
+        return Outcome([(kept, {"value": 1.144e7})], None, [], [], [], {kept.key: alternatives}, [])
+
+    assert _distinct_rivals(model, measured, final, outcome([(same, {"value": 0.8}, 0.0)]), None) == []
+    (rival, sep), = _distinct_rivals(model, measured, final, outcome(
+        [(other, {"mass": 0.05, "inertia": 1e-6, "position": 0.05}, 0.0)]), None)
+    assert rival.name == "added-mass" and sep["chi2"] > INDIFFERENCE and not sep["non_contact"]
+    assert sites(model, other, {}) == frozenset({"component:holder"})
