@@ -15,7 +15,8 @@ from substructure.updating.fit import fit
 from substructure.updating.likelihood import Likelihood, measured_frfs
 from substructure.updating.noise import estimate_noise
 from substructure.updating.parameters import (AssemblyParameterChange, ParameterChange, apply_path_si, get_parameter,
-                                              model_parameters, parameter_change, set_parameters)
+                                              material_changes, model_parameters, parameter_change,
+                                              set_parameters)
 from substructure.updating.selection import consistency, indifferent, significance
 from substructure.updating.structure import Evaluator, Structure
 
@@ -70,6 +71,17 @@ def test_every_parameter_moves_the_si_form_as_it_moves_the_assembly():
         assert get_parameter(changed, p.path) == pytest.approx(value if not p.linked or p.unit != "dimensionless"
                                                                else 1.0, rel=1e-9, abs=1e-12), p.path
     assert moved >= len(params) - 2  # only an unloaded insert bore and the like can leave the FRF alone
+    # "this part is made of another material": E, rho and nu of a component's own material together
+    changes = {c.where: c for c in material_changes(model)}
+    assert set(changes) == {f"components.{c.name}.material" for c in model.components}
+    steel = {"E": 210e9, "rho": 7850.0, "nu": 0.29}
+    assert steel in [dict(t) for t in changes["components.tool.material"].trials]  # the library's materials
+    for change in changes.values():
+        values = {s.name: float(np.clip(s.nominal * 0.9, s.lower, s.upper)) for s in change.specs}
+        ref = change.apply(model, values).frf(OUT, IN, F).data
+        got = evaluate(change.apply_si(structure, values))
+        assert np.abs(got - ref).max() <= 1e-10 * np.abs(ref).max(), change.where
+        assert np.abs(ref - base).max() > 1e-6 * np.abs(base).max(), change.where
 
 
 def test_a_changed_model_saves_and_reads_back_with_its_new_values():
