@@ -32,6 +32,7 @@ from typing import Callable, Sequence
 
 import attrs
 import numpy as np
+from scipy.optimize import minimize_scalar
 
 from ..errors import SubstructureError
 from ..updating.elements import AddedMass, GroundSpring, SectionChange, body_bounds
@@ -312,6 +313,7 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
         if best is not None and best_chi2 < chi2_now:
             scanned.append(Scored(change, dict(best), float(best_chi2), start=list(current)))
     scanned.sort(key=lambda s: s.chi2)
+    scanned = _polish(scanned, chi2_of, current)
     local = []
     p_now = sum(len(c.specs) for c, _ in current)
     for s in shortlist(scanned, chi2_now, likelihood.n, n_full, p_now):
@@ -326,6 +328,46 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
     local.sort(key=lambda s: s.chi2)
     done = {s.change.key for s in local}
     return [s for s in local + [s for s in scanned if s.change.key not in done] if s.chi2 < chi2_now]
+
+
+POLISHED = 24
+"""Candidates (best scanned first) whose main parameter is refined between its grid's neighbours after the scan."""
+
+
+def _polish(scanned: list, chi2_of, current) -> list:
+    """The main parameter of the best scanned candidates refined by a bounded 1-D search around its best trial.
+
+    A grid of nine values over decades misses minima narrower than its
+    step (a bearing pair half as stiff sits between 0.32 and 1 on a factor
+    grid, and moves the modes by many bandwidths on the way): each of the
+    :data:`POLISHED` best candidates gets a bounded scalar minimisation
+    (Brent's, at most ten evaluations) of its main parameter, on its fitted
+    scale, over one grid step either side of its best trial, the other
+    values held.  The order is then by the refined ``chi^2``.
+    """
+    out = []
+    for k, s in enumerate(scanned):
+        if k < POLISHED:
+            main = s.change.specs[0]
+            u0 = to_u(main, s.values[main.name])
+            lo_u, hi_u = to_u(main, main.lower), to_u(main, main.upper)
+            step = (hi_u - lo_u) / 8.0
+            lo, hi = max(lo_u, u0 - step), min(hi_u, u0 + step)
+
+            def cost(u):
+                try:
+                    return chi2_of(list(current) + [(s.change, {**s.values, main.name: from_u(main, u)})])
+                except (SubstructureError, ValueError, FloatingPointError):
+                    return math.inf
+
+            if hi > lo:
+                r = minimize_scalar(cost, bounds=(lo, hi), method="bounded", options={"maxiter": 10, "xatol": 1e-3})
+                if np.isfinite(r.fun) and r.fun < s.chi2:
+                    s = Scored(s.change, {**s.values, main.name: from_u(main, float(r.x))}, float(r.fun),
+                               start=s.start)
+        out.append(s)
+    out.sort(key=lambda x: x.chi2)
+    return out
 
 
 def _basis(likelihood, current) -> np.ndarray | None:

@@ -52,7 +52,7 @@ from .paths import apply_path_si
 
 __all__ = ["ParamSpec", "Change", "ModelParameter", "ParameterChange", "ParameterSet", "model_parameters",
            "material_changes", "parameter_change", "AssemblyParameterChange", "get_parameter", "set_parameters", "apply_path_si", "LENGTH_FACTOR", "ENGINEERING_E",
-           "ENGINEERING_RHO", "ENGINEERING_NU"]
+           "ENGINEERING_RHO", "ENGINEERING_NU", "POSITION_FRACTION"]
 
 
 @attrs.frozen
@@ -134,6 +134,16 @@ ENGINEERING_NU = (0.15, 0.40)
 """Range of Poisson's ratio of those materials (ceramics and carbides about 0.2, metals about 0.3)."""
 
 
+POSITION_FRACTION = 0.15
+"""A support or body the model places is where the drawing says within this fraction of its component's length
+(a bearing's effective centre, a nut's seat: centimetres, not across the part)."""
+
+
+def _position_bounds(x: float, length: float) -> tuple[float, float]:
+    half = POSITION_FRACTION * length
+    return float(max(0.0, x - half)), float(min(length, x + half))
+
+
 def _within(nominal: float, factor_lo: float, factor_hi: float, allowed: tuple[float, float]) -> tuple[float, float]:
     """Bounds ``factor_lo..factor_hi`` times nominal, cut to ``allowed`` but always holding the nominal value."""
     lo = min(max(factor_lo * nominal, allowed[0]), nominal)
@@ -171,7 +181,9 @@ def model_parameters(assembly) -> list[ModelParameter]:
     materials (:data:`ENGINEERING_E`, :data:`ENGINEERING_RHO`); ``nu`` 0 to
     0.49; loss factors 1e-5 to 0.2; joint and support entries 1e-3 to 1e3
     times (cross terms within passivity, ``k_ym^2 < k_yf k_tm``); positions
-    within the component; sensor and body masses 0.1 to 10 times; linked
+    of supports and bodies within :data:`POSITION_FRACTION` (0.15) of their
+    component's length of where the model has them; sensor and body masses
+    0.1 to 10 times; linked
     factors 0.25 to 4 (a component's ``E`` and ``rho`` within the
     engineering range too; a tool's overhang within 1.5 times).
 
@@ -262,7 +274,8 @@ def model_parameters(assembly) -> list[ModelParameter]:
         out += [m for m in _matrix_parameters(p, s, f"support {s.name or i} at {s.at}")]
         comp, x, length = _on_beam(assembly, s.at)
         if comp is not None:
-            out.append(_lin(f"{p}.at", "m", x, 0.0, length, f"position of support {s.name or i} along {comp}"))
+            out.append(_lin(f"{p}.at", "m", x, *_position_bounds(x, length),
+                            f"position of support {s.name or i} along {comp}"))
             if s.k:
                 per_component.setdefault(comp, []).append((x, i))
     for comp, found in per_component.items():
@@ -285,13 +298,13 @@ def model_parameters(assembly) -> list[ModelParameter]:
             if kind == "masses":
                 comp, x, length = _on_beam(assembly, s.at)
                 if comp is not None:
-                    out.append(_lin(f"{p}.at", "m", x, 0.0, length, f"position of {s.name} along {comp}"))
+                    out.append(_lin(f"{p}.at", "m", x, *_position_bounds(x, length), f"position of {s.name} along {comp}"))
     return out
 
 
 
 def material_changes(assembly, known=None) -> list["ParameterSet"]:
-    """Per beam component, "this part is made of another material": its ``E``, ``rho`` and ``nu`` fitted together.
+    """Per tool and holder, "this part is made of another material": its ``E``, ``rho`` and ``nu`` fitted together.
 
     The change is named ``components.C.material`` (effect
     ``model-parameter``) with the parameters ``E`` [Pa], ``rho`` [kg/m^3]
@@ -313,15 +326,19 @@ def material_changes(assembly, known=None) -> list["ParameterSet"]:
     Returns
     -------
     list of ParameterSet
-        One change per plain beam component.
+        One change per plain tool and holder component (a tool's material
+        is a choice among carbide grades, HSS and steels, a holder's among
+        steels and heavy metals; a spindle shaft is steel).
     """
     from ..materials import CATALOG
 
     known = dict(known) if known is not None else {**CATALOG, **{m.name: m for m in assembly.materials}}
+    from ..components import Holder
+
     out = []
     for comp in assembly.components:
-        if not _plain(comp):
-            continue
+        if not _plain(comp) or not isinstance(comp, (Tool, Holder)):
+            continue  # a tool's or a holder's material is a choice; a spindle shaft is steel
         own = comp.segments[0].material
         E, rho = own.E.m_as("Pa"), own.rho_si
         e_lo, e_hi = _within(E, 0.0, np.inf, ENGINEERING_E)
