@@ -73,7 +73,7 @@ def test_every_parameter_moves_the_si_form_as_it_moves_the_assembly():
     assert moved >= len(params) - 2  # only an unloaded insert bore and the like can leave the FRF alone
     # "this part is made of another material": E, rho and nu of a component's own material together
     changes = {c.where: c for c in material_changes(model)}
-    assert set(changes) == {f"components.{c.name}.material" for c in model.components}
+    assert set(changes) == {"components.tool.material", "components.holder.material"}  # a spindle shaft is steel
     steel = {"E": 210e9, "rho": 7850.0, "nu": 0.29}
     assert steel in [dict(t) for t in changes["components.tool.material"].trials]  # the library's materials
     for change in changes.values():
