@@ -13,7 +13,11 @@ step, drops at the end what no longer earns its parameters, and says
 When it is not, the report says so first, with where the remaining error
 lives and what kind of effect has that signature
 (:mod:`substructure.diagnose.report`).  Explanations the data cannot tell
-apart are reported together, with the measurement that would separate them.
+apart are reported together, with the measurement that would separate them;
+when they change different parts of the model (:func:`sites`) and a
+measurement would tell them apart, neither is claimed and the data are not
+explained.  The search runs within a budget of model evaluations
+(:data:`BUDGET`), so that the same data give the same answer on any machine.
 """
 
 

@@ -14,9 +14,18 @@ any change is left alone.  Then
   as ambiguous), and replaces it when it is preferred (a named effect of
   the catalogue before a linked parameter, before a single parameter,
   before an element; :func:`~substructure.diagnose.search.preference`);
+* the parsimony check compares an explanation of two or more changes by
+  BIC with every single candidate of the first step and (for three or
+  more) the best pairs fitted from the singles' own values, not only
+  extensions of the greedy path; the lowest BIC is kept, those within the
+  indifference region are its rivals;
 * the history is rebuilt from the changes kept, in the order that lowers
   ``chi^2`` most at each step, so that the "error fall" shows the final
   explanation.
+
+A :class:`~substructure.diagnose.search.Budget` of model evaluations bounds
+the work: once spent, no step is added, a step fits only its best candidate
+on all lines, and the parsimony check compares singles only.
 """
 
 from __future__ import annotations
