@@ -182,3 +182,27 @@ def test_a_rival_that_changes_another_part_is_not_claimed():
         [(other, {"mass": 0.05, "inertia": 1e-6, "position": 0.05}, 0.0)]), None)
     assert rival.name == "added-mass" and sep["chi2"] > INDIFFERENCE and not sep["non_contact"]
     assert sites(model, other, {}) == frozenset({"component:holder"})
+
+
+def test_parsimony_prefers_a_fair_single_to_a_greedy_path_that_compensates():
+    """Three changes where one does the work: the single (fitted from its own start) has the lower BIC."""
+    from substructure.diagnose.refine import _parsimony
+    from substructure.diagnose.search import Scored
+    from substructure.updating.fit import fit
+    from substructure.updating.likelihood import Likelihood, measured_frfs
+    from substructure.updating.parameters import parameter_change
+
+    model = hd.nominal_model()
+    measured, _ = measured_frfs(hd.measure(seed=7, ht_scale=0.5), None)
+    lik = Likelihood(model, measured)
+    params = {p.path: p for p in model_parameters(model)}
+    joint, stiff, heavy = (parameter_change(params[p]) for p in
+                           ("joints.holder-tool.k.yf", "components.spindle.E", "components.holder.rho"))
+    greedy = fit(lik, [(stiff, {"value": 1.02}), (heavy, {"value": 0.99}), (joint, {"value": 0.6e7})])
+    single = fit(lik, [(joint, {"value": 0.6e7})])
+    assert single.chi2_reduced < 1.1  # the single explains the data
+    first = [Scored(joint, dict(single.changes[0][1]), single.chi2, single)]
+    kept, chi2, rivals = _parsimony(lik, lik.subsample(9), list(greedy.changes), greedy.chi2, first,
+                                    lambda changes: True, None)
+    assert [c.key for c, _ in kept] == [joint.key] and chi2 == single.chi2
+    assert all(len(changes) > 1 for changes, _, _ in rivals)  # the greedy path, if it is within the region
