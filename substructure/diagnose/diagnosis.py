@@ -14,10 +14,10 @@ When it is not, the report says so first, with where the remaining error
 lives and what kind of effect has that signature
 (:mod:`substructure.diagnose.report`).  Explanations the data cannot tell
 apart are reported together, with the measurement that would separate them;
-when they change different parts of the model (:func:`sites`) and a
+when they change different parts of the model (``sites``) and a
 measurement would tell them apart, neither is claimed and the data are not
 explained.  The search runs within a budget of model evaluations
-(:data:`BUDGET`), so that the same data give the same answer on any machine.
+(``BUDGET``), so that the same data give the same answer on any machine.
 """
 
 
@@ -144,7 +144,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         positions besides the catalogue (default True).
     budget : float or None
         Budget of the search in model evaluations of all lines (default
-        :data:`BUDGET`; None: no limit): the same data give the same answer
+        ``BUDGET``; None: no limit): the same data give the same answer
         on any machine.  When it cuts the search, ``Diagnosis.search["cut"]``
         is true and, unless the data are explained, the report says so.
     time_limit : float or None

@@ -193,7 +193,7 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say, p
     later steps compensate and the path ends at several changes that a
     single or a pair of other changes explains as well.  Here every single
     of the first step (fitted from its own scan on all lines) and every pair
-    of the :data:`PAIR_POOL` best of them (fitted from the two singles'
+    of the ``PAIR_POOL`` best of them (fitted from the two singles'
     values, first on the screening lines, the best two on all lines) is
     compared with the kept explanation by BIC (``chi^2 / s^2 + p ln n``,
     ``s^2`` the misfit scale of the best of them).  The lowest BIC is kept;

@@ -340,7 +340,7 @@ def _polish(scanned: list, chi2_of, current) -> list:
     A grid of nine values over decades misses minima narrower than its
     step (a bearing pair half as stiff sits between 0.32 and 1 on a factor
     grid, and moves the modes by many bandwidths on the way): each of the
-    :data:`POLISHED` best candidates gets a bounded scalar minimisation
+    ``POLISHED`` best candidates gets a bounded scalar minimisation
     (Brent's, at most ten evaluations) of its main parameter, on its fitted
     scale, over one grid step either side of its best trial, the other
     values held.  The order is then by the refined ``chi^2``.

@@ -135,7 +135,7 @@ class AddedMass(_OnComponent):
     length : float
         Its length [m] (the position's bound).
     mass_max : float
-        Upper bound of the mass [kg] (see :func:`body_bounds`).
+        Upper bound of the mass [kg] (see ``body_bounds``).
     position : (float, float), optional
         Where it may sit [m from the base] (default the whole length).
     """

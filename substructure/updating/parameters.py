@@ -175,13 +175,13 @@ def model_parameters(assembly) -> list[ModelParameter]:
     """Every number of ``assembly`` a fit may correct, with physical bounds.
 
     Bounds per kind: lengths and outer diameters within
-    :data:`LENGTH_FACTOR` (1.5) times nominal either way (diameters above
+    ``LENGTH_FACTOR`` (1.5) times nominal either way (diameters above
     the bore); bores and inserts within the section; flutes' ratio 0.5 to 1;
     ``E`` and ``rho`` 0.25 to 4 times, within the range of engineering
-    materials (:data:`ENGINEERING_E`, :data:`ENGINEERING_RHO`); ``nu`` 0 to
+    materials (``ENGINEERING_E``, ``ENGINEERING_RHO``); ``nu`` 0 to
     0.49; loss factors 1e-5 to 0.2; joint and support entries 1e-3 to 1e3
     times (cross terms within passivity, ``k_ym^2 < k_yf k_tm``); positions
-    of supports and bodies within :data:`POSITION_FRACTION` (0.15) of their
+    of supports and bodies within ``POSITION_FRACTION`` (0.15) of their
     component's length of where the model has them; sensor and body masses
     0.1 to 10 times; linked
     factors 0.25 to 4 (a component's ``E`` and ``rho`` within the
@@ -310,8 +310,8 @@ def material_changes(assembly, known=None) -> list["ParameterSet"]:
     ``model-parameter``) with the parameters ``E`` [Pa], ``rho`` [kg/m^3]
     and ``nu`` of the component's own material (every segment of it;
     inserts keep theirs), bounded by the range of engineering materials
-    (:data:`ENGINEERING_E`, :data:`ENGINEERING_RHO`,
-    :data:`ENGINEERING_NU`), starting at the model's values; its extra
+    (``ENGINEERING_E``, ``ENGINEERING_RHO``,
+    ``ENGINEERING_NU``), starting at the model's values; its extra
     starting points (``trials``) are the materials the library and the
     assembly know, so that a fit reaches the right one from where it is (a
     carbide tool that is HSS: steel's constants).
