@@ -321,7 +321,8 @@ def _distinct_rivals(assembly, measured, final_effects, outcome, say) -> list:
 
     A rival is a whole explanation of the parsimony check
     (:func:`substructure.diagnose.refine.refine`) or the kept one with one
-    change replaced by an alternative of its step.  It is a *different
+    change replaced by an alternative of its step; one that holds every
+    kept change and more is not (the data do not decide the extra).  It is a *different
     structure* when some measurement with the test's sensors on (a point or
     cross FRF at the ends, quarter points and middles of the components)
     would tell the two apart (``chi^2 > INDIFFERENCE`` over the band);
@@ -340,6 +341,9 @@ def _distinct_rivals(assembly, measured, final_effects, outcome, say) -> list:
         for c, v, chi2 in outcome.alternatives.get(found.change.key, []):
             pool.append((chi2, [Found(c, v) if j == i else f for j, f in enumerate(final_effects)]))
     pool.sort(key=lambda t: t[0])
+    keys = {f.change.key for f in final_effects}
+    # a rival that holds every kept change plus more is not another explanation: the data do not decide the extra
+    pool = [(chi2, founds) for chi2, founds in pool if not keys <= {f.change.key for f in founds}]
     kept = Explanation(final_effects)
     kept_sites = frozenset().union(*(sites(assembly, f.change, f.values) for f in final_effects))
     out = []

@@ -196,9 +196,10 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say, p
     of the ``PAIR_POOL`` best of them (fitted from the two singles'
     values, first on the screening lines, the best two on all lines) is
     compared with the kept explanation by BIC (``chi^2 / s^2 + p ln n``,
-    ``s^2`` the misfit scale of the best of them).  The lowest BIC is kept;
-    the others within :data:`~substructure.updating.selection.INDIFFERENCE`
-    of it are its rivals.
+    ``s^2`` the misfit scale of the best of them).  Of those within
+    :data:`~substructure.updating.selection.INDIFFERENCE` of the lowest BIC
+    (the data do not decide between them) the one with the fewest
+    parameters is kept, then the lowest BIC; the others are its rivals.
 
     Returns
     -------
@@ -237,11 +238,13 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say, p
     p_best = next(_p(ch) for ch, chi2 in options if chi2 == best_chi2)
     s2 = max(1.0, best_chi2 / max(n - p_best, 1))
     scored = sorted(((ch, chi2, _bic(chi2, _p(ch), n, s2)) for ch, chi2 in options), key=lambda t: (t[2], _p(t[0])))
-    kept, kept_chi2, kept_bic = scored[0]
+    inside = [t for t in scored if t[2] - scored[0][2] <= INDIFFERENCE]
+    # the data do not decide between these: the one with the fewest parameters is kept (then the lowest BIC)
+    kept, kept_chi2, kept_bic = min(inside, key=lambda t: (_p(t[0]), t[2]))
     if say and sorted(c.key for c, _ in kept) != keys_now:
         say(f"parsimony: {', '.join(f'{c.effect} at {c.place(v)}' for c, v in kept)} explains as well with "
             f"{_p(kept)} parameter(s) instead of {_p(current)} (BIC {kept_bic:.1f})")
-    rivals = [(ch, chi2, b) for ch, chi2, b in scored[1:] if b - kept_bic <= INDIFFERENCE]
+    rivals = [t for t in inside if t[0] is not kept]
     return kept, kept_chi2, rivals
 
 
