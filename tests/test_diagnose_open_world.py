@@ -197,7 +197,7 @@ def test_parsimony_prefers_a_fair_single_to_a_greedy_path_that_compensates():
     lik = Likelihood(model, measured)
     params = {p.path: p for p in model_parameters(model)}
     joint, stiff, heavy = (parameter_change(params[p]) for p in
-                           ("joints.holder-tool.k.yf", "components.spindle.E", "components.holder.rho"))
+                           ("joints.holder-tool.k.yf", "components.holder.E", "components.holder.rho"))
     greedy = fit(lik, [(stiff, {"value": 1.02}), (heavy, {"value": 0.99}), (joint, {"value": 0.6e7})])
     single = fit(lik, [(joint, {"value": 0.6e7})])
     assert single.chi2_reduced < 1.1  # the single explains the data

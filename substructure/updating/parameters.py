@@ -43,7 +43,7 @@ from typing import Mapping
 import attrs
 import numpy as np
 
-from ..components import Tool
+from ..components import Spindle, Tool
 from ..errors import InvalidValueError
 from ..joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint
 from ..materials import Material
@@ -184,8 +184,9 @@ def model_parameters(assembly) -> list[ModelParameter]:
     of supports and bodies within ``POSITION_FRACTION`` (0.15) of their
     component's length of where the model has them; sensor and body masses
     0.1 to 10 times; linked
-    factors 0.25 to 4 (a component's ``E`` and ``rho`` within the
-    engineering range too; a tool's overhang within 1.5 times).
+    factors 0.25 to 4 (a component's own ``E`` and ``rho`` within the
+    engineering range too, and not for a spindle, whose shaft is steel; a
+    tool's overhang within 1.5 times).
 
     Parameters
     ----------
@@ -243,7 +244,11 @@ def model_parameters(assembly) -> list[ModelParameter]:
                                max(total / LENGTH_FACTOR, fixed + 0.1 * (total - fixed)),
                                LENGTH_FACTOR * total, f"overhang of {comp.name} (its fluted length kept)"))
         own = comp.segments[0].material
-        for prop, text in (("E", "stiffness (E)"), ("rho", "density"), ("loss_factor", "material damping")):
+        # a spindle shaft is steel, whose E and rho are known to a few per cent: its stiffness and mass are
+        # questions of geometry, bearings and joints, not of its own material (materials.steel.E stays)
+        props = (("loss_factor", "material damping"),) if isinstance(comp, Spindle) else (
+            ("E", "stiffness (E)"), ("rho", "density"), ("loss_factor", "material damping"))
+        for prop, text in props:
             if prop == "loss_factor":
                 lo, hi = 0.05, 20.0
             else:
