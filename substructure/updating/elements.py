@@ -310,6 +310,9 @@ def split_beam(beam, start: float, stop: float, od_factor: float = 1.0, flutes: 
                        insert_names=[beam.insert_names[i] for i in idx])
 
 
+_SLIVER = 1e-6  # m: the shortest segment a model holds (sections.py refuses shorter lengths)
+
+
 def split_segments(component, start: float, stop: float, change):
     """A beam component with its segments cut at ``start`` and ``stop`` [m], ``change(segment)`` between.
 
@@ -333,7 +336,11 @@ def split_segments(component, start: float, stop: float, change):
     for seg in component.segments:
         x0, x1 = x, x + seg.length_m
         x = x1
-        pieces = [p for p in (x0, max(x0, min(x1, start)), max(x0, min(x1, stop)), x1)]
+        cuts = []
+        for c in (start, stop):  # a cut within a micrometre of a segment's end is at that end (no slivers)
+            c = max(x0, min(x1, c))
+            cuts.append(x0 if c - x0 < _SLIVER else x1 if x1 - c < _SLIVER else c)
+        pieces = [x0, *cuts, x1]
         for a, b in zip(pieces[:-1], pieces[1:]):
             if b - a <= 1e-12 * max(x1, 1e-3):
                 continue

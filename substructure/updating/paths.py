@@ -247,6 +247,8 @@ def _set_one(assembly, path: str, value: float):
             seg = segs[i]
             what = ".".join(rest[2:])
             if what in ("length", "od", "id", "od_tip", "id_tip"):
+                if what in ("id", "id_tip") and value < 1e-6:  # a bore under a micrometre is no bore
+                    value = 0.0
                 segs[i] = attrs.evolve(seg, **{what: _si(value, "m")})
             elif what in ("insert.od", "insert.id"):
                 segs[i] = attrs.evolve(seg, insert=attrs.evolve(seg.insert, **{what[7:]: _si(value, "m")}))
