@@ -1,0 +1,674 @@
+"""The built-in effects of the diagnosis: the physical effects the catalogue names.
+
+A sensor's mass on a measured point, a joint's stiffness, damping and
+cross-coupling, a rigid joint made elastic, a fluted section of a tool and
+springs of a free-free test's suspension.  Each is an
+:class:`~substructure.diagnose.effects.Effect` registered by name when the
+package is imported, in this order (the built-in answer does not depend on
+the order, but ties between candidates are broken by it); each also gives
+its change on the SI form of the model (``apply_si``), so that fits do not
+rebuild objects.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import ClassVar
+
+import attrs
+import numpy as np
+
+from ..assembly import Assembly
+from ..beams import Flutes
+from ..components import Beam, Tool
+from ..errors import InvalidValueError, NonPassiveJointWarning, UnknownPointError
+from ..joints import Joint, Sensor, Support
+from ..points import parse_point
+from ..units import format_quantity, ureg
+from ..updating.elements import split_beam
+from ..updating.structure import LinkSI
+from .effects import Effect, Parameter, register_effect
+
+__all__: list[str] = []  # the effects are reached by name through the registry
+
+
+def _quiet_joint(joint: Joint, **kw) -> Joint:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NonPassiveJointWarning)
+        return joint.with_parameters(**kw)
+
+
+def _elastic_joints(assembly: Assembly) -> list[str]:
+    return [j.name for j in assembly.joints if not getattr(j, "rigid", False) and isinstance(j, Joint)]
+
+
+def _si(value: float, unit: str) -> str:
+    return format_quantity(ureg.Quantity(float(value), unit))
+
+
+@register_effect
+class SensorMass(Effect):
+    """A body on a measured point (an accelerometer, a magnet) that the model lacks: ``mass``, ``inertia``.
+
+    Written back as a sensor ``diagnosed-<point>`` that is on in every test (``always_on``), since the
+    records the diagnosis was fitted on do not list it.
+    """
+
+    name = "sensor-mass"
+    test_only: ClassVar[bool] = True  # a sensor is on the tested points only (see Change.test_only)
+    parameters = (
+        Parameter("mass", "kg", 1e-4, 0.2, 2e-3),
+        Parameter("inertia", "kg*m^2", 1e-10, 1e-4, 1e-8),
+    )
+    explanation = (
+        "a body on the structure (an accelerometer, a magnet) lowers every mode in proportion to "
+        "the square of its modal displacement at that point: the mode with most motion there "
+        "(the tool mode, for a tool-tip sensor) drops most, the others barely move"
+    )
+
+    @classmethod
+    def places(cls, assembly, measured_points):
+        """Where it may act.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        measured_points : sequence of str
+            The measured DOF labels.
+
+        Returns
+        -------
+        list of str
+            Places (points, joint or component names).
+        """
+        return list(dict.fromkeys(str(parse_point(p).point) for p in measured_points))
+
+    @classmethod
+    def starting_values(cls, assembly, where, shift):
+        """Starting values at a place.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        where : str
+            The place.
+        shift : float
+            Relative shift of the main mode, ``f_model / f_measured - 1``.
+
+        Returns
+        -------
+        dict of str to float
+            A value per parameter (SI).
+
+        Notes
+        -----
+        From the main mode's relative shift: a tip mode drops as ``sqrt(1 + dm / m_eff)``
+        with a quarter of the component's mass moving (model above measurement: a tip mass).
+        """
+        out = {p.name: p.start for p in cls.parameters}
+        try:
+            body = assembly.component(parse_point(where).component)
+            m_eff = 0.25 * body.mass()  # a cantilever's tip mode: about a quarter of its mass moves
+        except (AttributeError, UnknownPointError):
+            return out
+        if shift > 0:  # f_model / f_measured - 1 = sqrt(1 + dm / m_eff) - 1
+            out["mass"] = float(np.clip(m_eff * ((1 + shift) ** 2 - 1), 1e-4, 0.2))
+        return out
+
+    def apply(self, assembly):
+        """The assembly with the effect applied (a new assembly in normal form).
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model (or one test configuration of it).
+
+        Returns
+        -------
+        Assembly
+            The changed model.
+        """
+        base = f"diagnosed-{self.where.replace('.', '-').replace('@', '-at-').replace(' ', '')}"
+        taken = {s.name for s in assembly.sensors}
+        name, n = base, 2
+        while name in taken:  # a model improved before may carry one already
+            name, n = f"{base}-{n}", n + 1
+        sensor = Sensor(name, self.where, _si(self.values["mass"], "kg"), _si(self.values["inertia"], "kg*m^2"),
+                        always_on=True)
+        return assembly.attach(sensor)
+
+    def apply_si(self, structure):
+        """The same change on the SI form of the model (optional; fits use it when given).
+
+        Parameters
+        ----------
+        structure : Structure
+            The SI form of one test configuration.
+
+        Returns
+        -------
+        Structure
+            The changed structure.
+        """
+        return structure.add_link(LinkSI(("added", f"sensor-mass-{self.where}"), self.where,
+                                         M=np.diag([self.values["mass"], self.values["inertia"]])))
+
+
+class _JointEffect(Effect):
+    kind: ClassVar[str] = "k"
+    entries: ClassVar[tuple[str, ...]] = ()
+
+    @classmethod
+    def places(cls, assembly, measured_points):
+        """Where it may act.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        measured_points : sequence of str
+            The measured DOF labels.
+
+        Returns
+        -------
+        list of str
+            Places (points, joint or component names).
+        """
+        return _elastic_joints(assembly)
+
+    @classmethod
+    def starting_values(cls, assembly, where, shift):
+        """Starting values at a place.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        where : str
+            The place.
+        shift : float
+            Relative shift of the main mode, ``f_model / f_measured - 1``.
+
+        Returns
+        -------
+        dict of str to float
+            A value per parameter (SI).
+        """
+        joint = assembly.joint(where)
+        out = {}
+        for p in cls.parameters:
+            entry = p.name.split("_", 1)[1]
+            nominal = (joint.k if p.name[0] == "k" else joint.c).get(entry)
+            out[p.name] = float(np.clip(nominal if nominal > 0 else p.start, p.lower, p.upper))
+        return out
+
+    def apply(self, assembly):
+        """The assembly with the effect applied (a new assembly in normal form).
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model (or one test configuration of it).
+
+        Returns
+        -------
+        Assembly
+            The changed model.
+        """
+        joint = assembly.joint(self.where)
+        k, c = {}, {}
+        for name, value in self.values.items():
+            kind, entry = name.split("_", 1)
+            target, units = (k, {"yf": "N/m", "tm": "N*m/rad", "ym": "N"}) if kind == "k" else (
+                c, {"yf": "N*s/m", "tm": "N*m*s/rad", "ym": "N*s"})
+            for e in (("ym", "tf") if entry == "ym" else (entry,)):
+                unit = units[entry] if e != "tf" else ("N/rad" if kind == "k" else "N*s/rad")
+                target[e] = _si(value, unit)
+        return assembly.with_joint(_quiet_joint(joint, k=k, c=c))
+
+    def apply_si(self, structure):
+        """The same change on the SI form of the model (optional; fits use it when given).
+
+        Parameters
+        ----------
+        structure : Structure
+            The SI form of one test configuration.
+
+        Returns
+        -------
+        Structure
+            The changed structure.
+        """
+        i, link = structure.link(("joints", self.where))
+        if link.rigid or link.custom is not None:
+            raise UnknownPointError(f"joint {self.where!r} has no stiffness matrix here")
+        K, C = link.K.copy(), link.C.copy()
+        for name, value in self.values.items():
+            kind, entry = name.split("_", 1)
+            m = K if kind == "k" else C
+            if entry == "ym":
+                m[0, 1] = m[1, 0] = value
+            else:
+                m[(0, 1)[entry == "tm"], (0, 1)[entry == "tm"]] = value
+        return structure.with_link(i, link.evolve(K=K, C=C))
+
+
+@register_effect
+class JointStiffness(_JointEffect):
+    """A joint's stiffness ``k_yf``, ``k_tm`` off."""
+
+    name = "joint-stiffness"
+    parameters = (
+        Parameter("k_yf", "N/m", 1e4, 1e11, 1e7),
+        Parameter("k_tm", "N*m/rad", 1e2, 1e9, 1e5),
+    )
+    explanation = (
+        "a joint's stiffness sets the frequency of the mode it dominates: a softer joint lowers "
+        "that mode (and raises its peak), leaving modes far from the joint alone"
+    )
+
+
+@register_effect
+class JointDamping(_JointEffect):
+    """A joint's damping ``c_yf``, ``c_tm`` off."""
+
+    name = "joint-damping"
+    parameters = (
+        Parameter("c_yf", "N*s/m", 1e-2, 1e5, 50.0),
+        Parameter("c_tm", "N*m*s/rad", 1e-4, 1e3, 1.0),
+    )
+    explanation = (
+        "a joint's damping sets the height and width of the peak of the mode it dominates, "
+        "not its frequency"
+    )
+
+
+@register_effect
+class JointCrossCoupling(_JointEffect):
+    """A joint's cross terms ``k_ym = k_tf`` and ``c_ym = c_tf`` missing (within passivity)."""
+
+    name = "joint-cross-coupling"
+    parameters = (
+        Parameter("k_ym", "N", -1e9, 1e9, 0.0, log=False),
+        Parameter("c_ym", "N*s", -1e4, 1e4, 0.0, log=False),
+    )
+    explanation = (
+        "off-diagonal joint terms (k_ym = k_tf) couple the joint's translation and rotation: they "
+        "shift the joint's modes like a change of its stiffness, but differently at the tip and at "
+        "points further back"
+    )
+
+    @classmethod
+    def starting_values(cls, assembly, where, shift):
+        """Starting values at a place.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        where : str
+            The place.
+        shift : float
+            Relative shift of the main mode, ``f_model / f_measured - 1``.
+
+        Returns
+        -------
+        dict of str to float
+            A value per parameter (SI).
+        """
+        joint = assembly.joint(where)
+        scale = np.sqrt(max(joint.k.get("yf") * joint.k.get("tm"), 1.0))
+        return {"k_ym": 0.3 * scale * (-1 if shift < 0 else 1), "c_ym": 0.0}
+
+    @classmethod
+    def bounds(cls, assembly, where):
+        """Bounds of each parameter at this place.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        where : str
+            The place.
+
+        Returns
+        -------
+        dict of str to (float, float)
+            ``(lower, upper)`` per parameter, within the class's.
+
+        Notes
+        -----
+        Passive cross terms: ``k_ym^2 < k_yf k_tm`` and ``c_ym^2 < c_yf c_tm``.
+        """
+        joint = assembly.joint(where)
+        k = 0.999 * np.sqrt(max(joint.k.get("yf") * joint.k.get("tm"), 0.0))
+        c = 0.999 * np.sqrt(max(joint.c.get("yf") * joint.c.get("tm"), 0.0))
+        return {"k_ym": (-k, k), "c_ym": (-c, c) if c > 0 else (-1e-12, 1e-12)}
+
+
+@register_effect
+class RigidJointFlexibility(_JointEffect):
+    """A joint modelled as rigid is elastic: ``k_yf``, ``k_tm``."""
+
+    name = "rigid-joint-flexibility"
+    parameters = (
+        Parameter("k_yf", "N/m", 1e4, 1e12, 1e8),
+        Parameter("k_tm", "N*m/rad", 1e2, 1e10, 1e6),
+    )
+    explanation = (
+        "a connection modelled as rigid is elastic: the modes it takes part in are lower than the "
+        "model says"
+    )
+
+    @classmethod
+    def places(cls, assembly, measured_points):
+        """Where it may act.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        measured_points : sequence of str
+            The measured DOF labels.
+
+        Returns
+        -------
+        list of str
+            Places (points, joint or component names).
+        """
+        return [j.name for j in assembly.joints if getattr(j, "rigid", False)]
+
+    @classmethod
+    def starting_values(cls, assembly, where, shift):
+        """Starting values at a place.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        where : str
+            The place.
+        shift : float
+            Relative shift of the main mode, ``f_model / f_measured - 1``.
+
+        Returns
+        -------
+        dict of str to float
+            A value per parameter (SI).
+        """
+        return {p.name: p.start for p in cls.parameters}
+
+    def apply(self, assembly):
+        """The assembly with the effect applied (a new assembly in normal form).
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model (or one test configuration of it).
+
+        Returns
+        -------
+        Assembly
+            The changed model.
+        """
+        joint = assembly.joint(self.where)
+        elastic = Joint(joint.name, joint.between, k={"yf": _si(self.values["k_yf"], "N/m"),
+                                                      "tm": _si(self.values["k_tm"], "N*m/rad")})
+        return assembly.with_joint(elastic)
+
+    def apply_si(self, structure):
+        """The same change on the SI form of the model (optional; fits use it when given).
+
+        Parameters
+        ----------
+        structure : Structure
+            The SI form of one test configuration.
+
+        Returns
+        -------
+        Structure
+            The changed structure.
+        """
+        i, link = structure.link(("joints", self.where))
+        return structure.with_link(i, link.evolve(rigid=False, custom=None,
+                                                  K=np.diag([self.values["k_yf"], self.values["k_tm"]]),
+                                                  C=np.zeros((2, 2))))
+
+
+def _tools(assembly: Assembly) -> list[Beam]:
+    return [c for c in assembly.components if isinstance(c, Tool)]
+
+
+@register_effect
+class FlutedSection(Effect):
+    """A tool's last ``length`` fluted, at ``diameter_ratio`` (equivalent diameter)."""
+
+    name = "fluted-section"
+    parameters = (
+        Parameter("diameter_ratio", "dimensionless", 0.5, 1.0, 0.8, log=False),
+        Parameter("length", "m", 1e-3, 0.2, 0.03),
+    )
+    explanation = (
+        "flutes take stiffness and mass from the tool's last part: the tool modes drop (bending "
+        "stiffness falls faster than mass), the spindle and holder modes hardly move"
+    )
+
+    @classmethod
+    def places(cls, assembly, measured_points):
+        """Where it may act.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        measured_points : sequence of str
+            The measured DOF labels.
+
+        Returns
+        -------
+        list of str
+            Places (points, joint or component names).
+        """
+        return [t.name for t in _tools(assembly) if not any(s.flutes for s in t.segments)]
+
+    @classmethod
+    def starting_values(cls, assembly, where, shift):
+        """Starting values at a place.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        where : str
+            The place.
+        shift : float
+            Relative shift of the main mode, ``f_model / f_measured - 1``.
+
+        Returns
+        -------
+        dict of str to float
+            A value per parameter (SI).
+        """
+        tool = assembly.component(where)
+        return {"diameter_ratio": 0.8, "length": min(0.03, 0.5 * tool.length_m)}
+
+    @classmethod
+    def bounds(cls, assembly, where):
+        """Bounds of each parameter at this place.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        where : str
+            The place.
+
+        Returns
+        -------
+        dict of str to (float, float)
+            ``(lower, upper)`` per parameter, within the class's.
+        """
+        tool = assembly.component(where)
+        return {"diameter_ratio": (0.5, 1.0), "length": (1e-3, tool.length_m)}
+
+    def apply(self, assembly):
+        """The assembly with the effect applied (a new assembly in normal form).
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model (or one test configuration of it).
+
+        Returns
+        -------
+        Assembly
+            The changed model.
+        """
+        tool = assembly.component(self.where)
+        return assembly.with_component(flute_tip(tool, self.values["length"], self.values["diameter_ratio"]))
+
+    def apply_si(self, structure):
+        """The same change on the SI form of the model (optional; fits use it when given).
+
+        Parameters
+        ----------
+        structure : Structure
+            The SI form of one test configuration.
+
+        Returns
+        -------
+        Structure
+            The changed structure.
+        """
+        beam = structure.beam(self.where)
+        total = beam.total_length
+        return structure.with_beam(split_beam(beam, total - min(self.values["length"], total), total,
+                                              flutes=self.values["diameter_ratio"]))
+
+
+def flute_tip(tool: Beam, length_m: float, ratio: float) -> Beam:
+    """The tool with its last ``length_m`` fluted at ``ratio`` (segments split as needed).
+
+    Parameters
+    ----------
+    tool : Beam
+        The tool.
+    length_m : float
+        Fluted length [m] (at most the tool's).
+    ratio : float
+        The flutes' diameter ratio.
+
+    Returns
+    -------
+    Beam
+        A new tool.
+    """
+    total = tool.length_m
+    length_m = min(length_m, total)
+    start = total - length_m
+    segments, x = [], 0.0
+    for seg in tool.segments:
+        x0, x1 = x, x + seg.length_m
+        x = x1
+        if x1 <= start + 1e-12:
+            segments.append(seg)
+            continue
+        if x0 < start - 1e-12:
+            segments.append(attrs.evolve(seg, length=_si(start - x0, "m")))
+            x0 = start
+        segments.append(attrs.evolve(seg, length=_si(x1 - x0, "m"), flutes=Flutes(ratio)))
+    return attrs.evolve(tool, segments=segments)
+
+
+@register_effect
+class SupportSprings(Effect):
+    """Springs to the ground near both ends of the heaviest component: ``k_yf`` per spring, ``inset``."""
+
+    name = "support-springs"
+    parameters = (
+        Parameter("k_yf", "N/m", 1e1, 1e8, 1e5),
+        Parameter("inset", "dimensionless", 0.0, 0.45, 0.15, log=False),
+    )
+    explanation = (
+        "springs to the ground (suspension bands of a 'free-free' test, a fixture) turn the "
+        "rigid-body motion into low modes, tens of Hz for bands: the low end of the FRF rises "
+        "from the mass line into peaks"
+    )
+
+    @classmethod
+    def places(cls, assembly, measured_points):
+        """Where it may act.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        measured_points : sequence of str
+            The measured DOF labels.
+
+        Returns
+        -------
+        list of str
+            Places (points, joint or component names).
+        """
+        beams = [c for c in assembly.components if isinstance(c, Beam)]
+        if not beams:
+            return []
+        heaviest = max(beams, key=lambda b: b.mass())
+        return [f"{heaviest.name}.base,{heaviest.name}.tip"]
+
+    def apply(self, assembly):
+        """The assembly with the effect applied (a new assembly in normal form).
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model (or one test configuration of it).
+
+        Returns
+        -------
+        Assembly
+            The changed model.
+
+        Notes
+        -----
+        Two equal springs (``k_yf`` each) near the two points of ``where`` (the ends of a component,
+        ``"spindle.base,spindle.tip"``), ``inset`` of its length in from each.
+        """
+        points = [parse_point(p.strip()) for p in self.where.split(",")]
+        if len({p.component for p in points}) != 1 or {p.where for p in points} != {"base", "tip"}:
+            raise InvalidValueError(
+                f"support-springs: where = {self.where!r}; expected the ends of one component, "
+                "e.g. 'spindle.base,spindle.tip'"
+            )
+        comp = assembly.component(points[0].component)
+        k = _si(self.values["k_yf"], "N/m")
+        inset = self.values["inset"] * comp.length_m
+        near = f"{comp.name}@{_si(inset, 'm')}"
+        far = f"{comp.name}@{_si(comp.length_m - inset, 'm')}"
+        return assembly.support(Support(near, k={"yf": k}, name=f"diagnosed-{comp.name}-1")).support(
+            Support(far, k={"yf": k}, name=f"diagnosed-{comp.name}-2"))
+
+    def apply_si(self, structure):
+        """The same change on the SI form of the model (optional; fits use it when given).
+
+        Parameters
+        ----------
+        structure : Structure
+            The SI form of one test configuration.
+
+        Returns
+        -------
+        Structure
+            The changed structure.
+        """
+        points = [parse_point(p.strip()) for p in self.where.split(",")]
+        name = points[0].component
+        total = structure.beam(name).total_length
+        inset = self.values["inset"] * total
+        k = np.diag([self.values["k_yf"], 0.0])
+        near = LinkSI(("added", f"springs-{name}-1"), (name, inset), K=k)
+        far = LinkSI(("added", f"springs-{name}-2"), (name, total - inset), K=k)
+        return structure.add_link(near).add_link(far)
