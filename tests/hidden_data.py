@@ -14,7 +14,8 @@ Hidden effects (keyword arguments of :func:`measure`):
   joint damping, a softer spindle-holder rotation stiffness;
 * outside it: a longer tool overhang, a clamping nut (mass and rotary
   inertia) on the holder, a necked tool, a machine spindle on bearings with
-  the front pair softer, a different tool material.
+  the front pair softer, a different tool material, a tool shank clamped
+  less deep in the holder.
 
 :func:`nominal_model` is what the library's user believes: the same
 geometry and joint values, without the hidden effect.
@@ -96,7 +97,8 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
             nut: tuple[float, float, float] | None = None, neck: tuple[float, float, float] | None = None,
             bearings: tuple[float, float] | None = None, tool_E: float = 580e9, tool_rho: float = 14500.0,
             tool_nu: float = 0.22, ht_loss: float = 0.0,
-            drawbar: bool = False, taper: float | None = None, taper_pieces: int = 8, seed: int = 0,
+            drawbar: bool = False, taper: float | None = None, taper_pieces: int = 8, insert_length: float = 0.040,
+            seed: int = 0,
             points=("tool.tip",), excitation: str = "tool.tip", noise: float = 0.015, phase_deg: float = 0.5,
             floor: float = 1e-3) -> list[FRF]:
     """FRFs of the rig with the hidden effects, noisy (response at each point, hammer at ``excitation``).
@@ -109,7 +111,9 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
     0.29).  Beyond every candidate of the diagnosis: ht_loss, a hysteretic loss
     factor of the holder-tool joint (``k (1 + i eta)``: damping that does not grow with frequency);
     drawbar, a 20 mm steel rod in the spindle's bore held at two points; taper, the tool's tip
-    diameter [m] of a tool tapering linearly from 12 mm over its length (``taper_pieces`` uniform pieces).
+    diameter [m] of a tool tapering linearly from 12 mm over its length (``taper_pieces`` uniform pieces);
+    insert_length, how deep the tool's shank sits in the holder [m] (the model: 40 mm; the holder's length
+    stays 66 mm, its 40 mm collar longer by as much as the insert is shorter).
     """
     cb = fe.Material(tool_E, tool_nu, tool_rho, 0.002)
     m = fe.Model()
@@ -122,8 +126,8 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
         list(BEARINGS) if bearings else []) + ([0.30] if drawbar else [])
     s = m.add_beam([(0.12, fe.section(0.07, 0.04, STEEL)), (0.15, fe.section(0.09, 0.04, STEEL)),
                     (0.06, fe.section(0.11, 0.04, STEEL))], points=spindle_points)
-    h = m.add_beam([(0.016, fe.section(0.063, 0, STEEL)), (0.010, fe.section(0.04, 0, STEEL)),
-                    (0.040, fe.section(0.04, 0.012, STEEL, insert=CARBIDE))],
+    h = m.add_beam([(0.016, fe.section(0.063, 0, STEEL)), (0.050 - insert_length, fe.section(0.04, 0, STEEL)),
+                    (insert_length, fe.section(0.04, 0.012, STEEL, insert=CARBIDE))],
                    points=wanted["holder"] + ([nut[2]] if nut else []))
     fl_len, fl_ratio = flutes if flutes else (0.0, 1.0)
     cuts = [0.0, tool_length - fl_len, tool_length]

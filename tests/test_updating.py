@@ -52,7 +52,8 @@ def test_every_parameter_moves_the_si_form_as_it_moves_the_assembly():
     assert {"components.tool.segments.1.flutes.diameter_ratio", "components.holder.segments.2.insert.od",
             "materials.carbide.E", "joints.holder-tool.k.ym", "supports.1.k.tm", "supports.0.at",
             "sensors.acc.mass", "masses.nut.at", "components.tool.overhang", "components.tool.E",
-            "joints.holder-tool.c", "components.spindle.supports.k", "supports.1+2.k"} <= paths
+            "joints.holder-tool.c", "components.spindle.supports.k", "supports.1+2.k",
+            "components.tool.segments.0.end"} <= paths
     structure = Structure.from_assembly(model)
     evaluate = Evaluator(OUT, IN, F)
     base = model.frf(OUT, IN, F).data
@@ -95,6 +96,24 @@ def test_a_changed_model_saves_and_reads_back_with_its_new_values():
     assert again.mass("nut").at == changed.mass("nut").at
     with pytest.raises(Exception, match="not a parameter"):
         set_parameters(model, {"gremlins.x": 1.0})
+
+
+def test_a_step_between_segments_moves_and_the_component_keeps_its_length():
+    model = hd.nominal_model()
+    params = {p.path: p for p in model_parameters(model)}
+    step = params["components.holder.segments.1.end"]  # the collar (10 mm) meets the bore with the tool's shank
+    assert step.linked and step.nominal == pytest.approx(0.026)
+    assert (step.lower, step.upper) == pytest.approx((0.016 + 0.2 * 0.010, 0.066 - 0.2 * 0.040))
+    assert "components.spindle.segments.0.end" in params  # 70 mm to 90 mm: a step
+    deeper = set_parameters(model, {"components.holder.segments.1.end": 0.036})
+    holder = deeper.component("holder")
+    assert [s.length_m for s in holder.segments] == pytest.approx([0.016, 0.020, 0.030])
+    assert holder.length_m == pytest.approx(0.066) and get_parameter(deeper, step.path) == pytest.approx(0.036)
+    same = hd.nominal_model().with_component(Tool("tool", [Segment("46 mm", "12 mm", material="carbide"),
+                                                           Segment("30 mm", "12 mm", material="carbide")]))
+    assert "components.tool.segments.0.end" not in {p.path for p in model_parameters(same)}  # no step to move
+    with pytest.raises(Exception, match="no step"):
+        set_parameters(model, {"components.holder.segments.2.end": 0.05})
 
 
 def test_components_and_joints_the_si_form_cannot_hold_take_part_as_they_are():

@@ -112,8 +112,8 @@ def _main_shift(comparison: Comparison) -> float:
 
 BUDGET = 3000
 """Default budget of the search, in model evaluations of all lines (about 30 s for 3 FRFs of 2,500 lines on one
-core of a 2-core machine): once spent no step is added, a step fits only its best candidate on all lines, and
-the parsimony check compares singles only; the result and the JSON say so (``search``)."""
+core of a 2-core machine): once spent no step is added and a step fits only its best candidate on all lines (the
+checks after the forward search always run); the result and the JSON say so (``search``)."""
 
 
 def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", band=None,

@@ -15,17 +15,21 @@ any change is left alone.  Then
   the catalogue before a linked parameter, before a single parameter,
   before an element; :func:`~substructure.diagnose.search.preference`);
 * the parsimony check compares an explanation of two or more changes by
-  BIC with every single candidate of the first step and (for three or
-  more) the best pairs fitted from the singles' own values, not only
-  extensions of the greedy path; the lowest BIC is kept, those within the
-  indifference region are its rivals;
+  BIC with every single candidate of the first step and the best pairs
+  fitted from the values of the best singles that change the model in
+  different ways, not only extensions of the greedy path; the lowest BIC
+  is kept, those within the indifference region are its rivals;
 * the history is rebuilt from the changes kept, in the order that lowers
   ``chi^2`` most at each step, so that the "error fall" shows the final
   explanation.
 
 A :class:`~substructure.diagnose.search.Budget` of model evaluations bounds
-the work: once spent, no step is added, a step fits only its best candidate
-on all lines, and the parsimony check compares singles only.
+the forward search: once spent, no step is added and a step fits only its
+best candidate on all lines.  The checks after it always run (the parsimony
+check costs a few dozen evaluations: at most six short fits on the
+screening lines and two on all lines); a forward path that the budget cut
+short is exactly when a pair from fair starts is most likely to explain
+better.
 """
 
 from __future__ import annotations
@@ -34,6 +38,7 @@ import math
 from typing import Callable
 
 import attrs
+import numpy as np
 
 from ..errors import SubstructureError
 from ..updating.fit import Fit, fit
@@ -182,6 +187,42 @@ PAIR_POOL = 4
 """Singles of the first step (best first) whose pairs are fitted from fair starts in the parsimony check."""
 
 
+SAME_DIRECTION = 0.995
+"""Two singles whose changes of the residual (on the screening lines) have a cosine above this are one
+explanation under two names (a joint's stiffness and its ``k.yf`` entry; an overhang and its free segment's
+length): only one enters the pair pool, under the name :func:`~substructure.diagnose.search.preference` puts
+first."""
+
+
+def _distinct(screen_lik, singles, count: int) -> list:
+    """The best ``count`` singles that change the model in different ways (see :data:`SAME_DIRECTION`)."""
+    try:
+        r0 = screen_lik.residual([])
+    except (ValueError, ArithmeticError, SubstructureError):
+        return list(singles[:count])
+    pool, directions = [], []
+    for s in singles:
+        if len(pool) == count:
+            break
+        try:
+            d = screen_lik.residual(s.fit.changes) - r0
+        except (ValueError, ArithmeticError, SubstructureError):
+            continue
+        norm = float(np.linalg.norm(d))
+        if not np.isfinite(norm) or norm == 0.0:
+            continue
+        d = d / norm
+        same = [k for k, e in enumerate(directions) if abs(float(d @ e)) > SAME_DIRECTION]
+        if same:  # one explanation under two names: the preferred name stands for it (an overhang, not a length)
+            k = same[0]
+            if preference(s.change) < preference(pool[k].change):
+                pool[k] = s
+            continue
+        pool.append(s)
+        directions.append(d)
+    return pool
+
+
 def _bic(chi2: float, p: int, n: int, s2: float) -> float:
     return chi2 / s2 + p * math.log(n)
 
@@ -193,8 +234,9 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say, p
     later steps compensate and the path ends at several changes that a
     single or a pair of other changes explains as well.  Here every single
     of the first step (fitted from its own scan on all lines) and every pair
-    of the ``PAIR_POOL`` best of them (fitted from the two singles'
-    values, first on the screening lines, the best two on all lines) is
+    of the ``PAIR_POOL`` best of them that change the model in different
+    ways (:func:`_distinct`; fitted from the two singles' values, first on
+    the screening lines, the best two on all lines) is
     compared with the kept explanation by BIC (``chi^2 / s^2 + p ln n``,
     ``s^2`` the misfit scale of the best of them).  Of those within
     :data:`~substructure.updating.selection.INDIFFERENCE` of the lowest BIC
@@ -213,8 +255,8 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say, p
     for s in singles:
         if [s.change.key] != keys_now:
             options.append(([(c, dict(v)) for c, v in s.fit.changes], s.fit.chi2))
-    if len(current) >= 3 and pairs:
-        pool = singles[:PAIR_POOL]
+    if len(current) >= 2 and pairs:
+        pool = _distinct(screen_lik, singles, PAIR_POOL)
         trials = []
         for i in range(len(pool)):
             for j in range(i + 1, len(pool)):
@@ -267,9 +309,8 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     say : callable, optional
         Progress.
     budget : Budget, optional
-        Once it is spent the search adds no step, fits no more candidates in
-        a step than the first, and skips the pairs of the parsimony check
-        (recorded in ``Outcome.search``).
+        Once it is spent the search adds no step and fits no more candidates
+        in a step than the first (recorded in ``Outcome.search``).
 
     Returns
     -------
@@ -357,10 +398,7 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     rivals: list = []
     if len(current) >= 2:
         before = [c.key for c, _ in current]
-        if spent() and len(current) >= 3:
-            cut("the parsimony check compared singles only (no pairs)")
-        current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
-                                               pairs=not spent())
+        current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say)
         if [c.key for c, _ in current] != before:
             alternatives = {c.key: [] for c, _ in current}
     kept = [c.key for c, _ in current]

@@ -521,12 +521,21 @@ def rank(fitted: Sequence[Scored], n: int, p_now: int) -> list[Scored]:
     return sorted(fitted, key=lambda s: bic(s.chi2, p_now + s.k, n))
 
 
-def preference(change: Change) -> int:
+MEASURED = ("length", "od", "id", "od_tip", "id_tip", "insert.od", "insert.id")
+"""A segment's dimensions: what a user measures on the part with a caliper, and so trusts more than a number
+of the model (a flutes' ratio, a joint entry, a material constant) that gives the same FRF."""
+
+
+def preference(change: Change) -> float:
     """Which of explanations the data cannot tell apart is reported first (lower first).
 
     0: an effect of the catalogue (a named physical effect); 1: a linked
     model parameter (an overhang, a component's material, a joint's whole
-    stiffness); 2: a single model parameter; 3: an element at a fitted place.
+    stiffness); 2: a single model parameter, 2.5 when it is a dimension
+    the user measures on the part (:data:`MEASURED`: a fluted segment's
+    ``od`` and its flutes' ``diameter_ratio`` set the same equivalent
+    section, and the ratio is the model's guess); 3: an element at a
+    fitted place.
 
     Parameters
     ----------
@@ -535,13 +544,17 @@ def preference(change: Change) -> int:
 
     Returns
     -------
-    int
+    float
         Its class.
     """
     if isinstance(change, EffectChange):
         return 0
     if isinstance(change, ParameterChange):
-        return 1 if change.parameter.linked else 2
+        if change.parameter.linked:
+            return 1
+        parts = change.parameter.path.split(".")
+        measured = parts[0] == "components" and parts[2:3] == ["segments"] and ".".join(parts[4:]) in MEASURED
+        return 2.5 if measured else 2
     if getattr(change, "linked", False):
         return 1
     return 3
@@ -598,4 +611,4 @@ def physical(change: Change, values: dict) -> bool:
     return True
 
 
-__all__ += ["shortlist", "rank", "physical", "preference", "choose"]
+__all__ += ["shortlist", "rank", "physical", "preference", "choose", "MEASURED"]

@@ -9,6 +9,9 @@ path                                           value (SI)
 ``components.C.segments.I.od_tip|id_tip``      a tapered segment's diameters at its tip end [m]
 ``components.C.segments.I.insert.od|id``       the insert's diameters [m]
 ``components.C.segments.I.flutes.diameter_ratio``  the flutes' equivalent diameter ratio
+``components.C.segments.I.end``                where segment ``I`` ends and ``I+1`` begins, from the
+                                               component's base [m] (linked: both lengths change,
+                                               the component's length is kept)
 ``materials.M.E|rho|nu|loss_factor``           a material, in every part made of it
 ``joints.J.k.yf|ym|tm``, ``joints.J.c.yf|ym|tm``   a joint entry (``ym`` sets ``tf`` too)
 ``supports.I.k.E``, ``supports.I.c.E``         a support entry (``I``: index in the file)
@@ -20,6 +23,9 @@ path                                           value (SI)
 and a few *linked* parameters that move several numbers as one thing a user
 thinks of: ``components.C.overhang`` (a tool's length out of the holder [m]:
 the first segment at the shank end changes, the fluted length stays),
+``components.C.segments.I.end`` (the step between two different segments
+moves, the component's length kept: a bore or an insert deeper, a longer
+fluted length on a tool of the same length),
 ``components.C.E|rho|loss_factor`` (that component's own material only, as
 a factor: "this component is stiffer"; materials are shared between
 components, so ``materials.M.E`` is another candidate),
@@ -52,7 +58,7 @@ from .paths import apply_path_si
 
 __all__ = ["ParamSpec", "Change", "ModelParameter", "ParameterChange", "ParameterSet", "model_parameters",
            "material_changes", "parameter_change", "AssemblyParameterChange", "get_parameter", "set_parameters", "apply_path_si", "LENGTH_FACTOR", "ENGINEERING_E",
-           "ENGINEERING_RHO", "ENGINEERING_NU", "POSITION_FRACTION"]
+           "ENGINEERING_RHO", "ENGINEERING_NU", "POSITION_FRACTION", "STEP_KEEP"]
 
 
 @attrs.frozen
@@ -139,6 +145,19 @@ POSITION_FRACTION = 0.15
 (a bearing's effective centre, a nut's seat: centimetres, not across the part)."""
 
 
+STEP_KEEP = 0.2
+"""A step between two segments (``components.C.segments.I.end``) moves within its two segments, each keeping at
+least this fraction of its length (a bore or an insert deeper or shallower, not gone)."""
+
+
+def _same_section(a, b) -> bool:
+    """Two neighbouring segments of the same section (moving the step between them changes nothing)."""
+    if a.is_tapered or b.is_tapered:
+        return False
+    return (a.od == b.od and a.id == b.id and a.material == b.material and a.insert == b.insert
+            and a.flutes == b.flutes)
+
+
 def _position_bounds(x: float, length: float) -> tuple[float, float]:
     half = POSITION_FRACTION * length
     return float(max(0.0, x - half)), float(min(length, x + half))
@@ -186,7 +205,8 @@ def model_parameters(assembly) -> list[ModelParameter]:
     0.1 to 10 times; linked
     factors 0.25 to 4 (a component's own ``E`` and ``rho`` within the
     engineering range too, and not for a spindle, whose shaft is steel; a
-    tool's overhang within 1.5 times).
+    tool's overhang within 1.5 times; a step between segments within
+    them, each keeping ``STEP_KEEP`` (a fifth) of its length).
 
     Parameters
     ----------
@@ -237,6 +257,16 @@ def model_parameters(assembly) -> list[ModelParameter]:
                                 f"flutes' diameter ratio of segment {i} of {comp.name}"))
             if si:
                 materials.setdefault(seg.material.name, seg.material)
+        ends = np.cumsum([seg.length_m for seg in comp.segments])
+        for i in range(len(comp.segments) - 1):
+            a, b = comp.segments[i], comp.segments[i + 1]
+            if _same_section(a, b):
+                continue
+            start, stop = ends[i] - a.length_m, ends[i + 1]
+            out.append(ModelParameter(f"{base}.segments.{i}.end", "m", float(ends[i]),
+                                      float(start + STEP_KEEP * a.length_m), float(stop - STEP_KEEP * b.length_m),
+                                      False, f"step from segment {i} to {i + 1} of {comp.name}, from its base "
+                                             f"({comp.name}'s length kept)", True))
         if isinstance(comp, Tool) and _overhang_segment(comp) is not None:
             total = comp.length_m
             fixed = total - comp.segments[_overhang_segment(comp)].length_m

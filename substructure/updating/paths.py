@@ -57,6 +57,12 @@ def apply_path_si(structure, path: str, value: float):
                 arr = getattr(beam, what).copy()
                 arr[i] = value
                 return structure.with_beam(beam.evolve(**{what: arr}))
+            if what == "end":  # the step to the next segment moves, the component's length kept
+                length = beam.length.copy()
+                shift = value - float(length[:i + 1].sum())
+                length[i] += shift
+                length[i + 1] -= shift
+                return structure.with_beam(beam.evolve(length=length))
             if what in ("insert.od", "insert.id"):
                 ins = beam.insert.copy()
                 ins[i, 0 if what == "insert.od" else 1] = value
@@ -250,6 +256,12 @@ def _set_one(assembly, path: str, value: float):
                 if what in ("id", "id_tip") and value < 1e-6:  # a bore under a micrometre is no bore
                     value = 0.0
                 segs[i] = attrs.evolve(seg, **{what: _si(value, "m")})
+            elif what == "end":
+                if i + 1 >= len(segs):
+                    raise _unknown(path, f"segment {i} of {comp.name!r} is its last: it has no step to move")
+                shift = value - sum(x.length_m for x in segs[:i + 1])
+                segs[i] = attrs.evolve(seg, length=_si(seg.length_m + shift, "m"))
+                segs[i + 1] = attrs.evolve(segs[i + 1], length=_si(segs[i + 1].length_m - shift, "m"))
             elif what in ("insert.od", "insert.id"):
                 segs[i] = attrs.evolve(seg, insert=attrs.evolve(seg.insert, **{what[7:]: _si(value, "m")}))
             elif what == "flutes.diameter_ratio":
