@@ -13,7 +13,9 @@ modes to the stiffness and the mass of each component, each joint's
 stiffness and each component's supports (finite differences of 5 %); the
 knob ``j`` whose pattern ``a s_j`` fits ``d`` best (largest share of
 ``|d|^2`` explained) names the kind of effect, and each mode is named after
-the component whose stiffness moves it most.
+the component whose stiffness moves it most.  :func:`level_signature`
+recognises data that are a constant factor times the model with every mode
+in place: a calibration or unit error, not the structure.
 
 :func:`separation` ranks candidate measurements (point and cross FRFs at
 the ends, quarter points and middle of every beam component; with a
@@ -31,7 +33,7 @@ from ..measurements import model_of_measurement
 from ..updating.parameters import set_parameters
 from ..updating.selection import INDIFFERENCE
 
-__all__ = ["unexplained_report", "separation", "signature"]
+__all__ = ["unexplained_report", "separation", "signature", "level_signature", "LEVEL_BANDS"]
 
 
 def _plain_beams(assembly):
@@ -168,6 +170,64 @@ def signature(model, measured_frf, pairs) -> tuple[list[str], dict]:
     return lines, info
 
 
+LEVEL_BANDS = 8
+"""Bands of equal numbers of lines over which :func:`level_signature` compares the level of the data."""
+
+
+def level_signature(baseline, floor: float) -> tuple[list[str], dict]:
+    """A measurement that is a constant factor times the model everywhere, with the modes in place.
+
+    Per measured FRF, the ratio ``r = ln |H_measured / H_model|`` of the
+    model as given, its median ``m`` over all lines and its medians over
+    :data:`LEVEL_BANDS` bands of lines.  When for every FRF ``|m|`` is above
+    twice the noise floor, every band's median has the sign of ``m`` and
+    lies between half and twice it, and every paired mode is within 1 %
+    (or two lines) of the model's, the FRFs differ from the model by a scale: what a
+    calibration or unit error does (the hammer's or the sensor's
+    sensitivity, g taken for m/s^2), and what a change of the structure
+    does only by scaling every mass and stiffness alike.
+
+    Parameters
+    ----------
+    baseline : sequence of Comparison
+        The model as given against each measured FRF.
+    floor : float
+        The noise floor (``rms_log_ratio`` of a perfect model).
+
+    Returns
+    -------
+    (list of str, dict)
+        The report line (none when the pattern is absent) and the factors
+        per FRF (``level``).
+    """
+    factors = []
+    for c in baseline:
+        f = c.measured.frequency.hz
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r = np.log(np.abs(c.measured.data[:, 0, 0]) / np.abs(c.model.data[:, 0, 0]))
+        ok = np.isfinite(r)
+        if ok.sum() < 4 * LEVEL_BANDS:
+            return [], {}
+        r = r[ok]
+        m = float(np.median(r))
+        bands = np.array([np.median(b) for b in np.array_split(r, LEVEL_BANDS)])
+        step = float(f[1] - f[0]) if f.size > 1 else 1.0
+        # a peak picked on noisy lines moves by a few lines: "in place" is within 1 % (or two lines)
+        in_place = all(p.model_hz is not None and abs(p.model_hz - p.measured_hz) <= max(2 * step, 0.01 * p.model_hz)
+                       for p in c.modes)
+        if not (in_place and c.modes and abs(m) > 2 * floor and np.all(bands / m > 0.5) and np.all(bands / m < 2.0)):
+            return [], {}
+        factors.append((str(c.measured.outputs[0]), str(c.measured.inputs[0]), float(np.exp(m))))
+    if not factors:
+        return [], {}
+    text = "; ".join(f"{o} / {i}: {x:.3g} times" for o, i, x in factors)
+    line = (f"signature: the measurement is a constant factor times the model over the whole band with every mode "
+            f"in place ({text}): a calibration or unit error (the hammer's or the sensor's sensitivity, g taken "
+            f"for m/s^2) scales an FRF like this, while a change of the structure would have to scale every mass "
+            f"and stiffness alike; check the calibration before the model")
+    return [line], {"level": [{"response": o, "excitation": i, "factor": x} for o, i, x in factors]}
+
+
 def unexplained_report(lik, assembly, current, baseline, cons, final_error: float, floor: float,
                        explained: bool, say=None) -> list[str]:
     """The lines of the verdict when the data are not explained (see the module docstring).
@@ -231,6 +291,7 @@ def unexplained_report(lik, assembly, current, baseline, cons, final_error: floa
     except (SubstructureError, ValueError) as exc:
         if say:
             say(f"signature skipped: {exc}")
+    lines += level_signature(baseline, floor)[0]
     return lines
 
 
