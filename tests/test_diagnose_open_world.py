@@ -67,6 +67,14 @@ def overhang_and_joint(d):
     return len(d.effects) == 2 and any(map(overhang, d.effects)) and any(map(joint, d.effects))
 
 
+def asymmetric_bands(d):
+    """Suspension bands of 2e4 N/m at 50 and 300 mm of the 330 mm spindle: insets 0.15 and 0.09, the pitch
+    mode near the first line (12 Hz) and the bounce mode below it."""
+    (e,) = d.effects
+    return e.name == "support-springs" and _near(e.values["k_yf"], 2e4, 0.1) and \
+        abs(e.values["inset"] - 0.05 / 0.33) < 0.03 and abs(e.values["inset_tip"] - 0.03 / 0.33) < 0.03
+
+
 CASES = {  # name: (hidden in the FE rig, the library's model, diagnose keywords, check, seed)
     # a weak cross term near the noise floor: 2e5 N against sqrt(k_yf k_tm) = 1.2e7 N
     "weak spindle-holder cross term": (dict(sh_cross=2.0e5), {}, {}, weak_cross(2.0e5, 0.3), 1),
@@ -79,6 +87,8 @@ CASES = {  # name: (hidden in the FE rig, the library's model, diagnose keywords
     "tapered tool, tip diameter": (dict(taper=0.009, taper_pieces=32), dict(taper=0.010), {}, taper_tip, 4),
     # a linked parameter no issue named: where a step between two segments sits, the component's length kept
     "tool clamped less deep": (dict(insert_length=0.025), {}, {}, insert_depth, 6),
+    # soft suspension bands hung asymmetrically: a narrow minimum that a subsample of every k-th line misses
+    "asymmetric suspension bands": (dict(springs=(2e4, 0.05, 0.30)), {}, {}, asymmetric_bands, 8),
     # two effects, one outside the catalogue, that the greedy path alone gets wrong
     "overhang and a softer holder-tool joint": (dict(tool_length=0.082, ht_scale=9e6 / 1.43e7), {}, {},
                                                 overhang_and_joint, 7),
@@ -232,3 +242,45 @@ def test_parsimony_prefers_a_fair_single_to_a_greedy_path_that_compensates():
                                     lambda changes: True, None)
     assert [c.key for c, _ in kept] == [joint.key] and chi2 == single.chi2
     assert all(len(changes) > 1 for changes, _, _ in rivals)  # the greedy path, if it is within the region
+
+
+def test_a_change_smaller_than_a_grid_step_is_still_screened():
+    """A tool 1.5 mm longer lies between the nominal overhang and its neighbour on the scan's grid: the scan's
+    best value is the nominal one, and the candidate must still be refined (not dropped before)."""
+    from substructure.diagnose.diagnosis import _comparisons, _peak_lines
+    from substructure.diagnose.effects import registry
+    from substructure.diagnose.search import candidates, screen
+    from substructure.updating.likelihood import Likelihood, measured_frfs
+
+    model = hd.nominal_model()
+    measured, _ = measured_frfs(hd.measure(seed=9, tool_length=0.0775), None)
+    lik = Likelihood(model, measured)
+    base = _comparisons(lik, lik.log_ratios([]), [m.noise.floor for m in measured])
+    sub = lik.subsample(max(1, lik.lines.size // 250), keep=_peak_lines(base))
+    overhang = [c for c in candidates(model, ["tool.tip:y"], registry()) if c.where == "components.tool.overhang"]
+    (found,) = screen(sub, [], overhang, sub.chi2([]), lik.n)
+    assert abs(found.values["value"] - 0.0775) < 5e-4
+
+
+def test_a_ring_on_a_bar_tapped_at_its_middle_could_sit_either_side():
+    """A free bar tapped and measured at its middle cannot tell a ring at 60 mm from one at 140 mm (the point
+    FRF is the same by symmetry): the diagnosis finds one, fits the mirror as well from its own scan, and
+    calls the data unexplained with the measurement that tells them apart (one away from the middle)."""
+    from substructure import Assembly, Frequency, Mass, Material, Segment, Tool
+    from substructure.synthetic import simulate
+
+    steel = Material("damped-steel", "210 GPa", 0.29, "7850 kg/m^3", loss_factor=0.03)
+    model = Assembly("bar", components=(Tool("bar", [Segment("200 mm", "20 mm", material=steel)]),),
+                     materials=(steel,))
+    truth = model.attach(Mass("ring", "bar@60 mm", "40 g", "2e-6 kg*m^2"))
+    data = simulate(truth, ["bar@100 mm"], frequency=Frequency.from_range("20 Hz", "6000 Hz", "4 Hz"),
+                    noise=0.015, seed=3)
+    d = diagnose(model, data)
+    assert not d.explained
+    assert "the same change at other values" in d.report[0]
+    (found,) = d.effects
+    (rival, sep) = d.rivals[0]
+    positions = sorted([found.values["position"], rival.founds[0].values["position"]])
+    assert positions == pytest.approx([0.060, 0.140], abs=1e-3)
+    assert found.values["mass"] == pytest.approx(0.040, rel=0.02)
+    assert sep["chi2"] > INDIFFERENCE and sep["response"] != "bar@100 mm:y"

@@ -584,13 +584,21 @@ def flute_tip(tool: Beam, length_m: float, ratio: float) -> Beam:
 
 @register_effect
 class SupportSprings(Effect):
-    """Springs to the ground near both ends of the heaviest component: ``k_yf`` per spring, ``inset``."""
+    """Springs to the ground near both ends of the heaviest component: ``k_yf`` per spring, ``inset`` from the
+    first end and ``inset_tip`` from the second (as fractions of its length; ``inset_tip`` defaults to
+    ``inset``: bands rarely hang symmetrically)."""
 
     name = "support-springs"
     parameters = (
         Parameter("k_yf", "N/m", 1e1, 1e8, 1e5),
         Parameter("inset", "dimensionless", 0.0, 0.45, 0.15, log=False),
+        Parameter("inset_tip", "dimensionless", 0.0, 0.45, 0.15, log=False),
     )
+
+    def __init__(self, where: str, **values: float):
+        if "inset" in values and "inset_tip" not in values:
+            values["inset_tip"] = values["inset"]
+        super().__init__(where, **values)
     explanation = (
         "springs to the ground (suspension bands of a 'free-free' test, a fixture) turn the "
         "rigid-body motion into low modes, tens of Hz for bands: the low end of the FRF rises "
@@ -635,7 +643,8 @@ class SupportSprings(Effect):
         Notes
         -----
         Two equal springs (``k_yf`` each) near the two points of ``where`` (the ends of a component,
-        ``"spindle.base,spindle.tip"``), ``inset`` of its length in from each.
+        ``"spindle.base,spindle.tip"``), ``inset`` of its length in from the first and ``inset_tip`` from
+        the second.
         """
         points = [parse_point(p.strip()) for p in self.where.split(",")]
         if len({p.component for p in points}) != 1 or {p.where for p in points} != {"base", "tip"}:
@@ -647,7 +656,7 @@ class SupportSprings(Effect):
         k = _si(self.values["k_yf"], "N/m")
         inset = self.values["inset"] * comp.length_m
         near = f"{comp.name}@{_si(inset, 'm')}"
-        far = f"{comp.name}@{_si(comp.length_m - inset, 'm')}"
+        far = f"{comp.name}@{_si(comp.length_m - self.values['inset_tip'] * comp.length_m, 'm')}"
         return assembly.support(Support(near, k={"yf": k}, name=f"diagnosed-{comp.name}-1")).support(
             Support(far, k={"yf": k}, name=f"diagnosed-{comp.name}-2"))
 
@@ -670,5 +679,5 @@ class SupportSprings(Effect):
         inset = self.values["inset"] * total
         k = np.diag([self.values["k_yf"], 0.0])
         near = LinkSI(("added", f"springs-{name}-1"), (name, inset), K=k)
-        far = LinkSI(("added", f"springs-{name}-2"), (name, total - inset), K=k)
+        far = LinkSI(("added", f"springs-{name}-2"), (name, total - self.values["inset_tip"] * total), K=k)
         return structure.add_link(near).add_link(far)

@@ -81,6 +81,27 @@ def _comparisons(lik: Likelihood, ratios, floors) -> tuple[Comparison, ...]:
     return tuple(out)
 
 
+PEAK_LINES = 2
+"""Lines either side of every measured resonance the model lacks kept in the screening subsample."""
+
+
+def _peak_lines(baseline) -> np.ndarray:
+    """Positions of the lines within :data:`PEAK_LINES` of every measured resonance the model as given lacks
+    (no model mode paired with it): a subsample of every k-th line can step over such a narrow peak (a
+    suspension mode between two of its lines), and there a candidate's fit on the subsample says nothing about
+    all lines.  Paired modes are left to the mode starts (:mod:`substructure.diagnose.modes`): their lines
+    make the scan's landscape rugged where a model peak crosses them."""
+    keep: list[int] = []
+    for c in baseline:
+        hz = c.measured.frequency.hz
+        for p in c.modes:
+            if p.model_hz is not None:  # a paired mode: its shift is followed by the mode starts
+                continue
+            i = int(np.argmin(np.abs(hz - p.measured_hz)))
+            keep += range(max(0, i - PEAK_LINES), min(hz.size, i + PEAK_LINES + 1))
+    return np.unique(np.array(keep, dtype=int))
+
+
 def _rms(ratios) -> float:
     return float(np.sqrt(np.mean(np.concatenate([np.abs(r) ** 2 for r in ratios]))))
 
@@ -185,7 +206,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
             f"{': consistent with the noise' if cons.consistent else ''}")
     points = [lbl for m in measured for lbl in (m.frf.outputs[0], m.frf.inputs[0])]
     cands = candidates(assembly, points, catalogue, open_world, _main_shift(baseline[0]), say)
-    screen_lik = lik.subsample(max(1, lik.lines.size // SCREEN_LINES))
+    screen_lik = lik.subsample(max(1, lik.lines.size // SCREEN_LINES), keep=_peak_lines(baseline))
     limit = 0 if cons.consistent else (max_steps if refine else 1)
     outcome = refine_model(lik, screen_lik, cands, limit, lambda changes: _passive(lik, changes), say, meter)
     current = outcome.current
@@ -233,9 +254,13 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     if rivals:  # consistent with the noise, but not uniquely: claim neither
         explained = False
         kept = Explanation(final_effects)
+        keys = sorted(f.change.key for f in final_effects)
         report = [f"unexplained: no candidate explains the data uniquely: {kept.name} at {kept.where} and "
                   f"{rival.name} at {rival.where} both leave a residual consistent with the noise (their BIC "
-                  f"differ by at most {INDIFFERENCE:g}) but change different parts" for rival, _ in rivals[:1]]
+                  f"differ by at most {INDIFFERENCE:g}) but "
+                  + ("are the same change at other values (" + ", ".join(_values_text(f) for f in rival.founds) + ")"
+                     if sorted(f.change.key for f in rival.founds) == keys else "change different parts")
+                  for rival, _ in rivals[:1]]
         report += [f"to tell them apart: {sep['text']}" for rival, sep in rivals]
         report.append("the best (ambiguous) explanation is reported as partial: "
                       + ", ".join(repr(e) for e in final_effects))
@@ -320,8 +345,9 @@ def _distinct_rivals(assembly, measured, final_effects, outcome, say) -> list:
     """Rival explanations inside the indifference region that are different structures.
 
     A rival is a whole explanation of the parsimony check
-    (:func:`substructure.diagnose.refine.refine`) or the kept one with one
-    change replaced by an alternative of its step; one that holds every
+    (:func:`substructure.diagnose.refine.refine`), the kept one with one
+    change replaced by an alternative of its step, or the kept changes at
+    other values that fit as well (a second minimum); one that holds every
     kept change and more is not (the data do not decide the extra).  It is a *different
     structure* when some measurement with the test's sensors on (a point or
     cross FRF at the ends, quarter points and middles of the components)
@@ -343,13 +369,15 @@ def _distinct_rivals(assembly, measured, final_effects, outcome, say) -> list:
     pool.sort(key=lambda t: t[0])
     keys = {f.change.key for f in final_effects}
     # a rival that holds every kept change plus more is not another explanation: the data do not decide the extra
-    pool = [(chi2, founds) for chi2, founds in pool if not keys <= {f.change.key for f in founds}]
+    # (the same changes at other values are another explanation: a second minimum of the same changes)
+    pool = [(chi2, founds) for chi2, founds in pool if not keys < {f.change.key for f in founds}]
     kept = Explanation(final_effects)
     kept_sites = frozenset().union(*(sites(assembly, f.change, f.values) for f in final_effects))
     out = []
     for _, founds in pool[:RIVALS_CHECKED]:
         rival = Explanation(founds)
-        if frozenset().union(*(sites(assembly, f.change, f.values) for f in founds)) == kept_sites:
+        same_changes = {f.change.key for f in founds} == keys
+        if not same_changes and frozenset().union(*(sites(assembly, f.change, f.values) for f in founds)) == kept_sites:
             continue  # the same parts changed: an equivalent description
         rival = Explanation(founds)
         sep = separation(assembly, measured, kept, rival, say, contact_only=True)
@@ -358,6 +386,11 @@ def _distinct_rivals(assembly, measured, final_effects, outcome, say) -> list:
                 say(f"rival explanation {rival.name} at {rival.where}: {sep['text']}")
             out.append((rival, sep))
     return out
+
+
+def _values_text(found) -> str:
+    return ", ".join(f"{s.name} = {found.values[s.name]:.4g} {s.unit}".replace(" dimensionless", "")
+                     for s in found.change.specs)
 
 
 def _std_of(result, change) -> dict:

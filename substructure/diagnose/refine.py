@@ -45,7 +45,9 @@ from ..updating.fit import Fit, fit
 from ..updating.selection import INDIFFERENCE, significance
 from ..updating.likelihood import Likelihood
 from .modes import mode_starts
-from .search import Budget, Scored, _places as places, choose, full_fits, physical, preference, rank, screen, shortlist
+from ..updating.fit import to_u
+from .search import (Budget, Scored, _places as places, _trials as trials, choose, full_fits, physical, preference,
+                     rank, screen, shortlist)
 
 __all__ = ["Outcome", "refine"]
 
@@ -290,6 +292,83 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say, p
     return kept, kept_chi2, rivals
 
 
+OTHER_STARTS = 2
+"""Starts, per change kept (of two or more parameters), from which other values of the same change are fitted
+(:func:`_other_values`)."""
+OTHER_APART = 0.05
+"""Values of a change count as other values when some parameter differs by more than three of its standard
+deviations and by more than this share of its range (on its fitted scale)."""
+
+
+def _other_values(lik, screen_lik, current, final: Fit, passive, say) -> list:
+    """The same changes at other values that explain the data as well: a second minimum.
+
+    A fit finds the minimum its start leads to; springs that hold a body
+    whose modes sit below the band, say, fit as well at another stiffness
+    with other positions.  For each change kept, its screening trials
+    (with the other changes at their final values) are evaluated on the
+    subsample; the :data:`OTHER_STARTS` best that lie away from the kept
+    values start fits of every change on all lines.  A result inside the
+    indifference region whose values of that change lie apart
+    (:data:`OTHER_APART`) is the same explanation at other values: a rival.
+
+    Returns
+    -------
+    list of (changes, chi2, bic)
+        The rivals found (as the parsimony check gives them).
+    """
+    n = lik.n
+    chi2_now = final.chi2
+    s2 = max(1.0, chi2_now / max(n - _p(current), 1))
+    out = []
+    for i, (change, values) in enumerate(current):
+        if len(change.specs) < 2:  # one number: its scan and refinement have seen its whole range
+            continue
+        kept_u = {spec.name: to_u(spec, values[spec.name]) for spec in change.specs}
+        span = {spec.name: max(to_u(spec, spec.upper) - to_u(spec, spec.lower), 1e-300) for spec in change.specs}
+        std = final.std[i] if i < len(final.std) else {}
+
+        def apart(vals) -> bool:
+            for spec in change.specs:
+                u = to_u(spec, vals[spec.name])
+                sd = std.get(spec.name)
+                sd_u = abs(to_u(spec, values[spec.name] + sd) - kept_u[spec.name]) if sd and np.isfinite(sd) and \
+                    spec.lower <= values[spec.name] + sd <= spec.upper else 0.0
+                if abs(u - kept_u[spec.name]) > max(3 * sd_u, OTHER_APART * span[spec.name]):
+                    return True
+            return False
+
+        scored = []
+        for trial in trials(change):
+            vals = {**values, **{k: v for k, v in trial.items() if k in values}}
+            if not apart(vals):
+                continue
+            try:
+                chi2 = screen_lik.chi2(current[:i] + [(change, vals)] + current[i + 1:])
+            except (ValueError, ArithmeticError, SubstructureError):
+                continue
+            if np.isfinite(chi2):
+                scored.append((chi2, vals))
+        scored.sort(key=lambda t: t[0])
+        for _, vals in scored[:OTHER_STARTS]:
+            try:
+                result = fit(lik, current[:i] + [(change, vals)] + current[i + 1:])
+            except (ValueError, ArithmeticError, SubstructureError):
+                continue
+            got = result.changes[i][1]
+            if result.chi2 - chi2_now > INDIFFERENCE * s2 or not apart(got):
+                continue
+            if not (all(physical(c, v) for c, v in result.changes) and passive(result.changes)):
+                continue
+            if say:
+                say(f"{change.effect} at {change.where} fits as well at other values: "
+                    + ", ".join(f"{k} = {v:.4g}" for k, v in got.items()))
+            out.append(([(c, dict(v)) for c, v in result.changes], result.chi2,
+                        _bic(result.chi2, _p(current), n, s2)))
+            break
+    return out
+
+
 def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
            budget: Budget | None = None) -> Outcome:
     """Forward selection, then elimination, review and history (see the module docstring).
@@ -356,9 +435,20 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
         chosen = []
         for s in shortlist(scored, chi2_s, screen_lik.n, n, _p(current)):
             # the screened values checked on all lines (noise fitted on the subsample does not carry over)
-            chi2_all = lik.chi2(list(s.start if s.start is not None else current) + [(s.change, s.values)])
+            start = list(s.start if s.start is not None else current)
+            chi2_all = lik.chi2(start + [(s.change, s.values)])
             if significance(chi2_now, chi2_all, s.k, n, _p(current) + s.k).significant:
                 chosen.append(s)
+            elif not spent():
+                # a minimum narrower than the subsample's spacing (a mode just below the first line moves
+                # the lowest lines only): a short fit on all lines from the screened values decides
+                try:
+                    short = fit(lik, start + [(s.change, s.values)], max_nfev=5 * (_p(current) + s.k + 1))
+                except (ValueError, ArithmeticError, SubstructureError):
+                    continue
+                if significance(chi2_now, short.chi2, s.k, n, _p(current) + s.k).significant:
+                    chosen.append(Scored(s.change, dict(short.changes[-1][1]), short.chi2,
+                                         start=[(c, dict(v)) for c, v in short.changes[:-1]]))
         done = full_fits(lik, current, chosen, say, budget)
         search["full_fits"] += len(done)
         if len(done) < len(chosen):
@@ -407,4 +497,6 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     if final is not None:
         current = [(c, dict(v)) for c, v in final.changes]
     history = path if unchanged else (_history(lik, current, final, tried) if current else [])
+    if final is not None:
+        rivals = list(rivals) + _other_values(lik, screen_lik, current, final, passive, say)
     return Outcome(current, final, history, first_scored, first_fitted, alternatives, rivals, search)

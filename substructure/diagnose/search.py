@@ -26,6 +26,7 @@ effect can only add a candidate, not push a built-in one out.
 
 from __future__ import annotations
 
+import itertools
 import math
 import time
 from typing import Callable, Sequence
@@ -207,6 +208,16 @@ below its largest magnitude: its physically typical values are small next to its
 start at zero (where the model is as given) hides it."""
 
 
+NAMED_GRID = 33
+"""Values (in the first step; half as many later) of the size of an effect of the catalogue at one place that comes with positions (springs), crossed with
+them: near the edge of the band such effects have narrow minima (suspension springs whose modes sit just below
+the first line change the lowest lines only within a few tens of per cent of their stiffness)."""
+NAMED_SECOND = 10
+"""Positions (all alike) crossed with each size on that grid."""
+NAMED_THIRD = 6
+"""Values of each of two positions crossed with every other size of that grid."""
+
+
 def _grid(spec, count: int) -> np.ndarray:
     if spec.log:
         return np.geomspace(spec.lower, spec.upper, count)
@@ -230,9 +241,10 @@ def _places(change: Change) -> list[dict]:
     return [base]
 
 
-def _trials(change: Change) -> list[dict]:
+def _trials(change: Change, first: bool = True) -> list[dict]:
     """Starting points of the screening scan: the main parameter over its range (at each place), and
-    for effects of several log-scale parameters, all of them scaled together."""
+    for effects of several log-scale parameters, all of them scaled together (``first``: the first step,
+    where sizes and positions are crossed on finer grids)."""
     main = change.specs[0]
     count = 5 if len(_places(change)) > 1 else 9
     values = list(_grid(main, count))
@@ -243,6 +255,21 @@ def _trials(change: Change) -> list[dict]:
     if isinstance(change, SectionChange):
         values = [0.7, 0.85, 1.2]
     out = [{**place, main.name: v} for place in _places(change) for v in values]
+    # an effect of the catalogue at one place whose size (log scale) comes with where it sits (linear, not
+    # signed): springs and their positions, crossed, since a spring's stiffness and place act together
+    linear = [spec for spec in change.specs[1:] if not spec.log and spec.lower >= 0.0]
+    if isinstance(change, EffectChange) and len(_places(change)) == 1 and main.log and linear:
+        sizes = NAMED_GRID if first else NAMED_GRID // 2 + 1
+        fine = list(_grid(main, sizes))
+        place = _places(change)[0]
+        for v in fine:  # each position alike (both springs as far in), on the finer grid
+            for w in np.linspace(linear[0].lower, linear[0].upper, NAMED_SECOND):
+                out.append({**place, main.name: v, **{spec.name: float(w) for spec in linear[:2]}})
+        if len(linear) >= 2:  # and apart, on a coarser one
+            per = NAMED_THIRD if first else NAMED_THIRD - 1
+            for v in _grid(main, sizes // 2 + 1):
+                for combo in itertools.product(*[np.linspace(x.lower, x.upper, per) for x in linear[:2]]):
+                    out.append({**place, main.name: float(v), **{x.name: float(w) for x, w in zip(linear, combo)}})
     out += [{**_places(change)[0], **trial} for trial in getattr(change, "trials", ())]  # e.g. known materials
     logs = [s for s in change.specs if s.log]
     if len(logs) >= 2 and len(_places(change)) == 1:  # all log parameters scaled together too
@@ -302,7 +329,7 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
             progress(f"scanned {n}/{len(changes)} candidates")
         best_chi2, best = math.inf, None
         try:
-            for trial in _trials(change) + list((extra or {}).get(change.key, ())):
+            for trial in _trials(change, first=not current) + list((extra or {}).get(change.key, ())):
                 chi2 = chi2_of(list(current) + [(change, trial)])
                 if chi2 < best_chi2:
                     best_chi2, best = chi2, trial
@@ -310,10 +337,10 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
             if progress:
                 progress(f"  skipped {change.effect} at {change.where}: {exc}")
             continue
-        if best is not None and best_chi2 < chi2_now:
+        if best is not None and best_chi2 <= chi2_now * (1 + 1e-9):  # at its nominal value: the polish may still gain
             scanned.append(Scored(change, dict(best), float(best_chi2), start=list(current)))
     scanned.sort(key=lambda s: s.chi2)
-    scanned = _polish(scanned, chi2_of, current)
+    scanned = [s for s in _polish(scanned, chi2_of, current, chi2_now) if s.chi2 < chi2_now]
     local = []
     p_now = sum(len(c.specs) for c, _ in current)
     for s in shortlist(scanned, chi2_now, likelihood.n, n_full, p_now):
@@ -330,20 +357,27 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
     return [s for s in local + [s for s in scanned if s.change.key not in done] if s.chi2 < chi2_now]
 
 
-POLISHED = 24
-"""Candidates (best scanned first) whose main parameter is refined between its grid's neighbours after the scan."""
+POLISH_POINTS = 7
+"""Points across the bracket of one grid step either side that the refinement evaluates before Brent's."""
+POLISHED = 10 ** 6
+"""Candidates (best scanned first) whose main parameter is refined between its grid's neighbours after the scan:
+all of them (about one evaluation of all lines each): a change that lies within a grid step of the model's value
+scans no better than the model, or than a neighbour's small gain, and only the refinement shows it."""
 
 
-def _polish(scanned: list, chi2_of, current) -> list:
+def _polish(scanned: list, chi2_of, current, chi2_now: float = math.inf) -> list:
     """The main parameter of the best scanned candidates refined by a bounded 1-D search around its best trial.
 
     A grid of nine values over decades misses minima narrower than its
     step (a bearing pair half as stiff sits between 0.32 and 1 on a factor
     grid, and moves the modes by many bandwidths on the way): each of the
-    ``POLISHED`` best candidates gets a bounded scalar minimisation
-    (Brent's, at most ten evaluations) of its main parameter, on its fitted
-    scale, over one grid step either side of its best trial, the other
-    values held.  The order is then by the refined ``chi^2``.
+    ``POLISHED`` best candidates (all of them) gets :data:`POLISH_POINTS`
+    evaluations across one grid step either side of its best trial and a
+    bounded scalar minimisation (Brent's, at most eight evaluations) around
+    the best of those, of its main parameter on its fitted scale,
+    the other values held; a candidate whose scan found nothing better
+    than the model as it is takes part too (a grid step can be wider than
+    the change).  The order is then by the refined ``chi^2``.
     """
     out = []
     for k, s in enumerate(scanned):
@@ -361,10 +395,19 @@ def _polish(scanned: list, chi2_of, current) -> list:
                     return math.inf
 
             if hi > lo:
-                r = minimize_scalar(cost, bounds=(lo, hi), method="bounded", options={"maxiter": 10, "xatol": 1e-3})
-                if np.isfinite(r.fun) and r.fun < s.chi2:
-                    s = Scored(s.change, {**s.values, main.name: from_u(main, float(r.x))}, float(r.fun),
-                               start=s.start)
+                # a few points across the bracket first (between grid points the landscape can hold several
+                # minima where a model peak crosses the lines), then Brent's around the best of them
+                pts = np.linspace(lo, hi, POLISH_POINTS)
+                costs = [cost(u) for u in pts]
+                j = int(np.argmin(costs))
+                best_u, best_c = float(pts[j]), float(costs[j])
+                sub = (hi - lo) / (POLISH_POINTS - 1)
+                a_, b_ = max(lo, best_u - sub), min(hi, best_u + sub)
+                r = minimize_scalar(cost, bounds=(a_, b_), method="bounded", options={"maxiter": 8, "xatol": 1e-3})
+                if np.isfinite(r.fun) and r.fun < best_c:
+                    best_u, best_c = float(r.x), float(r.fun)
+                if np.isfinite(best_c) and best_c < s.chi2:
+                    s = Scored(s.change, {**s.values, main.name: from_u(main, best_u)}, best_c, start=s.start)
         out.append(s)
     out.sort(key=lambda x: x.chi2)
     return out

@@ -201,20 +201,28 @@ class Likelihood:
         self.n = 2 * sum(d.size for d in self.data)
         self.evaluations = 0
 
-    def subsample(self, step: int) -> "Likelihood":
-        """The same likelihood on every ``step``-th line (for cheap screening).
+    def subsample(self, step: int, keep=None) -> "Likelihood":
+        """The same likelihood on every ``step``-th line, and on the lines ``keep`` (for cheap screening).
 
         Parameters
         ----------
         step : int
             Keep every this-many-th line.
+        keep : array of int, optional
+            Positions in :attr:`lines` kept as well (the lines around
+            resonances, where a mode that moves by a line changes ``chi^2``
+            most).
 
         Returns
         -------
         Likelihood
             The subsampled likelihood (the same noise per line).
         """
-        return Likelihood(self.assembly, self.measured, self.lines[:: max(1, int(step))])
+        lines = self.lines[:: max(1, int(step))]
+        if keep is not None and len(keep):
+            keep = np.asarray(keep, dtype=int)
+            lines = np.union1d(lines, self.lines[keep[(keep >= 0) & (keep < self.lines.size)]])
+        return Likelihood(self.assembly, self.measured, lines)
 
     def predict(self, changes: Sequence[tuple] = ()) -> list[np.ndarray]:
         """Model values per measured FRF on the lines used.
