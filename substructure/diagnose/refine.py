@@ -46,8 +46,8 @@ from ..updating.selection import INDIFFERENCE, significance
 from ..updating.likelihood import Likelihood
 from .modes import mode_starts
 from ..updating.fit import to_u
-from .search import (Budget, Scored, _places as places, _trials as trials, choose, full_fits, physical, preference,
-                     rank, screen, shortlist)
+from .scan import places, trials
+from .search import Budget, Scored, choose, full_fits, physical, preference, rank, screen, shortlist
 
 __all__ = ["Outcome", "refine"]
 
