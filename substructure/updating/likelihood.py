@@ -209,7 +209,7 @@ class Likelihood:
         step : int
             Keep every this-many-th line.
         keep : array of int, optional
-            Positions in :attr:`lines` kept as well (the lines around
+            Positions in ``lines`` kept as well (the lines around
             resonances, where a mode that moves by a line changes ``chi^2``
             most).
 
