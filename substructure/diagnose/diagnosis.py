@@ -206,9 +206,11 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
             f"{': consistent with the noise' if cons.consistent else ''}")
     points = [lbl for m in measured for lbl in (m.frf.outputs[0], m.frf.inputs[0])]
     cands = candidates(assembly, points, catalogue, open_world, _main_shift(baseline[0]), say)
-    screen_lik = lik.subsample(max(1, lik.lines.size // SCREEN_LINES), keep=_peak_lines(baseline))
+    lacking = _peak_lines(baseline)
+    screen_lik = lik.subsample(max(1, lik.lines.size // SCREEN_LINES), keep=lacking)
     limit = 0 if cons.consistent else (max_steps if refine else 1)
-    outcome = refine_model(lik, screen_lik, cands, limit, lambda changes: _passive(lik, changes), say, meter)
+    outcome = refine_model(lik, screen_lik, cands, limit, lambda changes: _passive(lik, changes), say, meter,
+                           lacking=bool(len(lacking)))
     current = outcome.current
     p_now = sum(len(c.specs) for c, _ in current)
     steps = [Step(0, None, e0, chi2_now / n)]

@@ -293,8 +293,11 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say, p
 
 
 OTHER_STARTS = 2
-"""Starts, per change kept (of two or more parameters), from which other values of the same change are fitted
-(:func:`_other_values`)."""
+"""Starts, per change kept that has a place among its parameters (:data:`PLACING`), from which other values of
+the same change are fitted (:func:`_other_values`)."""
+PLACING = ("position", "start", "inset", "inset_tip")
+"""Parameters that place a change along a component: where a second minimum lives (a body either side of a
+symmetric point, springs further in at another stiffness)."""
 OTHER_APART = 0.05
 """Values of a change count as other values when some parameter differs by more than three of its standard
 deviations and by more than this share of its range (on its fitted scale)."""
@@ -322,8 +325,8 @@ def _other_values(lik, screen_lik, current, final: Fit, passive, say) -> list:
     s2 = max(1.0, chi2_now / max(n - _p(current), 1))
     out = []
     for i, (change, values) in enumerate(current):
-        if len(change.specs) < 2:  # one number: its scan and refinement have seen its whole range
-            continue
+        if not any(spec.name in PLACING for spec in change.specs[1:]):
+            continue  # without a place, its scan and refinement have seen its range; a place can mirror
         kept_u = {spec.name: to_u(spec, values[spec.name]) for spec in change.specs}
         span = {spec.name: max(to_u(spec, spec.upper) - to_u(spec, spec.lower), 1e-300) for spec in change.specs}
         std = final.std[i] if i < len(final.std) else {}
@@ -370,7 +373,7 @@ def _other_values(lik, screen_lik, current, final: Fit, passive, say) -> list:
 
 
 def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
-           budget: Budget | None = None) -> Outcome:
+           budget: Budget | None = None, lacking: bool = False) -> Outcome:
     """Forward selection, then elimination, review and history (see the module docstring).
 
     Parameters
@@ -390,6 +393,9 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     budget : Budget, optional
         Once it is spent the search adds no step and fits no more candidates
         in a step than the first (recorded in ``Outcome.search``).
+    lacking : bool
+        The data hold a resonance the model lacks (a suspension mode): the
+        first step crosses the sizes and positions of springs.
 
     Returns
     -------
@@ -431,7 +437,7 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
         # the current changes refitted on the subsample too: candidates are compared with that
         chi2_s = fit(screen_lik, current).chi2 if current else screen_lik.chi2([])
         extra = mode_starts(lik0, current, remaining, places)
-        scored = screen(screen_lik, current, remaining, chi2_s, n, say, extra)
+        scored = screen(screen_lik, current, remaining, chi2_s, n, say, extra, cross=lacking and not current)
         chosen = []
         for s in shortlist(scored, chi2_s, screen_lik.n, n, _p(current)):
             # the screened values checked on all lines (noise fitted on the subsample does not carry over)
@@ -439,9 +445,10 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
             chi2_all = lik.chi2(start + [(s.change, s.values)])
             if significance(chi2_now, chi2_all, s.k, n, _p(current) + s.k).significant:
                 chosen.append(s)
-            elif not spent():
-                # a minimum narrower than the subsample's spacing (a mode just below the first line moves
-                # the lowest lines only): a short fit on all lines from the screened values decides
+            elif lacking and not spent():
+                # data with a resonance the model lacks can hold a minimum narrower than the subsample's
+                # spacing (a mode just below the first line moves the lowest lines only): a short fit on all
+                # lines from the screened values decides
                 try:
                     short = fit(lik, start + [(s.change, s.values)], max_nfev=5 * (_p(current) + s.k + 1))
                 except (ValueError, ArithmeticError, SubstructureError):

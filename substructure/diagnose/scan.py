@@ -30,14 +30,14 @@ start at zero (where the model is as given) hides it."""
 
 
 NAMED_GRID = 33
-"""Values (in the first step; half as many later) of the size of an effect of the catalogue at one place that
-comes with positions (springs), crossed with them: near the edge of the band such effects have narrow minima
-(suspension springs whose modes sit just below the first line change the lowest lines only within a few tens
-of per cent of their stiffness)."""
+"""Values (in the first step, on data with a resonance the model lacks) of the size of an effect of the
+catalogue at one place that comes with positions (springs), crossed with them: near the edge of the band such
+effects have narrow minima (suspension springs whose modes sit just below the first line change the lowest lines
+only within a few tens of per cent of their stiffness)."""
 NAMED_SECOND = 10
 """Positions (all alike) crossed with each size on that grid."""
-NAMED_THIRD = 6
-"""Values of each of two positions crossed with every other size of that grid."""
+NAMED_THIRD = 4
+"""Values of each of two positions crossed with nine sizes."""
 
 
 def grid(spec, count: int) -> np.ndarray:
@@ -65,8 +65,8 @@ def places(change: Change) -> list[dict]:
 
 def trials(change: Change, first: bool = True) -> list[dict]:
     """Starting points of the screening scan: the main parameter over its range (at each place), and
-    for effects of several log-scale parameters, all of them scaled together (``first``: the first step,
-    where sizes and positions are crossed on finer grids)."""
+    for effects of several log-scale parameters, all of them scaled together (``first``: the first step of
+    data with a resonance the model lacks, where the sizes and positions of springs are crossed)."""
     main = change.specs[0]
     count = 5 if len(places(change)) > 1 else 9
     values = list(grid(main, count))
@@ -78,19 +78,18 @@ def trials(change: Change, first: bool = True) -> list[dict]:
         values = [0.7, 0.85, 1.2]
     out = [{**place, main.name: v} for place in places(change) for v in values]
     # an effect of the catalogue at one place whose size (log scale) comes with where it sits (linear, not
-    # signed): springs and their positions, crossed, since a spring's stiffness and place act together
+    # signed): springs and their positions, crossed in the first step when the data hold a resonance the model
+    # lacks (a suspension mode; the positions alike, then apart), since a spring's stiffness and place act
+    # together there
     linear = [spec for spec in change.specs[1:] if not spec.log and spec.lower >= 0.0]
-    if isinstance(change, EffectChange) and len(places(change)) == 1 and main.log and linear:
-        sizes = NAMED_GRID if first else NAMED_GRID // 2 + 1
-        fine = list(grid(main, sizes))
+    if first and isinstance(change, EffectChange) and len(places(change)) == 1 and main.log and linear:
         place = places(change)[0]
-        for v in fine:  # each position alike (both springs as far in), on the finer grid
+        for v in grid(main, NAMED_GRID):
             for w in np.linspace(linear[0].lower, linear[0].upper, NAMED_SECOND):
-                out.append({**place, main.name: v, **{spec.name: float(w) for spec in linear[:2]}})
-        if len(linear) >= 2:  # and apart, on a coarser one
-            per = NAMED_THIRD if first else NAMED_THIRD - 1
-            for v in grid(main, sizes // 2 + 1):
-                for combo in itertools.product(*[np.linspace(x.lower, x.upper, per) for x in linear[:2]]):
+                out.append({**place, main.name: float(v), **{spec.name: float(w) for spec in linear[:2]}})
+        if len(linear) >= 2:
+            for v in grid(main, 9):
+                for combo in itertools.product(*[np.linspace(x.lower, x.upper, NAMED_THIRD) for x in linear[:2]]):
                     out.append({**place, main.name: float(v), **{x.name: float(w) for x, w in zip(linear, combo)}})
     out += [{**places(change)[0], **trial} for trial in getattr(change, "trials", ())]  # e.g. known materials
     logs = [s for s in change.specs if s.log]

@@ -203,7 +203,7 @@ class Scored:
 
 
 def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2_now: float, n_full: int,
-           progress: Callable | None = None, extra: dict | None = None) -> list[Scored]:
+           progress: Callable | None = None, extra: dict | None = None, cross: bool = False) -> list[Scored]:
     """Screen candidates on a subsample: a scan with the changes already added held, then local fits.
 
     Every candidate's main parameter is scanned over its range (at each
@@ -230,6 +230,8 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
         Progress lines.
     extra : dict, optional
         More trials per candidate key (from :func:`substructure.diagnose.modes.mode_starts`).
+    cross : bool
+        Cross the sizes and positions of springs (:func:`substructure.diagnose.scan.trials`).
 
     Returns
     -------
@@ -250,7 +252,7 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
             progress(f"scanned {n}/{len(changes)} candidates")
         best_chi2, best = math.inf, None
         try:
-            for trial in _trials(change, first=not current) + list((extra or {}).get(change.key, ())):
+            for trial in _trials(change, first=cross) + list((extra or {}).get(change.key, ())):
                 chi2 = chi2_of(list(current) + [(change, trial)])
                 if chi2 < best_chi2:
                     best_chi2, best = chi2, trial
@@ -278,8 +280,11 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
     return [s for s in local + [s for s in scanned if s.change.key not in done] if s.chi2 < chi2_now]
 
 
-POLISH_POINTS = 7
-"""Points across the bracket of one grid step either side that the refinement evaluates before Brent's."""
+POLISH_POINTS = 3
+"""The refinement of the :data:`BRENT` best candidates evaluates points a third and two thirds of a grid step
+either side of the scan's best before Brent's (the others: the slope there, and Brent's down it)."""
+BRENT = 24
+"""Candidates (best scanned first) refined by points and Brent's; the others by their slope (see :func:`_polish`)."""
 POLISHED = 10 ** 6
 """Candidates (best scanned first) whose main parameter is refined between its grid's neighbours after the scan:
 all of them (about one evaluation of all lines each): a change that lies within a grid step of the model's value
@@ -292,10 +297,12 @@ def _polish(scanned: list, chi2_of, current, chi2_now: float = math.inf) -> list
     A grid of nine values over decades misses minima narrower than its
     step (a bearing pair half as stiff sits between 0.32 and 1 on a factor
     grid, and moves the modes by many bandwidths on the way): each of the
-    ``POLISHED`` best candidates (all of them) gets :data:`POLISH_POINTS`
-    evaluations across one grid step either side of its best trial and a
-    bounded scalar minimisation (Brent's, at most eight evaluations) around
-    the best of those, of its main parameter on its fitted scale,
+    ``POLISHED`` best candidates (all of them) is refined in its main
+    parameter on its fitted scale: the :data:`BRENT` best by evaluations at
+    points between its best trial and the grid's neighbours
+    (:data:`POLISH_POINTS`) and a bounded scalar minimisation (Brent's, at
+    most eight evaluations) around the best of those; the others by the
+    slope at the best trial and Brent's down it, when it descends,
     the other values held; a candidate whose scan found nothing better
     than the model as it is takes part too (a grid step can be wider than
     the change).  The order is then by the refined ``chi^2``.
@@ -316,17 +323,33 @@ def _polish(scanned: list, chi2_of, current, chi2_now: float = math.inf) -> list
                     return math.inf
 
             if hi > lo:
-                # a few points across the bracket first (between grid points the landscape can hold several
-                # minima where a model peak crosses the lines), then Brent's around the best of them
-                pts = np.linspace(lo, hi, POLISH_POINTS)
-                costs = [cost(u) for u in pts]
-                j = int(np.argmin(costs))
-                best_u, best_c = float(pts[j]), float(costs[j])
-                sub = (hi - lo) / (POLISH_POINTS - 1)
-                a_, b_ = max(lo, best_u - sub), min(hi, best_u + sub)
-                r = minimize_scalar(cost, bounds=(a_, b_), method="bounded", options={"maxiter": 8, "xatol": 1e-3})
-                if np.isfinite(r.fun) and r.fun < best_c:
-                    best_u, best_c = float(r.x), float(r.fun)
+                best_u, best_c = u0, float(s.chi2)
+                if k < BRENT:
+                    # points between the scan's best and the grid's neighbours (scanned already) first: the
+                    # landscape can hold several minima where a model peak crosses the lines; Brent's around
+                    # the best of them
+                    sub = step / POLISH_POINTS
+                    pts = [u for u in u0 + sub * np.arange(-POLISH_POINTS + 1, POLISH_POINTS) if lo < u < hi and u != u0]
+                    costs = [cost(u) for u in pts]
+                    if costs and min(costs) < best_c:
+                        j = int(np.argmin(costs))
+                        best_u, best_c = float(pts[j]), float(costs[j])
+                    bracket = (max(lo, best_u - sub), min(hi, best_u + sub))
+                else:
+                    # the others: the slope at the scan's best, then Brent's down it (a change smaller than a
+                    # grid step scans no better than the model, but the slope shows it)
+                    tiny = step / 20.0
+                    down = [(cost(u), u) for u in (u0 - tiny, u0 + tiny) if lo <= u <= hi]
+                    down = [(c, u) for c, u in down if c < best_c]
+                    bracket = None
+                    if down:
+                        c, u = min(down)
+                        best_u, best_c = u, c
+                        bracket = (lo, u0) if u < u0 else (u0, hi)
+                if bracket is not None and bracket[1] > bracket[0]:
+                    r = minimize_scalar(cost, bounds=bracket, method="bounded", options={"maxiter": 8, "xatol": 1e-3})
+                    if np.isfinite(r.fun) and r.fun < best_c:
+                        best_u, best_c = float(r.x), float(r.fun)
                 if np.isfinite(best_c) and best_c < s.chi2:
                     s = Scored(s.change, {**s.values, main.name: from_u(main, best_u)}, best_c, start=s.start)
         out.append(s)
