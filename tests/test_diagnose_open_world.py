@@ -284,3 +284,21 @@ def test_a_ring_on_a_bar_tapped_at_its_middle_could_sit_either_side():
     assert positions == pytest.approx([0.060, 0.140], abs=1e-3)
     assert found.values["mass"] == pytest.approx(0.040, rel=0.02)
     assert sep["chi2"] > INDIFFERENCE and sep["response"] != "bar@100 mm:y"
+
+
+def test_a_measured_dimension_gives_way_to_a_number_of_the_model():
+    """A fluted segment's od and its flutes' ratio set the same equivalent section: when the data cannot tell
+    them apart the ratio (the model's guess) is reported before the od (what the user measures)."""
+    from substructure import Flutes, Segment, Tool
+    from substructure.diagnose.search import preference
+    from substructure.updating.parameters import parameter_change
+
+    model = hd.nominal_model().with_component(Tool("tool", [
+        Segment("46 mm", "12 mm", material="carbide"),
+        Segment("30 mm", "12 mm", material="carbide", flutes=Flutes(0.8))]))
+    params = {p.path: p for p in model_parameters(model)}
+    od = parameter_change(params["components.tool.segments.1.od"])
+    ratio = parameter_change(params["components.tool.segments.1.flutes.diameter_ratio"])
+    joint = parameter_change(params["joints.holder-tool.k.yf"])
+    overhang = parameter_change(params["components.tool.overhang"])
+    assert preference(overhang) < preference(ratio) == preference(joint) < preference(od)
