@@ -114,6 +114,9 @@ def test_a_step_between_segments_moves_and_the_component_keeps_its_length():
     assert "components.tool.segments.0.end" not in {p.path for p in model_parameters(same)}  # no step to move
     with pytest.raises(Exception, match="no step"):
         set_parameters(model, {"components.holder.segments.2.end": 0.05})
+    for outside in (0.016, 0.1, -1.0, float("nan")):  # the step stays between where the two segments lie
+        with pytest.raises(InvalidValueError, match="16 mm to 66 mm from the base of 'holder'"):
+            set_parameters(model, {"components.holder.segments.1.end": outside})
 
 
 def test_components_and_joints_the_si_form_cannot_hold_take_part_as_they_are():

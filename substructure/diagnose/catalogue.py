@@ -7,7 +7,10 @@ springs of a free-free test's suspension.  Each is an
 package is imported, in this order (the built-in answer does not depend on
 the order, but ties between candidates are broken by it); each also gives
 its change on the SI form of the model (``apply_si``), so that fits do not
-rebuild objects.
+rebuild objects.  The methods follow the protocol documented on
+:class:`~substructure.diagnose.effects.Effect` (``places``, ``bounds``,
+``starting_values``, ``apply``, ``apply_si``); only what differs from it is
+written here.
 """
 
 from __future__ import annotations
@@ -68,20 +71,6 @@ class SensorMass(Effect):
 
     @classmethod
     def places(cls, assembly, measured_points):
-        """Where it may act.
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model.
-        measured_points : sequence of str
-            The measured DOF labels.
-
-        Returns
-        -------
-        list of str
-            Places (points, joint or component names).
-        """
         return list(dict.fromkeys(str(parse_point(p).point) for p in measured_points))
 
     @classmethod
@@ -118,18 +107,6 @@ class SensorMass(Effect):
         return out
 
     def apply(self, assembly):
-        """The assembly with the effect applied (a new assembly in normal form).
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model (or one test configuration of it).
-
-        Returns
-        -------
-        Assembly
-            The changed model.
-        """
         base = f"diagnosed-{self.where.replace('.', '-').replace('@', '-at-').replace(' ', '')}"
         taken = {s.name for s in assembly.sensors}
         name, n = base, 2
@@ -140,18 +117,6 @@ class SensorMass(Effect):
         return assembly.attach(sensor)
 
     def apply_si(self, structure):
-        """The same change on the SI form of the model (optional; fits use it when given).
-
-        Parameters
-        ----------
-        structure : Structure
-            The SI form of one test configuration.
-
-        Returns
-        -------
-        Structure
-            The changed structure.
-        """
         return structure.add_link(LinkSI(("added", f"sensor-mass-{self.where}"), self.where,
                                          M=np.diag([self.values["mass"], self.values["inertia"]])))
 
@@ -162,40 +127,10 @@ class _JointEffect(Effect):
 
     @classmethod
     def places(cls, assembly, measured_points):
-        """Where it may act.
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model.
-        measured_points : sequence of str
-            The measured DOF labels.
-
-        Returns
-        -------
-        list of str
-            Places (points, joint or component names).
-        """
         return _elastic_joints(assembly)
 
     @classmethod
     def starting_values(cls, assembly, where, shift):
-        """Starting values at a place.
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model.
-        where : str
-            The place.
-        shift : float
-            Relative shift of the main mode, ``f_model / f_measured - 1``.
-
-        Returns
-        -------
-        dict of str to float
-            A value per parameter (SI).
-        """
         joint = assembly.joint(where)
         out = {}
         for p in cls.parameters:
@@ -205,18 +140,6 @@ class _JointEffect(Effect):
         return out
 
     def apply(self, assembly):
-        """The assembly with the effect applied (a new assembly in normal form).
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model (or one test configuration of it).
-
-        Returns
-        -------
-        Assembly
-            The changed model.
-        """
         joint = assembly.joint(self.where)
         k, c = {}, {}
         for name, value in self.values.items():
@@ -229,18 +152,6 @@ class _JointEffect(Effect):
         return assembly.with_joint(_quiet_joint(joint, k=k, c=c))
 
     def apply_si(self, structure):
-        """The same change on the SI form of the model (optional; fits use it when given).
-
-        Parameters
-        ----------
-        structure : Structure
-            The SI form of one test configuration.
-
-        Returns
-        -------
-        Structure
-            The changed structure.
-        """
         i, link = structure.link(("joints", self.where))
         if link.rigid or link.custom is not None:
             raise UnknownPointError(f"joint {self.where!r} has no stiffness matrix here")
@@ -302,22 +213,6 @@ class JointCrossCoupling(_JointEffect):
 
     @classmethod
     def starting_values(cls, assembly, where, shift):
-        """Starting values at a place.
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model.
-        where : str
-            The place.
-        shift : float
-            Relative shift of the main mode, ``f_model / f_measured - 1``.
-
-        Returns
-        -------
-        dict of str to float
-            A value per parameter (SI).
-        """
         joint = assembly.joint(where)
         scale = np.sqrt(max(joint.k.get("yf") * joint.k.get("tm"), 1.0))
         return {"k_ym": 0.3 * scale * (-1 if shift < 0 else 1), "c_ym": 0.0}
@@ -364,73 +259,19 @@ class RigidJointFlexibility(_JointEffect):
 
     @classmethod
     def places(cls, assembly, measured_points):
-        """Where it may act.
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model.
-        measured_points : sequence of str
-            The measured DOF labels.
-
-        Returns
-        -------
-        list of str
-            Places (points, joint or component names).
-        """
         return [j.name for j in assembly.joints if getattr(j, "rigid", False)]
 
     @classmethod
     def starting_values(cls, assembly, where, shift):
-        """Starting values at a place.
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model.
-        where : str
-            The place.
-        shift : float
-            Relative shift of the main mode, ``f_model / f_measured - 1``.
-
-        Returns
-        -------
-        dict of str to float
-            A value per parameter (SI).
-        """
         return {p.name: p.start for p in cls.parameters}
 
     def apply(self, assembly):
-        """The assembly with the effect applied (a new assembly in normal form).
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model (or one test configuration of it).
-
-        Returns
-        -------
-        Assembly
-            The changed model.
-        """
         joint = assembly.joint(self.where)
         elastic = Joint(joint.name, joint.between, k={"yf": _si(self.values["k_yf"], "N/m"),
                                                       "tm": _si(self.values["k_tm"], "N*m/rad")})
         return assembly.with_joint(elastic)
 
     def apply_si(self, structure):
-        """The same change on the SI form of the model (optional; fits use it when given).
-
-        Parameters
-        ----------
-        structure : Structure
-            The SI form of one test configuration.
-
-        Returns
-        -------
-        Structure
-            The changed structure.
-        """
         i, link = structure.link(("joints", self.where))
         return structure.with_link(i, link.evolve(rigid=False, custom=None,
                                                   K=np.diag([self.values["k_yf"], self.values["k_tm"]]),
@@ -457,91 +298,23 @@ class FlutedSection(Effect):
 
     @classmethod
     def places(cls, assembly, measured_points):
-        """Where it may act.
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model.
-        measured_points : sequence of str
-            The measured DOF labels.
-
-        Returns
-        -------
-        list of str
-            Places (points, joint or component names).
-        """
         return [t.name for t in _tools(assembly) if not any(s.flutes for s in t.segments)]
 
     @classmethod
     def starting_values(cls, assembly, where, shift):
-        """Starting values at a place.
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model.
-        where : str
-            The place.
-        shift : float
-            Relative shift of the main mode, ``f_model / f_measured - 1``.
-
-        Returns
-        -------
-        dict of str to float
-            A value per parameter (SI).
-        """
         tool = assembly.component(where)
         return {"diameter_ratio": 0.8, "length": min(0.03, 0.5 * tool.length_m)}
 
     @classmethod
     def bounds(cls, assembly, where):
-        """Bounds of each parameter at this place.
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model.
-        where : str
-            The place.
-
-        Returns
-        -------
-        dict of str to (float, float)
-            ``(lower, upper)`` per parameter, within the class's.
-        """
         tool = assembly.component(where)
         return {"diameter_ratio": (0.5, 1.0), "length": (1e-3, tool.length_m)}
 
     def apply(self, assembly):
-        """The assembly with the effect applied (a new assembly in normal form).
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model (or one test configuration of it).
-
-        Returns
-        -------
-        Assembly
-            The changed model.
-        """
         tool = assembly.component(self.where)
         return assembly.with_component(flute_tip(tool, self.values["length"], self.values["diameter_ratio"]))
 
     def apply_si(self, structure):
-        """The same change on the SI form of the model (optional; fits use it when given).
-
-        Parameters
-        ----------
-        structure : Structure
-            The SI form of one test configuration.
-
-        Returns
-        -------
-        Structure
-            The changed structure.
-        """
         beam = structure.beam(self.where)
         total = beam.total_length
         return structure.with_beam(split_beam(beam, total - min(self.values["length"], total), total,
@@ -607,20 +380,6 @@ class SupportSprings(Effect):
 
     @classmethod
     def places(cls, assembly, measured_points):
-        """Where it may act.
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model.
-        measured_points : sequence of str
-            The measured DOF labels.
-
-        Returns
-        -------
-        list of str
-            Places (points, joint or component names).
-        """
         beams = [c for c in assembly.components if isinstance(c, Beam)]
         if not beams:
             return []
@@ -661,18 +420,6 @@ class SupportSprings(Effect):
             Support(far, k={"yf": k}, name=f"diagnosed-{comp.name}-2"))
 
     def apply_si(self, structure):
-        """The same change on the SI form of the model (optional; fits use it when given).
-
-        Parameters
-        ----------
-        structure : Structure
-            The SI form of one test configuration.
-
-        Returns
-        -------
-        Structure
-            The changed structure.
-        """
         points = [parse_point(p.strip()) for p in self.where.split(",")]
         name = points[0].component
         total = structure.beam(name).total_length

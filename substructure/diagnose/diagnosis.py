@@ -177,7 +177,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     Diagnosis
         The verdict, the candidates, the refinement and the refined model.
     """
-    from .report import Explanation, separation, unexplained_report
+    from .report import Explanation, separation, unexplained_report, values_text
 
     for name, value, what in (("budget", budget, "model evaluations"), ("time_limit", time_limit, "seconds")):
         if value is not None and not (isinstance(value, (int, float)) and not isinstance(value, bool)
@@ -260,7 +260,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         report = [f"unexplained: no candidate explains the data uniquely: {kept.name} at {kept.where} and "
                   f"{rival.name} at {rival.where} both leave a residual consistent with the noise (their BIC "
                   f"differ by at most {INDIFFERENCE:g}) but "
-                  + ("are the same change at other values (" + ", ".join(_values_text(f) for f in rival.founds) + ")"
+                  + ("are the same change at other values (" + "; ".join(values_text(f.change, f.values) for f in rival.founds) + ")"
                      if sorted(f.change.key for f in rival.founds) == keys else "change different parts")
                   for rival, _ in rivals[:1]]
         report += [f"to tell them apart: {sep['text']}" for rival, sep in rivals]
@@ -388,11 +388,6 @@ def _distinct_rivals(assembly, measured, final_effects, outcome, say) -> list:
                 say(f"rival explanation {rival.name} at {rival.where}: {sep['text']}")
             out.append((rival, sep))
     return out
-
-
-def _values_text(found) -> str:
-    return ", ".join(f"{s.name} = {found.values[s.name]:.4g} {s.unit}".replace(" dimensionless", "")
-                     for s in found.change.specs)
 
 
 def _std_of(result, change) -> dict:

@@ -229,7 +229,7 @@ def _bic(chi2: float, p: int, n: int, s2: float) -> float:
     return chi2 / s2 + p * math.log(n)
 
 
-def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say, pairs: bool = True):
+def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say):
     """The kept explanation against the best single and best pair ones fitted from fair starts.
 
     Forward selection extends its first choice; when that choice was wrong,
@@ -257,7 +257,7 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say, p
     for s in singles:
         if [s.change.key] != keys_now:
             options.append(([(c, dict(v)) for c, v in s.fit.changes], s.fit.chi2))
-    if len(current) >= 2 and pairs:
+    if len(current) >= 2:
         pool = _distinct(screen_lik, singles, PAIR_POOL)
         trials = []
         for i in range(len(pool)):

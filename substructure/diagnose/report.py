@@ -33,7 +33,25 @@ from ..measurements import model_of_measurement
 from ..updating.parameters import set_parameters
 from ..updating.selection import INDIFFERENCE
 
-__all__ = ["unexplained_report", "separation", "signature", "level_signature", "LEVEL_BANDS"]
+__all__ = ["unexplained_report", "separation", "signature", "level_signature", "LEVEL_BANDS", "values_text"]
+
+
+def values_text(change, values) -> str:
+    """``name = value unit, ...`` of a change's values, for reports.
+
+    Parameters
+    ----------
+    change : Change
+        The change (its ``specs`` give names and units).
+    values : dict
+        Its values (SI).
+
+    Returns
+    -------
+    str
+        The values, four significant digits each.
+    """
+    return ", ".join(f"{s.name} = {values[s.name]:.4g} {s.unit}".replace(" dimensionless", "") for s in change.specs)
 
 
 def _plain_beams(assembly):
@@ -279,7 +297,7 @@ def unexplained_report(lik, assembly, current, baseline, cons, final_error: floa
     if current:
         parts = []
         for c, v in current:
-            vals = ", ".join(f"{s.name} = {v[s.name]:.4g} {s.unit}".replace(" dimensionless", "") for s in c.specs)
+            vals = values_text(c, v)
             parts.append(f"{c.effect} at {c.place(v)} ({vals})")
         lines.append("best partial explanation (partial): " + "; ".join(parts))
     else:

@@ -263,7 +263,7 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
         if best is not None and best_chi2 <= chi2_now * (1 + 1e-9):  # at its nominal value: the polish may still gain
             scanned.append(Scored(change, dict(best), float(best_chi2), start=list(current)))
     scanned.sort(key=lambda s: s.chi2)
-    scanned = [s for s in _polish(scanned, chi2_of, current, chi2_now) if s.chi2 < chi2_now]
+    scanned = [s for s in _polish(scanned, chi2_of, current) if s.chi2 < chi2_now]
     local = []
     p_now = sum(len(c.specs) for c, _ in current)
     for s in shortlist(scanned, chi2_now, likelihood.n, n_full, p_now):
@@ -285,76 +285,71 @@ POLISH_POINTS = 3
 either side of the scan's best before Brent's (the others: the slope there, and Brent's down it)."""
 BRENT = 24
 """Candidates (best scanned first) refined by points and Brent's; the others by their slope (see :func:`_polish`)."""
-POLISHED = 10 ** 6
-"""Candidates (best scanned first) whose main parameter is refined between its grid's neighbours after the scan:
-all of them (about one evaluation of all lines each): a change that lies within a grid step of the model's value
-scans no better than the model, or than a neighbour's small gain, and only the refinement shows it."""
 
 
-def _polish(scanned: list, chi2_of, current, chi2_now: float = math.inf) -> list:
-    """The main parameter of the best scanned candidates refined by a bounded 1-D search around its best trial.
+def _polish(scanned: list, chi2_of, current) -> list:
+    """Every scanned candidate's main parameter refined around its best trial (on its fitted scale).
 
     A grid of nine values over decades misses minima narrower than its
     step (a bearing pair half as stiff sits between 0.32 and 1 on a factor
-    grid, and moves the modes by many bandwidths on the way): each of the
-    ``POLISHED`` best candidates (all of them) is refined in its main
-    parameter on its fitted scale: the :data:`BRENT` best by evaluations at
-    points between its best trial and the grid's neighbours
+    grid, and moves the modes by many bandwidths on the way), and a change
+    smaller than a step scans no better than the model as it is.  So every
+    candidate (those whose scan found nothing better too) is refined, the
+    other values held: the :data:`BRENT` best by evaluations at points
+    between their best trial and the grid's neighbours
     (:data:`POLISH_POINTS`) and a bounded scalar minimisation (Brent's, at
     most eight evaluations) around the best of those; the others by the
-    slope at the best trial and Brent's down it, when it descends,
-    the other values held; a candidate whose scan found nothing better
-    than the model as it is takes part too (a grid step can be wider than
-    the change).  The order is then by the refined ``chi^2``.
+    slope at their best trial and Brent's down it, when it descends.  The
+    order is then by the refined ``chi^2``.
     """
-    out = []
-    for k, s in enumerate(scanned):
-        if k < POLISHED:
-            main = s.change.specs[0]
-            u0 = to_u(main, s.values[main.name])
-            lo_u, hi_u = to_u(main, main.lower), to_u(main, main.upper)
-            step = (hi_u - lo_u) / 8.0
-            lo, hi = max(lo_u, u0 - step), min(hi_u, u0 + step)
-
-            def cost(u):
-                try:
-                    return chi2_of(list(current) + [(s.change, {**s.values, main.name: from_u(main, u)})])
-                except (SubstructureError, ValueError, FloatingPointError):
-                    return math.inf
-
-            if hi > lo:
-                best_u, best_c = u0, float(s.chi2)
-                if k < BRENT:
-                    # points between the scan's best and the grid's neighbours (scanned already) first: the
-                    # landscape can hold several minima where a model peak crosses the lines; Brent's around
-                    # the best of them
-                    sub = step / POLISH_POINTS
-                    pts = [u for u in u0 + sub * np.arange(-POLISH_POINTS + 1, POLISH_POINTS) if lo < u < hi and u != u0]
-                    costs = [cost(u) for u in pts]
-                    if costs and min(costs) < best_c:
-                        j = int(np.argmin(costs))
-                        best_u, best_c = float(pts[j]), float(costs[j])
-                    bracket = (max(lo, best_u - sub), min(hi, best_u + sub))
-                else:
-                    # the others: the slope at the scan's best, then Brent's down it (a change smaller than a
-                    # grid step scans no better than the model, but the slope shows it)
-                    tiny = step / 20.0
-                    down = [(cost(u), u) for u in (u0 - tiny, u0 + tiny) if lo <= u <= hi]
-                    down = [(c, u) for c, u in down if c < best_c]
-                    bracket = None
-                    if down:
-                        c, u = min(down)
-                        best_u, best_c = u, c
-                        bracket = (lo, u0) if u < u0 else (u0, hi)
-                if bracket is not None and bracket[1] > bracket[0]:
-                    r = minimize_scalar(cost, bounds=bracket, method="bounded", options={"maxiter": 8, "xatol": 1e-3})
-                    if np.isfinite(r.fun) and r.fun < best_c:
-                        best_u, best_c = float(r.x), float(r.fun)
-                if np.isfinite(best_c) and best_c < s.chi2:
-                    s = Scored(s.change, {**s.values, main.name: from_u(main, best_u)}, best_c, start=s.start)
-        out.append(s)
+    out = [_refined(s, chi2_of, current, thorough=k < BRENT) for k, s in enumerate(scanned)]
     out.sort(key=lambda x: x.chi2)
     return out
+
+
+def _refined(s: Scored, chi2_of, current, thorough: bool) -> Scored:
+    """One candidate of :func:`_polish` refined."""
+    main = s.change.specs[0]
+    u0 = to_u(main, s.values[main.name])
+    lo_u, hi_u = to_u(main, main.lower), to_u(main, main.upper)
+    step = (hi_u - lo_u) / 8.0
+    lo, hi = max(lo_u, u0 - step), min(hi_u, u0 + step)
+    if not hi > lo:
+        return s
+
+    def cost(u):
+        try:
+            return chi2_of(list(current) + [(s.change, {**s.values, main.name: from_u(main, u)})])
+        except (SubstructureError, ValueError, FloatingPointError):
+            return math.inf
+
+    best_u, best_c = u0, float(s.chi2)
+    bracket = None
+    if thorough:
+        # points between the scan's best and the grid's neighbours (scanned already) first: the landscape can
+        # hold several minima where a model peak crosses the lines; Brent's around the best of them
+        sub = step / POLISH_POINTS
+        pts = [u for u in u0 + sub * np.arange(-POLISH_POINTS + 1, POLISH_POINTS) if lo < u < hi and u != u0]
+        costs = [cost(u) for u in pts]
+        if costs and min(costs) < best_c:
+            j = int(np.argmin(costs))
+            best_u, best_c = float(pts[j]), float(costs[j])
+        bracket = (max(lo, best_u - sub), min(hi, best_u + sub))
+    else:
+        # the slope at the scan's best, then Brent's down it (a change smaller than a grid step scans no
+        # better than the model, but the slope shows it)
+        tiny = step / 20.0
+        down = [(c, u) for c, u in ((cost(u), u) for u in (u0 - tiny, u0 + tiny) if lo <= u <= hi) if c < best_c]
+        if down:
+            best_c, best_u = min(down)
+            bracket = (lo, u0) if best_u < u0 else (u0, hi)
+    if bracket is not None and bracket[1] > bracket[0]:
+        r = minimize_scalar(cost, bounds=bracket, method="bounded", options={"maxiter": 8, "xatol": 1e-3})
+        if np.isfinite(r.fun) and r.fun < best_c:
+            best_u, best_c = float(r.x), float(r.fun)
+    if np.isfinite(best_c) and best_c < s.chi2:
+        return Scored(s.change, {**s.values, main.name: from_u(main, best_u)}, best_c, start=s.start)
+    return s
 
 
 def _basis(likelihood, current) -> np.ndarray | None:

@@ -259,7 +259,14 @@ def _set_one(assembly, path: str, value: float):
             elif what == "end":
                 if i + 1 >= len(segs):
                     raise _unknown(path, f"segment {i} of {comp.name!r} is its last: it has no step to move")
-                shift = value - sum(x.length_m for x in segs[:i + 1])
+                start = sum(x.length_m for x in segs[:i])
+                stop = start + seg.length_m + segs[i + 1].length_m
+                if not start < value < stop:
+                    raise InvalidValueError(
+                        f"parameter {path!r}: got {value!r} m; expected a place strictly between where segment {i} "
+                        f"begins and segment {i + 1} ends ({start * 1e3:.6g} mm to {stop * 1e3:.6g} mm from the "
+                        f"base of {comp.name!r})")
+                shift = value - start - seg.length_m
                 segs[i] = attrs.evolve(seg, length=_si(seg.length_m + shift, "m"))
                 segs[i + 1] = attrs.evolve(segs[i + 1], length=_si(segs[i + 1].length_m - shift, "m"))
             elif what in ("insert.od", "insert.id"):
