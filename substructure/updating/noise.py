@@ -53,6 +53,15 @@ VARIANCE_CAP = float(np.pi**2 / 3.0)
 
 _TRIM = 18.42  # chi^2 with 2 degrees of freedom: upper 1e-4 tail
 _BLOCKS = 16
+_EULER = 0.5772156649015329  # -E[ln X] for X exponential with mean 1
+LOCAL_LINES = 21
+"""Width of the window over which the local scale of the noise is estimated [lines]."""
+LOCAL_Z = 2.5
+"""How many standard errors above the fitted model the local noise must lie to be taken as larger."""
+NOISE_DOMINATED = 0.1
+"""Share of the additive noise's variance in a line's log variance above which the line is read linearly."""
+COHERENCE_MIN = 1e-3
+"""Smallest coherence used in the variance of an H1 estimate (a line below it carries no information)."""
 
 
 @attrs.frozen
@@ -85,6 +94,10 @@ class NoiseModel:
     scale_error: float
     window: int
     scatter: np.ndarray = attrs.field(eq=False, repr=False)
+    local_scale: np.ndarray | None = attrs.field(default=None, eq=False, repr=False)
+    outliers: int = 0
+    coherence_factor: float | None = None
+    linear: tuple | None = attrs.field(default=None, eq=False, repr=False)
 
     @property
     def floor(self) -> float:
@@ -104,18 +117,57 @@ class NoiseModel:
         NoiseModel
             The same noise on those lines.
         """
-        return attrs.evolve(self, var_re=self.var_re[mask], var_im=self.var_im[mask], scatter=self.scatter[mask])
+        local = None if self.local_scale is None else self.local_scale[mask]
+        linear = None if self.linear is None else tuple(part[mask] for part in self.linear)
+        return attrs.evolve(self, var_re=self.var_re[mask], var_im=self.var_im[mask], scatter=self.scatter[mask],
+                            local_scale=local, linear=linear)
+
+    def line_scores(self, ratios: np.ndarray, lines=None) -> np.ndarray:
+        """Per line, half the squared whitened residual (exponential with mean 1 for noise).
+
+        Where the additive noise is as large as the signal (the data's own
+        antiresonances), the residual is read in the linear domain,
+        ``(M - H) / S(H)`` with the variances of the model uncapped, rather
+        than as ``ln(M / H)``: the log of a noise-dominated line is biased
+        and heavy-tailed, its linear residual is not.
+
+        Parameters
+        ----------
+        ratios : ndarray
+            ``ln(model / measured)`` on the lines ``lines``.
+        lines : array of int, optional
+            The lines of the noise model the ratios are on (default all).
+
+        Returns
+        -------
+        ndarray
+            ``0.5 (Re(r)^2 / v_re + Im(r)^2 / v_im)`` per line.
+        """
+        sel = slice(None) if lines is None else lines
+        r = np.asarray(ratios)
+        z = 0.5 * (r.real**2 / self.var_re[sel] + r.imag**2 / self.var_im[sel])
+        if self.linear is None:
+            return z
+        hs, lin_re, lin_im = (part[sel] for part in self.linear)
+        use = np.isfinite(lin_re) & np.isfinite(lin_im)
+        if use.any():
+            e = np.expm1(np.clip(r[use].real, -50.0, 50.0) + 1j * r[use].imag) * hs[use]
+            z = z.copy()
+            z[use] = 0.5 * (e.real**2 / lin_re[use] + e.imag**2 / lin_im[use])
+        return z
 
 
 def _variances(params, g, h0):
-    a_re, a_im, b = np.exp(params)
-    return (1.0 - h0) * (a_re + 0.5 * b * g), (1.0 - h0) * (a_im + 0.5 * b * g)
+    """``(1 - h0) v`` of the real and imaginary parts: ``a_re``/``a_im`` plus the regressors ``g`` weighted by ``b``."""
+    coef = np.exp(params)
+    extra = 0.5 * (coef[2:] @ g)
+    return (1.0 - h0) * (coef[0] + extra), (1.0 - h0) * (coef[1] + extra)
 
 
 def _nll(params, q_re2, q_im2, g, h0, nu=None):
     """Negative log-likelihood of the smoothing residual (Gaussian, or Student t with ``nu`` dof)."""
     v_re, v_im = _variances(params, g, h0)
-    a_re, a_im, b = np.exp(params)
+    coef = np.exp(params)
     if nu is None:
         value = np.sum(np.log(v_re) + q_re2 / v_re + np.log(v_im) + q_im2 / v_im)
         d_re = 1.0 / v_re - q_re2 / v_re**2
@@ -125,8 +177,36 @@ def _nll(params, q_re2, q_im2, g, h0, nu=None):
         value = np.sum(np.log(v_re) + (nu + 1) * np.log1p(u_re) + np.log(v_im) + (nu + 1) * np.log1p(u_im))
         d_re = (1.0 - (nu + 1) * u_re / (1 + u_re)) / v_re
         d_im = (1.0 - (nu + 1) * u_im / (1 + u_im)) / v_im
-    grad = (1.0 - h0) * np.array([np.sum(d_re) * a_re, np.sum(d_im) * a_im, np.sum((d_re + d_im) * 0.5 * g) * b])
+    grad = (1.0 - h0) * np.concatenate(([np.sum(d_re) * coef[0], np.sum(d_im) * coef[1]],
+                                         (g @ (d_re + d_im)) * 0.5 * coef[2:]))
     return value, grad
+
+
+def _running_mean(values: np.ndarray, width: int) -> tuple[np.ndarray, np.ndarray]:
+    """The mean of the finite values within ``width`` lines of each line, and how many there were."""
+    finite = np.isfinite(values)
+    kernel = np.ones(width)
+    total = np.convolve(np.where(finite, values, 0.0), kernel, mode="same")
+    count = np.convolve(finite.astype(float), kernel, mode="same")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return total / count, count
+
+
+def _local_scale(z: np.ndarray, width: int) -> np.ndarray:
+    """How much larger than the fitted model the noise is around each line (1 where not clearly larger).
+
+    ``z`` is the squared smoothing residual over the model (exponential with mean 1 for
+    complex Gaussian noise of the model's size).  Its log averaged over ``width`` lines
+    estimates ``ln m - EULER``; the noise is taken as larger (``m > 1``) only where that
+    estimate exceeds :data:`LOCAL_Z` of its own standard errors (``pi / sqrt(6 count)``),
+    so that Gaussian noise of the model's size is not rescaled by chance.
+    """
+    with np.errstate(divide="ignore"):
+        lz = np.where(np.isfinite(z) & (z > 0), np.log(np.maximum(z, 1e-300)), np.nan)
+    mean, count = _running_mean(lz, width)
+    log_m = mean + _EULER
+    se = np.pi / np.sqrt(6.0 * np.maximum(count, 1.0))
+    return np.where(np.isfinite(log_m) & (log_m > LOCAL_Z * se), np.exp(np.minimum(log_m, 50.0)), 1.0)
 
 
 def _window(frf: FRF, polyorder: int) -> int:
@@ -143,7 +223,21 @@ def _window(frf: FRF, polyorder: int) -> int:
     return w if w % 2 else w - 1
 
 
-def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3) -> NoiseModel:
+def _coherence_regressor(coherence, averages, n: int, label: str) -> np.ndarray | None:
+    """``(1 - gamma^2) / (2 n gamma^2)`` per line, the relative variance of an H1 estimate, or None."""
+    if coherence is None or averages is None:
+        return None
+    gamma = np.asarray(coherence, dtype=float).reshape(-1)
+    if gamma.size != n:
+        raise InvalidValueError(f"coherence of {label}: {gamma.size} values for {n} lines; expected one per line")
+    if int(averages) < 2:  # one average: the coherence is 1 by construction and says nothing
+        return None
+    gamma = np.clip(np.where(np.isfinite(gamma), gamma, 0.0), COHERENCE_MIN, 1.0 - 1e-9)
+    return (1.0 - gamma) / (2.0 * int(averages) * gamma)
+
+
+def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3, *, coherence=None,
+                   averages: int | None = None) -> NoiseModel:
     """The per-line noise of a measured FRF (one entry), estimated from the data.
 
     Parameters
@@ -155,6 +249,14 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3)
         when not given.
     polyorder : int, default 3
         Order of the smoother.
+    coherence : array_like, optional
+        The ordinary coherence of the measurement, one value per line in
+        ``[0, 1]`` (from the tap test's averages).  With ``averages`` of 2 or
+        more, the variance of an H1 estimate, ``(1 - gamma^2) / (2 n gamma^2)``
+        [Bendat and Piersol], is one more term of the model, its weight
+        fitted to the data.
+    averages : int, optional
+        The number of taps averaged.
 
     Returns
     -------
@@ -164,7 +266,8 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3)
     Raises
     ------
     InvalidValueError
-        For an FRF that is zero (or not finite) on every line, or too short.
+        For an FRF that is zero (or not finite) on every line, or too short,
+        or a coherence of the wrong length.
     """
     if measured.shape[1:] != (1, 1):
         raise InvalidValueError(f"measured: got {measured.shape[1]}x{measured.shape[2]} entries; expected one")
@@ -176,6 +279,7 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3)
     n = h.size
     if n < polyorder + 8:
         raise InvalidValueError(f"measured FRF {label}: {n} lines; the noise estimate needs at least {polyorder + 8}")
+    coh = _coherence_regressor(coherence, averages, n, label)
     clean = measured if usable.all() else FRF(measured.frequency, np.where(usable, h, 0.0)[:, None, None],
                                              measured.outputs, measured.inputs)
     w = window or _window(clean, polyorder)
@@ -190,21 +294,28 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3)
     if ok.sum() < 8:
         ok = usable & np.isfinite(q) & np.isfinite(g_all)
     scale = float(np.median(g_all[ok]))  # numbers of order one for the optimiser
-    g = g_all / scale
+    regressors = [np.where(np.isfinite(g_all), g_all, 0.0) / scale]
+    coh_scale = 1.0
+    if coh is not None:
+        coh_scale = max(float(np.median(coh[ok])), 1e-30)
+        regressors.append(coh / coh_scale)
+    g = np.array(regressors)
     q_re2, q_im2 = q.real**2, q.imag**2
     m0 = max(float(np.median(q_re2[ok] + q_im2[ok])) / 1.386, 1e-14)  # chi^2_2 median is 1.386
-    bounds = [(np.log(1e-16), np.log(10.0))] * 2 + [(np.log(1e-16), np.log(1e8))]
+    bounds = [(np.log(1e-16), np.log(10.0))] * 2 + [(np.log(1e-16), np.log(1e8))] * len(regressors)
 
     def solve(start, keep, nu=None):
-        res = minimize(_nll, start, args=(q_re2[keep], q_im2[keep], g[keep], h0, nu), jac=True, method="L-BFGS-B",
-                       bounds=bounds, options={"maxiter": 80, "ftol": 1e-10})  # a negligible b is flat: stop
-        return res.fun, res.x
+        res = minimize(_nll, start, args=(q_re2[keep], q_im2[keep], g[:, keep], h0, nu), jac=True,
+                       method="L-BFGS-B", bounds=bounds, options={"maxiter": 80, "ftol": 1e-10})
+        return res.fun, res.x  # (a negligible term is flat: stop early)
 
     # a robust first fit (Student t, 4 dof: lines where the smoother cannot follow a very
-    # sharp resonance pull little), from several starting shares of additive noise; then
-    # the Gaussian fit with the lines beyond the 1e-4 tail set aside, until they settle
-    params = min((solve(np.log([m0 / 2, m0 / 2, m0 * share]), ok, 4.0) for share in (1e-6, 1e-3, 1e-1, 10.0)),
-                 key=lambda r: r[0])[1]
+    # sharp resonance pull little), from several starting shares of the line-dependent terms;
+    # then the Gaussian fit with the lines beyond the 1e-4 tail set aside, until they settle
+    starts = [np.log([m0 / 2, m0 / 2] + [m0 * share] * len(regressors)) for share in (1e-6, 1e-3, 1e-1, 10.0)]
+    if coh is not None:  # the coherence alone, as its theory says
+        starts.append(np.log([m0 * 1e-3, m0 * 1e-3, m0 * 1e-6, 2.0 * coh_scale]))
+    params = min((solve(start, ok, 4.0) for start in starts), key=lambda r: r[0])[1]
     keep = None
     for _ in range(6):
         v_re, v_im = _variances(params, g, h0)
@@ -213,19 +324,46 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3)
             break
         keep = new
         params = solve(params, keep)[1]
-    a_re, a_im, b_rel = (float(v) for v in np.exp(params))
+    coef = np.exp(params)
+    v_re, v_im = (v / (1.0 - h0) for v in _variances(params, g, h0))
+    # the noise where it is clearly larger than the fitted model (a band of low coherence, the
+    # lines near the data's own antiresonances, a noisy end of the band): a local scale from the
+    # smoothing residual of the data alone, never from a model
     with np.errstate(divide="ignore", invalid="ignore"):
-        var_re = np.minimum(a_re + 0.5 * b_rel * g, VARIANCE_CAP)
-        var_im = np.minimum(a_im + 0.5 * b_rel * g, VARIANCE_CAP)
-    var_re = np.where(np.isfinite(var_re), var_re, VARIANCE_CAP)
-    var_im = np.where(np.isfinite(var_im), var_im, VARIANCE_CAP)
+        z = 0.5 * (q_re2 / ((1 - h0) * v_re) + q_im2 / ((1 - h0) * v_im))
+    z = np.where(usable & np.isfinite(z), z, np.nan)
+    width = min(LOCAL_LINES, n if n % 2 else n - 1)
+    local = _local_scale(z, width)
+    v_re, v_im = v_re * local, v_im * local
+    # a line whose own smoothing residual lies beyond the tail of even the local model is an
+    # outlier of the data (a spike, a line the smoother cannot follow): its variance is what
+    # the line itself shows, so that a model is neither blamed nor rewarded for it
+    with np.errstate(invalid="ignore"):
+        spike = usable & (z / local > _TRIM / 2)
+    own = np.abs(q) ** 2 / (1.0 - h0) ** 2
+    v_re = np.where(spike, np.maximum(v_re, own), v_re)
+    v_im = np.where(spike, np.maximum(v_im, own), v_im)
+    # lines where the additive noise is as large as the signal: the log of the data is biased
+    # and heavy-tailed there, and the tests read the residual in the linear domain
+    additive_share = 0.5 * coef[2] * g[0] * local
+    linear = usable & (additive_share > NOISE_DOMINATED)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        hs = np.where(linear, h / s, 0.0)
+    lin_re = np.where(linear & np.isfinite(v_re), v_re, np.nan)
+    lin_im = np.where(linear & np.isfinite(v_im), v_im, np.nan)
+    var_re = np.minimum(np.where(np.isfinite(v_re), v_re, VARIANCE_CAP), VARIANCE_CAP)
+    var_im = np.minimum(np.where(np.isfinite(v_im), v_im, VARIANCE_CAP), VARIANCE_CAP)
     var_re[~usable] = VARIANCE_CAP
     var_im[~usable] = VARIANCE_CAP
     # the scale's standard error from the spread over blocks of lines
-    z = 0.5 * (q_re2 / ((1 - h0) * var_re) + q_im2 / ((1 - h0) * var_im))
+    zf = 0.5 * (q_re2 / ((1 - h0) * var_re) + q_im2 / ((1 - h0) * var_im))
+    keep = keep & ~spike
     idx = np.flatnonzero(keep)
-    blocks = [z[part].mean() for part in np.array_split(idx, min(_BLOCKS, max(2, idx.size // 20))) if part.size]
+    blocks = [zf[part].mean() for part in np.array_split(idx, min(_BLOCKS, max(2, idx.size // 20))) if part.size]
     spread = float(np.std(blocks, ddof=1) / np.sqrt(len(blocks))) if len(blocks) > 1 else 1.0
-    scatter = np.where(keep, z, np.nan)
-    return NoiseModel(var_re, var_im, (a_re, a_im), b_rel / scale, max(spread, float(np.sqrt(1.0 / idx.size))), w,
-                      scatter)
+    scatter = np.where(keep, zf, np.nan)
+    coherence_factor = float(0.5 * coef[3] / coh_scale) if coh is not None else None
+    return NoiseModel(var_re, var_im, (float(coef[0]), float(coef[1])), float(coef[2]) / scale,
+                      max(spread, float(np.sqrt(1.0 / max(idx.size, 1)))), w, scatter,
+                      local_scale=local, outliers=int(spike.sum()), coherence_factor=coherence_factor,
+                      linear=(hs, lin_re, lin_im))
