@@ -31,6 +31,18 @@ standard error of the variance scale (:attr:`NoiseModel.scale_error`) comes
 from the spread of the normalised ``q^2`` over 16 blocks of lines: it
 widens the tests of :mod:`substructure.updating.selection` when the noise
 varies along the band more than the model says.
+
+Real tap-test noise is not of this fixed form everywhere (heavy-tailed,
+larger at low frequencies, near the data's own antiresonances and over
+bands of low coherence); four more steps follow it, from the data alone:
+the coherence of an H1 estimate over ``n`` taps adds the term
+``(1 - gamma^2) / (2 n gamma^2)`` with a fitted weight; a local scale
+(:data:`LOCAL_LINES` lines, taken only where it lies :data:`LOCAL_Z`
+standard errors above the model); a line beyond the tail of even the local
+model gets its own squared residual as variance; and the lines where the
+additive term of the log variance exceeds :data:`NOISE_DOMINATED` are read
+in the linear domain by :meth:`NoiseModel.line_scores`.  See
+docs/diagnose.md, "The noise model".
 """
 
 from __future__ import annotations
@@ -59,7 +71,7 @@ LOCAL_LINES = 21
 LOCAL_Z = 2.5
 """How many standard errors above the fitted model the local noise must lie to be taken as larger."""
 NOISE_DOMINATED = 0.1
-"""Share of the additive noise's variance in a line's log variance above which the line is read linearly."""
+"""Variance of ``ln H`` from the additive noise above which a line is read linearly [-] (its log is biased)."""
 COHERENCE_MIN = 1e-3
 """Smallest coherence used in the variance of an H1 estimate (a line below it carries no information)."""
 
@@ -85,6 +97,18 @@ class NoiseModel:
         model, ``(q_re^2 / v_re + q_im^2 / v_im) / (2 (1 - h0))`` (about 1 on
         average; NaN on the lines set aside): how well the model describes
         the noise locally.
+    local_scale : ndarray, shape (n_lines,), optional
+        The factor (>= 1) by which the data's own scatter shows the noise
+        larger around each line than the fitted model.
+    outliers : int
+        Lines whose variance is their own squared smoothing residual.
+    coherence_factor : float or None
+        The fitted weight of the coherence term relative to its theory
+        (about 1 when the coherence accounts for the scatter); None without
+        a coherence.
+    linear : tuple, optional
+        ``(H / S(H), v_re, v_im)`` on the lines drowned in additive noise
+        (NaN elsewhere), for :meth:`line_scores`.
     """
 
     var_re: np.ndarray = attrs.field(eq=False, repr=False)

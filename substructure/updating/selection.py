@@ -12,10 +12,10 @@ in every band:
   (one-sided 0.1 %), where ``e`` is the relative standard error of the
   noise variance estimated from the data (:attr:`NoiseModel.scale_error`);
 * in each block of lines (2 % of the band, at least 20 lines, per FRF), the
-  mean of the squared whitened residual stays below the upper
-  ``0.001 / M`` quantile of its chi-square distribution (Bonferroni over the
-  ``M`` blocks), times the local noise scale where the smoothing residual
-  shows the noise larger there than the model says.
+  mean of the line scores (half the squared whitened residual,
+  :meth:`NoiseModel.line_scores`), each capped at :data:`LINE_CAP`, stays
+  below the upper ``0.001 / M`` quantile of its distribution (Bonferroni
+  over the ``M`` blocks).
 
 **Significance of a change** (:func:`significance`).  A change with ``k``
 parameters that lowers ``chi^2`` from ``chi2_0`` to ``chi2_1`` enters only
