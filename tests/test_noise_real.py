@@ -20,7 +20,7 @@ import pytest
 
 import hidden_data as hd
 from substructure import FRF, Frequency
-from substructure.datasets import impact_records
+from substructure import datasets
 from substructure.diagnose import diagnose
 from substructure.smoothing import choose_window, smooth
 from substructure.updating import Likelihood, estimate_noise, measured_frfs
@@ -30,7 +30,7 @@ from substructure.updating.selection import consistency
 @pytest.fixture(scope="module")
 def real_residual() -> np.ndarray:
     """``H / S(H)`` of the real H1 estimate (20 Hz - 5 kHz at 1 Hz): the multiplicative noise of a real test."""
-    records = impact_records()
+    records = datasets.impact_records()
     spectra = [(np.fft.rfft(r.force), np.fft.rfft(r.response)) for r in records]
     gff = sum(np.abs(f) ** 2 for f, _ in spectra)
     gfx = sum(np.conj(f) * x for f, x in spectra)

@@ -70,6 +70,8 @@ LOCAL_LINES = 21
 """Width of the window over which the local scale of the noise is estimated [lines]."""
 LOCAL_Z = 2.5
 """How many standard errors above the fitted model the local noise must lie to be taken as larger."""
+LINEAR_LINES = 101
+"""Width of the window of the linear-domain noise of lines drowned in additive noise [lines]."""
 NOISE_DOMINATED = 0.1
 """Variance of ``ln H`` from the additive noise above which a line is read linearly [-] (its log is biased)."""
 COHERENCE_MIN = 1e-3
@@ -247,6 +249,19 @@ def _window(frf: FRF, polyorder: int) -> int:
     return w if w % 2 else w - 1
 
 
+def _best_domain_residual(clean: FRF, h, q, usable, window: int, polyorder: int) -> np.ndarray:
+    """Per line, the smoothing residual in H or in 1/H, whichever is smaller around the line (5 lines)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inverse = np.where(usable, 1.0 / h, 0.0)
+        s_inv = smooth(FRF(clean.frequency, inverse[:, None, None], clean.outputs, clean.inputs), window=window,
+                       polyorder=polyorder).data[:, 0, 0]
+        q_inv = np.log(h * s_inv)
+    e_direct, _ = _running_mean(np.where(np.isfinite(q), np.abs(q) ** 2, np.nan), 5)
+    e_inverse, _ = _running_mean(np.where(np.isfinite(q_inv), np.abs(q_inv) ** 2, np.nan), 5)
+    use_inverse = np.isfinite(q_inv) & (e_inverse < e_direct)
+    return np.where(use_inverse, q_inv, q)
+
+
 def _coherence_regressor(coherence, averages, n: int, label: str) -> np.ndarray | None:
     """``(1 - gamma^2) / (2 n gamma^2)`` per line, the relative variance of an H1 estimate, or None."""
     if coherence is None or averages is None:
@@ -343,7 +358,12 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     keep = None
     for _ in range(6):
         v_re, v_im = _variances(params, g, h0)
+        # lines drowned in additive noise are left to the linear domain below: their log is
+        # biased and would pull the fit (unless they are nearly all there is)
+        drowned = 0.5 * np.exp(params[2]) * g[0] > NOISE_DOMINATED
         new = ok & (q_re2 / v_re + q_im2 / v_im <= _TRIM)
+        if (new & ~drowned).sum() >= max(20, new.sum() // 10):
+            new &= ~drowned
         if keep is not None and np.array_equal(new, keep):
             break
         keep = new
@@ -353,9 +373,16 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     # the noise where it is clearly larger than the fitted model (a band of low coherence, the
     # lines near the data's own antiresonances, a noisy end of the band): a local scale from the
     # smoothing residual of the data alone, never from a model
+    # A resonance sharper than the window is not smooth in H but is in 1/H (a dynamic stiffness
+    # is a low-order polynomial of frequency near a resonance); noise is smooth in neither.  The
+    # local steps read, line by line, the residual of whichever domain follows the data better
+    # there, so that a sharp resonance of the data is never taken for noise.
+    q_local = _best_domain_residual(clean, h, q, usable, w, polyorder)
     with np.errstate(divide="ignore", invalid="ignore"):
-        z = 0.5 * (q_re2 / ((1 - h0) * v_re) + q_im2 / ((1 - h0) * v_im))
+        z = 0.5 * (q_local.real**2 / ((1 - h0) * v_re) + q_local.imag**2 / ((1 - h0) * v_im))
     z = np.where(usable & np.isfinite(z), z, np.nan)
+    z[:w] = np.nan  # the smoother's edges (its fits there lean to one side): no domain is reliable
+    z[n - w:] = np.nan
     width = min(LOCAL_LINES, n if n % 2 else n - 1)
     local = _local_scale(z, width)
     v_re, v_im = v_re * local, v_im * local
@@ -363,8 +390,8 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     # outlier of the data (a spike, a line the smoother cannot follow): its variance is what
     # the line itself shows, so that a model is neither blamed nor rewarded for it
     with np.errstate(invalid="ignore"):
-        spike = usable & (z / local > _TRIM / 2)
-    own = np.abs(q) ** 2 / (1.0 - h0) ** 2
+        spike = usable & np.isfinite(z) & (z / local > _TRIM / 2)
+    own = np.abs(q_local) ** 2 / (1.0 - h0) ** 2
     v_re = np.where(spike, np.maximum(v_re, own), v_re)
     v_im = np.where(spike, np.maximum(v_im, own), v_im)
     # lines where the additive noise is as large as the signal: the log of the data is biased
@@ -373,8 +400,22 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     linear = usable & (additive_share > NOISE_DOMINATED)
     with np.errstate(invalid="ignore", divide="ignore"):
         hs = np.where(linear, h / s, 0.0)
-    lin_re = np.where(linear & np.isfinite(v_re), v_re, np.nan)
-    lin_im = np.where(linear & np.isfinite(v_im), v_im, np.nan)
+    # their variance in the linear domain from the data's linear smoothing residual H - S(H)
+    # around each line (a running median over LINEAR_LINES lines: an exponential's median is
+    # ln 2 times its mean), per part and relative to |S|^2
+    d2 = np.where(usable, np.abs(h - s) ** 2, np.nan)
+    d2[:w] = np.nan
+    d2[n - w:] = np.nan
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a window of edges only: NaN, not used
+        padded = np.pad(d2, LINEAR_LINES // 2, constant_values=np.nan)
+        windows = np.lib.stride_tricks.sliding_window_view(padded, LINEAR_LINES)
+        local_d2 = np.nanmedian(windows, axis=1) / np.log(2.0) / (1.0 - h0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v_lin = 0.5 * local_d2 / np.abs(s) ** 2
+    linear = linear & np.isfinite(v_lin) & (v_lin > 0)
+    lin_re = np.where(linear, np.maximum(v_lin, coef[0]), np.nan)
+    lin_im = np.where(linear, np.maximum(v_lin, coef[1]), np.nan)
     var_re = np.minimum(np.where(np.isfinite(v_re), v_re, VARIANCE_CAP), VARIANCE_CAP)
     var_im = np.minimum(np.where(np.isfinite(v_im), v_im, VARIANCE_CAP), VARIANCE_CAP)
     var_re[~usable] = VARIANCE_CAP

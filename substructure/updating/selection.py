@@ -15,7 +15,7 @@ in every band:
   mean of the line scores (half the squared whitened residual,
   :meth:`NoiseModel.line_scores`), each capped at :data:`LINE_CAP`, stays
   below the upper ``0.001 / M`` quantile of its distribution (Bonferroni
-  over the ``M`` blocks).
+  over the ``M`` blocks), widened by ``1 + z e`` as the global test is.
 
 **Significance of a change** (:func:`significance`).  A change with ``k``
 parameters that lowers ``chi^2`` from ``chi2_0`` to ``chi2_1`` enters only
@@ -169,7 +169,8 @@ def consistency(likelihood, ratios: Sequence[np.ndarray], p: int) -> Consistency
     for item, sl, f in blocks:
         z = z2[item][sl]
         k = 2 * z.size
-        bound = _block_bound(z.size, CONSISTENCY_ALPHA / m_blocks)
+        # widened, as the global test is, by how well the noise itself is known
+        bound = _block_bound(z.size, CONSISTENCY_ALPHA / m_blocks) * (1.0 + _Z * float(errs[item]))
         ratio = float(np.minimum(z, LINE_CAP).mean())
         if ratio > bound:
             failing.append(Band(item, float(f[sl][0]), float(f[sl][-1]), ratio, bound,
