@@ -96,3 +96,20 @@ def test_an_empty_effect_list_a_band_half_outside_and_a_dead_channel_say_what_is
     captured = capsys.readouterr()
     assert "00_tool_tip__tool_tip.csv" in captured.err and "dead channel" in captured.err
     assert captured.out == "" and "Traceback" not in captured.err
+
+
+def test_an_unexplained_diagnosis_writes_no_partial_model_unless_asked(files, capsys, tmp_path):
+    """Only joint damping to explain a hidden sensor: unexplained, and its guesses stay out of the model file."""
+    model_out = tmp_path / "partial.toml"
+    args = ("--catalogue-only", "--effects", "joint-damping", "--save-model", str(model_out))
+    assert _run(files, *args, "--json") == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["explained"] is False
+    assert out["saved_model"] is None and "not written" in out["notes"][0] and "--save-partial" in out["notes"][0]
+    assert not model_out.exists()
+    assert _run(files, *args) == 0
+    assert "not written" in capsys.readouterr().err
+    assert not model_out.exists()
+    assert _run(files, *args, "--save-partial", "--json") == 0
+    assert json.loads(capsys.readouterr().out)["saved_model"] == str(model_out)
+    assert load_assembly(model_out).name

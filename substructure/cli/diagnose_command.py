@@ -115,11 +115,23 @@ def run(args: argparse.Namespace) -> int:
             fig = result.final[0].plot()
             save_figure(fig, out / FIGURES[2], args.overwrite)
             written.append(str(out / FIGURES[2]))
-    if args.save_model:
+    notes = []
+    saved = None
+    if args.save_model and (result.explained or args.save_partial):
         save_assembly(result.refined_assembly, args.save_model, overwrite=args.overwrite)
         written.append(args.save_model)
+        saved = args.save_model
+    elif args.save_model:
+        notes.append(f"{args.save_model} not written: the diagnosis is unexplained, and its partial changes are "
+                     "guesses (a model with them may predict what was not measured worse than the one given); "
+                     "--save-partial writes them anyway")
     if args.json:
-        return print_json(result.to_json())
+        data = result.to_json()
+        data["saved_model"] = saved
+        data["notes"] = notes
+        return print_json(data)
+    for note in notes:
+        print(f"{PROG}: {note}", file=sys.stderr)
     print("\n".join(_summary(result, assembly, measurements)))
     for path in written:
         print(f"wrote {path}")
@@ -145,6 +157,9 @@ def add_parser(commands) -> None:
     diag.add_argument("--band", type=band_range_arg, metavar="LO:HI", help="frequency band in Hz (default: all data)")
     diag.add_argument("--plot", metavar="DIR", help="write the figures (where it fails, error fall) to DIR")
     diag.add_argument("--save-model", metavar="FILE.toml", help="write the model with the changes found")
+    diag.add_argument("--save-partial", action="store_true",
+                      help="with --save-model: write the partial changes of an unexplained diagnosis too "
+                           "(by default only an explained diagnosis is written)")
     diag.add_argument("--overwrite", action="store_true",
                       help="let --save-model and --plot replace existing files (never an input)")
     diag.add_argument("--quiet", action="store_true", help="no progress on standard error")

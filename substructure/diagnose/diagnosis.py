@@ -231,7 +231,10 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     cons = consistency(lik, final_ratios, p_now)
     final_error = _rms(final_ratios)
     explained = bool(cons.consistent and final_error <= 1.5 * floor)
-    final_effects = tuple(Found(c, v, final_fit.std[i] if final_fit else {}) for i, (c, v) in enumerate(current))
+    hits = bound_hits(current, final_fit)
+    final_effects = tuple(Found(c, v, {k: x for k, x in (final_fit.std[i] if final_fit else {}).items()
+                                       if (i, k) not in {(h[0], h[1]) for h in hits}})
+                          for i, (c, v) in enumerate(current))
     refined = assembly
     for c, v in current:
         refined = c.apply(refined, v)
@@ -253,6 +256,17 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     final = _comparisons(lik, final_ratios, floors)
     report = unexplained_report(lik, assembly, current, baseline, cons, final_error, floor, explained, say) \
         if not explained else ()
+    if hits:  # a value on the bound of its search is not a measurement: never an explanation
+        words = "; ".join(bound_text(current, hit) for hit in hits)
+        if explained:
+            explained = False
+            report = [f"unexplained: no candidate explains the data within the bounds of its search: {words}; "
+                      "a value on its bound is not a measurement (the data ask for more than the change "
+                      "allows: the mark of another effect, missing)",
+                      "the best (bounded) explanation is reported as partial: "
+                      + ", ".join(repr(e) for e in final_effects)]
+        else:
+            report = list(report) + [f"on the bound of its search (not a measurement): {words}"]
     if rivals:  # consistent with the noise, but not uniquely: claim neither
         explained = False
         kept = Explanation(final_effects)
@@ -388,6 +402,65 @@ def _distinct_rivals(assembly, measured, final_effects, outcome, say) -> list:
                 say(f"rival explanation {rival.name} at {rival.where}: {sep['text']}")
             out.append((rival, sep))
     return out
+
+
+PHYSICAL_ENDS = ("position", "start", "inset", "inset_tip", "length", "end")
+"""Parameters whose bounds are the ends of a component (a body at the tip, a section over the whole tool):
+places, not limits of a search, so that a value on them is a finding."""
+
+
+def bound_hits(current, fit) -> list[tuple[int, str, float, float, str]]:
+    """The fitted parameters of the kept changes that ended on a bound of their search.
+
+    Parameters
+    ----------
+    current : sequence of (Change, dict)
+        The kept changes with their values.
+    fit : Fit or None
+        Their joint fit (``at_bound`` per fitted parameter).
+
+    Returns
+    -------
+    list of (change index, parameter name, value, bound, "lower" or "upper")
+        One entry per parameter on a bound.
+    """
+    if fit is None:
+        return []
+    out = []
+    for (i, name), on in zip(fit.names, fit.at_bound):
+        if not on or i >= len(current):
+            continue
+        change, values = current[i]
+        spec = next((sp for sp in change.specs if sp.name == name), None)
+        if spec is None or name not in values or name in PHYSICAL_ENDS:
+            continue
+        value = float(values[name])
+        side = "lower" if abs(value - spec.lower) <= abs(value - spec.upper) else "upper"
+        if side == "lower" and spec.log and spec is not change.specs[0]:
+            continue  # a secondary size at its floor: none detectable (a sensor's rotary inertia), not a limit
+        out.append((i, name, value, float(spec.lower if side == "lower" else spec.upper), side))
+    return out
+
+
+def bound_text(current, hit) -> str:
+    """One bound hit in words: the change, the parameter, its value and the bound.
+
+    Parameters
+    ----------
+    current : sequence of (Change, dict)
+        The kept changes.
+    hit : tuple
+        An entry of :func:`bound_hits`.
+
+    Returns
+    -------
+    str
+        E.g. ``"joint-damping at holder-tool: c_yf = 240 N*s/m, the upper bound of its search"``.
+    """
+    i, name, value, bound, side = hit
+    change = current[i][0]
+    unit = next((sp.unit for sp in change.specs if sp.name == name), "")
+    return f"{change.effect} at {change.where}: {name} = {value:.4g} {unit}, the {side} bound of its search ({bound:.4g} {unit})"
 
 
 def _std_of(result, change) -> dict:
