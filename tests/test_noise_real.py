@@ -34,7 +34,7 @@ def real_residual() -> np.ndarray:
     spectra = [(np.fft.rfft(r.force), np.fft.rfft(r.response)) for r in records]
     gff = sum(np.abs(f) ** 2 for f, _ in spectra)
     gfx = sum(np.conj(f) * x for f, x in spectra)
-    rate = records[0].sample_rate_hz
+    rate = 1.0 / float(records[0].time[1] - records[0].time[0])
     freq = np.fft.rfftfreq(records[0].force.size, 1.0 / rate)
     keep = (freq >= 20) & (freq <= 5000)
     h1 = (gfx / gff)[keep]
