@@ -181,7 +181,7 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3)
     w = window or _window(clean, polyorder)
     s = smooth(clean, window=w, polyorder=polyorder).data[:, 0, 0]
     h0 = float(savgol_coeffs(w, polyorder)[w // 2])
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         q = np.log(h / s)
         g_all = 1.0 / np.abs(s) ** 2
     ok = usable & np.isfinite(q) & np.isfinite(g_all)
@@ -189,7 +189,11 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3)
     ok[n - w // 2:] = False
     if ok.sum() < 8:
         ok = usable & np.isfinite(q) & np.isfinite(g_all)
-    scale = float(np.median(g_all[ok]))  # numbers of order one for the optimiser
+    scale = float(np.median(g_all[ok])) if ok.any() else 0.0  # numbers of order one for the optimiser
+    if not (np.isfinite(scale) and scale > 0):  # |H|^2 overflows (or underflows) on the lines that count
+        raise InvalidValueError(f"measured FRF {label}: |H| of {float(np.abs(h[usable]).max()):.3g} to "
+                                f"{float(np.abs(h[usable]).min()):.3g} in SI units is beyond any measured "
+                                "structure (its square is not a finite positive number); check the units")
     g = g_all / scale
     q_re2, q_im2 = q.real**2, q.imag**2
     m0 = max(float(np.median(q_re2[ok] + q_im2[ok])) / 1.386, 1e-14)  # chi^2_2 median is 1.386

@@ -95,10 +95,15 @@ def read_csv(
     FRF
         Shape ``(n_freq, 1, 1)``: frequencies in Hz, values as in the file (SI).
     """
-    from .. import read_text
+    return _read_csv(path, output, input, quantity)[0]
+
+
+def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF, np.ndarray]:
+    """:func:`read_csv`, and the line of the file each frequency line comes from."""
+    from .. import MAX_DATA_BYTES, read_text
 
     name = os.fspath(path)
-    lines = read_text(path).splitlines()
+    lines = read_text(path, "CSV file", MAX_DATA_BYTES).splitlines()
     numbered = [(k + 1, line) for k, line in enumerate(lines) if line.strip()]
     if not numbered:
         raise FileFormatError(f"{name}: the file is empty; expected the header {CSV_HEADER!r}")
@@ -107,7 +112,7 @@ def read_csv(
         from ..frf_exports import parse_export
 
         table, lines_of, said = parse_export(numbered, name, quantity)
-        return _checked_csv(table, lines_of, name, output, input, quantity or said or "receptance")
+        return _checked_csv(table, lines_of, name, output, input, quantity or said or "receptance"), lines_of
     numbered = numbered[1:]
     if len(numbered) < 2:
         raise FileFormatError(
@@ -133,7 +138,7 @@ def read_csv(
                     ) from None
         raise  # pragma: no cover - numpy and float() disagree on a cell
     lines_of = np.array([number for number, _ in numbered])
-    return _checked_csv(table, lines_of, name, output, input, quantity or "receptance")
+    return _checked_csv(table, lines_of, name, output, input, quantity or "receptance"), lines_of
 
 
 def _checked_csv(table: np.ndarray, lines_of: np.ndarray, name: str, output: str, input: str,

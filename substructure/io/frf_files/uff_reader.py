@@ -173,9 +173,9 @@ def read_uff(path: str | os.PathLike, record: int | None = None, quantity: str |
     """
     import pyuff
 
-    from .. import check_readable_file
+    from .. import MAX_DATA_BYTES, check_readable_file
 
-    name = check_readable_file(path, "universal file")
+    name = check_readable_file(path, "universal file", MAX_DATA_BYTES)
     if quantity is not None and quantity not in QUANTITIES:
         raise InvalidValueError(f"quantity: got {quantity!r}; expected one of {', '.join(QUANTITIES)}")
     _check_complete(name)
