@@ -38,7 +38,10 @@ def _column(cell: str, name: str, line: int) -> tuple[str, str | None]:
     raw = m["name"] if m else cell
     key = re.sub(r"[\s_\-./]", "", raw.lower())
     unit = (m["unit"] or "").strip() or None if m else None
-    if key.endswith("hz") and key[:-2] in _NAMES["frequency"] and unit is None:
+    if key.endswith("hz") and key[:-2] in _NAMES["frequency"]:
+        if unit is not None and unit.replace(" ", "").lower() != "hz":
+            raise FileFormatError(f"{name}, line {line}: column {cell!r}: its name says Hz but its unit says "
+                                  f"{unit!r}; rename it (e.g. 'Frequency [{unit}]') or correct the unit")
         key, unit = key[:-2], "Hz"  # frequency_hz
     for kind, names in _NAMES.items():
         if key in names:
@@ -165,6 +168,10 @@ def parse_export(numbered: list[tuple[int, str]], name: str, quantity: str | Non
                 except ValueError:
                     raise FileFormatError(f"{name}, line {n}: {column} is {cell!r}; expected a number") from None
         raise  # pragma: no cover - numpy and float() disagree on a cell
+    if angle is not None and (table[:, 1] < 0).any():
+        k = int(np.argmax(table[:, 1] < 0))
+        raise FileFormatError(f"{name}, line {lines[k]}: {cells[0][1]} is {data[k][1]!r}; a magnitude is >= 0 (a "
+                              "negative one would turn the phase by 180 degrees): check the export")
     with np.errstate(over="ignore", invalid="ignore"):
         table[:, 0] = np.asarray(cycles_per_second(table[:, 0] * funit, fcell), dtype=np.float64)
         if angle is not None:

@@ -143,6 +143,11 @@ def _window(frf: FRF, polyorder: int) -> int:
     return w if w % 2 else w - 1
 
 
+_MAGNITUDE_RANGE = (1e-140, 1e140)
+"""|H| outside this range (SI units) has a square or an inverse square that over- or underflows in the
+estimate; the file readers refuse receptances above 1 m/N long before."""
+
+
 def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3) -> NoiseModel:
     """The per-line noise of a measured FRF (one entry), estimated from the data.
 
@@ -164,7 +169,9 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3)
     Raises
     ------
     InvalidValueError
-        For an FRF that is zero (or not finite) on every line, or too short.
+        For an FRF that is zero (or not finite) on every line, too short, or
+        with magnitudes whose square overflows (beyond 1e140 in SI units) or
+        underflows (below 1e-140).
     """
     if measured.shape[1:] != (1, 1):
         raise InvalidValueError(f"measured: got {measured.shape[1]}x{measured.shape[2]} entries; expected one")
@@ -173,6 +180,12 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3)
     usable = np.isfinite(h) & (np.abs(h) > 0)
     if not usable.any():
         raise InvalidValueError(f"measured FRF {label}: zero (or not finite) on every line: a dead channel?")
+    with np.errstate(over="ignore"):
+        magnitude = np.abs(h[usable])
+    if not (magnitude.max() < _MAGNITUDE_RANGE[1] and magnitude.min() > _MAGNITUDE_RANGE[0]):
+        raise InvalidValueError(f"measured FRF {label}: |H| of {float(magnitude.min()):.3g} to "
+                                f"{float(magnitude.max()):.3g} in SI units is beyond any measured structure (its "
+                                "square is not a finite positive number); check the units")
     n = h.size
     if n < polyorder + 8:
         raise InvalidValueError(f"measured FRF {label}: {n} lines; the noise estimate needs at least {polyorder + 8}")
@@ -189,11 +202,7 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3)
     ok[n - w // 2:] = False
     if ok.sum() < 8:
         ok = usable & np.isfinite(q) & np.isfinite(g_all)
-    scale = float(np.median(g_all[ok])) if ok.any() else 0.0  # numbers of order one for the optimiser
-    if not (np.isfinite(scale) and scale > 0):  # |H|^2 overflows (or underflows) on the lines that count
-        raise InvalidValueError(f"measured FRF {label}: |H| of {float(np.abs(h[usable]).max()):.3g} to "
-                                f"{float(np.abs(h[usable]).min()):.3g} in SI units is beyond any measured "
-                                "structure (its square is not a finite positive number); check the units")
+    scale = float(np.median(g_all[ok]))  # numbers of order one for the optimiser
     g = g_all / scale
     q_re2, q_im2 = q.real**2, q.imag**2
     m0 = max(float(np.median(q_re2[ok] + q_im2[ok])) / 1.386, 1e-14)  # chi^2_2 median is 1.386
