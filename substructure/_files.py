@@ -28,9 +28,9 @@ MAX_TEXT_BYTES = 16 * 2**20
 """The largest TOML or CSV table the package reads (16 MiB): assembly, measurement set, study, workpiece
 table, joint table, modal CSV.  Such files are a few kB; a larger one is not what it claims to be."""
 
-MAX_DATA_BYTES = 256 * 2**20
-"""The largest measured FRF file (CSV or universal file) the package reads (256 MiB): a million lines of
-full-precision CSV are about 70 MB."""
+MAX_DATA_BYTES = 128 * 2**20
+"""The largest measured FRF file (CSV or universal file) the package reads (128 MiB): a million lines
+(``MAX_GRID_LINES``) of full-precision CSV are about 70 MB."""
 
 def _name(path, what: str) -> str:
     try:
@@ -125,7 +125,7 @@ def read_bytes(path, what: str = "file", limit: int = MAX_TEXT_BYTES) -> bytes:
     Raises
     ------
     FileFormatError
-        As :func:`check_file`, and for a file that cannot be read.
+        As ``check_file``, and for a file that cannot be read.
     """
     name = check_file(path, what, limit)
     try:

@@ -21,8 +21,16 @@ import tempfile
 from pathlib import Path
 from typing import Iterator
 
-from .._files import MAX_DATA_BYTES, MAX_TEXT_BYTES, check_file, decode_text, parse_toml, read_bytes
+from .. import _files
+from .._files import check_file, decode_text, parse_toml, read_bytes
 from ..errors import FileFormatError, OutputExistsError
+
+#: The largest TOML file or CSV table read (16 MiB): assembly, measurement set, study, workpiece, joint and
+#: combination tables, modes CSV.
+MAX_TEXT_BYTES = _files.MAX_TEXT_BYTES
+
+#: The largest measured FRF file read, CSV or universal file (128 MiB).
+MAX_DATA_BYTES = _files.MAX_DATA_BYTES
 
 __public_submodules__ = ("assembly_toml", "frf_files", "measurements")
 """Submodules that are public API of their own (documented on their own pages)."""
@@ -35,7 +43,7 @@ def check_readable_file(path, what: str = "file", limit: int = MAX_TEXT_BYTES) -
     """The path's name, after checking that it is a regular file of at most ``limit`` bytes.
 
     For readers that hand the name to another library (pyuff); see
-    :func:`substructure._files.check_file`.
+    ``substructure._files.check_file``.
 
     Parameters
     ----------
@@ -65,7 +73,7 @@ def read_text(path, what: str = "file", limit: int = MAX_TEXT_BYTES) -> str:
     """The text of a file, UTF-8 (or UTF-16 with its byte-order mark), without a leading byte-order mark.
 
     Only a regular file is read, and at most ``limit`` bytes of it
-    (:func:`substructure._files.read_bytes`).
+    (:func:`read_bytes`).
 
     Parameters
     ----------

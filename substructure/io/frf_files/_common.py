@@ -53,6 +53,12 @@ def _beyond_physical(hz: np.ndarray, values: np.ndarray, quantity: str) -> tuple
                "structure moves that much; a wrong unit or a broken export?")
 
 
+def _shown(text: str, limit: int = 60) -> str:
+    """``repr`` of a cell or a line for a message, cut after ``limit`` characters (a line may be megabytes)."""
+    text = str(text)
+    return repr(text) if len(text) <= limit else f"{text[:limit]!r}... ({len(text):,} characters)"
+
+
 def _require_frf(frf: Any, function: str) -> FRF:
     if not isinstance(frf, FRF):
         raise InvalidValueError(f"frf: {function} got {type(frf).__name__}; expected an FRF")

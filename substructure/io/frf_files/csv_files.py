@@ -12,8 +12,8 @@ import os
 import numpy as np
 
 from ...errors import FileFormatError, InvalidValueError
-from ...frf import FRF, Frequency
-from ._common import _refuse_all_zero, _require_frf
+from ...frf import FRF, MAX_GRID_LINES, Frequency
+from ._common import _refuse_all_zero, _require_frf, _shown
 
 __all__ = ["write_csv", "read_csv"]
 
@@ -103,7 +103,11 @@ def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF,
     from .. import MAX_DATA_BYTES, read_text
 
     name = os.fspath(path)
-    lines = read_text(path, "CSV file", MAX_DATA_BYTES).splitlines()
+    text = read_text(path, "CSV file", MAX_DATA_BYTES)
+    if text.count("\n") > MAX_GRID_LINES + 1000:  # before the lines are split: refused below in any case
+        raise FileFormatError(f"{name}: {text.count(chr(10)):,} lines; an FRF has at most {MAX_GRID_LINES:,} "
+                              "frequency lines (MAX_GRID_LINES)")
+    lines = text.splitlines()
     numbered = [(k + 1, line) for k, line in enumerate(lines) if line.strip()]
     if not numbered:
         raise FileFormatError(f"{name}: the file is empty; expected the header {CSV_HEADER!r}")
@@ -122,7 +126,7 @@ def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF,
     for (number, line), row in zip(numbered, cells):
         if len(row) != 3:
             raise FileFormatError(
-                f"{name}, line {number}: {line!r} has {len(row)} value(s); expected 3 "
+                f"{name}, line {number}: {_shown(line)} has {len(row)} value(s); expected 3 "
                 "(frequency_hz, real, imag)"
             )
     try:
@@ -134,7 +138,7 @@ def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF,
                     float(cell)
                 except ValueError:
                     raise FileFormatError(
-                        f"{name}, line {number}: {column} is {cell.strip()!r}; expected a number"
+                        f"{name}, line {number}: {column} is {_shown(cell.strip())}; expected a number"
                     ) from None
         raise  # pragma: no cover - numpy and float() disagree on a cell
     lines_of = np.array([number for number, _ in numbered])
