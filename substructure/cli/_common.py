@@ -306,15 +306,15 @@ def measurement_inputs(path) -> list:
     A file that cannot be read yields itself only: loading it reports the
     problem properly.
     """
-    import tomllib
+    from ..errors import SubstructureError
+    from ..io import parse_toml, read_text
 
     files: list = [path]
     try:
-        with open(path, "rb") as fh:
-            data = tomllib.loads(fh.read().decode("utf-8-sig"))
+        data = parse_toml(read_text(path, "measurement set file"), str(path))
         for table in data.get("frf", []):
             if isinstance(table, dict) and isinstance(table.get("file"), str):
                 files.append(Path(path).parent / table["file"])
-    except (OSError, ValueError, AttributeError):
+    except (SubstructureError, AttributeError):
         pass
     return files

@@ -74,12 +74,31 @@ def _demo_plot(state: DemoState) -> None:
 
 
 def _demo_assembly_file(state: DemoState) -> None:
+    """The built-in assembly file, to start from; a copy the user has edited is never replaced.
+
+    ``default_assembly.toml`` is written when it is absent, or present and
+    equal to the built-in file.  A copy that differs (the user's machine,
+    edited as the README invites) is kept even with ``--overwrite``: the
+    built-in file goes beside it as ``default_assembly.new.toml``, and the
+    summary says so.
+    """
     import importlib.resources
 
-    from ..io import write_text
+    from ..errors import SubstructureError
+    from ..io import read_text, write_text
 
     path = state.out / "default_assembly.toml"
     text = (importlib.resources.files("substructure") / "data" / "default_assembly.toml").read_text("utf-8")
+    if path.exists():
+        try:
+            edited = read_text(path, "assembly file").replace("\r\n", "\n") != text.replace("\r\n", "\n")
+        except SubstructureError:  # not a readable text file: not the demo's, in any case
+            edited = True
+        if edited:
+            path = state.out / "default_assembly.new.toml"
+            state.lines.append(f"{state.out / 'default_assembly.toml'} differs from the built-in assembly file (your "
+                               f"edits?): kept; the built-in file is written to {path}")
+            state.results["kept"] = [str(state.out / "default_assembly.toml")]
     write_text(path, text, state.overwrite)  # the packaged file, with its comments
     state.files.append(str(path))
 

@@ -16,6 +16,9 @@ def _features(text: str) -> dict[str, str]:
         name, sep, value = part.partition("=")
         if not sep or not name.strip() or not value.strip():
             raise UsageError(f"--features: cannot read {part.strip()!r}; expected NAME=VALUE, e.g. tool_diameter=14 mm")
+        if name.strip() in out:
+            raise UsageError(f"--features: {name.strip()} given twice ({out[name.strip()]!r} and {value.strip()!r}); "
+                             "give each feature once")
         out[name.strip()] = value.strip()
     return out
 
@@ -49,9 +52,10 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError("give --features NAME=VALUE,... (or --cross-validate)")
     if bool(args.assembly) != bool(args.joint):
         raise UsageError("--assembly and --joint go together: the assembly file and the joint to replace")
+    features = _features(args.features)  # read before the fit: a mistake costs no time
     targets = [args.target] if args.target else None
     model = surrogate.fit(table, targets)
-    prediction = model.predict(_features(args.features))
+    prediction = model.predict(features)
     result = prediction.to_json()
     band = None
     if args.assembly:
@@ -64,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
             fig = band.plot(label=f"{args.model} prediction")
             save_figure(fig, args.plot, args.overwrite)
     if args.json:
-        out = {"model": args.model, "features": _features(args.features), "parameters": result}
+        out = {"model": args.model, "features": features, "parameters": result}
         if band is not None:
             out["frf"] = {"at": point_arg(args.at), "joint": args.joint, **band.to_json()}
         return print_json(out)

@@ -137,6 +137,29 @@ core of a 2-core machine): once spent no step is added and a step fits only its 
 checks after the forward search always run); the result and the JSON say so (``search``)."""
 
 
+def _refuse_rotations(measurements) -> None:
+    """A measured rotation (``:theta`` response or excitation) is refused, with the reason.
+
+    A tap test measures translations per force (a hammer and an
+    accelerometer or a vibrometer); rotational receptances are estimated
+    from several translations (:mod:`substructure.rdof`), with their noise
+    amplified, and a diagnosis built on them would weigh noise as data.
+    """
+    where = getattr(measurements, "_where", lambda: "measurements")()
+    for m in measurements:
+        frf = m if isinstance(m, FRF) else getattr(m, "frf", None)
+        if not isinstance(frf, FRF):
+            continue  # measured_frfs names what is not a measurement
+        for label in (*frf.outputs, *frf.inputs):
+            if str(label).rsplit(":", 1)[-1] == "theta":
+                what = getattr(m, "describe", lambda: f"{frf.outputs[0]} / {frf.inputs[0]}")()
+                raise InvalidValueError(
+                    f"{where}: measured FRF {what}: {label} is a rotation; diagnose compares translational FRFs "
+                    "as tap tests measure them (a hammer's force, an accelerometer's or a vibrometer's motion "
+                    "along y); rotations are estimated from translations (substructure.rdof), not measured: "
+                    "leave this FRF out of the measurement set")
+
+
 def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", band=None,
              refine: bool = True, max_steps: int = 4, progress: bool | Callable[[str], None] = False,
              open_world: bool = True, budget: float | None = BUDGET, time_limit: float | None = None) -> Diagnosis:
@@ -148,7 +171,8 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         The model (sensors declared in it are applied as each measurement
         says; ``always_on`` sensors and permanent masses in every test).
     measurements : MeasurementSet, or sequence of measurements or FRFs
-        The data.
+        The data: translational FRFs (``:y``); a rotation (``:theta``) is
+        refused, as tap tests do not measure it.
     effects : "all", or sequence of names or Effect classes
         The catalogue effects to consider (default: a snapshot of every
         registered effect); classes given here need no registration.
@@ -191,6 +215,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     say = progress or None
     if hasattr(measurements, "validate"):
         measurements.validate(assembly)
+    _refuse_rotations(measurements)
     measured, band = measured_frfs(measurements, band)
     lik = Likelihood(assembly, measured)
     floors = [m.noise.floor for m in measured]

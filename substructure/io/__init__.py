@@ -4,7 +4,9 @@ Submodules are imported on use (``from substructure.io.frf_files import
 read_csv``), so that importing the package stays cheap and the core layers
 never depend on file formats.  This module holds what every file of the
 package shares: :func:`read_text` (UTF-8, a byte-order mark allowed, clear
-errors for a missing file or a directory) and the one way files are written,
+errors for a missing file, a directory, anything but a regular file and a
+file over the cap of its kind: :data:`MAX_TEXT_BYTES`, :data:`MAX_DATA_BYTES`),
+:func:`parse_toml`, and the one way files are written,
 :func:`replacing`, :func:`write_text` and :func:`write_bytes`: through a
 temporary file in the same directory and an atomic rename, so that a reader
 (or a second writer) never sees half a file and an existing file is replaced
@@ -19,16 +21,29 @@ import tempfile
 from pathlib import Path
 from typing import Iterator
 
+from .. import _files
+from .._files import check_file, decode_text, parse_toml, read_bytes
 from ..errors import FileFormatError, OutputExistsError
+
+#: The largest TOML file or CSV table read (16 MiB): assembly, measurement set, study, workpiece, joint and
+#: combination tables, modes CSV.
+MAX_TEXT_BYTES = _files.MAX_TEXT_BYTES
+
+#: The largest measured FRF file read, CSV or universal file (128 MiB).
+MAX_DATA_BYTES = _files.MAX_DATA_BYTES
 
 __public_submodules__ = ("assembly_toml", "frf_files", "measurements")
 """Submodules that are public API of their own (documented on their own pages)."""
 
-__all__ = ["read_text", "check_readable_file", "replacing", "write_text", "write_bytes", "check_writable"]
+__all__ = ["read_text", "read_bytes", "parse_toml", "MAX_TEXT_BYTES", "MAX_DATA_BYTES", "check_readable_file",
+           "replacing", "write_text", "write_bytes", "check_writable"]
 
 
-def check_readable_file(path, what: str = "file") -> str:
-    """The path's name; a missing path or a directory is a :class:`FileFormatError` naming it.
+def check_readable_file(path, what: str = "file", limit: int = MAX_TEXT_BYTES) -> str:
+    """The path's name, after checking that it is a regular file of at most ``limit`` bytes.
+
+    For readers that hand the name to another library (pyuff); see
+    ``substructure._files.check_file``.
 
     Parameters
     ----------
@@ -36,30 +51,38 @@ def check_readable_file(path, what: str = "file") -> str:
         The file to read.
     what : str
         What the file is, for the message (e.g. ``"universal file"``).
+    limit : int, default MAX_TEXT_BYTES
+        The largest size allowed, in bytes (:data:`MAX_TEXT_BYTES` for
+        tables and TOML files, :data:`MAX_DATA_BYTES` for FRF data files).
 
     Returns
     -------
     str
         ``os.fspath(path)``.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the path, for a missing path, a directory, anything else that
+        is not a regular file (a FIFO, a device) and a file over the cap.
     """
-    try:
-        name = os.fspath(path)
-    except TypeError:
-        raise FileFormatError(f"got {path!r} of type {type(path).__name__}; expected the name of a {what}") from None
-    if os.path.isdir(name):
-        raise FileFormatError(f"{name}: is a directory; expected a {what}")
-    if not os.path.exists(name):
-        raise FileFormatError(f"{name}: no such file")
-    return name
+    return check_file(path, what, limit)
 
 
-def read_text(path) -> str:
+def read_text(path, what: str = "file", limit: int = MAX_TEXT_BYTES) -> str:
     """The text of a file, UTF-8 (or UTF-16 with its byte-order mark), without a leading byte-order mark.
+
+    Only a regular file is read, and at most ``limit`` bytes of it
+    (:func:`read_bytes`).
 
     Parameters
     ----------
     path : str or path-like
         The file.
+    what : str, default "file"
+        What the file is, for the message.
+    limit : int, default MAX_TEXT_BYTES
+        The largest size allowed, in bytes.
 
     Returns
     -------
@@ -69,28 +92,12 @@ def read_text(path) -> str:
     Raises
     ------
     FileFormatError
-        Naming the file, for a missing file, a directory, an unreadable file
-        or bytes that are not UTF-8 (nor UTF-16 after a UTF-16 byte-order mark).
+        Naming the file, for a missing file, a directory, a FIFO or device,
+        a file over the cap, an unreadable file or bytes that are not UTF-8
+        (nor UTF-16 after a UTF-16 byte-order mark).
     """
-    name = check_readable_file(path)
-    try:
-        with open(name, "rb") as fh:
-            data = fh.read()
-    except OSError as exc:
-        raise FileFormatError(f"{name}: cannot read the file ({exc.strerror or exc})") from None
-    if data[:2] in (b"\xff\xfe", b"\xfe\xff"):  # UTF-16 with its byte-order mark (Excel's "Unicode text")
-        try:
-            return data.decode("utf-16")
-        except UnicodeDecodeError as exc:
-            raise FileFormatError(f"{name}: starts with a UTF-16 byte-order mark but is not UTF-16 text "
-                                  f"(byte {exc.start}); save the file as UTF-8") from None
-    try:
-        return data.decode("utf-8-sig")  # a BOM (Windows editors write one) is not part of the text
-    except UnicodeDecodeError as exc:
-        raise FileFormatError(
-            f"{name}: not UTF-8 text (byte {exc.start}: {data[exc.start:exc.start + 1]!r}); "
-            "save the file as UTF-8"
-        ) from None
+    data = read_bytes(path, what, limit)
+    return decode_text(data, os.fspath(path))
 
 
 def check_writable(path, overwrite: bool, option: str | None = None) -> Path:

@@ -19,6 +19,7 @@ import re
 import numpy as np
 
 from ..errors import FileFormatError
+from .frf_files._common import _shown
 
 __all__ = ["parse_export"]
 
@@ -38,17 +39,20 @@ def _column(cell: str, name: str, line: int) -> tuple[str, str | None]:
     raw = m["name"] if m else cell
     key = re.sub(r"[\s_\-./]", "", raw.lower())
     unit = (m["unit"] or "").strip() or None if m else None
-    if key.endswith("hz") and key[:-2] in _NAMES["frequency"] and unit is None:
+    if key.endswith("hz") and key[:-2] in _NAMES["frequency"]:
+        if unit is not None and unit.replace(" ", "").lower() != "hz":
+            raise FileFormatError(f"{name}, line {line}: column {_shown(cell)}: its name says Hz but its unit says "
+                                  f"{_shown(unit)}; rename it (e.g. 'Frequency [{unit}]') or correct the unit")
         key, unit = key[:-2], "Hz"  # frequency_hz
     for kind, names in _NAMES.items():
         if key in names:
             return kind, unit
     if "db" in key:
-        raise FileFormatError(f"{name}, line {line}: column {cell!r}: a magnitude in dB has no unit of its own "
+        raise FileFormatError(f"{name}, line {line}: column {_shown(cell)}: a magnitude in dB has no unit of its own "
                               "(dB of what?); export the real and imaginary parts, or the magnitude in a unit "
                               "such as m/N or g/N with the phase")
     raise FileFormatError(
-        f"{name}, line {line}: column {cell!r}; expected frequency, then real and imaginary parts or magnitude "
+        f"{name}, line {line}: column {_shown(cell)}; expected frequency, then real and imaginary parts or magnitude "
         "and phase (e.g. 'frequency_hz,real,imag' or 'Frequency [Hz];Magnitude [m/N];Phase [deg]')")
 
 
@@ -59,7 +63,7 @@ def _value_unit(unit: str | None, cell: str, name: str, line: int):
     if unit is None:
         return None, 1.0
     if "db" in unit.lower():
-        raise FileFormatError(f"{name}, line {line}: column {cell!r}: a magnitude in dB has no unit of its own "
+        raise FileFormatError(f"{name}, line {line}: column {_shown(cell)}: a magnitude in dB has no unit of its own "
                               "(dB of what?); give the magnitude in a unit such as m/N or g/N")
     try:
         q = _unit_of_label(unit.replace("µ", "u").replace("μ", "u"))
@@ -68,7 +72,7 @@ def _value_unit(unit: str | None, cell: str, name: str, line: int):
     exps = _exponents(q) if q is not None else None
     kind = _TIME_EXPONENT.get(exps[2]) if exps is not None and exps[:2] == (-1, 1) else None
     if kind is None:
-        raise FileFormatError(f"{name}, line {line}: column {cell!r}: the unit {unit!r} is not that of a "
+        raise FileFormatError(f"{name}, line {line}: column {_shown(cell)}: the unit {_shown(unit)} is not that of a "
                               "receptance, mobility or accelerance (e.g. m/N, mm/N, um/N, (m/s^2)/N, g/N)")
     return kind, float(q.m_as(f"meter / newton * second ** {exps[2]}"))
 
@@ -115,11 +119,11 @@ def parse_export(numbered: list[tuple[int, str]], name: str, quantity: str | Non
     kinds = [k for k, _ in columns]
     if kinds not in (["frequency", "real", "imag"], ["frequency", "magnitude", "phase"]):
         raise FileFormatError(
-            f"{name}, line {first}: columns {cells[0]}; expected frequency, then real and imaginary parts, or "
-            "frequency, magnitude and phase, in this order")
+            f"{name}, line {first}: columns {_shown(delimiter.join(cells[0]))}; expected frequency, then real and "
+            "imaginary parts, or frequency, magnitude and phase, in this order")
     fcell, vcells = cells[0][0], cells[0][1:]
     if columns[0][1] is None:
-        raise FileFormatError(f"{name}, line {first}: column {fcell!r} has no unit; name it frequency_hz or give "
+        raise FileFormatError(f"{name}, line {first}: column {_shown(fcell)} has no unit; name it frequency_hz or give "
                               "the unit, e.g. 'Frequency [Hz]'")
     try:
         funit = ureg.Quantity(1.0, columns[0][1].replace("HZ", "Hz"))
@@ -127,8 +131,8 @@ def parse_export(numbered: list[tuple[int, str]], name: str, quantity: str | Non
     except Exception:
         ok = False
     if not ok:
-        raise FileFormatError(f"{name}, line {first}: column {fcell!r}: {columns[0][1]!r} is not a frequency unit "
-                              "(Hz, kHz, rad/s, rpm)")
+        raise FileFormatError(f"{name}, line {first}: column {_shown(fcell)}: {_shown(columns[0][1])} is not a "
+                              "frequency unit (Hz, kHz, rad/s, rpm)")
     if kinds[1] == "real":
         said = [_value_unit(u, c, name, first) for (_, u), c in zip(columns[1:], vcells)]
         if said[0] != said[1]:
@@ -141,10 +145,10 @@ def parse_export(numbered: list[tuple[int, str]], name: str, quantity: str | Non
         angle = {"deg": np.pi / 180, "degree": np.pi / 180, "degrees": np.pi / 180, "°": np.pi / 180,
                  "rad": 1.0, "radian": 1.0, "radians": 1.0}.get((columns[2][1] or "").lower())
         if angle is None:
-            raise FileFormatError(f"{name}, line {first}: column {vcells[1]!r}: give the phase's unit, "
+            raise FileFormatError(f"{name}, line {first}: column {_shown(vcells[1])}: give the phase's unit, "
                                   "'Phase [deg]' or 'Phase [rad]'")
         if columns[1][1] is None and quantity is None:
-            raise FileFormatError(f"{name}, line {first}: column {vcells[0]!r} has no unit; give it "
+            raise FileFormatError(f"{name}, line {first}: column {_shown(vcells[0])} has no unit; give it "
                                   "(e.g. 'Magnitude [m/N]') or say the quantity")
     if kind is not None and quantity is not None and kind != quantity:
         raise FileFormatError(f"{name}, line {first}: the header's units are those of {'an' if kind[0] == 'a' else 'a'} {kind}, but the quantity "
@@ -153,7 +157,8 @@ def parse_export(numbered: list[tuple[int, str]], name: str, quantity: str | Non
     lines = np.array([n for n, _ in rows[1:]])
     for n, row in zip(lines, data):
         if len(row) != 3:
-            raise FileFormatError(f"{name}, line {n}: {delimiter.join(row)!r} has {len(row)} value(s); expected 3")
+            raise FileFormatError(f"{name}, line {n}: {_shown(delimiter.join(row))} has {len(row)} value(s); "
+                                  "expected 3")
     text = [[c.replace(",", ".") if delimiter != "," else c for c in row] for row in data]
     try:
         table = np.array(text, dtype=np.float64).reshape(-1, 3)
@@ -163,8 +168,13 @@ def parse_export(numbered: list[tuple[int, str]], name: str, quantity: str | Non
                 try:
                     float(cell)
                 except ValueError:
-                    raise FileFormatError(f"{name}, line {n}: {column} is {cell!r}; expected a number") from None
+                    raise FileFormatError(f"{name}, line {n}: {_shown(column)} is {_shown(cell)}; "
+                                          "expected a number") from None
         raise  # pragma: no cover - numpy and float() disagree on a cell
+    if angle is not None and (table[:, 1] < 0).any():
+        k = int(np.argmax(table[:, 1] < 0))
+        raise FileFormatError(f"{name}, line {lines[k]}: {cells[0][1]} is {_shown(data[k][1])}; a magnitude is >= 0 (a "
+                              "negative one would turn the phase by 180 degrees): check the export")
     with np.errstate(over="ignore", invalid="ignore"):
         table[:, 0] = np.asarray(cycles_per_second(table[:, 0] * funit, fcell), dtype=np.float64)
         if angle is not None:

@@ -27,7 +27,9 @@ message starts with the measurement file (and the line, where it can be
 found), names the key path (``frf[2].file``) and, for problems of the data,
 the data file: unknown keys, missing or mistyped values, unknown quantities,
 missing or unreadable data files, NaN or non-increasing frequencies in them,
-dead channels (an FRF that is 0 at every line), and data files on
+dead channels (an FRF that is 0 at every line), values beyond any measured
+structure (a receptance above 1 m/N, ``RECEPTANCE_LIMIT``; a mobility or an
+accelerance divided by ``2 pi f`` once or twice first), and data files on
 different frequency grids (never reconciled silently).
 """
 
@@ -35,17 +37,18 @@ from __future__ import annotations
 
 import os
 import re
-import tomllib
 import warnings
 from pathlib import Path
 from typing import Any
 
-from . import read_text
+from . import MAX_DATA_BYTES, check_readable_file, parse_toml, read_text
 from ..errors import FileFormatError, SubstructureError, SubstructureWarning
 from ..frf import FRF, QUANTITIES
 from ..measurements import Measurement, MeasurementSet, dof_label
 from ..points import check_name
-from .frf_files import read_csv, read_uff
+from .frf_files import read_uff
+from .frf_files._common import _beyond_physical
+from .frf_files.csv_files import _read_csv
 
 __all__ = ["load_measurements", "loads_measurements"]
 
@@ -150,17 +153,22 @@ class _Reader:
         suffix = path.suffix.lower()
         if suffix not in _CSV + _UFF:
             raise self.error(index, "file", f"{file!r}: unknown kind of file; expected .csv, .uff or .unv")
-        if path.is_dir():
-            raise self.error(index, "file", f"{path}: is a directory; expected a data file")
-        if not path.is_file():
+        if not path.exists():
             raise self.error(index, "file", f"{path}: no such file (paths are relative to the measurement file)")
         try:
+            check_readable_file(path, "data file", MAX_DATA_BYTES)
             if suffix in _CSV:
                 if record is not None:
                     raise self.error(index, "record", f"a CSV file ({file}) holds one FRF; record is for UFF files")
-                frf = read_csv(path, output=response, input=excitation, quantity=quantity)
+                frf, lines_of = _read_csv(path, output=response, input=excitation, quantity=quantity)
             else:
-                frf = self.uff(index, path, record, quantity, response, excitation)
+                frf, lines_of = self.uff(index, path, record, quantity, response, excitation), None
+            beyond = _beyond_physical(frf.frequency.hz, frf.data, frf.quantity)  # a measured FRF's range
+            if beyond is not None:
+                k, what = beyond
+                where = (f"line {lines_of[k]}" if lines_of is not None else
+                         f"type-58 record {record or 0}, value {k + 1} of {frf.frequency.n}")
+                raise FileFormatError(f"{path}, {where}: at {frf.frequency.hz[k]:g} Hz: {what}")
             return frf
         except _LocatedError:
             raise
@@ -310,10 +318,7 @@ def loads_measurements(text: str, base_dir: str | os.PathLike = ".", source: str
     text = text.removeprefix("\ufeff")  # a byte-order mark left by an editor is not part of the document
     if not text.strip():
         raise FileFormatError(f"{source}: the file is empty; expected a measurement set (docs/file-formats.md)")
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise FileFormatError(f"{source}: invalid TOML: {exc}") from None
+    data = parse_toml(text, source)
     try:
         return _Reader(text, Path(base_dir), source).measurement_set(data)
     except _LocatedError as exc:  # the public class, without the internal marker
@@ -334,5 +339,5 @@ def load_measurements(path: str | os.PathLike) -> MeasurementSet:
         The measurements, their FRFs read; errors name the file and the key.
     """
     name = os.fspath(path)
-    text = read_text(path)
+    text = read_text(path, "measurement set file")
     return loads_measurements(text, base_dir=Path(name).parent, source=name)

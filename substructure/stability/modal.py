@@ -18,6 +18,7 @@ in the modal model.
 from __future__ import annotations
 
 import csv
+import io
 import os
 import warnings
 from typing import Any
@@ -26,12 +27,14 @@ import attrs
 import numpy as np
 import pint
 
+from .._files import decode_text, read_bytes
 from ..errors import FileFormatError, InvalidValueError, SubstructureWarning
 from ..frf import FRF, Frequency
 from ..units import Q_, dimensionless, quantity
 from .structure import XY_LABELS, _one_entry, xy_receptance
 
-__all__ = ["Mode", "ModalModel", "ModalFitter", "fit_modes", "MODES_CSV_HEADER", "ModalFitWarning"]
+__all__ = ["Mode", "ModalModel", "ModalFitter", "fit_modes", "MODES_CSV_HEADER", "MODE_FREQUENCY_RANGE_HZ",
+           "MODE_STIFFNESS_RANGE_N_PER_M", "ModalFitWarning"]
 
 #: Most lines of a modal model's default grid (about 64 MB of 2x2 complex receptances).
 MAX_DEFAULT_LINES = 2_000_000
@@ -39,6 +42,15 @@ MAX_DEFAULT_LINES = 2_000_000
 #: The header of a modes CSV file (:meth:`ModalModel.from_csv`): direction ``x`` or ``y``,
 #: natural frequency in Hz, damping ratio, modal stiffness in N/m.
 MODES_CSV_HEADER = "direction,frequency_hz,damping_ratio,stiffness_n_per_m"
+
+
+#: The natural frequencies a mode may have, in Hz: a machine tool's modes lie between a few Hz and tens
+#: of kHz; outside 0.1 Hz to 1 MHz a number is a wrong unit (and 1e-300 Hz divides by zero in the lobes).
+MODE_FREQUENCY_RANGE_HZ = (0.1, 1e6)
+
+#: The modal stiffnesses a mode may have, in N/m: a tool point has 1e5 to 1e9 N/m; outside 1 N/m to
+#: 1e12 N/m a number is a wrong unit (and the lobes divide by zero or overflow).
+MODE_STIFFNESS_RANGE_N_PER_M = (1.0, 1e12)
 
 
 class ModalFitWarning(SubstructureWarning):
@@ -61,6 +73,19 @@ def _positive(field: str, dimension: str):
     return convert
 
 
+def _in_range(field: str, dimension: str, unit: str, limits: tuple[float, float], name: str):
+    def convert(value: Any) -> pint.Quantity:
+        q = _positive(field, dimension)(value)
+        lo, hi = limits
+        v = float(q.m_as(unit))
+        if not lo <= v <= hi:
+            raise InvalidValueError(f"{field}: got {v:.6g} {unit}; expected {lo:g} to {hi:g} {unit} ({name}): "
+                                    "a wrong unit?")
+        return q
+
+    return convert
+
+
 def _zeta(value: Any) -> float:
     z = dimensionless(value, "damping_ratio")
     if not 0.0 < z < 1.0:
@@ -77,18 +102,23 @@ class Mode:
     direction : {"x", "y"}
         The direction the mode acts in (x the feed direction).
     frequency : quantity or str
-        Natural frequency, e.g. ``"922 Hz"``.
+        Natural frequency, e.g. ``"922 Hz"``, from 0.1 Hz to 1 MHz
+        (``MODE_FREQUENCY_RANGE_HZ``).
     damping_ratio : float
         Viscous damping ratio ``zeta``, ``0 < zeta < 1``.
     stiffness : quantity or str
-        Modal stiffness, e.g. ``"1.34e6 N/m"``.  The modal mass is
+        Modal stiffness, e.g. ``"1.34e6 N/m"``, from 1 N/m to 1e12 N/m
+        (``MODE_STIFFNESS_RANGE_N_PER_M``).  The modal mass is
         ``k / (2 pi f_n)^2``.
     """
 
     direction: str = attrs.field(validator=lambda i, a, v: _direction(v))
-    frequency: pint.Quantity = attrs.field(converter=_positive("frequency", "1 / [time]"))
+    frequency: pint.Quantity = attrs.field(
+        converter=_in_range("frequency", "1 / [time]", "Hz", MODE_FREQUENCY_RANGE_HZ, "MODE_FREQUENCY_RANGE_HZ"))
     damping_ratio: float = attrs.field(converter=_zeta)
-    stiffness: pint.Quantity = attrs.field(converter=_positive("stiffness", "[mass] / [time] ** 2"))
+    stiffness: pint.Quantity = attrs.field(
+        converter=_in_range("stiffness", "[mass] / [time] ** 2", "N/m", MODE_STIFFNESS_RANGE_N_PER_M,
+                            "MODE_STIFFNESS_RANGE_N_PER_M"))
 
     @property
     def frequency_hz(self) -> float:
@@ -167,12 +197,11 @@ class ModalModel:
             The modes of the file.
         """
         name = os.fspath(path)
+        text = decode_text(read_bytes(path, "modes CSV file"), name)
         try:
-            with open(path, encoding="utf-8-sig", newline="") as fh:
-                rows = [(k + 1, row) for k, row in enumerate(csv.reader(fh)) if any(c.strip() for c in row)]
-        except FileNotFoundError:
-            raise FileFormatError(f"{name}: no such file") from None
-        except (OSError, UnicodeDecodeError, csv.Error) as exc:
+            rows = [(k + 1, row) for k, row in enumerate(csv.reader(io.StringIO(text, newline="")))
+                    if any(c.strip() for c in row)]
+        except csv.Error as exc:
             raise FileFormatError(f"{name}: cannot read the file ({exc})") from None
         if not rows:
             raise FileFormatError(f"{name}: the file is empty; expected the header {MODES_CSV_HEADER!r}")

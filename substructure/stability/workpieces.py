@@ -21,12 +21,12 @@ from __future__ import annotations
 
 import importlib.resources
 import os
-import tomllib
 from typing import Any
 
 import attrs
 import pint
 
+from .._files import decode_text, parse_toml, read_bytes
 from ..errors import FileFormatError, InvalidValueError
 from ..units import Q_, dimensionless, quantity
 
@@ -206,10 +206,7 @@ def _key(name: str) -> str:
 
 
 def _parse(text: str, source: str) -> tuple[Workpiece, ...]:
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise FileFormatError(f"{source}: invalid TOML: {exc}") from None
+    data = parse_toml(text, source)
     unknown = [k for k in data if k != "workpiece"]
     if unknown:
         raise FileFormatError(f"{source}: {unknown[0]}: unknown key; expected [[workpiece]] tables")
@@ -260,14 +257,7 @@ def load_workpieces(path: Any) -> tuple[Workpiece, ...]:
         Naming the file, the row and the key.
     """
     name = os.fspath(path)
-    try:
-        with open(path, encoding="utf-8-sig") as fh:
-            text = fh.read()
-    except FileNotFoundError:
-        raise FileFormatError(f"{name}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise FileFormatError(f"{name}: cannot read the file ({exc})") from None
-    return _parse(text, name)
+    return _parse(decode_text(read_bytes(path, "workpiece table"), name), name)
 
 
 def workpieces() -> tuple[Workpiece, ...]:

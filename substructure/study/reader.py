@@ -18,7 +18,6 @@ import io
 import math
 import os
 import re
-import tomllib
 from pathlib import Path
 from typing import Any
 
@@ -219,10 +218,9 @@ def loads_study(text: str, source: str = "<string>", base: Any = ".") -> Any:
     text = text.removeprefix("\ufeff")
     if not text.strip():
         raise FileFormatError(f"{source}: the file is empty; expected a study (docs/file-formats.md)")
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise FileFormatError(f"{source}: invalid TOML: {exc}") from None
+    from .._files import parse_toml
+
+    data = parse_toml(text, source)
     return _Reader(source, text, data, Path(base)).study()
 
 
@@ -242,7 +240,7 @@ def load_study(path: Any) -> Any:
     from ..io import read_text
 
     name = os.fspath(path)
-    return loads_study(read_text(name), source=name, base=Path(name).parent)
+    return loads_study(read_text(name, "study file"), source=name, base=Path(name).parent)
 
 
 # -- the CSV file of combinations -------------------------------------------------------------
@@ -304,7 +302,7 @@ def read_combinations_csv(path: Any) -> list:
     from .spec import Combination
 
     name = os.fspath(path)
-    text = read_text(name)
+    text = read_text(name, "combinations table")
     lines = [(n + 1, line) for n, line in enumerate(text.splitlines()) if line.strip() and not
              line.lstrip().startswith("#")]
     if not lines:

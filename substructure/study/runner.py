@@ -210,9 +210,11 @@ class _Store:
                 p.unlink(missing_ok=True)
 
     def load(self, task: dict) -> dict | None:
+        from ..io import read_text
+
         path = self.path("results", task["key"], ".json")
-        try:
-            data = json.loads(path.read_text(encoding="utf-8"))
+        try:  # the checked read: a FIFO or a huge file put there is not a result (FileFormatError is a ValueError)
+            data = json.loads(read_text(path, "study result"))
         except (OSError, ValueError):
             return None
         if (not isinstance(data, dict) or data.get("format") != RESULT_FORMAT

@@ -290,7 +290,7 @@ class Machine:
             resource = importlib.resources.files("substructure") / "data" / "default_assembly.toml"
             text, source = resource.read_text(encoding="utf-8"), "default_assembly.toml"
         elif isinstance(value, (str, os.PathLike)):
-            text, source = read_text(value), os.fspath(value)
+            text, source = read_text(value, "assembly file"), os.fspath(value)
         else:
             raise InvalidValueError(f"assembly: got {value!r}; expected 'default', an assembly file or an Assembly")
         object.__setattr__(self, "text", text)
@@ -416,7 +416,7 @@ class Cut:
             if self.workpiece_table is not None:
                 from ..io import read_text
 
-                object.__setattr__(self, "table_text", read_text(self.workpiece_table))
+                object.__setattr__(self, "table_text", read_text(self.workpiece_table, "workpiece table"))
 
     def spec(self) -> dict:
         """Plain data for a worker.

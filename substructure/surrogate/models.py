@@ -287,6 +287,9 @@ class JointSurrogate(BaseEstimator):
         return self
 
     def _columns(self, features) -> dict[str, list]:
+        if isinstance(features, (str, bytes)):
+            raise InvalidValueError(f"features: got the string {features!r}; expected a mapping such as "
+                                    "{'tool_diameter': '14 mm', 'gauge_length': '90 mm'} (or a list of them)")
         rows = [features] if isinstance(features, Mapping) else list(features)
         if not rows:
             raise InvalidValueError("features: got no feature sets")

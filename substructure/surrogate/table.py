@@ -176,7 +176,7 @@ class JointTable:
         """
         from ..io import read_text
 
-        return cls._from_csv_text(read_text(path), str(path), parameters)
+        return cls._from_csv_text(read_text(path, "joint table"), str(path), parameters)
 
     @classmethod
     def _from_csv_text(cls, text: str, where: str, parameters=None) -> "JointTable":
@@ -534,15 +534,10 @@ class JointTable:
         JointTable
             The table.
         """
-        import tomllib
-
-        from ..io import read_text
+        from ..io import parse_toml, read_text
 
         where = str(path)
-        try:
-            data = tomllib.loads(read_text(path))
-        except tomllib.TOMLDecodeError as exc:
-            raise FileFormatError(f"{where}: invalid TOML: {exc}") from None
+        data = parse_toml(read_text(path, "joint table"), where)
         unknown = set(data) - {"parameters", "features", "joints"}
         if unknown:
             raise FileFormatError(f"{where}: unknown keys {sorted(unknown)}; expected parameters, features, joints")

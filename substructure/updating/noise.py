@@ -249,6 +249,11 @@ def _window(frf: FRF, polyorder: int) -> int:
     return w if w % 2 else w - 1
 
 
+_MAGNITUDE_RANGE = (1e-140, 1e140)
+"""|H| outside this range (SI units) has a square or an inverse square that over- or underflows in the
+estimate; the file readers refuse receptances above 1 m/N long before."""
+
+
 def _best_domain_residual(clean: FRF, h, q, usable, window: int, polyorder: int) -> np.ndarray:
     """Per line, the smoothing residual in H or in 1/H, whichever is smaller around the line (5 lines)."""
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -305,8 +310,9 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     Raises
     ------
     InvalidValueError
-        For an FRF that is zero (or not finite) on every line, or too short,
-        or a coherence of the wrong length.
+        For an FRF that is zero (or not finite) on every line, too short,
+        with magnitudes whose square overflows (beyond 1e140 in SI units) or
+        underflows (below 1e-140), or a coherence of the wrong length.
     """
     if measured.shape[1:] != (1, 1):
         raise InvalidValueError(f"measured: got {measured.shape[1]}x{measured.shape[2]} entries; expected one")
@@ -315,6 +321,12 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     usable = np.isfinite(h) & (np.abs(h) > 0)
     if not usable.any():
         raise InvalidValueError(f"measured FRF {label}: zero (or not finite) on every line: a dead channel?")
+    with np.errstate(over="ignore"):
+        magnitude = np.abs(h[usable])
+    if not (magnitude.max() < _MAGNITUDE_RANGE[1] and magnitude.min() > _MAGNITUDE_RANGE[0]):
+        raise InvalidValueError(f"measured FRF {label}: |H| of {float(magnitude.min()):.3g} to "
+                                f"{float(magnitude.max()):.3g} in SI units is beyond any measured structure (its "
+                                "square is not a finite positive number); check the units")
     n = h.size
     if n < polyorder + 8:
         raise InvalidValueError(f"measured FRF {label}: {n} lines; the noise estimate needs at least {polyorder + 8}")
@@ -324,7 +336,7 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     w = window or _window(clean, polyorder)
     s = smooth(clean, window=w, polyorder=polyorder).data[:, 0, 0]
     h0 = float(savgol_coeffs(w, polyorder)[w // 2])
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         q = np.log(h / s)
         g_all = 1.0 / np.abs(s) ** 2
     ok = usable & np.isfinite(q) & np.isfinite(g_all)

@@ -13,10 +13,9 @@ from __future__ import annotations
 import importlib.resources
 import os
 import re
-import tomllib
 from typing import Any
 
-from .. import read_text
+from .. import parse_toml, read_text
 from ...assembly import Assembly
 from ...beams import Flutes, Insert, Segment
 from ...components import COMPONENT_TYPES, Beam
@@ -369,10 +368,7 @@ def loads_assembly(text: str, source: str = "<string>") -> Assembly:
     text = text.removeprefix("\ufeff")  # a byte-order mark left by an editor is not part of the document
     if not text.strip():
         raise FileFormatError(f"{source}: the file is empty; expected an assembly (docs/file-formats.md)")
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise FileFormatError(f"{source}: invalid TOML: {exc}") from None
+    data = parse_toml(text, source)
     return _Reader(source, text, data).assembly()
 
 
@@ -390,7 +386,7 @@ def load_assembly(path: str | os.PathLike) -> Assembly:
         The assembly; errors name the file and the key.
     """
     name = os.fspath(path)
-    text = read_text(path)
+    text = read_text(path, "assembly file")
     return loads_assembly(text, source=name)
 
 

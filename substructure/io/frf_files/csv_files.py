@@ -12,8 +12,8 @@ import os
 import numpy as np
 
 from ...errors import FileFormatError, InvalidValueError
-from ...frf import FRF, Frequency
-from ._common import _refuse_all_zero, _require_frf
+from ...frf import FRF, MAX_GRID_LINES, Frequency
+from ._common import _refuse_all_zero, _require_frf, _shown
 
 __all__ = ["write_csv", "read_csv"]
 
@@ -95,10 +95,19 @@ def read_csv(
     FRF
         Shape ``(n_freq, 1, 1)``: frequencies in Hz, values as in the file (SI).
     """
-    from .. import read_text
+    return _read_csv(path, output, input, quantity)[0]
+
+
+def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF, np.ndarray]:
+    """:func:`read_csv`, and the line of the file each frequency line comes from."""
+    from .. import MAX_DATA_BYTES, read_text
 
     name = os.fspath(path)
-    lines = read_text(path).splitlines()
+    text = read_text(path, "CSV file", MAX_DATA_BYTES)
+    if text.count("\n") > MAX_GRID_LINES + 1000:  # before the lines are split: refused below in any case
+        raise FileFormatError(f"{name}: {text.count(chr(10)):,} lines; an FRF has at most {MAX_GRID_LINES:,} "
+                              "frequency lines (MAX_GRID_LINES)")
+    lines = text.splitlines()
     numbered = [(k + 1, line) for k, line in enumerate(lines) if line.strip()]
     if not numbered:
         raise FileFormatError(f"{name}: the file is empty; expected the header {CSV_HEADER!r}")
@@ -107,7 +116,7 @@ def read_csv(
         from ..frf_exports import parse_export
 
         table, lines_of, said = parse_export(numbered, name, quantity)
-        return _checked_csv(table, lines_of, name, output, input, quantity or said or "receptance")
+        return _checked_csv(table, lines_of, name, output, input, quantity or said or "receptance"), lines_of
     numbered = numbered[1:]
     if len(numbered) < 2:
         raise FileFormatError(
@@ -117,7 +126,7 @@ def read_csv(
     for (number, line), row in zip(numbered, cells):
         if len(row) != 3:
             raise FileFormatError(
-                f"{name}, line {number}: {line!r} has {len(row)} value(s); expected 3 "
+                f"{name}, line {number}: {_shown(line)} has {len(row)} value(s); expected 3 "
                 "(frequency_hz, real, imag)"
             )
     try:
@@ -129,11 +138,11 @@ def read_csv(
                     float(cell)
                 except ValueError:
                     raise FileFormatError(
-                        f"{name}, line {number}: {column} is {cell.strip()!r}; expected a number"
+                        f"{name}, line {number}: {column} is {_shown(cell.strip())}; expected a number"
                     ) from None
         raise  # pragma: no cover - numpy and float() disagree on a cell
     lines_of = np.array([number for number, _ in numbered])
-    return _checked_csv(table, lines_of, name, output, input, quantity or "receptance")
+    return _checked_csv(table, lines_of, name, output, input, quantity or "receptance"), lines_of
 
 
 def _checked_csv(table: np.ndarray, lines_of: np.ndarray, name: str, output: str, input: str,

@@ -69,6 +69,38 @@ def _parse_record(dset: dict, name: str, number: int, quantity: str | None,
     return frequency, data * factor if factor != 1.0 else data, output, input_, kind
 
 
+_LABEL_LINES = {8: "abscissa_axis_units_lab", 9: "ordinate_axis_units_lab", 10: "orddenom_axis_units_lab"}
+
+
+def _latin1_labels(uff, position: int, dset: dict) -> None:
+    """Unit labels in Latin-1 (``m/s²`` with the byte 0xB2) read from the record's own bytes.
+
+    pyuff decodes a record as UTF-8 and turns a byte that is not UTF-8 into
+    U+FFFD, so that ``(1/N)*(m/s\xb2)`` would lose its exponent.  When a
+    label holds U+FFFD, its field (columns 48-67 of records 8-10, after the
+    ``58`` line) is read again from the file as Latin-1, the single-byte
+    code page of the programs that write such files.  Without the record's
+    offsets (another pyuff) the label is left as it is, and the reader
+    refuses it as unreadable.
+    """
+    if not any("\ufffd" in str(dset.get(key, "")) for key in _LABEL_LINES.values()):
+        return
+    try:
+        start, end = (int(v) for v in uff._block_ind[position])
+        with open(uff._filename, "rb") as fh:
+            fh.seek(start)
+            block = fh.read(min(end - start + 1, 16 * 1024))
+    except (AttributeError, IndexError, TypeError, ValueError, OSError):
+        return
+    lines = block.splitlines()
+    head = next((k for k, line in enumerate(lines) if line.strip() in (b"58", b"58b")), None)
+    if head is None or len(lines) <= head + 10:
+        return
+    for offset, key in _LABEL_LINES.items():
+        if "\ufffd" in str(dset.get(key, "")):
+            dset[key] = lines[head + offset][47:67].decode("latin-1").strip()
+
+
 def _check_complete(name: str) -> None:
     """A universal file starts and ends with a ``-1`` line; otherwise it is something else, or was cut off."""
     size = os.path.getsize(name)
@@ -173,9 +205,9 @@ def read_uff(path: str | os.PathLike, record: int | None = None, quantity: str |
     """
     import pyuff
 
-    from .. import check_readable_file
+    from .. import MAX_DATA_BYTES, check_readable_file
 
-    name = check_readable_file(path, "universal file")
+    name = check_readable_file(path, "universal file", MAX_DATA_BYTES)
     if quantity is not None and quantity not in QUANTITIES:
         raise InvalidValueError(f"quantity: got {quantity!r}; expected one of {', '.join(QUANTITIES)}")
     _check_complete(name)
@@ -206,6 +238,7 @@ def read_uff(path: str | os.PathLike, record: int | None = None, quantity: str |
             if before:
                 system = _unit_system(uff.read_sets(before[-1]), name)
             dset = uff.read_sets(positions[number])
+            _latin1_labels(uff, positions[number], dset)
         except FileFormatError:
             raise
         except Exception as exc:  # pyuff raises bare Exception

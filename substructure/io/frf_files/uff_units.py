@@ -52,18 +52,25 @@ def _a(word: str) -> str:
     return f"{'an' if word[:1].lower() in 'aeiou' else 'a'} {word}"
 
 
+_UNREADABLE = re.compile(r"[\ufffd\x00-\x1f\x7f-\x9f]")
+
+
 def _unit_of_label(label: Any):
     """A pint Quantity of 1 of the unit an axis units label names; None for no label; ValueError if unreadable.
 
     Labels of acquisition systems are made readable first: ``g`` is the
     standard acceleration of gravity (not the gram), ``s2`` and ``s²`` are
-    ``s^2``.
+    ``s^2`` (``²`` and ``³`` as UTF-8 or, in a label pyuff could not
+    decode, as Latin-1 bytes: ``_latin1_labels``).  A label with a byte
+    that is no character (U+FFFD) or a control character is unreadable.
     """
     from ...units import ureg
 
     text = str(label if label is not None else "").strip()
     if text.upper() in _NO_LABEL:
         return None
+    if _UNREADABLE.search(text):  # a byte that is no character (U+FFFD), a control character
+        raise ValueError(text)
     cleaned = text.replace("²", "^2").replace("³", "^3").replace("·", "*").replace("**", "^")
     cleaned = re.sub(r"(?<![A-Za-z_])g(?![A-Za-z_0-9])", "g_n", cleaned)  # g: gravity, in an FRF label
     cleaned = re.sub(r"([A-Za-z])(\d)", r"\1^\2", cleaned)  # m/s2 -> m/s^2

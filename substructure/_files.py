@@ -1,0 +1,222 @@
+"""The one checked way the package opens a file to read it, and the one way it parses TOML.
+
+Every reader of the package (assembly, measurement set, study, workpiece and
+joint tables, modal CSV files, FRF files in CSV and UFF) goes through
+:func:`read_bytes` (or :func:`check_file` for a reader that hands the name to
+another library): only a regular file is read (a FIFO with no writer would
+block forever, ``/dev/zero`` would never end), and never more than a cap of
+its kind, :data:`MAX_TEXT_BYTES` for tables and TOML files, and
+:data:`MAX_DATA_BYTES` for measured FRF files.  :func:`parse_toml` parses TOML
+text with the errors of a broken or absurdly nested document named by file.
+
+This module sits in the lowest layer (it needs only :mod:`substructure.errors`),
+so that every layer may read files through it; :mod:`substructure.io`
+re-exports it.
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+
+from .errors import FileFormatError
+
+__all__ = ["MAX_TEXT_BYTES", "MAX_DATA_BYTES", "check_file", "read_bytes", "decode_text",
+           "parse_toml"]
+
+MAX_TEXT_BYTES = 16 * 2**20
+"""The largest TOML or CSV table the package reads (16 MiB): assembly, measurement set, study, workpiece
+table, joint table, modal CSV.  Such files are a few kB; a larger one is not what it claims to be."""
+
+MAX_DATA_BYTES = 128 * 2**20
+"""The largest measured FRF file (CSV or universal file) the package reads (128 MiB): a million lines
+(``MAX_GRID_LINES``) of full-precision CSV are about 70 MB."""
+
+def _name(path, what: str) -> str:
+    try:
+        return os.fspath(path)
+    except TypeError:
+        raise FileFormatError(f"got {path!r} of type {type(path).__name__}; expected the name of {_a(what)}") from None
+
+
+def _a(what: str) -> str:
+    return f"{'an' if what[:1].lower() in 'aeiou' else 'a'} {what}"
+
+
+def _kind(mode: int) -> str:
+    if stat.S_ISDIR(mode):
+        return "a directory"
+    if stat.S_ISFIFO(mode):
+        return "a named pipe (FIFO)"
+    if stat.S_ISCHR(mode):
+        return "a character device"
+    if stat.S_ISBLK(mode):
+        return "a block device"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    return "not a regular file"
+
+
+def _check_stat(name: str, st: os.stat_result, what: str, limit: int) -> None:
+    if not stat.S_ISREG(st.st_mode):
+        raise FileFormatError(f"{name}: is {_kind(st.st_mode)}; expected {_a(what)} (a regular file)")
+    if st.st_size > limit:
+        raise FileFormatError(f"{name}: {st.st_size:,} bytes, more than the {limit:,} bytes {_a(what)} may have "
+                              "(docs/file-formats.md); is it the right file?")
+
+
+def check_file(path, what: str = "file", limit: int = MAX_TEXT_BYTES) -> str:
+    """The path's name, after checking that it is a regular file of at most ``limit`` bytes.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file to read.
+    what : str
+        What the file is, for the message (e.g. ``"universal file"``).
+    limit : int
+        The largest size allowed, in bytes (:data:`MAX_TEXT_BYTES` or
+        :data:`MAX_DATA_BYTES`).
+
+    Returns
+    -------
+    str
+        ``os.fspath(path)``.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the path, for a missing path, a directory, a FIFO, a device or
+        anything else that is not a regular file, and a file larger than
+        ``limit``.
+    """
+    name = _name(path, what)
+    try:
+        st = os.stat(name)
+    except FileNotFoundError:
+        raise FileFormatError(f"{name}: no such file") from None
+    except (OSError, ValueError) as exc:
+        raise FileFormatError(f"{name}: cannot read the file ({getattr(exc, 'strerror', None) or exc})") from None
+    _check_stat(name, st, what, limit)
+    return name
+
+
+def read_bytes(path, what: str = "file", limit: int = MAX_TEXT_BYTES) -> bytes:
+    """The bytes of a regular file of at most ``limit`` bytes.
+
+    The file is opened without blocking (a FIFO with no writer does not hang)
+    and checked on the open descriptor; at most ``limit + 1`` bytes are read
+    (a file that grows, or reports a size of 0, is still capped).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+    what : str
+        What the file is, for the message.
+    limit : int
+        The largest size allowed, in bytes.
+
+    Returns
+    -------
+    bytes
+        The file's content.
+
+    Raises
+    ------
+    FileFormatError
+        As ``check_file``, and for a file that cannot be read.
+    """
+    name = check_file(path, what, limit)
+    try:
+        fd = os.open(name, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0))
+    except FileNotFoundError:
+        raise FileFormatError(f"{name}: no such file") from None
+    except OSError as exc:
+        raise FileFormatError(f"{name}: cannot read the file ({exc.strerror or exc})") from None
+    try:
+        _check_stat(name, os.fstat(fd), what, limit)  # the file opened is the file checked
+        chunks, size = [], 0
+        while size <= limit:
+            chunk = os.read(fd, min(limit + 1 - size, 2**20))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            size += len(chunk)
+    except OSError as exc:
+        raise FileFormatError(f"{name}: cannot read the file ({exc.strerror or exc})") from None
+    finally:
+        os.close(fd)
+    if size > limit:
+        raise FileFormatError(f"{name}: more than the {limit:,} bytes {_a(what)} may have (docs/file-formats.md); "
+                              "is it the right file?")
+    return b"".join(chunks)
+
+
+def decode_text(data: bytes, name: str) -> str:
+    """UTF-8 text (or UTF-16 after its byte-order mark) without a leading byte-order mark.
+
+    Parameters
+    ----------
+    data : bytes
+        The file's content.
+    name : str
+        The file, for messages.
+
+    Returns
+    -------
+    str
+        The text.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the file and the byte, for bytes that are not UTF-8 (nor UTF-16
+        after a UTF-16 byte-order mark).
+    """
+    if data[:2] in (b"\xff\xfe", b"\xfe\xff"):  # UTF-16 with its byte-order mark (Excel's "Unicode text")
+        try:
+            return data.decode("utf-16")
+        except UnicodeDecodeError as exc:
+            raise FileFormatError(f"{name}: starts with a UTF-16 byte-order mark but is not UTF-16 text "
+                                  f"(byte {exc.start}); save the file as UTF-8") from None
+    try:
+        return data.decode("utf-8-sig")  # a BOM (Windows editors write one) is not part of the text
+    except UnicodeDecodeError as exc:
+        raise FileFormatError(
+            f"{name}: not UTF-8 text (byte {exc.start}: {data[exc.start:exc.start + 1]!r}); "
+            "save the file as UTF-8"
+        ) from None
+
+
+def parse_toml(text: str, source: str) -> dict:
+    """Parse TOML text; a syntax error or an absurdly deep nesting is an error naming ``source``.
+
+    Parameters
+    ----------
+    text : str
+        The TOML text.
+    source : str
+        The file (or a description of the text), for messages.
+
+    Returns
+    -------
+    dict
+        The parsed document.
+
+    Raises
+    ------
+    FileFormatError
+        For invalid TOML (with the line and column of the parser), and for
+        arrays or inline tables nested so deep that the parser runs out of
+        recursion (hundreds of levels).
+    """
+    import tomllib
+
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise FileFormatError(f"{source}: invalid TOML: {exc}") from None
+    except RecursionError:  # the parser recurses once per level of nesting
+        raise FileFormatError(f"{source}: invalid TOML: arrays or inline tables nested hundreds of levels "
+                              "deep; no file of the package needs more than a few levels") from None
