@@ -34,6 +34,7 @@ extensions = [
     "api_pages",  # the API reference pages, from __all__
     "repo_links",  # links to files of the repository, mapped to site pages
     "gallery_support",  # the examples' PNG figures in the gallery, and its checks
+    "offline_site",  # MathJax from _static, not a CDN; a check that no page loads from the network
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
@@ -127,6 +128,7 @@ html_theme_options = {
     "footer_start": ["copyright"],
     "footer_end": ["sphinx-version", "theme-version"],
 }
-html_static_path = []
+html_static_path = ["_static"]
+html_css_files = ["substructure.css"]  # code lines wrap instead of running out of the column
 html_show_sourcelink = True
 html_last_updated_fmt = None
