@@ -65,4 +65,4 @@ notebooks: $(NOTEBOOKS_STAMP)
 	$(BIN)/python docs/_ext/notebooks.py --out out/notebooks
 
 clean:
-	rm -rf $(VENV) out .pytest_cache build docs/_build docs/api docs/auto_examples substructure/_ckernels*.so
+	rm -rf $(VENV) out .pytest_cache build docs/_build docs/api docs/auto_examples docs/figures substructure/_ckernels*.so

@@ -35,11 +35,12 @@ extensions = [
     "repo_links",  # links to files of the repository, mapped to site pages
     "gallery_support",  # the examples' PNG figures in the gallery, and its checks
     "offline_site",  # MathJax from _static, not a CDN; a check that no page loads from the network
+    "chapter_figures",  # the chapter pages' figures, drawn from the library into docs/figures/
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build", "_ext", "_inventories", "_templates", "**/*.ipynb", "auto_examples/*.py",
+exclude_patterns = ["_build", "_ext", "_inventories", "_templates", "_static", "figures", "**/*.ipynb", "auto_examples/*.py",
                     "auto_examples/*.md5", "auto_examples/*.zip", "auto_examples/*.json"]
 templates_path = ["_templates"]
 
