@@ -4,7 +4,9 @@
 logarithmic scale over the phase (``kind="bode"``), the real and imaginary
 parts (``kind="real-imag"``) or the Nyquist plane (``kind="nyquist"``), in
 um/N by default (``unit=``), with plain-language axis labels and the
-technical names in a small note.  A free-free FRF's rigid-body (mass) line,
+technical names in a small note; limits of the value axes are given with
+their units (``limits=("0.01 um/N", "1e-3 m/N")``) and converted to the
+unit shown.  A free-free FRF's rigid-body (mass) line,
 which rises without bound toward 0 Hz, is detected and left out of the
 autoscaling (it is still drawn, in a shaded band), so the modes fill the
 axes.  Passing the axes of an earlier figure (or the figure itself)
