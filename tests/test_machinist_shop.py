@@ -148,13 +148,13 @@ def test_climb_and_conventional_are_down_and_up():
 def test_the_milling_default_is_said_in_every_output(capsys):
     _, out, _ = run(capsys, *BASE, *THESIS, "--speeds", "8000:12000", "--json")
     default = json.loads(out)
-    assert default["cut"]["milling"] == "up" and default["cut"]["milling_default"] is True
+    assert default["cut"]["milling"] == "up" and default["milling_default"] is True
     assert any("the default" in n and "climb" in n for n in default["notes"])
     _, out, _ = run(capsys, *BASE, *THESIS, "--speeds", "8000:12000")
     assert "up (conventional) milling" in out and "the default" in out
     _, out, _ = run(capsys, *BASE, *THESIS, "--speeds", "8000:12000", "--milling", "climb", "--json")
     climb = json.loads(out)
-    assert climb["cut"]["milling"] == "down" and climb["cut"]["milling_default"] is False
+    assert climb["cut"]["milling"] == "down" and climb["milling_default"] is False
     _, out, _ = run(capsys, *BASE, *THESIS, "--speeds", "8000:12000", "--milling", "down", "--json")
     assert json.loads(out)["depth_limit_m"] == climb["depth_limit_m"]
 

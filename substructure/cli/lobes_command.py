@@ -131,7 +131,7 @@ def run(args: argparse.Namespace) -> int:
             out["workpiece"] = cut.workpiece.to_json()
         if isinstance(cut, MillingCut):
             out["cut"] = cut.to_json()
-            out["cut"]["milling_default"] = MILLING_DEFAULT_NOTE in notes
+            out["milling_default"] = MILLING_DEFAULT_NOTE in notes
         out["cutting_data"] = shop
         out["notes"] = notes
         return print_json(out)
