@@ -194,7 +194,9 @@ def cut_from_args(args: argparse.Namespace, tool: Any, notes: list[str]):
 
     milling_only = {"--teeth": args.teeth, "--diameter": args.diameter, "--radial-depth": args.radial_depth,
                     "--immersion": args.immersion, "--kt": args.kt, "--kn": args.kn, "--kr": args.kr,
-                    "--workpiece": args.workpiece, "--feed-per-tooth": args.feed_per_tooth}
+                    "--workpiece": args.workpiece, "--feed-per-tooth": args.feed_per_tooth,
+                    "--tool-material": getattr(args, "tool_material", None),
+                    "--cutting-data": getattr(args, "cutting_data", None)}
     if args.turning:
         given = [name for name, value in milling_only.items() if value is not None]
         if given:
