@@ -265,3 +265,24 @@ def test_the_warning_category_is_a_substructure_warning():
     from substructure.errors import SubstructureWarning
 
     assert issubclass(CuttingDataWarning, SubstructureWarning)
+
+
+def test_a_users_cutting_data_table_is_searched_first_and_checked(capsys, tmp_path):
+    table = tmp_path / "shop.toml"
+    table.write_text('[[cutting]]\nworkpiece = "steel-1045"\ntool_material = "carbide"\n'
+                     'cutting_speed = ["100 m/min", "900 m/min"]\nfeed_per_tooth = ["0.01 mm", "0.1 mm"]\n'
+                     'default_feed_per_tooth = "0.03 mm"\nsource = "our coated tools, 2025"\n', encoding="utf-8")
+    argv = ["lobes", "--assembly", ASSEMBLY, "--at", "tool.tip", "--immersion", "1", "--workpiece", "steel-1045",
+            "--kr", "0.3", "--cutting-data", table, "--json"]
+    code, out, err = run(capsys, *argv)
+    result = json.loads(out)
+    assert code == 0 and result["cut"]["feed_per_tooth_m"] == pytest.approx(0.03e-3)
+    assert result["cutting_data"]["range"]["source"] == "our coated tools, 2025"
+    assert result["cutting_data"]["warnings"] == [] and "warning" not in err
+    table.write_text(table.read_text().replace('cutting_speed = ["100 m/min", "900 m/min"]',
+                                               'cutting_speed = "100 m/min"'), encoding="utf-8")
+    code, _, err = run(capsys, *argv)
+    assert code == 1 and str(table) in err and "cutting[0]" in err and "cutting_speed" in err
+    code, _, err = run(capsys, "lobes", "--assembly", ASSEMBLY, "--at", "tool.tip", "--turning", "--kf", "2000 MPa",
+                       "--tool-material", "hss")
+    assert code == 2 and "--tool-material" in err
