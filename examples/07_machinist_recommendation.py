@@ -191,7 +191,8 @@ print("8. Cutting data")
 print(f"    {best.cutting_speed_m_per_min:.0f} m/min ({best.cutting_speed_m_per_min / 0.3048:.0f} SFM), "
       f"{best.feed_per_tooth_m * 1e3:.3g} mm/tooth, {best.feed_rate_m_per_min * 1e3:.0f} mm/min")
 print(f"    usual for {data.workpiece} with carbide: {data.speed_range_m_per_min[0]:.0f} to "
-      f"{data.speed_range_m_per_min[1]:.0f} m/min; outside: {check_cutting(cut, best.spindle_speed_rpm, data) or 'none'}")
+      f"{data.speed_range_m_per_min[1]:.0f} m/min; outside: "
+      f"{check_cutting(cut, best.spindle_speed_rpm, data) or 'none'}")
 
 # %%
 # (j) A catalogue holder: priors instead of another holder's joints

@@ -117,7 +117,8 @@ def band_table(report: Any) -> str:
             continue
         lo, hi = r.window_rpm
         body += (f"<tr><td>{label}</td><td>{_num(r.spindle_speed_rpm, ',.0f')}</td><td>{_num(r.depth_m, '.3g', 1e3)}"
-                 f"</td><td>{_num(r.limit_depth_m, '.3g', 1e3)}</td><td>{_num(lo, ',.0f')}–{_num(hi, ',.0f')}</td></tr>")
+                 f"</td><td>{_num(r.limit_depth_m, '.3g', 1e3)}</td>"
+                 f"<td>{_num(lo, ',.0f')}–{_num(hi, ',.0f')}</td></tr>")
     head = ("<tr><th>Joints</th><th>Speed (rpm)</th><th>Axial depth (mm)</th><th>Chatter limit in the window (mm)"
             "</th><th>Speed window (rpm)</th></tr>")
     lower = report.band.lower_m

@@ -51,7 +51,8 @@ def _pressure(field: str, allow_zero: bool):
         q = quantity(value, field, "[mass] / [length] / [time] ** 2")
         if q.magnitude < 0 or (q.magnitude == 0 and not allow_zero):
             need = ">= 0" if allow_zero else "> 0"
-            raise InvalidValueError(f"{field}: got {show_value(value)}; expected a cutting coefficient {need} (a pressure)")
+            raise InvalidValueError(f"{field}: got {show_value(value)}; expected a cutting coefficient {need} "
+                                    "(a pressure)")
         return q
 
     return convert
@@ -61,7 +62,8 @@ def _edge(field: str):
     def convert(value: Any) -> pint.Quantity:
         q = quantity(value, field, "[mass] / [time] ** 2")
         if not q.magnitude >= 0:
-            raise InvalidValueError(f"{field}: got {show_value(value)}; expected an edge force per length >= 0 (e.g. '20 N/mm')")
+            raise InvalidValueError(f"{field}: got {show_value(value)}; expected an edge force per length >= 0 "
+                                    "(e.g. '20 N/mm')")
         return q
 
     return convert
