@@ -27,7 +27,6 @@ import os
 import tempfile
 from pathlib import Path
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from substructure import FRF, Frequency, Holder, Sensor, default_assembly
@@ -154,12 +153,10 @@ print(f"    {robust.describe()[0]} (limit {robust.limit_depth_m * 1e3:.2f} mm ov
 fig = lobes.plot(lobes=True, recommendation=best,
                  title=f"From tap test to spindle speed: {cut.describe()}")
 fig.savefig(out / "machinist_recommendation.png", dpi=110)
-plt.close(fig)
 fig = spread.plot()
 plot_recommendation(robust, ax=fig.axes[0])
 wrap_title(fig.axes[0], "Recommendation kept for every FRF of the joint's uncertainty band")
 fig.savefig(out / "machinist_recommendation_band.png", dpi=110)
-plt.close(fig)
 print(f"    wrote {out / 'machinist_recommendation.png'} and {out / 'machinist_recommendation_band.png'}")
 
 # %%
