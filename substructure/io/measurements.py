@@ -12,6 +12,7 @@ on what configuration::
     quantity = "receptance"          # receptance (default) | mobility | accelerance
     sensors = ["accelerometer"]      # optional: sensors on the structure in this test
     removed = ["tool"]               # optional: components taken off for this test
+    averages = 10                    # optional: taps averaged into the FRF (substructure tap writes it)
 
 :func:`load_measurements` and :func:`loads_measurements` return a
 :class:`~substructure.measurements.MeasurementSet`.  Data file paths are
@@ -28,7 +29,10 @@ found), names the key path (``frf[2].file``) and, for problems of the data,
 the data file: unknown keys, missing or mistyped values, unknown quantities,
 missing or unreadable data files, NaN or non-increasing frequencies in them,
 dead channels (an FRF that is 0 at every line), and data files on
-different frequency grids (never reconciled silently).
+different frequency grids (never reconciled silently).  A CSV data file
+with a fourth column ``coherence`` (written by ``substructure tap``) gives
+the measurement its coherence, cropped with the FRF when a 0 Hz line is
+dropped.
 """
 
 from __future__ import annotations
@@ -45,12 +49,12 @@ from ..errors import FileFormatError, SubstructureError, SubstructureWarning
 from ..frf import FRF, QUANTITIES
 from ..measurements import Measurement, MeasurementSet, dof_label
 from ..points import check_name
-from .frf_files import read_csv, read_uff
+from .frf_files import read_csv_with_coherence, read_uff
 
 __all__ = ["load_measurements", "loads_measurements"]
 
 _TOP_KEYS = ("name", "frf")
-_FRF_KEYS = ("response", "excitation", "file", "record", "quantity", "sensors", "removed")
+_FRF_KEYS = ("response", "excitation", "file", "record", "quantity", "sensors", "removed", "averages")
 _REQUIRED = ("response", "excitation", "file")
 _CSV = (".csv",)
 _UFF = (".uff", ".unv")
@@ -135,6 +139,14 @@ class _Reader:
             raise self.error(index, "quantity", f"got {value!r}; expected one of {', '.join(QUANTITIES)}")
         return value
 
+    def averages(self, table: dict, index: int) -> int | None:
+        if "averages" not in table:
+            return None
+        value = table["averages"]
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise self.error(index, "averages", f"got {value!r}; expected the number of averages (an integer >= 1)")
+        return value
+
     def record(self, table: dict, index: int) -> int | None:
         if "record" not in table:
             return None
@@ -145,7 +157,7 @@ class _Reader:
 
     # -- data files -----------------------------------------------------------
     def data(self, index: int, file: str, record: int | None, quantity: str | None,
-             response: str, excitation: str) -> FRF:
+             response: str, excitation: str) -> tuple[FRF, Any]:
         path = self.base_dir / file
         suffix = path.suffix.lower()
         if suffix not in _CSV + _UFF:
@@ -158,10 +170,8 @@ class _Reader:
             if suffix in _CSV:
                 if record is not None:
                     raise self.error(index, "record", f"a CSV file ({file}) holds one FRF; record is for UFF files")
-                frf = read_csv(path, output=response, input=excitation, quantity=quantity)
-            else:
-                frf = self.uff(index, path, record, quantity, response, excitation)
-            return frf
+                return read_csv_with_coherence(path, output=response, input=excitation, quantity=quantity)
+            return self.uff(index, path, record, quantity, response, excitation), None
         except _LocatedError:
             raise
         except FileFormatError as exc:  # names the data file (and its line)
@@ -229,7 +239,8 @@ class _Reader:
         file = self.string(table, index, "file")
         quantity, record = self.quantity(table, index), self.record(table, index)
         sensors, removed = self.names(table, index, "sensors"), self.names(table, index, "removed")
-        raw = self.data(index, file, record, quantity, response, excitation)
+        averages = self.averages(table, index)
+        raw, coherence = self.data(index, file, record, quantity, response, excitation)
         if raw.quantity != "receptance" and raw.frequency.hz[0] == 0.0:
             line = self.lines.line(index, "file")
             warnings.warn(
@@ -238,12 +249,14 @@ class _Reader:
                 SubstructureWarning, stacklevel=2,
             )
             raw = raw.crop(lo=raw.frequency.hz[1])
+            coherence = None if coherence is None else coherence[1:]
         try:
             receptance = raw.to_receptance()
         except SubstructureError as exc:
             raise self.error(index, "file", f"{self.base_dir / file}: {exc}") from None
         try:
-            return Measurement(response, excitation, receptance, raw.quantity, sensors, removed, file, record)
+            return Measurement(response, excitation, receptance, raw.quantity, sensors, removed, file, record,
+                               coherence, averages)
         except SubstructureError as exc:  # pragma: no cover - every field was checked above
             raise self.error(index, None, str(exc)) from None
 
