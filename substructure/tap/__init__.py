@@ -1,0 +1,40 @@
+"""Tap tests: time records of an instrumented hammer and a response sensor to an FRF with coherence.
+
+The package sits next to :mod:`substructure.frf` in the layers: it needs
+``frf``, ``units`` and ``errors`` and knows nothing of models.
+
+- :mod:`~substructure.tap.records`: :class:`TapRecord` (force and response on
+  one uniform time axis, SI units) and the conversion of channels in volts
+  with a sensor's sensitivity.
+- :mod:`~substructure.tap.detect`: the pulse of a tap, double hits,
+  clipping, records without a hit, swapped channels, the taps of a long
+  record; the thresholds as named constants.
+- :mod:`~substructure.tap.process`: :func:`process_taps` (windows, H1/H2/Hv,
+  coherence, the hammer's usable band, the window's added damping) and
+  :class:`TapResult`.
+- :mod:`~substructure.tap.plots`: :func:`plot_taps`, the figure to check a result.
+
+Files are read by :mod:`substructure.io.tap_files` (``read_tap_csv``,
+``read_tap_uff``); the command is ``substructure tap`` (docs/tap.md).
+"""
+
+from .detect import (CLIP_RUN, CLIP_TOLERANCE, DOUBLE_HIT_FRACTION, ENERGY_FRACTION, NO_HIT_FACTOR, PRE_TRIGGER_S,
+                     TRIGGER_FRACTION, SwappedChannelsError)
+from .process import (ESTIMATORS, EXP_WINDOW_END, FORCE_WINDOW_EXTRA, HAMMER_BAND_DB, Tap, TapResult, added_damping,
+                      process_taps)
+from .records import RESPONSE_QUANTITIES, TapRecord, channel_to_si, unit_of
+
+__all__ = [
+    "TapRecord", "process_taps", "TapResult", "Tap", "added_damping", "channel_to_si", "unit_of",
+    "SwappedChannelsError", "plot_taps", "ESTIMATORS", "RESPONSE_QUANTITIES", "TRIGGER_FRACTION", "NO_HIT_FACTOR",
+    "DOUBLE_HIT_FRACTION", "CLIP_RUN", "CLIP_TOLERANCE", "PRE_TRIGGER_S", "ENERGY_FRACTION", "EXP_WINDOW_END",
+    "FORCE_WINDOW_EXTRA", "HAMMER_BAND_DB",
+]
+
+
+def __getattr__(name: str):
+    if name == "plot_taps":  # matplotlib only when a figure is asked for
+        from .plots import plot_taps
+
+        return plot_taps
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
