@@ -13,8 +13,8 @@ import numpy as np
 from ..errors import InvalidValueError
 
 __all__ = ["TRIGGER_FRACTION", "NO_HIT_FACTOR", "DOUBLE_HIT_FRACTION", "CLIP_RUN", "CLIP_TOLERANCE",
-           "PRE_TRIGGER_S", "ENERGY_FRACTION", "Pulse", "SwappedChannelsError", "noise_level", "find_pulse",
-           "double_hit", "longest_flat_run", "tap_starts", "spread", "check_swapped"]
+           "CLIP_REACH", "PRE_TRIGGER_S", "CREST_FACTOR_PULSE", "Pulse", "SwappedChannelsError", "noise_level", "find_pulse",
+           "double_hit", "longest_flat_run", "tap_starts", "crest_factor", "check_swapped"]
 
 TRIGGER_FRACTION = 0.05
 """The trigger level as a fraction of the tap's peak force (the pulse starts where the force first exceeds it)."""
@@ -31,11 +31,14 @@ CLIP_RUN = 4
 CLIP_TOLERANCE = 1e-9
 """Samples within this fraction of the channel's range from its extreme count as at the extreme."""
 
+CLIP_REACH = 0.5
+"""Only an extreme at least this fraction of the channel's largest excursion from its median can be a clip."""
+
 PRE_TRIGGER_S = 0.005
 """Time kept before the force first crosses its trigger level, in s (less when the record starts later)."""
 
-ENERGY_FRACTION = 0.9
-"""The share of a channel's energy whose arrival time measures how spread out the channel is (swap check)."""
+CREST_FACTOR_PULSE = 10.0
+"""A response whose peak exceeds this many times its RMS, and more than the force's, is a pulse: swapped channels."""
 
 
 class SwappedChannelsError(InvalidValueError):
@@ -172,8 +175,13 @@ def longest_flat_run(values: np.ndarray, tolerance: float = CLIP_TOLERANCE) -> t
     span = hi - lo
     if span == 0.0:
         return int(values.size), "maximum"
+    middle = float(np.median(values))
+    reach = max(hi - middle, middle - lo)
     best, where = 0, "maximum"
-    for name, mask in (("maximum", values >= hi - tolerance * span), ("minimum", values <= lo + tolerance * span)):
+    for name, mask, extreme in (("maximum", values >= hi - tolerance * span, hi),
+                                ("minimum", values <= lo + tolerance * span, lo)):
+        if abs(extreme - middle) < CLIP_REACH * reach:  # the resting level (a force between taps) is no overload
+            continue
         edges = np.flatnonzero(np.diff(np.concatenate(([0], mask.view(np.int8), [0]))))
         runs = edges[1::2] - edges[::2]
         longest = int(runs.max()) if runs.size else 0
@@ -224,38 +232,33 @@ def tap_starts(force: np.ndarray, tap_samples: int, pre_samples: int,
     return starts
 
 
-def spread(values: np.ndarray, dt: float, fraction: float = ENERGY_FRACTION) -> float:
-    """The time (s, from the first sample) by which ``fraction`` of a channel's energy has arrived.
+def crest_factor(values: np.ndarray) -> float:
+    """The peak over the RMS of a channel, its median removed (dimensionless; large for a short pulse).
 
     Parameters
     ----------
     values : numpy.ndarray
-        The channel, its median removed first.
-    dt : float
-        The time step in s.
-    fraction : float
-        The share of the energy (dimensionless).
+        The channel.
 
     Returns
     -------
     float
-        The time in s.
+        ``max|v - median| / rms(v - median)``; 0 for a constant channel.
     """
-    energy = np.cumsum((values - np.median(values)) ** 2)
-    if energy[-1] == 0.0:
-        return values.size * dt
-    return float(np.searchsorted(energy, fraction * energy[-1]) * dt)
+    centred = values - np.median(values)
+    rms = float(np.sqrt(np.mean(centred**2)))
+    return float(np.max(np.abs(centred)) / rms) if rms > 0 else 0.0
 
 
 def check_swapped(force: np.ndarray, response: np.ndarray, dt: float, source: str, force_column: str,
                   response_column: str) -> None:
-    """Refuse a record whose force spreads its energy over a longer time than its response.
+    """Refuse a record whose response looks more like a hammer's pulse than its force does.
 
-    A hammer's force is a pulse of a few milliseconds: its energy arrives at
-    once.  A structure's response rings on after it.  When the force column
-    takes longer than the response to gather :data:`ENERGY_FRACTION` of its
-    energy, and the response gathers it within the first half of the record,
-    the columns are taken to be swapped.
+    A hammer's force is a pulse of a few milliseconds in a long record: its
+    peak is many times its RMS (its crest factor is large).  A structure's
+    response rings on after the hit: its crest factor is smaller.  When the
+    response's crest factor exceeds :data:`CREST_FACTOR_PULSE` (it is a
+    pulse, not noise) and the force's, the columns are taken to be swapped.
 
     Parameters
     ----------
@@ -271,11 +274,11 @@ def check_swapped(force: np.ndarray, response: np.ndarray, dt: float, source: st
     SwappedChannelsError
         Naming the file and both columns.
     """
-    t_force, t_response = spread(force, dt), spread(response, dt)
-    if t_force > t_response and t_response < 0.5 * force.size * dt:
+    c_force, c_response = crest_factor(force), crest_factor(response)
+    if c_response > CREST_FACTOR_PULSE and c_response > c_force:
         raise SwappedChannelsError(
             f"{source}: column {force_column!r} does not look like a hammer's force and column "
-            f"{response_column!r} does: {ENERGY_FRACTION:.0%} of the force's energy arrives within "
-            f"{t_force:.4g} s, of the response's within {t_response:.4g} s (a force is a short pulse, a "
-            "response rings on); the channels look swapped: check which column is which"
+            f"{response_column!r} does: the force's peak is {c_force:.3g} times its RMS, the response's "
+            f"{c_response:.3g} times (a force is a short pulse, a response rings on); the channels look swapped: "
+            "check which column is which"
         )

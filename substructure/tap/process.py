@@ -440,7 +440,8 @@ def process_taps(
         elif estimator == "H2":
             h = gxx / np.conj(gfx)
         else:
-            h = (gxx - gff + np.sqrt((gff - gxx) ** 2 + 4.0 * np.abs(gfx) ** 2)) / (2.0 * np.conj(gfx))
+            root = np.hypot(gff - gxx, 2.0 * np.abs(gfx))  # two forms of one root, each free of cancellation
+            h = np.where(gff >= gxx, 2.0 * gfx / (gff - gxx + root), (gxx - gff + root) / (2.0 * np.conj(gfx)))
         coherence = np.abs(gfx) ** 2 / (gff * gxx)
     coherence = np.clip(np.nan_to_num(coherence, nan=0.0), 0.0, 1.0)
     h = np.nan_to_num(h)
