@@ -139,7 +139,7 @@ def _coherence(value: Any) -> np.ndarray | None:
     bad = ~np.isfinite(array) | (array < 0.0) | (array > 1.0 + COHERENCE_ROUNDING)
     if bad.any():
         k = int(np.argmax(bad))
-        raise InvalidValueError(f"coherence: line {k} is {array[k]!r}; expected a number in [0, 1]")
+        raise InvalidValueError(f"coherence: line {k} is {float(array[k])!r}; expected a number in [0, 1]")
     array = np.minimum(array, 1.0)
     array.setflags(write=False)
     return array

@@ -102,8 +102,8 @@ def run(args: argparse.Namespace) -> int:
         print("exponential window: none")
     else:
         print(f"exponential window: tau = {result.tau:.4g} s (adds a damping ratio 1/(tau omega) to every mode)")
-    shown = [(f, z) for f, z in zip(peaks, added) if f <= result.hammer_band_hz][:12]
-    print("peaks within the band:" if shown else "peaks: none within the band")
+    shown = list(zip(peaks, added))
+    print(f"peaks within the band ({result.measured.quantity}):" if shown else "peaks: none within the band")
     for f, z in shown:
         print(f"  {f:10.6g} Hz   window's added damping ratio {z:.2e}")
     for path in written:

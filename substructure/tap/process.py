@@ -23,7 +23,7 @@ from .detect import (CLIP_RUN, DOUBLE_HIT_FRACTION, NO_HIT_FACTOR, PRE_TRIGGER_S
 from .records import RESPONSE_QUANTITIES, TapRecord
 
 __all__ = ["process_taps", "TapResult", "Tap", "ESTIMATORS", "EXP_WINDOW_END", "FORCE_WINDOW_EXTRA",
-           "HAMMER_BAND_DB", "added_damping"]
+           "HAMMER_BAND_DB", "PEAK_PROMINENCE", "added_damping"]
 
 ESTIMATORS = ("H1", "H2", "Hv")
 """The FRF estimators: H1 = Gfx/Gff (noise on the response), H2 = Gxx/Gxf (noise on the force), Hv (both)."""
@@ -33,6 +33,9 @@ EXP_WINDOW_END = 0.01
 
 FORCE_WINDOW_EXTRA = 1.0
 """The force window stays open this many pulse widths after the pulse ends."""
+
+PEAK_PROMINENCE = 0.02
+"""The peaks a result reports stand out by at least this fraction of the largest magnitude in the band."""
 
 HAMMER_BAND_DB = 20.0
 """The hammer's usable band ends where the force spectrum has fallen this many dB below its low-frequency level."""
@@ -153,21 +156,33 @@ class TapResult:
         """The rejected taps, each with its reason."""
         return tuple(t for t in self.taps if not t.kept)
 
-    def peaks(self, lo: Any = None, hi: Any = None) -> np.ndarray:
-        """Frequencies (Hz) of the peaks of |FRF| (:meth:`substructure.frf.FRF.peaks`) within a band.
+    def peaks(self, lo: float | None = None, hi: float | None = None,
+              prominence: float = PEAK_PROMINENCE) -> np.ndarray:
+        """Frequencies (Hz) of the prominent peaks of the FRF as measured, within a band.
+
+        The peaks are those of the measured quantity (an accelerance for an
+        accelerometer), whose modes stand out evenly over the band, found by
+        :meth:`substructure.frf.FRF.peaks` with a prominence.
 
         Parameters
         ----------
         lo, hi : float, optional
-            The band in Hz (default: the whole FRF).
+            The band in Hz (default: the FRF's first line to the hammer's usable band).
+        prominence : float
+            The least prominence as a fraction of the largest magnitude in the band (dimensionless).
 
         Returns
         -------
         numpy.ndarray
             The peak frequencies in Hz, ascending.
         """
-        frf = self.frf if lo is None and hi is None else self.frf.crop(lo, hi)
-        return np.asarray(frf.peaks(), dtype=np.float64)
+        hz = self.measured.frequency.hz
+        lo = hz[0] if lo is None else lo
+        hi = min(self.hammer_band_hz, hz[-1]) if hi is None else hi
+        frf = self.measured.crop(lo, hi)
+        if frf.frequency.n < 3:
+            return np.zeros(0)
+        return np.asarray(frf.peaks(prominence=prominence), dtype=np.float64)
 
     def added_damping(self, frequency_hz: Any) -> np.ndarray:
         """The damping ratio the exponential window added at ``frequency_hz`` (see :func:`added_damping`).

@@ -227,14 +227,14 @@ class TapRecord:
             bad = ~np.isfinite(values)
             if bad.any():
                 k = int(np.argmax(bad))
-                raise InvalidValueError(f"{where}: column {name!r}, sample {k}: {values[k]!r}; expected a finite "
+                raise InvalidValueError(f"{where}: column {name!r}, sample {k}: {float(values[k])!r}; expected a finite "
                                         "number (a gap in the acquisition?)")
         step = np.diff(self.time)
         mean = (self.time[-1] - self.time[0]) / (n - 1)
         if not mean > 0 or np.any(np.abs(step - mean) > TIME_STEP_TOLERANCE * mean):
             k = int(np.argmax(np.abs(step - mean))) + 1 if mean > 0 else 1
             raise InvalidValueError(
-                f"{where}: column 'time', sample {k}: step {step[k - 1]!r} s where the mean step is {mean!r} s; "
+                f"{where}: column 'time', sample {k}: step {float(step[k - 1])!r} s where the mean step is {float(mean)!r} s; "
                 "expected increasing, uniformly sampled times (one record per sample rate)"
             )
 
@@ -272,8 +272,8 @@ class TapRecord:
 
     @property
     def sample_rate(self) -> float:
-        """Samples per second (Hz)."""
-        return float((self.time.size - 1) / (self.time[-1] - self.time[0]))
+        """Samples per second (Hz), from the time axis, to 10 significant digits (the rounding of stored times)."""
+        return float(f"{(self.time.size - 1) / (self.time[-1] - self.time[0]):.10g}")
 
     @property
     def duration(self) -> float:

@@ -196,7 +196,7 @@ def read_csv_with_coherence(
         if bad.any():
             k = int(np.argmax(bad))
             raise FileFormatError(
-                f"{name}, line {lines_of[k]}: coherence is {coherence[k]!r}; expected a number in [0, 1]"
+                f"{name}, line {lines_of[k]}: coherence is {float(coherence[k])!r}; expected a number in [0, 1]"
             )
         table = table[:, :3]
     return _checked_csv(table, lines_of, name, output, input, quantity or "receptance"), coherence
