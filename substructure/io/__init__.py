@@ -21,7 +21,7 @@ from typing import Iterator
 
 from ..errors import FileFormatError, OutputExistsError
 
-__public_submodules__ = ("assembly_toml", "frf_files", "measurements")
+__public_submodules__ = ("assembly_toml", "frf_files", "measurements", "tap_files")
 """Submodules that are public API of their own (documented on their own pages)."""
 
 __all__ = ["read_text", "check_readable_file", "replacing", "write_text", "write_bytes", "check_writable"]

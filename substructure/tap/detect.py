@@ -32,7 +32,7 @@ CLIP_TOLERANCE = 1e-9
 """Samples within this fraction of the channel's range from its extreme count as at the extreme."""
 
 CLIP_REACH = 0.5
-"""Only an extreme at least this fraction of the channel's largest excursion from its median can be a clip."""
+"""Only an extreme at least this fraction of the channel's largest excursion from its mean can be a clip."""
 
 PRE_TRIGGER_S = 0.005
 """Time kept before the force first crosses its trigger level, in s (less when the record starts later)."""
@@ -45,13 +45,15 @@ class SwappedChannelsError(InvalidValueError):
     """The force column looks like a response and the response like a force."""
 
 
-def noise_level(values: np.ndarray) -> float:
+def noise_level(values: np.ndarray, median: float | None = None) -> float:
     """The robust standard deviation of a channel: 1.4826 times its median absolute deviation.
 
     Parameters
     ----------
     values : numpy.ndarray
         The samples, any unit.
+    median : float, optional
+        Their median, when it is known already.
 
     Returns
     -------
@@ -59,7 +61,8 @@ def noise_level(values: np.ndarray) -> float:
         The noise level in the unit of the samples (the short pulse of a tap
         does not move it).
     """
-    return float(1.4826 * np.median(np.abs(values - np.median(values))))
+    median = float(np.median(values)) if median is None else median
+    return float(1.4826 * np.median(np.abs(values - median)))
 
 
 @attrs.frozen
@@ -82,6 +85,8 @@ class Pulse:
         The force noise level in N.
     level : float
         The trigger level in N.
+    baseline : float
+        The force's resting level (its median) in N.
     """
 
     start: int
@@ -91,6 +96,7 @@ class Pulse:
     sign: float
     noise: float
     level: float
+    baseline: float = 0.0
 
 
 def find_pulse(force: np.ndarray, trigger_fraction: float = TRIGGER_FRACTION,
@@ -111,11 +117,11 @@ def find_pulse(force: np.ndarray, trigger_fraction: float = TRIGGER_FRACTION,
     Pulse or str
         The pulse, or a reason starting with ``"no hit"``.
     """
-    baseline = np.median(force)
+    baseline = float(np.median(force))
     centred = force - baseline
     k = int(np.argmax(np.abs(centred)))
     peak = float(abs(centred[k]))
-    noise = noise_level(force)
+    noise = noise_level(force, baseline)
     if not peak > no_hit_factor * noise:
         return (f"no hit: the force never exceeds {no_hit_factor:g} times its noise (peak {peak:.3g} N, "
                 f"noise {noise:.3g} N)")
@@ -126,7 +132,7 @@ def find_pulse(force: np.ndarray, trigger_fraction: float = TRIGGER_FRACTION,
     start = int(np.argmax(above))
     below = ~above[k:]
     end = k + int(np.argmax(below)) if below.any() else force.size
-    return Pulse(start, k, end, peak, sign, noise, level)
+    return Pulse(start, k, end, peak, sign, noise, level, baseline)
 
 
 def double_hit(force: np.ndarray, pulse: Pulse, fraction: float = DOUBLE_HIT_FRACTION) -> int | None:
@@ -146,7 +152,7 @@ def double_hit(force: np.ndarray, pulse: Pulse, fraction: float = DOUBLE_HIT_FRA
     int or None
         The sample index.
     """
-    after = pulse.sign * (force[pulse.end:] - np.median(force))
+    after = pulse.sign * (force[pulse.end:] - pulse.baseline)
     level = max(fraction * pulse.peak_force, 0.5 * NO_HIT_FACTOR * pulse.noise)
     hits = after > level
     if not hits.any():
@@ -175,7 +181,7 @@ def longest_flat_run(values: np.ndarray, tolerance: float = CLIP_TOLERANCE) -> t
     span = hi - lo
     if span == 0.0:
         return int(values.size), "maximum"
-    middle = float(np.median(values))
+    middle = float(np.mean(values))
     reach = max(hi - middle, middle - lo)
     best, where = 0, "maximum"
     for name, mask, extreme in (("maximum", values >= hi - tolerance * span, hi),
@@ -233,7 +239,7 @@ def tap_starts(force: np.ndarray, tap_samples: int, pre_samples: int,
 
 
 def crest_factor(values: np.ndarray) -> float:
-    """The peak over the RMS of a channel, its median removed (dimensionless; large for a short pulse).
+    """The peak over the RMS of a channel, its mean removed (dimensionless; large for a short pulse).
 
     Parameters
     ----------
@@ -243,9 +249,9 @@ def crest_factor(values: np.ndarray) -> float:
     Returns
     -------
     float
-        ``max|v - median| / rms(v - median)``; 0 for a constant channel.
+        ``max|v - mean| / rms(v - mean)``; 0 for a constant channel.
     """
-    centred = values - np.median(values)
+    centred = values - np.mean(values)
     rms = float(np.sqrt(np.mean(centred**2)))
     return float(np.max(np.abs(centred)) / rms) if rms > 0 else 0.0
 

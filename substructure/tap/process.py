@@ -15,6 +15,7 @@ from typing import Any, Sequence
 
 import attrs
 import numpy as np
+import scipy.fft
 
 from ..errors import InvalidValueError
 from ..frf import FRF, Frequency
@@ -311,7 +312,9 @@ def process_taps(
     tap_length : float, optional
         The length of one tap in s: a record is then cut into taps at every
         trigger crossing after the previous tap ended.  Default: one tap per
-        record, from the pre-trigger to the end of the shortest record.
+        record, from the pre-trigger to the end of the shortest record
+        (shortened to the nearest length below whose FFT is fast:
+        ``scipy.fft.prev_fast_len``).
     pre_trigger : float
         Time kept before the trigger crossing, in s.
     exponential : bool
@@ -376,8 +379,8 @@ def process_taps(
         for s in starts:
             cuts.append((record, s, len(taps)))
             taps.append(Tap(len(taps) + 1, record.source, float(record.time[s] - record.time[0])))
-    if tap_length is None:
-        length = min(len(r) - s for r, s, _ in cuts)
+    if tap_length is None:  # the longest length all taps have whose FFT is fast (no large prime factor)
+        length = scipy.fft.prev_fast_len(min(len(r) - s for r, s, _ in cuts), real=True)
     if length < 16:
         raise InvalidValueError(f"{cuts[0][0].source}: the taps are {length} samples long; expected more")
     force = np.stack([r.force[s:s + length] for r, s, _ in cuts])
@@ -387,6 +390,7 @@ def process_taps(
     force_window = np.zeros_like(force)
     kept: list[int] = []
     trigger = np.zeros(len(cuts))
+    baseline = np.zeros(len(cuts))
     for row, (record, s, index) in enumerate(cuts):
         tap = taps[index]
         pulse = find_pulse(force[row], trigger_fraction, no_hit_factor)
@@ -399,7 +403,7 @@ def process_taps(
         second = double_hit(force[row], pulse, double_hit_fraction)
         if second is not None:
             t = float(record.time[s + second] - record.time[0])
-            size = abs(force[row][second] - np.median(force[row]))
+            size = abs(force[row][second] - pulse.baseline)
             reason = (f"double hit at t = {t:.5g} s (a second pulse of {size:.3g} N after the first of "
                       f"{pulse.peak_force:.3g} N had ended)")
         for name, channel in ((record.force_column, force[row]), (record.response_column, response[row])):
@@ -412,11 +416,12 @@ def process_taps(
         close = min(pulse.end + int(np.ceil(force_window_extra * (pulse.end - pulse.start))) + 1, length)
         force_window[row, :close] = 1.0
         trigger[row] = pulse.start * dt
+        baseline[row] = pulse.baseline
         if reason is None:
             kept.append(row)
-    # the usable band per tap (kept or not, from the raw force)
-    power_raw = np.abs(np.fft.rfft(force - np.median(force, axis=1, keepdims=True), axis=1)) ** 2
-    bands = _band_end(power_raw, hz, hammer_band_db)
+    # the usable band per tap (kept or not), from the force in its window
+    power = np.abs(scipy.fft.rfft((force - baseline[:, None]) * force_window, axis=1)) ** 2
+    bands = _band_end(power, hz, hammer_band_db)
     for row, (_, _, index) in enumerate(cuts):
         if taps[index].peak_force > 0:
             taps[index] = attrs.evolve(taps[index], band_hz=float(bands[row]))
@@ -424,7 +429,7 @@ def process_taps(
         reasons = "; ".join(f"tap {t.number} ({t.source}): {t.reason}" for t in taps)
         raise InvalidValueError(f"no tap kept: {reasons}")
     rows = np.array(kept)
-    f = force[rows] - np.median(force[rows], axis=1, keepdims=True)
+    f = force[rows] - baseline[rows, None]
     x = response[rows].copy()
     pre_rows = (trigger[rows] / dt).astype(int)
     for i, p in enumerate(pre_rows.tolist()):  # per tap, not per line: the response's offset before the hit
@@ -444,8 +449,8 @@ def process_taps(
         f, x = f * w, x * w
     else:
         tau = None
-    F = np.fft.rfft(f, axis=1) * dt
-    X = np.fft.rfft(x, axis=1) * dt
+    F = scipy.fft.rfft(f, axis=1) * dt
+    X = scipy.fft.rfft(x, axis=1) * dt
     gff = np.mean(np.abs(F) ** 2, axis=0)
     gxx = np.mean(np.abs(X) ** 2, axis=0)
     gfx = np.mean(np.conj(F) * X, axis=0)
