@@ -133,7 +133,9 @@ def _coherence(value: Any) -> np.ndarray | None:
     try:
         array = np.array(value, dtype=np.float64)
     except (TypeError, ValueError):
-        raise InvalidValueError(f"coherence: got {type(value).__name__}; expected an array of floats in [0, 1]") from None
+        raise InvalidValueError(
+            f"coherence: got {type(value).__name__}; expected an array of floats in [0, 1]"
+        ) from None
     if array.ndim != 1:
         raise InvalidValueError(f"coherence: got shape {array.shape}; expected one value per frequency line")
     bad = ~np.isfinite(array) | (array < 0.0) | (array > 1.0 + COHERENCE_ROUNDING)

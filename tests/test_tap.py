@@ -109,8 +109,8 @@ def test_output_noise_lowers_coherence_and_h1_stays_unbiased():
     ratio = h1.frf.data[band, 0, 0] / true[band]
     # unbiased: the complex mean over the band's lines is 1 (its magnitude per line is not: |H + noise| > |H|)
     assert abs(np.mean(ratio) - 1.0) < 0.03
-    assert np.median(np.abs(h2.frf.data[band, 0, 0] / true[band])) > 1.05
-    assert np.median(h1.coherence[(hz > 300) & (hz < 500)]) > 0.99  # at the mode the response is strong  # H2 biased up by output noise
+    assert np.median(np.abs(h2.frf.data[band, 0, 0] / true[band])) > 1.05  # H2 biased up by output noise
+    assert np.median(h1.coherence[(hz > 300) & (hz < 500)]) > 0.99  # at the mode: a strong response
 
 
 def test_input_noise_biases_h1_down_and_not_h2():
@@ -228,6 +228,22 @@ def test_record_checks_name_the_column():
     y[5] = np.nan
     with pytest.raises(InvalidValueError, match=r"r.csv: column 'response', sample 5"):
         TapRecord(t, f, y, source="r.csv")
+    gap = t.copy()
+    gap[100:] += 0.5 / FS  # a sample lost: half a step late from there on
+    with pytest.raises(InvalidValueError, match=r"r.csv: column 'time', sample 100: step"):
+        TapRecord(gap, f, x, source="r.csv")
+    same = TapRecord.from_samples(f, x, "10.24 kHz", "displacement")
+    assert same.sample_rate == FS and np.array_equal(same.time, t)
+
+
+def test_a_result_becomes_a_measurement_with_coherence_and_averages():
+    from substructure.measurements import Measurement
+
+    result = process_taps(_noisy(3, out_noise=1e-8))
+    m = Measurement.from_frf(result.measured, "tool.tip", "tool.tip", coherence=result.coherence,
+                             averages=result.averages)
+    assert m.averages == 3 and np.array_equal(m.coherence, result.coherence)
+    assert np.allclose(m.values, result.frf.data[:, 0, 0]) and m.quantity == "receptance"
 
 
 # -- files ---------------------------------------------------------------------------------------------------------

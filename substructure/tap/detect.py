@@ -12,8 +12,8 @@ import numpy as np
 
 from ..errors import InvalidValueError
 
-__all__ = ["TRIGGER_FRACTION", "NO_HIT_FACTOR", "DOUBLE_HIT_FRACTION", "CLIP_RUN", "CLIP_TOLERANCE",
-           "CLIP_REACH", "PRE_TRIGGER_S", "CREST_FACTOR_PULSE", "Pulse", "SwappedChannelsError", "noise_level", "find_pulse",
+__all__ = ["TRIGGER_FRACTION", "NO_HIT_FACTOR", "DOUBLE_HIT_FRACTION", "CLIP_RUN", "CLIP_TOLERANCE", "CLIP_REACH",
+           "PRE_TRIGGER_S", "CREST_FACTOR_PULSE", "Pulse", "SwappedChannelsError", "noise_level", "find_pulse",
            "double_hit", "longest_flat_run", "tap_starts", "crest_factor", "check_swapped"]
 
 TRIGGER_FRACTION = 0.05

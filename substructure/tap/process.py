@@ -200,28 +200,6 @@ class TapResult:
         """
         return added_damping(self.tau, frequency_hz)
 
-    def to_measurement(self, response: str, excitation: str, file: str | None = None, **kw: Any):
-        """The result as a :class:`~substructure.measurements.Measurement` with coherence and averages.
-
-        Parameters
-        ----------
-        response, excitation : str
-            Point names (``"tool.tip"``).
-        file : str, optional
-            The data file it is written to.
-        **kw
-            ``sensors`` and ``removed`` (see :class:`~substructure.measurements.Measurement`).
-
-        Returns
-        -------
-        Measurement
-            The receptance with ``coherence`` and ``averages``.
-        """
-        from ..measurements import Measurement
-
-        return Measurement.from_frf(self.measured, response, excitation, file=file, coherence=self.coherence,
-                                    averages=self.averages, **kw)
-
     def summary(self) -> dict:
         """The result as plain data (the JSON of ``substructure tap``).
 

@@ -201,7 +201,7 @@ class TapRecord:
     ------
     InvalidValueError
         Naming ``source`` and the column: channels of different lengths,
-        fewer than :data:`MIN_SAMPLES` samples, NaN or infinite samples, a
+        fewer than 16 samples (``MIN_SAMPLES``), NaN or infinite samples, a
         time axis that is not increasing and uniform.
     """
 
@@ -227,14 +227,15 @@ class TapRecord:
             bad = ~np.isfinite(values)
             if bad.any():
                 k = int(np.argmax(bad))
-                raise InvalidValueError(f"{where}: column {name!r}, sample {k}: {float(values[k])!r}; expected a finite "
-                                        "number (a gap in the acquisition?)")
+                raise InvalidValueError(f"{where}: column {name!r}, sample {k}: {float(values[k])!r}; expected a "
+                                        "finite number (a gap in the acquisition?)")
         step = np.diff(self.time)
         mean = (self.time[-1] - self.time[0]) / (n - 1)
         if not mean > 0 or np.any(np.abs(step - mean) > TIME_STEP_TOLERANCE * mean):
             k = int(np.argmax(np.abs(step - mean))) + 1 if mean > 0 else 1
             raise InvalidValueError(
-                f"{where}: column 'time', sample {k}: step {float(step[k - 1])!r} s where the mean step is {float(mean)!r} s; "
+                f"{where}: column 'time', sample {k}: step {float(step[k - 1])!r} s where the mean step is "
+                f"{float(mean)!r} s; "
                 "expected increasing, uniformly sampled times (one record per sample rate)"
             )
 
