@@ -3,7 +3,9 @@ From hammer taps to an FRF with coherence and a measurement set
 ===============================================================
 
 A tap test starts as time records: the force of an instrumented hammer and
-the response of an accelerometer, one record per tap.  This example takes
+the response of an accelerometer, one record per tap.  The thesis computes
+its FRFs "using the frequency spectrums of the force and the response"
+before any identification; this is that step.  This example takes
 five real impact records (the pyFRF project's, MIT, shipped with the
 package: 25.6 kHz, 1 s each) through ``substructure.tap``:
 
