@@ -337,3 +337,16 @@ def test_pyuff_free_free_beam_peaks_follow_euler_bernoulli():
         six = np.sort(peaks[np.argsort(-magnitude[np.searchsorted(c.frequency.hz, peaks)])[:6]])
         assert np.allclose(six, [52, 142, 279, 460, 687, 959], atol=3)
         assert np.allclose(six / six[0], ratios, rtol=0.05)
+
+
+def test_the_windows_added_damping_is_taken_out_of_the_half_power_damping():
+    # a longer tap, so that the 1-DOF peak (8 Hz wide at 400 Hz) spans many lines
+    t, f = half_sine(n=4 * N)
+    record = TapRecord(t, f, simulate(f), "displacement", "long tap")
+    result = process_taps(record, tau=0.1)
+    (peak,) = result.damping(result.peaks(100, 1000))
+    added = 1 / (0.1 * 2 * np.pi * peak["frequency_hz"])
+    assert peak["added_damping_ratio"] == pytest.approx(added)
+    assert peak["damping_ratio"] == pytest.approx(ZETA + added, rel=0.01)  # what the windowed FRF shows
+    assert peak["damping_ratio_corrected"] == pytest.approx(ZETA, rel=0.01)  # the structure's own
+    assert abs(peak["damping_ratio"] - ZETA) > 0.3 * ZETA  # the window's share is not negligible here

@@ -76,6 +76,13 @@ def test_tap_json(records, capsys):
     assert data["frequency_hz"][0] == 10.0 and data["tau_s"] > 0
     peak = min(data["peaks"], key=lambda p: abs(p["frequency_hz"] - 900))
     assert peak["added_damping_ratio"] == pytest.approx(1 / (data["tau_s"] * 2 * np.pi * peak["frequency_hz"]))
+    assert "damping_ratio" not in peak
+    code, text, err = run(capsys, "tap", *paths[:3], "--json", "--correct-window-damping")
+    assert code == 0, err
+    for p in json.loads(text)["peaks"]:
+        if p["damping_ratio"] is not None:
+            assert p["damping_ratio_corrected"] == pytest.approx(p["damping_ratio"] - p["added_damping_ratio"])
+    assert any(p["damping_ratio"] is not None for p in json.loads(text)["peaks"])
 
 
 def test_tap_reports_a_rejected_tap_with_its_reason(records, tmp_path, capsys):

@@ -80,9 +80,14 @@ def run(args: argparse.Namespace) -> int:
                               + (" ..." if len(args.records) > 3 else "")), args.plot, args.overwrite)
         written.append(args.plot)
     added = result.added_damping(peaks) if len(peaks) else []
+    damping = result.damping(peaks) if args.correct_window_damping else None
     if args.json:
         out = result.summary()
         out["peaks"] = [{"frequency_hz": float(f), "added_damping_ratio": float(z)} for f, z in zip(peaks, added)]
+        if damping is not None:
+            for entry, d in zip(out["peaks"], damping):
+                entry["damping_ratio"] = d["damping_ratio"]
+                entry["damping_ratio_corrected"] = d["damping_ratio_corrected"]
         return print_json(out)
     import numpy as np
 
@@ -104,8 +109,15 @@ def run(args: argparse.Namespace) -> int:
         print(f"exponential window: tau = {result.tau:.4g} s (adds a damping ratio 1/(tau omega) to every mode)")
     shown = list(zip(peaks, added))
     print(f"peaks within the band ({result.measured.quantity}):" if shown else "peaks: none within the band")
-    for f, z in shown:
-        print(f"  {f:10.6g} Hz   window's added damping ratio {z:.2e}")
+    for k, (f, z) in enumerate(shown):
+        line = f"  {f:10.6g} Hz   window's added damping ratio {z:.2e}"
+        if damping is not None:
+            d = damping[k]
+            line += ("; half-power damping not found (peak too narrow or too close to another)"
+                     if d["damping_ratio"] is None else
+                     f"; half-power damping ratio {d['damping_ratio']:.3e}, without the window's "
+                     f"{d['damping_ratio_corrected']:.3e}")
+        print(line)
     for path in written:
         print(f"wrote {path}")
     return 0
@@ -139,6 +151,8 @@ def add_parser(commands) -> None:
     tap.add_argument("--tau", type=float, metavar="SECONDS",
                      help="time constant of the exponential window (default: 1%% left at the end of the tap)")
     tap.add_argument("--no-exponential-window", action="store_true", help="no exponential window")
+    tap.add_argument("--correct-window-damping", action="store_true",
+                     help="also each peak's half-power damping ratio, and the same less the window's 1/(tau omega)")
     tap.add_argument("--hammer-band-db", type=float, metavar="DB",
                      help="force spectrum drop that ends the hammer's usable band (default 20 dB, tap.HAMMER_BAND_DB)")
     tap.add_argument("--band", type=band_range_arg, metavar="LO:HI", help="keep only these lines (Hz)")

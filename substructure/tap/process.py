@@ -24,7 +24,7 @@ from .detect import (CLIP_RUN, DOUBLE_HIT_FRACTION, NO_HIT_FACTOR, PRE_TRIGGER_S
 from .records import RESPONSE_QUANTITIES, TapRecord
 
 __all__ = ["process_taps", "TapResult", "Tap", "ESTIMATORS", "EXP_WINDOW_END", "FORCE_WINDOW_EXTRA",
-           "HAMMER_BAND_DB", "PEAK_PROMINENCE", "added_damping"]
+           "HAMMER_BAND_DB", "PEAK_PROMINENCE", "HALF_POWER_LINES", "added_damping"]
 
 ESTIMATORS = ("H1", "H2", "Hv")
 """The FRF estimators: H1 = Gfx/Gff (noise on the response), H2 = Gxx/Gxf (noise on the force), Hv (both)."""
@@ -34,6 +34,9 @@ EXP_WINDOW_END = 0.01
 
 FORCE_WINDOW_EXTRA = 1.0
 """The force window stays open this many pulse widths after the pulse ends."""
+
+HALF_POWER_LINES = 3
+"""A half-power bandwidth narrower than this many lines gives no damping ratio (the grid cannot resolve it)."""
 
 PEAK_PROMINENCE = 0.02
 """The peaks a result reports stand out by at least this fraction of the largest magnitude in the band."""
@@ -199,6 +202,56 @@ class TapResult:
             Dimensionless added damping ratios.
         """
         return added_damping(self.tau, frequency_hz)
+
+    def damping(self, peaks: Any = None) -> list[dict]:
+        """The damping ratio of each peak by its half-power bandwidth, and with the window's share taken out.
+
+        The exponential window moves every pole by ``-1/tau`` (docs/tap.md,
+        section 3): a mode's decay rate ``zeta omega_n`` grows by ``1/tau``
+        exactly.  The half-power bandwidth of the windowed peak gives
+        ``zeta_measured = (f_2 - f_1) / (2 f_peak)`` (the crossings of
+        ``|H|^2 = max/2`` interpolated between lines, on the receptance);
+        ``zeta_corrected = zeta_measured - 1/(tau omega_peak)``.  It needs a
+        peak several lines wide and apart from its neighbours; a peak whose
+        half-power points are not found on both sides within half the
+        distance to the next peak, or lie fewer than :data:`HALF_POWER_LINES`
+        lines apart, gets None.
+
+        Parameters
+        ----------
+        peaks : array of float, optional
+            Peak frequencies in Hz (default: :meth:`peaks`).
+
+        Returns
+        -------
+        list of dict
+            Per peak: ``frequency_hz``, ``damping_ratio`` (half-power, as
+            measured, with the window's), ``added_damping_ratio`` and
+            ``damping_ratio_corrected`` (dimensionless; None where the
+            half-power points are not found).
+        """
+        peaks = self.peaks() if peaks is None else np.atleast_1d(np.asarray(peaks, dtype=np.float64))
+        hz = self.frf.frequency.hz
+        power = np.abs(self.frf.data[:, 0, 0]) ** 2
+        out = []
+        for j, f in enumerate(peaks.tolist()):  # per peak (a handful), not per line
+            k = int(np.argmin(np.abs(hz - f)))
+            lo_edge = 0.5 * (peaks[j - 1] + f) if j > 0 else hz[0]
+            hi_edge = 0.5 * (peaks[j + 1] + f) if j + 1 < peaks.size else hz[-1]
+            half = 0.5 * power[k]
+            left = np.flatnonzero((power[:k] < half) & (hz[:k] >= lo_edge))
+            right = np.flatnonzero((power[k:] < half) & (hz[k:] <= hi_edge)) + k
+            zeta = None
+            if left.size and right.size:
+                i, r = left[-1], right[0]
+                f1 = np.interp(half, [power[i], power[i + 1]], [hz[i], hz[i + 1]])
+                f2 = np.interp(half, [power[r], power[r - 1]], [hz[r], hz[r - 1]])
+                if f2 - f1 >= HALF_POWER_LINES * (hz[1] - hz[0]):
+                    zeta = float((f2 - f1) / (2.0 * hz[k]))
+            added = float(added_damping(self.tau, hz[k]))
+            out.append({"frequency_hz": float(hz[k]), "damping_ratio": zeta, "added_damping_ratio": added,
+                        "damping_ratio_corrected": None if zeta is None else zeta - added})
+        return out
 
     def summary(self) -> dict:
         """The result as plain data (the JSON of ``substructure tap``).
