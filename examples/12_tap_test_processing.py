@@ -33,7 +33,8 @@ import numpy as np
 from substructure.datasets import impact_records
 from substructure.io.frf_files import write_csv
 from substructure.io.measurements import load_measurements
-from substructure.tap import TapRecord, plot_taps, process_taps
+from substructure.plot import plot_taps
+from substructure.tap import TapRecord, process_taps
 
 out = Path(os.environ.get("SUBSTRUCTURE_EXAMPLES_OUT", "out/examples"))
 out.mkdir(parents=True, exist_ok=True)

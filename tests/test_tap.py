@@ -350,3 +350,21 @@ def test_the_windows_added_damping_is_taken_out_of_the_half_power_damping():
     assert peak["damping_ratio"] == pytest.approx(ZETA + added, rel=0.01)  # what the windowed FRF shows
     assert peak["damping_ratio_corrected"] == pytest.approx(ZETA, rel=0.01)  # the structure's own
     assert abs(peak["damping_ratio"] - ZETA) > 0.3 * ZETA  # the window's share is not negligible here
+
+
+def test_the_figure_shows_spectra_band_coherence_and_frf():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from substructure.plot import plot_taps
+
+    result = process_taps(_noisy(2, out_noise=1e-8))
+    fig = plot_taps(result, title="two taps")
+    ax_f, ax_c, ax_m, ax_p = fig.axes
+    assert len(ax_f.lines) == 3  # two taps and the band's line
+    assert ax_f.lines[-1].get_xdata()[0] == result.hammer_band_hz
+    assert np.array_equal(ax_c.lines[0].get_ydata(), result.coherence)
+    assert ax_m.get_yscale() == "log" and "two taps" in fig._suptitle.get_text()
+    plt.close(fig)

@@ -74,7 +74,7 @@ def run(args: argparse.Namespace) -> int:
         written.append(args.measurements)
     if args.plot:
         figures()
-        from ..tap.plots import plot_taps
+        from ..plot import plot_taps
 
         save_figure(plot_taps(result, title=", ".join(Path(p).name for p in args.records[:3])
                               + (" ..." if len(args.records) > 3 else "")), args.plot, args.overwrite)

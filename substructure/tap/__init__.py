@@ -12,10 +12,11 @@ The package sits next to :mod:`substructure.frf` in the layers: it needs
 - :mod:`~substructure.tap.process`: :func:`process_taps` (windows, H1/H2/Hv,
   coherence, the hammer's usable band, the window's added damping) and
   :class:`TapResult`.
-- :mod:`~substructure.tap.plots`: :func:`plot_taps`, the figure to check a result.
 
 Files are read by :mod:`substructure.io.tap_files` (``read_tap_csv``,
-``read_tap_uff``); the command is ``substructure tap`` (docs/tap.md).
+``read_tap_uff``), the figure to check a result is
+:func:`substructure.plot.plot_taps`; the command is ``substructure tap``
+(docs/tap.md).
 """
 
 from .detect import (CLIP_REACH, CLIP_RUN, CLIP_TOLERANCE, CREST_FACTOR_PULSE, DOUBLE_HIT_FRACTION, NO_HIT_FACTOR,
@@ -26,15 +27,8 @@ from .records import RESPONSE_QUANTITIES, TapRecord, channel_to_si, unit_of
 
 __all__ = [
     "TapRecord", "process_taps", "TapResult", "Tap", "added_damping", "channel_to_si", "unit_of",
-    "SwappedChannelsError", "plot_taps", "ESTIMATORS", "RESPONSE_QUANTITIES", "TRIGGER_FRACTION", "NO_HIT_FACTOR",
+    "SwappedChannelsError", "ESTIMATORS", "RESPONSE_QUANTITIES", "TRIGGER_FRACTION", "NO_HIT_FACTOR",
     "DOUBLE_HIT_FRACTION", "CLIP_RUN", "CLIP_TOLERANCE", "CLIP_REACH", "PRE_TRIGGER_S", "CREST_FACTOR_PULSE",
     "EXP_WINDOW_END", "FORCE_WINDOW_EXTRA", "HAMMER_BAND_DB", "PEAK_PROMINENCE", "HALF_POWER_LINES",
 ]
 
-
-def __getattr__(name: str):
-    if name == "plot_taps":  # matplotlib only when a figure is asked for
-        from .plots import plot_taps
-
-        return plot_taps
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
