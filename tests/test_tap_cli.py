@@ -156,3 +156,33 @@ def test_measurement_file_averages_and_coherence_column(tmp_path):
         load_measurements(tmp_path / "set.toml")
     write_csv(frf, tmp_path / "a.csv")  # an old three-column file: no coherence
     assert load_measurements(tmp_path / "set.toml").measurements[0].coherence is None
+
+
+def test_tap_reads_a_universal_file_and_a_long_record(tmp_path, capsys):
+    import pyuff
+
+    r = impact_records()[0]
+    path = tmp_path / "tap.uff"
+    uff = pyuff.UFF(str(path))
+    for data, spec, unit, node in ((r.force, 13, "N", 1), (r.response, 12, "m/s^2", 2)):
+        uff.write_sets(pyuff.prepare_58(
+            func_type=1, rsp_node=node, rsp_dir=3, ref_node=1, ref_dir=3, data=data, x=r.time, num_pts=len(r),
+            abscissa_spacing=1, abscissa_min=0.0, abscissa_inc=1 / 25600, abscissa_spec_data_type=17,
+            ordinate_spec_data_type=spec, ordinate_axis_units_lab=unit, id1=f"node {node}",
+            orddenom_spec_data_type=0, orddenom_axis_units_lab="", abscissa_axis_units_lab="s",
+            z_axis_spec_data_type=0, z_axis_axis_units_lab=""), mode="add")
+    code, text, err = run(capsys, "tap", path, "--json")
+    assert code == 0, err
+    data = json.loads(text)
+    assert data["taps"] == 1 and data["per_tap"][0]["peak_force_n"] == pytest.approx(68.6, abs=0.1)
+    # the five records one after the other in one file, cut again into five taps of 0.9 s
+    records = impact_records()
+    long = tmp_path / "long.csv"
+    t = np.arange(5 * len(r)) / 25600
+    np.savetxt(long, np.column_stack([t, np.concatenate([x.force for x in records]),
+                                      np.concatenate([x.response for x in records])]), delimiter=",",
+               header="time [s],force [N],acceleration [g]", comments="")
+    code, text, err = run(capsys, "tap", long, "--tap-length", "0.9", "--json")
+    assert code == 0, err
+    data = json.loads(text)
+    assert data["taps"] == 5 and [round(p["start_s"]) for p in data["per_tap"]] == [0, 1, 2, 3, 4]
