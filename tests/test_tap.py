@@ -368,3 +368,17 @@ def test_the_figure_shows_spectra_band_coherence_and_frf():
     assert np.array_equal(ax_c.lines[0].get_ydata(), result.coherence)
     assert ax_m.get_yscale() == "log" and "two taps" in fig._suptitle.get_text()
     plt.close(fig)
+
+
+def test_a_tap_the_record_cuts_short_is_rejected_and_a_quiet_long_record_is_an_error():
+    n = 2 * N
+    t = np.arange(n) / FS
+    f = half_sine(50.0, start=0.05, n=n)[1] + half_sine(60.0, start=1.5, n=n)[1]
+    record = TapRecord(t, f, simulate(f), "displacement", "long.csv")
+    result = process_taps(record, tap_length=0.9, pre_trigger=0.01)
+    assert [tp.kept for tp in result.taps] == [True, False]
+    assert result.taps[1].reason.startswith("cut short: the record ends 0.5099 s into this tap of 0.9 s")
+    rng = np.random.default_rng(5)
+    quiet = TapRecord(t, 0.01 * rng.standard_normal(n), 1e-9 * rng.standard_normal(n), "displacement", "q.csv")
+    with pytest.raises(InvalidValueError, match=r"no tap kept: tap 1 \(q.csv\): no hit"):
+        process_taps(quiet, tap_length=0.9)

@@ -401,15 +401,22 @@ def process_taps(
             start = 0 if isinstance(first, str) else max(first.start - pre, 0)
             starts = [start]
         else:
-            starts = [s for s in tap_starts(record.force, length, pre, trigger_fraction, no_hit_factor)
-                      if s + length <= len(record)]
+            starts = tap_starts(record.force, length, pre, trigger_fraction, no_hit_factor)
             if not starts:
                 taps.append(Tap(len(taps) + 1, record.source, 0.0,
-                                reason=f"no hit: no complete tap of {tap_length} s in the record"))
-                continue
+                                reason="no hit: the force never exceeds "
+                                       f"{no_hit_factor:g} times its noise in the record"))
         for s in starts:
-            cuts.append((record, s, len(taps)))
-            taps.append(Tap(len(taps) + 1, record.source, float(record.time[s] - record.time[0])))
+            tap = Tap(len(taps) + 1, record.source, float(record.time[s] - record.time[0]))
+            if tap_length is not None and s + length > len(record):  # the record ends inside this tap
+                tap = attrs.evolve(tap, reason=f"cut short: the record ends {(len(record) - s) / rate:.4g} s into "
+                                               f"this tap of {tap_length:g} s")
+            else:
+                cuts.append((record, s, len(taps)))
+            taps.append(tap)
+    if not cuts:
+        reasons = "; ".join(f"tap {t.number} ({t.source}): {t.reason}" for t in taps)
+        raise InvalidValueError(f"no tap kept: {reasons}")
     if tap_length is None:  # the longest length all taps have whose FFT is fast (no large prime factor)
         length = scipy.fft.prev_fast_len(min(len(r) - s for r, s, _ in cuts), real=True)
     if length < 16:
