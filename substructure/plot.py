@@ -29,7 +29,7 @@ from .errors import InvalidValueError, UnitError
 from .frf import FRF
 from .units import to_si
 
-__all__ = ["plot_frf", "plot_identification", "rigid_body_cutoff", "FRF_UNITS"]
+__all__ = ["plot_frf", "plot_identification", "plot_taps", "rigid_body_cutoff", "FRF_UNITS"]
 
 PARTS = ("magnitude", "phase", "real", "imag")
 KINDS = {"bode": ("magnitude", "phase"), "real-imag": ("real", "imag"), "nyquist": ("nyquist",)}
@@ -413,4 +413,50 @@ def plot_identification(result, names=("k_yf", "c_yf"), band=None, fitted=None, 
             twin.set_ylabel("|H| [m/N]", color="tab:orange")
     axes[0].legend(loc="best", fontsize="small")
     axes[-1].set_xlabel("frequency [Hz]")
+    return fig
+
+
+def plot_taps(result, title: str | None = None, unit: str = "um/N") -> Figure:
+    """Four panels for a person to check a tap test (:mod:`substructure.tap`); returns the Figure.
+
+    Top to bottom, on one frequency axis: each kept tap's force spectrum in
+    dB with the hammer's usable band marked, the coherence, and the
+    receptance's magnitude and phase drawn by :func:`plot_frf` (its units,
+    labels and rigid-body line left out of the scale).
+
+    Parameters
+    ----------
+    result : substructure.tap.TapResult
+        The processed taps.
+    title : str, optional
+        The figure's title (the estimator, the taps and the window follow it).
+    unit : {"um/N", "m/N", "mm/N", "nm/N"}
+        Unit of the magnitude axis.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure, never shown.
+    """
+    fig, axes = plt.subplots(4, 1, sharex=True, figsize=(7.5, 9.5), layout="constrained",
+                             gridspec_kw={"height_ratios": [1.2, 0.8, 1.5, 1.0]})
+    ax_f, ax_c, ax_m, ax_p = axes
+    hz = result.frf.frequency.hz
+    kept = [t for t in result.taps if t.kept]
+    for tap, spectrum in zip(kept, result.force_spectra_db):
+        ax_f.plot(hz, spectrum, lw=0.8, label=f"tap {tap.number} ({tap.peak_force:.0f} N)")
+    ax_f.axvline(result.hammer_band_hz, color="0.4", ls="--", lw=0.8,
+                 label=f"usable band: {result.hammer_band_hz:.0f} Hz (-{result.hammer_band_db:g} dB)")
+    ax_f.set_ylabel("force spectrum\n[dB re 1 N/Hz]")
+    ax_f.legend(fontsize=7, ncol=2, loc="lower left")
+    ax_c.plot(hz, result.coherence, color="C2", lw=0.8)
+    ax_c.set_ylim(-0.02, 1.02)
+    ax_c.set_ylabel("coherence")
+    for ax in (ax_f, ax_c):
+        ax.grid(True, alpha=0.3)
+    plot_frf(result.frf, ax=[ax_m, ax_p], unit=unit, note=False)
+    rejected = len(result.rejected)
+    about = (f"{result.estimator}, {result.averages} taps averaged" + (f", {rejected} rejected" if rejected else "")
+             + (f"; exponential window tau = {result.tau:.4g} s" if result.tau else "; no exponential window"))
+    fig.suptitle((title + "\n" if title else "") + about, fontsize=10)
     return fig
