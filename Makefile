@@ -9,8 +9,9 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 DOCS_STAMP := $(VENV)/.installed-docs
+NOTEBOOKS_STAMP := $(VENV)/.installed-notebooks
 
-.PHONY: demo test bench examples docs clean report-check
+.PHONY: demo test bench examples docs notebooks clean report-check
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -53,5 +54,15 @@ docs: $(DOCS_STAMP)
 	MPLBACKEND=Agg $(BIN)/python -m sphinx -b html -W --keep-going docs docs/_build/html
 	@echo "docs: open docs/_build/html/index.html"
 
+# The examples as Jupyter notebooks (the ones the site offers), each executed on a Python kernel
+# in out/notebooks/NN_name/ and checked to show its figures inline; see docs/teaching.md.
+# Open them with `.venv/bin/jupyter lab out/notebooks`.
+$(NOTEBOOKS_STAMP): $(STAMP) pyproject.toml
+	$(BIN)/python -m pip install --quiet -e ".[test,notebooks]"
+	touch $(NOTEBOOKS_STAMP)
+
+notebooks: $(NOTEBOOKS_STAMP)
+	$(BIN)/python docs/_ext/notebooks.py --out out/notebooks
+
 clean:
-	rm -rf $(VENV) out .pytest_cache build docs/_build docs/api docs/auto_examples substructure/_ckernels*.so
+	rm -rf $(VENV) out .pytest_cache build docs/_build docs/api docs/auto_examples docs/figures substructure/_ckernels*.so

@@ -34,11 +34,13 @@ extensions = [
     "api_pages",  # the API reference pages, from __all__
     "repo_links",  # links to files of the repository, mapped to site pages
     "gallery_support",  # the examples' PNG figures in the gallery, and its checks
+    "offline_site",  # MathJax from _static, not a CDN; a check that no page loads from the network
+    "chapter_figures",  # the chapter pages' figures, drawn from the library into docs/figures/
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build", "_ext", "_inventories", "_templates", "**/*.ipynb", "auto_examples/*.py",
+exclude_patterns = ["_build", "_ext", "_inventories", "_templates", "_static", "figures", "**/*.ipynb", "auto_examples/*.py",
                     "auto_examples/*.md5", "auto_examples/*.zip", "auto_examples/*.json"]
 templates_path = ["_templates"]
 
@@ -127,6 +129,7 @@ html_theme_options = {
     "footer_start": ["copyright"],
     "footer_end": ["sphinx-version", "theme-version"],
 }
-html_static_path = []
+html_static_path = ["_static"]
+html_css_files = ["substructure.css"]  # code lines wrap instead of running out of the column
 html_show_sourcelink = True
 html_last_updated_fmt = None

@@ -206,8 +206,10 @@ fig = SH11["holder.tip:y", "holder.tip:y"].plot(label="H of [SH11], holder tip: 
 SH11_eq.plot(ax=fig, label="H of [SH11]: eq. 2.1 (numpy)", ls=":", color="k")
 H_tool.plot(ax=fig, label="H of [SHT11], tool tip: Assembly")
 SHT11_eq.plot(ax=fig, label="H of [SHT11]: eq. 2.2 (numpy)", ls=":", color="k")
-SHT11_semi["tool.tip:y", "tool.tip:y"].plot(ax=fig, label="H of [SHT11]: measured + tool", ls="--")
-fig.axes[0].set_ylim(top=1e-3)  # head room for the legend
+# The axes show um/N (plot_frf's default unit): limits are given with their
+# unit, and converted to it.  The upper limit leaves head room for the legend.
+SHT11_semi["tool.tip:y", "tool.tip:y"].plot(ax=fig, label="H of [SHT11]: measured + tool", ls="--",
+                                            limits=(None, "1e-3 m/N"))
 fig.axes[0].legend(loc="upper right", fontsize="x-small")
 fig.suptitle("(b)-(d) Receptances H = y/f after coupling")
 save(fig, "01bcd_coupling.png")

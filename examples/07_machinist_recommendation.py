@@ -12,7 +12,10 @@ with a stated margin, its runners-up and a plot.
 Steps: (a) the structure and its rigid-body band; (b) the same from tap-test
 data; (c) the cut from the workpiece table; (d) the machine; (e) the
 recommendation and its margin, checked on a finer grid; (f) robust to an
-uncertain joint; (g) the plot; (h) all of it in one HTML report.
+uncertain joint; (g) the plot; (h) all of it in one HTML report; (i) the
+cutting speed and feed in the shop's units, against the usual range; (j) a
+catalogue holder whose joints were never identified: its priors and the
+stability band.
 
 Figures are written to $SUBSTRUCTURE_EXAMPLES_OUT (default: out/examples).
 """
@@ -24,13 +27,13 @@ import os
 import tempfile
 from pathlib import Path
 
-import matplotlib.pyplot as plt
 import numpy as np
 
-from substructure import FRF, Frequency, Sensor, default_assembly
+from substructure import FRF, Frequency, Holder, Sensor, default_assembly
+from substructure.joint_priors import joint_provenances, with_joint_priors
 from substructure.report import report
-from substructure.stability import (MachineLimits, MillingCut, assembly_structure, flexible_band, lobes_band,
-                                    recommend, spindle_speeds, workpiece, xy_frf, zoa)
+from substructure.stability import (MachineLimits, MillingCut, assembly_structure, check_cutting, cutting_data,
+                                    flexible_band, lobes_band, recommend, spindle_speeds, workpiece, xy_frf, zoa)
 from substructure.stability.plotting import plot_recommendation, wrap_title
 from substructure.sweep import sweep
 from substructure.units import Q_
@@ -83,7 +86,7 @@ print(f"    {found.reason}")
 # -------------------------------------------
 # Aluminium 7075-T6 from the project's table (linear edge-force model with
 # its published source), 3 mm radial depth, 0.05 mm feed per tooth.
-material = workpiece("aluminium-7075")
+material = workpiece("Aluminum 7075-T6")  # the shop's spelling finds the table's aluminium-7075
 cut = MillingCut.for_workpiece(tool.teeth, tool.cutting_diameter, material, radial_depth="3 mm",
                                feed_per_tooth="0.05 mm", milling="down")
 print("3. Cut")
@@ -150,12 +153,10 @@ print(f"    {robust.describe()[0]} (limit {robust.limit_depth_m * 1e3:.2f} mm ov
 fig = lobes.plot(lobes=True, recommendation=best,
                  title=f"From tap test to spindle speed: {cut.describe()}")
 fig.savefig(out / "machinist_recommendation.png", dpi=110)
-plt.close(fig)
 fig = spread.plot()
 plot_recommendation(robust, ax=fig.axes[0])
 wrap_title(fig.axes[0], "Recommendation kept for every FRF of the joint's uncertainty band")
 fig.savefig(out / "machinist_recommendation_band.png", dpi=110)
-plt.close(fig)
 print(f"    wrote {out / 'machinist_recommendation.png'} and {out / 'machinist_recommendation_band.png'}")
 
 # %%
@@ -174,3 +175,37 @@ path = page.save(out / "machinist_report.html", overwrite=True)
 print("7. Report")
 print(f"    wrote {path} ({path.stat().st_size / 1024:.0f} kB): {len(page.modes)} modes, "
       f"{len(page.assumptions())} assumptions stated")
+
+# %%
+# (i) Cutting speed and feed, in the shop's units
+# -----------------------------------------------
+# The recommendation in rpm, as a cutting speed (pi D n, in m/min and SFM)
+# and a feed rate, checked against the usual range of the work material
+# with a carbide tool (an assumed range of published orders of magnitude:
+# a warning outside it, never a clip).
+data = cutting_data(material, "carbide")
+print("8. Cutting data")
+print(f"    {best.cutting_speed_m_per_min:.0f} m/min ({best.cutting_speed_m_per_min / 0.3048:.0f} SFM), "
+      f"{best.feed_per_tooth_m * 1e3:.3g} mm/tooth, {best.feed_rate_m_per_min * 1e3:.0f} mm/min")
+print(f"    usual for {data.workpiece} with carbide: {data.speed_range_m_per_min[0]:.0f} to "
+      f"{data.speed_range_m_per_min[1]:.0f} m/min; outside: "
+      f"{check_cutting(cut, best.spindle_speed_rpm, data) or 'none'}")
+
+# %%
+# (j) A catalogue holder: priors instead of another holder's joints
+# ------------------------------------------------------------------
+# An HSK-A63 shrink-fit chuck from the catalogue has no joint values of its
+# own; the built-in assembly's are a collet chuck's.  The report says so.
+# Its documented priors (a wide uncertainty, factor 4) replace them, and
+# the report recommends the depth that is stable for every variant of the
+# joints within that uncertainty, next to the nominal one.
+shrink = assembly.with_component(Holder.from_catalog("HSK-A63 shrink-fit", bore="12 mm", gauge_length="80 mm"))
+print("9. HSK-A63 shrink-fit from the catalogue")
+for row in joint_provenances(shrink):
+    print(f"    {row['name']}: {row['kind']}" + (" (flagged: may be another holder's)" if row["warning"] else ""))
+priored = report(with_joint_priors(shrink), cut=cut, limits=limits, speeds=speeds)
+for row in joint_provenances(priored.assembly):
+    print(f"    {row['name']}: {row['kind']}, within a factor {row['uncertainty']:g}")
+nominal, banded = priored.recommendation, priored.band_recommendation
+print(f"    nominal joints: {nominal.describe()[0]}")
+print(f"    across {len(priored.band.members)} variants of the joints: {banded.describe()[0]}")

@@ -35,8 +35,6 @@ Figures are written to $SUBSTRUCTURE_EXAMPLES_OUT (default: out/examples).
 import os
 from pathlib import Path
 
-import matplotlib.pyplot as plt
-
 from substructure import Mass, default_assembly, save_assembly
 from substructure.diagnose import Effect, Parameter, diagnose
 from substructure.synthetic import simulate
@@ -46,9 +44,8 @@ out.mkdir(parents=True, exist_ok=True)
 
 
 def save(fig, name):
-    """Write a figure to the output directory (never shown: this runs in tests too)."""
+    """Write a figure to the output directory; it stays open, so that a notebook shows it."""
     fig.savefig(out / name, dpi=110)
-    plt.close(fig)
     print(f"    wrote {out / name}")
 
 

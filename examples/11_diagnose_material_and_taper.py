@@ -40,7 +40,6 @@ import os
 from pathlib import Path
 
 import attrs
-import matplotlib.pyplot as plt
 
 from substructure import Material, Segment, Tool, default_assembly
 from substructure.diagnose import diagnose
@@ -51,9 +50,8 @@ out.mkdir(parents=True, exist_ok=True)
 
 
 def save(fig, name):
-    """Write a figure to the output directory (never shown: this runs in tests too)."""
+    """Write a figure to the output directory; it stays open, so that a notebook shows it."""
     fig.savefig(out / name, dpi=110)
-    plt.close(fig)
     print(f"    wrote {out / name}")
 
 

@@ -29,7 +29,13 @@ from .errors import InvalidValueError, NonPassiveJointWarning, NonReciprocalWarn
 from .points import check_name, parse_point
 from .units import format_quantity, magnitude_in, quantity
 
-__all__ = ["JointMatrix", "Joint", "Support", "Sensor", "Mass", "STIFFNESS_UNITS", "DAMPING_UNITS"]
+__all__ = ["JointMatrix", "Joint", "JointProvenance", "PROVENANCE_KINDS", "Support", "Sensor", "Mass",
+           "STIFFNESS_UNITS", "DAMPING_UNITS"]
+
+PROVENANCE_KINDS = ("identified", "predicted", "borrowed", "prior")
+"""Where a joint's values come from: identified from a test of this assembly; predicted from a joint table
+(with the prediction's uncertainty); borrowed from another holder or tool; a prior (a literature or assumed
+value for this type of holder, with its source and a wide uncertainty)."""
 
 ENTRIES = ("yf", "ym", "tf", "tm")
 #: The SI unit of each stiffness entry: ``yf`` force per displacement, ``ym`` moment per
@@ -186,6 +192,73 @@ def _between(value) -> tuple[str, str]:
     return a, b
 
 
+def _uncertainty(value) -> float | None:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not 1.0 <= float(value) < 1e3:
+        raise InvalidValueError(f"uncertainty: got {value!r}; expected a factor >= 1 (the values may be this "
+                                "factor lower or higher, e.g. 3), or none")
+    return float(value)
+
+
+def _kind(value) -> str:
+    if value not in PROVENANCE_KINDS:
+        raise InvalidValueError(f"provenance: got {value!r}; expected one of {', '.join(PROVENANCE_KINDS)}")
+    return value
+
+
+@attrs.frozen
+class JointProvenance:
+    """Where the values of a joint come from, and how far they may be off.
+
+    Parameters
+    ----------
+    kind : {"identified", "predicted", "borrowed", "prior"}
+        See :data:`PROVENANCE_KINDS`.
+    source : str
+        The test, the table, the holder they were borrowed from, or the
+        literature the prior follows.
+    uncertainty : float, optional
+        A factor ``f >= 1``: the stiffness and damping may be between ``1/f``
+        and ``f`` times the values (None: not stated).
+    """
+
+    kind: str = attrs.field(converter=_kind)
+    source: str = attrs.field(default="", converter=str)
+    uncertainty: float | None = attrs.field(default=None, converter=_uncertainty)
+
+    def describe(self) -> str:
+        """One line: the kind, the uncertainty and the source.
+
+        Returns
+        -------
+        str
+            E.g. ``"prior (x/ 3): ..."``.
+        """
+        spread = f" (within a factor {self.uncertainty:g})" if self.uncertainty is not None else ""
+        return f"{self.kind}{spread}" + (f": {self.source}" if self.source else "")
+
+    def to_json(self) -> dict:
+        """``kind``, ``source``, ``uncertainty`` (None when not stated).
+
+        Returns
+        -------
+        dict
+            The three fields.
+        """
+        return {"kind": self.kind, "source": self.source, "uncertainty": self.uncertainty}
+
+
+def _provenance(value) -> JointProvenance | None:
+    if value is None or isinstance(value, JointProvenance):
+        return value
+    if isinstance(value, str):
+        return JointProvenance(value)
+    if isinstance(value, Mapping):
+        return JointProvenance(**value)
+    raise InvalidValueError(f"provenance: got {value!r}; expected a JointProvenance, a kind or a mapping")
+
+
 @attrs.frozen
 class Joint:
     """A connection between two points: rigid, or elastic with stiffness and damping.
@@ -201,6 +274,10 @@ class Joint:
         (conventions.md, Joints); missing entries are 0.
     rigid : bool
         Equal displacement and rotation of the two points (no ``k``/``c``).
+    provenance : JointProvenance, optional
+        Where ``k`` and ``c`` come from (a kind, a mapping or the object);
+        None when not stated.  It changes no number: equal joints with
+        other provenances are equal.
 
     Warns
     -----
@@ -216,6 +293,7 @@ class Joint:
     k: JointMatrix = attrs.field(default=None, converter=lambda v: JointMatrix.from_mapping(v, "stiffness", "k"))
     c: JointMatrix = attrs.field(default=None, converter=lambda v: JointMatrix.from_mapping(v, "damping", "c"))
     rigid: bool = attrs.field(default=False)
+    provenance: JointProvenance | None = attrs.field(default=None, kw_only=True, eq=False, converter=_provenance)
 
     def __attrs_post_init__(self) -> None:
         if not isinstance(self.rigid, bool):

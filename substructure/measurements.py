@@ -127,6 +127,52 @@ def _check_quantity(instance: Any, attribute: Any, value: Any) -> None:
         raise InvalidValueError(f"quantity: got {value!r}; expected one of {', '.join(QUANTITIES)}")
 
 
+def _coherence(value: Any) -> np.ndarray | None:
+    if value is None:
+        return None
+    try:
+        array = np.array(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InvalidValueError(
+            f"coherence: got {type(value).__name__}; expected an array of floats in [0, 1]"
+        ) from None
+    if array.ndim != 1:
+        raise InvalidValueError(f"coherence: got shape {array.shape}; expected one value per frequency line")
+    bad = ~np.isfinite(array) | (array < 0.0) | (array > 1.0 + COHERENCE_ROUNDING)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise InvalidValueError(f"coherence: line {k} is {float(array[k])!r}; expected a number in [0, 1]")
+    array = np.minimum(array, 1.0)
+    array.setflags(write=False)
+    return array
+
+
+COHERENCE_ROUNDING = 1e-9
+"""How far above 1 a coherence may lie and be read as 1 (rounding of its estimate)."""
+
+
+def _optional_averages(value: Any) -> int | None:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise InvalidValueError(f"averages: got {value!r}; expected the number of averages (an integer >= 1)")
+    return int(value)
+
+
+def _same_array(a: Any, b: Any) -> bool:
+    if a is None or b is None:
+        return a is b
+    return bool(np.array_equal(a, b))
+
+
+def _check_coherence(instance: "Measurement", attribute: Any, value: np.ndarray | None) -> None:
+    if value is not None and value.shape[0] != instance.frf.frequency.n:
+        raise InvalidValueError(
+            f"coherence: got {value.shape[0]} values for {instance.frf.frequency.n} frequency lines; expected "
+            "one per line of the FRF"
+        )
+
+
 def _check_frf(instance: "Measurement", attribute: Any, frf: Any) -> None:
     hint = "; build it with Measurement.from_frf(frf, response, excitation)"
     if not isinstance(frf, FRF):
@@ -165,6 +211,12 @@ class Measurement:
         The data file as written in the measurement file.
     record : int, optional
         The 0-based index of the type-58 record, for universal files.
+    coherence : array of float, optional
+        The ordinary coherence of the estimate (dimensionless, in [0, 1]),
+        one value per line of ``frf`` (a tap test's, see
+        :mod:`substructure.tap`); read-only.
+    averages : int, optional
+        The number of taps averaged into the FRF (>= 1).
     """
 
     response: str = attrs.field(converter=lambda value: dof_label(value, "response"))
@@ -175,11 +227,16 @@ class Measurement:
     removed: tuple[str, ...] = attrs.field(default=(), converter=_names("removed"))
     file: str | None = attrs.field(default=None)
     record: int | None = attrs.field(default=None, converter=_optional_record)
+    coherence: np.ndarray | None = attrs.field(
+        default=None, converter=_coherence, validator=_check_coherence, eq=attrs.cmp_using(eq=_same_array)
+    )
+    averages: int | None = attrs.field(default=None, converter=_optional_averages)
 
     @classmethod
     def from_frf(
         cls, frf: FRF, response: str, excitation: str, *, sensors: Sequence[str] = (),
         removed: Sequence[str] = (), file: str | None = None, record: int | None = None,
+        coherence: Any = None, averages: int | None = None,
     ) -> "Measurement":
         """A measurement from a one-entry FRF of any quantity.
 
@@ -203,6 +260,10 @@ class Measurement:
             The file the FRF came from, for messages.
         record : int, optional
             Its record in a universal file.
+        coherence : array of float, optional
+            The coherence (dimensionless, in [0, 1]) on the FRF's lines.
+        averages : int, optional
+            The number of averages (>= 1).
 
         Returns
         -------
@@ -217,7 +278,24 @@ class Measurement:
                 f"frf: got {frf.shape[1]}x{frf.shape[2]} entries; expected one FRF (select one entry first)"
             )
         receptance = frf.with_labels((out,), (inp,)).to_receptance()
-        return cls(out, inp, receptance, frf.quantity, sensors, removed, file, record)
+        return cls(out, inp, receptance, frf.quantity, sensors, removed, file, record, coherence, averages)
+
+    def crop(self, lo: Any = None, hi: Any = None) -> "Measurement":
+        """The measurement restricted to ``lo <= f <= hi``, its coherence on the same lines.
+
+        Parameters
+        ----------
+        lo, hi : float, pint.Quantity, str or None
+            Band limits; plain numbers are in Hz; ``None`` leaves that side open.
+
+        Returns
+        -------
+        Measurement
+            The lines of the band (an empty band is an error).
+        """
+        mask = self.frf.frequency.band_mask(lo, hi)
+        coherence = None if self.coherence is None else self.coherence[mask]
+        return attrs.evolve(self, frf=self.frf.crop(lo, hi), coherence=coherence)
 
     @property
     def configuration(self) -> Configuration:
@@ -349,6 +427,21 @@ class MeasurementSet:
 
     def _where(self) -> str:
         return f"measurement set {self.name!r}" + ("" if self.source is None else f" ({self.source})")
+
+    def crop(self, lo: Any = None, hi: Any = None) -> "MeasurementSet":
+        """The set restricted to ``lo <= f <= hi``; coherences stay aligned with the lines.
+
+        Parameters
+        ----------
+        lo, hi : float, pint.Quantity, str or None
+            Band limits; plain numbers are in Hz; ``None`` leaves that side open.
+
+        Returns
+        -------
+        MeasurementSet
+            Every measurement cropped (:meth:`Measurement.crop`).
+        """
+        return attrs.evolve(self, measurements=[m.crop(lo, hi) for m in self.measurements])
 
     def configurations(self) -> tuple[Configuration, ...]:
         """The distinct ``(sensors, removed)`` combinations, in order of first appearance.

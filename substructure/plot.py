@@ -4,7 +4,9 @@
 logarithmic scale over the phase (``kind="bode"``), the real and imaginary
 parts (``kind="real-imag"``) or the Nyquist plane (``kind="nyquist"``), in
 um/N by default (``unit=``), with plain-language axis labels and the
-technical names in a small note.  A free-free FRF's rigid-body (mass) line,
+technical names in a small note; limits of the value axes are given with
+their units (``limits=("0.01 um/N", "1e-3 m/N")``) and converted to the
+unit shown.  A free-free FRF's rigid-body (mass) line,
 which rises without bound toward 0 Hz, is detected and left out of the
 autoscaling (it is still drawn, in a shaded band), so the modes fill the
 axes.  Passing the axes of an earlier figure (or the figure itself)
@@ -23,10 +25,11 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from .errors import InvalidValueError
+from .errors import InvalidValueError, UnitError
 from .frf import FRF
+from .units import to_si
 
-__all__ = ["plot_frf", "plot_identification", "rigid_body_cutoff", "FRF_UNITS"]
+__all__ = ["plot_frf", "plot_identification", "plot_taps", "rigid_body_cutoff", "FRF_UNITS"]
 
 PARTS = ("magnitude", "phase", "real", "imag")
 KINDS = {"bode": ("magnitude", "phase"), "real-imag": ("real", "imag"), "nyquist": ("nyquist",)}
@@ -123,6 +126,30 @@ def _limits(values: list[np.ndarray], log: bool) -> tuple[float, float] | None:
     return lo - pad, hi + pad
 
 
+def _display_limits(limits: Any, si_units: list[str], factor: float, shown: str) -> tuple[Any, Any]:
+    """``limits`` (quantities or None) as numbers in the display unit of the axes."""
+    if isinstance(limits, (str, bytes)) or not isinstance(limits, Sequence) or len(limits) != 2:
+        raise InvalidValueError(
+            f"limits: got {limits!r}; expected a pair (lower, upper) of quantities with their units, "
+            "e.g. ('0.01 um/N', '100 um/N'), either of them None"
+        )
+    if len(set(si_units)) != 1:
+        raise InvalidValueError(
+            f"limits: the entries drawn have different units ({', '.join(sorted(set(si_units)))}); "
+            "draw them in separate figures to set limits"
+        )
+    out = []
+    for end, value in zip(("lower", "upper"), limits):
+        if value is None:
+            out.append(None)
+            continue
+        try:
+            out.append(to_si(value, f"limits ({end})", si_units[0]) * factor)
+        except UnitError as exc:
+            raise UnitError(f"{exc} (the axes show {shown}; write e.g. '100 {shown}')") from None
+    return out[0], out[1]
+
+
 def _autoscale(axes: list[Axes], parts: Sequence[str]) -> None:
     """Limits from every line's data above its rigid-body cutoff (lines keep theirs as an attribute)."""
     for part, axis in zip(parts, axes):
@@ -160,6 +187,7 @@ def plot_frf(
     unit: str = "um/N",
     title: str | None = None,
     note: bool = True,
+    limits: Sequence[Any] | None = None,
     **line_kw: Any,
 ) -> Figure:
     """Plot entries of an FRF: Bode (magnitude and phase), real and imaginary parts, or Nyquist.
@@ -197,6 +225,13 @@ def plot_frf(
         Add a small note with the technical names (the symbol and its
         definition, the entries, the rigid-body region when one is excluded
         from the scale).
+    limits : (lower, upper), optional
+        Limits of the value axis of the magnitude, real and imaginary panels
+        (of both axes of a Nyquist plot), each a quantity with its unit
+        (``"0.01 um/N"``, ``"1e-3 m/N"``, a pint Quantity) or None to keep
+        the automatic one; converted to the display unit ``unit``, so that a
+        limit means the same whatever unit the axes show.  A bare number is
+        refused (its unit would be a guess).  The phase panel keeps its own.
     **line_kw
         Passed to ``Axes.plot`` (``color``, ``linestyle``, ...).
 
@@ -234,6 +269,13 @@ def plot_frf(
     scales = [_scaled(frf, o, i, unit) for o, i in entries]
     units = sorted({u for _, u in scales})
     shown = units[0] if len(units) == 1 else "mixed units"
+    if limits is not None:
+        limits = _display_limits(limits, [frf.unit(o, i) for o, i in entries], scales[0][0], shown)
+        low = [v for v in limits if v is not None and v <= 0]
+        if "magnitude" in parts and low:
+            raise InvalidValueError(
+                f"limits: got {low[0]:g} {shown}; the magnitude axis is logarithmic: its limits must be > 0"
+            )
     axes = _axes_for(ax, parts)
     hz = frf.frequency.hz
     for (output, input_), y, (factor, _) in zip(entries, values, scales):
@@ -274,6 +316,12 @@ def plot_frf(
     if parts != ("nyquist",):
         axes[-1].set_xlabel("frequency (Hz)")
     _autoscale(axes, parts)
+    if limits is not None:
+        for part, axis in zip(parts, axes):
+            if part != "phase":
+                axis.set_ylim(*limits)
+            if part == "nyquist":
+                axis.set_xlim(*limits)
     fig = axes[0].figure
     if any(line.get_label() and not line.get_label().startswith("_") for line in axes[0].lines):
         axes[0].legend(fontsize="small")
@@ -365,4 +413,50 @@ def plot_identification(result, names=("k_yf", "c_yf"), band=None, fitted=None, 
             twin.set_ylabel("|H| [m/N]", color="tab:orange")
     axes[0].legend(loc="best", fontsize="small")
     axes[-1].set_xlabel("frequency [Hz]")
+    return fig
+
+
+def plot_taps(result, title: str | None = None, unit: str = "um/N") -> Figure:
+    """Four panels for a person to check a tap test (:mod:`substructure.tap`); returns the Figure.
+
+    Top to bottom, on one frequency axis: each kept tap's force spectrum in
+    dB with the hammer's usable band marked, the coherence, and the
+    receptance's magnitude and phase drawn by :func:`plot_frf` (its units,
+    labels and rigid-body line left out of the scale).
+
+    Parameters
+    ----------
+    result : substructure.tap.TapResult
+        The processed taps.
+    title : str, optional
+        The figure's title (the estimator, the taps and the window follow it).
+    unit : {"um/N", "m/N", "mm/N", "nm/N"}
+        Unit of the magnitude axis.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure, never shown.
+    """
+    fig, axes = plt.subplots(4, 1, sharex=True, figsize=(7.5, 9.5), layout="constrained",
+                             gridspec_kw={"height_ratios": [1.2, 0.8, 1.5, 1.0]})
+    ax_f, ax_c, ax_m, ax_p = axes
+    hz = result.frf.frequency.hz
+    kept = [t for t in result.taps if t.kept]
+    for tap, spectrum in zip(kept, result.force_spectra_db):
+        ax_f.plot(hz, spectrum, lw=0.8, label=f"tap {tap.number} ({tap.peak_force:.0f} N)")
+    ax_f.axvline(result.hammer_band_hz, color="0.4", ls="--", lw=0.8,
+                 label=f"usable band: {result.hammer_band_hz:.0f} Hz (-{result.hammer_band_db:g} dB)")
+    ax_f.set_ylabel("force spectrum\n[dB re 1 N/Hz]")
+    ax_f.legend(fontsize=7, ncol=2, loc="lower left")
+    ax_c.plot(hz, result.coherence, color="C2", lw=0.8)
+    ax_c.set_ylim(-0.02, 1.02)
+    ax_c.set_ylabel("coherence")
+    for ax in (ax_f, ax_c):
+        ax.grid(True, alpha=0.3)
+    plot_frf(result.frf, ax=[ax_m, ax_p], unit=unit, note=False)
+    rejected = len(result.rejected)
+    about = (f"{result.estimator}, {result.averages} taps averaged" + (f", {rejected} rejected" if rejected else "")
+             + (f"; exponential window tau = {result.tau:.4g} s" if result.tau else "; no exponential window"))
+    fig.suptitle((title + "\n" if title else "") + about, fontsize=10)
     return fig

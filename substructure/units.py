@@ -41,6 +41,7 @@ __all__ = [
     "frequency_hz",
     "CACHE_VARIABLE",
     "magnitude_in",
+    "show_value",
 ]
 
 CACHE_VARIABLE = "SUBSTRUCTURE_UNITS_CACHE"
@@ -169,6 +170,40 @@ def magnitude_in(q: pint.Quantity, unit: str) -> float:
     return float(q.magnitude * factor)
 
 
+def show_value(value: Any) -> str:
+    """A value as an error message shows it: in plain words, never a pint repr.
+
+    Parameters
+    ----------
+    value : object
+        What the user gave: a string (shown quoted, as typed), a quantity
+        (shown as its number and the full name of its unit, so that a
+        misread suffix is visible: ``20 boltzmann_constant`` for ``"20k"``),
+        a number or anything else (its ``repr``).
+
+    Returns
+    -------
+    str
+        The text for the message.
+
+    Examples
+    --------
+    >>> show_value(Q_(20, "k"))
+    '20 boltzmann_constant'
+    >>> show_value("20 kHz")
+    "'20 kHz'"
+    """
+    if isinstance(value, pint.Quantity):
+        m = value.magnitude
+        if np.ndim(m) == 0:
+            number = f"{float(m):g}" if isinstance(m, numbers.Real) else str(m)
+            return f"{number} {value.units}" if not value.dimensionless else number
+        arr = np.asarray(m)
+        text = np.array2string(arr.ravel()[:4], separator=", ", threshold=4)
+        return f"an array {text[:-1]}{', ...]' if arr.size > 4 else ']'} in {value.units}"
+    return repr(value)
+
+
 def quantity(value: Any, field: str, dimension: str) -> pint.Quantity:
     """Return ``value`` as a scalar quantity of this registry with ``dimension``.
 
@@ -197,38 +232,38 @@ def quantity(value: Any, field: str, dimension: str) -> pint.Quantity:
     expected = _describe(dimension)
     if isinstance(value, bool) or isinstance(value, numbers.Number) or isinstance(value, np.ndarray):
         raise UnitError(
-            f"{field}: got the bare number {value!r}; expected {expected}, with its unit"
+            f"{field}: got the bare number {show_value(value)}; expected {expected}, with its unit"
         )
     if isinstance(value, str):
         if not _NUMBER.match(value):  # pint reads "mm" as 1 mm and "a" as 1 year
             raise UnitError(
-                f"{field}: cannot read {value!r} as a quantity: it does not start with a number; expected {expected}"
+                f"{field}: cannot read {show_value(value)} as a quantity: it does not start with a number; expected {expected}"
             )
         try:
             magnitude, units = _parse(value)
         except Exception as exc:  # pint raises several types for bad strings
             raise UnitError(
-                f"{field}: cannot read {value!r} as a quantity ({exc}); expected {expected}"
+                f"{field}: cannot read {show_value(value)} as a quantity ({exc}); expected {expected}"
             ) from None
         if units is None or units.dimensionless and dimension != "":
             raise UnitError(
-                f"{field}: got {value!r} without a unit; expected {expected}, with its unit"
+                f"{field}: got {show_value(value)} without a unit; expected {expected}, with its unit"
             )
         q = ureg.Quantity(magnitude, units)
     elif isinstance(value, pint.Quantity):
         q = value if value._REGISTRY is ureg else ureg.Quantity(str(value))
     else:
         raise UnitError(
-            f"{field}: got {value!r} of type {type(value).__name__}; expected {expected}"
+            f"{field}: got {show_value(value)} of type {type(value).__name__}; expected {expected}"
         )
     if np.ndim(q.magnitude) != 0:
-        raise UnitError(f"{field}: got an array {value!r}; expected a single value")
+        raise UnitError(f"{field}: got an array {show_value(value)}; expected a single value")
     if not _has_dimension(q.units, dimension):
         raise UnitError(
-            f"{field}: got {value!r} with dimension {q.dimensionality}; expected {expected}"
+            f"{field}: got {show_value(value)} with dimension {q.dimensionality}; expected {expected}"
         )
     if not math.isfinite(float(q.magnitude)):
-        raise InvalidValueError(f"{field}: got {value!r}; expected a finite value")
+        raise InvalidValueError(f"{field}: got {show_value(value)}; expected a finite value")
     return q
 
 
@@ -275,11 +310,11 @@ def dimensionless(value: Any, field: str) -> float:
         The value, finite.
     """
     if isinstance(value, bool):
-        raise InvalidValueError(f"{field}: got {value!r}; expected a number")
+        raise InvalidValueError(f"{field}: got {show_value(value)}; expected a number")
     if isinstance(value, pint.Quantity):
         if not value.dimensionless:
             raise UnitError(
-                f"{field}: got {value!r} with dimension {value.dimensionality}; "
+                f"{field}: got {show_value(value)} with dimension {value.dimensionality}; "
                 "expected a dimensionless number"
             )
         value = value.m_as("dimensionless")
@@ -287,15 +322,15 @@ def dimensionless(value: Any, field: str) -> float:
         try:
             q = ureg.Quantity(value)
         except Exception:
-            raise InvalidValueError(f"{field}: cannot read {value!r}; expected a number") from None
+            raise InvalidValueError(f"{field}: cannot read {show_value(value)}; expected a number") from None
         return dimensionless(q, field)
     if not isinstance(value, numbers.Real):
         raise InvalidValueError(
-            f"{field}: got {value!r} of type {type(value).__name__}; expected a number"
+            f"{field}: got {show_value(value)} of type {type(value).__name__}; expected a number"
         )
     value = float(value)
     if not math.isfinite(value):
-        raise InvalidValueError(f"{field}: got {value!r}; expected a finite number")
+        raise InvalidValueError(f"{field}: got {show_value(value)}; expected a finite number")
     return value
 
 
@@ -414,4 +449,4 @@ def cycles_per_second(q: pint.Quantity, field: str) -> Any:
         return root.magnitude
     if angle == 1:
         return root.magnitude / (2.0 * math.pi)
-    raise UnitError(f"{field}: got {q!r}, an angle to the power {angle} per time; expected a frequency")
+    raise UnitError(f"{field}: got {show_value(q)}, an angle to the power {angle} per time; expected a frequency")

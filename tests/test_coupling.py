@@ -198,3 +198,22 @@ def test_couple_decouple_and_mass_invariants(overhang, k_yf, k_tm, mass_g):
     m = f"{mass_g} g"
     back = remove_mass(add_mass(coupled, "tool.tip", m, "1e-8 kg*m^2"), "tool.tip", m, "1e-8 kg*m^2")
     assert rel_err(back.data, coupled.data) < 1e-10
+
+
+def test_stiff_joint_converges_to_rigid_as_its_compliance_and_eq_2_2_with_no_compliance_is_rigid(grid):
+    """examples/13_rigid_joints.py: thesis eq. 2.2 with [K]^-1 = 0 (numpy) is the rigid joint, and an
+    elastic joint's difference to it falls tenfold per decade of stiffness (its compliance, 1/k)."""
+    holder, tool = make_holder(), make_tool()
+    rigid = Assembly("r", components=(holder, tool), joints=(Joint.rigid_between("j", "holder.tip", "tool.base"),))
+    h_rigid = rigid.receptance("tool.tip", frequency=grid).data
+    H = holder.receptance(grid, ["tip"]).data
+    T = tool.receptance(grid, ["tip", "base"]).data
+    eq = T[:, :2, :2] - T[:, :2, 2:] @ np.linalg.inv(T[:, 2:, 2:] + H) @ T[:, 2:, :2]
+    assert rel_err(eq, h_rigid) < 1e-10
+    diffs = []
+    for k in (1e11, 1e12, 1e13, 1e14):
+        joint = Joint("j", ("holder.tip", "tool.base"), k={"yf": f"{k:g} N/m", "tm": f"{k / 100:g} N*m/rad"},
+                      c={"yf": "100 N*s/m", "tm": "1 N*m*s/rad"})
+        diffs.append(rel_err(rigid.with_joint(joint).receptance("tool.tip", frequency=grid).data, h_rigid))
+    ratios = np.array(diffs[:-1]) / np.array(diffs[1:])
+    assert np.all((ratios > 9.0) & (ratios < 11.0)), ratios

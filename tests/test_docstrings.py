@@ -26,7 +26,7 @@ if not hasattr(public_api, "check_docstrings"):
     _spec.loader.exec_module(public_api)
 
 WORKFLOWS = ["substructure.identify", "substructure.diagnose", "substructure.stability", "substructure.surrogate",
-             "substructure.study"]
+             "substructure.study", "substructure.tap"]
 
 
 def test_every_public_name_is_documented_with_its_parameters():

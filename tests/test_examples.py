@@ -7,8 +7,9 @@ are picked up without editing this file.
 
 Where the examples run: ``make docs`` (and so CI, which runs it after ``make
 test``) executes every example once, with Python warnings as errors, and
-fails when one raises, prints nothing or writes no figure
-(docs/_ext/gallery_support.py); the test suite does not run them a second
+fails when one raises, prints nothing, writes no figure or saves a figure
+with an empty panel (docs/_ext/gallery_support.py, docs/_ext/figure_checks.py);
+the test suite does not run them a second
 time.  ``SUBSTRUCTURE_RUN_EXAMPLES=1 make test`` (or this file alone) runs
 them here as well, each in a subprocess with the same checks, for work on an
 example without building the docs.
@@ -25,7 +26,11 @@ from pathlib import Path
 
 import pytest
 
-EXAMPLES = sorted((Path(__file__).resolve().parent.parent / "examples").glob("[0-9]*.py"))
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLES = sorted((ROOT / "examples").glob("[0-9]*.py"))
+# Runs an example with every saved figure checked for empty panels, as the docs build does.
+RUNNER = ("import runpy, sys; sys.path.insert(0, sys.argv[1]); import figure_checks; "
+          "figure_checks.install(); runpy.run_path(sys.argv[2], run_name='__main__')")
 RUN = os.environ.get("SUBSTRUCTURE_RUN_EXAMPLES") == "1"
 
 
@@ -52,7 +57,8 @@ def test_example_is_a_gallery_page(script):
 def test_example_runs_prints_and_writes_figures(script, tmp_path):
     env = {**os.environ, "MPLBACKEND": "Agg", "SUBSTRUCTURE_EXAMPLES_OUT": str(tmp_path)}
     # -W error: as in the test run, a warning an example does not handle itself fails it.
-    done = subprocess.run([sys.executable, "-W", "error", str(script)], cwd=tmp_path, env=env,
+    done = subprocess.run([sys.executable, "-W", "error", "-c", RUNNER, str(ROOT / "docs" / "_ext"), str(script)],
+                          cwd=tmp_path, env=env,
                           capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, f"{script.name} failed:\n{done.stdout}\n{done.stderr}"
     assert done.stdout.strip(), f"{script.name} printed nothing"

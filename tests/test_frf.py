@@ -530,6 +530,33 @@ def test_plot_units_convert_exactly_and_label():
         frf.plot(kind="nyquist", parts=("real",))
 
 
+def test_plot_limits_carry_their_unit_whatever_the_axes_show():
+    """Limits with units land on the axes in the display unit (the lesson 01 bug: m/N on a um/N axis)."""
+    frf = point_matrix().select("a:y", "a:y")
+    for unit, factor in (("um/N", 1e6), ("m/N", 1.0), ("nm/N", 1e9)):
+        fig = frf.plot(unit=unit, limits=("2e-3 um/N", "1e-6 m/N"))
+        assert fig.axes[0].get_ylim() == pytest.approx((2e-9 * factor, 1e-6 * factor))
+        assert fig.axes[1].get_ylim()[1] < 200       # the phase panel keeps its own limits
+    fig = frf.plot(kind="real-imag", limits=(Q_(-3, "um/N"), None))
+    assert fig.axes[0].get_ylim()[0] == pytest.approx(-3) and fig.axes[1].get_ylim()[0] == pytest.approx(-3)
+    fig = frf.plot(kind="nyquist", unit="mm/N", limits=("-2 um/N", "2 um/N"))
+    assert fig.axes[0].get_xlim() == pytest.approx((-2e-3, 2e-3)) == fig.axes[0].get_ylim()
+    fig = frf.plot()
+    (2 * frf).plot(ax=fig, limits=(None, "1 mm/N"))          # on an overlay, the last call sets them
+    lo, hi = fig.axes[0].get_ylim()
+    assert hi == pytest.approx(1e3) and 0 < lo <= np.abs(frf.data).min() * 1e6
+    with pytest.raises(UnitError, match=r"limits \(upper\): got the bare number 0.001.*write e.g. '100 µm/N'"):
+        frf.plot(limits=(None, 1e-3))
+    with pytest.raises(UnitError, match=r"limits \(lower\).*dimension \[length\]"):
+        frf.plot(limits=("1 mm", None))
+    with pytest.raises(InvalidValueError, match="logarithmic"):
+        frf.plot(limits=("0 um/N", None))
+    with pytest.raises(InvalidValueError, match="pair"):
+        frf.plot(limits="1 um/N")
+    with pytest.raises(InvalidValueError, match="different units"):
+        point_matrix().plot(limits=(None, "1 m/N"))
+
+
 def test_plot_rigid_body_line_is_left_out_of_the_scale():
     from substructure.plot import rigid_body_cutoff
 

@@ -8,6 +8,8 @@ and values written here by hand.
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -204,7 +206,8 @@ def test_an_export_whose_units_contradict_the_quantity_given_is_refused(tmp_path
 
 
 def test_no_stability_limit_tells_a_command_line_user_the_option(tmp_path, capsys):
-    """A cutting coefficient of 1e-300 Pa leaves no finite limit: the message names --max-depth too."""
+    """A cutting coefficient of 1e-300 Pa leaves no finite limit: the lobes are given, the recommendation is
+    absent, and its reason names --max-depth."""
     from substructure import Frequency
     from substructure.io.frf_files import write_csv
 
@@ -213,7 +216,9 @@ def test_no_stability_limit_tells_a_command_line_user_the_option(tmp_path, capsy
     status = main(["lobes", "--frf", str(tmp_path / "tip.csv"), "--teeth", "4", "--diameter", "12 mm",
                    "--immersion", "0.5", "--kt", "1e-300 MPa", "--kr", "0.3", "--speeds", "5000:8000:100", "--json"])
     out, err = capsys.readouterr()
-    assert status == 1 and out == "" and "--max-depth" in err
+    result = json.loads(out)
+    assert status == 0 and result["recommended"] is None and "--max-depth" in result["no_recommendation_reason"]
+    assert not np.isfinite(np.array(result["depth_limit_m"], dtype=float)).any()
 
 
 def test_frf_from_csv_reads_the_quantity_from_the_header_as_read_csv_does(tmp_path):

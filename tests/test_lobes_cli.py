@@ -149,7 +149,7 @@ def test_turning(capsys, modes_file):
     (["--kt", "-625 MPa"], 1, "kt"),
     (["--kn", "-1 MPa"], 1, "kn"),
     (["--speeds", "50 Hz:300 Hz:1 Hz"], 2, "rpm"),
-    (["--speeds", "1000:2000"], 2, "START:STOP:STEP"),
+    (["--speeds", "1000:2000:50:5"], 2, "START:STOP:STEP"),  # START:STOP alone has a default step
     (["--diameter", "12"], 1, "diameter"),
     (["--kr", "100 MPa"], 2, "--kr"),
 ])

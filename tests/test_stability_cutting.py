@@ -60,7 +60,7 @@ def test_alternatives_must_be_given_once():
     with pytest.raises(InvalidValueError, match="exactly one"):
         MillingCut.from_spec(4, "12 mm", radial_depth="3 mm", kt="625 MPa", kn="100 MPa", kr=0.16)
     with pytest.raises(InvalidValueError, match="milling"):
-        thesis_cut(milling="climb")
+        thesis_cut(milling="sideways")  # climb and conventional are the shop's up and down
 
 
 def test_pressure_and_ratio_give_the_same_cut():

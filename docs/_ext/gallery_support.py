@@ -8,6 +8,9 @@ for the reader).  In the documentation build:
   example a directory of its own under ``docs/_build/examples-out/`` through
   that variable, and runs it with Python warnings turned into errors, as the
   test run does; a warning that an example does not handle itself fails it;
+  every figure the example saves is checked for empty panels as it is saved
+  (docs/_ext/figure_checks.py: a panel whose data all lie outside its limits,
+  or show only as a sliver, fails the example);
 * :func:`png_scraper` (a sphinx-gallery image scraper) puts the PNG files that
   a code block wrote, in the order they were written, under that block on
   the example's page, then closes the block's matplotlib figures (scripts
@@ -29,6 +32,8 @@ import warnings
 from pathlib import Path
 
 from sphinx.errors import ExtensionError
+
+import figure_checks
 
 OUT_ROOT = Path(__file__).resolve().parent.parent / "_build" / "examples-out"
 _state: dict = {"written": set(), "warnings": None}
@@ -61,7 +66,9 @@ def prepare_example(gallery_conf, fname, when):
         _state["warnings"] = warnings.catch_warnings()
         _state["warnings"].__enter__()
         warnings.simplefilter("error")
+        figure_checks.install()
     elif _state["warnings"] is not None:
+        figure_checks.uninstall()
         _state["warnings"].__exit__(None, None, None)
         _state["warnings"] = None
         import matplotlib.pyplot as plt

@@ -1,6 +1,6 @@
 """The ``substructure`` command: the library's workflows without writing code.
 
-Each subcommand is a module of this package (``frf_command``, ``identify_command``,
+Each subcommand is a module of this package (``frf_command``, ``tap_command``, ``identify_command``,
 ``diagnose_command``, ``lobes_command``, ``predict_command``, ``report_command``,
 ``study_command``, ``demo_command``) with ``add_parser(commands)`` and ``run(args)``; the modules
 import the heavy parts of the library only when their command runs, so that a
@@ -32,7 +32,7 @@ from ._common import EXIT_ERROR, EXIT_INTERNAL, EXIT_INTERRUPTED, EXIT_USAGE, PR
 
 __all__ = ["main", "DEMO_STEPS", "DemoState", "COMMANDS"]
 
-COMMANDS = ("frf", "identify", "diagnose", "lobes", "predict", "report", "study", "demo")
+COMMANDS = ("frf", "tap", "identify", "diagnose", "lobes", "predict", "report", "study", "demo")
 """The subcommands, in the order of ``substructure --help``; each is the module ``<name>_command``."""
 
 

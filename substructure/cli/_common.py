@@ -110,16 +110,18 @@ def print_json(value: Any) -> int:
 _LEADING_NUMBER = re.compile(r"^\s*[-+]?(\d|\.\d)")
 
 
-def range_arg(text: str, unit: str, build: Callable, example: str):
-    """``START:STOP:STEP`` of quantities: plain numbers are in ``unit``, units may be written."""
+def range_arg(text: str, unit: str, build: Callable, example: str, shown: str | None = None):
+    """``START:STOP:STEP`` of quantities: plain numbers are in ``unit``, units may be written; ``shown`` is what
+    the user typed, for messages (default ``text``)."""
+    shown = text if shown is None else shown
     parts = text.split(":")
     if len(parts) != 3:
-        raise argparse.ArgumentTypeError(f"got {text!r}; expected START:STOP:STEP, e.g. {example}")
+        raise argparse.ArgumentTypeError(f"got {shown!r}; expected START:STOP:STEP, e.g. {example}")
     values: list[Any] = []
     for name, part in zip(("START", "STOP", "STEP"), parts):
         if not _LEADING_NUMBER.match(part):
             raise argparse.ArgumentTypeError(
-                f"got {text!r}; {name} {part.strip()!r} is not a number; expected START:STOP:STEP, e.g. {example}"
+                f"got {shown!r}; {name} {part.strip()!r} is not a number; expected START:STOP:STEP, e.g. {example}"
             )
         try:
             values.append(f"{float(part)!r} {unit}")  # a plain number: in the option's unit
@@ -128,7 +130,7 @@ def range_arg(text: str, unit: str, build: Callable, example: str):
     try:
         return build(*values)
     except SubstructureError as exc:
-        raise argparse.ArgumentTypeError(f"{text!r}: {one_line(str(exc))}") from None
+        raise argparse.ArgumentTypeError(f"{shown!r}: {one_line(str(exc))}") from None
 
 
 def grid_arg(text: str) -> Frequency:

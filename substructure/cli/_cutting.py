@@ -10,6 +10,7 @@ parsers: the library's modules are imported inside the functions.
 from __future__ import annotations
 
 import argparse
+import re
 from typing import Any
 
 from ._common import UsageError, band_arg, range_arg
@@ -18,15 +19,44 @@ CUT_OPTIONS = ("radial_depth", "immersion", "kt", "kn", "kr", "workpiece", "feed
                "orientation")
 """The options (argparse destinations) that describe a cut: any one of them given means a cut is asked for."""
 
+MILLING_WORDS = ("down", "climb", "up", "conventional")
+"""What ``--milling`` accepts: climb is down milling, conventional is up milling."""
+
 MACHINE_OPTIONS = ("max_speed", "min_speed", "power", "power_curve", "torque", "torque_curve", "max_depth")
 """The options (argparse destinations) that describe the machine's limits."""
 
 
+DEFAULT_SPEED_STEP = 50.0
+"""The step [rpm] of ``--speeds START:STOP`` (and ``--speed-range START-STOP``) without a step: the default
+grid's."""
+
+_THOUSANDS = re.compile(r"^\s*(\d+(?:\.\d*)?|\.\d+)\s*k\s*(rpm)?\s*$", re.IGNORECASE)
+_DASHED = re.compile(r"^\s*(\d+(?:\.\d*)?|\.\d+)\s*(k?)\s*(?:-|\.\.|to)\s*(\d+(?:\.\d*)?|\.\d+)\s*(k?)\s*(?:rpm)?\s*$",
+                     re.IGNORECASE)
+
+
+def _thousands(text: str) -> str:
+    """``20k`` (or ``20k rpm``, ``2.4K``) is 20,000 rpm: the shop's thousands, not pint's Boltzmann constant."""
+    match = _THOUSANDS.match(text)
+    return f"{float(match.group(1)) * 1000.0!r} rpm" if match else text
+
+
 def speeds_arg(text: str):
-    """``START:STOP:STEP`` spindle speeds: plain numbers are rpm; units allowed, Hz refused."""
+    """Spindle speeds: ``START:STOP:STEP``, ``START:STOP`` or ``START-STOP`` (the step
+    :data:`DEFAULT_SPEED_STEP`); plain numbers are rpm, ``20k`` is 20,000 rpm; units allowed, Hz refused."""
     from ..stability import spindle_speeds
 
-    return range_arg(text, "rpm", spindle_speeds, "2000:24000:50 (rpm) or '2000 rpm:24000 rpm:50 rpm'")
+    dashed = _DASHED.match(text) if ":" not in text else None
+    if dashed:
+        lo, klo, hi, khi = dashed.groups()
+        parts = [f"{float(lo) * (1000.0 if klo else 1.0)!r}", f"{float(hi) * (1000.0 if khi else 1.0)!r}"]
+    else:
+        parts = [_thousands(p) for p in text.split(":")]
+    if len(parts) == 2:
+        parts.append(f"{DEFAULT_SPEED_STEP!r}")
+    return range_arg(":".join(parts), "rpm", spindle_speeds,
+                     "2000:24000:50 (rpm), 2000:24000 (50 rpm steps), 2k-24k or '2000 rpm:24000 rpm:50 rpm'",
+                     shown=text)
 
 
 def structure_band_arg(text: str):
@@ -55,11 +85,23 @@ def curve_arg(text: str, unit: str):
 
 
 def speed_arg(text: str) -> str:
-    """A spindle speed: a plain number is rpm."""
+    """A spindle speed: a plain number is rpm, ``20k`` is 20,000 rpm; a value in other words is refused here,
+    in plain language."""
     try:
         return f"{float(text)!r} rpm"
     except ValueError:
-        return text
+        pass
+    text = _thousands(text)
+    from ..errors import SubstructureError
+    from ..stability import as_speed_rpm
+
+    try:
+        as_speed_rpm(text)
+    except SubstructureError:
+        raise argparse.ArgumentTypeError(
+            f"got {text!r}; expected a spindle speed in rpm: a number (20000), thousands (20k) or with its unit "
+            "('20000 rpm')") from None
+    return text
 
 
 def add_cut_options(parser: argparse.ArgumentParser) -> None:
@@ -70,7 +112,8 @@ def add_cut_options(parser: argparse.ArgumentParser) -> None:
                          help="tool diameter with its unit, e.g. '12 mm' (default: the tool's, with an assembly)")
     cutting.add_argument("--radial-depth", metavar="A", help="radial depth of cut with its unit, e.g. '3 mm'")
     cutting.add_argument("--immersion", type=float, metavar="RATIO", help="radial immersion a/D, in (0, 1]")
-    cutting.add_argument("--milling", choices=("up", "down"), default="up", help="up (default) or down milling")
+    cutting.add_argument("--milling", type=str.lower, choices=MILLING_WORDS, metavar="{down,climb,up,conventional}",
+                         help="down (= climb) or up (= conventional) milling; default up, said in every output")
     cutting.add_argument("--kt", metavar="PRESSURE", help="tangential cutting coefficient, e.g. '625 MPa'")
     cutting.add_argument("--kn", metavar="PRESSURE", help="normal (radial) cutting coefficient, e.g. '100 MPa'")
     cutting.add_argument("--kr", type=float, metavar="RATIO", help="or the ratio Kn/Kt, e.g. 0.16")
@@ -78,7 +121,13 @@ def add_cut_options(parser: argparse.ArgumentParser) -> None:
                          help="cutting coefficients from the table, e.g. aluminium-7075, steel-1045 (instead of --kt)")
     cutting.add_argument("--workpiece-table", metavar="FILE.toml", help="your own table of workpieces, searched first")
     cutting.add_argument("--feed-per-tooth", metavar="C",
-                         help="feed per tooth with its unit, e.g. '0.1 mm' (removal rate, power; Kienzle entries)")
+                         help="feed per tooth with its unit, e.g. '0.1 mm' (removal rate, power; Kienzle entries); "
+                              "with --workpiece the table's default for the work and tool material")
+    cutting.add_argument("--tool-material", type=str.lower, choices=("carbide", "hss"),
+                         help="the tool's material, for the cutting-speed and feed check (default: the tool's in "
+                              "the assembly, else carbide, said in a note)")
+    cutting.add_argument("--cutting-data", metavar="FILE.toml",
+                         help="your own table of cutting-speed and feed ranges, searched first")
     machine = parser.add_argument_group("machine and recommendation")
     machine.add_argument("--max-speed", type=speed_arg, metavar="RPM", help="highest spindle speed (rpm)")
     machine.add_argument("--min-speed", type=speed_arg, metavar="RPM", help="lowest spindle speed (rpm)")
@@ -105,8 +154,10 @@ def add_lobes_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--method", choices=("zoa", "sdm"), default="zoa",
                         help="zoa: zero-order (default, from FRF data); sdm: semi-discretization (modes; fitted "
                              "to FRF data when needed)")
-    parser.add_argument("--speeds", type=speeds_arg, default="2000:24000:50", metavar="START:STOP:STEP",
-                        help="spindle speeds in rpm (default 2000:24000:50)")
+    parser.add_argument("--speeds", "--speed-range", type=speeds_arg, default="2000:24000:50",
+                        metavar="START:STOP[:STEP]",
+                        help="spindle speeds in rpm: 2000:24000:50, 2000:24000 or 2000-24000 (50 rpm steps), "
+                             "2k-24k (default 2000:24000:50)")
     parser.add_argument("--intervals", type=int, metavar="M",
                         help="sdm: intervals in the cut per delay period (default: chosen per speed)")
 
@@ -143,7 +194,9 @@ def cut_from_args(args: argparse.Namespace, tool: Any, notes: list[str]):
 
     milling_only = {"--teeth": args.teeth, "--diameter": args.diameter, "--radial-depth": args.radial_depth,
                     "--immersion": args.immersion, "--kt": args.kt, "--kn": args.kn, "--kr": args.kr,
-                    "--workpiece": args.workpiece, "--feed-per-tooth": args.feed_per_tooth}
+                    "--workpiece": args.workpiece, "--feed-per-tooth": args.feed_per_tooth,
+                    "--tool-material": getattr(args, "tool_material", None),
+                    "--cutting-data": getattr(args, "cutting_data", None)}
     if args.turning:
         given = [name for name, value in milling_only.items() if value is not None]
         if given:
@@ -184,17 +237,90 @@ def cut_from_args(args: argparse.Namespace, tool: Any, notes: list[str]):
         raise UsageError("give --kn (a pressure) or --kr (the ratio Kn/Kt), not both")
     if args.workpiece_table is not None and args.workpiece is None:
         raise UsageError("--workpiece-table goes with --workpiece NAME")
+    milling = milling_of(args, notes)
     if args.workpiece is not None:
         if args.kt is not None:
             raise UsageError("give --workpiece NAME or --kt, not both (the table gives Kt)")
         entry = workpiece(args.workpiece, args.workpiece_table)
         notes.append(f"workpiece: {entry.describe()}")
+        feed = args.feed_per_tooth
+        if feed is None:
+            data = cutting_data_of(args, entry, tool, notes)
+            if data is not None:
+                feed = data.default_feed_per_tooth
+                notes.append(f"feed per tooth: {feed:~P}, the default for {entry.name} with a {data.tool_material} "
+                             "tool (cutting_data.toml); give --feed-per-tooth for yours")
         return MillingCut.for_workpiece(teeth, diameter, entry, radial_depth=args.radial_depth,
-                                        immersion=args.immersion, milling=args.milling,
-                                        feed_per_tooth=args.feed_per_tooth, kn=args.kn, kr=args.kr)
+                                        immersion=args.immersion, milling=milling,
+                                        feed_per_tooth=feed, kn=args.kn, kr=args.kr)
     extra = {"feed_per_tooth": args.feed_per_tooth} if args.feed_per_tooth is not None else {}
     return MillingCut.from_spec(teeth, diameter, radial_depth=args.radial_depth, immersion=args.immersion,
-                                milling=args.milling, kt=args.kt, kn=args.kn, kr=args.kr, **extra)
+                                milling=milling, kt=args.kt, kn=args.kn, kr=args.kr, **extra)
+
+
+def tool_material_of(args: argparse.Namespace, tool: Any, notes: list[str]) -> str:
+    """``--tool-material``, else the material of the assembly's tool when it is carbide or HSS, else carbide (with
+    a note saying it was assumed)."""
+    given = getattr(args, "tool_material", None)
+    if given is not None:
+        return given
+    if tool is not None:
+        names = {s.material.name.lower() for s in getattr(tool, "segments", ()) if s.material is not None}
+        for name in ("carbide", "hss"):
+            if any(name in n for n in names):
+                return name
+    notes.append("tool material: carbide assumed for the cutting-speed check; give --tool-material hss for a "
+                 "high-speed steel tool")
+    return "carbide"
+
+
+def cutting_data_of(args: argparse.Namespace, entry: Any, tool: Any, notes: list[str]):
+    """The cutting-data row of the workpiece ``entry`` and the tool material (None when no table has one; noted).
+    Looked up once per command: the result is kept on ``args``."""
+    if hasattr(args, "_cutting_data"):
+        return args._cutting_data
+    from ..stability import cutting_data
+
+    material = tool_material_of(args, tool, notes)
+    row = cutting_data(entry, material, getattr(args, "cutting_data", None))
+    if row is None:
+        notes.append(f"cutting data: no range for {entry.name} with a {material} tool; the cutting speed and feed "
+                     "are not checked")
+    args._cutting_data = row
+    return row
+
+
+def cutting_check(args: argparse.Namespace, cut: Any, tool: Any, best: Any, notes: list[str]) -> dict | None:
+    """The shop's numbers of the recommendation checked against the table (the ``cutting_data`` object of
+    ``--json``), with a :class:`~substructure.stability.CuttingDataWarning` per value outside its range."""
+    import warnings
+
+    from ..stability import CuttingDataWarning, check_cutting, cutting_conditions
+
+    if best is None or getattr(cut, "workpiece", None) is None:
+        return None
+    data = cutting_data_of(args, cut.workpiece, tool, notes)
+    out = cutting_conditions(cut, best.spindle_speed_rpm, data)
+    out["warnings"] = check_cutting(cut, best.spindle_speed_rpm, data)
+    for text in out["warnings"]:
+        warnings.warn(f"{text}: check the recommendation against your tool maker's data", CuttingDataWarning,
+                      stacklevel=2)
+    return out
+
+
+MILLING_DEFAULT_NOTE = ("milling: up (conventional) milling, the default (kept for the results of earlier "
+                        "versions); most CNC programs climb-mill: give --milling down (or climb) for that")
+"""The note every output carries when ``--milling`` was not given."""
+
+
+def milling_of(args: argparse.Namespace, notes: list[str]) -> str:
+    """The milling direction of ``--milling`` as ``"up"`` or ``"down"``; the default up, with
+    :data:`MILLING_DEFAULT_NOTE` appended to ``notes``."""
+    given = getattr(args, "milling", None)
+    if given is None:
+        notes.append(MILLING_DEFAULT_NOTE)
+        return "up"
+    return "down" if given in ("down", "climb") else "up"
 
 
 def limits_from_args(args: argparse.Namespace, tool: Any, notes: list[str]):

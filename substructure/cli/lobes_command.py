@@ -9,9 +9,11 @@ import warnings
 from ..errors import SubstructureError
 from ._common import UsageError, check_outputs, check_plot, figures, grid_text, point_arg, print_json, save_figure
 from ._cutting import (
+    MILLING_DEFAULT_NOTE,
     add_cut_options,
     add_lobes_options,
     cut_from_args,
+    cutting_check,
     limits_from_args,
     structure_band_arg,
     tool_of,
@@ -69,11 +71,12 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from ..frf import FRF
-    from ..stability import MillingCut, ModalFitter, ModalFitWarning, ModalModel, recommend, sdm, zoa
+    from ..stability import (MillingCut, ModalFitter, ModalFitWarning, ModalModel, NoRecommendationError, recommend,
+                             sdm, zoa)
 
     check_plot(args.plot)
-    check_outputs([("--plot", args.plot)], [args.assembly, args.frf, args.frf_y, args.modes, args.workpiece_table],
-                  args.overwrite)
+    check_outputs([("--plot", args.plot)], [args.assembly, args.frf, args.frf_y, args.modes, args.workpiece_table,
+                                            args.cutting_data], args.overwrite)
     if args.intervals is not None and args.method != "sdm":
         raise UsageError("--intervals sets the semi-discretization: use it with --method sdm")
     structure, what, band, tool = _lobes_structure(args)
@@ -103,24 +106,33 @@ def run(args: argparse.Namespace) -> int:
         lo, hi = info["intervals_in_cut"]
         notes.append(f"discretisation: {lo}" + (f" to {hi}" if hi != lo else "") + " intervals in the cut per "
                      f"delay period; boundary to {info['depth_rtol']:.1%}")
-    best = None
+    best = why = None
     if limits is not None:
-        best = recommend(lobes, cut, limits, margin=args.margin, speed_tolerance=args.speed_tolerance)
+        try:
+            best = recommend(lobes, cut, limits, margin=args.margin, speed_tolerance=args.speed_tolerance)
+        except NoRecommendationError as exc:  # the lobes stand; the recommendation is absent, with the reason
+            why = " ".join(str(exc).split())
     else:
-        notes.append("no recommendation: the machinist's recommendation is for milling cuts")
+        why = "the machinist's recommendation is for milling cuts"
+        notes.append(f"no recommendation: {why}")
+    shop = cutting_check(args, cut, tool, best, notes) if isinstance(cut, MillingCut) else None
     if args.plot:
         figures()
-        fig = lobes.plot(lobes=args.method == "zoa", recommendation=best, title=f"Stability lobes: {cut.describe()}")
+        fig = lobes.plot(lobes=args.method == "zoa", recommendation=best, title=f"Stability lobes: {cut.describe()}",
+                         limits=limits, cut=cut if isinstance(cut, MillingCut) else None)
         save_figure(fig, args.plot, args.overwrite)
     if args.json:
         out = lobes.to_json()
         out["recommended"] = None if best is None else best.to_json()
+        out["no_recommendation_reason"] = why
         if limits is not None:
             out["machine"] = limits.to_json()
         if getattr(cut, "workpiece", None) is not None:
             out["workpiece"] = cut.workpiece.to_json()
         if isinstance(cut, MillingCut):
             out["cut"] = cut.to_json()
+            out["milling_default"] = MILLING_DEFAULT_NOTE in notes
+        out["cutting_data"] = shop
         out["notes"] = notes
         return print_json(out)
     speeds = lobes.spindle_speed_rpm
@@ -157,9 +169,18 @@ def run(args: argparse.Namespace) -> int:
             print(f"  {line}")
         if best.mrr_m3_per_s is None:
             print("  (give --feed-per-tooth for the removal rate and the power check)")
+        if shop is not None and shop.get("range") is not None:
+            row = shop["range"]
+            state = "outside" if shop["warnings"] else "inside"
+            print(f"  {state} the usual {row['cutting_speed_m_per_min'][0]:.0f} to "
+                  f"{row['cutting_speed_m_per_min'][1]:.0f} m/min and {row['feed_per_tooth_m'][0] * 1e3:.3g} to "
+                  f"{row['feed_per_tooth_m'][1] * 1e3:.3g} mm/tooth for {row['workpiece']} with a "
+                  f"{row['tool_material']} tool")
         for k, other in enumerate(best.runners_up, 1):
             print(f"runner-up {k}: {other.describe()[0]} (limit {other.limit_depth_m * 1e3:.3g} mm within "
                   f"{other.window_rpm[0]:.0f}..{other.window_rpm[1]:.0f} rpm)")
+    elif why is not None and limits is not None:
+        print(f"recommended: none; {why}")
     if args.plot:
         print(f"wrote {args.plot}")
     return 0

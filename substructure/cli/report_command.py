@@ -80,7 +80,15 @@ def run(args: argparse.Namespace) -> int:
     result = report(args.assembly, args.measurements, cut, limits, at=at, speeds=args.speeds if given else None,
                     band="auto" if args.band is None else args.band, method=args.method, intervals=args.intervals,
                     margin=args.margin, speed_tolerance=args.speed_tolerance, identify=args.identify,
-                    title=args.title, notes=notes, command=command, progress=progress or False)
+                    title=args.title, notes=notes, command=command, progress=progress or False,
+                    tool_material=args.tool_material, cutting_table=args.cutting_data)
+    import warnings
+
+    from ..stability import CuttingDataWarning
+
+    for text in (result.cutting or {}).get("warnings", []):
+        warnings.warn(f"{text}: check the recommendation against your tool maker's data", CuttingDataWarning,
+                      stacklevel=2)
     path = result.save(args.out, overwrite=args.overwrite)
     size = path.stat().st_size
     if args.json:
@@ -93,6 +101,14 @@ def run(args: argparse.Namespace) -> int:
     if best is not None:
         print(f"recommended: {best.describe()[0]}")
         print(f"  {best.describe()[1]}")
+        shop = [line for line in best.describe() if line.startswith("cutting speed")]
+        if shop:
+            print(f"  {shop[0]}")
+        robust = result.band_recommendation
+        if robust is not None:
+            print(f"  across the joints' uncertainty ({len(result.band.members)} variants): {robust.describe()[0]}")
+        elif result.band_no_recommendation:
+            print(f"  across the joints' uncertainty: no recommendation ({result.band_no_recommendation})")
     elif result.no_recommendation:
         print(f"no recommendation: {result.no_recommendation}")
     else:

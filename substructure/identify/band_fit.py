@@ -28,7 +28,7 @@ import numpy as np
 from ..assembly import Assembly
 from ..errors import InvalidValueError, NonPassiveJointWarning
 from ..frf import FRF
-from ..joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint
+from ..joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint, JointProvenance
 from ..measurements import model_of_measurement
 from ..points import parse_point
 from ..updating.fit import fit
@@ -211,7 +211,8 @@ class JointIdentifier:
             _set_parameter(k, c, name, value)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", (NonPassiveJointWarning,))
-            return Joint(template.name, template.between, k=k, c=c)
+            return Joint(template.name, template.between, k=k, c=c,
+                         provenance=JointProvenance("identified", "fitted to the measured FRFs (band fit)"))
 
     def _specs(self, names, start: Mapping[str, float]) -> list[ParamSpec]:
         specs = []

@@ -32,7 +32,7 @@ MAX_TEXT_BYTES = _files.MAX_TEXT_BYTES
 #: The largest measured FRF file read, CSV or universal file (128 MiB).
 MAX_DATA_BYTES = _files.MAX_DATA_BYTES
 
-__public_submodules__ = ("assembly_toml", "frf_files", "measurements")
+__public_submodules__ = ("assembly_toml", "frf_files", "measurements", "tap_files")
 """Submodules that are public API of their own (documented on their own pages)."""
 
 __all__ = ["read_text", "read_bytes", "parse_toml", "MAX_TEXT_BYTES", "MAX_DATA_BYTES", "check_readable_file",

@@ -12,6 +12,7 @@ on what configuration::
     quantity = "receptance"          # receptance (default) | mobility | accelerance
     sensors = ["accelerometer"]      # optional: sensors on the structure in this test
     removed = ["tool"]               # optional: components taken off for this test
+    averages = 10                    # optional: taps averaged into the FRF (substructure tap writes it)
 
 :func:`load_measurements` and :func:`loads_measurements` return a
 :class:`~substructure.measurements.MeasurementSet`.  Data file paths are
@@ -30,7 +31,10 @@ missing or unreadable data files, NaN or non-increasing frequencies in them,
 dead channels (an FRF that is 0 at every line), values beyond any measured
 structure (a receptance above 1 m/N, ``RECEPTANCE_LIMIT``; a mobility or an
 accelerance divided by ``2 pi f`` once or twice first), and data files on
-different frequency grids (never reconciled silently).
+different frequency grids (never reconciled silently).  A CSV data file
+with a fourth column ``coherence`` (written by ``substructure tap``) gives
+the measurement its coherence, cropped with the FRF when a 0 Hz line is
+dropped.
 """
 
 from __future__ import annotations
@@ -53,7 +57,7 @@ from .frf_files.csv_files import _read_csv
 __all__ = ["load_measurements", "loads_measurements"]
 
 _TOP_KEYS = ("name", "frf")
-_FRF_KEYS = ("response", "excitation", "file", "record", "quantity", "sensors", "removed")
+_FRF_KEYS = ("response", "excitation", "file", "record", "quantity", "sensors", "removed", "averages")
 _REQUIRED = ("response", "excitation", "file")
 _CSV = (".csv",)
 _UFF = (".uff", ".unv")
@@ -138,6 +142,14 @@ class _Reader:
             raise self.error(index, "quantity", f"got {value!r}; expected one of {', '.join(QUANTITIES)}")
         return value
 
+    def averages(self, table: dict, index: int) -> int | None:
+        if "averages" not in table:
+            return None
+        value = table["averages"]
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise self.error(index, "averages", f"got {value!r}; expected the number of averages (an integer >= 1)")
+        return value
+
     def record(self, table: dict, index: int) -> int | None:
         if "record" not in table:
             return None
@@ -148,7 +160,7 @@ class _Reader:
 
     # -- data files -----------------------------------------------------------
     def data(self, index: int, file: str, record: int | None, quantity: str | None,
-             response: str, excitation: str) -> FRF:
+             response: str, excitation: str) -> tuple[FRF, Any]:
         path = self.base_dir / file
         suffix = path.suffix.lower()
         if suffix not in _CSV + _UFF:
@@ -160,16 +172,17 @@ class _Reader:
             if suffix in _CSV:
                 if record is not None:
                     raise self.error(index, "record", f"a CSV file ({file}) holds one FRF; record is for UFF files")
-                frf, lines_of = _read_csv(path, output=response, input=excitation, quantity=quantity)
+                frf, lines_of, coherence = _read_csv(path, output=response, input=excitation, quantity=quantity)
             else:
                 frf, lines_of = self.uff(index, path, record, quantity, response, excitation), None
+                coherence = None
             beyond = _beyond_physical(frf.frequency.hz, frf.data, frf.quantity)  # a measured FRF's range
             if beyond is not None:
                 k, what = beyond
                 where = (f"line {lines_of[k]}" if lines_of is not None else
                          f"type-58 record {record or 0}, value {k + 1} of {frf.frequency.n}")
                 raise FileFormatError(f"{path}, {where}: at {frf.frequency.hz[k]:g} Hz: {what}")
-            return frf
+            return frf, coherence
         except _LocatedError:
             raise
         except FileFormatError as exc:  # names the data file (and its line)
@@ -237,7 +250,8 @@ class _Reader:
         file = self.string(table, index, "file")
         quantity, record = self.quantity(table, index), self.record(table, index)
         sensors, removed = self.names(table, index, "sensors"), self.names(table, index, "removed")
-        raw = self.data(index, file, record, quantity, response, excitation)
+        averages = self.averages(table, index)
+        raw, coherence = self.data(index, file, record, quantity, response, excitation)
         if raw.quantity != "receptance" and raw.frequency.hz[0] == 0.0:
             line = self.lines.line(index, "file")
             warnings.warn(
@@ -246,12 +260,14 @@ class _Reader:
                 SubstructureWarning, stacklevel=2,
             )
             raw = raw.crop(lo=raw.frequency.hz[1])
+            coherence = None if coherence is None else coherence[1:]
         try:
             receptance = raw.to_receptance()
         except SubstructureError as exc:
             raise self.error(index, "file", f"{self.base_dir / file}: {exc}") from None
         try:
-            return Measurement(response, excitation, receptance, raw.quantity, sensors, removed, file, record)
+            return Measurement(response, excitation, receptance, raw.quantity, sensors, removed, file, record,
+                               coherence, averages)
         except SubstructureError as exc:  # pragma: no cover - every field was checked above
             raise self.error(index, None, str(exc)) from None
 

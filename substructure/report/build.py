@@ -32,7 +32,8 @@ __all__ = ["Report", "ToolMode", "report", "tool_point", "SUMMARY_KEYS", "DEFAUL
 #: and ``bytes`` added).
 SUMMARY_KEYS = ("title", "created", "version", "sources", "assembly", "tool_point", "frequency_hz",
                 "structure_band", "modes", "cut", "workpiece", "machine", "method", "absolute_limit_m",
-                "recommended", "no_recommendation", "diagnosis", "joints", "assumptions", "notes")
+                "recommended", "no_recommendation", "diagnosis", "joints", "assumptions", "notes",
+                "stability_band", "cutting_data")
 
 DEFAULT_SPEEDS = ("2000 rpm", "24000 rpm", "50 rpm")
 """The spindle speeds of the lobes when none are given (as ``substructure lobes``)."""
@@ -118,6 +119,18 @@ class Report:
         The version of substructure that made it.
     command : str or None
         The command line that made it, shown in the report.
+    band : LobesBand or None
+        The lobes over the joints' stated uncertainty
+        (:func:`~substructure.joint_priors.joint_variants`), the nominal among
+        them; None when no joint states one.
+    band_recommendation : Recommendation or None
+        The speed and depth stable for every member of ``band``.
+    band_no_recommendation : str or None
+        Why there is none over the band, when there is a band.
+    cutting : dict or None
+        The recommendation's cutting speed and feed against the usual range
+        (:func:`~substructure.stability.cutting_conditions`, with
+        ``warnings``); None without a recommendation.
     """
 
     title: str
@@ -141,6 +154,10 @@ class Report:
     created: str = ""
     version: str = ""
     command: str | None = None
+    band: Any = None
+    band_recommendation: Any = None
+    band_no_recommendation: str | None = None
+    cutting: dict | None = None
 
     @property
     def tool(self):
@@ -200,6 +217,11 @@ class Report:
             "joints": joints_json(self),
             "assumptions": self.assumptions(),
             "notes": list(self.notes),
+            "stability_band": None if self.band is None else {
+                "members": len(self.band.members),
+                "recommended": None if self.band_recommendation is None else self.band_recommendation.to_json(),
+                "no_recommendation": self.band_no_recommendation},
+            "cutting_data": self.cutting,
         }
 
     def to_html(self) -> str:
@@ -356,11 +378,53 @@ def _lobes(structure: Any, band: Any, cut: Any, speeds: Any, method: str, interv
     return attrs.evolve(sdm(fit_modes(xy), cut, speeds, intervals=intervals), band=band)
 
 
+def _joint_band(assembly, at, band, chosen, lobes, cut, limits, speeds, method, intervals, margin, tolerance, say):
+    """The lobes over the joints' stated uncertainty and the recommendation stable across them (None, None, None
+    when no joint states an uncertainty)."""
+    from ..joint_priors import joint_variants
+    from ..stability import (NoRecommendationError, assembly_structure, choose_band, lobes_band, recommend)
+
+    variants = joint_variants(assembly)
+    if len(variants) < 2:
+        return None, None, None
+    say(f"stability band: lobes of {len(variants)} variants of the joints within their uncertainty")
+    members = []
+    for variant in variants:
+        if isinstance(band, str) and band == "auto":
+            structure, used = assembly_structure(variant, at)
+        else:
+            structure, used = choose_band(variant.receptance(at, frequency=variant.frequency), band)
+        members.append(_lobes(structure, used, cut, speeds, method, intervals, lambda text: None))
+    spread = lobes_band(members, nominal=lobes, label="joints within their uncertainty")
+    try:
+        return spread, recommend(lobes, cut, limits, margin=margin, speed_tolerance=tolerance, band=spread), None
+    except NoRecommendationError as exc:
+        return spread, None, " ".join(str(exc).split())
+
+
+def _cutting(cut: Any, best: Any, tool: Any, table: Any, material: str | None) -> dict | None:
+    """The recommendation's cutting speed and feed against the usual range of the work and tool material."""
+    from ..stability import check_cutting, cutting_conditions, cutting_data
+
+    if best is None:
+        return None
+    wp = getattr(cut, "workpiece", None)
+    if material is None and tool is not None:
+        names = " ".join(s.material.name.lower() for s in getattr(tool, "segments", ()) if s.material is not None)
+        material = next((m for m in ("carbide", "hss") if m in names), None)
+    data = cutting_data(wp, material or "carbide", table) if wp is not None else None
+    out = cutting_conditions(cut, best.spindle_speed_rpm, data)
+    out["tool_material"] = material or ("carbide (assumed)" if wp is not None else None)
+    out["warnings"] = check_cutting(cut, best.spindle_speed_rpm, data)
+    return out
+
+
 def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any = None, *, at: str | None = None,
            speeds: Any = None, band: Any = "auto", method: str = "zoa", intervals: int | None = None,
            margin: float = 0.2, speed_tolerance: float = 0.03, identify: Any = "auto", title: str | None = None,
            notes: Sequence[str] = (), command: str | None = None,
-           progress: bool | Callable[[str], None] = False) -> Report:
+           progress: bool | Callable[[str], None] = False, tool_material: str | None = None,
+           cutting_table: Any = None) -> Report:
     """Compute everything a report shows, with the library's workflows.
 
     Parameters
@@ -401,6 +465,12 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
         The command line that made the report, shown in it.
     progress : bool or callable, default False
         Report the steps (to standard error when True).
+    tool_material : {"carbide", "hss"}, optional
+        For the check of the cutting speed and feed; default the material of
+        the assembly's tool when it is carbide or HSS, else carbide (said so).
+    cutting_table : str or os.PathLike, optional
+        A user's table of cutting-speed and feed ranges, searched first
+        (:func:`~substructure.stability.load_cutting_data`).
 
     Returns
     -------
@@ -468,7 +538,7 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
         structure, chosen = choose_band(frf, band)
     modes, fit_error = _modes(structure, notes)
     tool = _tool_of(assembly, at)
-    lobes = best = why = None
+    lobes = best = why = spread = robust = robust_why = shop = None
     if cut is not None:
         milling = hasattr(cut, "radial_depth")
         if milling:
@@ -493,6 +563,9 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
                 best = recommend(lobes, cut, limits, margin=margin, speed_tolerance=speed_tolerance)
             except InvalidValueError as exc:  # the lobes leave nothing to recommend: the report says why
                 why = str(exc)
+            spread, robust, robust_why = _joint_band(assembly, at, band, chosen, lobes, cut, limits, speeds, method,
+                                                     intervals, margin, speed_tolerance, say)
+            shop = _cutting(cut, best, tool, cutting_table, tool_material)
         else:
             why = "the recommendation of a speed and depth is for milling cuts; the lobes are shown"
     diagnosis = None
@@ -515,4 +588,5 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
         modes=modes, modal_fit_error=fit_error, cut=cut, limits=limits if cut is not None else None, lobes=lobes,
         recommendation=best, no_recommendation=why, measurements=measurements, diagnosis=diagnosis,
         identifications=identified, identification_errors=failed, notes=notes, sources=sources, created=created,
-        version=substructure.__version__, command=command)
+        version=substructure.__version__, command=command, band=spread, band_recommendation=robust,
+        band_no_recommendation=robust_why, cutting=shop)

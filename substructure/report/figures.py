@@ -81,10 +81,20 @@ def lobes_figure(report: Any) -> str:
     str
         The PNG ``data:`` address.
     """
+    import numpy as np
+
     lobes = report.lobes
+    milling = hasattr(report.cut, "radial_depth")
     fig = lobes.plot(lobes=lobes.method == "zoa", recommendation=report.recommendation,
-                     title=f"Chatter-free axial depth against spindle speed: {report.cut.describe()}")
+                     title=f"Chatter-free axial depth against spindle speed: {report.cut.describe()}",
+                     limits=report.limits if milling else None, cut=report.cut if milling else None)
     ax = fig.axes[0]
+    band = getattr(report, "band", None)
+    if band is not None:  # the joints within their stated uncertainty
+        lo = np.where(np.isfinite(band.lower_m), band.lower_m, np.nan) * 1e3
+        hi = np.where(np.isfinite(band.upper_m), band.upper_m, np.nan) * 1e3
+        ax.fill_between(band.spindle_speed_rpm, lo, hi, color="tab:purple", alpha=0.12, lw=0,
+                        label=f"stability band ({len(band.members)} variants of the joints)")
     handles, labels = ax.get_legend_handles_labels()
     if ax.get_legend() is not None:  # beside the axes: never over the recommendation and its window
         ax.get_legend().remove()

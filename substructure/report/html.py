@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from . import figures
+from .shop import band_lines, band_table, cutting_lines, provenance_note, provenance_warnings, readable
 from .style import STYLE
 from .text import ENTRY_NAMES, EFFECT_NAMES, assumptions, diagnosis_verdict, joint_findings
 
@@ -123,7 +124,7 @@ def _answer(report: Any) -> str:
     if r is not None:
         lines = [f'<p class="big">Run at <strong>{fixed(r.spindle_speed_rpm, ",.0f")} rpm</strong> with an axial '
                  f"depth of cut of <strong>{fixed(r.depth_m, '.3g', 1e3)} mm</strong>.</p>"]
-        what = f"{esc(cut.milling)} milling, radial depth {mm(cut.radial_depth)} mm of {mm(cut.diameter)} mm, " \
+        what = f"{esc(_direction(cut))} milling, radial depth {mm(cut.radial_depth)} mm of {mm(cut.diameter)} mm, " \
                f"{cut.teeth} teeth"
         if cut.feed_per_tooth is not None:
             what += f", feed {fixed(cut.feed_per_tooth.m_as('mm'), '.3g')} mm per tooth"
@@ -135,6 +136,7 @@ def _answer(report: Any) -> str:
         lines.append(f"<p>Safety margin: the depth is {1 - r.reserve:.0%} of the chatter limit, {limit} mm, "
                      f"which is the lowest limit anywhere between {fixed(lo, ',.0f')} and {fixed(hi, ',.0f')} rpm "
                      f"(speed ±{r.speed_tolerance:.0%}); the depth is set by {esc(r.limited_by)}.</p>")
+        lines += band_lines(report) + cutting_lines(report)
         if r.mrr_m3_per_s is not None:
             power = f"cutting power {fixed(r.power_w, '.2g', 1e-3)} kW"
             if np.isfinite(r.available_power_w):
@@ -161,6 +163,7 @@ def _answer(report: Any) -> str:
     for c in report.assembly.components:
         if "APPROXIMATE" in (getattr(c, "description", "") or ""):
             facts.append(f"The geometry of {esc(c.name)} is approximate (from the holder catalogue): check it.")
+    facts += provenance_warnings(_provenances(report))
     if facts:
         parts.append("<ul class=\"facts\">" + "".join(f"<li>{f}</li>" for f in facts) + "</ul>")
     return "".join(parts)
@@ -365,19 +368,9 @@ def _diagnosis(report: Any) -> str:
                    + note("Every effect the diagnosis knows, fitted at every place it can act; the best first."))
     other = {k: v for k, v in data.items() if k not in _SHOWN}
     if other:
-        rows = [[tech(k), esc(_short(v))] for k, v in other.items()]
+        rows = [[esc(str(k).replace("_", " ")) + " " + tech(k), readable(v)] for k, v in other.items()]
         out.append("<h3>More from the diagnosis</h3>" + table(["Key", "Value"], rows, cls="small"))
     return "".join(out)
-
-
-def _short(value: Any, limit: int = 300) -> str:
-    import json
-
-    try:
-        text = json.dumps(value, default=str)
-    except (TypeError, ValueError):
-        text = str(value)
-    return text if len(text) <= limit else text[:limit] + " …"
 
 
 # -- stability -------------------------------------------------------------------------------------------
@@ -409,6 +402,7 @@ def _stability(report: Any) -> str:
                                                f"reserve {r.reserve:.3f}, limiting speed {r.limiting_speed_rpm:.0f} rpm")))
     elif report.no_recommendation:
         out.append(f'<p class="verdict unexplained">No recommendation: {esc(report.no_recommendation)}</p>')
+    out.append(band_table(report))
     out.append(figure(figures.lobes_figure(report), "stability lobes",
                       "Below the curve the cut is stable, above it chatters. The star is the recommended speed and "
                       "depth, the green box its safe window, the dashed line the limit it keeps its margin from. "
@@ -419,7 +413,7 @@ def _stability(report: Any) -> str:
         wp = getattr(cut, "workpiece", None)
         rows = [["Teeth", str(cut.teeth)], ["Tool diameter", f"{mm(cut.diameter)} mm"],
                 ["Radial depth of cut", f"{mm(cut.radial_depth)} mm ({cut.immersion:.0%} of the diameter)"],
-                ["Direction", f"{esc(cut.milling)} milling"],
+                ["Direction", f"{esc(_direction(cut))} milling"],
                 ["Feed per tooth", "not given" if cut.feed_per_tooth is None
                  else f"{fixed(cut.feed_per_tooth.m_as('mm'), '.3g')} mm"],
                 ["Work material", "not named (coefficients given)" if wp is None
@@ -524,6 +518,7 @@ def _joints(report: Any) -> str:
                     row.append("–" if f is None else _entry(f["value"], f["std"], unit(f["unit"])))
                 rows.append(row)
         out.append(f"<h3>{esc(j.name)}</h3><p>{esc(j.between[0])} – {esc(j.between[1])}.</p>" + table(headers, rows))
+        out.append(provenance_note(j, _provenances(report)))
         if ident is not None:
             lo, hi = ident.band
             out.append(note(f"Identified over {lo:.5g}–{hi:.5g} Hz from every FRF measured with the joint in place; "
@@ -536,6 +531,16 @@ def _joints(report: Any) -> str:
         elif j.name in failed:
             out.append(note("Not identified: " + esc(failed[j.name])))
     return "".join(out)
+
+
+def _provenances(report: Any) -> list[dict]:
+    from ..joint_priors import joint_provenances
+
+    return joint_provenances(report.assembly)
+
+
+def _direction(cut: Any) -> str:
+    return f"{cut.milling} ({'conventional' if cut.milling == 'up' else 'climb'})"
 
 
 # -- the page ----------------------------------------------------------------------------------------------

@@ -159,8 +159,13 @@ def joints_json(report: Any) -> list[dict]:
     list of dict
         Per joint: ``name``, ``between``, ``rigid``, ``model`` (``k`` and ``c`` in SI units),
         ``identified`` (``IdentificationReport.to_json()`` or None), ``identification_error``
-        (why it could not be identified, or None) and ``diagnosis`` (:func:`joint_findings`).
+        (why it could not be identified, or None), ``diagnosis`` (:func:`joint_findings`) and
+        ``provenance`` (where the values come from: ``kind``, ``source``, ``uncertainty``, ``warning``;
+        :func:`~substructure.joint_priors.joint_provenances`; None for a rigid joint).
     """
+    from ..joint_priors import joint_provenances
+
+    where = {row["name"]: row for row in joint_provenances(report.assembly)}
     data = None if report.diagnosis is None else report.diagnosis.to_json()
     identified = {r.joint: r for r in report.identifications}
     failed = dict(report.identification_errors)
@@ -172,7 +177,8 @@ def joints_json(report: Any) -> list[dict]:
             model = {kind: {e: getattr(j, kind).get(e) for e in ENTRY_NAMES} for kind in ("k", "c")}
         out.append({"name": j.name, "between": list(j.between), "rigid": rigid, "model": model,
                     "identified": identified[j.name].to_json() if j.name in identified else None,
-                    "identification_error": failed.get(j.name), "diagnosis": joint_findings(data, j.name)})
+                    "identification_error": failed.get(j.name), "diagnosis": joint_findings(data, j.name),
+                    "provenance": where.get(j.name)})
     return out
 
 
@@ -225,6 +231,24 @@ def assumptions(report: Any) -> list[str]:
             out.append(f"Approximate geometry: {c.name!r} is built from the holder catalogue ({text.split(':')[0]}); "
                        "its body and nose are typical values, not your holder's drawing. Check the diameters and "
                        "lengths with a caliper and override what differs.")
+    from ..joint_priors import joint_provenances
+
+    for row in joint_provenances(report.assembly):
+        if row["warning"]:
+            out.append(f"Joint values: {row['warning']}.")
+        elif row["kind"] in ("prior", "borrowed", "predicted"):
+            spread = f", within a factor {row['uncertainty']:g}" if row["uncertainty"] is not None else ""
+            out.append(f"Joint {row['name']!r}: {row['kind']}{spread}, not identified on this machine"
+                       + (f" ({row['source'].split(':')[0]})" if row["source"] else "") + ".")
+    if report.band is not None:
+        out.append(f"The stability band: the lobes of {len(report.band.members)} variants of the model, each joint "
+                   "with a stated uncertainty at the ends and the middle of its range; the band's recommendation "
+                   "is stable for every one of them, not for values beyond them.")
+    if report.cutting is not None and report.cutting.get("range") is not None:
+        row = report.cutting["range"]
+        out.append(f"The cutting-speed and feed ranges of {row['workpiece']} with a {row['tool_material']} tool "
+                   f"are {row['source'].split(';')[0]} ranges of the published orders of magnitude, for a warning "
+                   "only: nothing is clipped to them.")
     data = None if report.diagnosis is None else report.diagnosis.to_json()
     if data is not None:
         floor = _number(data.get("noise_floor"))

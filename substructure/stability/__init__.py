@@ -22,7 +22,10 @@ best speeds, and how much the lobes move when the FRF changes.
   spindle speed and depth of cut to use, with a stated margin, within the
   machine's speed, power, torque and depth.
 * :func:`workpiece`, :class:`Workpiece`: published cutting coefficients of
-  common work materials, by name.
+  common work materials, by name (aliases and the shop's spellings).
+* :func:`cutting_data`, :func:`cutting_conditions`, :func:`check_cutting`:
+  cutting speed (m/min, SFM), feed per tooth and feed rate, checked against
+  the usual range per work and tool material.
 
 Spindle speeds are in rpm (:func:`spindle_speeds`), depths in m, frequencies
 in Hz; see ``docs/stability.md``.
@@ -38,13 +41,15 @@ Examples
 """
 
 from .band import FlexibleBand, assembly_structure, choose_band, flexible_band
+from .cutting_data import (CuttingData, CuttingDataWarning, check_cutting, cutting_conditions, cutting_data,
+                           load_cutting_data)
 from .cutting import MillingCut, TurningCut, as_speed_rpm, spindle_speeds, tooth_passing_hz
 from .machine import MachineLimits, SpeedCurve, cut_power, cut_torque, removal_rate
 from .modal import MODES_CSV_HEADER, ModalFitter, ModalFitWarning, ModalModel, Mode, fit_modes
 from .result import Lobes, LobesBand, StabilityWarning, lobes_band
 from .sdm import sdm, spectral_radius
 from .structure import XY_LABELS, xy_frf
-from .recommend import RECOMMENDATION_KEYS, Recommendation, recommend
+from .recommend import RECOMMENDATION_KEYS, NoRecommendationError, Recommendation, recommend
 from .workpieces import Workpiece, load_workpieces, workpiece, workpieces
 from .zoa import zoa
 
@@ -55,6 +60,7 @@ __all__ = [
     "Lobes", "LobesBand", "lobes_band", "StabilityWarning",
     "FlexibleBand", "flexible_band", "choose_band", "assembly_structure",
     "MachineLimits", "SpeedCurve", "cut_power", "cut_torque", "removal_rate",
-    "Recommendation", "recommend", "RECOMMENDATION_KEYS",
+    "Recommendation", "recommend", "RECOMMENDATION_KEYS", "NoRecommendationError",
     "Workpiece", "workpiece", "workpieces", "load_workpieces",
+    "CuttingData", "CuttingDataWarning", "cutting_data", "load_cutting_data", "cutting_conditions", "check_cutting",
 ]

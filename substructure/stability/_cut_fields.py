@@ -13,9 +13,11 @@ from typing import Any
 import pint
 
 from ..errors import InvalidValueError, UnitError
-from ..units import quantity
+from ..units import quantity, show_value
 
 MILLING_MODES = ("up", "down")
+MILLING_ALIASES = {"up": "up", "conventional": "up", "down": "down", "climb": "down"}
+"""The shop's words for the milling direction: climb milling is down milling, conventional is up milling."""
 
 
 def _teeth(value: Any) -> int:
@@ -23,9 +25,9 @@ def _teeth(value: Any) -> int:
         if isinstance(value, numbers.Real) and float(value).is_integer() and not isinstance(value, bool):
             value = int(value)
         else:
-            raise InvalidValueError(f"teeth: got {value!r}; expected a whole number of teeth >= 1")
+            raise InvalidValueError(f"teeth: got {show_value(value)}; expected a whole number of teeth >= 1")
     if value < 1:
-        raise InvalidValueError(f"teeth: got {value!r}; expected a whole number of teeth >= 1")
+        raise InvalidValueError(f"teeth: got {show_value(value)}; expected a whole number of teeth >= 1")
     return int(value)
 
 
@@ -33,7 +35,7 @@ def _length(field: str):
     def convert(value: Any) -> pint.Quantity:
         q = quantity(value, field, "[length]")
         if q.magnitude <= 0:
-            raise InvalidValueError(f"{field}: got {value!r}; expected a positive length")
+            raise InvalidValueError(f"{field}: got {show_value(value)}; expected a positive length")
         return q
 
     return convert
@@ -43,13 +45,14 @@ def _pressure(field: str, allow_zero: bool):
     def convert(value: Any) -> pint.Quantity:
         if isinstance(value, numbers.Real) and not isinstance(value, bool) and field == "kn":
             raise UnitError(
-                f"kn: got the bare number {value!r}; kn is the normal (radial) cutting pressure, e.g. "
+                f"kn: got the bare number {show_value(value)}; kn is the normal (radial) cutting pressure, e.g. "
                 "'100 MPa'. For the ratio Kr = Kn/Kt use MillingCut.from_spec(..., kr=0.16)"
             )
         q = quantity(value, field, "[mass] / [length] / [time] ** 2")
         if q.magnitude < 0 or (q.magnitude == 0 and not allow_zero):
             need = ">= 0" if allow_zero else "> 0"
-            raise InvalidValueError(f"{field}: got {value!r}; expected a cutting coefficient {need} (a pressure)")
+            raise InvalidValueError(f"{field}: got {show_value(value)}; expected a cutting coefficient {need} "
+                                    "(a pressure)")
         return q
 
     return convert
@@ -59,13 +62,15 @@ def _edge(field: str):
     def convert(value: Any) -> pint.Quantity:
         q = quantity(value, field, "[mass] / [time] ** 2")
         if not q.magnitude >= 0:
-            raise InvalidValueError(f"{field}: got {value!r}; expected an edge force per length >= 0 (e.g. '20 N/mm')")
+            raise InvalidValueError(f"{field}: got {show_value(value)}; expected an edge force per length >= 0 "
+                                    "(e.g. '20 N/mm')")
         return q
 
     return convert
 
 
 def _milling(value: Any) -> str:
-    if value not in MILLING_MODES:
-        raise InvalidValueError(f"milling: got {value!r}; expected 'up' or 'down'")
-    return value
+    key = value.strip().lower() if isinstance(value, str) else value
+    if key not in MILLING_ALIASES:
+        raise InvalidValueError(f"milling: got {show_value(value)}; expected 'down' (climb) or 'up' (conventional)")
+    return MILLING_ALIASES[key]

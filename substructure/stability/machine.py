@@ -27,7 +27,7 @@ import numpy as np
 import pint
 
 from ..errors import InvalidValueError
-from ..units import Q_, quantity
+from ..units import Q_, quantity, show_value
 from .speeds import as_speed_rpm
 
 __all__ = ["MachineLimits", "SpeedCurve", "cut_power", "removal_rate", "cut_torque"]
@@ -90,13 +90,13 @@ def _limit(field: str, dimension: str, unit: str):
         if isinstance(value, (str, pint.Quantity)) and np.ndim(getattr(value, "magnitude", 0)) == 0:
             q = quantity(value, field, dimension)
             if not q.magnitude > 0:
-                raise InvalidValueError(f"{field}: got {value!r}; expected a positive value")
+                raise InvalidValueError(f"{field}: got {show_value(value)}; expected a positive value")
             return q
         try:
             speeds, values = value if len(value) == 2 and not isinstance(value[0], (tuple, list)) else zip(*value)
         except (TypeError, ValueError):
             raise InvalidValueError(
-                f"{field}: got {value!r}; expected a constant ('15 kW') or a curve: (speeds, values) as two "
+                f"{field}: got {show_value(value)}; expected a constant ('15 kW') or a curve: (speeds, values) as two "
                 "quantity arrays, or a list of (speed, value) pairs") from None
         speed_rpm = _curve_speeds(_stack([speeds] if isinstance(speeds, str) else speeds, f"{field} speeds"),
                                   f"{field} speeds")
@@ -263,7 +263,7 @@ class MachineLimits:
 def _positive_length(value: Any, field: str) -> pint.Quantity:
     q = quantity(value, field, "[length]")
     if not q.magnitude > 0:
-        raise InvalidValueError(f"{field}: got {value!r}; expected a positive length")
+        raise InvalidValueError(f"{field}: got {show_value(value)}; expected a positive length")
     return q
 
 

@@ -74,9 +74,11 @@ class MillingCut:
         Without helix and lead angle the radial force is the normal force, so
         a "Kr" given as a pressure is this ``kn``; a "Kr" given as a ratio is
         ``kn / kt`` (use :meth:`from_spec` with ``kr=``).
-    milling : {"up", "down"}
+    milling : {"up", "down", "conventional", "climb"}
         Up (conventional) milling: the tooth enters at zero chip thickness;
-        down (climb) milling: it leaves at zero chip thickness.
+        down (climb) milling: it leaves at zero chip thickness.  The shop's
+        words are accepted and stored as ``"up"`` or ``"down"``; the default
+        is up milling (kept for the results of earlier versions).
     feed_per_tooth : quantity or str, optional
         Feed per tooth (chip load), e.g. ``"0.1 mm"``.  Stability does not use
         it (the linear model has no static chip); the material removal rate
@@ -108,7 +110,7 @@ class MillingCut:
     radial_depth: pint.Quantity = attrs.field(converter=_length("radial_depth"))
     kt: pint.Quantity = attrs.field(kw_only=True, converter=_pressure("kt", allow_zero=False))
     kn: pint.Quantity = attrs.field(kw_only=True, converter=_pressure("kn", allow_zero=True))
-    milling: str = attrs.field(default="up", kw_only=True, validator=lambda i, a, v: _milling(v))
+    milling: str = attrs.field(default="up", kw_only=True, converter=_milling)
     feed_per_tooth: pint.Quantity | None = attrs.field(default=None, kw_only=True, converter=attrs.converters.optional(
         _length("feed_per_tooth")))
     kte: pint.Quantity = attrs.field(default="0 N/m", kw_only=True, converter=_edge("kte"))
@@ -294,7 +296,8 @@ class MillingCut:
         str
             The cut with its units.
         """
-        text = (f"{self.milling} milling, {self.teeth} teeth, D = {self.diameter:~P}, "
+        shop = "conventional" if self.milling == "up" else "climb"
+        text = (f"{self.milling} ({shop}) milling, {self.teeth} teeth, D = {self.diameter:~P}, "
                 f"a_e = {self.radial_depth:~P} (a_e/D = {self.immersion:.3g}), "
                 f"Kt = {self.kt.to('MPa'):.4g~P}, Kn = {self.kn.to('MPa'):.4g~P} (Kn/Kt = {self.kr:.3g})")
         if self.feed_per_tooth is not None:
@@ -315,6 +318,7 @@ class MillingCut:
         feed = self.feed_per_tooth
         return {"teeth": self.teeth, "diameter_m": float(self.diameter.m_as("m")),
                 "radial_depth_m": float(self.radial_depth.m_as("m")), "milling": self.milling,
+                "milling_shop_name": "conventional" if self.milling == "up" else "climb",
                 "kt_pa": self.kt_pa, "kn_pa": self.kn_pa,
                 "feed_per_tooth_m": None if feed is None else float(feed.m_as("m"))}
 

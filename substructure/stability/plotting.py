@@ -24,7 +24,7 @@ from matplotlib.figure import Figure
 
 from ..errors import InvalidValueError
 
-__all__ = ["plot_lobes", "plot_band", "plot_recommendation", "METHOD_NAMES"]
+__all__ = ["plot_lobes", "plot_band", "plot_recommendation", "plot_machine_limits", "METHOD_NAMES"]
 
 METHOD_NAMES = {
     "zoa": ("zero-order", "zero-order approximation (Altintas & Budak 1995), 'zoa'"),
@@ -75,7 +75,8 @@ def _label(r: Any) -> str:
 
 
 def plot_lobes(results: Sequence[Any], ax: Any = None, lobes: bool = False, ylim_factor: float = 3.0,
-               recommendation: Any = None, title: str | None = None, **line_kw: Any) -> Figure:
+               recommendation: Any = None, title: str | None = None, limits: Any = None, cut: Any = None,
+               **line_kw: Any) -> Figure:
     """Depth limit against spindle speed for one or more :class:`Lobes`.
 
     Parameters
@@ -93,6 +94,11 @@ def plot_lobes(results: Sequence[Any], ax: Any = None, lobes: bool = False, ylim
         Mark it with its safe window (:func:`plot_recommendation`).
     title : str, optional
         Wrapped to the width of the figure.
+    limits : MachineLimits, optional
+        Draw the machine's limits (:func:`plot_machine_limits`).
+    cut : MillingCut, optional
+        With ``limits`` and a feed per tooth: the depth the spindle's power
+        and torque allow is drawn too.
     **line_kw
         Passed to ``Axes.plot`` for every result (``color``, ``linestyle``).
 
@@ -127,10 +133,58 @@ def plot_lobes(results: Sequence[Any], ax: Any = None, lobes: bool = False, ylim
     if notes and not overlay:
         ax.text(0.0, -0.2, "; ".join(notes), transform=ax.transAxes, fontsize="x-small", color="0.35",
                 va="top", wrap=True)
+    if limits is not None:
+        plot_machine_limits(limits, cut=cut, ax=ax)
     if recommendation is not None:
         plot_recommendation(recommendation, ax=ax)
     if title is not None:
         wrap_title(ax, title)
+    _finish(ax)
+    return ax.figure
+
+
+def plot_machine_limits(limits: Any, cut: Any = None, ax: Any = None) -> Figure:
+    """Draw what the machine allows on a lobe plot: the speeds outside its range shaded, the largest depth, and
+    (with a cut that has a feed per tooth) the depth its power and torque allow at each speed.
+
+    Parameters
+    ----------
+    limits : MachineLimits
+        The machine's limits.
+    cut : MillingCut, optional
+        For the power and torque limit: the cut with ``feed_per_tooth``.
+    ax : Axes or Figure, optional
+        Usually the axes of :func:`plot_lobes` (its speed axis is used).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure; the depth axis is left as it was.
+    """
+    from .machine import cut_power, cut_torque
+
+    ax = _axes(ax)
+    left, right = ax.get_xlim()
+    bottom, top = ax.get_ylim()
+    grey = {"color": "0.5", "alpha": 0.18, "lw": 0}
+    if limits.max_speed is not None and limits.max_speed < right:
+        ax.axvspan(limits.max_speed, right, label=f"above the machine's {limits.max_speed:,.0f} rpm", **grey)
+    if limits.min_speed is not None and limits.min_speed > left:
+        ax.axvspan(left, limits.min_speed, label=f"below the machine's {limits.min_speed:,.0f} rpm", **grey)
+    if np.isfinite(limits.max_depth_m) and limits.max_depth_m * 1e3 < top:
+        ax.axhline(limits.max_depth_m * 1e3, color="0.3", lw=0.9, ls="-.", label="largest depth")
+    has_feed = cut is not None and getattr(cut, "feed_per_tooth", None) is not None
+    if has_feed and (limits.power is not None or limits.torque is not None):
+        n = np.linspace(max(left, 1.0), right, 400)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            by_power = limits.power_w(n) / cut_power(cut, 1.0, n)
+            by_torque = limits.torque_nm(n) / cut_torque(cut, 1.0, n)
+        depth = np.minimum(by_power, by_torque) * 1e3
+        if np.any(depth < top):
+            ax.plot(n, np.where(np.isfinite(depth), depth, np.nan), color="tab:red", lw=1.0, ls="--",
+                    label="depth the spindle's power/torque allow")
+    ax.set_xlim(left, right)
+    ax.set_ylim(bottom, top)
     _finish(ax)
     return ax.figure
 

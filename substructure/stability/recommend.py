@@ -37,7 +37,18 @@ import numpy as np
 from ..errors import InvalidValueError
 from .machine import MachineLimits, cut_power, cut_torque, removal_rate
 
-__all__ = ["Recommendation", "recommend", "RECOMMENDATION_KEYS"]
+__all__ = ["Recommendation", "recommend", "RECOMMENDATION_KEYS", "NoRecommendationError"]
+
+
+class NoRecommendationError(InvalidValueError):
+    """The lobes are fine, but no operating point can be recommended from them.
+
+    Raised by :func:`recommend` when no computed speed has its whole window
+    inside the computed range and the machine's speed range, when no limit
+    at all bounds the depth, or when every candidate chatters on a
+    rigid-body line.  The message says which; a command prints the lobes
+    and gives the message as the reason (``"recommended": null``).
+    """
 
 #: The keys of ``Recommendation.to_json()`` that the ``recommended`` object of
 #: ``substructure lobes --json`` always has.
@@ -81,6 +92,12 @@ class Recommendation:
         What the spindle offers at that speed [W] (``inf``: no limit given).
     band_members : int
         How many lobe diagrams the window was checked on (1 + the band's).
+    cutting_speed_m_per_min : float or None
+        The cutting (surface) speed ``pi D n`` [m/min].
+    feed_per_tooth_m : float or None
+        The cut's feed per tooth [m] (None without one).
+    feed_rate_m_per_min : float or None
+        The table feed ``f_z z n`` [m/min] (None without a feed per tooth).
     runners_up : tuple of Recommendation
         The best choices of other pockets, best first.
     """
@@ -100,6 +117,9 @@ class Recommendation:
     torque_n_m: float | None = None
     available_power_w: float = float("inf")
     band_members: int = 1
+    cutting_speed_m_per_min: float | None = None
+    feed_per_tooth_m: float | None = None
+    feed_rate_m_per_min: float | None = None
     runners_up: tuple = attrs.field(default=(), converter=tuple)
 
     @property
@@ -140,6 +160,11 @@ class Recommendation:
             "torque_n_m": num(self.torque_n_m),
             "available_power_w": num(self.available_power_w),
             "band_members": self.band_members,
+            "cutting_speed_m_per_min": num(self.cutting_speed_m_per_min),
+            "cutting_speed_sfm": None if self.cutting_speed_m_per_min is None
+            else float(self.cutting_speed_m_per_min / 0.3048),
+            "feed_per_tooth_m": num(self.feed_per_tooth_m),
+            "feed_rate_m_per_min": num(self.feed_rate_m_per_min),
         }
         if runners_up:
             out["runners_up"] = [r.to_json(runners_up=False) for r in self.runners_up]
@@ -165,6 +190,11 @@ class Recommendation:
         if np.isfinite(self.chatter_frequency_hz):
             lines.append(f"chatter there would be at {self.chatter_frequency_hz:.5g} Hz; the limit at "
                          f"{self.spindle_speed_rpm:.0f} rpm itself is {self.limit_at_speed_m * 1e3:.3g} mm")
+        if self.cutting_speed_m_per_min is not None:
+            vc = self.cutting_speed_m_per_min
+            feed = ("" if self.feed_per_tooth_m is None else
+                    f", feed {self.feed_per_tooth_m * 1e3:.3g} mm/tooth = {self.feed_rate_m_per_min * 1e3:.4g} mm/min")
+            lines.append(f"cutting speed {vc:.0f} m/min ({vc / 0.3048:.0f} SFM){feed}")
         if self.power_w is not None:
             avail = (f" of {self.available_power_w / 1e3:.3g} kW available" if np.isfinite(self.available_power_w)
                      else "")
@@ -232,9 +262,13 @@ def recommend(lobes: Any, cut: Any, limits: MachineLimits | None = None, *, marg
     ------
     InvalidValueError
         For a margin outside ``[0, 1)``, a tolerance outside ``[0, 0.5)``, a
-        cut other than the lobes', no speed whose window fits the computed
-        range and the machine's, and power or torque limits without a feed
+        cut other than the lobes', and power or torque limits without a feed
         per tooth.
+    NoRecommendationError
+        (an ``InvalidValueError``) When no speed's whole window
+        ``n (1 +- x)`` fits the computed range and the machine's speed range,
+        or nothing bounds the depth: the lobes stand, the recommendation is
+        absent, and the message says why.
     """
     from .result import Lobes, LobesBand
 
@@ -263,11 +297,16 @@ def recommend(lobes: Any, cut: Any, limits: MachineLimits | None = None, *, marg
         members += [m for m in band.members if m is not lobes]
     speeds = lobes.spindle_speed_rpm
     lo, hi = speeds * (1 - x), speeds * (1 + x)
-    eligible = (lo >= speeds[0] * (1 - 1e-12)) & (hi <= speeds[-1] * (1 + 1e-12)) & limits.speed_ok(speeds)
+    # the whole window, not only its centre, must lie inside the computed speeds and the machine's range
+    eligible = ((lo >= speeds[0] * (1 - 1e-12)) & (hi <= speeds[-1] * (1 + 1e-12)) & limits.speed_ok(lo)
+                & limits.speed_ok(hi))
     if not eligible.any():
-        raise InvalidValueError(
+        machine = "".join(f", {name} {v:g} rpm" for name, v in (("min speed", limits.min_speed),
+                                                                 ("max speed", limits.max_speed)) if v is not None)
+        raise NoRecommendationError(
             f"speeds: no computed speed has its whole window n(1 +- {x:g}) inside the computed range "
-            f"{speeds[0]:g}..{speeds[-1]:g} rpm and the machine's speed range; widen the speeds")
+            f"{speeds[0]:g}..{speeds[-1]:g} rpm and the machine's speed range{machine}; widen the speeds "
+            "(or lower --speed-tolerance)")
     # per speed: a bound on the window's limit from the computed speeds (exact minima come later)
     sampled = np.min([m.depth_limit_m for m in members], axis=0)
     first = np.searchsorted(speeds, lo, side="left")
@@ -287,7 +326,7 @@ def recommend(lobes: Any, cut: Any, limits: MachineLimits | None = None, *, marg
     bound = depth_of(coarse[order], order) * speeds[order]
     finite = np.isfinite(bound)
     if not finite.any():
-        raise InvalidValueError("lobes: no stability limit found in any speed window and no largest depth, power "
+        raise NoRecommendationError("lobes: no stability limit found in any speed window and no largest depth, power "
                                 "or torque limit given; give limits=MachineLimits(max_depth=...) "
                                 "(--max-depth on the command line)")
     order, bound = order[finite], bound[finite]  # no limit at all there: nothing to recommend
@@ -327,7 +366,7 @@ def recommend(lobes: Any, cut: Any, limits: MachineLimits | None = None, *, marg
             break
         settle()
     if not chosen:
-        raise InvalidValueError("lobes: every candidate speed is limited by chatter on a rigid-body or suspension "
+        raise NoRecommendationError("lobes: every candidate speed is limited by chatter on a rigid-body or suspension "
                                 "line; check the structure band")
     results = []
     for i in chosen:
@@ -343,5 +382,8 @@ def recommend(lobes: Any, cut: Any, limits: MachineLimits | None = None, *, marg
             limited_by=min(reasons, key=reasons.get),
             power_w=float(per_depth_power[i] * depth) if has_feed else None,
             torque_n_m=float(per_depth_torque[i] * depth) if has_feed else None,
-            available_power_w=float(limits.available_power_w(speeds[i])), band_members=len(members)))
+            available_power_w=float(limits.available_power_w(speeds[i])), band_members=len(members),
+            cutting_speed_m_per_min=float(np.pi * cut.diameter.m_as("m") * speeds[i]),
+            feed_per_tooth_m=float(cut.feed_per_tooth.m_as("m")) if has_feed else None,
+            feed_rate_m_per_min=float(cut.feed_per_tooth.m_as("m") * cut.teeth * speeds[i]) if has_feed else None))
     return attrs.evolve(results[0], runners_up=tuple(results[1:]))

@@ -15,7 +15,7 @@ import numpy as np
 import pint
 
 from ..errors import InvalidValueError, UnitError
-from ..units import Q_, ureg
+from ..units import Q_, show_value, ureg
 
 __all__ = ["spindle_speeds", "as_speed_rpm", "tooth_passing_hz", "MAX_SPEEDS"]
 
@@ -35,7 +35,7 @@ def _speed_units_ok(q: pint.Quantity) -> bool:
 
 def _speed_error(field: str, value: Any) -> UnitError:
     return UnitError(
-        f"{field}: got {value!r}; expected spindle speeds in rpm with their unit, e.g. "
+        f"{field}: got {show_value(value)}; expected spindle speeds in rpm with their unit, e.g. "
         "Q_(np.linspace(2000, 20000, 500), 'rpm') or spindle_speeds('2000 rpm', '20000 rpm', '10 rpm')"
     )
 
@@ -116,7 +116,7 @@ def spindle_speeds(start: Any, stop: Any, step: Any) -> pint.Quantity:
     """
     lo, hi, dn = (float(as_speed_rpm(v, f)[0]) for v, f in ((start, "start"), (stop, "stop"), (step, "step")))
     if hi < lo:
-        raise InvalidValueError(f"stop: got {stop!r} below start {start!r}")
+        raise InvalidValueError(f"stop: got {show_value(stop)} below start {show_value(start)}")
     count = (hi - lo) / dn
     if count + 1 > MAX_SPEEDS:
         raise InvalidValueError(

@@ -19,8 +19,10 @@ entries have no radial coefficient, which the user then gives.
 
 from __future__ import annotations
 
+import difflib
 import importlib.resources
 import os
+import re
 from typing import Any
 
 import attrs
@@ -28,7 +30,7 @@ import pint
 
 from .._files import decode_text, parse_toml, read_bytes
 from ..errors import FileFormatError, InvalidValueError
-from ..units import Q_, dimensionless, quantity
+from ..units import Q_, dimensionless, quantity, show_value
 
 __all__ = ["Workpiece", "workpiece", "workpieces", "load_workpieces", "WORKPIECE_KEYS"]
 
@@ -44,7 +46,7 @@ def _optional(field: str, dimension: str):
             return None
         q = quantity(value, field, dimension)
         if not q.magnitude >= 0:
-            raise InvalidValueError(f"{field}: got {value!r}; expected a value >= 0")
+            raise InvalidValueError(f"{field}: got {show_value(value)}; expected a value >= 0")
         return q
 
     return convert
@@ -55,13 +57,28 @@ def _mc(value: Any) -> float | None:
         return None
     mc = dimensionless(value, "mc")
     if not 0.0 <= mc < 1.0:
-        raise InvalidValueError(f"mc: got {value!r}; expected the Kienzle exponent in [0, 1)")
+        raise InvalidValueError(f"mc: got {show_value(value)}; expected the Kienzle exponent in [0, 1)")
     return mc
+
+
+def _aliases(value: Any, field: str) -> tuple:
+    """A list of names; a string is refused (``tuple("mill")`` would be the aliases m, i, l, l)."""
+    if isinstance(value, str):
+        raise InvalidValueError(f"{field}: got the string {value!r}; expected a list of names, e.g. "
+                                f"aliases = [{value!r}]")
+    try:
+        names = tuple(value)
+    except TypeError:
+        raise InvalidValueError(f"{field}: got {show_value(value)}; expected a list of names") from None
+    bad = [a for a in names if not isinstance(a, str) or not a.strip()]
+    if bad:
+        raise InvalidValueError(f"{field}: got {show_value(bad[0])} in the list; expected names (strings)")
+    return names
 
 
 def _model(value: Any) -> str:
     if value not in ("linear", "kienzle"):
-        raise InvalidValueError(f"model: got {value!r}; expected 'linear' or 'kienzle'")
+        raise InvalidValueError(f"model: got {show_value(value)}; expected 'linear' or 'kienzle'")
     return value
 
 
@@ -97,7 +114,7 @@ class Workpiece:
     kre: pint.Quantity | None = attrs.field(default=None, converter=_optional("kre", _EDGE))
     kc11: pint.Quantity | None = attrs.field(default=None, converter=_optional("kc11", _PRESSURE))
     mc: float | None = attrs.field(default=None, converter=_mc)
-    aliases: tuple = attrs.field(default=(), converter=tuple)
+    aliases: tuple = attrs.field(default=(), converter=lambda v: _aliases(v, "aliases"))
     material: str = ""
     tool: str = ""
     source: str = ""
@@ -139,7 +156,7 @@ class Workpiece:
                 "chip thickness; give the feed per tooth (e.g. '0.1 mm')")
         h = quantity(mean_chip_thickness, "mean_chip_thickness", "[length]").m_as("mm")
         if not h > 0:
-            raise InvalidValueError(f"mean_chip_thickness: got {mean_chip_thickness!r}; expected > 0")
+            raise InvalidValueError(f"mean_chip_thickness: got {show_value(mean_chip_thickness)}; expected > 0")
         kt = (1.0 - self.mc) * self.kc11 * h ** (-self.mc)
         return {"kt": kt.to("MPa"), "kn": None, "kte": zero, "kne": zero}
 
@@ -201,8 +218,27 @@ class Workpiece:
         return out
 
 
+_SPELLINGS = {"aluminum": "aluminium", "alu": "aluminium", "al": "aluminium", "aisi": "", "sae": "",
+              "gray": "grey", "stainless-steel": "stainless", "ss": "stainless"}
+"""Common spellings mapped to the table's words (a word mapped to "" is dropped: AISI 1045 is 1045)."""
+_TEMPER = re.compile(r"^t\d{1,4}$")  # aluminium tempers: -T6, -T651, -T73
+_WORDS = re.compile(r"[\s_\-/]+")
+_LETTERS_DIGITS = re.compile(r"^([a-z]+)(\d{3,}[a-z]?)$")  # al6061 -> al 6061, ss304 -> ss 304
+
+
 def _key(name: str) -> str:
-    return "".join(str(name).lower().split()).replace("_", "-")
+    """The normalised form of a workpiece name: case, spaces, hyphens and underscores, the word order, the
+    spellings aluminium/aluminum and a temper suffix (6061-T651 is 6061) do not matter."""
+    words = []
+    for word in _WORDS.split(str(name).strip().lower()):
+        if _TEMPER.match(word):
+            continue
+        split = _LETTERS_DIGITS.match(word)
+        for part in (split.groups() if split else (word,)):
+            part = _SPELLINGS.get(part, part)
+            if part and not _TEMPER.match(part):
+                words.append(part)
+    return " ".join(sorted(words))
 
 
 def _parse(text: str, source: str) -> tuple[Workpiece, ...]:
@@ -291,9 +327,26 @@ def workpiece(name: str, table: Any = None) -> Workpiece:
     if table is not None:
         entries += list(load_workpieces(table) if isinstance(table, (str, os.PathLike)) else table)
     entries += list(workpieces())
+    if not isinstance(name, str) or not name.strip():
+        raise InvalidValueError(f"workpiece: got {show_value(name)}; expected the name of a work material, "
+                                "e.g. aluminium-6061 or steel-1045")
     key = _key(name)
     for w in entries:
         if key in {_key(a) for a in (w.name, *w.aliases)}:
             return w
     names = ", ".join(dict.fromkeys(w.name for w in entries))
-    raise InvalidValueError(f"workpiece: got {name!r}; known: {names}")
+    raise InvalidValueError(f"workpiece: got {name!r}; {_suggest(key, entries)}known: {names}")
+
+
+def _suggest(key: str, entries: list) -> str:
+    """'did you mean ...; ' for a name that is not in the table: the entries whose names hold every word of it
+    (``aluminium`` -> both aluminium alloys: a choice, never a guess), else the close spellings."""
+    words = set(key.split())
+    holding = [w.name for w in entries if any(words <= set(_key(a).split()) for a in (w.name, *w.aliases))]
+    if not holding:
+        spelled = {_key(a): w.name for w in entries for a in (w.name, *w.aliases)}
+        holding = [spelled[k] for k in difflib.get_close_matches(key, list(spelled), n=6, cutoff=0.6)]
+    holding = list(dict.fromkeys(holding))
+    if not holding:
+        return ""
+    return f"did you mean {' or '.join(holding)}? "

@@ -21,7 +21,7 @@ from ...beams import Flutes, Insert, Segment
 from ...components import COMPONENT_TYPES, Beam
 from ...errors import FileFormatError, SubstructureError
 from ...frf import Frequency
-from ...joints import Joint, Mass, Sensor, Support
+from ...joints import Joint, JointProvenance, Mass, Sensor, Support
 from ...materials import CATALOG, Material
 from ...points import parse_point
 from ...units import to_si
@@ -316,8 +316,38 @@ class _Reader:
         if not isinstance(between, list) or len(between) != 2:
             raise self.error(parts + ["between"], f"got {between!r}; expected two point names")
         points = [self.point(p, parts + ["between", m], base) for m, p in enumerate(between)]
+        if table.get("prior", False) is not False:
+            return self.prior_joint(table, parts, base, points)
+        stated = {key: table[key] for key in ("provenance", "source", "uncertainty") if key in table}
+        if stated and "provenance" not in stated:
+            raise self.error(parts + [next(iter(stated))], "goes with provenance = \"identified\", \"predicted\", "
+                             "\"borrowed\" or \"prior\"")
+        if "provenance" in stated and table.get("rigid", False):
+            raise self.error(parts + ["provenance"], "a rigid joint has no values to come from anywhere")
+        for key, kind in (("source", str), ("provenance", str)):
+            if key in stated and not isinstance(stated[key], kind):
+                raise self.error(parts + [key], f"got {stated[key]!r}; expected a string")
+        provenance = self.call(parts, JointProvenance, stated["provenance"], stated.get("source", ""),
+                               stated.get("uncertainty")) if stated else None
         return self.call(parts, Joint, table["name"], points, rigid=table.get("rigid", False),
-                         **self.matrices(table, parts))
+                         provenance=provenance, **self.matrices(table, parts))
+
+    def prior_joint(self, table, parts, base: Assembly, points) -> Joint:
+        """``prior = true``: the documented prior of the catalogue holder the joint touches."""
+        from ...joint_priors import prior_for
+
+        if table["prior"] is not True:
+            raise self.error(parts + ["prior"], f"got {table['prior']!r}; expected true (or leave it out)")
+        clash = [key for key in ("k", "c", "rigid", "provenance", "source", "uncertainty") if key in table]
+        if clash:
+            raise self.error(parts + [clash[0]], "prior = true takes its values and provenance from the prior "
+                             "table; give one or the other")
+        probe = Joint(table["name"], points, rigid=True)
+        prior = self.call(parts, prior_for, base, probe)
+        if prior is None:
+            raise self.error(parts + ["prior"], "priors exist for the holder-tool and spindle-holder joints of a "
+                             "catalogue holder (catalog = \"...\"); this joint is not one: give k and c")
+        return prior
 
     def support(self, table, parts, base: Assembly) -> Support:
         table = self.table(table, parts, _SUPPORT_KEYS, ("at",))

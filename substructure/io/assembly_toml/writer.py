@@ -179,6 +179,15 @@ def _field_value(component, kind: str, field: str, value):
     )
 
 
+def _provenance(joint) -> dict:
+    """The provenance keys of a joint (none when not stated); a prior is written out as its values."""
+    p = getattr(joint, "provenance", None)
+    if p is None:
+        return {}
+    return {"provenance": p.kind, **({"source": p.source} if p.source else {}),
+            **({"uncertainty": p.uncertainty} if p.uncertainty is not None else {})}
+
+
 def _matrices(item) -> dict:
     return {key: m.as_dict() for key, m in (("k", item.k), ("c", item.c)) if m}
 
@@ -263,7 +272,8 @@ def dumps_assembly(assembly: Assembly) -> str:
             )
     if assembly.joints:
         doc["joints"] = [
-            {"name": j.name, "between": list(j.between), **({"rigid": True} if j.rigid else _matrices(j))}
+            {"name": j.name, "between": list(j.between), **({"rigid": True} if j.rigid else _matrices(j)),
+             **_provenance(j)}
             for j in assembly.joints
         ]
     if assembly.supports:

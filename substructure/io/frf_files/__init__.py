@@ -22,6 +22,7 @@ significant digits, and any other grid is refused with an error that says
 what to do.
 
 The package holds one format per module: ``csv_files`` (:func:`read_csv`,
+:func:`read_csv_with_coherence`,
 :func:`write_csv`), ``uff_writer`` (:func:`write_uff`), ``uff_reader``
 (:func:`read_uff`) and ``uff_units`` (what a type-58 record holds: its
 labels, quantity, units and abscissa), with ``_common`` for the checks and
@@ -30,8 +31,8 @@ codes they share; every name is imported from here.
 
 from __future__ import annotations
 
-from .csv_files import CSV_HEADER, read_csv, write_csv  # noqa: F401 (CSV_HEADER: its old place)
+from .csv_files import CSV_HEADER, read_csv, read_csv_with_coherence, write_csv  # noqa: F401 (CSV_HEADER: its old place)
 from .uff_reader import read_uff
 from .uff_writer import write_uff
 
-__all__ = ["write_csv", "read_csv", "write_uff", "read_uff"]
+__all__ = ["write_csv", "read_csv", "read_csv_with_coherence", "write_uff", "read_uff"]

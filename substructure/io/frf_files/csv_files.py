@@ -2,7 +2,10 @@
 
 One FRF per file, header ``frequency_hz,real,imag``, one line per frequency,
 receptance in m/N unless told otherwise; values are written with every
-digit (``repr``) so that a written file reads back to the same floats.
+digit (``repr``) so that a written file reads back to the same floats.  A
+fourth column ``coherence`` (the ordinary coherence of a tap test, in
+[0, 1]) may follow: :func:`read_csv_with_coherence` returns it,
+:func:`read_csv` reads such files too and returns the FRF alone.
 """
 
 from __future__ import annotations
@@ -15,13 +18,14 @@ from ...errors import FileFormatError, InvalidValueError
 from ...frf import FRF, MAX_GRID_LINES, Frequency
 from ._common import _refuse_all_zero, _require_frf, _shown
 
-__all__ = ["write_csv", "read_csv"]
+__all__ = ["write_csv", "read_csv", "read_csv_with_coherence"]
 
 CSV_HEADER = "frequency_hz,real,imag"
+COHERENCE_HEADER = CSV_HEADER + ",coherence"
 
 
-def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True) -> None:
-    """Write a one-entry FRF to a CSV file ``frequency_hz,real,imag``.
+def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coherence=None) -> None:
+    """Write a one-entry FRF to a CSV file ``frequency_hz,real,imag`` (``,coherence`` when given).
 
     Parameters
     ----------
@@ -34,12 +38,15 @@ def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True) -> None
         (:func:`substructure.io.replacing`).
     overwrite : bool, default True
         Whether an existing file may be replaced.
+    coherence : array of float, optional
+        The coherence (dimensionless, in [0, 1]) on the FRF's lines, written
+        as a fourth column ``coherence``.
 
     Raises
     ------
     InvalidValueError
         For an FRF of more than one entry or of fewer than 2 lines (which
-        no reader takes).
+        no reader takes), or a coherence of another length or outside [0, 1].
     """
     from .. import write_text
 
@@ -56,9 +63,19 @@ def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True) -> None
         )
     values = frf.data[:, 0, 0]
     _refuse_all_zero(frf, os.fspath(path))
-    rows = zip(frf.frequency.hz.tolist(), values.real.tolist(), values.imag.tolist())
-    text = "".join(f"{f!r},{re_!r},{im!r}\n" for f, re_, im in rows)
-    write_text(path, CSV_HEADER + "\n" + text, overwrite=overwrite)
+    if coherence is None:
+        rows = zip(frf.frequency.hz.tolist(), values.real.tolist(), values.imag.tolist())
+        text = "".join(f"{f!r},{re_!r},{im!r}\n" for f, re_, im in rows)
+        write_text(path, CSV_HEADER + "\n" + text, overwrite=overwrite)
+        return
+    gamma = np.asarray(coherence, dtype=np.float64)
+    if gamma.shape != (frf.frequency.n,) or not np.all((gamma >= 0) & (gamma <= 1)):
+        raise InvalidValueError(
+            f"coherence: cannot write {os.fspath(path)}: expected {frf.frequency.n} values in [0, 1], one per line"
+        )
+    rows4 = zip(frf.frequency.hz.tolist(), values.real.tolist(), values.imag.tolist(), gamma.tolist())
+    text = "".join(f"{f!r},{re_!r},{im!r},{g!r}\n" for f, re_, im, g in rows4)
+    write_text(path, COHERENCE_HEADER + "\n" + text, overwrite=overwrite)
 
 
 def read_csv(
@@ -68,6 +85,9 @@ def read_csv(
     quantity: str | None = None,
 ) -> FRF:
     """Read a CSV file ``frequency_hz,real,imag`` into a one-entry FRF.
+
+    A file with a fourth column ``coherence`` is read too; the coherence is
+    checked and returned by :func:`read_csv_with_coherence`.
 
     Parameters
     ----------
@@ -98,8 +118,43 @@ def read_csv(
     return _read_csv(path, output, input, quantity)[0]
 
 
-def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF, np.ndarray]:
-    """:func:`read_csv`, and the line of the file each frequency line comes from."""
+def read_csv_with_coherence(
+    path: str | os.PathLike,
+    output: str = "response",
+    input: str = "excitation",
+    quantity: str | None = None,
+) -> tuple[FRF, np.ndarray | None]:
+    """Read a CSV file ``frequency_hz,real,imag[,coherence]``: the FRF and its coherence.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file (see :func:`read_csv`).
+    output, input : str
+        Labels of the response and excitation DOFs.
+    quantity : {"receptance", "mobility", "accelerance"}, optional
+        What the file holds (see :func:`read_csv`).
+
+    Returns
+    -------
+    FRF
+        Shape ``(n_freq, 1, 1)``.
+    numpy.ndarray or None
+        The coherence (dimensionless, in [0, 1]) per line, or None for a
+        file without the column.
+
+    Raises
+    ------
+    FileFormatError
+        As :func:`read_csv`, and for a coherence that is not a number in
+        [0, 1], naming the file and the line.
+    """
+    frf, _, coherence = _read_csv(path, output, input, quantity)
+    return frf, coherence
+
+
+def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF, np.ndarray, np.ndarray | None]:
+    """:func:`read_csv_with_coherence`, with the line of the file each frequency line comes from."""
     from .. import MAX_DATA_BYTES, read_text
 
     name = os.fspath(path)
@@ -112,11 +167,13 @@ def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF,
     if not numbered:
         raise FileFormatError(f"{name}: the file is empty; expected the header {CSV_HEADER!r}")
     first, header = numbered[0]
-    if header.replace(" ", "") != CSV_HEADER:  # another program's export: read what is unambiguous
+    columns = header.replace(" ", "").lstrip("\ufeff")
+    if columns not in (CSV_HEADER, COHERENCE_HEADER):  # another program's export: read what is unambiguous
         from ..frf_exports import parse_export
 
         table, lines_of, said = parse_export(numbered, name, quantity)
-        return _checked_csv(table, lines_of, name, output, input, quantity or said or "receptance"), lines_of
+        return _checked_csv(table, lines_of, name, output, input, quantity or said or "receptance"), lines_of, None
+    names = columns.split(",")
     numbered = numbered[1:]
     if len(numbered) < 2:
         raise FileFormatError(
@@ -124,16 +181,16 @@ def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF,
         )
     cells = [line.split(",") for _, line in numbered]
     for (number, line), row in zip(numbered, cells):
-        if len(row) != 3:
+        if len(row) != len(names):
             raise FileFormatError(
-                f"{name}, line {number}: {_shown(line)} has {len(row)} value(s); expected 3 "
-                "(frequency_hz, real, imag)"
+                f"{name}, line {number}: {_shown(line)} has {len(row)} value(s); expected {len(names)} "
+                f"({', '.join(names)})"
             )
     try:
         table = np.array(cells, dtype=np.float64)
     except ValueError:
         for (number, _), row in zip(numbered, cells):
-            for column, cell in zip(CSV_HEADER.split(","), row):
+            for column, cell in zip(names, row):
                 try:
                     float(cell)
                 except ValueError:
@@ -142,7 +199,17 @@ def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF,
                     ) from None
         raise  # pragma: no cover - numpy and float() disagree on a cell
     lines_of = np.array([number for number, _ in numbered])
-    return _checked_csv(table, lines_of, name, output, input, quantity or "receptance"), lines_of
+    coherence = None
+    if len(names) == 4:
+        coherence = table[:, 3]
+        bad = ~(np.isfinite(coherence) & (coherence >= 0.0) & (coherence <= 1.0))
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise FileFormatError(
+                f"{name}, line {lines_of[k]}: coherence is {float(coherence[k])!r}; expected a number in [0, 1]"
+            )
+        table = table[:, :3]
+    return _checked_csv(table, lines_of, name, output, input, quantity or "receptance"), lines_of, coherence
 
 
 def _checked_csv(table: np.ndarray, lines_of: np.ndarray, name: str, output: str, input: str,

@@ -1,0 +1,161 @@
+"""The ``substructure tap`` command: time records of taps to an FRF with coherence (and a measurement set)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+from pathlib import Path
+
+from ._common import UsageError, band_range_arg, check_outputs, check_plot, figures, print_json, save_figure
+
+_RECORD_SUFFIXES = (".csv", ".uff", ".unv")
+
+
+def _read(path: str, args: argparse.Namespace):
+    from ..io.tap_files import read_tap_csv, read_tap_uff
+
+    suffix = Path(path).suffix.lower()
+    if suffix == ".csv":
+        if args.force_record is not None or args.response_record is not None:
+            raise UsageError("--force-record and --response-record choose records of a universal file, "
+                             f"not columns of {path}")
+        return read_tap_csv(path, args.sensitivity, args.hammer_sensitivity, args.quantity)
+    return read_tap_uff(path, args.sensitivity, args.hammer_sensitivity, args.quantity, args.force_record,
+                        args.response_record)
+
+
+def _set_text(name: str, response: str, excitation: str, file: str, averages: int) -> str:
+    import tomli_w
+
+    return tomli_w.dumps({"name": name, "frf": [{"response": response, "excitation": excitation, "file": file,
+                                                 "quantity": "receptance", "averages": averages}]})
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..io import write_text
+    from ..io.frf_files import write_csv
+    from ..measurements import dof_label
+    from ..tap import HAMMER_BAND_DB, PRE_TRIGGER_S, process_taps
+
+    for path in args.records:
+        if Path(path).suffix.lower() not in _RECORD_SUFFIXES:
+            raise UsageError(f"{path}: expected a tap record in a .csv, .uff or .unv file")
+    if args.out and Path(args.out).suffix.lower() != ".csv":
+        raise UsageError(f"argument --out: {args.out!r}: expected a .csv file (frequency_hz,real,imag,coherence)")
+    if args.measurements:
+        if not args.out:
+            raise UsageError("--measurements needs --out: the FRF's data file that the set names")
+        if not (args.response and args.excitation):
+            raise UsageError("--measurements needs --response POINT and --excitation POINT")
+        if Path(args.measurements).suffix.lower() != ".toml":
+            raise UsageError(f"argument --measurements: {args.measurements!r}: expected a .toml file")
+    elif args.response or args.excitation:
+        raise UsageError("--response and --excitation name the points of the measurement set; give --measurements")
+    response = dof_label(args.response, "--response") if args.response else None
+    excitation = dof_label(args.excitation, "--excitation") if args.excitation else None
+    check_plot(args.plot)
+    check_outputs([("--out", args.out), ("--measurements", args.measurements), ("--plot", args.plot)],
+                  args.records, args.overwrite)
+    records = [_read(path, args) for path in args.records]
+    result = process_taps(records, args.estimator, tap_length=args.tap_length,
+                          pre_trigger=PRE_TRIGGER_S if args.pre_trigger is None else args.pre_trigger,
+                          exponential=not args.no_exponential_window, tau=args.tau, band=args.band,
+                          hammer_band_db=HAMMER_BAND_DB if args.hammer_band_db is None else args.hammer_band_db)
+    peaks = result.peaks()
+    written = []
+    if args.out:
+        write_csv(result.frf, args.out, args.overwrite, coherence=result.coherence)
+        written.append(args.out)
+    if args.measurements:
+        relative = os.path.relpath(os.path.abspath(args.out), os.path.dirname(os.path.abspath(args.measurements)))
+        name = args.name or f"tap test: {response} / {excitation}"
+        write_text(args.measurements, _set_text(name, response, excitation, Path(relative).as_posix(),
+                                                result.averages), overwrite=args.overwrite)
+        written.append(args.measurements)
+    if args.plot:
+        figures()
+        from ..plot import plot_taps
+
+        save_figure(plot_taps(result, title=", ".join(Path(p).name for p in args.records[:3])
+                              + (" ..." if len(args.records) > 3 else "")), args.plot, args.overwrite)
+        written.append(args.plot)
+    added = result.added_damping(peaks) if len(peaks) else []
+    damping = result.damping(peaks) if args.correct_window_damping else None
+    if args.json:
+        out = result.summary()
+        out["peaks"] = [{"frequency_hz": float(f), "added_damping_ratio": float(z)} for f, z in zip(peaks, added)]
+        if damping is not None:
+            for entry, d in zip(out["peaks"], damping):
+                entry["damping_ratio"] = d["damping_ratio"]
+                entry["damping_ratio_corrected"] = d["damping_ratio_corrected"]
+        return print_json(out)
+    import numpy as np
+
+    print(f"records: {len(records)}, {result.sample_rate:g} Hz, {result.tap_samples} samples per tap "
+          f"({result.tap_samples / result.sample_rate:g} s)")
+    print(f"taps: {len(result.taps)} found, {result.averages} averaged ({result.estimator}), "
+          f"{len(result.rejected)} rejected")
+    for tap in result.taps:
+        state = "kept" if tap.kept else f"rejected: {tap.reason}"
+        print(f"  tap {tap.number} ({tap.source}, t = {tap.start_s:.4g} s): peak {tap.peak_force:.4g} N, "
+              f"pulse {tap.pulse_width_s * 1e3:.3g} ms, band {tap.band_hz:.0f} Hz; {state}")
+    print(f"hammer's usable band: up to {result.hammer_band_hz:.0f} Hz (force spectrum -{result.hammer_band_db:g} dB)")
+    usable = result.frf.frequency.hz <= result.hammer_band_hz
+    gamma = result.coherence[usable] if usable.any() else result.coherence
+    print(f"coherence within the band: median {np.median(gamma):.4f}, minimum {np.min(gamma):.4f}")
+    if result.tau is None:
+        print("exponential window: none")
+    else:
+        print(f"exponential window: tau = {result.tau:.4g} s (adds a damping ratio 1/(tau omega) to every mode)")
+    shown = list(zip(peaks, added))
+    print(f"peaks within the band ({result.measured.quantity}):" if shown else "peaks: none within the band")
+    for k, (f, z) in enumerate(shown):
+        line = f"  {f:10.6g} Hz   window's added damping ratio {z:.2e}"
+        if damping is not None:
+            d = damping[k]
+            line += ("; half-power damping not found (peak too narrow or too close to another)"
+                     if d["damping_ratio"] is None else
+                     f"; half-power damping ratio {d['damping_ratio']:.3e}, without the window's "
+                     f"{d['damping_ratio_corrected']:.3e}")
+        print(line)
+    for path in written:
+        print(f"wrote {path}")
+    return 0
+
+
+def add_parser(commands) -> None:
+    """Add the ``tap`` subcommand to the subparsers ``commands``."""
+    tap = commands.add_parser("tap", help="time records of hammer taps to an FRF with coherence")
+    tap.add_argument("records", nargs="+", metavar="RECORD",
+                     help="tap records: CSV (time [s],force [N],acceleration [m/s^2]) or UFF type-58 time records")
+    tap.add_argument("--out", metavar="FRF.csv", help="write the receptance with its coherence column")
+    tap.add_argument("--measurements", metavar="SET.toml", help="write a measurement set naming --out")
+    tap.add_argument("--response", metavar="POINT", help="the response point of the measurement set")
+    tap.add_argument("--excitation", metavar="POINT", help="the excitation point of the measurement set")
+    tap.add_argument("--name", help="the measurement set's name")
+    tap.add_argument("--plot", metavar="FILE.png", help="force spectra, coherence and FRF to an image file")
+    tap.add_argument("--estimator", choices=("H1", "H2", "Hv"), default="H1",
+                     help="H1 (noise on the response, default), H2 (noise on the force), Hv (both)")
+    tap.add_argument("--quantity", choices=("acceleration", "velocity", "displacement"),
+                     help="what the response is (must agree with the file's unit)")
+    tap.add_argument("--sensitivity", metavar="VALUE", help="response sensor sensitivity for a channel in volts, "
+                     "e.g. '10.2 mV/g'")
+    tap.add_argument("--hammer-sensitivity", metavar="VALUE",
+                     help="hammer sensitivity for a force channel in volts, e.g. '2.25 mV/N'")
+    tap.add_argument("--force-record", type=int, metavar="N", help="UFF: 0-based index of the force record")
+    tap.add_argument("--response-record", type=int, metavar="N", help="UFF: 0-based index of the response record")
+    tap.add_argument("--tap-length", type=float, metavar="SECONDS",
+                     help="cut long records into taps of this length (default: one tap per record)")
+    tap.add_argument("--pre-trigger", type=float, metavar="SECONDS",
+                     help="time kept before the force's trigger crossing (default 0.005 s, tap.PRE_TRIGGER_S)")
+    tap.add_argument("--tau", type=float, metavar="SECONDS",
+                     help="time constant of the exponential window (default: 1%% left at the end of the tap)")
+    tap.add_argument("--no-exponential-window", action="store_true", help="no exponential window")
+    tap.add_argument("--correct-window-damping", action="store_true",
+                     help="also each peak's half-power damping ratio, and the same less the window's 1/(tau omega)")
+    tap.add_argument("--hammer-band-db", type=float, metavar="DB",
+                     help="force spectrum drop that ends the hammer's usable band (default 20 dB, tap.HAMMER_BAND_DB)")
+    tap.add_argument("--band", type=band_range_arg, metavar="LO:HI", help="keep only these lines (Hz)")
+    tap.add_argument("--overwrite", action="store_true", help="let the outputs replace existing files")
+    tap.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
+    tap.set_defaults(run=run)

@@ -1,0 +1,239 @@
+"""The parts of the report a machinist checks before trusting a number: cutting data, the stability band, where the
+joint values come from, and the diagnosis's further results as readable text.
+
+Each function returns HTML for :mod:`substructure.report.html` to place; like
+it, they compute nothing and only present what :func:`~substructure.report.report`
+returned.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+from typing import Any
+
+__all__ = ["cutting_lines", "band_lines", "band_table", "provenance_note", "provenance_warnings", "readable"]
+
+
+def _esc(value: Any) -> str:
+    return html.escape(str(value), quote=True)
+
+
+def _num(value: Any, fmt: str, scale: float = 1.0) -> str:
+    try:
+        v = float(value) * scale
+    except (TypeError, ValueError):
+        return "–"
+    return format(v, fmt) if math.isfinite(v) else "–"
+
+
+def cutting_lines(report: Any) -> list[str]:
+    """Paragraphs for the answer: cutting speed (m/min, SFM), feed per tooth and feed rate, checked against the
+    usual range; the milling direction in the shop's words.
+
+    Parameters
+    ----------
+    report : Report
+        The report.
+
+    Returns
+    -------
+    list of str
+        HTML paragraphs (none without a recommendation).
+    """
+    r, c = report.recommendation, report.cutting
+    if r is None or r.cutting_speed_m_per_min is None:
+        return []
+    vc = r.cutting_speed_m_per_min
+    text = (f"Cutting speed <strong>{_num(vc, ',.0f')} m/min</strong> ({_num(vc / 0.3048, ',.0f')} SFM)")
+    if r.feed_per_tooth_m is not None:
+        text += (f", feed <strong>{_num(r.feed_per_tooth_m, '.3g', 1e3)} mm per tooth</strong>, feed rate "
+                 f"{_num(r.feed_rate_m_per_min, ',.0f', 1e3)} mm/min")
+    out = [f'<p class="cutting-data">{text}.</p>']
+    if c is not None and c.get("range") is not None:
+        row = c["range"]
+        lo, hi = row["cutting_speed_m_per_min"]
+        flo, fhi = row["feed_per_tooth_m"]
+        usual = (f"The usual range for {_esc(row['workpiece'])} with a {_esc(row['tool_material'])} tool: "
+                 f"{_num(lo, ',.0f')} to {_num(hi, ',.0f')} m/min, {_num(flo, '.3g', 1e3)} to {_num(fhi, '.3g', 1e3)} "
+                 f"mm per tooth ({_esc(row['source'].split(';')[0])}).")
+        if c.get("warnings"):
+            out.append('<p class="verdict unexplained">Outside the usual cutting data: '
+                       + "; ".join(_esc(w) for w in c["warnings"]) + ". " + usual
+                       + " Check with your tool maker's data before you run it.</p>")
+        else:
+            out.append(f"<p>{usual}</p>")
+    return out
+
+
+def band_lines(report: Any) -> list[str]:
+    """Paragraphs for the answer: the depth stable across the joints' uncertainty next to the nominal one.
+
+    Parameters
+    ----------
+    report : Report
+        The report.
+
+    Returns
+    -------
+    list of str
+        HTML paragraphs (none without a band).
+    """
+    if report.band is None or report.recommendation is None:
+        return []
+    n = len(report.band.members)
+    robust = report.band_recommendation
+    if robust is None:
+        return [f'<p class="verdict unexplained">Across the uncertainty of the joints ({n} variants) no speed and '
+                f"depth is stable with the margin: {_esc(report.band_no_recommendation)}</p>"]
+    r = report.recommendation
+    return [f'<p class="band">Stability band: with every joint anywhere within its stated uncertainty ({n} '
+            f"variants), <strong>{_num(robust.spindle_speed_rpm, ',.0f')} rpm at "
+            f"{_num(robust.depth_m, '.3g', 1e3)} mm</strong> stays stable with the same margin; the nominal "
+            f"joints alone give {_num(r.spindle_speed_rpm, ',.0f')} rpm at {_num(r.depth_m, '.3g', 1e3)} mm. Until "
+            "the joints are identified, run at the band's depth.</p>"]
+
+
+def band_table(report: Any) -> str:
+    """A table of the nominal recommendation and the one across the stability band.
+
+    Parameters
+    ----------
+    report : Report
+        The report.
+
+    Returns
+    -------
+    str
+        HTML (empty without a band).
+    """
+    if report.band is None or report.recommendation is None:
+        return ""
+    rows = [("nominal joints", report.recommendation), ("across the stability band", report.band_recommendation)]
+    body = ""
+    for label, r in rows:
+        if r is None:
+            body += f"<tr><td>{label}</td><td colspan=\"4\">{_esc(report.band_no_recommendation or 'none')}</td></tr>"
+            continue
+        lo, hi = r.window_rpm
+        body += (f"<tr><td>{label}</td><td>{_num(r.spindle_speed_rpm, ',.0f')}</td><td>{_num(r.depth_m, '.3g', 1e3)}"
+                 f"</td><td>{_num(r.limit_depth_m, '.3g', 1e3)}</td>"
+                 f"<td>{_num(lo, ',.0f')}–{_num(hi, ',.0f')}</td></tr>")
+    head = ("<tr><th>Joints</th><th>Speed (rpm)</th><th>Axial depth (mm)</th><th>Chatter limit in the window (mm)"
+            "</th><th>Speed window (rpm)</th></tr>")
+    lower = report.band.lower_m
+    finite = lower[[math.isfinite(v) for v in lower]]
+    low = f" The lowest limit over the band is {_num(min(finite), '.3g', 1e3)} mm." if finite.size else ""
+    return ("<h3>The stability band: the joints within their uncertainty</h3>"
+            f'<table class="wide"><thead>{head}</thead><tbody>{body}</tbody></table>'
+            f'<p class="note">The lobes were computed for {len(report.band.members)} variants of the model, each joint '
+            "with a stated uncertainty at its lower end, nominal value and upper end (stiffness and damping "
+            f"together); the band's recommendation holds its margin for every one of them.{low}</p>")
+
+
+def provenance_note(joint: Any, rows: list[dict]) -> str:
+    """Where a joint's values come from, one paragraph.
+
+    Parameters
+    ----------
+    joint : Joint
+        The joint.
+    rows : list of dict
+        :func:`~substructure.joint_priors.joint_provenances` of the report's assembly.
+
+    Returns
+    -------
+    str
+        HTML.
+    """
+    row = next((r for r in rows if r["name"] == joint.name), None)
+    if row is None:
+        return ""
+    kind = row["kind"]
+    plain = {"identified": "identified from a tap test", "predicted": "predicted from a joint table",
+             "borrowed": "borrowed from another holder", "prior": "a prior for this type of holder",
+             "not stated": "not stated"}.get(kind, kind)
+    spread = (f"; within a factor {row['uncertainty']:g} either way" if row["uncertainty"] is not None else
+              "; no uncertainty stated")
+    text = f'<p class="provenance">Where the values come from: <strong>{_esc(plain)}</strong>{spread}.'
+    if row["source"]:
+        text += f" Source: {_esc(row['source'])}."
+    text += "</p>"
+    if row["warning"]:
+        text += f'<p class="verdict unexplained">{_esc(row["warning"])}.</p>'
+    return text
+
+
+def provenance_warnings(rows: list[dict]) -> list[str]:
+    """The answer's facts about joint values that cannot be trusted for this holder.
+
+    Parameters
+    ----------
+    rows : list of dict
+        :func:`~substructure.joint_priors.joint_provenances`.
+
+    Returns
+    -------
+    list of str
+        HTML fragments, one per joint with a warning or a prior.
+    """
+    out = []
+    for row in rows:
+        if row["warning"]:
+            out.append(_esc(row["warning"]) + ".")
+        elif row["kind"] == "prior":
+            out.append(f"The joint {_esc(row['name'])} uses a prior for its holder type (a wide uncertainty, "
+                       "not a measurement): see the stability band.")
+    return out
+
+
+def readable(value: Any, depth: int = 0) -> str:
+    """A value of a JSON object as readable HTML: numbers rounded, mappings as definition lists, lists of
+    mappings as tables, never raw JSON.
+
+    Parameters
+    ----------
+    value : object
+        A JSON value.
+    depth : int
+        Nesting depth (deeper values are summarised).
+
+    Returns
+    -------
+    str
+        HTML.
+    """
+    if value is None:
+        return "–"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, (int, float)):
+        v = float(value)
+        if not math.isfinite(v):
+            return "–"
+        return f"{int(value):,}" if isinstance(value, int) else format(v, ".4g")
+    if isinstance(value, str):
+        return _esc(value)
+    if depth >= 3:
+        return f"({len(value)} items)"
+    if isinstance(value, dict):
+        if not value:
+            return "none"
+        items = "".join(f"<li>{_esc(str(k).replace('_', ' '))}: {readable(v, depth + 1)}</li>"
+                        for k, v in value.items())
+        return f"<ul>{items}</ul>"
+    if isinstance(value, (list, tuple)):
+        if not value:
+            return "none"
+        if all(isinstance(v, dict) for v in value):
+            keys = list(dict.fromkeys(k for v in value for k in v))[:8]
+            head = "".join(f"<th>{_esc(str(k).replace('_', ' '))}</th>" for k in keys)
+            body = "".join("<tr>" + "".join(f"<td>{readable(v.get(k), depth + 1)}</td>" for k in keys) + "</tr>"
+                           for v in value[:12])
+            more = f"<p class=\"note\">and {len(value) - 12} more</p>" if len(value) > 12 else ""
+            return f'<table class="small"><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>{more}'
+        if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
+            shown = ", ".join(readable(v) for v in value[:8])
+            return shown + (f", … ({len(value)} values)" if len(value) > 8 else "")
+        return "<ul>" + "".join(f"<li>{readable(v, depth + 1)}</li>" for v in value[:12]) + "</ul>"
+    return _esc(value)

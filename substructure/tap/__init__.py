@@ -1,0 +1,34 @@
+"""Tap tests: time records of an instrumented hammer and a response sensor to an FRF with coherence.
+
+The package sits next to :mod:`substructure.frf` in the layers: it needs
+``frf``, ``units`` and ``errors`` and knows nothing of models.
+
+- :mod:`~substructure.tap.records`: :class:`TapRecord` (force and response on
+  one uniform time axis, SI units) and the conversion of channels in volts
+  with a sensor's sensitivity.
+- :mod:`~substructure.tap.detect`: the pulse of a tap, double hits,
+  clipping, records without a hit, swapped channels, the taps of a long
+  record; the thresholds as named constants.
+- :mod:`~substructure.tap.process`: :func:`process_taps` (windows, H1/H2/Hv,
+  coherence, the hammer's usable band, the window's added damping) and
+  :class:`TapResult`.
+
+Files are read by :mod:`substructure.io.tap_files` (``read_tap_csv``,
+``read_tap_uff``), the figure to check a result is
+:func:`substructure.plot.plot_taps`; the command is ``substructure tap``
+(docs/tap.md).
+"""
+
+from .detect import (CLIP_REACH, CLIP_RUN, CLIP_TOLERANCE, CREST_FACTOR_PULSE, DOUBLE_HIT_FRACTION, NO_HIT_FACTOR,
+                     PRE_TRIGGER_S, TRIGGER_FRACTION, SwappedChannelsError)
+from .process import (ESTIMATORS, EXP_WINDOW_END, FORCE_WINDOW_EXTRA, HALF_POWER_LINES, HAMMER_BAND_DB, PEAK_PROMINENCE,
+                      Tap, TapResult, added_damping, process_taps)
+from .records import RESPONSE_QUANTITIES, TapRecord, channel_to_si, unit_of
+
+__all__ = [
+    "TapRecord", "process_taps", "TapResult", "Tap", "added_damping", "channel_to_si", "unit_of",
+    "SwappedChannelsError", "ESTIMATORS", "RESPONSE_QUANTITIES", "TRIGGER_FRACTION", "NO_HIT_FACTOR",
+    "DOUBLE_HIT_FRACTION", "CLIP_RUN", "CLIP_TOLERANCE", "CLIP_REACH", "PRE_TRIGGER_S", "CREST_FACTOR_PULSE",
+    "EXP_WINDOW_END", "FORCE_WINDOW_EXTRA", "HAMMER_BAND_DB", "PEAK_PROMINENCE", "HALF_POWER_LINES",
+]
+

@@ -1,0 +1,188 @@
+"""The ``substructure tap`` command and the measurement set it writes; coherence and averages of measurements."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from substructure.cli import main
+from substructure.datasets import impact_records
+from substructure.errors import FileFormatError, InvalidValueError
+from substructure.frf import FRF, Frequency
+from substructure.io.frf_files import read_csv, read_csv_with_coherence, write_csv
+from substructure.io.measurements import load_measurements
+from substructure.measurements import Measurement, MeasurementSet
+
+
+@pytest.fixture(scope="module")
+def records(tmp_path_factory):
+    """The five pyFRF impact records as CSV files, the third one's channels in volts."""
+    folder = tmp_path_factory.mktemp("taps")
+    paths = []
+    for i, r in enumerate(impact_records()):
+        path = folder / f"tap{i + 1}.csv"
+        np.savetxt(path, np.column_stack([r.time, r.force, r.response]), delimiter=",",
+                   header="time [s],force [N],acceleration [m/s^2]", comments="")
+        paths.append(str(path))
+    return folder, paths
+
+
+def run(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_tap_writes_frf_with_coherence_and_a_set_that_reads_back(records, tmp_path, capsys):
+    _, paths = records
+    out, toml, png = tmp_path / "frf.csv", tmp_path / "set.toml", tmp_path / "tap.png"
+    code, text, err = run(capsys, "tap", *paths, "--out", out, "--measurements", toml, "--response", "tool.tip",
+                          "--excitation", "tool.tip", "--plot", png)
+    assert code == 0, err
+    assert "taps: 5 found, 5 averaged (H1), 0 rejected" in text
+    assert "exponential window: tau = 0.217 s" in text
+    assert png.stat().st_size > 10_000
+    frf, coherence = read_csv_with_coherence(out)
+    assert coherence is not None and coherence.shape == (frf.frequency.n,)
+    assert read_csv(out).frequency == frf.frequency  # the three-column reader reads it too
+    measurements = load_measurements(toml)
+    (m,) = measurements.measurements
+    assert m.averages == 5 and m.response == "tool.tip:y"
+    assert np.array_equal(m.coherence, coherence)
+    hz = m.frf.frequency.hz
+    assert np.median(m.coherence[(hz >= 20) & (hz <= 5000)]) > 0.99
+    cropped = measurements.crop(100, 200)
+    assert np.array_equal(cropped.measurements[0].coherence, coherence[(hz >= 100) & (hz <= 200)])
+    # nothing the user wrote is replaced without --overwrite
+    before = toml.read_text()
+    code, _, err = run(capsys, "tap", *paths, "--out", out, "--measurements", toml, "--response", "tool.tip",
+                       "--excitation", "tool.tip")
+    assert code == 1 and "--overwrite" in err and toml.read_text() == before
+    code, _, err = run(capsys, "tap", *paths, "--out", out, "--measurements", toml, "--response", "holder.tip",
+                       "--excitation", "tool.tip", "--overwrite")
+    assert code == 0, err
+    assert load_measurements(toml).measurements[0].response == "holder.tip:y"
+
+
+def test_tap_json(records, capsys):
+    _, paths = records
+    code, text, err = run(capsys, "tap", *paths[:3], "--json", "--estimator", "H2", "--band", "10:6000")
+    assert code == 0, err
+    data = json.loads(text)
+    assert data["taps"] == 3 and data["rejected"] == [] and data["estimator"] == "H2"
+    assert len(data["frequency_hz"]) == len(data["real"]) == len(data["imag"]) == len(data["coherence"]) == 5991
+    assert data["frequency_hz"][0] == 10.0 and data["tau_s"] > 0
+    peak = min(data["peaks"], key=lambda p: abs(p["frequency_hz"] - 900))
+    assert peak["added_damping_ratio"] == pytest.approx(1 / (data["tau_s"] * 2 * np.pi * peak["frequency_hz"]))
+    assert "damping_ratio" not in peak
+    code, text, err = run(capsys, "tap", *paths[:3], "--json", "--correct-window-damping")
+    assert code == 0, err
+    for p in json.loads(text)["peaks"]:
+        if p["damping_ratio"] is not None:
+            assert p["damping_ratio_corrected"] == pytest.approx(p["damping_ratio"] - p["added_damping_ratio"])
+    assert any(p["damping_ratio"] is not None for p in json.loads(text)["peaks"])
+
+
+def test_tap_reports_a_rejected_tap_with_its_reason(records, tmp_path, capsys):
+    _, paths = records
+    r = impact_records()[0]
+    force = r.force.copy()
+    force[5000:5008] += r.force[20:28]  # the same pulse again at 0.195 s
+    bad = tmp_path / "double.csv"
+    np.savetxt(bad, np.column_stack([r.time, force, r.response]), delimiter=",",
+               header="time [s],force [N],acceleration [m/s^2]", comments="")
+    code, text, err = run(capsys, "tap", paths[1], bad, "--json")
+    assert code == 0, err
+    data = json.loads(text)
+    assert data["taps"] == 1
+    (rejected,) = data["rejected"]
+    assert rejected["tap"] == 2 and rejected["file"] == str(bad)
+    assert rejected["reason"].startswith("double hit at t = 0.195")
+
+
+def test_tap_errors_name_the_file(records, tmp_path, capsys):
+    _, paths = records
+    swapped = tmp_path / "swapped.csv"
+    r = impact_records()[0]
+    np.savetxt(swapped, np.column_stack([r.time, r.response, r.force]), delimiter=",",
+               header="time [s],force [N],acceleration [m/s^2]", comments="")
+    code, _, err = run(capsys, "tap", swapped)
+    assert code == 1 and f"{swapped}: column 'force [N]' does not look like a hammer's force" in err
+    code, _, err = run(capsys, "tap", paths[0], "--measurements", tmp_path / "s.toml")
+    assert code == 2 and "--measurements needs --out" in err
+    code, _, err = run(capsys, "tap", paths[0], "--sensitivity", "10 mV/g")
+    assert code == 1 and "already in" in err and "tap1.csv" in err
+    code, _, err = run(capsys, "tap", tmp_path / "x.txt")
+    assert code == 2 and "expected a tap record in a .csv, .uff or .unv file" in err
+
+
+# -- the measurement's new fields ---------------------------------------------------------------------------
+
+def _frf(n=5):
+    return FRF.single(Frequency.from_hz(np.arange(1.0, n + 1)), np.full(n, 1e-7 + 0j), "tool.tip:y", "tool.tip:y")
+
+
+def test_measurement_coherence_and_averages_are_checked():
+    m = Measurement("tool.tip", "tool.tip", _frf(), coherence=[0.5, 0.9, 1.0, 0.0, 1.0 + 1e-12], averages=10)
+    assert m.coherence[-1] == 1.0 and m.averages == 10 and not m.coherence.flags.writeable
+    assert m == Measurement("tool.tip", "tool.tip", _frf(), coherence=m.coherence, averages=10)
+    assert m != Measurement("tool.tip", "tool.tip", _frf(), averages=10)
+    with pytest.raises(InvalidValueError, match="coherence: got 4 values for 5 frequency lines"):
+        Measurement("tool.tip", "tool.tip", _frf(), coherence=[1, 1, 1, 1])
+    with pytest.raises(InvalidValueError, match=r"coherence: line 1 is 1.5; expected a number in \[0, 1\]"):
+        Measurement("tool.tip", "tool.tip", _frf(), coherence=[1, 1.5, 1, 1, 1])
+    with pytest.raises(InvalidValueError, match="averages: got 0"):
+        Measurement("tool.tip", "tool.tip", _frf(), averages=0)
+    cropped = MeasurementSet("s", [m]).crop(2, 4).measurements[0]
+    assert np.array_equal(cropped.coherence, [0.9, 1.0, 0.0]) and cropped.frf.frequency.n == 3
+
+
+def test_measurement_file_averages_and_coherence_column(tmp_path):
+    frf = _frf()
+    write_csv(frf, tmp_path / "a.csv", coherence=[0.1, 0.2, 0.3, 0.4, 0.5])
+    (tmp_path / "set.toml").write_text('[[frf]]\nresponse = "tool.tip"\nexcitation = "tool.tip"\n'
+                                       'file = "a.csv"\naverages = 7\n')
+    m = load_measurements(tmp_path / "set.toml").measurements[0]
+    assert m.averages == 7 and np.array_equal(m.coherence, [0.1, 0.2, 0.3, 0.4, 0.5])
+    (tmp_path / "bad.toml").write_text('[[frf]]\nresponse = "tool.tip"\nexcitation = "tool.tip"\n'
+                                       'file = "a.csv"\naverages = 0\n')
+    with pytest.raises(FileFormatError, match=r"bad.toml, line 5: frf\[0\].averages: got 0"):
+        load_measurements(tmp_path / "bad.toml")
+    text = (tmp_path / "a.csv").read_text().replace("0.3\n", "1.3\n")
+    (tmp_path / "a.csv").write_text(text)
+    with pytest.raises(FileFormatError, match=r"a.csv, line 4: coherence is 1.3"):
+        load_measurements(tmp_path / "set.toml")
+    write_csv(frf, tmp_path / "a.csv")  # an old three-column file: no coherence
+    assert load_measurements(tmp_path / "set.toml").measurements[0].coherence is None
+
+
+def test_tap_reads_a_universal_file_and_a_long_record(tmp_path, capsys):
+    import pyuff
+
+    r = impact_records()[0]
+    path = tmp_path / "tap.uff"
+    uff = pyuff.UFF(str(path))
+    for data, spec, unit, node in ((r.force, 13, "N", 1), (r.response, 12, "m/s^2", 2)):
+        uff.write_sets(pyuff.prepare_58(
+            func_type=1, rsp_node=node, rsp_dir=3, ref_node=1, ref_dir=3, data=data, x=r.time, num_pts=len(r),
+            abscissa_spacing=1, abscissa_min=0.0, abscissa_inc=1 / 25600, abscissa_spec_data_type=17,
+            ordinate_spec_data_type=spec, ordinate_axis_units_lab=unit, id1=f"node {node}",
+            orddenom_spec_data_type=0, orddenom_axis_units_lab="", abscissa_axis_units_lab="s",
+            z_axis_spec_data_type=0, z_axis_axis_units_lab=""), mode="add")
+    code, text, err = run(capsys, "tap", path, "--json")
+    assert code == 0, err
+    data = json.loads(text)
+    assert data["taps"] == 1 and data["per_tap"][0]["peak_force_n"] == pytest.approx(68.6, abs=0.1)
+    # the five records one after the other in one file, cut again into five taps of 0.9 s
+    records = impact_records()
+    long = tmp_path / "long.csv"
+    t = np.arange(5 * len(r)) / 25600
+    np.savetxt(long, np.column_stack([t, np.concatenate([x.force for x in records]),
+                                      np.concatenate([x.response for x in records])]), delimiter=",",
+               header="time [s],force [N],acceleration [g]", comments="")
+    code, text, err = run(capsys, "tap", long, "--tap-length", "0.9", "--json")
+    assert code == 0, err
+    data = json.loads(text)
+    assert data["taps"] == 5 and [round(p["start_s"]) for p in data["per_tap"]] == [0, 1, 2, 3, 4]
