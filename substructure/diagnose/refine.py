@@ -35,6 +35,7 @@ better.
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 from typing import Callable
 
 import attrs
@@ -237,7 +238,8 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say):
     single or a pair of other changes explains as well.  Here every single
     of the first step (fitted from its own scan on all lines) and every pair
     of the ``PAIR_POOL`` best of them that change the model in different
-    ways (:func:`_distinct`; fitted from the two singles' values, first on
+    ways and of the changes the path kept (:func:`_distinct`; fitted from
+    the two changes' values, first on
     the screening lines, the best two on all lines) is
     compared with the kept explanation by BIC (``chi^2 / s^2 + p ln n``,
     ``s^2`` the misfit scale of the best of them).  Of those within
@@ -258,7 +260,13 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say):
         if [s.change.key] != keys_now:
             options.append(([(c, dict(v)) for c, v in s.fit.changes], s.fit.chi2))
     if len(current) >= 2:
+        # the pool: the best singles of the first step, and the changes the path kept (a change the
+        # first step ranked too low to fit, found later once another had taken its share, pairs too)
+        kept_path = [SimpleNamespace(change=c, values=dict(v), fit=SimpleNamespace(changes=[(c, dict(v))]))
+                     for c, v in current]
         pool = _distinct(screen_lik, singles, PAIR_POOL)
+        keys = {s.change.key for s in pool}
+        pool += [k for k in _distinct(screen_lik, kept_path, len(kept_path)) if k.change.key not in keys]
         trials = []
         for i in range(len(pool)):
             for j in range(i + 1, len(pool)):
