@@ -504,6 +504,9 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     if len(current) >= 2:
         before = [c.key for c, _ in current]
         current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say)
+        if len(current) > 1:  # what the review and the parsimony check kept must each still earn its place
+            current, chi2_now, late = _prune(lik, current, chi2_now, say)
+            dropped += late
         if [c.key for c, _ in current] != before:
             alternatives = {c.key: [] for c, _ in current}
     kept = [c.key for c, _ in current]
