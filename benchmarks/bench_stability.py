@@ -36,9 +36,9 @@ def benchmarks():
            lambda args: sdm(*args, rtol=0.005), 3)
     yield ("stability_sdm_insperger_stepan_aD0.05_200_speeds_0.5pct", lambda: _benchmark(0.05),
            lambda args: sdm(*args, rtol=0.005), 5)
-    yield ("stability_sdm_thesis_cut_3_modes_xy_50_speeds", lambda: (_fitted(), MillingCut(4, "12 mm", "3 mm", kt="625 MPa",
-                                                                                    kn="100 MPa"),
-                                                           spindle_speeds("8000 rpm", "20000 rpm", "245 rpm")),
+    yield ("stability_sdm_thesis_cut_3_modes_xy_50_speeds",
+           lambda: (_fitted(), MillingCut(4, "12 mm", "3 mm", kt="625 MPa", kn="100 MPa"),
+                    spindle_speeds("8000 rpm", "20000 rpm", "245 rpm")),
            lambda args: sdm(*args), 1)
 
 

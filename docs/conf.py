@@ -40,8 +40,8 @@ extensions = [
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build", "_ext", "_inventories", "_templates", "_static", "figures", "**/*.ipynb", "auto_examples/*.py",
-                    "auto_examples/*.md5", "auto_examples/*.zip", "auto_examples/*.json"]
+exclude_patterns = ["_build", "_ext", "_inventories", "_templates", "_static", "figures", "**/*.ipynb",
+                    "auto_examples/*.py", "auto_examples/*.md5", "auto_examples/*.zip", "auto_examples/*.json"]
 templates_path = ["_templates"]
 
 # -- Warnings: every unresolved reference is an error (with -W) ------------------------------------

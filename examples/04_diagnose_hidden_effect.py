@@ -30,7 +30,6 @@ import os
 from pathlib import Path
 
 import attrs
-import matplotlib.pyplot as plt
 
 from substructure import Segment, Sensor, Tool, default_assembly, load_assembly, save_assembly
 from substructure.diagnose import Effect, Parameter, compare, diagnose, register_effect

@@ -34,7 +34,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from scipy.integrate import quad
 
-from substructure import Assembly, Frequency, Holder, Joint, Segment, Tool, default_assembly
+from substructure import Assembly, Frequency, Holder, Segment, Tool, default_assembly
 from substructure.beams import segment_transfer_matrix
 from substructure.holders import catalog_names, design
 from substructure.io.assembly_toml import dumps_assembly, loads_assembly

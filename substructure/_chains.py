@@ -1,4 +1,5 @@
-"""Free-free receptances of chains of uniform intervals (internal): the transfer-matrix chain, cut where it loses digits.
+"""Free-free receptances of chains of uniform intervals (internal): the transfer-matrix chain, cut where it loses
+digits.
 
 The machinery under :mod:`substructure.beams` and :mod:`substructure.tapers`:
 an interval is a pair ``(section, length)`` of uniform Timoshenko beam;

@@ -218,10 +218,12 @@ def segment_coefficients(ei, kga, rhoa, rhoi, omega_max):
 
 
 chain_lines = _c.chain_lines
-"""The chain kernel: ``chain_lines(omega, coef, rhoa, rhoi, length, slot, table, seg_of, nodes, place, out, table_only, lo, hi)``."""
+"""The chain kernel:
+``chain_lines(omega, coef, rhoa, rhoi, length, slot, table, seg_of, nodes, place, out, table_only, lo, hi)``."""
 
 couple_lines = _c.couple_lines
-"""The coupling kernel: ``couple_lines(ya, yb, a_src, a_idx, b_src, b_idx, src, idx, stiffness, rigid, out, lo, hi)``."""
+"""The coupling kernel:
+``couple_lines(ya, yb, a_src, a_idx, b_src, b_idx, src, idx, stiffness, rigid, out, lo, hi)``."""
 
 transcendental_floor = _c.transcendental_floor
 """``exp(x) + cos(y) + sin(y)`` summed over arrays: the floor of the beam kernel (benchmarks only)."""

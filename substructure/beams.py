@@ -44,6 +44,7 @@ import pint
 from . import _blocks as bk
 from ._chains import _CHUNK_KL, _chain_receptance, _chain_single, _is_shared, _phase, _stack_sections  # noqa: F401
 from .errors import InvalidValueError
+from .materials import Material
 from .sections import Flutes, Insert, Section, _length, _material, _metres, shear_coefficient
 from .units import magnitude_in, quantity
 

@@ -238,8 +238,9 @@ def design(entry: str, **parameters: Any) -> HolderDesign:
         elif key in chuck:
             p[key] = Q_(chuck[key])
     p["taper_ratio"] = parameters.get("taper_ratio", face["taper_ratio"])
-    if isinstance(p["taper_ratio"], bool) or not isinstance(p["taper_ratio"], (int, float)) or not 0 < p["taper_ratio"] < 2:
-        raise InvalidValueError(f"taper_ratio: got {p['taper_ratio']!r}; expected the change of diameter per length, e.g. 7/24")
+    ratio = p["taper_ratio"]
+    if isinstance(ratio, bool) or not isinstance(ratio, (int, float)) or not 0 < ratio < 2:
+        raise InvalidValueError(f"taper_ratio: got {ratio!r}; expected the change of diameter per length, e.g. 7/24")
     bore = p["bore"] = quantity(parameters["bore"], "bore", "[length]")
     if bore.magnitude <= 0:
         raise InvalidValueError(f"bore: got {parameters['bore']!r}; expected a positive diameter")
@@ -286,10 +287,12 @@ def _profile(kind: str, p: dict, front: float) -> list[tuple[float, float, float
         return [(front - nut_len, body, body), (nut_len, nut, nut)]
     nose = p["nose_diameter"].m_as("mm")
     if kind == "hydraulic":
-        nose_len = p["nose_length"].m_as("mm") if "nose_length" in p else min(front, p["clamp_length"].m_as("mm") + 10.0)
+        nose_len = (p["nose_length"].m_as("mm") if "nose_length" in p
+                    else min(front, p["clamp_length"].m_as("mm") + 10.0))
         p["nose_length"] = Q_(nose_len, "mm")
         if nose_len > front:
-            raise InvalidValueError(f"nose_length: got {p['nose_length']:~P}; longer than the holder in front of its flange")
+            raise InvalidValueError(
+                f"nose_length: got {p['nose_length']:~P}; longer than the holder in front of its flange")
         return ([(front - nose_len, body, body)] if nose_len < front else []) + [(nose_len, nose, nose)]
     slope = 2.0 * math.tan(p["nose_angle"].m_as("rad"))   # diameter change per length of the cone
     cone = max(0.0, (body - nose) / slope)
@@ -301,7 +304,9 @@ def _profile(kind: str, p: dict, front: float) -> list[tuple[float, float, float
 
 
 def _segments(kind: str, p: dict) -> tuple[tuple[Segment, ...], pint.Quantity]:
-    mm = lambda q: q.m_as("mm")
+    def mm(q: pint.Quantity) -> float:
+        return q.m_as("mm")
+
     gauge_length = mm(p["gauge_length"])
     front = gauge_length - mm(p["gap_length"]) - mm(p["flange_length"])
     if front <= 0:
@@ -353,7 +358,8 @@ def _segments(kind: str, p: dict) -> tuple[tuple[Segment, ...], pint.Quantity]:
 
 
 def _describe(face: dict, chuck: dict, p: dict, given: tuple[str, ...]) -> str:
-    tool = "empty bore" if p["tool_material"] is None else f"{p['tool_material'].name} shank {p['clamp_length']:~P} deep"
+    tool = ("empty bore" if p["tool_material"] is None
+            else f"{p['tool_material'].name} shank {p['clamp_length']:~P} deep")
     where = "flange contact face" if p["gap_length"].magnitude == 0 else "gauge line"
     parts = [
         f"{face['title']} + {chuck['title']}: APPROXIMATE catalogue geometry; check it against your "

@@ -80,7 +80,7 @@ def _check_structure(plans, assemblies) -> None:
             g[0].name == r[0].name and [str(p) for _, p in g[1]] == [str(p) for _, p in r[1]]
             for g, r in zip(groups, ref_groups)
         )
-        same = same and all(l[3] == r[3] for l, r in zip(links, ref_links))
+        same = same and all(k[3] == r[3] for k, r in zip(links, ref_links))
         if not same:
             raise InvalidValueError(
                 f"sweep: variant {i} ({assemblies[i].name!r}) has another structure than variant 0; "

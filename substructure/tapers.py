@@ -71,8 +71,10 @@ def _taper_arrays(seg: Segment, t: np.ndarray):
     if seg.insert is not None:
         ins = Section.ring(seg.insert.od.m_as("m"), seg.insert.id.m_as("m"), seg.insert.material)
         ei, kga, rhoa, rhoi = ei + ins.EI, kga + ins.kGA, rhoa + ins.rhoA, rhoi + ins.rhoI
-    return (np.broadcast_to(np.asarray(ei, dtype=complex), t.shape), np.broadcast_to(np.asarray(kga, dtype=complex), t.shape),
-            np.broadcast_to(np.asarray(rhoa, dtype=float), t.shape), np.broadcast_to(np.asarray(rhoi, dtype=float), t.shape))
+    return (np.broadcast_to(np.asarray(ei, dtype=complex), t.shape),
+            np.broadcast_to(np.asarray(kga, dtype=complex), t.shape),
+            np.broadcast_to(np.asarray(rhoa, dtype=float), t.shape),
+            np.broadcast_to(np.asarray(rhoi, dtype=float), t.shape))
 
 
 def _taper_sections(seg: Segment, t: np.ndarray) -> list[Section]:

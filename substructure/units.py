@@ -237,7 +237,8 @@ def quantity(value: Any, field: str, dimension: str) -> pint.Quantity:
     if isinstance(value, str):
         if not _NUMBER.match(value):  # pint reads "mm" as 1 mm and "a" as 1 year
             raise UnitError(
-                f"{field}: cannot read {show_value(value)} as a quantity: it does not start with a number; expected {expected}"
+                f"{field}: cannot read {show_value(value)} as a quantity: it does not start with a number; "
+                f"expected {expected}"
             )
         try:
             magnitude, units = _parse(value)

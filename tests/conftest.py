@@ -8,11 +8,6 @@ import numpy as np
 import pytest
 from hypothesis import settings
 
-# Property-based tests are deterministic (a fixed seed) and keep no example
-# database, so that every run, here and in CI, tests the same cases.
-settings.register_profile("substructure", derandomize=True, database=None, deadline=None)
-settings.load_profile("substructure")
-
 from substructure import (
     Assembly,
     Flutes,
@@ -26,6 +21,11 @@ from substructure import (
     Tool,
 )
 from substructure.datasets import thesis_joint
+
+# Property-based tests are deterministic (a fixed seed) and keep no example
+# database, so that every run, here and in CI, tests the same cases.
+settings.register_profile("substructure", derandomize=True, database=None, deadline=None)
+settings.load_profile("substructure")
 
 
 def make_spindle() -> Spindle:

@@ -105,7 +105,7 @@ class Section:
     rhoA: float
     rhoI: float
     A: float = 0.0
-    I: float = 0.0
+    I: float = 0.0  # noqa: E741 (the second moment of area, as in the formulas)
 
     def __add__(self, other: "Section") -> "Section":
         return Section(self.EI + other.EI, self.kGA + other.kGA, self.rhoA + other.rhoA,
@@ -115,7 +115,7 @@ class Section:
 def ring(od: float, id: float, mat: Material) -> Section:
     """Circular ring (``id = 0``: solid) of one material."""
     A = math.pi / 4.0 * (od**2 - id**2)
-    I = math.pi / 64.0 * (od**4 - id**4)
+    I = math.pi / 64.0 * (od**4 - id**4)  # noqa: E741 (the second moment of area)
     c = 1.0 + 1j * mat.eta
     G = mat.E / (2.0 * (1.0 + mat.nu))
     kappa = cowper_kappa(mat.nu, id / od)
@@ -168,7 +168,9 @@ class Taper:
 
     def part(self, t0: float, t1: float) -> "Taper":
         """The same taper restricted to the fractions ``[t0, t1]`` of the segment."""
-        lin = lambda a, b, t: a + (b - a) * t
+        def lin(a, b, t):
+            return a + (b - a) * t
+
         return Taper(lin(self.od0, self.od1, t0), lin(self.od0, self.od1, t1),
                      lin(self.id0, self.id1, t0), lin(self.id0, self.id1, t1),
                      self.mat, self.ratio, self.insert, self.insert_od, self.insert_id)
@@ -219,7 +221,9 @@ def element(L: float, s: Section, order: int = ORDER):
         EI, kGA, rhoA, rhoI = (np.array([getattr(q, f) for q in secs]) for f in ("EI", "kGA", "rhoA", "rhoI"))
     else:
         EI, kGA, rhoA, rhoI = (np.full(len(xg), getattr(s, f)) for f in ("EI", "kGA", "rhoA", "rhoI"))
-    quad = lambda c, A, B: np.einsum("g,gi,gj->ij", wg * c, A, B)
+    def quad(c, A, B):
+        return np.einsum("g,gi,gj->ij", wg * c, A, B)
+
     K = quad(EI, dNt, dNt) + quad(kGA, g, g)
     M = quad(rhoA, Ny, Ny) + quad(rhoI, Nt, Nt)
     return np.asarray(K, complex), M.real
@@ -336,7 +340,9 @@ class Model:
     def add_joint(self, point_a, point_b, k, c=0.0):
         """Joint: ``[f, m] = (k + i w c) [y_a - y_b, th_a - th_b]``, ``k`` and ``c`` as
         ``[[kyf, kym], [ktf, ktm]]`` (or per-DOF 2-vectors / scalar, see add_support)."""
-        blk = lambda A: np.block([[A, -A], [-A, A]])
+        def blk(A):
+            return np.block([[A, -A], [-A, A]])
+
         dofs = self._dofs2(point_a) + self._dofs2(point_b)
         self._blocks.append((dofs, blk(_mat2(k)), blk(_mat2(c)), np.zeros((4, 4))))
 

@@ -66,8 +66,9 @@ def nominal_model(flutes: tuple[float, float] | None = None, bearings: bool = Fa
                              Segment("30 mm", "12 mm", material="carbide")])
     supports = ()
     if bearings:
-        supports = tuple(Support(f"spindle@{x * 1e3!r} mm", k={"yf": f"{BEARING_K} N/m"}, c={"yf": f"{BEARING_C} N*s/m"},
-                                 name=f"bearing-{i + 1}") for i, x in enumerate(BEARINGS))
+        supports = tuple(Support(f"spindle@{x * 1e3!r} mm", k={"yf": f"{BEARING_K} N/m"},
+                                 c={"yf": f"{BEARING_C} N*s/m"}, name=f"bearing-{i + 1}")
+                         for i, x in enumerate(BEARINGS))
     return Assembly("rig", components=(spindle, holder, tool), joints=(
         Joint("spindle-holder", ("spindle.tip", "holder.base"), k={"yf": "4.1e7 N/m", "tm": "3.5e6 N*m/rad"},
               c={"yf": "400 N*s/m", "tm": "7 N*m*s/rad"}),
@@ -183,7 +184,8 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
         h_true = h_all[:, i : i + 1, :]
         n = h_true.shape
         level = floor * np.median(np.abs(h_true))
-        noisy = (h_true * (1 + noise * rng.standard_normal(n)) * np.exp(1j * np.radians(phase_deg) * rng.standard_normal(n))
+        noisy = (h_true * (1 + noise * rng.standard_normal(n))
+                 * np.exp(1j * np.radians(phase_deg) * rng.standard_normal(n))
                  + level * (rng.standard_normal(n) + 1j * rng.standard_normal(n)) / np.sqrt(2))
         out.append(FRF(GRID, noisy, (f"{p}:y",), (f"{excitation}:y",)))
     return out

@@ -1,11 +1,10 @@
 """Assembly graph: building, lookups, joints' checks and bad input."""
 
-import warnings
 
 import numpy as np
 import pytest
 
-from conftest import make_assembly, make_holder, make_spindle, make_tool
+from conftest import make_assembly, make_holder, make_tool
 from substructure import (
     Assembly,
     AssemblyError,
@@ -116,7 +115,8 @@ def test_building_returns_new_assemblies(assembly, grid):
     assert stiffer.joint("holder-tool").k.get("tm") == assembly.joint("holder-tool").k.get("tm")
     # With a passive (diagonal) joint, a stiffer joint raises the tool mode.
     diagonal = {"ym": "0 N", "tf": "0 N/rad"}
-    soft = assembly.with_joint(assembly.joint("holder-tool").with_parameters(k={"yf": "1e7 N/m", **diagonal}, c={"ym": "0 N*s", "tf": "0 N*s/rad"}))
+    soft = assembly.with_joint(assembly.joint("holder-tool").with_parameters(
+        k={"yf": "1e7 N/m", **diagonal}, c={"ym": "0 N*s", "tf": "0 N*s/rad"}))
     hard = soft.with_joint(soft.joint("holder-tool").with_parameters(k={"yf": "1e8 N/m"}))
     f_soft = soft.receptance("tool.tip:y", frequency=grid).peaks()
     f_hard = hard.receptance("tool.tip:y", frequency=grid).peaks()

@@ -152,10 +152,12 @@ def test_reciprocity_and_splitting_invariants(segments, frac):
 def test_batch_equals_single_configurations():
     f = np.linspace(20, 5000, 300)
     configs = [
-        [Segment("20 mm", "12 mm", material="carbide"), Segment(f"{L} mm", "12 mm", material="carbide", flutes=Flutes(0.8))]
+        [Segment("20 mm", "12 mm", material="carbide"),
+         Segment(f"{L} mm", "12 mm", material="carbide", flutes=Flutes(0.8))]
         for L in (10, 33, 70)
     ] + [  # a segment that is the same in every configuration is computed once
-        [Segment(f"{L} mm", "12 mm", material="carbide"), Segment("30 mm", "12 mm", material="carbide", flutes=Flutes(0.8))]
+        [Segment(f"{L} mm", "12 mm", material="carbide"),
+         Segment("30 mm", "12 mm", material="carbide", flutes=Flutes(0.8))]
         for L in (10, 33, 300)
     ]
     batch = np.concatenate([stepped_beam_receptance_batch(configs[:3], ["tip", "base"], f),

@@ -181,7 +181,8 @@ def test_frf_plot_unit_and_kind(capsys, tmp_path, monkeypatch):
     png = tmp_path / "tip.png"
     assert run(capsys, "frf", EXAMPLE, "--at", "tool.tip", "--plot", png)[0] == 0
     assert saved[-1][0] == "receptance |H| (µm/N)" and "tool.tip:y / tool.tip:y" in saved[-1][2].replace("\n", " ")
-    assert run(capsys, "frf", EXAMPLE, "--at", "tool.tip", "--plot", png, "--overwrite", "--unit", "m/N", "--kind", "nyquist")[0] == 0
+    assert run(capsys, "frf", EXAMPLE, "--at", "tool.tip", "--plot", png, "--overwrite", "--unit", "m/N",
+               "--kind", "nyquist")[0] == 0
     assert saved[-1][:2] == ("receptance, imaginary part (m/N)", "receptance, real part (m/N)")
     status, _, err = run(capsys, "frf", EXAMPLE, "--at", "tool.tip", "--plot", png, "--unit", "in/N")
     assert status == 2 and "--unit" in err

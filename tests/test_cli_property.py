@@ -57,11 +57,13 @@ def pool(tmp_path_factory):
     (d / "binary.toml").write_bytes(bytes(range(256)) * 4)
     assembly = loads_assembly(model)
     frf = assembly.receptance("tool.tip:y")
-    rows = "".join(f"{float(f)!r},{float(v.real)!r},{float(v.imag)!r}\n" for f, v in zip(frf.frequency.hz, frf.data[:, 0, 0]))
+    rows = "".join(f"{float(f)!r},{float(v.real)!r},{float(v.imag)!r}\n"
+                   for f, v in zip(frf.frequency.hz, frf.data[:, 0, 0]))
     (d / "tap.csv").write_text("frequency_hz,real,imag\n" + rows)
     (d / "tap_bom.csv").write_bytes(b"\xef\xbb\xbffrequency_hz,real,imag\n" + rows.encode())
     (d / "nan.csv").write_text("frequency_hz,real,imag\n" + rows.replace(rows.splitlines()[3], "280.0,nan,1e-7"))
-    (d / "dead.csv").write_text("frequency_hz,real,imag\n" + "".join(f"{float(f)!r},0.0,0.0\n" for f in frf.frequency.hz))
+    (d / "dead.csv").write_text("frequency_hz,real,imag\n"
+                                + "".join(f"{float(f)!r},0.0,0.0\n" for f in frf.frequency.hz))
     (d / "one.csv").write_text("frequency_hz,real,imag\n" + rows.splitlines()[0] + "\n")
     write_uff(frf.with_labels(("tool.tip:y",), ("tool.tip:y",)), d / "tap.uff")
     lines = (d / "tap.uff").read_text().splitlines()

@@ -1,19 +1,16 @@
 """The generic coupling engine against the thesis's equations and its own inverses."""
 
-import warnings
-
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from conftest import make_assembly, make_holder, make_spindle, make_tool, rel_err, thesis_joints
+from conftest import make_holder, make_spindle, make_tool, rel_err, thesis_joints
 from substructure import (
     Assembly,
     Frequency,
     Joint,
     MeasuredComponent,
-    NonPassiveJointWarning,
     Segment,
     Sensor,
     Tool,
@@ -147,7 +144,8 @@ def test_loop_and_branch_topologies(grid):
     right = Tool("right", [Segment("50 mm", "20 mm")])
     loop = Assembly(
         "loop", components=(left, right),
-        joints=(Joint.rigid_between("j1", "left.base", "right.base"), Joint.rigid_between("j2", "left.tip", "right.tip")),
+        joints=(Joint.rigid_between("j1", "left.base", "right.base"),
+                Joint.rigid_between("j2", "left.tip", "right.tip")),
     )
     # Two identical beams tied at both ends: same frequencies as one, receptance halved.
     got = loop.receptance("left.tip", frequency=grid).data

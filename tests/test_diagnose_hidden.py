@@ -66,7 +66,8 @@ def damping_3x(d):
 
 
 def overhang_80(d):
-    return any(abs(e.values["value"] - 0.080) < 0.001 for e in _found(d, "model-parameter", "components.tool.overhang")) \
+    return any(abs(e.values["value"] - 0.080) < 0.001
+               for e in _found(d, "model-parameter", "components.tool.overhang")) \
         or any(abs(e.values["value"] - {"0": 0.050, "1": 0.034}[e.where[-8]]) < 0.001 for e in d.effects
                if e.where in ("components.tool.segments.0.length", "components.tool.segments.1.length"))
 

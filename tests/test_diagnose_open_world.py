@@ -30,9 +30,10 @@ def _near(value, target, rel):
 def weak_cross(target, rel):
     """The spindle-holder cross term, as the catalogue effect or as the joint's matrix entry."""
     def check(d):
-        return any(e.where == "spindle-holder" and e.name == "joint-cross-coupling" and _near(e.values["k_ym"], target, rel)
-                   for e in d.effects) or any(e.where == "joints.spindle-holder.k.ym" and _near(e.values["value"], target, rel)
-                                              for e in d.effects)
+        return any(e.where == "spindle-holder" and e.name == "joint-cross-coupling"
+                   and _near(e.values["k_ym"], target, rel) for e in d.effects) \
+            or any(e.where == "joints.spindle-holder.k.ym" and _near(e.values["value"], target, rel)
+                   for e in d.effects)
     return check
 
 
@@ -163,7 +164,8 @@ def test_bodies_sit_only_where_they_can_and_weigh_what_they_can():
     lo, hi, _ = body_bounds(model, spindle)
     assert isinstance(spindle, Spindle) and (lo, hi) == pytest.approx((0.27, 0.33))  # the nose: its last segment
     machine = hd.nominal_model(bearings=True)
-    assert body_bounds(machine, machine.component("spindle"))[0] == pytest.approx(hd.BEARINGS[-1])  # past the front bearing
+    # past the front bearing
+    assert body_bounds(machine, machine.component("spindle"))[0] == pytest.approx(hd.BEARINGS[-1])
     _, _, tool_max = body_bounds(model, tool)
     assert tool_max == pytest.approx(STEEL_DENSITY * math.pi / 4 * 3 * 0.012 ** 3)  # a steel ring 12-24 mm, 12 mm long
     assert body_bounds(model, holder) == pytest.approx((0.0, 0.066, holder.mass()))  # its own mass is the smaller bound

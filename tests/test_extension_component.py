@@ -162,7 +162,8 @@ def test_hooks_that_do_not_agree_are_refused():
             def to_toml(self):
                 return {"nut_mass": f"{self.nut_mass.m_as('g')!r} g"}
 
-        with pytest.raises(InvalidValueError, match=r"'holder' \(ForgetfulHolder\) would not read back equal.*nut_mass"):
+        with pytest.raises(InvalidValueError,
+                           match=r"'holder' \(ForgetfulHolder\) would not read back equal.*nut_mass"):
             dumps_assembly(build(ForgetfulHolder("holder", SEGMENTS, nut_mass="400 g")))
     finally:
         COMPONENT_TYPES.clear()

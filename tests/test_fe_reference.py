@@ -272,8 +272,12 @@ def taper_compliance(L, tp):
     from scipy.integrate import quad
 
     opts = dict(epsabs=0.0, epsrel=1e-13, limit=200)
-    u = lambda x: 1.0 / tp.at(x / L).EI.real
-    s = lambda x: 1.0 / tp.at(x / L).kGA.real
+    def u(x):
+        return 1.0 / tp.at(x / L).EI.real
+
+    def s(x):
+        return 1.0 / tp.at(x / L).kGA.real
+
     h = quad(lambda x: (L - x) ** 2 * u(x), 0, L, **opts)[0] + quad(s, 0, L, **opts)[0]
     ln = quad(lambda x: (L - x) * u(x), 0, L, **opts)[0]
     p = quad(u, 0, L, **opts)[0]

@@ -78,7 +78,6 @@ def test_free_free_natural_frequencies_match_fe(segments, fe_segments):
     model = fe.Model()
     model.add_beam(fe_segments)  # default mesh: first five within 2.5e-6 of converged
     expected = model.natural_frequencies(5)
-    length = beam.length_m
 
     def h(f):
         return beam.receptance(f, ["tip"]).data[:, 0, 0].real
@@ -90,10 +89,12 @@ def test_free_free_natural_frequencies_match_fe(segments, fe_segments):
 def _library_assembly(loss: bool):
     steel = Material.from_catalog("steel") if loss else STEEL0
     carbide = Material.from_catalog("carbide") if loss else CARBIDE0
-    spindle = Spindle("spindle", [Segment("120 mm", "70 mm", "40 mm", steel), Segment("150 mm", "90 mm", "40 mm", steel)])
+    spindle = Spindle("spindle", [Segment("120 mm", "70 mm", "40 mm", steel),
+                                  Segment("150 mm", "90 mm", "40 mm", steel)])
     holder = Holder("holder", [Segment("16 mm", "63 mm", material=steel),
                                Segment("40 mm", "40 mm", "12 mm", steel, insert=Insert("12 mm", carbide))])
-    tool = Tool("tool", [Segment("40 mm", "12 mm", material=carbide), Segment("30 mm", "12 mm", material=carbide, flutes=Flutes(0.8))])
+    tool = Tool("tool", [Segment("40 mm", "12 mm", material=carbide),
+                         Segment("30 mm", "12 mm", material=carbide, flutes=Flutes(0.8))])
     damping = {"yf": "400 N*s/m", "tm": "7 N*m*s/rad"} if loss else {}
     damping_ht = {"yf": "54 N*s/m", "ym": "2 N*s", "tf": "2 N*s", "tm": "1 N*m*s/rad"} if loss else {}
     return Assembly(

@@ -509,7 +509,8 @@ def test_plot_units_convert_exactly_and_label():
     y = np.abs(frf.entry("a:y", "a:y"))
     assert fig.axes[0].get_ylabel() == "receptance |H| (µm/N)" and fig.axes[1].get_ylabel() == "phase (deg)"
     np.testing.assert_array_equal(fig.axes[0].lines[0].get_ydata(), y * 1e6)
-    for unit, factor, shown in (("m/N", 1.0, "m/N"), ("mm/N", 1e3, "mm/N"), ("nm/N", 1e9, "nm/N"), ("µm/N", 1e6, "µm/N")):
+    for unit, factor, shown in (("m/N", 1.0, "m/N"), ("mm/N", 1e3, "mm/N"), ("nm/N", 1e9, "nm/N"),
+                                ("µm/N", 1e6, "µm/N")):
         fig = frf.plot(entries=[("a:y", "a:y")], kind="real-imag", unit=unit)
         np.testing.assert_array_equal(fig.axes[0].lines[0].get_ydata(), frf.entry("a:y", "a:y").real * factor)
         np.testing.assert_array_equal(fig.axes[1].lines[0].get_ydata(), frf.entry("a:y", "a:y").imag * factor)

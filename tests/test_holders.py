@@ -76,7 +76,8 @@ def test_geometry_follows_the_data_shrink_fit_with_taper():
     cone = 0.054
     d_back = 0.027 + slope * cone
     expected = (frustum_mass(0.032, 0.048 - 0.0032, 0.048, 0.036) + ring_mass(0.026, 0.063)
-                + frustum_mass(cone, d_back, 0.027) - ring_mass(0.048, 0.016) + ring_mass(0.048, 0.016, rho=RHO_CARBIDE))
+                + frustum_mass(cone, d_back, 0.027) - ring_mass(0.048, 0.016)
+                + ring_mass(0.048, 0.016, rho=RHO_CARBIDE))
     assert holder.mass() == pytest.approx(expected, rel=1e-5)   # diameters rounded to 0.1 um in the model
     assert holder.segments[0].is_tapered and holder.segments[-1].is_tapered
     assert holder.segments[-1].od_tip.m_as("mm") == pytest.approx(27.0)
@@ -182,7 +183,8 @@ def test_assembly_file_catalog_key_and_round_trip():
 @pytest.mark.parametrize("change, match", [
     (('catalog = "HSK-A63 shrink-fit"', 'catalog = "HSK-A63 shrinkfit"'), r"components\[1\]\.catalog: unknown holder"),
     (('nose_diameter = "27.5 mm"', 'nose_diameterr = "27.5 mm"'), r"components\[1\]\.nose_diameterr: unknown key"),
-    (('nose_diameter = "27.5 mm"', 'nose_diameter = "27.5"'), r"components\[1\]\.nose_diameter: got '27.5' without a unit"),
+    (('nose_diameter = "27.5 mm"', 'nose_diameter = "27.5"'),
+     r"components\[1\]\.nose_diameter: got '27.5' without a unit"),
     (('gauge_length = "90 mm"', 'gauge_length = "10 mm"'), r"components\[1\]\.gauge_length: got 10 mm"),
     (('tool_material = "hss"', 'tool_material = "hsss"'), r"components\[1\]\.tool_material: unknown material"),
     (('type = "holder"\ncatalog', 'type = "tool"\ncatalog'), r"components\[1\]\.catalog: only holders"),
@@ -194,7 +196,8 @@ def test_assembly_file_catalog_errors(change, match):
 
 
 def test_description_key_for_any_beam():
-    text = TEXT.replace('name = "tool"\ntype = "tool"', 'name = "tool"\ntype = "tool"\ndescription = "HSS end mill, 4 flutes"')
+    text = TEXT.replace('name = "tool"\ntype = "tool"',
+                        'name = "tool"\ntype = "tool"\ndescription = "HSS end mill, 4 flutes"')
     asm = loads_assembly(text)
     assert asm.component("tool").description == "HSS end mill, 4 flutes"
     assert loads_assembly(dumps_assembly(asm)) == asm

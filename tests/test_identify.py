@@ -1,11 +1,10 @@
 """Joint identification: the closed form (thesis eq. 2.3) and the robust band fit."""
 
-import warnings
 
 import numpy as np
 import pytest
 
-from conftest import make_assembly, make_holder, make_spindle, make_tool, thesis_joints
+from conftest import make_holder
 from substructure import (
     FRF,
     Assembly,
@@ -60,7 +59,8 @@ def test_closed_form_in_another_topology():
     holder = make_holder()
     a = Tool("a", [Segment("50 mm", "12 mm", material="carbide")])
     b = Tool("b", [Segment("40 mm", "10 mm", material="carbide")])
-    ja = Joint("ja", ("holder.tip", "a.base"), k={"yf": "3e7 N/m", "ym": "1e5 N", "tf": "1e5 N/rad", "tm": "5e4 N*m/rad"},
+    ja = Joint("ja", ("holder.tip", "a.base"),
+               k={"yf": "3e7 N/m", "ym": "1e5 N", "tf": "1e5 N/rad", "tm": "5e4 N*m/rad"},
                c={"yf": "40 N*s/m", "tm": "2 N*m*s/rad"})
     jb = Joint("jb", ("holder@30 mm", "b.base"), k={"yf": "2e7 N/m", "tm": "4e4 N*m/rad"}, c={"yf": "20 N*s/m"})
     asm = Assembly("branch", components=(holder, a, b), joints=(ja, jb))

@@ -30,7 +30,8 @@ def _fe_measurements():
     t = m.add_beam([(0.046, fe.section(0.012, 0, cb)), (0.030, fe.fluted(0.012, 0.8, cb))],
                    points=[TIP - S, TIP - 2 * S])
     m.add_joint((s, 0.33), (h, 0.0), k=[[4.1e7, 0], [0, 3.5e6]], c=[[400, 0], [0, 7]])
-    m.add_joint((h, 0.066), (t, 0.0), k=[[TRUE["k_yf"], 0], [0, TRUE["k_tm"]]], c=[[TRUE["c_yf"], 0], [0, TRUE["c_tm"]]])
+    m.add_joint((h, 0.066), (t, 0.0), k=[[TRUE["k_yf"], 0], [0, TRUE["k_tm"]]],
+                c=[[TRUE["c_yf"], 0], [0, TRUE["c_tm"]]])
     pts = [(t, TIP, "y"), (t, TIP - S, "y"), (t, TIP - 2 * S, "y")]
     return m.receptance(GRID.hz, pts, pts)  # (n, 3, 3): point and cross FRFs
 
@@ -50,7 +51,8 @@ def _model(start):
     return Assembly("fe twin", components=(spindle, holder, tool), joints=(
         Joint("spindle-holder", ("spindle.tip", "holder.base"), k={"yf": "4.1e7 N/m", "tm": "3.5e6 N*m/rad"},
               c={"yf": "400 N*s/m", "tm": "7 N*m*s/rad"}),
-        Joint("holder-tool", ("holder.tip", "tool.base"), k={"yf": f"{start['k_yf']} N/m", "tm": f"{start['k_tm']} N*m/rad"},
+        Joint("holder-tool", ("holder.tip", "tool.base"),
+              k={"yf": f"{start['k_yf']} N/m", "tm": f"{start['k_tm']} N*m/rad"},
               c={"yf": f"{start['c_yf']} N*s/m", "tm": f"{start['c_tm']} N*m*s/rad"}),
     ))
 
@@ -63,7 +65,8 @@ def test_band_fit_on_fe_data_with_noise_has_honest_uncertainty(fe_data):
         rng = np.random.default_rng(seed)
         noise = (rng.standard_normal(fe_data.shape) + 1j * rng.standard_normal(fe_data.shape)) / np.sqrt(2)
         measured = FRF(GRID, fe_data * (1 + 0.02 * noise), labels, labels)
-        entries = [measured.select([o], [i]) for o, i in ((labels[0], labels[0]), (labels[1], labels[0]), (labels[2], labels[0]))]
+        entries = [measured.select([o], [i])
+                   for o, i in ((labels[0], labels[0]), (labels[1], labels[0]), (labels[2], labels[0]))]
         ident = JointIdentifier("holder-tool").fit(start, entries)
         k, c = ident.values_["k_yf"], ident.values_["c_yf"]
         k_err.append(abs(k / TRUE["k_yf"] - 1))

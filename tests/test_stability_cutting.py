@@ -86,8 +86,10 @@ def test_entry_and_exit_angles():
 def altintas_alpha(st, ex, kr):
     """Altintas & Budak's directional coefficients, written out (Manufacturing Automation, ch. 3)."""
     def f(p):
-        return 0.5 * np.array([[np.cos(2 * p) - 2 * kr * p + kr * np.sin(2 * p), -np.sin(2 * p) - 2 * p + kr * np.cos(2 * p)],
-                               [-np.sin(2 * p) + 2 * p + kr * np.cos(2 * p), -np.cos(2 * p) - 2 * kr * p - kr * np.sin(2 * p)]])
+        return 0.5 * np.array([[np.cos(2 * p) - 2 * kr * p + kr * np.sin(2 * p),
+                                -np.sin(2 * p) - 2 * p + kr * np.cos(2 * p)],
+                               [-np.sin(2 * p) + 2 * p + kr * np.cos(2 * p),
+                                -np.cos(2 * p) - 2 * kr * p - kr * np.sin(2 * p)]])
     return f(ex) - f(st)
 
 

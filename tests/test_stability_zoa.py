@@ -155,7 +155,8 @@ def test_lobes_are_listed_and_the_limit_is_their_lower_envelope():
 
 
 def test_frf_without_the_xy_data_is_an_error():
-    assembly_frf = default_assembly().receptance("tool.tip", frequency=Frequency.from_range("500 Hz", "900 Hz", "100 Hz"))
+    assembly_frf = default_assembly().receptance("tool.tip",
+                                                 frequency=Frequency.from_range("500 Hz", "900 Hz", "100 Hz"))
     cut = MillingCut(4, "12 mm", "3 mm", kt="625 MPa", kn="100 MPa")
     with pytest.raises(InvalidValueError, match="x \\(feed\\) and y.*xy_frf"):
         zoa(assembly_frf, cut, SPEEDS)  # (y, theta) receptances, not x and y

@@ -45,7 +45,7 @@ def test_sweep_needs_one_structure():
 
 import attrs  # noqa: E402
 
-from substructure import Holder, Segment  # noqa: E402
+from substructure import Holder  # noqa: E402
 from substructure.components import is_plain_beam  # noqa: E402
 from substructure.coupling import Link, couple_substructures  # noqa: E402
 

@@ -133,7 +133,8 @@ def test_tapered_holder_in_an_assembly_matches_fe_receptances():
     h = m.add_beam([(0.02, fe.ring(0.063, 0.0, FE_STEEL_D)),
                     (0.05, fe.Taper(0.044, 0.024, 0.012, 0.012, FE_STEEL_D, insert=FE_CARBIDE_D, insert_od=0.012))],
                    n_elem=12)
-    t = m.add_beam([(0.04, fe.ring(0.012, 0.0, FE_CARBIDE_D)), (0.03, fe.Taper(0.012, 0.01, 0.0, 0.0, FE_CARBIDE_D, ratio=0.8))],
+    t = m.add_beam([(0.04, fe.ring(0.012, 0.0, FE_CARBIDE_D)),
+                    (0.03, fe.Taper(0.012, 0.01, 0.0, 0.0, FE_CARBIDE_D, ratio=0.8))],
                    n_elem=12)
     m.add_joint((s, 0.26), (h, 0.0), k=[[4e7, 0], [0, 3e6]], c=[[400, 0], [0, 7]])
     m.add_joint((h, 0.07), (t, 0.0), k=[[1.4e7, 0], [0, 8e4]], c=[[12, 0], [0, 4]])
@@ -148,7 +149,9 @@ def test_tapered_holder_in_an_assembly_matches_fe_receptances():
 def test_mass_is_the_frustum_and_the_model_carries_it():
     seg = Segment("80 mm", "30 mm", "10 mm", STEEL0, od_tip="50 mm", id_tip="20 mm")
     r0, r1, q0, q1 = 0.015, 0.025, 0.005, 0.010
-    cone = lambda a, b: math.pi * 0.08 / 3 * (a * a + a * b + b * b)
+    def cone(a, b):
+        return math.pi * 0.08 / 3 * (a * a + a * b + b * b)
+
     assert seg.mass() == pytest.approx(7850 * (cone(r0, r1) - cone(q0, q1)), rel=1e-13)
     # the stepped model (two-point Gauss per step) integrates rho*A exactly
     sections = seg.piece_sections()
@@ -196,7 +199,8 @@ def test_split_gives_the_same_beam():
     f = np.linspace(100.0, 8000.0, 30)
     one = stepped_beam_receptance([seg], [0.0, 0.06], f)
     two = stepped_beam_receptance([a, b], [0.0, 0.06], f)
-    assert (np.abs(one - two) / np.abs(one).max(axis=-1, keepdims=True)).max() < TAPER_ERROR_BOUND  # no resonance below 8 kHz
+    # no resonance below 8 kHz
+    assert (np.abs(one - two) / np.abs(one).max(axis=-1, keepdims=True)).max() < TAPER_ERROR_BOUND
     with pytest.raises(InvalidValueError, match="at:"):
         seg.split("60 mm")
 
@@ -267,7 +271,8 @@ def test_assembly_file_round_trip_and_errors():
         Segment("20 mm", "63 mm", material=STEEL0),
         Segment("50 mm", "40 mm", "12 mm", STEEL0, insert=Insert("12 mm", CARBIDE0), od_tip="1 in", taper_steps=5),
     ], description="a tapered holder")
-    tool = Tool("tool", [Segment("30 mm", "12 mm", material=CARBIDE0, flutes=Flutes(0.8), od_tip="10 mm", id_tip="2 mm")])
+    tool = Tool("tool", [Segment("30 mm", "12 mm", material=CARBIDE0, flutes=Flutes(0.8), od_tip="10 mm",
+                                 id_tip="2 mm")])
     asm = Assembly("tapers", [holder, tool], [Joint("ht", ["holder.tip", "tool.base"], rigid=True)],
                    frequency=Frequency.from_range("100 Hz", "3000 Hz", "100 Hz"), materials=[STEEL0, CARBIDE0])
     text = dumps_assembly(asm)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import hidden_data as hd
-from substructure import (FRF, Assembly, Flutes, Frequency, Holder, Insert, InvalidValueError, Joint, Mass,
+from substructure import (FRF, Assembly, Flutes, Insert, InvalidValueError, Joint, Mass,
                           MeasuredComponent, Segment, Sensor, Support, Tool, default_assembly, dumps_assembly,
                           loads_assembly)
 from substructure.beams import stepped_beam_receptance, stepped_beam_receptance_si
@@ -258,7 +258,8 @@ def test_a_tapered_tool_takes_part_as_it_is():
     params = {p.path: p for p in model_parameters(tapered) if p.path.startswith("components.tool.")}
     tip = params["components.tool.segments.1.od_tip"]
     assert tip.nominal == pytest.approx(0.010) and not tip.si and tip.lower < 0.010 < tip.upper
-    assert {"components.tool.segments.0.od", "components.tool.segments.1.length", "components.tool.overhang"} <= set(params)
+    assert {"components.tool.segments.0.od", "components.tool.segments.1.length",
+            "components.tool.overhang"} <= set(params)
     change = parameter_change(tip)
     assert isinstance(change, AssemblyParameterChange)
     lik_model = tapered.with_component(Tool("tool", [Segment("46 mm", "12 mm", material="carbide"),

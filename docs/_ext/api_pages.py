@@ -19,7 +19,6 @@ import importlib
 import inspect
 from pathlib import Path
 
-from docutils import nodes
 from sphinx.util import logging
 
 import public_api

@@ -32,7 +32,6 @@ import inspect
 import pkgutil
 import sys
 from dataclasses import dataclass, field
-from pathlib import Path
 
 PACKAGE = "substructure"
 

@@ -51,7 +51,8 @@ class PreparedFRF:
         f = self.frequency.hz
         self._groups = groups
         self._blocks = [
-            ([k for k, _ in items], by_chunks(lambda ff, o=owner, r=[ref for _, ref in items]: o.receptance_matrix(r, ff), f))
+            ([k for k, _ in items],
+             by_chunks(lambda ff, o=owner, r=[ref for _, ref in items]: o.receptance_matrix(r, ff), f))
             for owner, items in groups
         ]
         self._rows = [2 * i + d for i, d in out_idx]

@@ -107,7 +107,8 @@ def speed_arg(text: str) -> str:
 def add_cut_options(parser: argparse.ArgumentParser) -> None:
     """Add the groups "milling cut", "machine and recommendation" and "turning" to a command's parser."""
     cutting = parser.add_argument_group("milling cut")
-    cutting.add_argument("--teeth", type=int, metavar="N", help="number of teeth (default: the tool's, with an assembly)")
+    cutting.add_argument("--teeth", type=int, metavar="N",
+                         help="number of teeth (default: the tool's, with an assembly)")
     cutting.add_argument("--diameter", metavar="D",
                          help="tool diameter with its unit, e.g. '12 mm' (default: the tool's, with an assembly)")
     cutting.add_argument("--radial-depth", metavar="A", help="radial depth of cut with its unit, e.g. '3 mm'")

@@ -142,7 +142,8 @@ def add_parser(commands) -> None:
     rep.add_argument("--title", metavar="TEXT", help="the report's title (default: 'Tool report: <assembly name>')")
     rep.add_argument("--overwrite", action="store_true", help="let --out replace an existing file (never an input)")
     rep.add_argument("--quiet", action="store_true", help="no progress on standard error")
-    rep.add_argument("--json", action="store_true", help="print one JSON object (the report's summary) instead of the lines for people")
+    rep.add_argument("--json", action="store_true",
+                     help="print one JSON object (the report's summary) instead of the lines for people")
     rep.set_defaults(run=run)
     # '-2000:24000:50' is a (bad) value, not an option: let it reach the option's check
     rep._negative_number_matcher = re.compile(r"^-[\d.]")

@@ -307,7 +307,8 @@ def component_info(component: Any) -> str:
     """One line describing a component, for summaries."""
     kind = getattr(component, "kind", type(component).__name__)
     if isinstance(component, Beam):
-        text = f"{component.name} ({kind}, {len(component.segments)} segments, {component.length:~P}, {component.mass():.3g} kg)"
+        text = (f"{component.name} ({kind}, {len(component.segments)} segments, {component.length:~P}, "
+                f"{component.mass():.3g} kg)")
         if component.description:  # its first sentence: catalogue holders carry their sources after it
             text += ": " + component.description.split(". ")[0].rstrip(".")
         return text

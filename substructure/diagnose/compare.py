@@ -239,7 +239,10 @@ def pair_modes(model: FRF, measured: FRF, floor: float = 0.02, window: int | Non
     fm, hm = _peaks(smooth(measured, window=w), floor, prominence)
     fo, ho = _peaks(model, floor, 0.1)
     candidates = sorted(
-        (abs(np.log(a / b)), i, j) for i, a in enumerate(fm) for j, b in enumerate(fo) if abs(np.log(a / b)) < np.log(1.5)
+        (abs(np.log(a / b)), i, j)
+        for i, a in enumerate(fm)
+        for j, b in enumerate(fo)
+        if abs(np.log(a / b)) < np.log(1.5)
     )
     used_i, used_j, match = set(), set(), {}
     for _, i, j in candidates:

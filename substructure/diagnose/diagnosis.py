@@ -299,7 +299,8 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         report = [f"unexplained: no candidate explains the data uniquely: {kept.name} at {kept.where} and "
                   f"{rival.name} at {rival.where} both leave a residual consistent with the noise (their BIC "
                   f"differ by at most {INDIFFERENCE:g}) but "
-                  + ("are the same change at other values (" + "; ".join(values_text(f.change, f.values) for f in rival.founds) + ")"
+                  + ("are the same change at other values ("
+                     + "; ".join(values_text(f.change, f.values) for f in rival.founds) + ")"
                      if sorted(f.change.key for f in rival.founds) == keys else "change different parts")
                   for rival, _ in rivals[:1]]
         report += [f"to tell them apart: {sep['text']}" for rival, sep in rivals]
@@ -485,7 +486,8 @@ def bound_text(current, hit) -> str:
     i, name, value, bound, side = hit
     change = current[i][0]
     unit = next((sp.unit for sp in change.specs if sp.name == name), "")
-    return f"{change.effect} at {change.where}: {name} = {value:.4g} {unit}, the {side} bound of its search ({bound:.4g} {unit})"
+    return (f"{change.effect} at {change.where}: {name} = {value:.4g} {unit}, "
+            f"the {side} bound of its search ({bound:.4g} {unit})")
 
 
 def _std_of(result, change) -> dict:

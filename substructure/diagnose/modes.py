@@ -15,9 +15,9 @@ from one value to the next); the least squares step
 Mode frequencies are smooth in ``u`` but not linear (a stiff joint's modes
 hardly move until it is soft enough), so the step is repeated three times
 with secant slopes (steps limited to a factor ``e^1.5`` on log scales); the
-iterates become extra starting points of the screening scan.  When every paired mode is within two lines of the model's,
-there is nothing to predict from and no extra start is made.  Elements are linearised at every other screening place from where
-they do nothing (a zero mass, a zero spring), with three trials around the
+iterates become extra starting points of the screening scan.  When every paired mode is within two lines of the
+model's, there is nothing to predict from and no extra start is made.  Elements are linearised at every other
+screening place from where they do nothing (a zero mass, a zero spring), with three trials around the
 prediction; a section change's three parameters are left to its scan.
 """
 

@@ -347,7 +347,8 @@ class Diagnosis:
             "correlation": self.correlation,
             "consistency": None if cons is None else {
                 "chi2_reduced": _finite(cons.chi2_reduced), "threshold": _finite(cons.threshold),
-                "bands_hz": [{"frf": self.final[b.item].measured.outputs[0] + " / " + self.final[b.item].measured.inputs[0],
+                "bands_hz": [{"frf": (self.final[b.item].measured.outputs[0] + " / "
+                                      + self.final[b.item].measured.inputs[0]),
                               "lo": b.lo_hz, "hi": b.hi_hz, "ratio": _finite(b.ratio), "share": _finite(b.share)}
                              for b in cons.bands]},
             "ambiguous": [{"effect": a.name, "where": a.where, "parameters": a.parameters_json(),

@@ -41,7 +41,7 @@ from ..updating.parameters import Change, ParameterChange, material_changes, mod
 from ..updating.structure import si_beam
 from ..updating.selection import INDIFFERENCE, bic, significance
 from .effects import EffectChange, effect_change
-from .scan import places as _places, trials as _trials
+from .scan import trials as _trials
 
 __all__ = ["Scored", "Budget", "candidates", "screen", "full_fits", "SCREEN_LINES", "SHORTLIST_SHARE"]
 
@@ -588,7 +588,8 @@ def physical(change: Change, values: dict) -> bool:
     """
     for spec in change.specs:
         v = values.get(spec.name)
-        if v is None or not np.isfinite(v) or v < spec.lower - 1e-12 * abs(spec.lower) or v > spec.upper * (1 + 1e-12) + 1e-300:
+        if (v is None or not np.isfinite(v) or v < spec.lower - 1e-12 * abs(spec.lower)
+                or v > spec.upper * (1 + 1e-12) + 1e-300):
             return False
     return True
 

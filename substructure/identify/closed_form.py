@@ -250,7 +250,8 @@ def closed_form(coupled: FRF, side_a: FRF, side_b: FRF, *, at: str, at_a: str, a
         diff = t11 - yc
         cancellation = np.sqrt((np.abs(t11) ** 2).sum(axis=(0, 1)) / (np.abs(diff) ** 2).sum(axis=(0, 1)))
         condition = {"T12": _cond2(t12), "T21": _cond2(t21), "W": _cond2(w), "K_inv": _cond2(k_inv)}
-    result = ClosedFormResult(freq, np.moveaxis(k, -1, 0), condition, cancellation * condition["W"] * condition["K_inv"])
+    result = ClosedFormResult(freq, np.moveaxis(k, -1, 0), condition,
+                              cancellation * condition["W"] * condition["K_inv"])
     bad = result.ill_conditioned()
     if warn and np.any(bad):
         f = freq.hz[bad]

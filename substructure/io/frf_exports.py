@@ -151,8 +151,8 @@ def parse_export(numbered: list[tuple[int, str]], name: str, quantity: str | Non
             raise FileFormatError(f"{name}, line {first}: column {_shown(vcells[0])} has no unit; give it "
                                   "(e.g. 'Magnitude [m/N]') or say the quantity")
     if kind is not None and quantity is not None and kind != quantity:
-        raise FileFormatError(f"{name}, line {first}: the header's units are those of {'an' if kind[0] == 'a' else 'a'} {kind}, but the quantity "
-                              f"given is {quantity}")
+        raise FileFormatError(f"{name}, line {first}: the header's units are those of "
+                              f"{'an' if kind[0] == 'a' else 'a'} {kind}, but the quantity given is {quantity}")
     data = cells[1:]
     lines = np.array([n for n, _ in rows[1:]])
     for n, row in zip(lines, data):

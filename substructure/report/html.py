@@ -267,7 +267,8 @@ def _tool_point(report: Any) -> str:
     band = report.structure_band
     if report.modes:
         worst = max(report.modes, key=lambda m: m.peak_m_per_n)
-        rows = [[("<strong>" if m is worst else "") + fixed(m.frequency_hz, ",.0f") + ("</strong>" if m is worst else ""),
+        rows = [[("<strong>" if m is worst else "") + fixed(m.frequency_hz, ",.0f")
+                 + ("</strong>" if m is worst else ""),
                  fixed(m.peak_m_per_n, ".3g", 1e6),
                  fixed(m.damping_ratio, ".2g", 100.0) if m.damping_ratio is not None else "–",
                  fixed(m.stiffness_n_per_m, ".3g", 1e-6) if m.stiffness_n_per_m is not None else "–"]
@@ -399,7 +400,8 @@ def _stability(report: Any) -> str:
                         f"(±{r.speed_tolerance:.0%}); the limit at the recommended speed itself is "
                         f"{fixed(r.limit_at_speed_m, '.3g', 1e3)} mm. Runners-up are the best of other pockets of "
                         "the diagram. " + tech(f"margin {r.margin:g}, speed_tolerance {r.speed_tolerance:g}, "
-                                               f"reserve {r.reserve:.3f}, limiting speed {r.limiting_speed_rpm:.0f} rpm")))
+                                               f"reserve {r.reserve:.3f}, "
+                                               f"limiting speed {r.limiting_speed_rpm:.0f} rpm")))
     elif report.no_recommendation:
         out.append(f'<p class="verdict unexplained">No recommendation: {esc(report.no_recommendation)}</p>')
     out.append(band_table(report))

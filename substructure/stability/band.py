@@ -48,7 +48,8 @@ import numpy as np
 from ..errors import InvalidValueError
 from ..frf import FRF
 
-__all__ = ["FlexibleBand", "flexible_band", "choose_band", "assembly_structure", "MASS_LINE_PHASE_DEG", "SUSPENSION_RATIO"]
+__all__ = ["FlexibleBand", "flexible_band", "choose_band", "assembly_structure", "MASS_LINE_PHASE_DEG",
+           "SUSPENSION_RATIO"]
 
 MASS_LINE_PHASE_DEG = 30.0
 """A line is mass-like when its phase is within this many degrees of -180."""

@@ -453,7 +453,8 @@ class ModalFitter:
         p = sol.x
         order = np.argsort(p[:n])
         self.modes_ = tuple(
-            Mode(direction, Q_(float(np.exp(p[i])), "Hz"), float(np.exp(p[n + i])), Q_(float(np.exp(p[2 * n + i])), "N/m"))
+            Mode(direction, Q_(float(np.exp(p[i])), "Hz"), float(np.exp(p[n + i])),
+                 Q_(float(np.exp(p[2 * n + i])), "N/m"))
             for i in order
         )
         self.model_ = ModalModel(self.modes_)
@@ -483,7 +484,8 @@ class ModalFitter:
         frequency = self.frequency_ if frequency is None else frequency
         f = frequency.hz
         i = XY_LABELS.index(self.modes_[0].direction)
-        h = self.model_.receptance(f)[:, i, i] + self.residual_compliance_ - self.residual_inverse_mass_ / (2 * np.pi * f) ** 2
+        h = (self.model_.receptance(f)[:, i, i] + self.residual_compliance_
+             - self.residual_inverse_mass_ / (2 * np.pi * f) ** 2)
         return FRF.single(frequency, h, output=self.modes_[0].direction, input=self.modes_[0].direction)
 
 

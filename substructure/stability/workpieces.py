@@ -208,7 +208,8 @@ class Workpiece:
             entry has (``kt_pa``, ``kr_pa``, ``kte_n_per_m``, ``kre_n_per_m``,
             ``kc11_pa``, ``mc``).
         """
-        out = {"name": self.name, "model": self.model, "material": self.material, "source": " ".join(self.source.split())}
+        out = {"name": self.name, "model": self.model, "material": self.material,
+               "source": " ".join(self.source.split())}
         for key, unit in (("kt", "Pa"), ("kr", "Pa"), ("kte", "N/m"), ("kre", "N/m"), ("kc11", "Pa")):
             q = getattr(self, key)
             if q is not None:

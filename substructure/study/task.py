@@ -24,7 +24,6 @@ import tempfile
 import threading
 import time
 import warnings
-from typing import Any
 
 import numpy as np
 

@@ -407,7 +407,8 @@ class GPSurrogate(JointSurrogate):
         mu, sd = logy.mean(), logy.std() or 1.0
         z = (logy - mu) / sd
         kernel = (ConstantKernel(1.0, (1e-2, 1e2))
-                  * RBF(np.full(X.shape[1], max(float(self.length_scale), self.min_length_scale)), (self.min_length_scale, 1e2))
+                  * RBF(np.full(X.shape[1], max(float(self.length_scale), self.min_length_scale)),
+                        (self.min_length_scale, 1e2))
                   + WhiteKernel(self.noise_level, (1e-3, 1.0)))
         gp = GaussianProcessRegressor(kernel=kernel, normalize_y=False, n_restarts_optimizer=self.n_restarts_optimizer,
                                       random_state=self.random_state)

@@ -191,7 +191,8 @@ class JointTable:
         for col in header:
             m = _HEADER.match(col)
             if not m:
-                raise FileFormatError(f"{where}: cannot read the column header {col!r}; expected 'name [unit]' or 'name'")
+                raise FileFormatError(
+                    f"{where}: cannot read the column header {col!r}; expected 'name [unit]' or 'name'")
             names.append(m.group(1))
             units.append(m.group(2).strip() if m.group(2) else None)
         twice = sorted({n for n in names if names.count(n) > 1})
@@ -313,7 +314,8 @@ class JointTable:
             One value per row: numbers in the feature's unit, or names for a categorical feature.
         """
         if name not in self.features:
-            raise InvalidValueError(f"feature {name!r} is not in the table; it has {', '.join(self.features) or 'none'}")
+            raise InvalidValueError(
+                f"feature {name!r} is not in the table; it has {', '.join(self.features) or 'none'}")
         return self.columns[name]
 
     def _check_parameter(self, parameter: str) -> None:

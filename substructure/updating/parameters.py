@@ -54,11 +54,12 @@ from ..errors import InvalidValueError
 from ..joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint
 from ..materials import Material
 from .changes import Change, ParamSpec
-from .paths import apply_path_si
+from .paths import _on_beam, _overhang_segment, _plain, _segmented, _unknown, apply_path_si, set_parameters
 
 __all__ = ["ParamSpec", "Change", "ModelParameter", "ParameterChange", "ParameterSet", "model_parameters",
-           "material_changes", "parameter_change", "AssemblyParameterChange", "get_parameter", "set_parameters", "apply_path_si", "LENGTH_FACTOR", "ENGINEERING_E",
-           "ENGINEERING_RHO", "ENGINEERING_NU", "POSITION_FRACTION", "STEP_KEEP"]
+           "material_changes", "parameter_change", "AssemblyParameterChange", "get_parameter", "set_parameters",
+           "apply_path_si", "LENGTH_FACTOR", "ENGINEERING_E", "ENGINEERING_RHO", "ENGINEERING_NU", "POSITION_FRACTION",
+           "STEP_KEEP"]
 
 
 @attrs.frozen
@@ -107,10 +108,6 @@ class ModelParameter:
         """
         start = float(np.clip(self.nominal, self.lower, self.upper))
         return ParamSpec("value", self.unit, self.lower, self.upper, start, self.log, self.nominal)
-
-
-from .paths import _on_beam, _overhang_segment, _plain, _segmented, _unknown, set_parameters
-
 
 
 def _log(path, unit, nominal, lo, hi, text) -> ModelParameter:
@@ -232,7 +229,8 @@ def model_parameters(assembly) -> list[ModelParameter]:
             out.append(_log(f"{p}.length", "m", L, L / LENGTH_FACTOR, LENGTH_FACTOR * L,
                             f"length of segment {i} of {comp.name}"))
             low = max(od / LENGTH_FACTOR, 1.02 * id_ / (seg.flutes.diameter_ratio if seg.flutes else 1.0))
-            out.append(_log(f"{p}.od", "m", od, low, LENGTH_FACTOR * od, f"outer diameter of segment {i} of {comp.name}"))
+            out.append(_log(f"{p}.od", "m", od, low, LENGTH_FACTOR * od,
+                            f"outer diameter of segment {i} of {comp.name}"))
             if seg.is_tapered:
                 od1, id1 = seg._od_tip.m_as("m"), seg._id_tip.m_as("m")
                 low = max(od1 / LENGTH_FACTOR, 1.02 * id1 / (seg.flutes.diameter_ratio if seg.flutes else 1.0))
@@ -243,7 +241,8 @@ def model_parameters(assembly) -> list[ModelParameter]:
                                                                             f"{i} of {comp.name}"))
             if seg.insert is None:
                 narrow = min(od, seg._od_tip.m_as("m")) if seg.is_tapered else od
-                out.append(_lin(f"{p}.id", "m", id_, 0.0, 0.9 * narrow * (seg.flutes.diameter_ratio if seg.flutes else 1.0),
+                out.append(_lin(f"{p}.id", "m", id_, 0.0,
+                                0.9 * narrow * (seg.flutes.diameter_ratio if seg.flutes else 1.0),
                                 f"bore of segment {i} of {comp.name}"))
             else:
                 iod = seg.insert.od.m_as("m")
@@ -283,8 +282,10 @@ def model_parameters(assembly) -> list[ModelParameter]:
                 lo, hi = 0.05, 20.0
             else:
                 value = own.E.m_as("Pa") if prop == "E" else own.rho_si
-                lo, hi = (x / value for x in _within(value, 0.25, 4.0, ENGINEERING_E if prop == "E" else ENGINEERING_RHO))
-            out.append(_linked(f"{base}.{prop}", "dimensionless", 1.0, lo, hi, f"{text} of {comp.name} only, as a factor"))
+                engineering = ENGINEERING_E if prop == "E" else ENGINEERING_RHO
+                lo, hi = (x / value for x in _within(value, 0.25, 4.0, engineering))
+            out.append(_linked(f"{base}.{prop}", "dimensionless", 1.0, lo, hi,
+                               f"{text} of {comp.name} only, as a factor"))
         if not si:  # tapered segments: set on the assembly in fits
             out[first:] = [attrs.evolve(x, si=False) for x in out[first:]]
     for name, m in materials.items():
@@ -333,7 +334,8 @@ def model_parameters(assembly) -> list[ModelParameter]:
             if kind == "masses":
                 comp, x, length = _on_beam(assembly, s.at)
                 if comp is not None:
-                    out.append(_lin(f"{p}.at", "m", x, *_position_bounds(x, length), f"position of {s.name} along {comp}"))
+                    out.append(_lin(f"{p}.at", "m", x, *_position_bounds(x, length),
+                                    f"position of {s.name} along {comp}"))
     return out
 
 

@@ -117,7 +117,8 @@ def apply_path_si(structure, path: str, value: float):
             if parts[2] == "at":
                 return structure.with_link(i, link.evolve(a=(_component_of(link.a), value)))
             if len(parts) == 3:
-                return structure.with_link(i, link.evolve(**{parts[2].upper(): getattr(link, parts[2].upper()) * value}))
+                name = parts[2].upper()
+                return structure.with_link(i, link.evolve(**{name: getattr(link, name) * value}))
             kind, entry = parts[2], parts[3]
             m = getattr(link, kind.upper()).copy()
             if entry == "ym":

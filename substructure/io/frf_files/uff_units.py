@@ -86,11 +86,11 @@ def _exponents(q) -> tuple[int, int, int] | None:
     dims = dict(q.dimensionality)
     if set(dims) - {"[mass]", "[length]", "[time]"}:
         return None
-    m, l, t = (dims.get(k, 0) for k in ("[mass]", "[length]", "[time]"))
-    if any(float(x) != int(x) for x in (m, l, t)):
+    m, n, t = (dims.get(k, 0) for k in ("[mass]", "[length]", "[time]"))
+    if any(float(x) != int(x) for x in (m, n, t)):
         return None
-    m, l, t = int(m), int(l), int(t)
-    return m, l - m, t + 2 * m  # M^m L^l T^t = F^m L^(l-m) T^(t+2m)
+    m, n, t = int(m), int(n), int(t)
+    return m, n - m, t + 2 * m  # M^m L^n T^t = F^m L^(n-m) T^(t+2m)
 
 
 def _frf_unit(dset: dict, where: str):
