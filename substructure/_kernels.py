@@ -30,6 +30,7 @@ is stable: model-updating code may call :func:`chain_receptance` and
 
 from __future__ import annotations
 
+import importlib
 import itertools
 import os
 
@@ -38,7 +39,9 @@ import numpy as np
 from .errors import InvalidValueError, SubstructureError
 
 try:
-    from . import _ckernels as _c
+    # The C extension by name: it imports nothing of the package, and a static reading of
+    # `from . import _ckernels` (which cannot see an extension module) takes it for the package itself.
+    _c = importlib.import_module("._ckernels", __package__)
 except ImportError as exc:  # pragma: no cover - an installation problem, not a user's input
     raise SubstructureError(
         "the compiled kernels of substructure (substructure._ckernels) are missing or do not load "

@@ -45,6 +45,7 @@ from . import _blocks as bk
 from ._chains import _CHUNK_KL, _chain_receptance, _chain_single, _is_shared, _phase, _stack_sections  # noqa: F401
 from .errors import InvalidValueError
 from .materials import Material
+from .tapers import MAX_TAPER_STEPS, _steps  # noqa: F401 (MAX_TAPER_STEPS: read from here as before)
 from .sections import Flutes, Insert, Section, _length, _material, _metres, shear_coefficient
 from .units import magnitude_in, quantity
 
@@ -67,21 +68,6 @@ def _optional_length(field: str, *, allow_zero: bool = False):
         return None if value is None else convert(value)
 
     return optional
-
-
-MAX_TAPER_STEPS = 10_000
-"""The most steps ``taper_steps`` may ask for (each is a beam element at every frequency line)."""
-
-
-def _steps(value) -> int | None:
-    if value is None:
-        return None
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-        raise InvalidValueError(f"taper_steps: got {value!r}; expected a whole number of steps >= 1")
-    if value > MAX_TAPER_STEPS:
-        raise InvalidValueError(f"taper_steps: got {value!r}; expected at most {MAX_TAPER_STEPS:,} steps (each is a "
-                                "beam element at every frequency line; the default error bound needs far fewer)")
-    return int(value)
 
 
 @attrs.frozen

@@ -29,16 +29,18 @@ frequency line.  Static compliances and natural frequencies are then within
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from typing import TYPE_CHECKING, Sequence
 
 import attrs
 import numpy as np
 
 from ._chains import _phase, _stack_sections
-from .beams import Segment
 from .sections import Section, shear_coefficient
 from .errors import InvalidValueError
 from .units import Q_, quantity
+
+if TYPE_CHECKING:  # beams imports this module (Segment delegates its tapers to it); the annotations only
+    from .beams import Segment
 
 __all__ = ["TAPER_STEP_RATIO", "TAPER_STEP_PHASE", "TAPER_ERROR_BOUND", "check_taper", "step_count",
            "piece_sections", "section_at", "split", "mass", "piecewise_sections", "tapered_column"]
@@ -51,6 +53,20 @@ TAPER_STEP_PHASE = 0.6
 
 TAPER_ERROR_BOUND = 1e-4
 """Bound on the relative error of the default stepped model of a taper (docs/beams.md, "Tapered segments")."""
+
+MAX_TAPER_STEPS = 10_000
+"""The most steps ``taper_steps`` may ask for (each is a beam element at every frequency line)."""
+
+
+def _steps(value) -> int | None:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise InvalidValueError(f"taper_steps: got {value!r}; expected a whole number of steps >= 1")
+    if value > MAX_TAPER_STEPS:
+        raise InvalidValueError(f"taper_steps: got {value!r}; expected at most {MAX_TAPER_STEPS:,} steps (each is a "
+                                "beam element at every frequency line; the default error bound needs far fewer)")
+    return int(value)
 
 
 def _taper_arrays(seg: Segment, t: np.ndarray):
@@ -215,8 +231,6 @@ def piece_sections(seg: Segment, steps: int | None, omega_max: float) -> list[Se
         ``2 * steps`` Magnus half-steps of a tapered segment, or ``steps``
         copies of a uniform segment's section; all of the same length.
     """
-    from .beams import _steps
-
     n = step_count(seg, omega_max) if steps is None else _steps(steps)
     if not seg.is_tapered:
         return [seg.section()] * n

@@ -18,6 +18,9 @@ from .compare import METRIC, Comparison, compare, error, frac, noise_floor, pair
 from .diagnosis import Candidate, Diagnosis, Found, Step, diagnose
 from .effects import EFFECTS, Effect, Parameter, get_effect, register_effect, registered, registry
 
+# The built-in effects register themselves on import; importing any module of the package runs this first.
+from . import catalogue as _catalogue  # noqa: F401
+
 __all__ = [
     "METRIC", "Comparison", "compare", "error", "frac", "noise_floor", "pair_modes", "Candidate",
     "Diagnosis", "Found", "Step", "diagnose", "EFFECTS", "Effect", "Parameter", "get_effect", "register_effect",

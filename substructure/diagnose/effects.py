@@ -431,7 +431,3 @@ class _AssemblyOnlyEffect(EffectChange):
     """An effect without an SI form: fits apply it to the assembly (slower)."""
 
     apply_si = Change.apply_si
-
-
-# The built-in catalogue registers itself on import, after the machinery above exists.
-from . import catalogue as _catalogue  # noqa: E402,F401

@@ -169,7 +169,7 @@ def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF,
     first, header = numbered[0]
     columns = header.replace(" ", "").lstrip("\ufeff")
     if columns not in (CSV_HEADER, COHERENCE_HEADER):  # another program's export: read what is unambiguous
-        from ..frf_exports import parse_export
+        from .exports import parse_export
 
         table, lines_of, said = parse_export(numbered, name, quantity)
         return _checked_csv(table, lines_of, name, output, input, quantity or said or "receptance"), lines_of, None
