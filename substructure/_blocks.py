@@ -51,12 +51,13 @@ def by_chunks(compute, frequency_hz: np.ndarray) -> np.ndarray:
     f = np.asarray(frequency_hz, dtype=float)
     if f.size <= CHUNK_LINES:
         return compute(f)
-    out = None
+    out: np.ndarray | None = None
     for i in range(0, f.size, CHUNK_LINES):
         part = compute(f[i : i + CHUNK_LINES])
         if out is None:
             out = np.empty(part.shape[:-1] + (f.size,), dtype=part.dtype)
         out[..., i : i + part.shape[-1]] = part
+    assert out is not None  # f.size > CHUNK_LINES: at least one chunk
     return out
 
 

@@ -12,7 +12,7 @@ joined rigidly by the coupling engine, so that rounding stays near 3e-13.
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -58,7 +58,7 @@ def _chain_single(intervals: list[tuple[Section, object]], nodes: list[int], ome
     from . import _kernels
 
     index: dict[tuple, int] = {}
-    unique: list[tuple[Section, object]] = []
+    unique: list[tuple[Section, Any]] = []
     seg_of = []
     for sec, length in intervals:
         key = (id(sec), id(length) if isinstance(length, np.ndarray) else length)
@@ -141,16 +141,16 @@ def _chain_receptance(
     blocks, links = [], []
     last = len(bounds) - 2
     for c, (n0, n1) in enumerate(zip(bounds[:-1], bounds[1:])):
-        local = {nd for nd in nodes if n0 <= nd <= n1}
+        wanted = {nd for nd in nodes if n0 <= nd <= n1}
         if c > 0:
-            local.add(n0)
+            wanted.add(n0)
             links.append(Link((c - 1, n0), (c, n0), None, "a beam's own cross-section"))
         if c < last:
-            local.add(n1)
-        local = sorted(local)
+            wanted.add(n1)
+        local = sorted(wanted)
         y = _chain_single(refined[n0:n1], [nd - n0 for nd in local], omega, n_config)
         blocks.append(([(c, nd) for nd in local], y))
-    outputs = [None] * len(nodes)
+    outputs: list[tuple[int, int] | None] = [None] * len(nodes)
     for i, nd in enumerate(nodes):
         c = next(c for c, (n0, n1) in enumerate(zip(bounds[:-1], bounds[1:])) if n0 <= nd <= n1)
         outputs[i if place is None else place[i]] = (c, nd)

@@ -110,15 +110,15 @@ class Segment:
     0.504
     """
 
-    length: pint.Quantity = attrs.field(converter=_length("length"))
-    od: pint.Quantity = attrs.field(converter=_length("od"))
-    id: pint.Quantity = attrs.field(default="0 mm", converter=_length("id", allow_zero=True))
-    material: Material = attrs.field(default="steel", converter=_material)
+    length: pint.Quantity = attrs.field(converter=_length("length"))  # type: ignore[misc]  # attrs plugin: converter factory
+    od: pint.Quantity = attrs.field(converter=_length("od"))  # type: ignore[misc]  # attrs plugin: converter factory
+    id: pint.Quantity = attrs.field(default="0 mm", converter=_length("id", allow_zero=True))  # type: ignore[misc]  # attrs plugin: converter factory
+    material: Material = attrs.field(default="steel", converter=_material)  # type: ignore[assignment]  # via the converter
     insert: Insert | None = attrs.field(default=None)
     flutes: Flutes | None = attrs.field(default=None)
-    od_tip: pint.Quantity | None = attrs.field(default=None, kw_only=True, converter=_optional_length("od_tip"))
+    od_tip: pint.Quantity | None = attrs.field(default=None, kw_only=True, converter=_optional_length("od_tip"))  # type: ignore[misc]  # attrs plugin: converter factory
     id_tip: pint.Quantity | None = attrs.field(
-        default=None, kw_only=True, converter=_optional_length("id_tip", allow_zero=True)
+        default=None, kw_only=True, converter=_optional_length("id_tip", allow_zero=True)  # type: ignore[misc]  # attrs plugin: converter factory
     )
     taper_steps: int | None = attrs.field(default=None, kw_only=True, converter=_steps)
     # SI values, derived once (the kernels need them at every call)
@@ -228,7 +228,7 @@ class Segment:
             from .tapers import mass
 
             return mass(self)
-        return self.section().rhoA * self.length_m
+        return float(self.section().rhoA * self.length_m)
 
     # -- tapered (conical) segments: the stepping is in substructure.tapers ----------
     @property

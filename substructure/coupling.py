@@ -28,7 +28,7 @@ at the bottom take and return :class:`~substructure.frf.FRF` objects.
 
 from __future__ import annotations
 
-from typing import Sequence
+from typing import Any, Sequence
 
 import attrs
 import numpy as np
@@ -209,7 +209,7 @@ def remove_mass(frf: FRF, at: str, mass, inertia=None) -> FRF:
     return modify(frf, at, _mass_stiffness(+1.0, m, j))
 
 
-def decouple(coupled: FRF, removed: FRF, interface: Sequence[tuple[str, str, object]]) -> FRF:
+def decouple(coupled: FRF, removed: FRF, interface: Sequence[tuple[str, str, Any]]) -> FRF:
     """Remove a known substructure from a coupled system's receptances.
 
     Parameters

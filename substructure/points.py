@@ -75,10 +75,8 @@ class PointRef:
         return attrs.evolve(self, dof=None)
 
     def __str__(self) -> str:
-        if self.where == "at":
-            text = f"{self.component}@{format_quantity(self.distance)}"
-        elif self.where == "from_tip":
-            text = f"{self.component}.tip-{format_quantity(self.distance)}"
+        if self.where in ("at", "from_tip") and self.distance is not None:  # the two always have a distance
+            text = f"{self.component}{'@' if self.where == 'at' else '.tip-'}{format_quantity(self.distance)}"
         else:
             text = f"{self.component}.{self.where}"
         return text if self.dof is None else f"{text}:{self.dof}"

@@ -60,7 +60,7 @@ def _metres(value, field: str) -> pint.Quantity:
     return ureg.Quantity(float(value), _METRE)
 
 
-def _material(value) -> Material:
+def _material(value: Material | str) -> Material:
     if isinstance(value, Material):
         return value
     if isinstance(value, str):
@@ -106,10 +106,11 @@ class Section:
         Rotary inertia per length [kg m].
     """
 
-    EI: complex
-    kGA: complex
-    rhoA: float
-    rhoI: float
+    # each an ndarray over configurations in the stacked sections of the batched kernels (_chains)
+    EI: complex | np.ndarray
+    kGA: complex | np.ndarray
+    rhoA: float | np.ndarray
+    rhoI: float | np.ndarray
 
     def __add__(self, other: "Section") -> "Section":
         return Section(self.EI + other.EI, self.kGA + other.kGA, self.rhoA + other.rhoA, self.rhoI + other.rhoI)
@@ -157,9 +158,9 @@ class Insert:
         Inner diameter of the insert (0 for a solid shank).
     """
 
-    od: pint.Quantity = attrs.field(converter=_length("insert.od"))
+    od: pint.Quantity = attrs.field(converter=_length("insert.od"))  # type: ignore[misc]  # attrs plugin: converter factory
     material: Material = attrs.field(converter=_material)
-    id: pint.Quantity = attrs.field(default="0 mm", converter=_length("insert.id", allow_zero=True))
+    id: pint.Quantity = attrs.field(default="0 mm", converter=_length("insert.id", allow_zero=True))  # type: ignore[misc]  # attrs plugin: converter factory
     _si: tuple = attrs.field(init=False, eq=False, repr=False)
 
     def __attrs_post_init__(self) -> None:

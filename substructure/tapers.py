@@ -71,6 +71,7 @@ def _steps(value) -> int | None:
 
 def _taper_arrays(seg: Segment, t: np.ndarray):
     """``EI, kGA, rhoA, rhoI`` arrays of a tapered segment at fractions ``t`` of its length (SI)."""
+    assert seg._taper is not None  # called for tapered segments only
     od0, od1, id0, id1 = seg._taper
     od = od0 + (od1 - od0) * t
     idd = id0 + (id1 - id0) * t
@@ -231,7 +232,9 @@ def piece_sections(seg: Segment, steps: int | None, omega_max: float) -> list[Se
         ``2 * steps`` Magnus half-steps of a tapered segment, or ``steps``
         copies of a uniform segment's section; all of the same length.
     """
-    n = step_count(seg, omega_max) if steps is None else _steps(steps)
+    n = _steps(steps)
+    if n is None:
+        n = step_count(seg, omega_max)
     if not seg.is_tapered:
         return [seg.section()] * n
     return _magnus_sections(seg, n)
@@ -251,7 +254,7 @@ def mass(seg: Segment) -> float:
         Mass in kg, insert included.
     """
     ends = _taper_sections(seg, np.array([0.0, 0.5, 1.0]))
-    return seg.length_m * (ends[0].rhoA + 4.0 * ends[1].rhoA + ends[2].rhoA) / 6.0
+    return float(seg.length_m * (ends[0].rhoA + 4.0 * ends[1].rhoA + ends[2].rhoA) / 6.0)
 
 
 def section_at(seg: Segment, x) -> Section:

@@ -129,7 +129,7 @@ def _describe(dimension: str) -> str:
 @functools.lru_cache(maxsize=8192)
 def _parse(text: str) -> tuple[Any, Any]:
     """Magnitude and unit of a string pint reads (exceptions are not cached)."""
-    q = ureg.Quantity(text)
+    q: Any = ureg.Quantity(text)
     if not isinstance(q, pint.Quantity):
         return q, None
     return q.magnitude, q.units
@@ -321,7 +321,7 @@ def dimensionless(value: Any, field: str) -> float:
         value = value.m_as("dimensionless")
     elif isinstance(value, str):
         try:
-            q = ureg.Quantity(value)
+            q: Any = ureg.Quantity(value)
         except Exception:
             raise InvalidValueError(f"{field}: cannot read {show_value(value)}; expected a number") from None
         return dimensionless(q, field)

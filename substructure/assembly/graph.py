@@ -58,11 +58,11 @@ class Assembly:
     name: str = attrs.field(default="assembly")
     components: tuple = attrs.field(default=(), converter=_component_check)
     joints: tuple = attrs.field(default=(), converter=_joint_check)
-    supports: tuple[Support, ...] = attrs.field(default=(), converter=_tuple(Support))
-    sensors: tuple[Sensor, ...] = attrs.field(default=(), converter=_tuple(Sensor))
+    supports: tuple[Support, ...] = attrs.field(default=(), converter=_tuple(Support))  # type: ignore[misc]  # attrs plugin: converter factory
+    sensors: tuple[Sensor, ...] = attrs.field(default=(), converter=_tuple(Sensor))  # type: ignore[misc]  # attrs plugin: converter factory
     frequency: Frequency | None = attrs.field(default=None)
-    materials: tuple[Material, ...] = attrs.field(default=(), converter=_tuple(Material))
-    masses: tuple[Mass, ...] = attrs.field(default=(), converter=_tuple(Mass))
+    materials: tuple[Material, ...] = attrs.field(default=(), converter=_tuple(Material))  # type: ignore[misc]  # attrs plugin: converter factory
+    masses: tuple[Mass, ...] = attrs.field(default=(), converter=_tuple(Mass))  # type: ignore[misc]  # attrs plugin: converter factory
 
     def __attrs_post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.strip():
@@ -82,16 +82,16 @@ class Assembly:
         for kind, items in (("joint", self.joints), ("sensor", self.sensors), ("support", named_supports),
                             ("mass", self.masses)):
             names = [i.name for i in items]
-            dup = {n for n in names if names.count(n) > 1}
+            dup = {n for n in names if n is not None and names.count(n) > 1}  # supports: the named ones
             if dup:
                 raise AssemblyError(f"{kind} names used twice: {', '.join(sorted(dup))}")
         for j in self.joints:
             for p in j.between:
                 self._resolve(p, f"joint {j.name!r}")
-        for s in self.sensors:
-            self._resolve(s.at, f"sensor {s.name!r}")
-        for s in self.supports:
-            self._resolve(s.at, "support")
+        for sensor in self.sensors:
+            self._resolve(sensor.at, f"sensor {sensor.name!r}")
+        for support in self.supports:
+            self._resolve(support.at, "support")
         for m in self.masses:
             self._resolve(m.at, f"mass {m.name!r}")
 
@@ -584,10 +584,11 @@ class Assembly:
         for j in self.joints:
             what = "rigid" if j.rigid else ", ".join(f"k_{k}={v}" for k, v in j.k.as_dict().items())
             lines.append(f"  joint {j.name}: {j.between[0]} -- {j.between[1]} ({what})")
-        for s in self.supports:
-            lines.append(f"  support at {s.at}: " + ", ".join(f"k_{k}={v}" for k, v in s.k.as_dict().items()))
-        for s in self.sensors:
-            lines.append(f"  sensor {s.name} at {s.at}: {s.mass:~P}")
+        for support in self.supports:
+            lines.append(f"  support at {support.at}: "
+                         + ", ".join(f"k_{k}={v}" for k, v in support.k.as_dict().items()))
+        for sensor in self.sensors:
+            lines.append(f"  sensor {sensor.name} at {sensor.at}: {sensor.mass:~P}")
         for m in self.masses:
             lines.append(f"  mass {m.name} at {m.at}: {m.mass:~P}")
         return "\n".join(lines)

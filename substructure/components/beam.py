@@ -149,9 +149,9 @@ class Beam:
             x = 0.0
         elif ref.where == "tip":
             x = total
-        elif ref.where == "at":
+        elif ref.where == "at" and ref.distance is not None:  # "at" and "from_tip" always have a distance
             x = float(ref.distance.m_as("m"))
-        elif ref.where == "from_tip":
+        elif ref.where == "from_tip" and ref.distance is not None:
             x = total - float(ref.distance.m_as("m"))
         else:
             raise UnknownPointError(

@@ -7,7 +7,7 @@ each names the field and what was expected when it refuses a value.
 from __future__ import annotations
 
 import numbers
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -72,7 +72,7 @@ def _check_frequency(instance: Any, attribute: Any, value: Any) -> None:
 
 def _scalar(value: Any) -> complex | None:
     if isinstance(value, numbers.Number) and not isinstance(value, bool):
-        value = complex(value)
+        value = complex(cast(Any, value))  # any numbers.Number (Decimal, Fraction, numpy scalars)
         if not np.isfinite(value):
             raise InvalidValueError(f"factor: got {value!r}; expected a finite number")
         return value

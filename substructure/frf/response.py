@@ -56,8 +56,8 @@ class FRF:
 
     frequency: Frequency = attrs.field(validator=_check_frequency)
     data: np.ndarray = attrs.field(converter=_complex_array, eq=attrs.cmp_using(eq=np.array_equal))
-    outputs: tuple[str, ...] = attrs.field(converter=_labels("outputs"))
-    inputs: tuple[str, ...] = attrs.field(converter=_labels("inputs"))
+    outputs: tuple[str, ...] = attrs.field(converter=_labels("outputs"))  # type: ignore[misc]  # attrs plugin: converter factory
+    inputs: tuple[str, ...] = attrs.field(converter=_labels("inputs"))  # type: ignore[misc]  # attrs plugin: converter factory
     quantity: str = attrs.field(default="receptance", validator=_check_quantity)
 
     def __attrs_post_init__(self) -> None:
