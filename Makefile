@@ -10,8 +10,9 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 DOCS_STAMP := $(VENV)/.installed-docs
 NOTEBOOKS_STAMP := $(VENV)/.installed-notebooks
+LINT_STAMP := $(VENV)/.installed-lint
 
-.PHONY: demo test bench examples docs notebooks clean report-check
+.PHONY: demo test lint bench examples docs notebooks clean report-check
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -27,6 +28,18 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q -n 2 --dist loadfile
+
+# The static checks, run by CI before the tests: ruff (pycodestyle and pyflakes rules), the import
+# contracts of the layers (lint-imports; docs/architecture.md, "What CI enforces") and mypy on the
+# core layers. Configured in pyproject.toml; the tools are the `lint` extra.
+$(LINT_STAMP): $(STAMP) pyproject.toml
+	$(BIN)/python -m pip install --quiet -e ".[test,lint]"
+	touch $(LINT_STAMP)
+
+lint: $(LINT_STAMP)
+	$(BIN)/ruff check .
+	$(BIN)/lint-imports
+	$(BIN)/mypy
 
 # The report in a real browser: headless chromium renders `substructure report`'s page offline and
 # the check finds every figure on the screenshot (docs/report.md). Skipped, with the reason, where
@@ -65,4 +78,4 @@ notebooks: $(NOTEBOOKS_STAMP)
 	$(BIN)/python docs/_ext/notebooks.py --out out/notebooks
 
 clean:
-	rm -rf $(VENV) out .pytest_cache build docs/_build docs/api docs/auto_examples docs/figures substructure/_ckernels*.so
+	rm -rf $(VENV) out .pytest_cache .mypy_cache .ruff_cache build docs/_build docs/api docs/auto_examples docs/figures substructure/_ckernels*.so
