@@ -149,3 +149,76 @@ def test_the_diagnosis_of_random_hidden_effects_never_fails(seed):
                     noise=0.015, seed=seed)
     result = diagnose(model, taps, budget=150, max_steps=2)
     assert np.isfinite(result.baseline_error)
+
+
+# -- parameter paths name what exists, or are refused with what does -------------------------------------------
+
+
+@pytest.mark.parametrize("path, value, message", [
+    ("components.tool.segments.-1.od", 0.01, "segment index of 'tool' '-1': valid indices are 0 to 1"),
+    ("components.tool.segments.2.od", 0.01, "valid indices are 0 to 1"),
+    ("joints.holder-tool.q.yf", 5.0, "unknown key 'q' after 'joints.holder-tool'; expected one of k, c"),
+    ("materials.carbide.colour", 0.5, "unknown key 'colour' after 'materials.carbide'; expected one of E, nu, rho, "
+                                      "loss_factor"),
+    ("materials.carbide.e", 0.3, "unknown key 'e'"),
+    ("joints.holder-tool.k.xx", 1.0, "unknown key 'xx' after 'joints.holder-tool.k'; expected one of yf, ym, tf, tm"),
+    ("components.gremlin.segments.0.od", 0.01, "expected one of holder, spindle, tool"),
+    ("components.tool.segments.0.banana", 0.01, "expected one of length, od, id"),
+    ("components.tool.colour", 1.0, "expected one of segments, overhang, E"),
+    ("components.tool.material.e", 1.0, "unknown key 'e' after 'components.tool.material'"),
+    ("components.holder.overhang", 0.1, "'holder' has no overhang"),
+    ("components.tool.segments.0.insert.od", 0.01, "segment 0 of 'tool' has no insert"),
+    ("materials.unobtainium.E", 1e9, "materials of the parts: carbide, steel"),
+    ("supports.0.k.yf", 1.0, "support index '0': there are none"),
+    ("sensors.acc.mass", 0.001, "unknown key 'acc' after 'sensors'"),
+    ("gremlins.x", 1.0, "not a parameter path"),
+])
+def test_a_path_naming_nothing_is_refused_with_the_keys_that_exist(path, value, message):
+    from substructure import UnknownPointError, default_assembly
+    from substructure.updating.parameters import set_parameters
+
+    model = default_assembly()
+    with pytest.raises(UnknownPointError, match=f"parameter {path!r}: .*" if "joint" in path else None) as caught:
+        set_parameters(model, {path: value})
+    assert message in str(caught.value) and f"parameter {path!r}" in str(caught.value)
+
+
+def test_a_valid_path_changes_what_it_names_and_nothing_else():
+    from substructure import default_assembly
+    from substructure.updating.parameters import set_parameters
+
+    model = default_assembly()
+    tool = model.component("tool")
+    last = set_parameters(model, {"components.tool.segments.1.od": 0.0096}).component("tool")
+    assert [s.od.m_as("m") for s in last.segments] == pytest.approx([tool.segments[0].od.m_as("m"), 0.0096])
+    joint = set_parameters(model, {"joints.holder-tool.c.yf": 5.0}).joint("holder-tool")
+    assert joint.c.values[0, 0] == 5.0 and joint.k.values[0, 0] == model.joint("holder-tool").k.values[0, 0]
+    cross = set_parameters(model, {"joints.holder-tool.k.tf": 3e5}).joint("holder-tool")
+    assert cross.k.values[0, 1] == cross.k.values[1, 0] == 3e5  # one number: tf sets ym as well
+    carbide = set_parameters(model, {"materials.carbide.loss_factor": 0.01, "materials.carbide.E": 6e11})
+    mat = carbide.component("tool").segments[0].material
+    assert mat.name == "carbide" and carbide.component("holder").segments[2].insert.material == mat
+    assert mat.loss_factor == 0.01 and mat.E.m_as("Pa") == 6e11
+
+
+def test_the_si_form_refuses_the_same_paths():
+    from substructure import UnknownPointError, default_assembly
+    from substructure.updating.parameters import apply_path_si, model_parameters, parameter_change
+    from substructure.updating.structure import Structure
+
+    model = default_assembly()
+    structure = Structure.from_assembly(model)
+    for path in ("components.tool.segments.-1.od", "joints.holder-tool.k.xx", "materials.carbide.colour"):
+        with pytest.raises(UnknownPointError, match="valid indices|unknown key"):
+            apply_path_si(structure, path, 0.01)
+    # tf and ym are one number on the SI form too: the same FRF as on the assembly
+    from substructure.updating.parameters import set_parameters
+
+    params = {p.path: p for p in model_parameters(model)}
+    change = parameter_change(params["joints.holder-tool.k.ym"])
+    a = apply_path_si(structure, "joints.holder-tool.k.tf", 1e5)
+    b = change.apply_si(structure, {"value": 1e5})
+    i, link_a = a.link(("joints", "holder-tool"))
+    _, link_b = b.link(("joints", "holder-tool"))
+    assert np.array_equal(link_a.K, link_b.K) and link_a.K[0, 1] == link_a.K[1, 0] == 1e5
+    assert set_parameters(model, {"joints.holder-tool.k.tf": 1e5}).joint("holder-tool").k.values[1, 0] == 1e5

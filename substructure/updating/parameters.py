@@ -13,7 +13,7 @@ path                                           value (SI)
                                                component's base [m] (linked: both lengths change,
                                                the component's length is kept)
 ``materials.M.E|rho|nu|loss_factor``           a material, in every part made of it
-``joints.J.k.yf|ym|tm``, ``joints.J.c.yf|ym|tm``   a joint entry (``ym`` sets ``tf`` too)
+``joints.J.k.yf|ym|tf|tm``, ``joints.J.c.E``   a joint entry (``ym`` and ``tf`` are one number: either sets both)
 ``supports.I.k.E``, ``supports.I.c.E``         a support entry (``I``: index in the file)
 ``supports.I.at``                              a support's position along its component [m]
 ``sensors.S.mass|inertia``                     a sensor [kg, kg m^2]
@@ -40,6 +40,11 @@ every support on a component, as a factor: a bearing preload).
 (:mod:`substructure.updating.structure`) for fits.  :class:`Change` is the
 protocol every fitted change follows (a parameter correction, an added
 element, an effect of the diagnosis catalogue).
+
+Every key of a path must name something of the assembly, case-sensitively:
+an unknown key, a negative or too large index, a matrix other than ``k``
+and ``c`` or an entry other than ``yf``, ``ym``, ``tf``, ``tm`` is refused
+with the keys that exist there (``substructure.updating.paths.check_path``).
 """
 
 from __future__ import annotations

@@ -22,7 +22,7 @@ from ..joints import DAMPING_UNITS, STIFFNESS_UNITS
 from ..materials import Material
 from ..units import Q_, format_quantity
 
-__all__ = ["apply_path_si", "set_parameters"]
+__all__ = ["apply_path_si", "set_parameters", "check_path"]
 
 
 _MAT_COLUMN = {"E": 0, "nu": 1, "rho": 2, "loss_factor": 3}
@@ -51,7 +51,7 @@ def apply_path_si(structure, path: str, value: float):
         beam = structure.beam(parts[1])
         rest = parts[2:]
         if rest[0] == "segments":
-            i = int(rest[1])
+            i = _index(path, rest[1], beam.length.size, f"segment index of {parts[1]!r}")
             what = ".".join(rest[2:])
             if what in ("length", "od", "id"):
                 arr = getattr(beam, what).copy()
@@ -90,6 +90,7 @@ def apply_path_si(structure, path: str, value: float):
                     out = out.with_link(i, link.evolve(K=link.K * value))
             return out
     if head == "materials":
+        _key(path, ".".join(parts[:-1]), parts[-1], _MATERIAL_KEYS)
         name, column = ".".join(parts[1:-1]), _MAT_COLUMN[parts[-1]]
         out, found = structure, False
         for beam in structure.beams.values():
@@ -117,10 +118,13 @@ def apply_path_si(structure, path: str, value: float):
             if parts[2] == "at":
                 return structure.with_link(i, link.evolve(a=(_component_of(link.a), value)))
             if len(parts) == 3:
+                _key(path, ".".join(parts[:2]), parts[2], _MATRIX_KEYS)
                 return structure.with_link(i, link.evolve(**{parts[2].upper(): getattr(link, parts[2].upper()) * value}))
             kind, entry = parts[2], parts[3]
+            _key(path, ".".join(parts[:2]), kind, _MATRIX_KEYS)
+            _key(path, ".".join(parts[:3]), entry, _ENTRIES)
             m = getattr(link, kind.upper()).copy()
-            if entry == "ym":
+            if entry in ("ym", "tf"):  # one number (reciprocity): either sets both
                 m[0, 1] = m[1, 0] = value
             else:
                 m[(0, 1)[entry == "tm"], (0, 1)[entry == "tm"]] = value
@@ -202,6 +206,135 @@ def _unknown(path: str, why: str) -> UnknownPointError:
     return UnknownPointError(f"parameter {path!r}: {why}")
 
 
+_HEADS = ("components", "materials", "joints", "supports", "sensors", "masses")
+"""The first key of a parameter path."""
+_SEGMENT_KEYS = ("length", "od", "id", "od_tip", "id_tip", "end", "insert.od", "insert.id", "flutes.diameter_ratio")
+"""The values of ``components.C.segments.I``."""
+_COMPONENT_KEYS = ("segments", "overhang", "E", "rho", "loss_factor", "material", "supports")
+"""The keys after ``components.C``."""
+_MATERIAL_KEYS = tuple(_MAT_COLUMN)
+"""The values of a material (``materials.M.*``, ``components.C.material.*``): case-sensitive."""
+_MATRIX_KEYS = ("k", "c")
+"""A joint's or a support's stiffness and damping."""
+_ENTRIES = ("yf", "ym", "tf", "tm")
+"""The entries of a stiffness or damping matrix (``ym`` and ``tf`` are one number: either sets both)."""
+
+
+def _expected(keys) -> str:
+    return ", ".join(str(k) for k in keys) or "none"
+
+
+def _key(path: str, where: str, got: str, allowed) -> None:
+    """Refuse ``got`` after ``where`` unless it is one of ``allowed`` (case-sensitive)."""
+    if got not in allowed:
+        after = f"after {where!r}" if where else "at the start (not a parameter path)"
+        raise _unknown(path, f"unknown key {got!r} {after}; expected one of {_expected(allowed)}")
+
+
+def _index(path: str, text: str, count: int, what: str) -> int:
+    """A list index as written in a path: ``0`` to ``count - 1``, no sign (``-1`` is refused, not the last)."""
+    if not text.isdecimal() or not text.isascii() or int(text) >= count:
+        if count == 0:
+            raise _unknown(path, f"{what} {text!r}: there are none")
+        valid = f"0 to {count - 1}" if count > 1 else "0"
+        raise _unknown(path, f"{what} {text!r}: valid indices are {valid} (from 0; a negative index does not count "
+                             "from the end)")
+    return int(text)
+
+
+def _length(path: str, parts: list[str], allowed: tuple[int, ...]) -> None:
+    if len(parts) not in allowed:
+        raise _unknown(path, "not a parameter path (see substructure.updating.parameters)")
+
+
+def check_path(assembly, path: str) -> list[str]:
+    """The keys of ``path`` after checking that each names something of ``assembly``.
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model.
+    path : str
+        A parameter path (see :mod:`substructure.updating.parameters`).
+
+    Returns
+    -------
+    list of str
+        The path's keys.
+
+    Raises
+    ------
+    UnknownPointError
+        For a key that names nothing, with the keys that exist there (a
+        negative index, an entry other than ``yf``, ``ym``, ``tf``,
+        ``tm``, a material value other than ``E``, ``rho``, ``nu``,
+        ``loss_factor``: keys are case-sensitive).
+    """
+    parts = _parts(path)
+    head = parts[0]
+    _key(path, "", head, _HEADS)
+    if head == "components":
+        _length(path, parts, range(3, 7))
+        names = sorted(assembly.component_names)
+        _key(path, "components", parts[1], names)
+        comp = assembly.component(parts[1])
+        if not _segmented(comp):
+            raise _unknown(path, f"{parts[1]!r} is not a stepped beam")
+        rest, where = parts[2:], f"components.{parts[1]}"
+        _key(path, where, rest[0], _COMPONENT_KEYS)
+        if rest[0] == "segments":
+            _length(path, rest, (3, 4))
+            i = _index(path, rest[1], len(comp.segments), f"segment index of {comp.name!r}")
+            what, seg = ".".join(rest[2:]), comp.segments[i]
+            _key(path, f"{where}.segments.{i}", what, _SEGMENT_KEYS)
+            if what.startswith("insert.") and seg.insert is None:
+                raise _unknown(path, f"segment {i} of {comp.name!r} has no insert")
+            if what.startswith("flutes.") and seg.flutes is None:
+                raise _unknown(path, f"segment {i} of {comp.name!r} has no flutes")
+        elif rest[0] == "material":
+            _length(path, rest, (2,))
+            _key(path, f"{where}.material", rest[1], _MATERIAL_KEYS)
+        elif rest[0] == "supports":
+            _length(path, rest, (2,))
+            _key(path, f"{where}.supports", rest[1], ("k",))
+        else:
+            _length(path, rest, (1,))
+            from ..components import Tool
+
+            if rest[0] == "overhang" and (not isinstance(comp, Tool) or _overhang_segment(comp) is None):
+                raise _unknown(path, f"{comp.name!r} has no overhang (a tool with a segment without flutes has)")
+    elif head == "materials":
+        _length(path, parts, range(3, 100))
+        _key(path, ".".join(parts[:-1]), parts[-1], _MATERIAL_KEYS)
+    elif head == "joints":
+        _length(path, parts, (3, 4))
+        assembly.joint(parts[1])  # unknown: the joints there are listed
+        _key(path, f"joints.{parts[1]}", parts[2], _MATRIX_KEYS)
+        if len(parts) == 4:
+            _key(path, f"joints.{parts[1]}.{parts[2]}", parts[3], _ENTRIES)
+    elif head == "supports":
+        count = len(assembly.supports)
+        if "+" in parts[1]:
+            _length(path, parts, (3,))
+            for text in parts[1].split("+"):
+                _index(path, text, count, "support index")
+            _key(path, f"supports.{parts[1]}", parts[2], ("k",))
+        else:
+            _length(path, parts, (3, 4))
+            _index(path, parts[1], count, "support index")
+            where = f"supports.{parts[1]}"
+            _key(path, where, parts[2], ("at",) if len(parts) == 3 else _MATRIX_KEYS)
+            if len(parts) == 4:
+                _key(path, f"{where}.{parts[2]}", parts[3], _ENTRIES)
+    else:
+        _length(path, parts, (3,))
+        names = [s.name for s in getattr(assembly, head)]
+        _key(path, head, parts[1], names)
+        _key(path, f"{head}.{parts[1]}", parts[2], ("mass", "inertia", "at") if head == "masses" else
+             ("mass", "inertia"))
+    return parts
+
+
 
 def _quiet(build):
     with warnings.catch_warnings():
@@ -215,7 +348,7 @@ def _scaled_matrix(matrix, factor: float, units) -> dict:
 
 def _set_matrix(owner, kind: str, entry: str, value: float):
     units = STIFFNESS_UNITS if kind == "k" else DAMPING_UNITS
-    entries = ("ym", "tf") if entry == "ym" else (entry,)
+    entries = ("ym", "tf") if entry in ("ym", "tf") else (entry,)  # one number (reciprocity): either sets both
     update = {e: _si(value, units[e]) for e in entries}
     k, c = owner.k.as_dict(), owner.c.as_dict()
     (k if kind == "k" else c).update(update)
@@ -239,7 +372,7 @@ def _material_value(material: Material, prop: str, value: float) -> Material:
 
 
 def _set_one(assembly, path: str, value: float):
-    parts = _parts(path)
+    parts = check_path(assembly, path)
     head = parts[0]
     value = float(value)
     if head == "components" and len(parts) >= 3:
@@ -318,7 +451,9 @@ def _set_one(assembly, path: str, value: float):
                     found = True
             comps.append(attrs.evolve(comp, segments=segs))
         if not found:
-            raise _unknown(path, f"no part is made of {name!r}")
+            made = sorted({m.name for c in assembly.components if _plain(c) for seg in c.segments
+                           for m in (seg.material, *((seg.insert.material,) if seg.insert is not None else ()))})
+            raise _unknown(path, f"no part is made of {name!r} (materials of the parts: {_expected(made)})")
         mats = tuple(_material_value(m, prop, value) if m.name == name else m for m in assembly.materials)
         return attrs.evolve(assembly, components=tuple(comps), materials=mats)
     if head == "joints" and len(parts) in (3, 4):
