@@ -222,3 +222,31 @@ def test_the_si_form_refuses_the_same_paths():
     _, link_b = b.link(("joints", "holder-tool"))
     assert np.array_equal(link_a.K, link_b.K) and link_a.K[0, 1] == link_a.K[1, 0] == 1e5
     assert set_parameters(model, {"joints.holder-tool.k.tf": 1e5}).joint("holder-tool").k.values[1, 0] == 1e5
+
+
+# -- support springs honour the order of the ends named ------------------------------------------------------
+
+
+def test_support_springs_measure_inset_from_the_first_end_named():
+    from substructure import InvalidValueError
+    from substructure.diagnose.effects import registry
+    from substructure.points import parse_point
+    from substructure.updating.structure import Evaluator, Structure
+
+    springs = registry()["support-springs"]
+    model = hd.nominal_model()
+    length = model.component("spindle").length_m
+    tip_first = springs("spindle.tip,spindle.base", k_yf=1e5, inset=0.1, inset_tip=0.3)
+    base_first = springs("spindle.base,spindle.tip", k_yf=1e5, inset=0.3, inset_tip=0.1)
+    placed = tip_first.apply(model)
+    at = {s.name: model.component("spindle").position(parse_point(s.at)) for s in placed.supports}
+    assert at == pytest.approx({"diagnosed-spindle-1": 0.9 * length, "diagnosed-spindle-2": 0.3 * length})
+    f = hd.GRID.hz[::20]
+    a = placed.frf(["tool.tip"], ["tool.tip"], f).data
+    b = base_first.apply(model).frf(["tool.tip"], ["tool.tip"], f).data
+    np.testing.assert_allclose(a, b, rtol=1e-10)  # the same two springs, named from the other end
+    si = Evaluator(["tool.tip:y"], ["tool.tip:y"], f)(tip_first.apply_si(Structure.from_assembly(model)))
+    np.testing.assert_allclose(si[:, 0, 0], a[:, 0, 0], rtol=1e-8)
+    for where in ("spindle.tip,spindle.tip", "spindle.base", "spindle.base,holder.tip", "spindle.base,spindle.tip,x"):
+        with pytest.raises(InvalidValueError, match="two ends of one component in either order"):
+            springs(where, k_yf=1e5).apply(model)

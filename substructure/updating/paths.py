@@ -119,7 +119,8 @@ def apply_path_si(structure, path: str, value: float):
                 return structure.with_link(i, link.evolve(a=(_component_of(link.a), value)))
             if len(parts) == 3:
                 _key(path, ".".join(parts[:2]), parts[2], _MATRIX_KEYS)
-                return structure.with_link(i, link.evolve(**{parts[2].upper(): getattr(link, parts[2].upper()) * value}))
+                which = parts[2].upper()
+                return structure.with_link(i, link.evolve(**{which: getattr(link, which) * value}))
             kind, entry = parts[2], parts[3]
             _key(path, ".".join(parts[:2]), kind, _MATRIX_KEYS)
             _key(path, ".".join(parts[:3]), entry, _ENTRIES)
