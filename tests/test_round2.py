@@ -250,3 +250,55 @@ def test_support_springs_measure_inset_from_the_first_end_named():
     for where in ("spindle.tip,spindle.tip", "spindle.base", "spindle.base,holder.tip", "spindle.base,spindle.tip,x"):
         with pytest.raises(InvalidValueError, match="two ends of one component in either order"):
             springs(where, k_yf=1e5).apply(model)
+
+
+# -- a resumed study trusts only whole result files ----------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def finished_study(tmp_path_factory):
+    pytest.importorskip("distributed")
+    from study_files import write_study
+
+    from substructure.study import Study
+
+    folder = tmp_path_factory.mktemp("study")
+    path = write_study(folder / "s", n=3)
+    study = Study.from_file(path)
+    whole = study.run(scheduler="serial", progress=False)
+    return path, whole
+
+
+def _copy_out(tmp_path, path):
+    from substructure.study import Study
+
+    out = tmp_path / "out"
+    Study.from_file(path).run(scheduler="serial", out=out, progress=False)
+    return out, sorted((out / "results").glob("*.json"))
+
+
+@pytest.mark.parametrize("damage, message", [
+    (lambda record: {**record, "rows": record["rows"] + record["rows"][:1]}, "3 rows for 2 cuts"),
+    (lambda record: {k: v for k, v in record.items() if k != "rows"}, "no 'rows' list"),
+    (lambda record: {**record, "rows": "none"}, "no 'rows' list"),
+])
+def test_resume_over_a_damaged_result_file_recomputes_it_and_says_so(finished_study, tmp_path, damage, message):
+    import json
+
+    import pandas as pd
+
+    from substructure.errors import SubstructureWarning
+    from substructure.study import Study
+
+    path, whole = finished_study
+    out, results = _copy_out(tmp_path, path)
+    record = json.loads(results[1].read_text())
+    results[1].write_text(json.dumps(damage(record)))
+    for attempt in range(2):  # the second resume finds the file rewritten whole
+        if attempt == 0:
+            with pytest.warns(SubstructureWarning, match=f"{results[1].name}: {message}.*computed again"):
+                table = Study.from_file(path).run(scheduler="serial", out=out, resume=True, progress=False)
+        else:
+            table = Study.from_file(path).run(scheduler="serial", out=out, resume=True, progress=False)
+        assert len(table) == len(whole) == 2 * 4  # four combinations, two cuts: no row twice
+        pd.testing.assert_frame_equal(table, whole, check_exact=True)

@@ -31,10 +31,11 @@ import os
 import re
 import sys
 import time
+import warnings
 from pathlib import Path
 from typing import Any
 
-from ..errors import InvalidValueError, OutputExistsError
+from ..errors import InvalidValueError, OutputExistsError, SubstructureWarning
 
 __all__ = ["run_study", "Progress", "parse_scheduler", "json_text", "RESULT_FORMAT"]
 
@@ -209,7 +210,8 @@ class _Store:
             if any(p.name.startswith(f".{name}.") for name in _TABLE_FILES):
                 p.unlink(missing_ok=True)
 
-    def load(self, task: dict) -> dict | None:
+    def load(self, task: dict, problems: list[str] | None = None) -> dict | None:
+        """The saved result of ``task`` if it is this task's and whole; else None (``problems`` says why)."""
         from ..io import read_text
 
         path = self.path("results", task["key"], ".json")
@@ -219,6 +221,11 @@ class _Store:
             return None
         if (not isinstance(data, dict) or data.get("format") != RESULT_FORMAT
                 or data.get("fingerprint") != task["fingerprint"] or data.get("status") != "done"):
+            return None
+        why = _rows_problem(data.get("rows"), task)
+        if why:
+            if problems is not None:
+                problems.append(f"{path}: {why}; not trusted, computed again")
             return None
         return data
 
@@ -239,6 +246,21 @@ class _Store:
             record["frf"] = f"frf/{key}.csv"
         write_text(self.path("results", key, ".json"), json_text(record) + "\n")  # last: the combination is done
         return record
+
+
+def _rows_problem(rows: Any, task: dict) -> str:
+    """Why a result file's ``rows`` are not this combination's rows (one per cut, in order), or ``""``."""
+    cuts = [spec["name"] for spec in task["cuts"]] or [""]
+    if not isinstance(rows, list) or not all(isinstance(row, dict) for row in rows):
+        return f"no 'rows' list of objects (expected one row per cut: {len(cuts)})"
+    got = [row.get("cut") for row in rows]
+    keys = {row.get("key") for row in rows}
+    if got != cuts or keys != {task["key"]}:
+        doubled = sorted({str(c) for c in got if got.count(c) > 1})
+        return (f"{len(rows)} rows for {len(cuts)} cut{'s' if len(cuts) != 1 else ''} ({', '.join(map(repr, cuts))})"
+                + (f", repeated: {', '.join(doubled)}" if doubled else "")
+                + ("" if keys == {task["key"]} else f", rows of other combinations ({len(keys - {task['key']})})"))
+    return ""
 
 
 def _plain(value: Any) -> Any:
@@ -418,10 +440,13 @@ def run_study(study, client: Any = None, out: Any = None, scheduler: str | None 
     if store is not None:
         store.check(tasks, resume, overwrite)
         if resume:
+            problems: list[str] = []
             for task in tasks:
-                record = store.load(task)
+                record = store.load(task, problems)
                 if record is not None:
                     finished[task["key"]] = record
+            for problem in problems:  # a result file edited or cut short by hand: never a row twice or a crash
+                warnings.warn(f"resume: {problem}", SubstructureWarning, stacklevel=2)
         store.root.mkdir(parents=True, exist_ok=True)
     todo = [t for t in tasks if t["key"] not in finished]
     report = Progress(stream, len(tasks), resumed=len(finished))
