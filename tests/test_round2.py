@@ -302,3 +302,119 @@ def test_resume_over_a_damaged_result_file_recomputes_it_and_says_so(finished_st
             table = Study.from_file(path).run(scheduler="serial", out=out, resume=True, progress=False)
         assert len(table) == len(whole) == 2 * 4  # four combinations, two cuts: no row twice
         pd.testing.assert_frame_equal(table, whole, check_exact=True)
+
+
+# -- names reach the page and the figures as plain text ------------------------------------------------------
+
+ODD = "bench \x01\x0b\x1f\x7f $\\frac{1}{0}$ <b>&amp; \ud800 end"
+"""A name with C0 controls, DEL, mathtext that does not parse, markup and a lone surrogate."""
+
+
+def _no_mathtext(fig) -> list[str]:
+    """The texts of a figure matplotlib would read as mathtext (none may be)."""
+    from matplotlib.text import Text
+
+    fig.canvas.draw()  # every text laid out: a mathtext error would raise here
+    return [t.get_text() for t in fig.findobj(Text)  # tick labels are matplotlib's own mathtext (10^-9)
+            if t.get_text() and not t.get_text().startswith("$\\mathdefault{") and t._preprocess_math(t.get_text())[1]]
+
+
+def test_a_report_of_a_model_with_control_characters_in_its_name_is_xml():
+    import xml.etree.ElementTree as ET
+
+    from substructure import default_assembly
+    from substructure.report import report
+
+    model = attrs.evolve(default_assembly(), name=ODD)
+    page = report(model).to_html()
+    root = ET.fromstring(page.split("\n", 1)[1])  # XML 1.0: no control character, even escaped
+    title = root.find("head/title").text
+    assert title == "Tool report: bench \ufffd\ufffd\ufffd\ufffd $\\frac{1}{0}$ <b>&amp; \ufffd end"
+    assert "<b>" not in page and page.encode("utf-8")  # markup escaped; the page encodes (no lone surrogate)
+
+
+def test_names_with_dollar_signs_are_drawn_as_plain_text(tmp_path):
+    import matplotlib.pyplot as plt
+
+    from substructure import default_assembly
+    from substructure._text import plain_text
+    from substructure.stability import MillingCut, zoa
+    from substructure.stability.plotting import plot_lobes
+
+    assert plain_text("a $x$ \x07") == "a \\$x\\$ \ufffd"
+    model = attrs.evolve(default_assembly(), name="cutter $\\frac{1}{0}$")
+    frf = model.frf(["tool.tip"], ["tool.tip"], np.linspace(50.0, 5000.0, 200))
+    fig = frf.plot(title=f"{model.name}: tool.tip", label="T$1$ \x01")
+    assert _no_mathtext(fig) == []
+    assert fig.get_suptitle().replace("\\$", "$") == "cutter $\\frac{1}{0}$: tool.tip"  # drawn as written
+    plt.close(fig)
+    cut = MillingCut.for_workpiece(4, "12 mm", "aluminium-7075", radial_depth="3 mm", feed_per_tooth="0.05 mm",
+                                   milling="down")
+    from substructure.stability import assembly_structure, spindle_speeds
+
+    lobes = zoa(assembly_structure(model, "tool.tip:y", model.frequency)[0], cut,
+                spindle_speeds("5000 rpm", "20000 rpm", "500 rpm")).with_label("$x$ lobes")
+    fig = plot_lobes([lobes], title="Stability of $tool$")
+    assert _no_mathtext(fig) == []
+    plt.close(fig)
+    save_assembly(model, tmp_path / "m.toml")
+    code = main(["frf", str(tmp_path / "m.toml"), "--at", "tool.tip", "--plot", str(tmp_path / "frf.png")])
+    assert code == 0 and (tmp_path / "frf.png").stat().st_size > 0
+
+
+def test_a_study_with_dollar_signs_and_controls_in_its_names_draws_and_resumes(tmp_path, capsys):
+    pytest.importorskip("distributed")
+    from study_files import write_study
+
+    odd = ('[[combinations]]\nname = "cutter $\\\\nosuchsymbol$ \\u0007"\n'
+           'tool = { diameter = "12 mm", overhang = "70 mm", flute_length = "30 mm", teeth = 4 }\n'
+           'joint = { k = { yf = "1.43e7 N/m" } }\n')
+    path = write_study(tmp_path / "s", n=1, figures=True, extra_combinations=odd)
+    out = tmp_path / "out"
+    code = main(["study", str(path), "--out", str(out), "--scheduler", "serial", "--quiet"])
+    err = capsys.readouterr().err
+    assert code == 0, err
+    assert (out / "summary.png").stat().st_size > 0 and len(list((out / "figures").glob("*.png"))) == 3
+    code = main(["study", str(path), "--out", str(out), "--scheduler", "serial", "--quiet", "--resume"])
+    assert code == 0, capsys.readouterr().err
+
+
+def test_the_study_summary_figure_draws_names_as_plain_text():
+    pytest.importorskip("pandas")
+    from substructure.study.table import empty_row, make_table, summary_figure
+
+    rows = []
+    for i, (name, machine) in enumerate([("T$1$", "mill $a$"), ("T\x07$2", "mill $b$")]):
+        row = empty_row()
+        row.update(combination=name, machine=machine, cut="c$ut$", status="ok", key=f"k{i}",
+                   spindle_speed_rpm=10000.0 + i, depth_m=1e-3 * (i + 1), tool_mode_hz=2000.0,
+                   mrr_m3_per_s=1e-6 * (i + 1))
+        rows.append(row)
+    failed = empty_row()
+    failed.update(combination="bad $x$", machine="mill $a$", cut="c$ut$", status="failed", key="k9", error="no")
+    fig = summary_figure(make_table(rows + [failed]), title="study $s$: ranked")
+    assert _no_mathtext(fig) == []
+
+
+def test_a_latin1_title_is_cleaned_where_it_enters_and_the_page_is_written(tmp_path):
+    """Bytes that are not UTF-8 on the command line (a Latin-1 terminal): U+FFFD, a warning, the page written."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from substructure import default_assembly
+
+    save_assembly(default_assembly(), tmp_path / "m.toml")
+    out = tmp_path / "r.html"
+    argv = [os.fsencode(sys.executable), b"-m", b"substructure", b"report", os.fsencode(tmp_path / "m.toml"),
+            b"--out", os.fsencode(out), b"--quiet", b"--title", b"Rapport d'\xe9t\xe9 \xa7 5"]
+    root = Path(__file__).resolve().parents[1]
+    env = {**os.environ, "MPLBACKEND": "Agg", "PYTHONPATH": str(root), "LC_ALL": "C.UTF-8", "PYTHONUTF8": "1"}
+    done = subprocess.run(argv, capture_output=True, env=env, timeout=300)
+    err = done.stderr.decode("utf-8", "replace")
+    assert done.returncode == 0, err
+    assert "warning: --title: bytes that are not UTF-8 (0xa7, 0xe9)" in err
+    page = out.read_text(encoding="utf-8")
+    assert "<title>Rapport d&#x27;\ufffdt\ufffd \ufffd 5</title>" in page
+    assert "Rapport d'\ufffdt\ufffd \ufffd 5" in done.stdout.decode("utf-8")
