@@ -418,3 +418,68 @@ def test_a_latin1_title_is_cleaned_where_it_enters_and_the_page_is_written(tmp_p
     page = out.read_text(encoding="utf-8")
     assert "<title>Rapport d&#x27;\ufffdt\ufffd \ufffd 5</title>" in page
     assert "Rapport d'\ufffdt\ufffd \ufffd 5" in done.stdout.decode("utf-8")
+
+
+# -- an interrupted study says so in one line ------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("quiet", [False, True])
+def test_an_interrupted_study_says_what_is_saved_in_one_line(tmp_path, capsys, monkeypatch, quiet):
+    """The main process's part: Ctrl-C after the first combination (the serial runner interrupted)."""
+    pytest.importorskip("distributed")
+    from study_files import write_study
+
+    import substructure.study.runner as runner
+
+    serial = runner._serial
+
+    def interrupted(tasks):
+        for k, done in enumerate(serial(tasks)):
+            if k == 1:
+                raise KeyboardInterrupt
+            yield done
+
+    monkeypatch.setattr(runner, "_serial", interrupted)
+    path = write_study(tmp_path / "s", n=3)
+    out = tmp_path / "out"
+    code = main(["study", str(path), "--out", str(out), "--scheduler", "serial", *(["--quiet"] if quiet else [])])
+    err = capsys.readouterr().err
+    assert code == 130
+    lines = [line for line in err.splitlines() if "interrupted" in line]
+    assert lines == [f"{'substructure' if quiet else 'study'}: interrupted: 1 of 4 combinations saved in {out}; "
+                     "--resume (resume=True) to continue"], err
+    assert "Traceback" not in err and len(list((out / "results").glob("*.json"))) == 1
+
+
+def test_ctrl_c_on_a_process_cluster_prints_no_worker_traceback(tmp_path):
+    """SIGINT to the whole process group, as a terminal's Ctrl-C: the workers ignore it, the command says one line."""
+    pytest.importorskip("distributed")
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+    from pathlib import Path
+
+    from study_files import write_study
+
+    path = write_study(tmp_path / "s", n=8, figures=True)
+    out = tmp_path / "out"
+    root = Path(__file__).resolve().parents[1]
+    env = {**os.environ, "MPLBACKEND": "Agg", "PYTHONPATH": f"{root}{os.pathsep}{root / 'tests'}"}
+    process = subprocess.Popen([sys.executable, "-m", "substructure", "study", str(path), "--out", str(out),
+                                "--scheduler", "processes:2"], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               text=True, start_new_session=True)
+    start = time.monotonic()
+    while time.monotonic() - start < 240 and process.poll() is None:
+        if (out / "results").is_dir() and any((out / "results").glob("*.json")):
+            break
+        time.sleep(0.05)
+    os.killpg(process.pid, signal.SIGINT)
+    _, err = process.communicate(timeout=180)
+    if process.returncode == 0:
+        pytest.skip("the study finished before the signal")
+    assert process.returncode == 130, err
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
+    lines = [line for line in err.splitlines() if "interrupted" in line]
+    assert len(lines) == 1 and "combinations saved in" in lines[0] and "--resume" in lines[0], err

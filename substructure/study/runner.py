@@ -26,10 +26,13 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import re
+import signal
 import sys
+import threading
 import time
 import warnings
 from pathlib import Path
@@ -369,12 +372,31 @@ def _local_cluster(kind: str, n: int, progress: Progress):
         extra["dashboard_address"] = _dashboard_address()
     else:  # no dashboard; the scheduler's HTTP server (health, metrics) on any free port, not on a busy 8787
         extra.update(dashboard_address=None, scheduler_kwargs={"dashboard_address": ":0"})
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=kind == "processes",
-                           silence_logs=logging.ERROR, **extra)
+    # the cluster's own logs stay quiet: what a user needs of them (a lost worker, a failed combination) is in the
+    # rows and the progress lines; an interruption closes the scheduler under busy workers, whose heartbeats
+    # would log tracebacks
+    with _workers_ignore_ctrl_c(kind == "processes"):
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=kind == "processes",
+                               silence_logs=logging.CRITICAL, **extra)
     client = Client(cluster, set_as_default=False)
     where = "worker processes" if kind == "processes" else "worker threads in this process"
     progress.say(f"local Dask cluster: {n} {where}")
     return cluster, client
+
+
+@contextlib.contextmanager
+def _workers_ignore_ctrl_c(processes: bool):
+    """Worker processes started inside ignore SIGINT: Ctrl-C in a terminal reaches the whole process group, and
+    only this process (which saves, says what is saved and closes the cluster) should hear it; workers started
+    with SIGINT ignored keep ignoring it (Python installs no handler then), so none prints a traceback."""
+    if not processes or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def _dashboard_address() -> str:
@@ -493,11 +515,12 @@ def run_study(study, client: Any = None, out: Any = None, scheduler: str | None 
                     record = store.load(task)
                     if record is not None:
                         finished[task["key"]] = record
-        report.say(f"interrupted: {len(finished)} of {len(tasks)} combinations are saved"
-                   + (f" in {store.root}; run again with --resume (resume=True) to finish" if store else ""))
+        message = (f"interrupted: {len(finished)} of {len(tasks)} combinations saved"
+                   + (f" in {store.root}; --resume (resume=True) to continue" if store else " (no output directory)"))
+        report.say(message)
         if store is not None:
             _assemble(study, tasks, finished, store)
-        raise
+        raise KeyboardInterrupt(message) from None
     finally:
         if own is not None:
             own.close()
