@@ -158,7 +158,8 @@ def add_parser(commands) -> None:
     rep.add_argument("--identify", type=_identify, default="auto", metavar="auto|none|NAMES",
                      help="joints to identify from the measurements: auto (every elastic joint, default), none, "
                           "or comma-separated names")
-    rep.add_argument("--title", type=_title, metavar="TEXT", help="the report's title (default: 'Tool report: <assembly name>')")
+    rep.add_argument("--title", type=_title, metavar="TEXT",
+                     help="the report's title (default: 'Tool report: <assembly name>')")
     rep.add_argument("--overwrite", action="store_true", help="let --out replace an existing file (never an input)")
     rep.add_argument("--quiet", action="store_true", help="no progress on standard error")
     rep.add_argument("--json", action="store_true", help="print one JSON object (the report's summary) instead of the lines for people")
