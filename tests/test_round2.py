@@ -11,6 +11,8 @@ an interrupted study says so in one line.
 
 from __future__ import annotations
 
+import re
+
 import attrs
 import numpy as np
 import pytest
@@ -181,6 +183,11 @@ def test_a_path_naming_nothing_is_refused_with_the_keys_that_exist(path, value, 
     with pytest.raises(UnknownPointError, match=f"parameter {path!r}: .*" if "joint" in path else None) as caught:
         set_parameters(model, {path: value})
     assert message in str(caught.value) and f"parameter {path!r}" in str(caught.value)
+    if "." in path.split(".", 1)[1]:  # reading names the same problem
+        from substructure.updating.parameters import get_parameter
+
+        with pytest.raises(UnknownPointError, match=re.escape(message)):
+            get_parameter(model, path)
 
 
 def test_a_valid_path_changes_what_it_names_and_nothing_else():

@@ -114,7 +114,7 @@ class ModelParameter:
         return ParamSpec("value", self.unit, self.lower, self.upper, start, self.log, self.nominal)
 
 
-from .paths import _on_beam, _overhang_segment, _plain, _segmented, _unknown, set_parameters
+from .paths import _on_beam, _overhang_segment, _plain, _segmented, _unknown, check_path, set_parameters
 
 
 
@@ -427,6 +427,7 @@ def get_parameter(assembly, path: str) -> float:
     for p in model_parameters(assembly):
         if p.path == path:
             return p.nominal
+    check_path(assembly, path)  # a key that names nothing: refused with the keys that exist
     raise _unknown(path, "not a parameter of this assembly (see model_parameters)")
 
 

@@ -248,6 +248,12 @@ def _length(path: str, parts: list[str], allowed: tuple[int, ...]) -> None:
         raise _unknown(path, "not a parameter path (see substructure.updating.parameters)")
 
 
+def _materials_of_parts(assembly) -> list[str]:
+    """The names of the materials the plain beam components' segments and inserts are made of."""
+    return sorted({m.name for c in assembly.components if _plain(c) for seg in c.segments
+                   for m in (seg.material, *((seg.insert.material,) if seg.insert is not None else ()))})
+
+
 def check_path(assembly, path: str) -> list[str]:
     """The keys of ``path`` after checking that each names something of ``assembly``.
 
@@ -307,6 +313,9 @@ def check_path(assembly, path: str) -> list[str]:
     elif head == "materials":
         _length(path, parts, range(3, 100))
         _key(path, ".".join(parts[:-1]), parts[-1], _MATERIAL_KEYS)
+        name, made = ".".join(parts[1:-1]), _materials_of_parts(assembly)
+        if name not in made:
+            raise _unknown(path, f"no part is made of {name!r} (materials of the parts: {_expected(made)})")
     elif head == "joints":
         _length(path, parts, (3, 4))
         assembly.joint(parts[1])  # unknown: the joints there are listed
@@ -452,9 +461,8 @@ def _set_one(assembly, path: str, value: float):
                     found = True
             comps.append(attrs.evolve(comp, segments=segs))
         if not found:
-            made = sorted({m.name for c in assembly.components if _plain(c) for seg in c.segments
-                           for m in (seg.material, *((seg.insert.material,) if seg.insert is not None else ()))})
-            raise _unknown(path, f"no part is made of {name!r} (materials of the parts: {_expected(made)})")
+            raise _unknown(path, f"no part is made of {name!r} (materials of the parts: "
+                                 f"{_expected(_materials_of_parts(assembly))})")
         mats = tuple(_material_value(m, prop, value) if m.name == name else m for m in assembly.materials)
         return attrs.evolve(assembly, components=tuple(comps), materials=mats)
     if head == "joints" and len(parts) in (3, 4):
