@@ -231,6 +231,26 @@ def test_the_si_form_refuses_the_same_paths():
     assert set_parameters(model, {"joints.holder-tool.k.tf": 1e5}).joint("holder-tool").k.values[1, 0] == 1e5
 
 
+@pytest.mark.parametrize("path, value, what", [
+    ("components.holder.segments.2.od", 0.011, "a bore as wide as the section"),  # the bore is 12 mm
+    ("components.holder.segments.2.insert.od", 0.013, "an insert wider than its bore"),
+    ("components.tool.segments.0.length", 5e-7, "a segment shorter than 1 um"),
+    ("components.tool.segments.0.od", float("nan"), "a size that is not a finite number"),
+    ("components.tool.overhang", 0.030, "a segment shorter than 1 um"),  # 46 mm + 30 mm fluted: 30 mm leaves none
+])
+def test_the_si_form_refuses_a_section_the_assembly_refuses(path, value, what):
+    """So that a value a fit keeps always writes back to the assembly (a trial beyond it is infeasible)."""
+    from substructure import InvalidValueError
+    from substructure.updating.parameters import apply_path_si, set_parameters
+    from substructure.updating.structure import Structure
+
+    model = hd.nominal_model(flutes=(0.030, 0.8))
+    with pytest.raises(InvalidValueError, match=f"parameter {re.escape(repr(path))}: the value makes {what}"):
+        apply_path_si(Structure.from_assembly(model), path, value)
+    with pytest.raises(Exception):
+        set_parameters(model, {path: value})  # the assembly refuses it as well
+
+
 # -- support springs honour the order of the ends named ------------------------------------------------------
 
 

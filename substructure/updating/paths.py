@@ -50,31 +50,8 @@ def apply_path_si(structure, path: str, value: float):
     if head == "components":
         beam = structure.beam(parts[1])
         rest = parts[2:]
-        if rest[0] == "segments":
-            i = _index(path, rest[1], beam.length.size, f"segment index of {parts[1]!r}")
-            what = ".".join(rest[2:])
-            if what in ("length", "od", "id"):
-                arr = getattr(beam, what).copy()
-                arr[i] = value
-                return structure.with_beam(beam.evolve(**{what: arr}))
-            if what == "end":  # the step to the next segment moves, the component's length kept
-                length = beam.length.copy()
-                shift = value - float(length[:i + 1].sum())
-                length[i] += shift
-                length[i + 1] -= shift
-                return structure.with_beam(beam.evolve(length=length))
-            if what in ("insert.od", "insert.id"):
-                ins = beam.insert.copy()
-                ins[i, 0 if what == "insert.od" else 1] = value
-                return structure.with_beam(beam.evolve(insert=ins))
-            ratio = beam.ratio.copy()
-            ratio[i] = value
-            return structure.with_beam(beam.evolve(ratio=ratio))
-        if rest == ["overhang"]:
-            i = _overhang_index(beam)
-            length = beam.length.copy()
-            length[i] += value - beam.total_length
-            return structure.with_beam(beam.evolve(length=length))
+        if rest[0] in ("segments", "overhang"):
+            return structure.with_beam(_section_checked(path, _geometry(beam, path, rest, value)))
         if rest in (["E"], ["rho"], ["loss_factor"]):
             mat = beam.material.copy()
             mat[:, _MAT_COLUMN[rest[0]]] *= value
@@ -136,6 +113,52 @@ def apply_path_si(structure, path: str, value: float):
         m[(0, 1)[parts[2] == "inertia"], (0, 1)[parts[2] == "inertia"]] = value
         return structure.with_link(i, link.evolve(M=m))
     raise UnknownPointError(f"parameter {path!r}: not a parameter path")
+
+
+def _geometry(beam, path: str, rest: list[str], value: float):
+    """The beam arrays with a segment's size or the overhang set (``rest``: the path after the component)."""
+    if rest == ["overhang"]:
+        i = _overhang_index(beam)
+        length = beam.length.copy()
+        length[i] += value - beam.total_length
+        return beam.evolve(length=length)
+    i = _index(path, rest[1], beam.length.size, f"segment index of {beam.name!r}")
+    what = ".".join(rest[2:])
+    if what in ("length", "od", "id"):
+        arr = getattr(beam, what).copy()
+        arr[i] = value
+        return beam.evolve(**{what: arr})
+    if what == "end":  # the step to the next segment moves, the component's length kept
+        length = beam.length.copy()
+        shift = value - float(length[:i + 1].sum())
+        length[i] += shift
+        length[i + 1] -= shift
+        return beam.evolve(length=length)
+    if what in ("insert.od", "insert.id"):
+        ins = beam.insert.copy()
+        ins[i, 0 if what == "insert.od" else 1] = value
+        return beam.evolve(insert=ins)
+    ratio = beam.ratio.copy()
+    ratio[i] = value
+    return beam.evolve(ratio=ratio)
+
+
+def _section_checked(path: str, beam):
+    """``beam`` if every segment is one the assembly holds (the checks of :class:`~substructure.beams.Segment`),
+    else an error naming the value: the SI form refuses what the assembly would (a fit counts the trial as
+    infeasible), so that a fitted value always writes back."""
+    insert_od, insert_id = beam.insert[:, 0], beam.insert[:, 1]
+    sizes = np.concatenate([beam.length, beam.od, beam.id, beam.ratio, insert_od, insert_id])
+    problems = (("a size that is not a finite number", ~np.isfinite(sizes)),
+                ("a segment shorter than 1 um", beam.length < 1e-6),
+                ("an outer diameter under 1 um", beam.od < 1e-6),
+                ("a bore as wide as the section", beam.id >= beam.od * beam.ratio),
+                ("an insert wider than its bore", (insert_od > 0) & (insert_od > beam.id)),
+                ("an insert's bore as wide as the insert", (insert_od > 0) & (insert_id >= insert_od)))
+    for what, bad in problems:
+        if np.any(bad):
+            raise InvalidValueError(f"parameter {path!r}: the value makes {what} in {beam.name!r}")
+    return beam
 
 
 def _component_of(point) -> str:
