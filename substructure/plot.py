@@ -460,5 +460,5 @@ def plot_taps(result, title: str | None = None, unit: str = "um/N") -> Figure:
     rejected = len(result.rejected)
     about = (f"{result.estimator}, {result.averages} taps averaged" + (f", {rejected} rejected" if rejected else "")
              + (f"; exponential window tau = {result.tau:.4g} s" if result.tau else "; no exponential window"))
-    fig.suptitle((title + "\n" if title else "") + about, fontsize=10)
+    fig.suptitle(plain_text((f"{title}\n" if title else "") + about), fontsize=10)
     return fig
