@@ -145,7 +145,7 @@ DRAW = {
 def _digest() -> str:
     h = hashlib.sha256(Path(__file__).read_bytes())
     h.update(Path(figure_checks.__file__).read_bytes())
-    for source in sorted(PACKAGE.rglob("*.py")) + sorted((PACKAGE / "data").glob("*")):
+    for source in sorted(PACKAGE.rglob("*.py")) + sorted(p for p in (PACKAGE / "data").glob("*") if p.is_file()):
         h.update(str(source.relative_to(PACKAGE)).encode() + source.read_bytes())
     return h.hexdigest()
 
