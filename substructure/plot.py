@@ -25,6 +25,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
+from ._text import plain_text
 from .errors import InvalidValueError, UnitError
 from .frf import FRF
 from .units import to_si
@@ -282,6 +283,7 @@ def plot_frf(
         name = f"{output} / {input_}"
         text = (label if len(entries) == 1 else f"{label} {name}") if label else (
             name if len(entries) > 1 else None)
+        text = None if text is None else plain_text(text)  # names are plain text, never mathtext
         cutoff = rigid_body_cutoff(hz, np.abs(y))
         re, im = y.real * factor, y.imag * factor   # the SI values times an exact factor
         for part, axis in zip(parts, axes):
@@ -326,8 +328,8 @@ def plot_frf(
     if any(line.get_label() and not line.get_label().startswith("_") for line in axes[0].lines):
         axes[0].legend(fontsize="small")
     if title is not None:
-        fig.suptitle(_wrap(str(title), 0.9 * fig.get_figwidth(), plt.rcParams["figure.titlesize"]
-                           if isinstance(plt.rcParams["figure.titlesize"], (int, float)) else 12.0))
+        fig.suptitle(plain_text(_wrap(str(title), 0.9 * fig.get_figwidth(), plt.rcParams["figure.titlesize"]
+                                      if isinstance(plt.rcParams["figure.titlesize"], (int, float)) else 12.0)))
     if note:
         earlier = [t for t in axes[-1].texts if t.get_gid() == _NOTE_GID]
         text = f"{symbol} = {definition} ({frf.quantity}), time convention x(t) = X exp(i omega t)"
@@ -341,7 +343,7 @@ def plot_frf(
         for t in earlier:  # an overlay: one note for the figure
             t.remove()
         width = axes[-1].get_position().width * fig.get_figwidth()
-        axes[-1].annotate(_wrap(text, width, 8.5), xy=(0.0, 0.0), xycoords="axes fraction", xytext=(0, -44),
+        axes[-1].annotate(plain_text(_wrap(text, width, 8.5)), xy=(0.0, 0.0), xycoords="axes fraction", xytext=(0, -44),
                           textcoords="offset points", va="top", ha="left", fontsize="x-small", color="0.35",
                           annotation_clip=False, gid=_NOTE_GID)
     return fig
@@ -458,5 +460,5 @@ def plot_taps(result, title: str | None = None, unit: str = "um/N") -> Figure:
     rejected = len(result.rejected)
     about = (f"{result.estimator}, {result.averages} taps averaged" + (f", {rejected} rejected" if rejected else "")
              + (f"; exponential window tau = {result.tau:.4g} s" if result.tau else "; no exponential window"))
-    fig.suptitle((title + "\n" if title else "") + about, fontsize=10)
+    fig.suptitle(plain_text((f"{title}\n" if title else "") + about), fontsize=10)
     return fig

@@ -99,7 +99,7 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
             bearings: tuple[float, float] | None = None, tool_E: float = 580e9, tool_rho: float = 14500.0,
             tool_nu: float = 0.22, ht_loss: float = 0.0,
             drawbar: bool = False, taper: float | None = None, taper_pieces: int = 8, insert_length: float = 0.040,
-            seed: int = 0,
+            tool_bore: float = 0.0, seed: int = 0,
             points=("tool.tip",), excitation: str = "tool.tip", noise: float = 0.015, phase_deg: float = 0.5,
             floor: float = 1e-3) -> list[FRF]:
     """FRFs of the rig with the hidden effects, noisy (response at each point, hammer at ``excitation``).
@@ -114,7 +114,8 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
     drawbar, a 20 mm steel rod in the spindle's bore held at two points; taper, the tool's tip
     diameter [m] of a tool tapering linearly from 12 mm over its length (``taper_pieces`` uniform pieces);
     insert_length, how deep the tool's shank sits in the holder [m] (the model: 40 mm; the holder's length
-    stays 66 mm, its 40 mm collar longer by as much as the insert is shorter).
+    stays 66 mm, its 40 mm collar longer by as much as the insert is shorter); tool_bore, a coolant bore
+    through the whole tool [m] (the shank in the holder too).
     """
     cb = fe.Material(tool_E, tool_nu, tool_rho, 0.002)
     m = fe.Model()
@@ -128,7 +129,7 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
     s = m.add_beam([(0.12, fe.section(0.07, 0.04, STEEL)), (0.15, fe.section(0.09, 0.04, STEEL)),
                     (0.06, fe.section(0.11, 0.04, STEEL))], points=spindle_points)
     h = m.add_beam([(0.016, fe.section(0.063, 0, STEEL)), (0.050 - insert_length, fe.section(0.04, 0, STEEL)),
-                    (insert_length, fe.section(0.04, 0.012, STEEL, insert=CARBIDE))],
+                    (insert_length, fe.section(0.04, 0.012, STEEL, insert=CARBIDE, insert_id=tool_bore))],
                    points=wanted["holder"] + ([nut[2]] if nut else []))
     fl_len, fl_ratio = flutes if flutes else (0.0, 1.0)
     cuts = [0.0, tool_length - fl_len, tool_length]
@@ -142,7 +143,7 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
         pieces = [(cuts[1] / n_t, fe.section(0.012 + (taper - 0.012) * (i + 0.5) * cuts[1] / n_t / tool_length, 0, cb))
                   for i in range(n_t)]
     else:
-        pieces = [(cuts[1], fe.section(0.012, 0, cb))]
+        pieces = [(cuts[1], fe.section(0.012, tool_bore, cb))]
     if flutes:
         pieces.append((fl_len, fe.fluted(0.012, fl_ratio, cb)))
     t = m.add_beam([pc for pc in pieces if pc[0] > 0], points=wanted["tool"])

@@ -15,6 +15,7 @@ import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Iterable
 
+from .._text import plain_text
 from ..errors import SubstructureError
 
 if TYPE_CHECKING:
@@ -189,7 +190,7 @@ def save_plot(frf: FRF, path: str | os.PathLike, title: str, overwrite: bool = T
     """Plot an FRF (magnitude and phase) with a title to an image file."""
     figures()
     fig = frf.plot()
-    fig.suptitle(title)
+    fig.suptitle(plain_text(title))
     save_figure(fig, path, overwrite)
 
 

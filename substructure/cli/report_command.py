@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import argparse
+import os
 import re
 import shlex
 import sys
+import warnings
 from pathlib import Path
 
+from ..errors import SubstructureWarning
 from ._common import PROG, UsageError, check_outputs, measurement_inputs, print_json
 from ._cutting import (
     add_cut_options,
@@ -35,6 +38,22 @@ def _identify(text: str):
     if not names:
         raise argparse.ArgumentTypeError(f"got {text!r}; expected auto, none or joint names, e.g. holder-tool")
     return names
+
+
+def _title(text: str) -> str:
+    """``--title``: bytes of the command line that are not UTF-8 (a Latin-1 terminal) as U+FFFD, said at once.
+
+    Python hands such bytes over as lone surrogates, which no page can be
+    written with; they are replaced here, before anything is computed.
+    """
+    if not any("\udc80" <= ch <= "\udcff" for ch in text):
+        return text
+    raw = os.fsencode(text)  # the bytes as typed
+    bad = sorted({f"0x{ord(ch) - 0xdc00:02x}" for ch in text if "\udc80" <= ch <= "\udcff"})
+    cleaned = raw.decode("utf-8", errors="replace")
+    warnings.warn(f"--title: bytes that are not UTF-8 ({', '.join(bad)}) are shown as U+FFFD: {cleaned!r} (give "
+                  "the title in UTF-8, the encoding of the page)", SubstructureWarning, stacklevel=2)
+    return cleaned
 
 
 def run(args: argparse.Namespace) -> int:
@@ -139,7 +158,8 @@ def add_parser(commands) -> None:
     rep.add_argument("--identify", type=_identify, default="auto", metavar="auto|none|NAMES",
                      help="joints to identify from the measurements: auto (every elastic joint, default), none, "
                           "or comma-separated names")
-    rep.add_argument("--title", metavar="TEXT", help="the report's title (default: 'Tool report: <assembly name>')")
+    rep.add_argument("--title", type=_title, metavar="TEXT",
+                     help="the report's title (default: 'Tool report: <assembly name>')")
     rep.add_argument("--overwrite", action="store_true", help="let --out replace an existing file (never an input)")
     rep.add_argument("--quiet", action="store_true", help="no progress on standard error")
     rep.add_argument("--json", action="store_true",

@@ -5,9 +5,10 @@ from __future__ import annotations
 import argparse
 import os
 import signal
+import sys
 from pathlib import Path
 
-from ._common import UsageError, check_outputs, print_json
+from ._common import EXIT_INTERRUPTED, PROG, UsageError, check_outputs, print_json
 
 
 def _interrupt(signum, frame):  # SIGTERM stops the study as Ctrl-C does: saved results stay, clusters close
@@ -37,6 +38,10 @@ def run(args: argparse.Namespace) -> int:
     try:
         table = study.run(out=out, scheduler=args.scheduler or "processes", resume=args.resume,
                           overwrite=args.overwrite, progress=not args.quiet)
+    except KeyboardInterrupt as exc:  # one line: what is saved and how to go on (the progress said it unless quiet)
+        if args.quiet and exc.args:
+            print(f"{PROG}: {exc.args[0]}", file=sys.stderr)
+        return EXIT_INTERRUPTED
     finally:
         signal.signal(signal.SIGTERM, previous)
     return _report(args, study, table, out)

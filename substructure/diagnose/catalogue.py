@@ -28,7 +28,7 @@ from ..errors import InvalidValueError, NonPassiveJointWarning, UnknownPointErro
 from ..joints import Joint, Sensor, Support
 from ..points import parse_point
 from ..units import format_quantity, ureg
-from ..updating.elements import split_beam
+from ..updating.elements import split_beam, split_segments
 from ..updating.structure import LinkSI
 from .effects import Effect, Parameter, register_effect
 
@@ -340,19 +340,15 @@ def flute_tip(tool: Beam, length_m: float, ratio: float) -> Beam:
     """
     total = tool.length_m
     length_m = min(length_m, total)
-    start = total - length_m
-    segments, x = [], 0.0
-    for seg in tool.segments:
-        x0, x1 = x, x + seg.length_m
-        x = x1
-        if x1 <= start + 1e-12:
-            segments.append(seg)
-            continue
-        if x0 < start - 1e-12:
-            segments.append(attrs.evolve(seg, length=_si(start - x0, "m")))
-            x0 = start
-        segments.append(attrs.evolve(seg, length=_si(x1 - x0, "m"), flutes=Flutes(ratio)))
-    return attrs.evolve(tool, segments=segments)
+
+    def fluted(seg):
+        bore = seg.id.m_as("m")
+        if bore >= ratio * seg.od.m_as("m"):  # flutes do not cut into a bore: the SI form's rule (split_beam)
+            seg = attrs.evolve(seg, od=_si(1.0001 * bore / ratio, "m"))
+        return attrs.evolve(seg, flutes=Flutes(ratio))
+
+    # a cut within a micrometre of a segment's end is at that end: no sliver the beam model refuses
+    return split_segments(tool, total - length_m, total, fluted)
 
 
 @register_effect
@@ -401,30 +397,39 @@ class SupportSprings(Effect):
 
         Notes
         -----
-        Two equal springs (``k_yf`` each) near the two points of ``where`` (the ends of a component,
-        ``"spindle.base,spindle.tip"``), ``inset`` of its length in from the first and ``inset_tip`` from
-        the second.
+        Two equal springs (``k_yf`` each) near the two points of ``where`` (the ends of a component in
+        either order, ``"spindle.base,spindle.tip"``), ``inset`` of its length in from the first end named
+        and ``inset_tip`` from the second.
         """
-        points = [parse_point(p.strip()) for p in self.where.split(",")]
-        if len({p.component for p in points}) != 1 or {p.where for p in points} != {"base", "tip"}:
+        name, first, second = self._places(self.where, assembly.component(self._ends(self.where)[0]).length_m)
+        k = {"yf": _si(self.values["k_yf"], "N/m")}
+        return assembly.support(Support(f"{name}@{_si(first, 'm')}", k=k, name=f"diagnosed-{name}-1")).support(
+            Support(f"{name}@{_si(second, 'm')}", k=k, name=f"diagnosed-{name}-2"))
+
+    @staticmethod
+    def _ends(where: str) -> tuple[str, bool]:
+        """The component and whether the first end named is its base (``where`` checked)."""
+        texts = [p.strip() for p in where.split(",")]
+        points = [parse_point(p) for p in texts] if len(texts) == 2 else []
+        if len(points) != 2 or len({p.component for p in points}) != 1 or {p.where for p in points} != {"base", "tip"}:
             raise InvalidValueError(
-                f"support-springs: where = {self.where!r}; expected the ends of one component, "
-                "e.g. 'spindle.base,spindle.tip'"
+                f"support-springs: where = {where!r}; expected the two ends of one component in either order, "
+                "e.g. 'spindle.base,spindle.tip' (inset from the base) or 'spindle.tip,spindle.base' (inset from "
+                "the tip)"
             )
-        comp = assembly.component(points[0].component)
-        k = _si(self.values["k_yf"], "N/m")
-        inset = self.values["inset"] * comp.length_m
-        near = f"{comp.name}@{_si(inset, 'm')}"
-        far = f"{comp.name}@{_si(comp.length_m - self.values['inset_tip'] * comp.length_m, 'm')}"
-        return assembly.support(Support(near, k={"yf": k}, name=f"diagnosed-{comp.name}-1")).support(
-            Support(far, k={"yf": k}, name=f"diagnosed-{comp.name}-2"))
+        return points[0].component, points[0].where == "base"
+
+    def _places(self, where: str, total: float) -> tuple[str, float, float]:
+        """The component and the two springs' places from its base [m]: ``inset`` from the first end named,
+        ``inset_tip`` from the second."""
+        name, base_first = self._ends(where)
+        a, b = self.values["inset"] * total, self.values["inset_tip"] * total
+        return (name, a, total - b) if base_first else (name, total - a, b)
 
     def apply_si(self, structure):
-        points = [parse_point(p.strip()) for p in self.where.split(",")]
-        name = points[0].component
-        total = structure.beam(name).total_length
-        inset = self.values["inset"] * total
+        name = self._ends(self.where)[0]
+        _, first, second = self._places(self.where, structure.beam(name).total_length)
         k = np.diag([self.values["k_yf"], 0.0])
-        near = LinkSI(("added", f"springs-{name}-1"), (name, inset), K=k)
-        far = LinkSI(("added", f"springs-{name}-2"), (name, total - self.values["inset_tip"] * total), K=k)
+        near = LinkSI(("added", f"springs-{name}-1"), (name, first), K=k)
+        far = LinkSI(("added", f"springs-{name}-2"), (name, second), K=k)
         return structure.add_link(near).add_link(far)

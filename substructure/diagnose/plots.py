@@ -5,6 +5,8 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 
+from .._text import plain_text
+
 __all__ = ["plot_comparison", "plot_history"]
 
 
@@ -58,7 +60,7 @@ def plot_comparison(comparison, ax=None):
             continue
         axes[0].annotate(f"{m.shift_hz:+.0f} Hz", (m.measured_hz, m.measured_amplitude),
                          textcoords="offset points", xytext=(0, 6), ha="center", fontsize="x-small")
-    axes[0].set_ylabel(f"|{meas.outputs[0]} / {meas.inputs[0]}| [m/N]")
+    axes[0].set_ylabel(plain_text(f"|{meas.outputs[0]} / {meas.inputs[0]}| [m/N]"))
     axes[0].legend(fontsize="small")
     axes[0].set_title(f"error {comparison.error:.3g} (noise floor {comparison.noise_floor:.3g}), "
                       f"FRAC {comparison.frac:.3f}; shaded: where the error is")
@@ -96,7 +98,7 @@ def plot_history(diagnosis, ax=None):
     ax.semilogy(x, y, "o-", color="tab:blue")
     for s in steps:
         label = "model as given" if s.added is None else f"+ {s.added.name}\n({s.added.where})"
-        ax.annotate(label, (s.step, s.error), textcoords="offset points", xytext=(6, 6), fontsize="x-small")
+        ax.annotate(plain_text(label), (s.step, s.error), textcoords="offset points", xytext=(6, 6), fontsize="x-small")
     ax.axhline(diagnosis.noise_floor, color="tab:green", ls="--", label="noise floor")
     ax.axhline(1.5 * diagnosis.noise_floor, color="tab:green", ls=":", label="1.5 x noise floor")
     ax.set_xticks(x)

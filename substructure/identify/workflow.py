@@ -15,6 +15,7 @@ from typing import Sequence
 import attrs
 import numpy as np
 
+from .._text import plain_text
 from ..assembly import Assembly
 from ..coupling import remove_mass
 from ..errors import SubstructureError
@@ -161,10 +162,10 @@ class IdentificationReport:
         ax.semilogy(f, np.abs(self.predicted.data[:, 0, 0]), color="tab:blue", lw=1.2, label="model, fitted joint")
         ax.axvspan(*self.band, color="tab:green", alpha=0.12)
         ax.set_xlabel("frequency [Hz]")
-        ax.set_ylabel(f"|{self.measured.outputs[0]} / {self.measured.inputs[0]}| [m/N]")
+        ax.set_ylabel(plain_text(f"|{self.measured.outputs[0]} / {self.measured.inputs[0]}| [m/N]"))
         ax.legend(fontsize="small")
         ax.grid(True, alpha=0.3)
-        fig.suptitle(f"joint {self.joint!r}: band fit {self.band[0]:.0f}-{self.band[1]:.0f} Hz")
+        fig.suptitle(plain_text(f"joint {self.joint!r}: band fit {self.band[0]:.0f}-{self.band[1]:.0f} Hz"))
         return fig
 
 

@@ -10,6 +10,7 @@ written ``<img ... />``, no named entities), so that it also parses as XML.
 from __future__ import annotations
 
 import html
+import re
 from typing import Any
 
 import numpy as np
@@ -30,9 +31,19 @@ _C_UNITS = {"yf": "N·s/m", "ym": "N·s", "tf": "N·s/rad", "tm": "N·m·s/rad"}
 # -- small pieces -------------------------------------------------------------------------------------
 
 
+_NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f\ud800-\udfff\ufffe\uffff]")
+"""Characters XML 1.0 forbids even as references (C0 controls but tab and line ends, lone surrogates, U+FFFE and
+U+FFFF), with DEL and the C1 controls, which HTML calls errors."""
+
+
+def clean(text: str) -> str:
+    """Text with every character the page may not hold replaced by U+FFFD (shown, never dropped)."""
+    return _NOT_XML.sub("\ufffd", text)
+
+
 def esc(value: Any) -> str:
-    """Text made safe for the page."""
-    return html.escape(str(value), quote=True)
+    """Text made safe for the page: markup escaped, control characters and lone surrogates as U+FFFD."""
+    return html.escape(clean(str(value)), quote=True)
 
 
 def unit(text: Any) -> str:
@@ -581,10 +592,11 @@ def render(report: Any) -> str:
                      + (f"<h3>Taken from the inputs</h3><ul>{notes}</ul>" if notes else "")))
     toc = "".join(f'<li><a href="#{i}">{esc(t)}</a></li>' for i, t, _ in sections)
     body = "".join(section(i, t, b) for i, t, b in sections)
-    return ("<!DOCTYPE html>\n"
+    page = ("<!DOCTYPE html>\n"
             '<html lang="en"><head><meta charset="utf-8" />'
             '<meta name="viewport" content="width=device-width, initial-scale=1" />'
             f"<title>{esc(report.title)}</title><style>{STYLE}</style></head>"
             f'<body><header><h1>{esc(report.title)}</h1><p class="meta">Made by substructure {esc(report.version)} on '
             f"{esc(report.created)}. This page holds everything in itself: it opens in any browser, offline.</p>"
             f'<nav><ol>{toc}</ol></nav></header><main>{body}</main></body></html>\n')
+    return clean(page)  # a name with a control character or a lone surrogate: U+FFFD, the page stays XML

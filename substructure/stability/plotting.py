@@ -23,6 +23,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from ..errors import InvalidValueError
+from .._text import plain_text
 
 __all__ = ["plot_lobes", "plot_band", "plot_recommendation", "plot_machine_limits", "METHOD_NAMES"]
 
@@ -62,16 +63,17 @@ def wrap_title(ax: Axes, text: str, width: int = 95, **kw: Any) -> None:
     ----------
     ax : Axes
     text : str
+        The title, as plain text (a ``$`` is a dollar sign, not mathematics).
     width : int, default 95
         Characters per line.
     **kw
         Passed to ``Axes.set_title``.
     """
-    ax.set_title("\n".join(textwrap.wrap(" ".join(str(text).split()), width)), fontsize="small", **kw)
+    ax.set_title(plain_text("\n".join(textwrap.wrap(" ".join(str(text).split()), width))), fontsize="small", **kw)
 
 
 def _label(r: Any) -> str:
-    return r.label or METHOD_NAMES.get(r.method, (r.method, ""))[0]
+    return plain_text(r.label or METHOD_NAMES.get(r.method, (r.method, ""))[0])
 
 
 def plot_lobes(results: Sequence[Any], ax: Any = None, lobes: bool = False, ylim_factor: float = 3.0,
@@ -242,7 +244,7 @@ def plot_band(band: Any, ax: Any = None, color: str | None = None, alpha: float 
     n = band.spindle_speed_rpm
     lo = np.where(np.isfinite(band.lower_m), band.lower_m, np.nan) * 1e3
     hi = np.where(np.isfinite(band.upper_m), band.upper_m, np.nan) * 1e3
-    fill = ax.fill_between(n, lo, hi, color=color, alpha=alpha, lw=0, label=band.label or "band")
+    fill = ax.fill_between(n, lo, hi, color=color, alpha=alpha, lw=0, label=plain_text(band.label or "band"))
     if band.nominal is not None:
         plot_lobes([band.nominal], ax=ax, color=fill.get_facecolor()[0][:3], **line_kw)
     else:

@@ -26,15 +26,19 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import re
+import signal
 import sys
+import threading
 import time
+import warnings
 from pathlib import Path
 from typing import Any
 
-from ..errors import InvalidValueError, OutputExistsError
+from ..errors import InvalidValueError, OutputExistsError, SubstructureWarning
 
 __all__ = ["run_study", "Progress", "parse_scheduler", "json_text", "RESULT_FORMAT"]
 
@@ -209,7 +213,8 @@ class _Store:
             if any(p.name.startswith(f".{name}.") for name in _TABLE_FILES):
                 p.unlink(missing_ok=True)
 
-    def load(self, task: dict) -> dict | None:
+    def load(self, task: dict, problems: list[str] | None = None) -> dict | None:
+        """The saved result of ``task`` if it is this task's and whole; else None (``problems`` says why)."""
         from ..io import read_text
 
         path = self.path("results", task["key"], ".json")
@@ -219,6 +224,11 @@ class _Store:
             return None
         if (not isinstance(data, dict) or data.get("format") != RESULT_FORMAT
                 or data.get("fingerprint") != task["fingerprint"] or data.get("status") != "done"):
+            return None
+        why = _rows_problem(data.get("rows"), task)
+        if why:
+            if problems is not None:
+                problems.append(f"{path}: {why}; not trusted, computed again")
             return None
         return data
 
@@ -239,6 +249,21 @@ class _Store:
             record["frf"] = f"frf/{key}.csv"
         write_text(self.path("results", key, ".json"), json_text(record) + "\n")  # last: the combination is done
         return record
+
+
+def _rows_problem(rows: Any, task: dict) -> str:
+    """Why a result file's ``rows`` are not this combination's rows (one per cut, in order), or ``""``."""
+    cuts = [spec["name"] for spec in task["cuts"]] or [""]
+    if not isinstance(rows, list) or not all(isinstance(row, dict) for row in rows):
+        return f"no 'rows' list of objects (expected one row per cut: {len(cuts)})"
+    got = [row.get("cut") for row in rows]
+    keys = {row.get("key") for row in rows}
+    if got != cuts or keys != {task["key"]}:
+        doubled = sorted({str(c) for c in got if got.count(c) > 1})
+        return (f"{len(rows)} rows for {len(cuts)} cut{'s' if len(cuts) != 1 else ''} ({', '.join(map(repr, cuts))})"
+                + (f", repeated: {', '.join(doubled)}" if doubled else "")
+                + ("" if keys == {task["key"]} else f", rows of other combinations ({len(keys - {task['key']})})"))
+    return ""
 
 
 def _plain(value: Any) -> Any:
@@ -347,12 +372,31 @@ def _local_cluster(kind: str, n: int, progress: Progress):
         extra["dashboard_address"] = _dashboard_address()
     else:  # no dashboard; the scheduler's HTTP server (health, metrics) on any free port, not on a busy 8787
         extra.update(dashboard_address=None, scheduler_kwargs={"dashboard_address": ":0"})
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=kind == "processes",
-                           silence_logs=logging.ERROR, **extra)
+    # the cluster's own logs stay quiet: what a user needs of them (a lost worker, a failed combination) is in the
+    # rows and the progress lines; an interruption closes the scheduler under busy workers, whose heartbeats
+    # would log tracebacks
+    with _workers_ignore_ctrl_c(kind == "processes"):
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=kind == "processes",
+                               silence_logs=logging.CRITICAL, **extra)
     client = Client(cluster, set_as_default=False)
     where = "worker processes" if kind == "processes" else "worker threads in this process"
     progress.say(f"local Dask cluster: {n} {where}")
     return cluster, client
+
+
+@contextlib.contextmanager
+def _workers_ignore_ctrl_c(processes: bool):
+    """Worker processes started inside ignore SIGINT: Ctrl-C in a terminal reaches the whole process group, and
+    only this process (which saves, says what is saved and closes the cluster) should hear it; workers started
+    with SIGINT ignored keep ignoring it (Python installs no handler then), so none prints a traceback."""
+    if not processes or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def _dashboard_address() -> str:
@@ -418,10 +462,13 @@ def run_study(study, client: Any = None, out: Any = None, scheduler: str | None 
     if store is not None:
         store.check(tasks, resume, overwrite)
         if resume:
+            problems: list[str] = []
             for task in tasks:
-                record = store.load(task)
+                record = store.load(task, problems)
                 if record is not None:
                     finished[task["key"]] = record
+            for problem in problems:  # a result file edited or cut short by hand: never a row twice or a crash
+                warnings.warn(f"resume: {problem}", SubstructureWarning, stacklevel=2)
         store.root.mkdir(parents=True, exist_ok=True)
     todo = [t for t in tasks if t["key"] not in finished]
     report = Progress(stream, len(tasks), resumed=len(finished))
@@ -468,11 +515,12 @@ def run_study(study, client: Any = None, out: Any = None, scheduler: str | None 
                     record = store.load(task)
                     if record is not None:
                         finished[task["key"]] = record
-        report.say(f"interrupted: {len(finished)} of {len(tasks)} combinations are saved"
-                   + (f" in {store.root}; run again with --resume (resume=True) to finish" if store else ""))
+        message = (f"interrupted: {len(finished)} of {len(tasks)} combinations saved"
+                   + (f" in {store.root}; --resume (resume=True) to continue" if store else " (no output directory)"))
+        report.say(message)
         if store is not None:
             _assemble(study, tasks, finished, store)
-        raise
+        raise KeyboardInterrupt(message) from None
     finally:
         if own is not None:
             own.close()

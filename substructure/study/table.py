@@ -16,6 +16,8 @@ from typing import Any
 
 import numpy as np
 
+from .._text import plain_text
+
 __all__ = ["COLUMNS", "make_table", "write_table", "summary_figure", "rank_value"]
 
 #: The columns of the table: ``(name, kind, meaning)``, kind ``str``, ``float`` or ``int``.
@@ -207,7 +209,7 @@ def summary_figure(table, title: str = "", top: int = 25):
                     if r["spindle_speed_rpm"] == r["spindle_speed_rpm"] else f" {r['tool_mode_hz']:.0f} Hz")
             ax.text(r["_v"], yy, what, va="center", fontsize="xx-small")
         ax.margins(x=0.15)
-        ax.set_yticks(y, names, fontsize="x-small")
+        ax.set_yticks(y, [plain_text(n) for n in names], fontsize="x-small")
         ax.set_xlabel(label, fontsize="small")
         ax.grid(True, axis="x", alpha=0.3)
         failed = rows[rows["status"] != "ok"]
@@ -217,14 +219,14 @@ def summary_figure(table, title: str = "", top: int = 25):
             text += f"; not ranked ({len(failed)}): " + ", ".join(
                 f"{c} [{s}]" for c, s in zip(failed["combination"].head(8), failed["status"].head(8)))
             text += ", ..." if len(failed) > 8 else ""
-        ax.set_title(text, fontsize="small", loc="left")
+        ax.set_title(plain_text(text), fontsize="small", loc="left")
         if not len(shown):
             ax.text(0.5, 0.5, "nothing to rank", transform=ax.transAxes, ha="center", va="center")
     if len(machines) > 1:
         from matplotlib.patches import Patch
 
-        axes[0].legend(handles=[Patch(color=colours[m], label=m) for m in machines], fontsize="x-small",
+        axes[0].legend(handles=[Patch(color=colours[m], label=plain_text(m)) for m in machines], fontsize="x-small",
                        loc="lower right")
     if title:
-        fig.suptitle(title, fontsize="medium")
+        fig.suptitle(plain_text(title), fontsize="medium")
     return fig

@@ -376,6 +376,7 @@ def _figure(task: dict, nominal: dict, members: list, envelope, cuts: list) -> b
     from matplotlib.figure import Figure
 
     from ..stability.plotting import plot_recommendation, wrap_title
+    from .._text import plain_text
 
     panels = 1 + len(cuts)
     fig = Figure(figsize=(8.0, 3.2 + 3.6 * len(cuts)), layout="constrained")
@@ -407,7 +408,7 @@ def _figure(task: dict, nominal: dict, members: list, envelope, cuts: list) -> b
                width=80)
     for ax, (spec, lobes, best, lband) in zip(axes[1:], cuts):
         if lobes is None:
-            ax.text(0.5, 0.5, f"cut {spec['name']!r}: failed", transform=ax.transAxes, ha="center")
+            ax.text(0.5, 0.5, plain_text(f"cut {spec['name']!r}: failed"), transform=ax.transAxes, ha="center")
             ax.set_axis_off()
             continue
         chosen = task["compute"]["recommend_method"]

@@ -16,6 +16,7 @@ import warnings
 import attrs
 import numpy as np
 
+from .._text import plain_text
 from ..assembly import Assembly
 from ..errors import InvalidValueError, NonPassiveJointWarning
 from ..frf import FRF, Frequency
@@ -107,10 +108,11 @@ class FRFBand:
         else:
             fig = ax.figure
         f = self.frequency.hz
-        ax.fill_between(f, self.lower, self.upper, color="tab:blue", alpha=0.25, label=f"{label}: envelope")
-        ax.semilogy(f, np.abs(self.nominal.data[:, 0, 0]), color="tab:blue", lw=1.2, label=f"{label}: median joint")
+        ax.fill_between(f, self.lower, self.upper, color="tab:blue", alpha=0.25, label=plain_text(f"{label}: envelope"))
+        ax.semilogy(f, np.abs(self.nominal.data[:, 0, 0]), color="tab:blue", lw=1.2,
+                    label=plain_text(f"{label}: median joint"))
         ax.set_xlabel("frequency [Hz]")
-        ax.set_ylabel(f"|{self.nominal.outputs[0]} / {self.nominal.inputs[0]}| [m/N]")
+        ax.set_ylabel(plain_text(f"|{self.nominal.outputs[0]} / {self.nominal.inputs[0]}| [m/N]"))
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize="small")
         return fig

@@ -13,6 +13,7 @@ import attrs
 import numpy as np
 from sklearn.base import clone
 
+from .._text import plain_text
 from ..errors import InvalidValueError
 from .models import JointSurrogate
 from .table import JointTable
@@ -123,10 +124,10 @@ class CrossValidation:
         ax.errorbar(t, p, yerr=[p - lo, hi - p], fmt="o", ms=4, capsize=2, label="held out, 95 % interval")
         ends = [min(t.min(), lo.min()), max(t.max(), hi.max())]
         ax.plot(ends, ends, "k--", lw=0.8, label="parity")
-        ax.set_xlabel(f"identified {self.target} [{self.unit}]")
-        ax.set_ylabel(f"predicted {self.target} [{self.unit}]")
-        ax.set_title(f"{self.model}, {self.scheme}: MAPE {self.mean_abs_percent_error:.1f} %, "
-                     f"95 % cover {self.coverage(0.95):.0%}", fontsize="small")
+        ax.set_xlabel(plain_text(f"identified {self.target} [{self.unit}]"))
+        ax.set_ylabel(plain_text(f"predicted {self.target} [{self.unit}]"))
+        ax.set_title(plain_text(f"{self.model}, {self.scheme}: MAPE {self.mean_abs_percent_error:.1f} %, "
+                                f"95 % cover {self.coverage(0.95):.0%}"), fontsize="small")
         ax.legend(fontsize="small")
         return ax.figure
 

@@ -24,16 +24,19 @@ import attrs
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..errors import InvalidValueError
+from ..errors import InvalidValueError, SubstructureError
 from .parameters import Change, ParamSpec
 
-__all__ = ["Fit", "fit", "scan", "FTOL", "XTOL"]
+__all__ = ["Fit", "fit", "scan", "FTOL", "XTOL", "INFEASIBLE"]
 
 FTOL = 1e-7
 """Relative change of ``chi^2`` at which a fit stops: well below one unit of ``chi^2`` for any data set
 of fewer than ten million residuals, so that likelihood ratios are not blurred by unconverged fits."""
 XTOL = 1e-7
 """Relative change of the fitted variables at which a fit stops."""
+INFEASIBLE = 1e4
+"""Every whitened residual of a trial the model cannot hold (values a library check refuses, such as a
+segment shorter than a micrometre): a misfit far above any the data give, so that the optimiser steps back."""
 
 
 def _scale(spec: ParamSpec) -> float:
@@ -177,8 +180,20 @@ def fit(likelihood, changes: Sequence[tuple], free: Sequence[bool] | None = None
             current[i][1][spec.name] = from_u(spec, ui)
         return current
 
+    size = []
+
     def residual(u):
-        return likelihood.residual(model_of(u))
+        # a trial the model cannot hold (a library check refuses the values the optimiser tried) is a large
+        # misfit, never the user's error; a fit whose start cannot be evaluated still raises
+        try:
+            r = likelihood.residual(model_of(u))
+        except (SubstructureError, ValueError, FloatingPointError):
+            if not size:
+                raise
+            return np.full(size[0], INFEASIBLE)
+        if not size:
+            size.append(r.size)
+        return r
 
     if not slots:
         r = likelihood.residual(changes)
@@ -242,7 +257,10 @@ def scan(likelihood, fixed: Sequence[tuple], change: Change, values: dict, name:
     best = (np.inf, float(values.get(name, np.nan)))
     for v in grid:
         trial = {**values, name: float(v)}
-        chi2 = likelihood.chi2(list(fixed) + [(change, trial)])
+        try:
+            chi2 = likelihood.chi2(list(fixed) + [(change, trial)])
+        except (SubstructureError, ValueError, FloatingPointError):  # a trial the model cannot hold
+            continue
         if chi2 < best[0]:
             best = (chi2, float(v))
     return best

@@ -13,7 +13,7 @@ path                                           value (SI)
                                                component's base [m] (linked: both lengths change,
                                                the component's length is kept)
 ``materials.M.E|rho|nu|loss_factor``           a material, in every part made of it
-``joints.J.k.yf|ym|tm``, ``joints.J.c.yf|ym|tm``   a joint entry (``ym`` sets ``tf`` too)
+``joints.J.k.yf|ym|tf|tm``, ``joints.J.c.E``   a joint entry (``ym`` and ``tf`` are one number: either sets both)
 ``supports.I.k.E``, ``supports.I.c.E``         a support entry (``I``: index in the file)
 ``supports.I.at``                              a support's position along its component [m]
 ``sensors.S.mass|inertia``                     a sensor [kg, kg m^2]
@@ -40,6 +40,11 @@ every support on a component, as a factor: a bearing preload).
 (:mod:`substructure.updating.structure`) for fits.  :class:`Change` is the
 protocol every fitted change follows (a parameter correction, an added
 element, an effect of the diagnosis catalogue).
+
+Every key of a path must name something of the assembly, case-sensitively:
+an unknown key, a negative or too large index, a matrix other than ``k``
+and ``c`` or an entry other than ``yf``, ``ym``, ``tf``, ``tm`` is refused
+with the keys that exist there (``substructure.updating.paths.check_path``).
 """
 
 from __future__ import annotations
@@ -54,7 +59,7 @@ from ..errors import InvalidValueError
 from ..joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint
 from ..materials import Material
 from .changes import Change, ParamSpec
-from .paths import _on_beam, _overhang_segment, _plain, _segmented, _unknown, apply_path_si, set_parameters
+from .paths import _on_beam, _overhang_segment, _plain, _segmented, _unknown, apply_path_si, check_path, set_parameters
 
 __all__ = ["ParamSpec", "Change", "ModelParameter", "ParameterChange", "ParameterSet", "model_parameters",
            "material_changes", "parameter_change", "AssemblyParameterChange", "get_parameter", "set_parameters",
@@ -424,6 +429,7 @@ def get_parameter(assembly, path: str) -> float:
     for p in model_parameters(assembly):
         if p.path == path:
             return p.nominal
+    check_path(assembly, path)  # a key that names nothing: refused with the keys that exist
     raise _unknown(path, "not a parameter of this assembly (see model_parameters)")
 
 

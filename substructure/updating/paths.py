@@ -22,7 +22,7 @@ from ..joints import DAMPING_UNITS, STIFFNESS_UNITS
 from ..materials import Material
 from ..units import Q_, format_quantity
 
-__all__ = ["apply_path_si", "set_parameters"]
+__all__ = ["apply_path_si", "set_parameters", "check_path"]
 
 
 _MAT_COLUMN = {"E": 0, "nu": 1, "rho": 2, "loss_factor": 3}
@@ -50,31 +50,8 @@ def apply_path_si(structure, path: str, value: float):
     if head == "components":
         beam = structure.beam(parts[1])
         rest = parts[2:]
-        if rest[0] == "segments":
-            i = int(rest[1])
-            what = ".".join(rest[2:])
-            if what in ("length", "od", "id"):
-                arr = getattr(beam, what).copy()
-                arr[i] = value
-                return structure.with_beam(beam.evolve(**{what: arr}))
-            if what == "end":  # the step to the next segment moves, the component's length kept
-                length = beam.length.copy()
-                shift = value - float(length[:i + 1].sum())
-                length[i] += shift
-                length[i + 1] -= shift
-                return structure.with_beam(beam.evolve(length=length))
-            if what in ("insert.od", "insert.id"):
-                ins = beam.insert.copy()
-                ins[i, 0 if what == "insert.od" else 1] = value
-                return structure.with_beam(beam.evolve(insert=ins))
-            ratio = beam.ratio.copy()
-            ratio[i] = value
-            return structure.with_beam(beam.evolve(ratio=ratio))
-        if rest == ["overhang"]:
-            i = _overhang_index(beam)
-            length = beam.length.copy()
-            length[i] += value - beam.total_length
-            return structure.with_beam(beam.evolve(length=length))
+        if rest[0] in ("segments", "overhang"):
+            return structure.with_beam(_section_checked(path, _geometry(beam, path, rest, value)))
         if rest in (["E"], ["rho"], ["loss_factor"]):
             mat = beam.material.copy()
             mat[:, _MAT_COLUMN[rest[0]]] *= value
@@ -90,6 +67,7 @@ def apply_path_si(structure, path: str, value: float):
                     out = out.with_link(i, link.evolve(K=link.K * value))
             return out
     if head == "materials":
+        _key(path, ".".join(parts[:-1]), parts[-1], _MATERIAL_KEYS)
         name, column = ".".join(parts[1:-1]), _MAT_COLUMN[parts[-1]]
         out, found = structure, False
         for beam in structure.beams.values():
@@ -117,11 +95,14 @@ def apply_path_si(structure, path: str, value: float):
             if parts[2] == "at":
                 return structure.with_link(i, link.evolve(a=(_component_of(link.a), value)))
             if len(parts) == 3:
-                name = parts[2].upper()
-                return structure.with_link(i, link.evolve(**{name: getattr(link, name) * value}))
+                _key(path, ".".join(parts[:2]), parts[2], _MATRIX_KEYS)
+                which = parts[2].upper()
+                return structure.with_link(i, link.evolve(**{which: getattr(link, which) * value}))
             kind, entry = parts[2], parts[3]
+            _key(path, ".".join(parts[:2]), kind, _MATRIX_KEYS)
+            _key(path, ".".join(parts[:3]), entry, _ENTRIES)
             m = getattr(link, kind.upper()).copy()
-            if entry == "ym":
+            if entry in ("ym", "tf"):  # one number (reciprocity): either sets both
                 m[0, 1] = m[1, 0] = value
             else:
                 m[(0, 1)[entry == "tm"], (0, 1)[entry == "tm"]] = value
@@ -132,6 +113,52 @@ def apply_path_si(structure, path: str, value: float):
         m[(0, 1)[parts[2] == "inertia"], (0, 1)[parts[2] == "inertia"]] = value
         return structure.with_link(i, link.evolve(M=m))
     raise UnknownPointError(f"parameter {path!r}: not a parameter path")
+
+
+def _geometry(beam, path: str, rest: list[str], value: float):
+    """The beam arrays with a segment's size or the overhang set (``rest``: the path after the component)."""
+    if rest == ["overhang"]:
+        i = _overhang_index(beam)
+        length = beam.length.copy()
+        length[i] += value - beam.total_length
+        return beam.evolve(length=length)
+    i = _index(path, rest[1], beam.length.size, f"segment index of {beam.name!r}")
+    what = ".".join(rest[2:])
+    if what in ("length", "od", "id"):
+        arr = getattr(beam, what).copy()
+        arr[i] = value
+        return beam.evolve(**{what: arr})
+    if what == "end":  # the step to the next segment moves, the component's length kept
+        length = beam.length.copy()
+        shift = value - float(length[:i + 1].sum())
+        length[i] += shift
+        length[i + 1] -= shift
+        return beam.evolve(length=length)
+    if what in ("insert.od", "insert.id"):
+        ins = beam.insert.copy()
+        ins[i, 0 if what == "insert.od" else 1] = value
+        return beam.evolve(insert=ins)
+    ratio = beam.ratio.copy()
+    ratio[i] = value
+    return beam.evolve(ratio=ratio)
+
+
+def _section_checked(path: str, beam):
+    """``beam`` if every segment is one the assembly holds (the checks of :class:`~substructure.beams.Segment`),
+    else an error naming the value: the SI form refuses what the assembly would (a fit counts the trial as
+    infeasible), so that a fitted value always writes back."""
+    insert_od, insert_id = beam.insert[:, 0], beam.insert[:, 1]
+    sizes = np.concatenate([beam.length, beam.od, beam.id, beam.ratio, insert_od, insert_id])
+    problems = (("a size that is not a finite number", ~np.isfinite(sizes)),
+                ("a segment shorter than 1 um", beam.length < 1e-6),
+                ("an outer diameter under 1 um", beam.od < 1e-6),
+                ("a bore as wide as the section", beam.id >= beam.od * beam.ratio),
+                ("an insert wider than its bore", (insert_od > 0) & (insert_od > beam.id)),
+                ("an insert's bore as wide as the insert", (insert_od > 0) & (insert_id >= insert_od)))
+    for what, bad in problems:
+        if np.any(bad):
+            raise InvalidValueError(f"parameter {path!r}: the value makes {what} in {beam.name!r}")
+    return beam
 
 
 def _component_of(point) -> str:
@@ -203,6 +230,144 @@ def _unknown(path: str, why: str) -> UnknownPointError:
     return UnknownPointError(f"parameter {path!r}: {why}")
 
 
+_HEADS = ("components", "materials", "joints", "supports", "sensors", "masses")
+"""The first key of a parameter path."""
+_SEGMENT_KEYS = ("length", "od", "id", "od_tip", "id_tip", "end", "insert.od", "insert.id", "flutes.diameter_ratio")
+"""The values of ``components.C.segments.I``."""
+_COMPONENT_KEYS = ("segments", "overhang", "E", "rho", "loss_factor", "material", "supports")
+"""The keys after ``components.C``."""
+_MATERIAL_KEYS = tuple(_MAT_COLUMN)
+"""The values of a material (``materials.M.*``, ``components.C.material.*``): case-sensitive."""
+_MATRIX_KEYS = ("k", "c")
+"""A joint's or a support's stiffness and damping."""
+_ENTRIES = ("yf", "ym", "tf", "tm")
+"""The entries of a stiffness or damping matrix (``ym`` and ``tf`` are one number: either sets both)."""
+
+
+def _expected(keys) -> str:
+    return ", ".join(str(k) for k in keys) or "none"
+
+
+def _key(path: str, where: str, got: str, allowed) -> None:
+    """Refuse ``got`` after ``where`` unless it is one of ``allowed`` (case-sensitive)."""
+    if got not in allowed:
+        after = f"after {where!r}" if where else "at the start (not a parameter path)"
+        raise _unknown(path, f"unknown key {got!r} {after}; expected one of {_expected(allowed)}")
+
+
+def _index(path: str, text: str, count: int, what: str) -> int:
+    """A list index as written in a path: ``0`` to ``count - 1``, no sign (``-1`` is refused, not the last)."""
+    if not text.isdecimal() or not text.isascii() or int(text) >= count:
+        if count == 0:
+            raise _unknown(path, f"{what} {text!r}: there are none")
+        valid = f"0 to {count - 1}" if count > 1 else "0"
+        raise _unknown(path, f"{what} {text!r}: valid indices are {valid} (from 0; a negative index does not count "
+                             "from the end)")
+    return int(text)
+
+
+def _length(path: str, parts: list[str], allowed: tuple[int, ...]) -> None:
+    if len(parts) not in allowed:
+        raise _unknown(path, "not a parameter path (see substructure.updating.parameters)")
+
+
+def _materials_of_parts(assembly) -> list[str]:
+    """The names of the materials the plain beam components' segments and inserts are made of."""
+    return sorted({m.name for c in assembly.components if _plain(c) for seg in c.segments
+                   for m in (seg.material, *((seg.insert.material,) if seg.insert is not None else ()))})
+
+
+def check_path(assembly, path: str) -> list[str]:
+    """The keys of ``path`` after checking that each names something of ``assembly``.
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model.
+    path : str
+        A parameter path (see :mod:`substructure.updating.parameters`).
+
+    Returns
+    -------
+    list of str
+        The path's keys.
+
+    Raises
+    ------
+    UnknownPointError
+        For a key that names nothing, with the keys that exist there (a
+        negative index, an entry other than ``yf``, ``ym``, ``tf``,
+        ``tm``, a material value other than ``E``, ``rho``, ``nu``,
+        ``loss_factor``: keys are case-sensitive).
+    """
+    parts = _parts(path)
+    head = parts[0]
+    _key(path, "", head, _HEADS)
+    if head == "components":
+        _length(path, parts, range(3, 7))
+        names = sorted(assembly.component_names)
+        _key(path, "components", parts[1], names)
+        comp = assembly.component(parts[1])
+        if not _segmented(comp):
+            raise _unknown(path, f"{parts[1]!r} is not a stepped beam")
+        rest, where = parts[2:], f"components.{parts[1]}"
+        _key(path, where, rest[0], _COMPONENT_KEYS)
+        if rest[0] == "segments":
+            _length(path, rest, (3, 4))
+            i = _index(path, rest[1], len(comp.segments), f"segment index of {comp.name!r}")
+            what, seg = ".".join(rest[2:]), comp.segments[i]
+            _key(path, f"{where}.segments.{i}", what, _SEGMENT_KEYS)
+            if what.startswith("insert.") and seg.insert is None:
+                raise _unknown(path, f"segment {i} of {comp.name!r} has no insert")
+            if what.startswith("flutes.") and seg.flutes is None:
+                raise _unknown(path, f"segment {i} of {comp.name!r} has no flutes")
+        elif rest[0] == "material":
+            _length(path, rest, (2,))
+            _key(path, f"{where}.material", rest[1], _MATERIAL_KEYS)
+        elif rest[0] == "supports":
+            _length(path, rest, (2,))
+            _key(path, f"{where}.supports", rest[1], ("k",))
+        else:
+            _length(path, rest, (1,))
+            from ..components import Tool
+
+            if rest[0] == "overhang" and (not isinstance(comp, Tool) or _overhang_segment(comp) is None):
+                raise _unknown(path, f"{comp.name!r} has no overhang (a tool with a segment without flutes has)")
+    elif head == "materials":
+        _length(path, parts, range(3, 100))
+        _key(path, ".".join(parts[:-1]), parts[-1], _MATERIAL_KEYS)
+        name, made = ".".join(parts[1:-1]), _materials_of_parts(assembly)
+        if name not in made:
+            raise _unknown(path, f"no part is made of {name!r} (materials of the parts: {_expected(made)})")
+    elif head == "joints":
+        _length(path, parts, (3, 4))
+        assembly.joint(parts[1])  # unknown: the joints there are listed
+        _key(path, f"joints.{parts[1]}", parts[2], _MATRIX_KEYS)
+        if len(parts) == 4:
+            _key(path, f"joints.{parts[1]}.{parts[2]}", parts[3], _ENTRIES)
+    elif head == "supports":
+        count = len(assembly.supports)
+        if "+" in parts[1]:
+            _length(path, parts, (3,))
+            for text in parts[1].split("+"):
+                _index(path, text, count, "support index")
+            _key(path, f"supports.{parts[1]}", parts[2], ("k",))
+        else:
+            _length(path, parts, (3, 4))
+            _index(path, parts[1], count, "support index")
+            where = f"supports.{parts[1]}"
+            _key(path, where, parts[2], ("at",) if len(parts) == 3 else _MATRIX_KEYS)
+            if len(parts) == 4:
+                _key(path, f"{where}.{parts[2]}", parts[3], _ENTRIES)
+    else:
+        _length(path, parts, (3,))
+        names = [s.name for s in getattr(assembly, head)]
+        _key(path, head, parts[1], names)
+        _key(path, f"{head}.{parts[1]}", parts[2], ("mass", "inertia", "at") if head == "masses" else
+             ("mass", "inertia"))
+    return parts
+
+
 
 def _quiet(build):
     with warnings.catch_warnings():
@@ -216,7 +381,7 @@ def _scaled_matrix(matrix, factor: float, units) -> dict:
 
 def _set_matrix(owner, kind: str, entry: str, value: float):
     units = STIFFNESS_UNITS if kind == "k" else DAMPING_UNITS
-    entries = ("ym", "tf") if entry == "ym" else (entry,)
+    entries = ("ym", "tf") if entry in ("ym", "tf") else (entry,)  # one number (reciprocity): either sets both
     update = {e: _si(value, units[e]) for e in entries}
     k, c = owner.k.as_dict(), owner.c.as_dict()
     (k if kind == "k" else c).update(update)
@@ -240,7 +405,7 @@ def _material_value(material: Material, prop: str, value: float) -> Material:
 
 
 def _set_one(assembly, path: str, value: float):
-    parts = _parts(path)
+    parts = check_path(assembly, path)
     head = parts[0]
     value = float(value)
     if head == "components" and len(parts) >= 3:
@@ -319,7 +484,8 @@ def _set_one(assembly, path: str, value: float):
                     found = True
             comps.append(attrs.evolve(comp, segments=segs))
         if not found:
-            raise _unknown(path, f"no part is made of {name!r}")
+            raise _unknown(path, f"no part is made of {name!r} (materials of the parts: "
+                                 f"{_expected(_materials_of_parts(assembly))})")
         mats = tuple(_material_value(m, prop, value) if m.name == name else m for m in assembly.materials)
         return attrs.evolve(assembly, components=tuple(comps), materials=mats)
     if head == "joints" and len(parts) in (3, 4):
