@@ -53,7 +53,8 @@ from .protocol import COMPONENT_TYPES, as_frequency, dof_labels, is_plain_beam, 
 
 # in this order, so that COMPONENT_TYPES lists the types as it always has: beam, spindle,
 # holder, tool, measured; component_info is for Assembly.describe
-from .beam import Beam, Holder, Spindle, component_info  # noqa: E402, F401
+from .beam import Beam, Spindle, component_info  # noqa: E402, F401
+from .holder import Holder  # noqa: E402
 from .tool import Tool  # noqa: E402
 from .measured import MeasuredComponent  # noqa: E402
 

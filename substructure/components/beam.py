@@ -1,4 +1,6 @@
-"""Stepped Timoshenko beams as components: :class:`Beam` and its kinds :class:`Spindle` and :class:`Holder`.
+"""Stepped Timoshenko beams as components: :class:`Beam` and its kind :class:`Spindle`.
+
+:class:`~substructure.components.Holder` is in ``components.holder``, with the holder catalogue.
 
 A beam is a name and its segments from base to tip; its points are the ends
 and positions along it (``tip-15 mm``), its receptances those of the stepped
@@ -20,7 +22,7 @@ from ..frf import FRF
 from ..points import PointRef, check_name, parse_point
 from .protocol import _positive_frequencies, as_frequency, dof_labels, register_component
 
-__all__ = ["Beam", "Spindle", "Holder", "component_info"]
+__all__ = ["Beam", "Spindle", "component_info"]
 
 
 def _segments(value) -> tuple[Segment, ...]:
@@ -243,64 +245,6 @@ class Spindle(Beam):
     description : str, optional
         What the component is and where its numbers come from (keyword only).
     """
-
-
-@register_component("holder")
-@attrs.frozen
-class Holder(Beam):
-    """A tool holder: base at the taper end, tip at its face.
-
-    Parameters
-    ----------
-    name : str
-        Name used in point names (``"holder"`` gives ``"holder.tip"``).
-    segments : sequence of Segment
-        Base to tip.
-    description : str, optional
-        What the component is and where its numbers come from (keyword only).
-
-    Notes
-    -----
-    The part of the tool inside the holder is usually modelled as an
-    :class:`~substructure.beams.Insert` of the holder's bore segment
-    (thesis section 2.1).  Standard holders (BT40, CAT40, HSK-A63 with ER
-    collet chucks, shrink-fit or hydraulic noses) come from
-    :meth:`from_catalog`.
-    """
-
-    @classmethod
-    def from_catalog(cls, entry: str, *, name: str = "holder", **parameters) -> "Holder":
-        """A standard holder of approximate geometry from the catalogue, with overrides.
-
-        Parameters
-        ----------
-        entry : str
-            ``"<interface> <clamp>"``, e.g. ``"HSK-A63 shrink-fit"``, ``"BT40 ER32"``,
-            ``"CAT40 hydraulic"`` (:func:`substructure.holders.catalog_names`).
-        name : str
-            Component name.
-        **parameters
-            ``bore`` (the tool shank diameter, required), ``gauge_length``,
-            ``clamp_length``, ``material``, ``tool_material``, ``shank_taper``
-            and any geometric value of the catalogue by name, e.g.
-            ``nose_diameter="27 mm"`` (:func:`substructure.holders.design`).
-
-        Returns
-        -------
-        Holder
-            From the gauge line (its base, the spindle-holder joint) to the
-            nose, the tool shank as an insert over the clamped length; its
-            ``description`` says it is approximate and cites the sources.
-
-        Examples
-        --------
-        >>> h = Holder.from_catalog("BT40 ER32", bore="12 mm", gauge_length="70 mm", nut_diameter="48 mm")
-        >>> round(h.mass(), 2)
-        1.11
-        """
-        from ..holders import design
-
-        return design(entry, **parameters).holder(name, cls)
 
 
 def component_info(component: Any) -> str:

@@ -488,9 +488,9 @@ class FRF:
         matplotlib.figure.Figure
             The figure (never shown by the library).
         """
-        from ..plot import plot_frf
+        from .plotting import draw_frf
 
-        return plot_frf(self, ax=ax, **kw)
+        return draw_frf(self, ax=ax, **kw)
 
     def to_csv(self, path: Any) -> None:
         """Write a 1x1 FRF to a CSV file (:func:`substructure.io.frf_files.write_csv`).

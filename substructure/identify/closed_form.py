@@ -175,7 +175,7 @@ class ClosedFormResult:
         Figure
             The figure (see :func:`substructure.plot.plot_identification`).
         """
-        from ..plot import plot_identification
+        from .plotting import plot_identification
 
         return plot_identification(self, names=names, band=band, fitted=fitted, ax=ax, measured=measured)
 

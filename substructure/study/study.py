@@ -212,9 +212,9 @@ class Study:
         FileFormatError
             Naming the file, the line and the key.
         """
-        from .reader import load_study
+        from ._reader import read_study
 
-        return load_study(path)
+        return read_study(cls, path)
 
     # -- tasks -------------------------------------------------------------------------
     def pairs(self) -> list[tuple[Combination, Machine]]:

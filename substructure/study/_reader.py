@@ -1,0 +1,358 @@
+"""Study files (internal): a TOML file (and optionally a CSV file of combinations) read into a study.
+
+The public readers are :mod:`substructure.study.reader` and :meth:`Study.from_file`; this module
+is below both and takes the class to build, so that ``study`` and ``reader`` do not import each
+other.
+
+The format is docs/file-formats.md, "substructure study".  Every problem
+of the structure (TOML syntax, unknown or missing keys, wrong types, units
+of the values every combination shares, names that do not exist) raises
+:class:`~substructure.errors.FileFormatError` whose message starts with
+the file and the line and names the key path (``cuts[1].radial_depth``,
+``combinations[3].tool.diameter``; for the CSV file the line and the
+column).  The values of one combination's tool, holder and joint are
+checked when it is computed: a bad combination fails its rows, with the
+file and line in the message, and the study goes on.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import os
+import re
+from pathlib import Path
+from typing import Any
+
+from ..errors import FileFormatError, SubstructureError
+
+__all__ = ["read_study", "reads_study", "read_combinations_csv", "TOP_KEYS"]
+
+#: The top-level keys and tables of a study file.
+TOP_KEYS = ("name", "joint", "plugins", "combinations_csv", "grid", "compute", "surrogate", "machines", "cuts",
+            "combinations")
+_MACHINE_KEYS = ("name", "assembly", "supports", "limits")
+_CUT_KEYS = ("name", "workpiece", "workpiece_table", "kt", "kn", "kr", "radial_depth", "immersion", "milling",
+             "feed_per_tooth", "max_depth")
+_COMBINATION_KEYS = ("name", "tool", "holder", "joint", "features", "machines", "cuts")
+_GRID_KEYS = ("frequency", "speeds", "sdm_speeds")
+_COMPUTE_KEYS = ("at", "lobes", "recommend", "band", "samples", "quantiles", "margin", "speed_tolerance", "figures",
+                 "frf_files")
+_SURROGATE_KEYS = ("table", "model", "targets", "features")
+_HEADER = re.compile(r"^\s*(\[\[?)\s*([^\[\]#]+?)\s*\]\]?\s*(?:#.*)?$")
+_FIELD = re.compile(r"^([A-Za-z_][A-Za-z0-9_.\[\]]*): (.*)$", re.DOTALL)
+
+
+class _Lines:
+    """Best-effort line numbers of keys in the TOML text, for messages."""
+
+    def __init__(self, text: str):
+        self.lines = text.splitlines()
+        self.headers = []
+        for n, line in enumerate(self.lines):
+            m = _HEADER.match(line)
+            if m:
+                self.headers.append((n, m.group(2).strip().strip("\"'"), m.group(1) == "[["))
+
+    def line(self, parts: list) -> int | None:
+        start, rest = None, list(parts)
+        if len(parts) >= 2 and isinstance(parts[0], str) and isinstance(parts[1], int):
+            heads = [n for n, name, array in self.headers if array and name == parts[0]]
+            if parts[1] < len(heads):
+                start, rest = heads[parts[1]], list(parts[2:])
+        elif parts and isinstance(parts[0], str):
+            heads = [n for n, name, array in self.headers if not array and name == parts[0]]
+            if heads:
+                start, rest = heads[0], list(parts[1:])
+        if start is None:  # a top-level key: the lines before the first table
+            first, end = 0, (self.headers[0][0] if self.headers else len(self.lines))
+        else:
+            later = [n for n, _, _ in self.headers if n > start]
+            first, end = start, (later[0] if later else len(self.lines))
+        keys = [p for p in rest if isinstance(p, str)]
+        for key in dict.fromkeys(reversed(keys)):  # the innermost key first, then its containers
+            pattern = re.compile(r"(?:^|[\s{,])" + re.escape(key) + r"\s*=")
+            for n in range(first, end):
+                if pattern.search(self.lines[n]):
+                    return n + 1
+        return None if start is None else start + 1
+
+
+def _path(parts) -> str:
+    text = ""
+    for p in parts:
+        text += f"[{p}]" if isinstance(p, int) else (f".{p}" if text else str(p))
+    return text
+
+
+class _Reader:
+    def __init__(self, source: str, text: str, data: dict, base: Path):
+        self.source, self.data, self.base, self.lines = source, data, base, _Lines(text)
+        self.inputs: list[str] = [source]
+
+    def where(self, parts) -> str:
+        line = self.lines.line(list(parts))
+        return f"{self.source}, line {line}" if line else self.source
+
+    def error(self, parts, message: str) -> FileFormatError:
+        key = _path(parts)
+        return FileFormatError(f"{self.where(parts)}: {key}: {message}" if key else f"{self.where(parts)}: {message}")
+
+    def call(self, parts, factory, *args, **kwargs):
+        try:
+            return factory(*args, **kwargs)
+        except FileFormatError:
+            raise
+        except SubstructureError as exc:
+            message = " ".join(str(exc).split())
+            if message.startswith(self.source):  # it names the file and line already
+                raise FileFormatError(message) from None
+            m = _FIELD.match(message)
+            if m and not message.startswith(self.source):
+                inner = [int(i) if i else k for k, i in re.findall(r"([^.\[\]]+)|\[(\d+)\]", m.group(1))]
+                raise self.error(list(parts) + inner, m.group(2)) from None
+            raise self.error(parts, message) from None
+
+    def table(self, value, parts, allowed, required=()) -> dict:
+        if not isinstance(value, dict):
+            raise self.error(parts, f"got {value!r}; expected a table")
+        for key in value:
+            if key not in allowed:
+                raise self.error(list(parts) + [key], f"unknown key; allowed keys: {', '.join(allowed)}")
+        for key in required:
+            if key not in value:
+                raise self.error(list(parts) + [key], "missing; this value is required")
+        return value
+
+    def array(self, key: str) -> list:
+        value = self.data.get(key, [])
+        if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
+            raise self.error([key], f"got {value!r}; expected [[{key}]] tables")
+        return value
+
+    def file(self, value, parts) -> str:
+        if not isinstance(value, str) or not value.strip():
+            raise self.error(parts, f"got {value!r}; expected a file name (relative to the study file)")
+        path = value if os.path.isabs(value) else os.path.normpath(self.base / value)
+        if not os.path.isfile(path):
+            raise self.error(parts, f"{value!r}: no such file" + (f" ({path})" if path != value else ""))
+        self.inputs.append(path)
+        return path
+
+    # -- sections ------------------------------------------------------------------
+    def study(self, cls):
+        from .settings import Compute, Grid
+        from .spec import SurrogateSpec
+
+        data = self.table(self.data, [], TOP_KEYS, ("name",))
+        if not isinstance(data["name"], str) or not data["name"].strip():
+            raise self.error(["name"], f"got {data['name']!r}; expected the study's name")
+        joint = data.get("joint", "holder-tool")
+        if not isinstance(joint, str) or not joint:
+            raise self.error(["joint"], f"got {joint!r}; expected the name of the machines' holder-tool joint")
+        plugins = data.get("plugins", [])
+        if not isinstance(plugins, list) or not all(isinstance(p, str) and p for p in plugins):
+            raise self.error(["plugins"], f"got {plugins!r}; expected a list of module names")
+        grid = self.call(["grid"], Grid, **self.table(data.get("grid", {}), ["grid"], _GRID_KEYS))
+        compute = self.call(["compute"], Compute, **self.table(data.get("compute", {}), ["compute"], _COMPUTE_KEYS))
+        surrogate = None
+        if "surrogate" in data:
+            s = self.table(data["surrogate"], ["surrogate"], _SURROGATE_KEYS, ("table",))
+            kw = dict(s)
+            kw["table"] = self.file(s["table"], ["surrogate", "table"])
+            surrogate = self.call(["surrogate"], SurrogateSpec, **kw)
+        machines = [self.machine(m, ["machines", i]) for i, m in enumerate(self.array("machines"))]
+        if not machines:
+            raise self.error([], "no [[machines]] table; a study needs at least one machine (assembly = \"default\" "
+                             "is the built-in one)")
+        cuts = [self.cut(c, ["cuts", i]) for i, c in enumerate(self.array("cuts"))]
+        combos = [self.combination(c, ["combinations", i]) for i, c in enumerate(self.array("combinations"))]
+        if "combinations_csv" in data:
+            path = self.file(data["combinations_csv"], ["combinations_csv"])
+            combos += read_combinations_csv(path)
+        if not combos:
+            raise self.error([], "no combinations: give [[combinations]] tables or combinations_csv = \"FILE.csv\"")
+        return self.call([], cls, data["name"], machines, combos, cuts, compute, grid, surrogate, joint,
+                         tuple(plugins), source=self.source, inputs=tuple(self.inputs))
+
+    def machine(self, table, parts):
+        from .spec import Machine
+
+        table = self.table(table, parts, _MACHINE_KEYS, ("name",))
+        kw = dict(table)
+        assembly = table.get("assembly", "default")
+        kw["assembly"] = "default" if assembly == "default" else self.file(assembly, parts + ["assembly"])
+        return self.call(parts, Machine, **kw, where=f"{self.where(parts)}: {_path(parts)}")
+
+    def cut(self, table, parts):
+        from .spec import Cut
+
+        table = self.table(table, parts, _CUT_KEYS, ("name",))
+        kw = dict(table)
+        if "workpiece_table" in table:
+            kw["workpiece_table"] = self.file(table["workpiece_table"], parts + ["workpiece_table"])
+        return self.call(parts, Cut, **kw, where=f"{self.where(parts)}: {_path(parts)}")
+
+    def combination(self, table, parts):
+        from .spec import Combination
+
+        table = self.table(table, parts, _COMBINATION_KEYS, ("name",))
+        return self.call(parts, Combination, **table, where=f"{self.where(parts)}: {_path(parts)}")
+
+
+def reads_study(cls: Any, text: str, source: str = "<string>", base: Any = ".") -> Any:
+    """Read a study from TOML text.
+
+    Parameters
+    ----------
+    cls : type
+        The study class (:class:`~substructure.study.Study` or a subclass).
+    text : str
+        The study file's text.
+    source : str
+        Its name in messages.
+    base : str or path
+        The folder that relative file names are relative to.
+
+    Returns
+    -------
+    Study
+        The study.
+    """
+    text = text.removeprefix("\ufeff")
+    if not text.strip():
+        raise FileFormatError(f"{source}: the file is empty; expected a study (docs/file-formats.md)")
+    from .._files import parse_toml
+
+    data = parse_toml(text, source)
+    return _Reader(source, text, data, Path(base)).study(cls)
+
+
+def read_study(cls: Any, path: Any) -> Any:
+    """Read a study file (TOML).
+
+    Parameters
+    ----------
+    cls : type
+        The study class (:class:`~substructure.study.Study` or a subclass).
+    path : str or path
+        The study file.
+
+    Returns
+    -------
+    Study
+        The study; relative file names in it are relative to its folder.
+    """
+    from ..io import read_text
+
+    name = os.fspath(path)
+    return reads_study(cls, read_text(name, "study file"), source=name, base=Path(name).parent)
+
+
+# -- the CSV file of combinations -------------------------------------------------------------
+
+_HEAD = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_.]*)\s*(?:\[([^\]]*)\])?\s*$")
+_CSV_PREFIXES = ("tool.", "holder.", "joint.k.", "joint.c.", "features.")
+_CSV_PLAIN = ("name", "machines", "cuts")
+_INTEGER = ("tool.teeth",)
+_NUMBER = ("tool.diameter_ratio",)
+_BOOL = ("holder.shank_taper",)
+
+
+def _csv_cell(column: str, unit: str | None, cell: str, where: str):
+    if unit is not None:
+        try:
+            finite = math.isfinite(float(cell))
+        except ValueError:
+            finite = False
+        if not finite:
+            raise FileFormatError(f"{where}: {column}: got {cell!r}; expected a finite number (in {unit})")
+        return f"{cell} {unit}"
+    if column in _INTEGER:
+        try:
+            return int(cell)
+        except ValueError:
+            raise FileFormatError(f"{where}: {column}: got {cell!r}; expected a whole number") from None
+    if column in _NUMBER:
+        try:
+            return float(cell)
+        except ValueError:
+            raise FileFormatError(f"{where}: {column}: got {cell!r}; expected a number") from None
+    if column in _BOOL:
+        if cell.lower() not in ("true", "false"):
+            raise FileFormatError(f"{where}: {column}: got {cell!r}; expected true or false")
+        return cell.lower() == "true"
+    if column in ("machines", "cuts"):
+        return [v.strip() for v in cell.split(";") if v.strip()]
+    return cell
+
+
+def read_combinations_csv(path: Any) -> list:
+    """Combinations from a CSV file: one per line, columns named by the key paths of a combination.
+
+    Parameters
+    ----------
+    path : str or path
+        The CSV file.  Columns: ``name`` (required), ``machines``, ``cuts``
+        (names separated by ``;``), and ``tool.KEY``, ``holder.KEY``,
+        ``joint.k.ENTRY``, ``joint.c.ENTRY``, ``features.NAME`` with the unit
+        in brackets for quantities (``tool.diameter [mm]``); an empty cell
+        is a value not given.  Lines starting with ``#`` are comments.
+
+    Returns
+    -------
+    list of Combination
+        In file order, each knowing its file and line.
+    """
+    from ..io import read_text
+    from .spec import Combination
+
+    name = os.fspath(path)
+    text = read_text(name, "combinations table")
+    lines = [(n + 1, line) for n, line in enumerate(text.splitlines()) if line.strip() and not
+             line.lstrip().startswith("#")]
+    if not lines:
+        raise FileFormatError(f"{name}: no header; expected columns such as name,tool.diameter [mm],...")
+    rows = list(csv.reader(io.StringIO("\n".join(line for _, line in lines))))
+    header, numbers = rows[0], [n for n, _ in lines]
+    columns = []
+    for i, head in enumerate(header):
+        m = _HEAD.match(head)
+        if not m:
+            raise FileFormatError(f"{name}, line {numbers[0]}: column {i + 1} {head!r}: expected NAME or NAME [UNIT]")
+        column, unit = m.group(1), (m.group(2).strip() if m.group(2) is not None else None)
+        if column not in _CSV_PLAIN and not column.startswith(_CSV_PREFIXES):
+            raise FileFormatError(f"{name}, line {numbers[0]}: column {head!r}: unknown; expected name, machines, "
+                                  "cuts, tool.KEY, holder.KEY, joint.k.ENTRY, joint.c.ENTRY or features.NAME")
+        if column.startswith(("joint.k.", "joint.c.")) and unit is None:
+            raise FileFormatError(f"{name}, line {numbers[0]}: column {head!r}: a joint entry needs its unit, "
+                                  "e.g. joint.k.yf [N/m]")
+        if column in [c for c, _ in columns]:
+            raise FileFormatError(f"{name}, line {numbers[0]}: column {column!r} given twice")
+        columns.append((column, unit))
+    if "name" not in [c for c, _ in columns]:
+        raise FileFormatError(f"{name}, line {numbers[0]}: no column 'name'")
+    out = []
+    for row, number in zip(rows[1:], numbers[1:]):
+        where = f"{name}, line {number}"
+        if len(row) != len(columns):
+            raise FileFormatError(f"{where}: {len(row)} cells; the header has {len(columns)} columns")
+        table: dict[str, Any] = {}
+        for (column, unit), cell in zip(columns, row):
+            cell = cell.strip()
+            if not cell:
+                continue
+            value = _csv_cell(column, unit, cell, where)
+            parts = column.split(".")
+            target = table
+            for part in parts[:-1]:
+                target = target.setdefault(part, {})
+            target[parts[-1]] = value
+        try:
+            out.append(Combination(**table, where=where))
+        except TypeError:
+            raise FileFormatError(f"{where}: name: missing") from None
+        except SubstructureError as exc:
+            raise FileFormatError(f"{where}: {' '.join(str(exc).split())}") from None
+    return out
