@@ -20,6 +20,7 @@ import numpy as np
 from ..errors import FrequencyAxisMismatchError, InvalidValueError, NonReciprocalWarning, UnknownPointError
 from ._fields import _check_frequency, _check_quantity, _complex_array, _labels, _scalar
 from .axis import _GRID_RTOL, Frequency
+from .files._common import register_frf_class
 from .peaks import local_maxima
 
 __all__ = ["FRF"]
@@ -500,7 +501,7 @@ class FRF:
         path : str or os.PathLike
             The file.
         """
-        from ..io.frf_files import write_csv
+        from .files.csv_files import write_csv
 
         write_csv(self, path)
 
@@ -526,7 +527,7 @@ class FRF:
         FRF
             The FRF (a receptance in m/N), shape ``(n_freq, 1, 1)``.
         """
-        from ..io.frf_files import read_csv
+        from .files.csv_files import read_csv
 
         return read_csv(path, output=output, input=input, quantity=quantity)
 
@@ -538,7 +539,7 @@ class FRF:
         path : str or os.PathLike
             The file.
         """
-        from ..io.frf_files import write_uff
+        from .files.uff_writer import write_uff
 
         write_uff(self, path)
 
@@ -560,7 +561,7 @@ class FRF:
         FRF
             The FRF.
         """
-        from ..io.frf_files import read_uff
+        from .files.uff_reader import read_uff
 
         return read_uff(path, record=record, quantity=quantity)
 
@@ -575,3 +576,7 @@ class FRF:
             f"FRF({self.quantity}, {self.frequency!r}, {len(self.outputs)}x{len(self.inputs)}, "
             f"outputs=[{short(self.outputs)}], inputs=[{short(self.inputs)}])"
         )
+
+
+# the class the files of frf.files are read into (they cannot import this module, which imports them)
+register_frf_class(FRF)

@@ -51,8 +51,8 @@ from ..frf import FRF, QUANTITIES
 from ..measurements import Measurement, MeasurementSet, dof_label
 from ..points import check_name
 from .frf_files import read_uff
-from .frf_files._common import _beyond_physical
-from .frf_files.csv_files import _read_csv
+from ..frf.files._common import _beyond_physical
+from ..frf.files.csv_files import _read_csv
 
 __all__ = ["load_measurements", "loads_measurements"]
 

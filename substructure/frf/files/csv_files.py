@@ -1,0 +1,248 @@
+"""CSV files of one FRF: :func:`write_csv` and :func:`read_csv`.
+
+One FRF per file, header ``frequency_hz,real,imag``, one line per frequency,
+receptance in m/N unless told otherwise; values are written with every
+digit (``repr``) so that a written file reads back to the same floats.  A
+fourth column ``coherence`` (the ordinary coherence of a tap test, in
+[0, 1]) may follow: :func:`read_csv_with_coherence` returns it,
+:func:`read_csv` reads such files too and returns the FRF alone.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ...errors import FileFormatError, InvalidValueError
+from ..axis import MAX_GRID_LINES, Frequency
+from ._common import _refuse_all_zero, _require_frf, _shown, frf_class
+
+if TYPE_CHECKING:  # the annotations only (frf.response imports this module)
+    from ..response import FRF
+
+__all__ = ["write_csv", "read_csv", "read_csv_with_coherence"]
+
+CSV_HEADER = "frequency_hz,real,imag"
+COHERENCE_HEADER = CSV_HEADER + ",coherence"
+
+
+def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coherence=None) -> None:
+    """Write a one-entry FRF to a CSV file ``frequency_hz,real,imag`` (``,coherence`` when given).
+
+    Parameters
+    ----------
+    frf : FRF
+        Shape ``(n_freq, 1, 1)``; select one entry of a larger FRF first,
+        e.g. ``frf["tool.tip:y", "tool.tip:y"]``.  The data are written as
+        they are (the file does not record labels or quantity).
+    path : str or path-like
+        The file, written through a temporary file and an atomic rename
+        (:func:`substructure.io.replacing`).
+    overwrite : bool, default True
+        Whether an existing file may be replaced.
+    coherence : array of float, optional
+        The coherence (dimensionless, in [0, 1]) on the FRF's lines, written
+        as a fourth column ``coherence``.
+
+    Raises
+    ------
+    InvalidValueError
+        For an FRF of more than one entry or of fewer than 2 lines (which
+        no reader takes), or a coherence of another length or outside [0, 1].
+    """
+    from ..._files import write_text
+
+    frf = _require_frf(frf, "write_csv")
+    if frf.frequency.n < 2:
+        raise InvalidValueError(
+            f"frf: cannot write {os.fspath(path)}: an FRF file needs at least 2 frequency lines (readers refuse fewer)"
+        )
+    if frf.shape[1:] != (1, 1):
+        raise InvalidValueError(
+            f"frf: a CSV file holds one FRF, this one has {frf.shape[1]}x{frf.shape[2]} entries "
+            f"(outputs {list(frf.outputs)}, inputs {list(frf.inputs)}); select one entry first, "
+            f"e.g. frf[{frf.outputs[0]!r}, {frf.inputs[0]!r}]"
+        )
+    values = frf.data[:, 0, 0]
+    _refuse_all_zero(frf, os.fspath(path))
+    if coherence is None:
+        rows = zip(frf.frequency.hz.tolist(), values.real.tolist(), values.imag.tolist())
+        text = "".join(f"{f!r},{re_!r},{im!r}\n" for f, re_, im in rows)
+        write_text(path, CSV_HEADER + "\n" + text, overwrite=overwrite)
+        return
+    gamma = np.asarray(coherence, dtype=np.float64)
+    if gamma.shape != (frf.frequency.n,) or not np.all((gamma >= 0) & (gamma <= 1)):
+        raise InvalidValueError(
+            f"coherence: cannot write {os.fspath(path)}: expected {frf.frequency.n} values in [0, 1], one per line"
+        )
+    rows4 = zip(frf.frequency.hz.tolist(), values.real.tolist(), values.imag.tolist(), gamma.tolist())
+    text = "".join(f"{f!r},{re_!r},{im!r},{g!r}\n" for f, re_, im, g in rows4)
+    write_text(path, COHERENCE_HEADER + "\n" + text, overwrite=overwrite)
+
+
+def read_csv(
+    path: str | os.PathLike,
+    output: str = "response",
+    input: str = "excitation",
+    quantity: str | None = None,
+) -> FRF:
+    """Read a CSV file ``frequency_hz,real,imag`` into a one-entry FRF.
+
+    A file with a fourth column ``coherence`` is read too; the coherence is
+    checked and returned by :func:`read_csv_with_coherence`.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.  Blank lines are ignored; a UTF-8 byte-order mark is allowed.
+        Other exports (``;`` or tab separators with decimal commas, comment
+        lines, units in the header, magnitude and phase) are read by
+        ``substructure.io.frf_exports`` when unambiguous.
+    output, input : str
+        Labels of the response and excitation DOFs, e.g. ``"tool.tip:y"``.
+    quantity : {"receptance", "mobility", "accelerance"}, optional
+        What the file holds; default: what the header's units say, else
+        receptance.  A quantity that contradicts the header's units is refused.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the file and the line, for a missing file, a directory, a
+        wrong header, a row without three numbers, NaN or inf, a negative,
+        repeated or decreasing frequency, fewer than two rows, or a dead
+        channel (every value 0).
+
+    Returns
+    -------
+    FRF
+        Shape ``(n_freq, 1, 1)``: frequencies in Hz, values as in the file (SI).
+    """
+    return _read_csv(path, output, input, quantity)[0]
+
+
+def read_csv_with_coherence(
+    path: str | os.PathLike,
+    output: str = "response",
+    input: str = "excitation",
+    quantity: str | None = None,
+) -> tuple[FRF, np.ndarray | None]:
+    """Read a CSV file ``frequency_hz,real,imag[,coherence]``: the FRF and its coherence.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file (see :func:`read_csv`).
+    output, input : str
+        Labels of the response and excitation DOFs.
+    quantity : {"receptance", "mobility", "accelerance"}, optional
+        What the file holds (see :func:`read_csv`).
+
+    Returns
+    -------
+    FRF
+        Shape ``(n_freq, 1, 1)``.
+    numpy.ndarray or None
+        The coherence (dimensionless, in [0, 1]) per line, or None for a
+        file without the column.
+
+    Raises
+    ------
+    FileFormatError
+        As :func:`read_csv`, and for a coherence that is not a number in
+        [0, 1], naming the file and the line.
+    """
+    frf, _, coherence = _read_csv(path, output, input, quantity)
+    return frf, coherence
+
+
+def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF, np.ndarray, np.ndarray | None]:
+    """:func:`read_csv_with_coherence`, with the line of the file each frequency line comes from."""
+    from ..._files import MAX_DATA_BYTES, read_text
+
+    name = os.fspath(path)
+    text = read_text(path, "CSV file", MAX_DATA_BYTES)
+    if text.count("\n") > MAX_GRID_LINES + 1000:  # before the lines are split: refused below in any case
+        raise FileFormatError(f"{name}: {text.count(chr(10)):,} lines; an FRF has at most {MAX_GRID_LINES:,} "
+                              "frequency lines (MAX_GRID_LINES)")
+    lines = text.splitlines()
+    numbered = [(k + 1, line) for k, line in enumerate(lines) if line.strip()]
+    if not numbered:
+        raise FileFormatError(f"{name}: the file is empty; expected the header {CSV_HEADER!r}")
+    first, header = numbered[0]
+    columns = header.replace(" ", "").lstrip("\ufeff")
+    if columns not in (CSV_HEADER, COHERENCE_HEADER):  # another program's export: read what is unambiguous
+        from .exports import parse_export
+
+        table, lines_of, said = parse_export(numbered, name, quantity)
+        return _checked_csv(table, lines_of, name, output, input, quantity or said or "receptance"), lines_of, None
+    names = columns.split(",")
+    numbered = numbered[1:]
+    if len(numbered) < 2:
+        raise FileFormatError(
+            f"{name}: {len(numbered)} data row(s); an FRF needs at least 2 frequency lines"
+        )
+    cells = [line.split(",") for _, line in numbered]
+    for (number, line), row in zip(numbered, cells):
+        if len(row) != len(names):
+            raise FileFormatError(
+                f"{name}, line {number}: {_shown(line)} has {len(row)} value(s); expected {len(names)} "
+                f"({', '.join(names)})"
+            )
+    try:
+        table = np.array(cells, dtype=np.float64)
+    except ValueError:
+        for (number, _), row in zip(numbered, cells):
+            for column, cell in zip(names, row):
+                try:
+                    float(cell)
+                except ValueError:
+                    raise FileFormatError(
+                        f"{name}, line {number}: {column} is {_shown(cell.strip())}; expected a number"
+                    ) from None
+        raise  # pragma: no cover - numpy and float() disagree on a cell
+    lines_of = np.array([number for number, _ in numbered])
+    coherence = None
+    if len(names) == 4:
+        coherence = table[:, 3]
+        bad = ~(np.isfinite(coherence) & (coherence >= 0.0) & (coherence <= 1.0))
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise FileFormatError(
+                f"{name}, line {lines_of[k]}: coherence is {float(coherence[k])!r}; expected a number in [0, 1]"
+            )
+        table = table[:, :3]
+    return _checked_csv(table, lines_of, name, output, input, quantity or "receptance"), lines_of, coherence
+
+
+def _checked_csv(table: np.ndarray, lines_of: np.ndarray, name: str, output: str, input: str,
+                 quantity: str) -> FRF:
+    """The FRF of a table ``frequency_hz, real, imag`` (SI) after the checks of every CSV file."""
+    if table.shape[0] < 2:
+        raise FileFormatError(f"{name}: {table.shape[0]} data row(s); an FRF needs at least 2 frequency lines")
+    bad = ~np.isfinite(table)
+    if bad.any():
+        row, column = np.argwhere(bad)[0]
+        raise FileFormatError(
+            f"{name}, line {lines_of[row]}: {CSV_HEADER.split(',')[column]} is {table[row, column]}; "
+            "expected a finite number"
+        )
+    hz = table[:, 0]
+    if hz[0] < 0:
+        raise FileFormatError(f"{name}, line {lines_of[0]}: frequency {float(hz[0])!r} Hz is negative")
+    step_bad = np.diff(hz) <= 0
+    if step_bad.any():
+        k = int(np.argmax(step_bad)) + 1
+        raise FileFormatError(
+            f"{name}, line {lines_of[k]}: frequency {float(hz[k])!r} Hz does not exceed {float(hz[k - 1])!r} Hz "
+            f"of line {lines_of[k - 1]}; frequencies must be strictly increasing, without repeats"
+        )
+    values = table[:, 1] + 1j * table[:, 2]
+    if not np.any(values):
+        raise FileFormatError(
+            f"{name}: every value is 0, a dead channel (a sensor or the hammer not connected?); leave this "
+            "FRF out or measure it again"
+        )
+    return frf_class().single(Frequency.from_hz(hz), values, output=output, input=input, quantity=quantity)
+

@@ -1,0 +1,187 @@
+"""CSV exports of measured FRFs as spreadsheet and acquisition programs write them.
+
+:func:`substructure.io.frf_files.read_csv` reads its own layout
+(``frequency_hz,real,imag`` in SI units) directly and hands every other
+header to :func:`parse_export`, which reads what is unambiguous and refuses
+the rest with what to give instead: comment lines (``#``) before the header,
+``;`` or tab separators (with decimal commas), quoted cells, empty trailing
+columns, units in the header (``Frequency [Hz]``, ``Real [mm/N]``,
+``Magnitude [g/N]``, ``Phase [deg]``), real and imaginary parts or magnitude
+and phase.  A magnitude in dB is refused (its reference is not in the file),
+and so is a column that is neither of these.
+"""
+
+from __future__ import annotations
+
+import csv
+import re
+from typing import Any
+
+import numpy as np
+
+from ...errors import FileFormatError
+from ._common import _shown
+
+__all__ = ["parse_export"]
+
+_NAMES = {
+    "frequency": {"frequency", "freq", "f", "frequencyhz", "freqhz", "frequencies"},
+    "real": {"real", "re", "realpart"},
+    "imag": {"imag", "im", "imaginary", "imagpart", "imaginarypart"},
+    "magnitude": {"magnitude", "mag", "amplitude", "abs", "modulus"},
+    "phase": {"phase", "angle", "arg"},
+}
+_HEADER = re.compile(r"^\s*(?P<name>[^\[\(]*?)\s*(?:[\[\(](?P<unit>.*)[\]\)])?\s*$")
+_TIME_EXPONENT = {0: "receptance", -1: "mobility", -2: "accelerance"}
+
+
+def _column(cell: str, name: str, line: int) -> tuple[str, str | None]:
+    m = _HEADER.match(cell)
+    raw = m["name"] if m else cell
+    key = re.sub(r"[\s_\-./]", "", raw.lower())
+    unit = (m["unit"] or "").strip() or None if m else None
+    if key.endswith("hz") and key[:-2] in _NAMES["frequency"]:
+        if unit is not None and unit.replace(" ", "").lower() != "hz":
+            raise FileFormatError(f"{name}, line {line}: column {_shown(cell)}: its name says Hz but its unit says "
+                                  f"{_shown(unit)}; rename it (e.g. 'Frequency [{unit}]') or correct the unit")
+        key, unit = key[:-2], "Hz"  # frequency_hz
+    for kind, names in _NAMES.items():
+        if key in names:
+            return kind, unit
+    if "db" in key:
+        raise FileFormatError(f"{name}, line {line}: column {_shown(cell)}: a magnitude in dB has no unit of its own "
+                              "(dB of what?); export the real and imaginary parts, or the magnitude in a unit "
+                              "such as m/N or g/N with the phase")
+    raise FileFormatError(
+        f"{name}, line {line}: column {_shown(cell)}; expected frequency, then real and imaginary parts or magnitude "
+        "and phase (e.g. 'frequency_hz,real,imag' or 'Frequency [Hz];Magnitude [m/N];Phase [deg]')")
+
+
+def _value_unit(unit: str | None, cell: str, name: str, line: int):
+    """``(quantity, factor to SI)`` of a value column's unit; ``(None, 1)`` without one."""
+    from .uff_units import _exponents, _unit_of_label
+
+    if unit is None:
+        return None, 1.0
+    if "db" in unit.lower():
+        raise FileFormatError(f"{name}, line {line}: column {_shown(cell)}: a magnitude in dB has no unit of its own "
+                              "(dB of what?); give the magnitude in a unit such as m/N or g/N")
+    try:
+        q = _unit_of_label(unit.replace("µ", "u").replace("μ", "u"))
+    except ValueError:
+        q = None
+    exps = _exponents(q) if q is not None else None
+    kind = _TIME_EXPONENT.get(exps[2]) if exps is not None and exps[:2] == (-1, 1) else None
+    if kind is None:
+        raise FileFormatError(f"{name}, line {line}: column {_shown(cell)}: the unit {_shown(unit)} is not that of a "
+                              "receptance, mobility or accelerance (e.g. m/N, mm/N, um/N, (m/s^2)/N, g/N)")
+    assert q is not None and exps is not None  # kind is found only for a unit read
+    return kind, float(q.m_as(f"meter / newton * second ** {exps[2]}"))
+
+
+def parse_export(numbered: list[tuple[int, str]], name: str, quantity: str | None):
+    """Read a CSV export whose header is not the package's own.
+
+    Parameters
+    ----------
+    numbered : list of (int, str)
+        The non-blank lines of the file with their 1-based line numbers.
+    name : str
+        The file, for messages.
+    quantity : str or None
+        The quantity the caller says the file holds; ``None`` when not said.
+
+    Returns
+    -------
+    table : numpy.ndarray
+        ``(n, 3)``: frequency in Hz, real and imaginary parts in SI units.
+    lines : numpy.ndarray
+        The line number of each row.
+    quantity : str or None
+        The quantity the header's units say (``None`` when they say nothing).
+
+    Raises
+    ------
+    FileFormatError
+        Naming the file and the line, for what cannot be read unambiguously.
+    """
+    from ...units import cycles_per_second, ureg
+
+    rows = [(n, line) for n, line in numbered if not line.lstrip().startswith("#")]
+    if not rows:
+        raise FileFormatError(f"{name}: only comment lines; expected a header such as 'frequency_hz,real,imag'")
+    first, header = rows[0]
+    delimiter = ";" if ";" in header else "\t" if "\t" in header else ","
+    cells = list(csv.reader([line for _, line in rows], delimiter=delimiter))
+    cells = [[c.strip() for c in row] for row in cells]
+    for row in cells:
+        while row and row[-1] == "":  # an empty trailing column (a spreadsheet's last separator)
+            row.pop()
+    columns = [_column(c, name, first) for c in cells[0]]
+    kinds = [k for k, _ in columns]
+    if kinds not in (["frequency", "real", "imag"], ["frequency", "magnitude", "phase"]):
+        raise FileFormatError(
+            f"{name}, line {first}: columns {_shown(delimiter.join(cells[0]))}; expected frequency, then real and "
+            "imaginary parts, or frequency, magnitude and phase, in this order")
+    fcell, vcells = cells[0][0], cells[0][1:]
+    if columns[0][1] is None:
+        raise FileFormatError(f"{name}, line {first}: column {_shown(fcell)} has no unit; name it frequency_hz or give "
+                              "the unit, e.g. 'Frequency [Hz]'")
+    try:
+        funit = ureg.Quantity(1.0, columns[0][1].replace("HZ", "Hz"))
+        ok = funit.check("1 / [time]")
+    except Exception:
+        ok = False
+    if not ok:
+        raise FileFormatError(f"{name}, line {first}: column {_shown(fcell)}: {_shown(columns[0][1])} is not a "
+                              "frequency unit (Hz, kHz, rad/s, rpm)")
+    if kinds[1] == "real":
+        said = [_value_unit(u, c, name, first) for (_, u), c in zip(columns[1:], vcells)]
+        if said[0] != said[1]:
+            raise FileFormatError(f"{name}, line {first}: the real and imaginary parts have different units "
+                                  f"({columns[1][1]!r}, {columns[2][1]!r})")
+        kind, factor = said[0]
+        angle = None
+    else:
+        kind, factor = _value_unit(columns[1][1], vcells[0], name, first)
+        angle = {"deg": np.pi / 180, "degree": np.pi / 180, "degrees": np.pi / 180, "°": np.pi / 180,
+                 "rad": 1.0, "radian": 1.0, "radians": 1.0}.get((columns[2][1] or "").lower())
+        if angle is None:
+            raise FileFormatError(f"{name}, line {first}: column {_shown(vcells[1])}: give the phase's unit, "
+                                  "'Phase [deg]' or 'Phase [rad]'")
+        if columns[1][1] is None and quantity is None:
+            raise FileFormatError(f"{name}, line {first}: column {_shown(vcells[0])} has no unit; give it "
+                                  "(e.g. 'Magnitude [m/N]') or say the quantity")
+    if kind is not None and quantity is not None and kind != quantity:
+        raise FileFormatError(f"{name}, line {first}: the header's units are those of "
+                              f"{'an' if kind[0] == 'a' else 'a'} {kind}, but the quantity given is {quantity}")
+    data = cells[1:]
+    lines = np.array([n for n, _ in rows[1:]])
+    for n, row in zip(lines, data):
+        if len(row) != 3:
+            raise FileFormatError(f"{name}, line {n}: {_shown(delimiter.join(row))} has {len(row)} value(s); "
+                                  "expected 3")
+    text = [[c.replace(",", ".") if delimiter != "," else c for c in row] for row in data]
+    try:
+        table = np.array(text, dtype=np.float64).reshape(-1, 3)
+    except ValueError:
+        for n, row in zip(lines, text):
+            for column, cell in zip(cells[0], row):
+                try:
+                    float(cell)
+                except ValueError:
+                    raise FileFormatError(f"{name}, line {n}: {_shown(column)} is {_shown(cell)}; "
+                                          "expected a number") from None
+        raise  # pragma: no cover - numpy and float() disagree on a cell
+    if angle is not None and (table[:, 1] < 0).any():
+        k = int(np.argmax(table[:, 1] < 0))
+        raise FileFormatError(f"{name}, line {lines[k]}: {cells[0][1]} is {_shown(data[k][1])}; a magnitude is >= 0 (a "
+                              "negative one would turn the phase by 180 degrees): check the export")
+    with np.errstate(over="ignore", invalid="ignore"):
+        hz: Any = table[:, 0] * funit  # a quantity: the column times its unit
+        table[:, 0] = np.asarray(cycles_per_second(hz, fcell), dtype=np.float64)
+        if angle is not None:
+            value = table[:, 1] * np.exp(1j * table[:, 2] * angle)
+            table[:, 1], table[:, 2] = value.real, value.imag
+        table[:, 1:] *= factor
+    return table, lines, kind
