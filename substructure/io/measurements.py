@@ -14,7 +14,8 @@ on what configuration::
     removed = ["tool"]               # optional: components taken off for this test
     averages = 10                    # optional: taps averaged into the FRF (substructure tap writes it)
 
-:func:`load_measurements` and :func:`loads_measurements` return a
+:func:`load_measurements` and :func:`loads_measurements` (and :meth:`MeasurementSet.from_file`;
+the reading itself is in ``substructure.measurements.files``) return a
 :class:`~substructure.measurements.MeasurementSet`.  Data file paths are
 relative to the measurement file.  Files ending in ``.csv`` are CSV
 (``frequency_hz,real,imag``); ``.uff`` and ``.unv`` are universal files,
@@ -40,267 +41,11 @@ dropped.
 from __future__ import annotations
 
 import os
-import re
-import warnings
-from pathlib import Path
-from typing import Any
 
-from . import MAX_DATA_BYTES, check_readable_file, parse_toml, read_text
-from ..errors import FileFormatError, SubstructureError, SubstructureWarning
-from ..frf import FRF, QUANTITIES
-from ..measurements import Measurement, MeasurementSet, dof_label
-from ..points import check_name
-from .frf_files import read_uff
-from ..frf.files._common import _beyond_physical
-from ..frf.files.csv_files import _read_csv
+from ..measurements import MeasurementSet
+from ..measurements.files import read_measurements, reads_measurements
 
 __all__ = ["load_measurements", "loads_measurements"]
-
-_TOP_KEYS = ("name", "frf")
-_FRF_KEYS = ("response", "excitation", "file", "record", "quantity", "sensors", "removed", "averages")
-_REQUIRED = ("response", "excitation", "file")
-_CSV = (".csv",)
-_UFF = (".uff", ".unv")
-_TABLE = re.compile(r"^\s*\[\[\s*frf\s*\]\]\s*(?:#.*)?$")
-
-
-class _LocatedError(FileFormatError):
-    """An error already naming the measurement file and the key path."""
-
-
-class _Lines:
-    """Best-effort line numbers of the keys of a measurement file, for messages."""
-
-    def __init__(self, text: str):
-        self.lines = text.splitlines()
-        self.tables = [n for n, line in enumerate(self.lines) if _TABLE.match(line)]
-
-    def line(self, index: int | None, key: str | None) -> int | None:
-        if index is None:
-            start, end = 0, (self.tables[0] if self.tables else len(self.lines))
-        elif index < len(self.tables):
-            start = self.tables[index]
-            later = [n for n in self.tables if n > start]
-            end = later[0] if later else len(self.lines)
-        else:
-            return None
-        if key is not None:
-            pattern = re.compile(r"^\s*" + re.escape(key) + r"\s*=")
-            for n in range(start, end):
-                if pattern.match(self.lines[n]):
-                    return n + 1
-        return start + 1 if index is not None else None
-
-
-class _Reader:
-    def __init__(self, text: str, base_dir: Path, source: str):
-        self.base_dir, self.source, self.lines = base_dir, source, _Lines(text)
-
-    def error(self, index: int | None, key: str | None, message: str) -> FileFormatError:
-        line = self.lines.line(index, key)
-        where = f"{self.source}, line {line}" if line else self.source
-        path = "" if index is None else f"frf[{index}]"
-        if key is not None:
-            path = f"{path}.{key}" if path else key
-        return _LocatedError(f"{where}: {path}: {message}" if path else f"{where}: {message}")
-
-    # -- values ------------------------------------------------------------
-    def string(self, table: dict, index: int, key: str) -> str:
-        value = table[key]
-        if not isinstance(value, str) or not value.strip():
-            raise self.error(index, key, f"got {value!r}; expected a non-empty string")
-        return value
-
-    def point(self, table: dict, index: int, key: str) -> str:
-        value = self.string(table, index, key)
-        try:
-            return dof_label(value, key)
-        except SubstructureError as exc:
-            message = str(exc)
-            raise self.error(index, key, message.split(": ", 1)[1] if message.startswith(key) else message) from None
-
-    def names(self, table: dict, index: int, key: str) -> tuple[str, ...]:
-        value = table.get(key, [])
-        what = "sensor names declared in the assembly" if key == "sensors" else "component names"
-        if not isinstance(value, list):
-            raise self.error(index, key, f"got {value!r}; expected an array of {what}, e.g. [\"accelerometer\"]")
-        for name in value:
-            try:
-                check_name(name, key)
-            except SubstructureError as exc:
-                raise self.error(index, key, str(exc).split(": ", 1)[1]) from None
-        twice = sorted({n for n in value if value.count(n) > 1})
-        if twice:
-            raise self.error(index, key, f"{', '.join(map(repr, twice))} given more than once")
-        return tuple(value)
-
-    def quantity(self, table: dict, index: int) -> str | None:
-        if "quantity" not in table:
-            return None
-        value = table["quantity"]
-        if value not in QUANTITIES:
-            raise self.error(index, "quantity", f"got {value!r}; expected one of {', '.join(QUANTITIES)}")
-        return value
-
-    def averages(self, table: dict, index: int) -> int | None:
-        if "averages" not in table:
-            return None
-        value = table["averages"]
-        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-            raise self.error(index, "averages", f"got {value!r}; expected the number of averages (an integer >= 1)")
-        return value
-
-    def record(self, table: dict, index: int) -> int | None:
-        if "record" not in table:
-            return None
-        value = table["record"]
-        if isinstance(value, bool) or not isinstance(value, int) or value < 0:
-            raise self.error(index, "record", f"got {value!r}; expected the 0-based index of a type-58 record")
-        return value
-
-    # -- data files -----------------------------------------------------------
-    def data(self, index: int, file: str, record: int | None, quantity: str | None,
-             response: str, excitation: str) -> tuple[FRF, Any]:
-        path = self.base_dir / file
-        suffix = path.suffix.lower()
-        if suffix not in _CSV + _UFF:
-            raise self.error(index, "file", f"{file!r}: unknown kind of file; expected .csv, .uff or .unv")
-        if not path.exists():
-            raise self.error(index, "file", f"{path}: no such file (paths are relative to the measurement file)")
-        try:
-            check_readable_file(path, "data file", MAX_DATA_BYTES)
-            if suffix in _CSV:
-                if record is not None:
-                    raise self.error(index, "record", f"a CSV file ({file}) holds one FRF; record is for UFF files")
-                frf, lines_of, coherence = _read_csv(path, output=response, input=excitation, quantity=quantity)
-            else:
-                frf, lines_of = self.uff(index, path, record, quantity, response, excitation), None
-                coherence = None
-            beyond = _beyond_physical(frf.frequency.hz, frf.data, frf.quantity)  # a measured FRF's range
-            if beyond is not None:
-                k, what = beyond
-                where = (f"line {lines_of[k]}" if lines_of is not None else
-                         f"type-58 record {record or 0}, value {k + 1} of {frf.frequency.n}")
-                raise FileFormatError(f"{path}, {where}: at {frf.frequency.hz[k]:g} Hz: {what}")
-            return frf, coherence
-        except _LocatedError:
-            raise
-        except FileFormatError as exc:  # names the data file (and its line)
-            raise self.error(index, "file", str(exc)) from None
-        except SubstructureError as exc:
-            raise self.error(index, "file", f"{path}: {exc}") from None
-
-    def uff(self, index: int, path: Path, record: int | None, quantity: str | None,
-            response: str, excitation: str) -> FRF:
-        try:
-            frf = read_uff(path, record=record, quantity=quantity)
-        except SubstructureError as exc:
-            if str(exc).startswith("record:"):  # an index beyond the file's records
-                raise self.error(index, "record", f"{path}: {str(exc)[len('record: '):]}") from None
-            raise
-        if frf.shape[1:] != (1, 1):
-            raise self.error(
-                index, "record", f"missing; {path} holds {frf.shape[1] * frf.shape[2]} type-58 records: "
-                "give the 0-based index of this FRF's record, record = N"
-            )
-        stored = []
-        for label in (frf.outputs[0], frf.inputs[0]):
-            try:
-                stored.append(dof_label(label))
-            except SubstructureError:
-                return frf.with_labels((response,), (excitation,))  # labels of another program: not comparable
-        if stored != [response, excitation]:
-            raise self.error(
-                index, "record" if record is not None else "file",
-                f"{path}, record {record if record is not None else 0} holds response {stored[0]} / excitation "
-                f"{stored[1]}, not {response} / {excitation} as this table says; check the record index (0-based)",
-            )
-        return frf.with_labels((response,), (excitation,))
-
-    # -- the file, top down ----------------------------------------------------
-    def measurement_set(self, data: dict) -> MeasurementSet:
-        for key in data:
-            if key not in _TOP_KEYS:
-                raise self.error(None, key, f"unknown key; allowed keys: {', '.join(_TOP_KEYS)}")
-        name = data.get("name", Path(self.source).stem if self.source != "<string>" else "measurements")
-        if not isinstance(name, str) or not name.strip():
-            raise self.error(None, "name", f"got {name!r}; expected a non-empty string")
-        tables = data.get("frf")
-        if tables is None:
-            raise self.error(None, "frf", "missing; a measurement set needs at least one [[frf]] table")
-        if not isinstance(tables, list) or not tables:
-            raise self.error(None, "frf", f"got {tables!r}; expected [[frf]] tables")
-        measurements = [self.measurement(table, index) for index, table in enumerate(tables)]
-        self.check_set(measurements)
-        try:
-            return MeasurementSet(name, measurements, source=self.source)
-        except SubstructureError as exc:  # pragma: no cover - check_set found these first
-            raise FileFormatError(f"{self.source}: {exc}") from None
-
-    def measurement(self, table: Any, index: int) -> Measurement:
-        if not isinstance(table, dict):
-            raise self.error(index, None, f"got {table!r}; expected a table")
-        for key in table:
-            if key not in _FRF_KEYS:
-                raise self.error(index, key, f"unknown key; allowed keys: {', '.join(_FRF_KEYS)}")
-        for key in _REQUIRED:
-            if key not in table:
-                raise self.error(index, key, "missing; this value is required")
-        response, excitation = self.point(table, index, "response"), self.point(table, index, "excitation")
-        file = self.string(table, index, "file")
-        quantity, record = self.quantity(table, index), self.record(table, index)
-        sensors, removed = self.names(table, index, "sensors"), self.names(table, index, "removed")
-        averages = self.averages(table, index)
-        raw, coherence = self.data(index, file, record, quantity, response, excitation)
-        if raw.quantity != "receptance" and raw.frequency.hz[0] == 0.0:
-            line = self.lines.line(index, "file")
-            warnings.warn(
-                f"{self.source}{f', line {line}' if line else ''}: frf[{index}].file: {file}: dropped the 0 Hz "
-                f"line: a {raw.quantity} has no receptance at 0 Hz",
-                SubstructureWarning, stacklevel=2,
-            )
-            raw = raw.crop(lo=raw.frequency.hz[1])
-            coherence = None if coherence is None else coherence[1:]
-        try:
-            receptance = raw.to_receptance()
-        except SubstructureError as exc:
-            raise self.error(index, "file", f"{self.base_dir / file}: {exc}") from None
-        try:
-            return Measurement(response, excitation, receptance, raw.quantity, sensors, removed, file, record,
-                               coherence, averages)
-        except SubstructureError as exc:  # pragma: no cover - every field was checked above
-            raise self.error(index, None, str(exc)) from None
-
-    def check_set(self, measurements: list[Measurement]) -> None:
-        first = measurements[0]
-        seen: dict[tuple, int] = {}
-        sources: dict[tuple, int] = {}
-        for i, m in enumerate(measurements):
-            if m.frf.frequency != first.frf.frequency:
-                raise self.error(
-                    i, "file",
-                    f"{m.file} and {first.file} (frf[0].file) have different frequency axes "
-                    f"({m.frf.frequency!r} and {first.frf.frequency!r}); all FRFs of a measurement set "
-                    "must share one grid: interpolate them to a common grid (FRF.interpolate) and write "
-                    "them again",
-                )
-            key = (m.response, m.excitation, m.configuration)
-            if key in seen:
-                raise self.error(
-                    i, None,
-                    f"measures {m.response} / {m.excitation} in the same configuration as frf[{seen[key]}] "
-                    "(same sensors and removed components); keep one",
-                )
-            seen[key] = i
-            source = (os.path.realpath(self.base_dir / m.file), m.record or 0)
-            if source in sources:
-                j = sources[source]
-                raise self.error(
-                    i, "record" if m.record is not None else "file",
-                    f"reads the same data as frf[{j}] ({m.file}{f', record {m.record}' if m.record else ''}); "
-                    "each [[frf]] table is a measurement of its own: check the file name and the record index",
-                )
-            sources[source] = i
 
 
 def loads_measurements(text: str, base_dir: str | os.PathLike = ".", source: str = "<string>") -> MeasurementSet:
@@ -329,16 +74,7 @@ def loads_measurements(text: str, base_dir: str | os.PathLike = ".", source: str
         Naming ``source``, the key path and the data file; see the module
         documentation for the checks.
     """
-    if not isinstance(text, str):
-        raise FileFormatError(f"{source}: got {type(text).__name__}; expected the TOML text as a str")
-    text = text.removeprefix("\ufeff")  # a byte-order mark left by an editor is not part of the document
-    if not text.strip():
-        raise FileFormatError(f"{source}: the file is empty; expected a measurement set (docs/file-formats.md)")
-    data = parse_toml(text, source)
-    try:
-        return _Reader(text, Path(base_dir), source).measurement_set(data)
-    except _LocatedError as exc:  # the public class, without the internal marker
-        raise FileFormatError(str(exc)) from None
+    return reads_measurements(MeasurementSet, text, base_dir, source)
 
 
 def load_measurements(path: str | os.PathLike) -> MeasurementSet:
@@ -354,6 +90,4 @@ def load_measurements(path: str | os.PathLike) -> MeasurementSet:
     MeasurementSet
         The measurements, their FRFs read; errors name the file and the key.
     """
-    name = os.fspath(path)
-    text = read_text(path, "measurement set file")
-    return loads_measurements(text, base_dir=Path(name).parent, source=name)
+    return read_measurements(MeasurementSet, path)

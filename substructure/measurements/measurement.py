@@ -1,0 +1,318 @@
+"""One measurement: :class:`Measurement` (a measured FRF and the configuration it was taken in), :func:`dof_label`.
+
+The errors of measurement sets (:class:`MeasurementSetError`, :class:`MissingMeasurementError`) are
+here too; :class:`~substructure.measurements.MeasurementSet` is in ``measurement_set``.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+import attrs
+import numpy as np
+
+from ..errors import InvalidValueError, SubstructureError, UnknownPointError
+from ..frf import FRF, QUANTITIES
+from ..points import check_name, parse_point
+
+__all__ = ["Measurement", "MeasurementSetError", "MissingMeasurementError", "dof_label", "Configuration"]
+
+Configuration = tuple[tuple[str, ...], tuple[str, ...]]
+
+
+class MeasurementSetError(SubstructureError, ValueError):
+    """A measurement set does not fit an assembly, or lacks what a computation needs.
+
+    Parameters
+    ----------
+    message : str
+        The message (it lists every problem).
+    problems : sequence of str
+        One line per problem found; kept as the attribute ``problems``.
+    """
+
+    def __init__(self, message: str, problems: Sequence[str] = ()):
+        super().__init__(message)
+        self.problems = tuple(problems)
+
+
+class MissingMeasurementError(MeasurementSetError):
+    """FRFs needed for a receptance matrix are not in the measurement set.
+
+    Parameters
+    ----------
+    message : str
+        The message.
+    missing : sequence of (str, str)
+        The ``(response, excitation)`` DOF labels that are missing; kept as the
+        attribute ``missing``.
+    """
+
+    def __init__(self, message: str, missing: Sequence[tuple[str, str]] = ()):
+        super().__init__(message, [f"{r} / {e}" for r, e in missing])
+        self.missing = tuple(missing)
+
+
+def dof_label(point: Any, field: str = "point") -> str:
+    """The canonical DOF label of a point name, ``:y`` by default.
+
+    ``"tool.tip"`` gives ``"tool.tip:y"``, ``"tool@30mm:theta"`` gives
+    ``"tool@30 mm:theta"`` (the spelling :class:`~substructure.assembly.Assembly`
+    uses in its labels).
+
+    Parameters
+    ----------
+    point : str
+        A point name, with or without a DOF suffix.
+    field : str
+        Name of the argument, for error messages.
+
+    Returns
+    -------
+    str
+        The DOF label.
+
+    Raises
+    ------
+    UnknownPointError
+        When ``point`` is not a point name; the message starts with ``field``.
+    """
+    try:
+        ref = parse_point(point)
+    except UnknownPointError as exc:
+        raise UnknownPointError(f"{field}: {exc}") from None
+    return f"{ref.point}:{ref.dof or 'y'}"
+
+
+def _names(field: str):
+    def convert(value: Any) -> tuple[str, ...]:
+        if value is None:
+            return ()
+        if isinstance(value, str):
+            value = (value,)
+        try:
+            names = tuple(value)
+        except TypeError:
+            raise InvalidValueError(f"{field}: got {value!r}; expected a sequence of names") from None
+        for i, name in enumerate(names):
+            check_name(name, f"{field}[{i}]")
+        twice = sorted({n for n in names if names.count(n) > 1})
+        if twice:
+            raise InvalidValueError(f"{field}: {', '.join(map(repr, twice))} given more than once")
+        return names
+
+    return convert
+
+
+def _optional_record(value: Any) -> int | None:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+        raise InvalidValueError(f"record: got {value!r}; expected a 0-based record index (an integer >= 0)")
+    return int(value)
+
+
+def _check_quantity(instance: Any, attribute: Any, value: Any) -> None:
+    if value not in QUANTITIES:
+        raise InvalidValueError(f"quantity: got {value!r}; expected one of {', '.join(QUANTITIES)}")
+
+
+def _coherence(value: Any) -> np.ndarray | None:
+    if value is None:
+        return None
+    try:
+        array = np.array(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InvalidValueError(
+            f"coherence: got {type(value).__name__}; expected an array of floats in [0, 1]"
+        ) from None
+    if array.ndim != 1:
+        raise InvalidValueError(f"coherence: got shape {array.shape}; expected one value per frequency line")
+    bad = ~np.isfinite(array) | (array < 0.0) | (array > 1.0 + COHERENCE_ROUNDING)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise InvalidValueError(f"coherence: line {k} is {float(array[k])!r}; expected a number in [0, 1]")
+    array = np.minimum(array, 1.0)
+    array.setflags(write=False)
+    return array
+
+
+COHERENCE_ROUNDING = 1e-9
+"""How far above 1 a coherence may lie and be read as 1 (rounding of its estimate)."""
+
+
+def _optional_averages(value: Any) -> int | None:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise InvalidValueError(f"averages: got {value!r}; expected the number of averages (an integer >= 1)")
+    return int(value)
+
+
+def _same_array(a: Any, b: Any) -> bool:
+    if a is None or b is None:
+        return a is b
+    return bool(np.array_equal(a, b))
+
+
+def _check_coherence(instance: "Measurement", attribute: Any, value: np.ndarray | None) -> None:
+    if value is not None and value.shape[0] != instance.frf.frequency.n:
+        raise InvalidValueError(
+            f"coherence: got {value.shape[0]} values for {instance.frf.frequency.n} frequency lines; expected "
+            "one per line of the FRF"
+        )
+
+
+def _check_frf(instance: "Measurement", attribute: Any, frf: Any) -> None:
+    hint = "; build it with Measurement.from_frf(frf, response, excitation)"
+    if not isinstance(frf, FRF):
+        raise InvalidValueError(f"frf: got {type(frf).__name__}; expected an FRF{hint}")
+    if frf.shape[1:] != (1, 1):
+        raise InvalidValueError(f"frf: got {frf.shape[1]}x{frf.shape[2]} entries; expected one FRF (1x1){hint}")
+    if frf.quantity != "receptance":
+        raise InvalidValueError(f"frf: got a {frf.quantity}; expected a receptance (FRF.to_receptance){hint}")
+    if frf.outputs != (instance.response,) or frf.inputs != (instance.excitation,):
+        raise InvalidValueError(
+            f"frf: labels {frf.outputs[0]!r} / {frf.inputs[0]!r} differ from response "
+            f"{instance.response!r} / excitation {instance.excitation!r}{hint}"
+        )
+
+
+def _describe_configuration(configuration: Configuration) -> str:
+    sensors, removed = configuration
+    return f"sensors=[{', '.join(sensors)}], removed=[{', '.join(removed)}]"
+
+
+@attrs.frozen(repr=False)
+class Measurement:
+    """One measured FRF and the configuration of the structure during the test.
+
+    Parameters
+    ----------
+    response, excitation : str
+        Point names with an optional DOF (``"tool.tip"``, ``"tool.tip-5 mm:y"``);
+        stored as canonical DOF labels, ``:y`` by default (``"tool.tip:y"``).
+    frf : FRF
+        One receptance (1x1) whose labels are ``response`` and ``excitation``.
+        :meth:`from_frf` relabels and converts any FRF.
+    quantity : {"receptance", "mobility", "accelerance"}
+        What the data were before conversion to receptance (as measured).
+    sensors : sequence of str
+        Names of the sensors (declared in the assembly) on the structure
+        during this test.
+    removed : sequence of str
+        Names of the components taken off the assembly for this test.
+    file : str, optional
+        The data file as written in the measurement file.
+    record : int, optional
+        The 0-based index of the type-58 record, for universal files.
+    coherence : array of float, optional
+        The ordinary coherence of the estimate (dimensionless, in [0, 1]),
+        one value per line of ``frf`` (a tap test's, see
+        :mod:`substructure.tap`); read-only.
+    averages : int, optional
+        The number of taps averaged into the FRF (>= 1).
+    """
+
+    response: str = attrs.field(converter=lambda value: dof_label(value, "response"))
+    excitation: str = attrs.field(converter=lambda value: dof_label(value, "excitation"))
+    frf: FRF = attrs.field(validator=_check_frf)
+    quantity: str = attrs.field(default="receptance", validator=_check_quantity)
+    sensors: tuple[str, ...] = attrs.field(default=(), converter=_names("sensors"))
+    removed: tuple[str, ...] = attrs.field(default=(), converter=_names("removed"))
+    file: str | None = attrs.field(default=None)
+    record: int | None = attrs.field(default=None, converter=_optional_record)
+    coherence: np.ndarray | None = attrs.field(
+        default=None, converter=_coherence, validator=_check_coherence, eq=attrs.cmp_using(eq=_same_array)
+    )
+    averages: int | None = attrs.field(default=None, converter=_optional_averages)
+
+    @classmethod
+    def from_frf(
+        cls, frf: FRF, response: str, excitation: str, *, sensors: Sequence[str] = (),
+        removed: Sequence[str] = (), file: str | None = None, record: int | None = None,
+        coherence: Any = None, averages: int | None = None,
+    ) -> "Measurement":
+        """A measurement from a one-entry FRF of any quantity.
+
+        The FRF is relabelled with the canonical labels of ``response`` and
+        ``excitation`` and converted to receptance; its quantity is kept in
+        ``quantity``.
+
+        Parameters
+        ----------
+        frf : FRF
+            One entry: a receptance (m/N), mobility (m/(N s)) or accelerance (m/(N s^2)).
+        response : str
+            The response point, e.g. ``"tool.tip"`` (``:y`` by default).
+        excitation : str
+            The excitation point.
+        sensors : sequence of str
+            Sensors on the structure during the test (names declared in the assembly).
+        removed : sequence of str
+            Components absent during the test.
+        file : str, optional
+            The file the FRF came from, for messages.
+        record : int, optional
+            Its record in a universal file.
+        coherence : array of float, optional
+            The coherence (dimensionless, in [0, 1]) on the FRF's lines.
+        averages : int, optional
+            The number of averages (>= 1).
+
+        Returns
+        -------
+        Measurement
+            The measurement, its FRF a receptance in m/N.
+        """
+        if not isinstance(frf, FRF):
+            raise InvalidValueError(f"frf: got {type(frf).__name__}; expected an FRF")
+        out, inp = dof_label(response, "response"), dof_label(excitation, "excitation")
+        if frf.shape[1:] != (1, 1):
+            raise InvalidValueError(
+                f"frf: got {frf.shape[1]}x{frf.shape[2]} entries; expected one FRF (select one entry first)"
+            )
+        receptance = frf.with_labels((out,), (inp,)).to_receptance()
+        return cls(out, inp, receptance, frf.quantity, sensors, removed, file, record, coherence, averages)
+
+    def crop(self, lo: Any = None, hi: Any = None) -> "Measurement":
+        """The measurement restricted to ``lo <= f <= hi``, its coherence on the same lines.
+
+        Parameters
+        ----------
+        lo, hi : float, pint.Quantity, str or None
+            Band limits; plain numbers are in Hz; ``None`` leaves that side open.
+
+        Returns
+        -------
+        Measurement
+            The lines of the band (an empty band is an error).
+        """
+        mask = self.frf.frequency.band_mask(lo, hi)
+        coherence = None if self.coherence is None else self.coherence[mask]
+        return attrs.evolve(self, frf=self.frf.crop(lo, hi), coherence=coherence)
+
+    @property
+    def configuration(self) -> Configuration:
+        """``(sensors, removed)``, each sorted: what identifies the tested configuration."""
+        return tuple(sorted(self.sensors)), tuple(sorted(self.removed))
+
+    @property
+    def values(self) -> np.ndarray:
+        """The receptance as a 1-D complex array (read-only)."""
+        return self.frf.data[:, 0, 0]
+
+    def describe(self) -> str:
+        """``response / excitation`` and, when known, the file: for messages.
+
+        Returns
+        -------
+        str
+            The description.
+        """
+        where = "" if self.file is None else f" ({self.file}{'' if self.record is None else f', record {self.record}'})"
+        return f"{self.response} / {self.excitation}{where}"
+
+    def __repr__(self) -> str:
+        config = _describe_configuration(self.configuration)
+        return f"Measurement({self.describe()}, {self.quantity}, {config}, {self.frf.frequency!r})"
