@@ -1,6 +1,7 @@
 """Exact Timoshenko beams against closed forms and invariants."""
 
 import math
+import typing
 
 import numpy as np
 import pytest
@@ -227,3 +228,9 @@ def test_segments_at_the_ends_of_the_range_give_finite_reciprocal_receptances():
         assert np.allclose(h, np.swapaxes(h, 0, 1), rtol=1e-6, atol=0)   # Maxwell reciprocity
     with pytest.raises(InvalidValueError, match="taper_steps: .*at most 10,000"):
         Segment("10 mm", "10 mm", od_tip="5 mm", taper_steps=10**9)
+
+
+def test_segment_annotations_resolve():
+    # every annotation names something importable (typing.get_type_hints once raised NameError: Material)
+    hints = typing.get_type_hints(Segment)
+    assert hints["material"] is Material and hints["insert"] == Insert | None
