@@ -111,6 +111,7 @@ class Holder(Beam):
         """
         return design(entry, **parameters).holder(name, cls)
 
+
 _LENGTH_KEYS = {
     "interface": ("gauge_diameter", "taper_length", "taper_bore", "gap_length", "gap_diameter",
                   "flange_diameter", "flange_length"),

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import textwrap
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -44,9 +44,9 @@ def _axes_for(ax: Any, parts: Sequence[str]) -> list[Axes]:
         if parts == ("nyquist",):
             fig, axis = plt.subplots(figsize=(6.4, 6.4), layout="constrained")
             return [axis]
-        fig, axes = plt.subplots(len(parts), 1, sharex=True, squeeze=False,
+        fig, grid = plt.subplots(len(parts), 1, sharex=True, squeeze=False,
                                  figsize=(7.0, 2.2 + 1.8 * len(parts)), layout="constrained")
-        return list(axes[:, 0])
+        return list(grid[:, 0])
     if isinstance(ax, Figure):
         ax = ax.axes
     axes = [ax] if isinstance(ax, Axes) else list(np.ravel(np.asarray(ax, dtype=object)))
@@ -132,7 +132,7 @@ def _display_limits(limits: Any, si_units: list[str], factor: float, shown: str)
             f"limits: the entries drawn have different units ({', '.join(sorted(set(si_units)))}); "
             "draw them in separate figures to set limits"
         )
-    out = []
+    out: list[float | None] = []
     for end, value in zip(("lower", "upper"), limits):
         if value is None:
             out.append(None)
@@ -144,13 +144,23 @@ def _display_limits(limits: Any, si_units: list[str], factor: float, shown: str)
     return out[0], out[1]
 
 
+def _mark(line: Any, hz: np.ndarray, cutoff: float | None) -> None:
+    """Keep a line's frequencies and rigid-body cutoff on it, for later autoscaling of overlays."""
+    line._substructure_freq = hz
+    line._substructure_cutoff = cutoff
+
+
+def _cutoff(line: Any) -> float | None:
+    return getattr(line, "_substructure_cutoff", None)
+
+
 def _autoscale(axes: list[Axes], parts: Sequence[str]) -> None:
     """Limits from every line's data above its rigid-body cutoff (lines keep theirs as an attribute)."""
     for part, axis in zip(parts, axes):
         if part == "phase":
             continue
-        lines = [ln for ln in axis.lines if hasattr(ln, "_substructure_freq")]
-        if not any(getattr(ln, "_substructure_cutoff", None) for ln in lines):
+        lines: list[Any] = [ln for ln in axis.lines if hasattr(ln, "_substructure_freq")]
+        if not any(_cutoff(ln) for ln in lines):
             continue
         if part == "nyquist":
             keep = [ln._substructure_freq > (ln._substructure_cutoff or -np.inf) for ln in lines]
@@ -200,7 +210,7 @@ def draw_frf(
             )
     if entries is None:
         entries = [(o, i) for o in frf.outputs for i in frf.inputs]
-    entries = [tuple(e) for e in entries]
+    entries = [cast("tuple[str, str]", tuple(e)) for e in entries]
     values = [frf.entry(o, i) for o, i in entries]  # raises UnknownPointError for bad labels
     scales = [_scaled(frf, o, i, unit) for o, i in entries]
     units = sorted({u for _, u in scales})
@@ -230,8 +240,7 @@ def draw_frf(
                 (line,) = axis.plot(re, im, label=text, **line_kw)
             else:
                 (line,) = axis.plot(hz, re if part == "real" else im, label=text, **line_kw)
-            line._substructure_freq = hz
-            line._substructure_cutoff = cutoff
+            _mark(line, hz, cutoff)
     plain, symbol, definition = _NAMES[frf.quantity]
     ylabels = {
         "magnitude": f"{plain} |{symbol}| ({shown})",
@@ -259,8 +268,8 @@ def draw_frf(
                 axis.set_ylim(*limits)
             if part == "nyquist":
                 axis.set_xlim(*limits)
-    fig = axes[0].figure
-    if any(line.get_label() and not line.get_label().startswith("_") for line in axes[0].lines):
+    fig = cast(Figure, axes[0].figure)  # the axes of a figure (a subfigure's have no width to wrap text in)
+    if any(line.get_label() and not str(line.get_label()).startswith("_") for line in axes[0].lines):
         axes[0].legend(fontsize="small")
     if title is not None:
         fig.suptitle(plain_text(_wrap(str(title), 0.9 * fig.get_figwidth(), plt.rcParams["figure.titlesize"]
@@ -270,8 +279,7 @@ def draw_frf(
         text = f"{symbol} = {definition} ({frf.quantity}), time convention x(t) = X exp(i omega t)"
         if len(entries) == 1 and not earlier:
             text += f"; response {entries[0][0]}, excitation {entries[0][1]}"
-        found = [ln._substructure_cutoff for a in axes for ln in a.lines
-                 if getattr(ln, "_substructure_cutoff", None) is not None]
+        found = [c for a in axes for ln in a.lines if (c := _cutoff(ln)) is not None]
         if found:
             where = "below" if parts == ("nyquist",) else "shaded, below"
             text += f"; {where} {max(found):.4g} Hz: rigid-body (mass) line, drawn but left out of the scale"

@@ -30,6 +30,7 @@ def frf_class() -> Any:
     """The FRF class (:class:`substructure.frf.FRF`)."""
     return _FRF_CLASS[0]
 
+
 _DIRECTION = {"y": 2, "theta": 6}  # UFF direction codes: +Y translation, +Z rotation
 _DIRECTION_NAME = {2: "y", 6: "theta"}
 _SPEC_TYPE = {"receptance": 8, "mobility": 11, "accelerance": 12}  # displacement, velocity, acceleration
