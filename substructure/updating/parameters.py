@@ -23,6 +23,8 @@ path                                           value (SI)
 and a few *linked* parameters that move several numbers as one thing a user
 thinks of: ``components.C.overhang`` (a tool's length out of the holder [m]:
 the first segment at the shank end changes, the fluted length stays),
+``components.C.bore`` (a bore through the whole part [m], its shank held in
+another part too: a coolant bore, a hollow shank),
 ``components.C.segments.I.end`` (the step between two different segments
 moves, the component's length kept: a bore or an insert deeper, a longer
 fluted length on a tool of the same length),
@@ -114,7 +116,7 @@ class ModelParameter:
         return ParamSpec("value", self.unit, self.lower, self.upper, start, self.log, self.nominal)
 
 
-from .paths import _on_beam, _overhang_segment, _plain, _segmented, _unknown, check_path, set_parameters
+from .paths import _on_beam, _overhang_segment, _plain, _segmented, _unknown, bore_segments, check_path, set_parameters
 
 
 
@@ -278,6 +280,12 @@ def model_parameters(assembly) -> list[ModelParameter]:
             out.append(_linked(f"{base}.overhang", "m", total,
                                max(total / LENGTH_FACTOR, fixed + 0.1 * (total - fixed)),
                                LENGTH_FACTOR * total, f"overhang of {comp.name} (its fluted length kept)"))
+        free = bore_segments(comp)
+        if free is not None:  # a bore through the whole part (a coolant bore, a hollow shank or holder)
+            narrow = min(comp.segments[i].od.m_as("m") * (comp.segments[i].flutes.diameter_ratio
+                                                          if comp.segments[i].flutes else 1.0) for i in free)
+            out.append(ModelParameter(f"{base}.bore", "m", comp.segments[free[0]].id.m_as("m"), 0.0, 0.9 * narrow,
+                                      False, f"bore through {comp.name} (every segment without an insert)", True))
         own = comp.segments[0].material
         # a spindle shaft is steel, whose E and rho are known to a few per cent: its stiffness and mass are
         # questions of geometry, bearings and joints, not of its own material (materials.steel.E stays)
