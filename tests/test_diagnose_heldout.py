@@ -87,3 +87,15 @@ def test_the_bored_tools_saved_model_predicts_what_was_not_fitted(bored):
         saved = _error(d.refined_assembly, truth, entry, grid)
         given = _error(nominal, truth, entry, grid)
         assert saved < 0.1 * given, (entry, saved, given)
+
+
+def test_a_rear_bearing_mounted_50_mm_forward_is_placed_to_the_precision_the_data_allow():
+    """Before: stopped at the 15 % window (79.5 mm), with a softer bearing set and a spring that does not exist."""
+    frfs = hd.measure(seed=6, bearings=(1.0, 1.0), bearing_moved=(0, 0.08))
+    d = diagnose(hd.nominal_model(bearings=True), frfs)
+    assert d.explained, d.report
+    (found,) = d.effects
+    assert (found.name, found.where) == ("model-parameter", "supports.0.at")
+    assert found.values["value"] == pytest.approx(0.08, abs=1e-3)
+    std = found.std["value"]
+    assert 0 < std < 1e-3 and abs(found.values["value"] - 0.08) < 4 * std + 2e-4

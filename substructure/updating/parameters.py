@@ -147,7 +147,7 @@ ENGINEERING_NU = (0.15, 0.40)
 """Range of Poisson's ratio of those materials (ceramics and carbides about 0.2, metals about 0.3)."""
 
 
-POSITION_FRACTION = 0.15
+POSITION_FRACTION = 0.25
 """A support or body the model places is where the drawing says within this fraction of its component's length
 (a bearing's effective centre, a nut's seat: centimetres, not across the part)."""
 
@@ -207,7 +207,7 @@ def model_parameters(assembly) -> list[ModelParameter]:
     materials (``ENGINEERING_E``, ``ENGINEERING_RHO``); ``nu`` 0 to
     0.49; loss factors 1e-5 to 0.2; joint and support entries 1e-3 to 1e3
     times (cross terms within passivity, ``k_ym^2 < k_yf k_tm``); positions
-    of supports and bodies within ``POSITION_FRACTION`` (0.15) of their
+    of supports and bodies within ``POSITION_FRACTION`` (0.25) of their
     component's length of where the model has them; sensor and body masses
     0.1 to 10 times; linked
     factors 0.25 to 4 (a component's own ``E`` and ``rho`` within the
