@@ -99,7 +99,7 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
             bearings: tuple[float, float] | None = None, tool_E: float = 580e9, tool_rho: float = 14500.0,
             tool_nu: float = 0.22, ht_loss: float = 0.0,
             drawbar: bool = False, taper: float | None = None, taper_pieces: int = 8, insert_length: float = 0.040,
-            tool_bore: float = 0.0, seed: int = 0,
+            tool_bore: float = 0.0, bearing_moved: tuple[int, float] | None = None, seed: int = 0,
             points=("tool.tip",), excitation: str = "tool.tip", noise: float = 0.015, phase_deg: float = 0.5,
             floor: float = 1e-3) -> list[FRF]:
     """FRFs of the rig with the hidden effects, noisy (response at each point, hammer at ``excitation``).
@@ -115,7 +115,8 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
     diameter [m] of a tool tapering linearly from 12 mm over its length (``taper_pieces`` uniform pieces);
     insert_length, how deep the tool's shank sits in the holder [m] (the model: 40 mm; the holder's length
     stays 66 mm, its 40 mm collar longer by as much as the insert is shorter); tool_bore, a coolant bore
-    through the whole tool [m] (the shank in the holder too).
+    through the whole tool [m] (the shank in the holder too); bearing_moved, (index, position m) of one
+    bearing placed elsewhere than the model says (with ``bearings``).
     """
     cb = fe.Material(tool_E, tool_nu, tool_rho, 0.002)
     m = fe.Model()
@@ -124,8 +125,11 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
     for p in list(points) + [excitation]:
         comp, x = _offset(p, lengths[p.split(".")[0].split("@")[0]])
         wanted[comp].append(x)
+    places = list(BEARINGS)
+    if bearing_moved:
+        places[bearing_moved[0]] = bearing_moved[1]
     spindle_points = wanted["spindle"] + ([springs[1], springs[2]] if springs else []) + (
-        list(BEARINGS) if bearings else []) + ([0.30] if drawbar else [])
+        places if bearings else []) + ([0.30] if drawbar else [])
     s = m.add_beam([(0.12, fe.section(0.07, 0.04, STEEL)), (0.15, fe.section(0.09, 0.04, STEEL)),
                     (0.06, fe.section(0.11, 0.04, STEEL))], points=spindle_points)
     h = m.add_beam([(0.016, fe.section(0.063, 0, STEEL)), (0.050 - insert_length, fe.section(0.04, 0, STEEL)),
@@ -168,7 +172,7 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
         m.add_joint((s, 0.0), (rod, 0.0), [[1e8, 0], [0, 1e4]])
         m.add_joint((s, 0.30), (rod, 0.30), [[1e8, 0], [0, 1e4]])
     if bearings:
-        for i, x in enumerate(BEARINGS):
+        for i, x in enumerate(places):
             factor = bearings[0] if i < 2 else bearings[1]
             m.add_support((s, x), [[BEARING_K * factor, 0], [0, 0]], [[BEARING_C, 0], [0, 0]])
     beams = {"spindle": s, "holder": h, "tool": t}

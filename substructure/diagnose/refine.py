@@ -244,8 +244,9 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say):
     compared with the kept explanation by BIC (``chi^2 / s^2 + p ln n``,
     ``s^2`` the misfit scale of the best of them).  Of those within
     :data:`~substructure.updating.selection.INDIFFERENCE` of the lowest BIC
-    (the data do not decide between them) the one with the fewest
-    parameters is kept, then the lowest BIC; the others are its rivals.
+    (the data do not decide between them) the one with the fewest changes
+    is kept, then the one whose names :func:`preference` puts first, then
+    the fewest parameters and the lowest BIC; the others are its rivals.
 
     Returns
     -------
@@ -291,8 +292,11 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say):
     s2 = max(1.0, best_chi2 / max(n - p_best, 1))
     scored = sorted(((ch, chi2, _bic(chi2, _p(ch), n, s2)) for ch, chi2 in options), key=lambda t: (t[2], _p(t[0])))
     inside = [t for t in scored if t[2] - scored[0][2] <= INDIFFERENCE]
-    # the data do not decide between these: the one with the fewest parameters is kept (then the lowest BIC)
-    kept, kept_chi2, kept_bic = min(inside, key=lambda t: (_p(t[0]), t[2]))
+    # the data do not decide between these: the one with the fewest changes is kept, then the preferred names
+    # (flutes over the same equivalent diameter written as a segment's od), then the fewest parameters and
+    # the lowest BIC
+    kept, kept_chi2, kept_bic = min(inside, key=lambda t: (len(t[0]), sum(preference(c) for c, _ in t[0]),
+                                                           _p(t[0]), t[2]))
     if say and sorted(c.key for c, _ in kept) != keys_now:
         say(f"parsimony: {', '.join(f'{c.effect} at {c.place(v)}' for c, v in kept)} explains as well with "
             f"{_p(kept)} parameter(s) instead of {_p(current)} (BIC {kept_bic:.1f})")

@@ -23,6 +23,8 @@ path                                           value (SI)
 and a few *linked* parameters that move several numbers as one thing a user
 thinks of: ``components.C.overhang`` (a tool's length out of the holder [m]:
 the first segment at the shank end changes, the fluted length stays),
+``components.C.bore`` (a bore through the whole part [m], its shank held in
+another part too: a coolant bore, a hollow shank),
 ``components.C.segments.I.end`` (the step between two different segments
 moves, the component's length kept: a bore or an insert deeper, a longer
 fluted length on a tool of the same length),
@@ -59,7 +61,17 @@ from ..errors import InvalidValueError
 from ..joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint
 from ..materials import Material
 from .changes import Change, ParamSpec
-from .paths import _on_beam, _overhang_segment, _plain, _segmented, _unknown, apply_path_si, check_path, set_parameters
+from .paths import (
+    _on_beam,
+    _overhang_segment,
+    _plain,
+    _segmented,
+    _unknown,
+    apply_path_si,
+    bore_segments,
+    check_path,
+    set_parameters,
+)
 
 __all__ = ["ParamSpec", "Change", "ModelParameter", "ParameterChange", "ParameterSet", "model_parameters",
            "material_changes", "parameter_change", "AssemblyParameterChange", "get_parameter", "set_parameters",
@@ -142,7 +154,7 @@ ENGINEERING_NU = (0.15, 0.40)
 """Range of Poisson's ratio of those materials (ceramics and carbides about 0.2, metals about 0.3)."""
 
 
-POSITION_FRACTION = 0.15
+POSITION_FRACTION = 0.25
 """A support or body the model places is where the drawing says within this fraction of its component's length
 (a bearing's effective centre, a nut's seat: centimetres, not across the part)."""
 
@@ -202,7 +214,7 @@ def model_parameters(assembly) -> list[ModelParameter]:
     materials (``ENGINEERING_E``, ``ENGINEERING_RHO``); ``nu`` 0 to
     0.49; loss factors 1e-5 to 0.2; joint and support entries 1e-3 to 1e3
     times (cross terms within passivity, ``k_ym^2 < k_yf k_tm``); positions
-    of supports and bodies within ``POSITION_FRACTION`` (0.15) of their
+    of supports and bodies within ``POSITION_FRACTION`` (0.25) of their
     component's length of where the model has them; sensor and body masses
     0.1 to 10 times; linked
     factors 0.25 to 4 (a component's own ``E`` and ``rho`` within the
@@ -277,6 +289,12 @@ def model_parameters(assembly) -> list[ModelParameter]:
             out.append(_linked(f"{base}.overhang", "m", total,
                                max(total / LENGTH_FACTOR, fixed + 0.1 * (total - fixed)),
                                LENGTH_FACTOR * total, f"overhang of {comp.name} (its fluted length kept)"))
+        free = bore_segments(comp)
+        if free is not None:  # a bore through the whole part (a coolant bore, a hollow shank or holder)
+            narrow = min(comp.segments[i].od.m_as("m") * (comp.segments[i].flutes.diameter_ratio
+                                                          if comp.segments[i].flutes else 1.0) for i in free)
+            out.append(ModelParameter(f"{base}.bore", "m", comp.segments[free[0]].id.m_as("m"), 0.0, 0.9 * narrow,
+                                      False, f"bore through {comp.name} (every segment without an insert)", True))
         own = comp.segments[0].material
         # a spindle shaft is steel, whose E and rho are known to a few per cent: its stiffness and mass are
         # questions of geometry, bearings and joints, not of its own material (materials.steel.E stays)

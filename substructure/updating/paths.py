@@ -52,6 +52,21 @@ def apply_path_si(structure, path: str, value: float):
         rest = parts[2:]
         if rest[0] in ("segments", "overhang"):
             return structure.with_beam(_section_checked(path, _geometry(beam, path, rest, value)))
+        if rest == ["bore"]:  # every segment without an insert: a coolant bore, a hollow shank
+            value = 0.0 if value < 1e-6 else value
+            bore = np.where(beam.insert[:, 0] > 0, beam.id, value)
+            out = structure.with_beam(_section_checked(path, beam.evolve(id=bore)))
+            # the part's shank clamped in another part (an insert of its material and its diameter) too
+            od, name = float(beam.od[0]), beam.material_names[0]
+            for other in structure.beams.values():
+                if other.name == beam.name:
+                    continue
+                hit = np.array([n == name for n in other.insert_names]) & np.isclose(other.insert[:, 0], od)
+                if hit.any():
+                    ins = other.insert.copy()
+                    ins[hit, 1] = value
+                    out = out.with_beam(_section_checked(path, other.evolve(insert=ins)))
+            return out
         if rest in (["E"], ["rho"], ["loss_factor"]):
             mat = beam.material.copy()
             mat[:, _MAT_COLUMN[rest[0]]] *= value
@@ -197,6 +212,23 @@ def _segmented(component) -> bool:
                                                                              for s in component.segments)
 
 
+def bore_segments(comp) -> list[int] | None:
+    """The segments a component's common bore (``components.C.bore``) runs through, or None.
+
+    A bore through the whole part: every segment without an insert, when none is tapered and they
+    share one bore diameter (0 for a solid part).  Setting it bores the part's shank where another
+    part holds it too (an insert of the part's material and outer diameter, as a holder's insert
+    stands for the tool's shank).
+    """
+    segs = getattr(comp, "segments", None)
+    if not segs or any(seg.is_tapered for seg in segs):
+        return None
+    free = [i for i, seg in enumerate(segs) if seg.insert is None]
+    if not free or len({segs[i].id.m_as("m") for i in free}) != 1:
+        return None
+    return free
+
+
 def _overhang_segment(tool) -> int | None:
     """The segment whose length a tool's overhang changes: the first without flutes."""
     for i, seg in enumerate(tool.segments):
@@ -234,7 +266,7 @@ _HEADS = ("components", "materials", "joints", "supports", "sensors", "masses")
 """The first key of a parameter path."""
 _SEGMENT_KEYS = ("length", "od", "id", "od_tip", "id_tip", "end", "insert.od", "insert.id", "flutes.diameter_ratio")
 """The values of ``components.C.segments.I``."""
-_COMPONENT_KEYS = ("segments", "overhang", "E", "rho", "loss_factor", "material", "supports")
+_COMPONENT_KEYS = ("segments", "overhang", "E", "rho", "loss_factor", "material", "supports", "bore")
 """The keys after ``components.C``."""
 _MATERIAL_KEYS = tuple(_MAT_COLUMN)
 """The values of a material (``materials.M.*``, ``components.C.material.*``): case-sensitive."""
@@ -333,6 +365,9 @@ def check_path(assembly, path: str) -> list[str]:
 
             if rest[0] == "overhang" and (not isinstance(comp, Tool) or _overhang_segment(comp) is None):
                 raise _unknown(path, f"{comp.name!r} has no overhang (a tool with a segment without flutes has)")
+            if rest[0] == "bore" and bore_segments(comp) is None:
+                raise _unknown(path, f"{comp.name!r} has no common bore (its segments without an insert, none "
+                                     "tapered, with one bore diameter have)")
     elif head == "materials":
         _length(path, parts, range(3, 100))
         _key(path, ".".join(parts[:-1]), parts[-1], _MATERIAL_KEYS)
@@ -442,6 +477,22 @@ def _set_one(assembly, path: str, value: float):
             else:
                 raise _unknown(path, f"unknown segment value {what!r}")
             return assembly.with_component(attrs.evolve(comp, segments=segs))
+        if rest == ["bore"]:
+            bore = _si(0.0 if value < 1e-6 else value, "m")  # a bore under a micrometre is no bore
+            segs = [seg if seg.insert is not None else attrs.evolve(seg, id=bore) for seg in segs]
+            out = assembly.with_component(attrs.evolve(comp, segments=segs))
+            # the part's shank clamped in another part (an insert of its material and its diameter) too
+            od, material = comp.segments[0].od.m_as("m"), comp.segments[0].material.name
+            for other in assembly.components:
+                if other.name == comp.name or not _segmented(other):
+                    continue
+                new = [attrs.evolve(seg, insert=attrs.evolve(seg.insert, id=bore))
+                       if seg.insert is not None and seg.insert.material.name == material
+                       and abs(seg.insert.od.m_as("m") - od) <= 1e-9 * max(od, 1e-3) else seg
+                       for seg in other.segments]
+                if new != list(other.segments):
+                    out = out.with_component(attrs.evolve(other, segments=new))
+            return out
         if rest == ["overhang"]:
             i = _overhang_segment(comp)
             seg = segs[i]
