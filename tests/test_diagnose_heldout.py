@@ -99,3 +99,13 @@ def test_a_rear_bearing_mounted_50_mm_forward_is_placed_to_the_precision_the_dat
     assert found.values["value"] == pytest.approx(0.08, abs=1e-3)
     std = found.std["value"]
     assert 0 < std < 1e-3 and abs(found.values["value"] - 0.08) < 4 * std + 2e-4
+
+
+def test_a_body_at_the_spindles_rear_end_is_one_body_not_three_geometry_changes():
+    """A 1.5 kg pulley at the rear end: before, three changes of the spindle's geometry, or two, 'explained'."""
+    d = diagnose(hd.nominal_model(), hd.measure(seed=7, spindle_body=(1.5, 2e-3, 0.0)))
+    assert d.explained, d.report
+    (found,) = d.effects
+    assert found.name == "added-mass" and found.change.where == "spindle rear end"
+    assert found.values["mass"] == pytest.approx(1.5, rel=0.05)
+    assert found.values["position"] < 0.01
