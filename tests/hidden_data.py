@@ -99,7 +99,8 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
             bearings: tuple[float, float] | None = None, tool_E: float = 580e9, tool_rho: float = 14500.0,
             tool_nu: float = 0.22, ht_loss: float = 0.0,
             drawbar: bool = False, taper: float | None = None, taper_pieces: int = 8, insert_length: float = 0.040,
-            tool_bore: float = 0.0, bearing_moved: tuple[int, float] | None = None, seed: int = 0,
+            tool_bore: float = 0.0, bearing_moved: tuple[int, float] | None = None,
+            spindle_body: tuple[float, float, float] | None = None, seed: int = 0,
             points=("tool.tip",), excitation: str = "tool.tip", noise: float = 0.015, phase_deg: float = 0.5,
             floor: float = 1e-3) -> list[FRF]:
     """FRFs of the rig with the hidden effects, noisy (response at each point, hammer at ``excitation``).
@@ -116,7 +117,8 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
     insert_length, how deep the tool's shank sits in the holder [m] (the model: 40 mm; the holder's length
     stays 66 mm, its 40 mm collar longer by as much as the insert is shorter); tool_bore, a coolant bore
     through the whole tool [m] (the shank in the holder too); bearing_moved, (index, position m) of one
-    bearing placed elsewhere than the model says (with ``bearings``).
+    bearing placed elsewhere than the model says (with ``bearings``); spindle_body, (mass kg, rotary inertia
+    kg m^2, x m) of a body on the spindle (a pulley, a rotary union at its rear end).
     """
     cb = fe.Material(tool_E, tool_nu, tool_rho, 0.002)
     m = fe.Model()
@@ -128,7 +130,7 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
     places = list(BEARINGS)
     if bearing_moved:
         places[bearing_moved[0]] = bearing_moved[1]
-    spindle_points = wanted["spindle"] + ([springs[1], springs[2]] if springs else []) + (
+    spindle_points = wanted["spindle"] + ([spindle_body[2]] if spindle_body else []) + ([springs[1], springs[2]] if springs else []) + (
         places if bearings else []) + ([0.30] if drawbar else [])
     s = m.add_beam([(0.12, fe.section(0.07, 0.04, STEEL)), (0.15, fe.section(0.09, 0.04, STEEL)),
                     (0.06, fe.section(0.11, 0.04, STEEL))], points=spindle_points)
@@ -164,6 +166,8 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
         m.add_mass((t, tool_length), sensor_kg, 0.0)
     if nut:
         m.add_mass((h, nut[2]), nut[0], nut[1])
+    if spindle_body:
+        m.add_mass((s, spindle_body[2]), spindle_body[0], spindle_body[1])
     if springs:
         m.add_support((s, springs[1]), [[springs[0], 0], [0, 0]])
         m.add_support((s, springs[2]), [[springs[0], 0], [0, 0]])

@@ -281,6 +281,14 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     final = _comparisons(lik, final_ratios, floors)
     report = unexplained_report(lik, assembly, current, baseline, cons, final_error, floor, explained, say) \
         if not explained else ()
+    if explained and len(current) > MOST_CHANGES:  # a composite that only just reaches the noise
+        explained = False
+        names = ", ".join(f"{c.effect} at {c.place(v)}" for c, v in current)
+        report = [f"unexplained: no candidate explains the data with at most {MOST_CHANGES} changes; "
+                  f"{len(current)} together reach the noise ({names}): several changes that each buy a small "
+                  "improvement are the mark of one effect the search lacks, not of several effects",
+                  "the best (composite) explanation is reported as partial: "
+                  + ", ".join(repr(e) for e in final_effects)]
     if hits:  # a value on the bound of its search is not a measurement: never an explanation
         words = "; ".join(bound_text(current, hit) for hit in hits)
         if explained:
@@ -429,6 +437,11 @@ def _distinct_rivals(assembly, measured, final_effects, outcome, say) -> list:
             out.append((rival, sep))
     return out
 
+
+MOST_CHANGES = 2
+"""Most changes an explanation may hold: two effects at once (a reground tool and a forgotten sensor) are
+found together; three or more that together only just reach the noise are the mark of one effect the search
+lacks, and the verdict says so."""
 
 PHYSICAL_ENDS = ("position", "start", "inset", "inset_tip", "length", "end")
 """Parameters whose bounds are the ends of a component (a body at the tip, a section over the whole tool):

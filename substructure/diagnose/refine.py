@@ -500,6 +500,7 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     dropped: list = []
     if len(current) > 1:
         current, chi2_now, dropped = _prune(lik, current, chi2_now, say)
+    pruned = sorted(c.key for c, _ in current)
     alternatives: dict = {}
     if current:
         current, chi2_now, alternatives = _review(lik, current, chi2_now, steps_fitted, steps_inside, dropped,
@@ -508,7 +509,8 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     if len(current) >= 2:
         before = [c.key for c, _ in current]
         current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say)
-        if len(current) > 1:  # what the review and the parsimony check kept must each still earn its place
+        if len(current) > 1 and sorted(c.key for c, _ in current) != pruned:
+            # what the review and the parsimony check put in must each still earn its place
             current, chi2_now, late = _prune(lik, current, chi2_now, say)
             dropped += late
         if [c.key for c, _ in current] != before:

@@ -35,7 +35,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ..errors import SubstructureError
-from ..updating.elements import AddedMass, GroundSpring, SectionChange, body_bounds
+from ..updating.elements import AddedMass, GroundSpring, SectionChange, body_bounds, rear_bounds
 from ..updating.fit import Fit, fit, from_u, to_u
 from ..updating.parameters import Change, ParameterChange, material_changes, model_parameters, parameter_change
 from ..updating.structure import si_beam
@@ -155,7 +155,15 @@ def candidates(assembly, measured_points: Sequence[str], effects: dict, open_wor
             if not _plain(comp):
                 continue
             lo, hi, mass_max = body_bounds(assembly, comp)
-            out.append(AddedMass(comp.name, comp.length_m, mass_max, (lo, hi)))
+            # the largest rotary inertia: that mass at the radius of twice the widest section (at least 1e-3)
+            widest = max(float(s.od.m_as("m")) for s in comp.segments)
+            inertia_max = max(1e-3, mass_max * widest**2)
+            out.append(AddedMass(comp.name, comp.length_m, mass_max, (lo, hi), inertia_max))
+            rear = rear_bounds(assembly, comp)
+            if rear is not None:  # a spindle's rear end: a pulley, a rotary union
+                body = AddedMass(comp.name, comp.length_m, mass_max, rear, inertia_max)
+                body.where = f"{comp.name} rear end"
+                out.append(body)
             out.append(GroundSpring(comp.name, comp.length_m))
             out.append(SectionChange(comp.name, comp.length_m))
     for name, cls in effects.items():

@@ -358,7 +358,10 @@ def _on_dask(client, tasks: list[dict]):
             yield task, result
     finally:
         if futures:
-            client.cancel(list(futures))
+            try:
+                client.cancel(list(futures))
+            except RuntimeError:  # the client's loop already closed (an interruption): nothing left to cancel
+                pass
 
 
 def _local_cluster(kind: str, n: int, progress: Progress):

@@ -28,6 +28,7 @@ from .parameters import Change, ParamSpec
 from .structure import LinkSI
 
 __all__ = ["AddedMass", "GroundSpring", "SectionChange", "split_beam", "split_segments", "unique_name", "body_bounds",
+           "rear_bounds",
            "STEEL_DENSITY"]
 
 
@@ -79,6 +80,35 @@ def body_bounds(assembly, component) -> tuple[float, float, float]:
     if isinstance(component, Spindle):
         lo = max(supports) if len(supports) else length - float(component.segments[-1].length_m)
     return float(lo), length, float(mass_max)
+
+
+def rear_bounds(assembly, component) -> tuple[float, float] | None:
+    """Where on a spindle's rear end a body the model lacks may sit (a pulley, a rotary union, an encoder).
+
+    The shaft between the bearings runs inside the housing; behind the rear-most
+    bearing it is reached again: from the base to the rear-most support on it, or
+    without supports, the first segment.  None for other components.
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model (for the supports on the component).
+    component : Beam
+        A plain beam component of it.
+
+    Returns
+    -------
+    (float, float) or None
+        Lowest and highest position [m from the base].
+    """
+    from ..components import Spindle
+    from .paths import _on_beam
+
+    if not isinstance(component, Spindle):
+        return None
+    supports = [x for name, x, _ in (_on_beam(assembly, s.at) for s in assembly.supports) if name == component.name]
+    hi = min(supports) if supports else float(component.segments[0].length_m)
+    return (0.0, float(hi)) if hi > 0 else None
 
 
 def unique_name(taken, base: str) -> str:
@@ -138,18 +168,22 @@ class AddedMass(_OnComponent):
         Upper bound of the mass [kg] (see ``body_bounds``).
     position : (float, float), optional
         Where it may sit [m from the base] (default the whole length).
+    inertia_max : float, default 1e-3
+        Upper bound of its rotary inertia [kg m^2] (:func:`body_bounds`' ring:
+        ``mass_max`` at the radius of twice the component's widest section).
     """
 
     effect = "added-mass"
     explanation = ("a body on the structure (a clamping nut, a balancing ring, a sensor) lowers the modes in "
                    "proportion to the square of their motion where it sits: the modes that move most there drop most")
 
-    def __init__(self, component: str, length: float, mass_max: float, position: tuple[float, float] | None = None):
+    def __init__(self, component: str, length: float, mass_max: float, position: tuple[float, float] | None = None,
+                 inertia_max: float = 1e-3):
         super().__init__(component, length)
         lo, hi = position if position is not None else (0.0, self.length)
         self.specs = (
             ParamSpec("mass", "kg", 1e-4, float(mass_max), min(0.01, float(mass_max))),
-            ParamSpec("inertia", "kg*m^2", 1e-10, 1e-3, 1e-8),
+            ParamSpec("inertia", "kg*m^2", 1e-10, max(float(inertia_max), 1e-9), 1e-8),
             ParamSpec("position", "m", float(lo), float(hi), 0.5 * (lo + hi), log=False),
         )
 
