@@ -130,8 +130,9 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
     places = list(BEARINGS)
     if bearing_moved:
         places[bearing_moved[0]] = bearing_moved[1]
-    spindle_points = wanted["spindle"] + ([spindle_body[2]] if spindle_body else []) + ([springs[1], springs[2]] if springs else []) + (
-        places if bearings else []) + ([0.30] if drawbar else [])
+    spindle_points = (wanted["spindle"] + ([spindle_body[2]] if spindle_body else [])
+                      + ([springs[1], springs[2]] if springs else []) + (places if bearings else [])
+                      + ([0.30] if drawbar else []))
     s = m.add_beam([(0.12, fe.section(0.07, 0.04, STEEL)), (0.15, fe.section(0.09, 0.04, STEEL)),
                     (0.06, fe.section(0.11, 0.04, STEEL))], points=spindle_points)
     h = m.add_beam([(0.016, fe.section(0.063, 0, STEEL)), (0.050 - insert_length, fe.section(0.04, 0, STEEL)),
