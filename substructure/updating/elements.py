@@ -169,7 +169,7 @@ class AddedMass(_OnComponent):
     position : (float, float), optional
         Where it may sit [m from the base] (default the whole length).
     inertia_max : float, default 1e-3
-        Upper bound of its rotary inertia [kg m^2] (:func:`body_bounds`' ring:
+        Upper bound of its rotary inertia [kg m^2] (a ring of
         ``mass_max`` at the radius of twice the component's widest section).
     """
 
