@@ -161,9 +161,7 @@ def candidates(assembly, measured_points: Sequence[str], effects: dict, open_wor
             out.append(AddedMass(comp.name, comp.length_m, mass_max, (lo, hi), inertia_max))
             rear = rear_bounds(assembly, comp)
             if rear is not None:  # a spindle's rear end: a pulley, a rotary union
-                body = AddedMass(comp.name, comp.length_m, mass_max, rear, inertia_max)
-                body.where = f"{comp.name} rear end"
-                out.append(body)
+                out.append(AddedMass(comp.name, comp.length_m, mass_max, rear, inertia_max, f"{comp.name} rear end"))
             out.append(GroundSpring(comp.name, comp.length_m))
             out.append(SectionChange(comp.name, comp.length_m))
     for name, cls in effects.items():

@@ -171,6 +171,9 @@ class AddedMass(_OnComponent):
     inertia_max : float, default 1e-3
         Upper bound of its rotary inertia [kg m^2] (a ring of
         ``mass_max`` at the radius of twice the component's widest section).
+    where : str, optional
+        Its name in reports when several ranges of one component are
+        candidates (default the component's name), e.g. ``"spindle rear end"``.
     """
 
     effect = "added-mass"
@@ -178,8 +181,9 @@ class AddedMass(_OnComponent):
                    "proportion to the square of their motion where it sits: the modes that move most there drop most")
 
     def __init__(self, component: str, length: float, mass_max: float, position: tuple[float, float] | None = None,
-                 inertia_max: float = 1e-3):
+                 inertia_max: float = 1e-3, where: str | None = None):
         super().__init__(component, length)
+        self.where = where or component
         lo, hi = position if position is not None else (0.0, self.length)
         self.specs = (
             ParamSpec("mass", "kg", 1e-4, float(mass_max), min(0.01, float(mass_max))),
