@@ -3,7 +3,7 @@
 The catalogue (interfaces BT40, CAT40, HSK-A63 with ER collet, shrink-fit or
 hydraulic noses; approximate geometry from ``substructure/data/holders.toml``
 with its sources, overridable by name) lives in
-:mod:`substructure.components.holder`, beside the :class:`~substructure.Holder`
+``substructure.components.holder``, beside the ``Holder``
 class it builds; see that module and docs/holders.md.
 """
 

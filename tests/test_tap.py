@@ -382,3 +382,21 @@ def test_a_tap_the_record_cuts_short_is_rejected_and_a_quiet_long_record_is_an_e
     quiet = TapRecord(t, 0.01 * rng.standard_normal(n), 1e-9 * rng.standard_normal(n), "displacement", "q.csv")
     with pytest.raises(InvalidValueError, match=r"no tap kept: tap 1 \(q.csv\): no hit"):
         process_taps(quiet, tap_length=0.9)
+
+
+def test_csv_of_another_acquisition_system_semicolons_decimal_commas_and_parentheses(tmp_path):
+    """Exports of decimal-comma locales: 'Time (s);Force (N);Acceleration (g)' and 0,5 in the cells."""
+    t, f = half_sine()
+    x = simulate(f)
+    plain = _write(tmp_path / "plain.csv", "time [s],force [N],acceleration [g]", [t, f, x])
+    rows = ["Time (s);Force (N);Acceleration (g)"] + [
+        ";".join(repr(float(v)).replace(".", ",") for v in row) for row in zip(t, f, x)]
+    (tmp_path / "semi.csv").write_text("\n".join(rows) + "\n")
+    a, b = read_tap_csv(plain), read_tap_csv(tmp_path / "semi.csv")
+    assert b.quantity == a.quantity == "acceleration"
+    assert np.array_equal(a.time, b.time) and np.array_equal(a.force, b.force)
+    assert np.array_equal(a.response, b.response)
+    tabbed = ["time [s]\tforce [N]\tacceleration [g]"] + ["\t".join(repr(float(v)) for v in row)
+                                                         for row in zip(t, f, x)]
+    (tmp_path / "tab.csv").write_text("\n".join(tabbed) + "\n")
+    assert np.array_equal(read_tap_csv(tmp_path / "tab.csv").response, a.response)

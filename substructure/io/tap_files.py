@@ -30,6 +30,7 @@ from . import check_readable_file, read_text
 __all__ = ["read_tap_csv", "read_tap_uff"]
 
 _COLUMN = re.compile(r"^\s*([^\[\]]*?)\s*\[\s*([^\[\]]*?)\s*\]\s*$")
+_COLUMN_PARENS = re.compile(r"^\s*([^()\[\]]*?)\s*\(\s*([^()\[\]]*?)\s*\)\s*$")  # 'time (s)', as exports write it
 _RESPONSES = ("acceleration", "velocity", "displacement")
 
 
@@ -51,7 +52,9 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
     ----------
     path : str or path-like
         The file: header ``time [s],force [N],acceleration [m/s^2]`` (units
-        in brackets; the response may be ``[g]``, velocity ``[m/s]``,
+        in brackets, or in parentheses ``time (s)``; columns separated by
+        commas, or by semicolons or tabs with decimal commas allowed in the
+        cells; the response may be ``[g]``, velocity ``[m/s]``,
         ``[mm/s]``, displacement ``[m]``, ``[um]``, or a voltage).
     sensitivity : str or pint.Quantity, optional
         The response sensor's sensitivity, e.g. ``"10.2 mV/g"``: required
@@ -81,12 +84,17 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
         raise FileFormatError(f"{name}: the file is empty; expected a header such as "
                               "'time [s],force [N],acceleration [m/s^2]' and one row per sample")
     header_line, header = numbered[0]
+    header = header.lstrip("\ufeff")
+    # the separator the header uses: a comma, or (acquisition systems of decimal-comma locales) a semicolon
+    # or a tab, whose cells may then write 0,5 for 0.5
+    sep = "," if "," in header else ";" if ";" in header else "\t" if "\t" in header else ","
     names, units = [], []
-    for k, cell in enumerate(header.lstrip("\ufeff").split(",")):
-        match = _COLUMN.match(cell)
+    for k, cell in enumerate(header.split(sep)):
+        match = _COLUMN.match(cell) or _COLUMN_PARENS.match(cell)
         if not match or not match.group(1) or not match.group(2):
             raise FileFormatError(f"{name}, line {header_line}: column {k + 1} {cell.strip()!r} has no unit in "
-                                  "brackets; expected e.g. 'time [s]', 'force [N]', 'acceleration [m/s^2]'")
+                                  "brackets; expected e.g. 'time [s]', 'force [N]', 'acceleration [m/s^2]' "
+                                  "(separated by commas, semicolons or tabs)")
         names.append(match.group(1))
         units.append(match.group(2))
     labels = [f"{n} [{u}]" for n, u in zip(names, units)]
@@ -115,7 +123,7 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
     rows = numbered[1:]
     if not rows:
         raise FileFormatError(f"{name}: a header and no samples; expected one row per sample")
-    cells = [line.split(",") for _, line in rows]
+    cells = [line.split(sep) if sep == "," else line.replace(",", ".").split(sep) for _, line in rows]
     for (number, line), row in zip(rows, cells):
         if len(row) != 3:
             raise FileFormatError(f"{name}, line {number}: {len(row)} value(s); expected 3 ({', '.join(labels)})")
