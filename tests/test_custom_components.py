@@ -221,3 +221,25 @@ def test_a_type_that_cannot_take_part_is_refused_with_what_it_lacks():
     with pytest.raises(SubstructureError, match="not a component .it has no 'node_key'"):
         Assembly("x", components=(default_assembly().component("spindle"), NoPoints()),
                  joints=(Joint("j", ("spindle.tip", "holder.base"), rigid=True),))
+
+
+def test_a_chuck_of_ones_own_in_a_study(tmp_path, registered):
+    """study: a machine whose holder is the custom chuck; a heavier nut moves its tool-point mode down."""
+    from study_files import write_study
+    from substructure.study import Study
+
+    for grams in (150, 900):
+        save_assembly(_chuck(default_assembly(), grams), tmp_path / f"chuck{grams}.toml")
+    machines = "".join(f'\n[[machines]]\nname = "chuck{g}"\nassembly = "{tmp_path / f"chuck{g}.toml"}"\n'
+                       for g in (150, 900))
+    combos = "".join(f'\n[[combinations]]\nname = "on chuck{g}"\nmachines = ["chuck{g}"]\n'
+                     'tool = { diameter = "12 mm", overhang = "76 mm", flute_length = "30 mm", teeth = 4 }\n'
+                     'joint = { k = { yf = "1.43e7 N/m" } }\n' for g in (150, 900))
+    path = write_study(tmp_path / "s", n=1, extra_machines=machines, extra_combinations=combos)
+    text = path.read_text().replace("combinations_csv", "#")
+    path.write_text(text.replace('name = "explicit 12 mm"', 'name = "explicit 12 mm"\nmachines = ["bench"]'))
+    table = Study.from_file(path).run(scheduler="serial", progress=False)
+    assert (table["status"] == "ok").all(), table[["combination", "cut", "error"]]
+    rows = {c: table[table["combination"] == c].iloc[0] for c in ("on chuck150", "on chuck900")}
+    modes = {c: r["tool_mode_hz"] for c, r in rows.items()}
+    assert modes["on chuck900"] < modes["on chuck150"], modes
