@@ -1,21 +1,18 @@
 """TOML documents that know the line of every key: the one reader of the package's TOML files.
 
 Every TOML file the package reads (assembly, measurement set, study,
-workpiece, cutting-data and joint tables, and the package's own data) is
-parsed by :func:`loads_toml` or :func:`read_toml` into a
-:class:`TomlDocument`: the parsed data with the text they came from, so that
-an error names the file, the line and the key path,
-``"bench.toml, line 12: components[1].segments[0].od: ..."``.
+workpiece, cutting-data and joint tables, the package's own data) is parsed
+by :func:`loads_toml` or :func:`read_toml` into a :class:`TomlDocument`: the
+data with the text they came from, so that an error names the file, the line
+and the key path: ``"bench.toml, line 12: components[1].segments[0].od: ..."``.
 
-The line of a key is found by a scan of the text's structure (table headers,
-arrays of tables nested at any depth, dotted and quoted keys, inline tables,
-arrays across lines, strings and comments skipped), run once, when a line is
-first asked for; the text is valid TOML by then (:func:`parse_toml` read it).
-A key path that is not in the text (a missing key, a field a constructor
-named) is given the line of its nearest container that is.
-
-This module sits in the lowest layer beside :mod:`substructure._files`, so
-that every layer reads its TOML through it.
+The lines come from a scan of the text's structure (table headers, arrays of
+tables nested at any depth, dotted and quoted keys, inline tables, arrays
+across lines; strings and comments skipped), run when a line is first asked
+for, on text the parser has accepted.  A key path the text does not have (a
+missing key, a field a constructor named) gets the line of its nearest
+container that it has.  In the lowest layer, beside :mod:`substructure._files`,
+so that every layer reads TOML through it.
 """
 
 from __future__ import annotations
@@ -43,11 +40,11 @@ _SCALAR = re.compile(r"[^,\]}#\n]*")  # a number, boolean or date: up to the nex
 _FIELD = re.compile(r"^([A-Za-z_][A-Za-z0-9_.\[\]]*): (.*)$", re.DOTALL)
 _PART = re.compile(r"([^.\[\]]+)|\[(\d+)\]")
 
-Path = tuple  # a key path: names (str) and array indices (int)
+Parts = Sequence[str | int]
 
 
-def key_path(parts: Sequence[str | int]) -> str:
-    """A key path as messages write it: ``components[1].segments[0].od``.
+def key_path(parts: Parts) -> str:
+    """A key path as messages write it, ``components[1].segments[0].od`` (``""`` for the document).
 
     Parameters
     ----------
@@ -57,7 +54,7 @@ def key_path(parts: Sequence[str | int]) -> str:
     Returns
     -------
     str
-        The path; ``""`` for the document itself.
+        The path.
     """
     text = ""
     for p in parts:
@@ -66,66 +63,57 @@ def key_path(parts: Sequence[str | int]) -> str:
 
 
 class _Scanner:
-    """The 1-based line of every key and array element of valid TOML text."""
+    """The 1-based line of every key, table and array element of valid TOML text (``lines``)."""
 
     def __init__(self, text: str):
         self.text, self.pos = text, 0
         self.breaks = [m.start() for m in re.finditer("\n", text)]
-        self.explicit: dict[Path, int] = {}  # where a key, table or element is written
-        self.implicit: dict[Path, int] = {}  # where a table is first named inside a longer name
-        self.arrays: dict[Path, int] = {}  # an array of tables (its concrete path) -> its tables so far
-
-    def line_at(self, pos: int) -> int:
-        return bisect.bisect_left(self.breaks, pos) + 1
-
-    def mark(self, path: Path, line: int) -> None:
-        self.explicit.setdefault(path, line)
-        for size in range(1, len(path)):
-            self.implicit.setdefault(path[:size], line)
-
-    def skip(self, pattern: re.Pattern = _SPACE) -> None:
-        m = pattern.match(self.text, self.pos)  # every pattern here matches the empty string
-        self.pos = m.end() if m else self.pos
-
-    def scan(self) -> None:
-        table: Path = ()
+        self.lines: dict[tuple, int] = {}  # a key path -> the line where it first appears
+        self.arrays: dict[tuple, int] = {}  # an array of tables (its path) -> its tables so far
+        table: tuple = ()
         while True:
             self.skip()
-            if self.pos >= len(self.text):
-                return
             before = self.pos
-            if self.text[self.pos] == "[":
+            if self.pos >= len(text):
+                return
+            if text[self.pos] == "[":
                 table = self.header()
             else:
                 self.keyval(table)
             if self.pos == before:  # not TOML the parser accepted: keep what was found
                 return
 
-    def header(self) -> Path:
-        line, array = self.line_at(self.pos), self.text.startswith("[[", self.pos)
+    def mark(self, path: tuple, pos: int) -> None:
+        line = bisect.bisect_left(self.breaks, pos) + 1
+        for size in range(1, len(path) + 1):
+            self.lines.setdefault(path[:size], line)
+
+    def skip(self, pattern: re.Pattern = _SPACE) -> None:
+        m = pattern.match(self.text, self.pos)  # every pattern given matches the empty string
+        self.pos = m.end() if m else self.pos
+
+    def header(self) -> tuple:
+        start, array = self.pos, self.text.startswith("[[", self.pos)
         self.pos += 2 if array else 1
         keys = self.key()
         self.skip(_BLANK)
         self.pos += 2 if array else 1
-        path: Path = ()
-        for name in keys[:-1]:
+        path: tuple = ()
+        for i, name in enumerate(keys):
             path += (name,)
-            if path in self.arrays:  # [[a.b]] and [a.b] after [[a]]: in a's last table
-                path += (self.arrays[path] - 1,)
-        path += tuple(keys[-1:])
+            if path in self.arrays and i < len(keys) - 1:
+                path += (self.arrays[path] - 1,)  # [[a.b]] and [a.b] after [[a]]: in a's last table
         if array:
-            self.mark(path, line)
             self.arrays[path] = self.arrays.get(path, 0) + 1
             path += (self.arrays[path] - 1,)
-        self.mark(path, line)
+        self.mark(path, start)
         return path
 
     def key(self) -> list[str]:
         names: list[str] = []
         while True:
             self.skip(_BLANK)
-            quote = self.text[self.pos:self.pos + 1]
-            if quote in ('"', "'"):
+            if self.text[self.pos:self.pos + 1] in ('"', "'"):
                 start = self.pos
                 self.string()
                 names.append(_unquote(self.text[start:self.pos]))
@@ -140,68 +128,49 @@ class _Scanner:
                 return names
             self.pos += 1
 
-    def keyval(self, table: Path) -> None:
-        line = self.line_at(self.pos)
+    def keyval(self, table: tuple) -> None:
+        start = self.pos
         keys = self.key()
-        if not keys:
-            return
-        self.skip(_BLANK)
-        if self.text[self.pos:self.pos + 1] == "=":
-            self.pos += 1
-        path = table + tuple(keys)
-        self.mark(path, line)
-        self.value(path)
+        if keys:
+            self.skip(_BLANK)
+            self.pos += self.text[self.pos:self.pos + 1] == "="
+            self.mark(table + tuple(keys), start)
+            self.value(table + tuple(keys))
 
-    def value(self, path: Path) -> None:
+    def value(self, path: tuple) -> None:
         self.skip(_BLANK)
         first = self.text[self.pos:self.pos + 1]
         if first in ('"', "'"):
             self.string()
-        elif first == "[":
-            self.array(path)
-        elif first == "{":
-            self.inline_table(path)
+        elif first in ("[", "{"):
+            self.items(path, first == "[")
         else:
             self.skip(_SCALAR)
 
     def string(self) -> None:
         quote = self.text[self.pos] * 3
-        pattern = _STRING[quote] if self.text.startswith(quote, self.pos) else _STRING[quote[0]]
-        m = pattern.match(self.text, self.pos)
+        m = (_STRING[quote] if self.text.startswith(quote, self.pos) else _STRING[quote[0]]).match(self.text, self.pos)
         self.pos = m.end() if m else len(self.text)
 
-    def array(self, path: Path) -> None:
+    def items(self, path: tuple, array: bool) -> None:
+        """An array (its elements numbered) or an inline table, from its opening bracket."""
         self.pos += 1
         index = 0
         while True:
             self.skip()
-            char = self.text[self.pos:self.pos + 1]
-            if char in ("]", ""):
+            char, before = self.text[self.pos:self.pos + 1], self.pos
+            if char in ("]", "}", ""):
                 self.pos += 1
                 return
             if char == ",":
                 self.pos += 1
                 continue
-            before = self.pos
-            self.mark(path + (index,), self.line_at(self.pos))
-            self.value(path + (index,))
-            if self.pos == before:
-                return
-            index += 1
-
-    def inline_table(self, path: Path) -> None:
-        self.pos += 1
-        while True:
-            self.skip()
-            char = self.text[self.pos:self.pos + 1]
-            if char in ("}", ""):
-                self.pos += 1
-                return
-            if char == ",":
-                self.pos += 1
-                continue
-            before = self.pos
-            self.keyval(path)
+            if array:
+                self.mark(path + (index,), self.pos)
+                self.value(path + (index,))
+                index += 1
+            else:
+                self.keyval(path)
             if self.pos == before:
                 return
 
@@ -217,7 +186,10 @@ def _unquote(raw: str) -> str:
 
 
 class TomlDocument:
-    """A parsed TOML document with its text and name: errors that name the file, the line and the key path.
+    """A parsed TOML document with its text and name, for errors that name the file, the line and the key path.
+
+    Key paths (``parts``) are sequences of key names and 0-based indices
+    into arrays of tables and arrays of values, outermost first.
 
     Parameters
     ----------
@@ -231,128 +203,81 @@ class TomlDocument:
 
     def __init__(self, source: str, text: str, data: dict):
         self.source, self.text, self.data = source, text, data
-        self._scanner: _Scanner | None = None
+        self._lines: dict[tuple, int] | None = None
 
     def __repr__(self) -> str:
         return f"TomlDocument({self.source!r}, {len(self.text)} characters)"
 
-    def line(self, parts: Sequence[str | int]) -> int | None:
-        """The 1-based line of a key path, or None when neither it nor a container of it is in the text.
-
-        Parameters
-        ----------
-        parts : sequence of str and int
-            Names of keys and 0-based array indices (of arrays of tables and
-            of arrays of values), outermost first.
-
-        Returns
-        -------
-        int or None
-            The line of the key (of the element, of the table's header);
-            for a key the text does not have, the line of its nearest
-            container that it has; None for a top-level key the text does
-            not have.
-        """
-        if self._scanner is None:
-            self._scanner = _Scanner(self.text)
-            self._scanner.scan()
-        found = self._scanner
+    def line(self, parts: Parts) -> int | None:
+        """The 1-based line of a key path (or of its nearest container in the text), or None."""
+        if self._lines is None:
+            self._lines = _Scanner(self.text).lines
         path = tuple(parts)
-        for size in range(len(path), 0, -1):
-            line = found.explicit.get(path[:size]) or found.implicit.get(path[:size])
-            if line:
-                return line
-        return None
+        return next((self._lines[path[:n]] for n in range(len(path), 0, -1) if path[:n] in self._lines), None)
 
-    def where(self, parts: Sequence[str | int] = ()) -> str:
-        """``"<file>, line N"`` for a key path (``"<file>"`` when it has no line).
-
-        Parameters
-        ----------
-        parts : sequence of str and int
-            The key path (see :meth:`line`).
-
-        Returns
-        -------
-        str
-            The place, for the start of a message.
-        """
+    def where(self, parts: Parts = ()) -> str:
+        """``"<file>, line N"`` for a key path (``"<file>"`` when it has no line)."""
         line = self.line(parts)
         return f"{self.source}, line {line}" if line else self.source
 
-    def error(self, parts: Sequence[str | int], message: str,
-              cls: type[FileFormatError] = FileFormatError) -> FileFormatError:
-        """The error ``"<file>, line N: key.path: message"`` (the key path left out when empty).
-
-        Parameters
-        ----------
-        parts : sequence of str and int
-            The key path (see :meth:`line`).
-        message : str
-            What was given and what was expected.
-        cls : type, default FileFormatError
-            The class of the error (FileFormatError or a subclass).
-
-        Returns
-        -------
-        FileFormatError
-            The error, to be raised.
-        """
+    def error(self, parts: Parts, message: str, cls: type[FileFormatError] = FileFormatError) -> FileFormatError:
+        """The error ``"<file>, line N: key.path: message"`` (of class ``cls``), to be raised."""
         key = key_path(parts)
         return cls(f"{self.where(parts)}: {key}: {message}" if key else f"{self.where(parts)}: {message}")
 
-    def wrap(self, parts: Sequence[str | int], message: str,
-              cls: type[FileFormatError] = FileFormatError) -> FileFormatError:
-        """A constructor's message for the value at ``parts``, its own field path merged into the key path.
+    def wrap(self, parts: Parts, message: str, cls: type[FileFormatError] = FileFormatError) -> FileFormatError:
+        """A constructor's message for the value at ``parts`` as an error, its field path merged into the key path.
 
-        ``"od: got 0 mm; expected ..."`` from the segment at
-        ``components[1].segments[0]`` becomes the error at
-        ``components[1].segments[0].od``; a message that names a path from
-        the top (``components[1].segments[0].od: ...``) is kept as it is,
-        and one that starts with the file's name already is returned
-        unchanged.
-
-        Parameters
-        ----------
-        parts : sequence of str and int
-            The key path of the value the constructor was given.
-        message : str
-            The constructor's message.
-        cls : type, default FileFormatError
-            The class of the error (FileFormatError or a subclass).
-
-        Returns
-        -------
-        FileFormatError
-            The error, to be raised.
+        ``"od: got 0 mm; ..."`` for the segment at ``components[1].segments[0]``
+        is the error at ``components[1].segments[0].od``; a message that gives
+        the path from the top already is kept, one that starts with the file's
+        name is returned as it is.
         """
         if message.startswith(self.source):
             return cls(message)
         m = _FIELD.match(message)
         if not m:
             return self.error(parts, message, cls)
-        field: list[str | int] = [int(i) if i else k for k, i in _PART.findall(m.group(1))]
+        field = [int(i) if i else k for k, i in _PART.findall(m.group(1))]
         own = key_path(parts)
         full = bool(parts) and (m.group(1) == own or m.group(1).startswith(own + "."))
         return self.error(field if full else [*parts, *field], m.group(2), cls)
 
+    def table(self, value: Any, parts: Parts, allowed: Sequence[str], required: Sequence[str] = (),
+              what: str = "a table") -> dict:
+        """``value`` (at ``parts``), checked to be a table of ``allowed`` keys that has the ``required`` ones."""
+        if not isinstance(value, dict):
+            raise self.error(parts, f"got {value!r}; expected {what}")
+        for key in value:
+            if key not in allowed:
+                raise self.error([*parts, key], f"unknown key; allowed keys: {', '.join(allowed)}")
+        for key in required:
+            if key not in value:
+                raise self.error([*parts, key], "missing; this value is required")
+        return value
 
-def _article(what: str) -> str:
-    return f"{'an' if what[:1].lower() in 'aeiou' else 'a'} {what}"
+    def tables(self, key: str, allowed: Sequence[str], required: Sequence[str] = ()) -> list[dict]:
+        """The document's ``[[key]]`` tables (at least one), each checked by :meth:`table`."""
+        rows = self.data.get(key)
+        if rows is None or rows == []:
+            raise self.error([], f"no [[{key}]] table")
+        if not isinstance(rows, list):
+            raise self.error([key], f"got {rows!r}; expected [[{key}]] tables")
+        return [self.table(row, [key, i], allowed, required) for i, row in enumerate(rows)]
 
 
 def loads_toml(text: Any, source: str = "<string>", what: str | None = None) -> TomlDocument:
-    """Parse TOML text into a :class:`TomlDocument`.
+    """Parse TOML text (a leading byte-order mark dropped) into a :class:`TomlDocument`.
 
     Parameters
     ----------
     text : str
-        The TOML text; a leading byte-order mark is dropped.
+        The TOML text.
     source : str, default "<string>"
         The file (or a description of the text), for messages.
     what : str, optional
-        What the document is (``"assembly"``, ``"measurement set"``); given,
-        an empty or blank text is an error saying what was expected.
+        What the document is (``"assembly"``): given, an empty text is an
+        error saying what was expected.
 
     Returns
     -------
@@ -369,12 +294,12 @@ def loads_toml(text: Any, source: str = "<string>", what: str | None = None) -> 
         raise FileFormatError(f"{source}: got {type(text).__name__}; expected the TOML text as a str")
     text = text.removeprefix("\ufeff")  # a byte-order mark left by an editor is not part of the document
     if what is not None and not text.strip():
-        raise FileFormatError(f"{source}: the file is empty; expected {_article(what)} (docs/file-formats.md)")
+        article = "an" if what[:1] in "aeiou" else "a"
+        raise FileFormatError(f"{source}: the file is empty; expected {article} {what} (docs/file-formats.md)")
     return TomlDocument(source, text, parse_toml(text, source))
 
 
-def read_toml(path: Any, what: str = "TOML file", expected: str | None = None,
-              limit: int = MAX_TEXT_BYTES) -> TomlDocument:
+def read_toml(path: Any, what: str = "TOML file", limit: int = MAX_TEXT_BYTES) -> TomlDocument:
     """Read a TOML file through the checked read (:func:`~substructure._files.read_text`) and parse it.
 
     Parameters
@@ -382,10 +307,7 @@ def read_toml(path: Any, what: str = "TOML file", expected: str | None = None,
     path : str or path-like
         The file.
     what : str, default "TOML file"
-        What the file is, for the messages of the read (``"workpiece table"``).
-    expected : str, optional
-        What the document is, for the message of an empty file (see
-        :func:`loads_toml`).
+        What the file is, for the messages (``"workpiece table"``).
     limit : int, default MAX_TEXT_BYTES
         The largest size allowed, in bytes.
 
@@ -393,11 +315,5 @@ def read_toml(path: Any, what: str = "TOML file", expected: str | None = None,
     -------
     TomlDocument
         The document, named by ``os.fspath(path)``.
-
-    Raises
-    ------
-    FileFormatError
-        As :func:`~substructure._files.read_text` and :func:`loads_toml`.
     """
-    text = read_text(path, what, limit)
-    return loads_toml(text, os.fspath(path), expected)
+    return loads_toml(read_text(path, what, limit), os.fspath(path))

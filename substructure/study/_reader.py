@@ -63,15 +63,7 @@ class _Reader:
             raise self.doc.wrap(parts, " ".join(str(exc).split())) from None
 
     def table(self, value, parts, allowed, required=()) -> dict:
-        if not isinstance(value, dict):
-            raise self.error(parts, f"got {value!r}; expected a table")
-        for key in value:
-            if key not in allowed:
-                raise self.error(list(parts) + [key], f"unknown key; allowed keys: {', '.join(allowed)}")
-        for key in required:
-            if key not in value:
-                raise self.error(list(parts) + [key], "missing; this value is required")
-        return value
+        return self.doc.table(value, parts, allowed, required)
 
     def array(self, key: str) -> list:
         value = self.data.get(key, [])

@@ -49,15 +49,7 @@ class _Reader:
             raise self.wrap(parts, exc) from None
 
     def table(self, value, parts, allowed, required=(), what="a table") -> dict:
-        if not isinstance(value, dict):
-            raise self.error(parts, f"got {value!r}; expected {what}")
-        for key in value:
-            if key not in allowed:
-                raise self.error(list(parts) + [key], f"unknown key; allowed keys: {', '.join(allowed)}")
-        for key in required:
-            if key not in value:
-                raise self.error(list(parts) + [key], "missing; this value is required")
-        return value
+        return self.doc.table(value, parts, allowed, required, what)
 
     def array(self, value, parts, what: str) -> list:
         if not isinstance(value, list):
