@@ -1,18 +1,13 @@
 """TOML documents that know the line of every key: the one reader of the package's TOML files.
 
-Every TOML file the package reads (assembly, measurement set, study,
-workpiece, cutting-data and joint tables, the package's own data) is parsed
-by :func:`loads_toml` or :func:`read_toml` into a :class:`TomlDocument`: the
-data with the text they came from, so that an error names the file, the line
-and the key path: ``"bench.toml, line 12: components[1].segments[0].od: ..."``.
-
-The lines come from a scan of the text's structure (table headers, arrays of
-tables nested at any depth, dotted and quoted keys, inline tables, arrays
-across lines; strings and comments skipped), run when a line is first asked
-for, on text the parser has accepted.  A key path the text does not have (a
-missing key, a field a constructor named) gets the line of its nearest
-container that it has.  In the lowest layer, beside :mod:`substructure._files`,
-so that every layer reads TOML through it.
+Every TOML file the package reads is parsed by :func:`loads_toml` or
+:func:`read_toml` into a :class:`TomlDocument`, the data with their text, so
+that errors name the file, the line and the key path
+(``"bench.toml, line 12: components[1].segments[0].od: ..."``).  The lines come
+from a scan of the text's structure (headers, arrays of tables at any depth,
+dotted and quoted keys, inline tables, arrays across lines; strings and
+comments skipped) on the first error; a key the text does not have gets the
+line of its nearest container.
 """
 
 from __future__ import annotations
@@ -44,18 +39,7 @@ Parts = Sequence[str | int]
 
 
 def key_path(parts: Parts) -> str:
-    """A key path as messages write it, ``components[1].segments[0].od`` (``""`` for the document).
-
-    Parameters
-    ----------
-    parts : sequence of str and int
-        Names of keys and 0-based array indices, outermost first.
-
-    Returns
-    -------
-    str
-        The path.
-    """
+    """A key path as messages write it, ``components[1].segments[0].od`` (``""`` for the document)."""
     text = ""
     for p in parts:
         text += f"[{p}]" if isinstance(p, int) else (f".{p}" if text else str(p))
@@ -186,27 +170,15 @@ def _unquote(raw: str) -> str:
 
 
 class TomlDocument:
-    """A parsed TOML document with its text and name, for errors that name the file, the line and the key path.
+    """A parsed TOML document (``data``) with its ``text`` and ``source`` (the file's name, the start of messages).
 
-    Key paths (``parts``) are sequences of key names and 0-based indices
-    into arrays of tables and arrays of values, outermost first.
-
-    Parameters
-    ----------
-    source : str
-        The file (or a description of the text), the start of every message.
-    text : str
-        The TOML text.
-    data : dict
-        The document parsed from ``text``.
+    Key paths (``parts``) are key names and 0-based indices of arrays (of
+    tables or of values), outermost first.
     """
 
     def __init__(self, source: str, text: str, data: dict):
         self.source, self.text, self.data = source, text, data
         self._lines: dict[tuple, int] | None = None
-
-    def __repr__(self) -> str:
-        return f"TomlDocument({self.source!r}, {len(self.text)} characters)"
 
     def line(self, parts: Parts) -> int | None:
         """The 1-based line of a key path (or of its nearest container in the text), or None."""
@@ -257,7 +229,9 @@ class TomlDocument:
         return value
 
     def tables(self, key: str, allowed: Sequence[str], required: Sequence[str] = ()) -> list[dict]:
-        """The document's ``[[key]]`` tables (at least one), each checked by :meth:`table`."""
+        """The ``[[key]]`` tables of a document of nothing else (at least one), each checked by :meth:`table`."""
+        for other in [k for k in self.data if k != key][:1]:
+            raise self.error([other], f"unknown key; expected [[{key}]] tables")
         rows = self.data.get(key)
         if rows is None or rows == []:
             raise self.error([], f"no [[{key}]] table")
@@ -267,28 +241,10 @@ class TomlDocument:
 
 
 def loads_toml(text: Any, source: str = "<string>", what: str | None = None) -> TomlDocument:
-    """Parse TOML text (a leading byte-order mark dropped) into a :class:`TomlDocument`.
+    """TOML text (a leading byte-order mark dropped) parsed into a :class:`TomlDocument` named ``source``.
 
-    Parameters
-    ----------
-    text : str
-        The TOML text.
-    source : str, default "<string>"
-        The file (or a description of the text), for messages.
-    what : str, optional
-        What the document is (``"assembly"``): given, an empty text is an
-        error saying what was expected.
-
-    Returns
-    -------
-    TomlDocument
-        The parsed document with its text.
-
-    Raises
-    ------
-    FileFormatError
-        Naming ``source``: text that is not a str, an empty text (with
-        ``what``), invalid TOML (with the parser's line and column).
+    Text that is not a str, invalid TOML and, with ``what`` (what the
+    document is: ``"assembly"``), an empty text are errors naming ``source``.
     """
     if not isinstance(text, str):
         raise FileFormatError(f"{source}: got {type(text).__name__}; expected the TOML text as a str")
@@ -300,20 +256,5 @@ def loads_toml(text: Any, source: str = "<string>", what: str | None = None) -> 
 
 
 def read_toml(path: Any, what: str = "TOML file", limit: int = MAX_TEXT_BYTES) -> TomlDocument:
-    """Read a TOML file through the checked read (:func:`~substructure._files.read_text`) and parse it.
-
-    Parameters
-    ----------
-    path : str or path-like
-        The file.
-    what : str, default "TOML file"
-        What the file is, for the messages (``"workpiece table"``).
-    limit : int, default MAX_TEXT_BYTES
-        The largest size allowed, in bytes.
-
-    Returns
-    -------
-    TomlDocument
-        The document, named by ``os.fspath(path)``.
-    """
+    """A TOML file read through :func:`~substructure._files.read_text` (``what`` names it there) and parsed."""
     return loads_toml(read_text(path, what, limit), os.fspath(path))

@@ -133,9 +133,6 @@ class CuttingData:
 
 
 def _parse(doc: TomlDocument) -> tuple[CuttingData, ...]:
-    unknown = [k for k in doc.data if k != "cutting"]
-    if unknown:
-        raise doc.error(unknown[:1], "unknown key; expected [[cutting]] tables")
     out = []
     for i, row in enumerate(doc.tables("cutting", _KEYS, _KEYS)):
         try:

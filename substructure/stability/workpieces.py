@@ -243,9 +243,6 @@ def _key(name: str) -> str:
 
 
 def _parse(doc: TomlDocument) -> tuple[Workpiece, ...]:
-    unknown = [k for k in doc.data if k != "workpiece"]
-    if unknown:
-        raise doc.error(unknown[:1], "unknown key; expected [[workpiece]] tables")
     out: list[Workpiece] = []
     seen: dict[str, str] = {}
     for i, row in enumerate(doc.tables("workpiece", WORKPIECE_KEYS, ("name", "model", "source"))):

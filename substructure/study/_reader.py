@@ -46,13 +46,8 @@ _SURROGATE_KEYS = ("table", "model", "targets", "features")
 class _Reader:
     def __init__(self, doc: TomlDocument, base: Path):
         self.source, self.data, self.base, self.doc = doc.source, doc.data, base, doc
+        self.where, self.error, self.table = doc.where, doc.error, doc.table
         self.inputs: list[str] = [doc.source]
-
-    def where(self, parts) -> str:
-        return self.doc.where(parts)
-
-    def error(self, parts, message: str) -> FileFormatError:
-        return self.doc.error(parts, message)
 
     def call(self, parts, factory, *args, **kwargs):
         try:
@@ -61,9 +56,6 @@ class _Reader:
             raise
         except SubstructureError as exc:
             raise self.doc.wrap(parts, " ".join(str(exc).split())) from None
-
-    def table(self, value, parts, allowed, required=()) -> dict:
-        return self.doc.table(value, parts, allowed, required)
 
     def array(self, key: str) -> list:
         value = self.data.get(key, [])

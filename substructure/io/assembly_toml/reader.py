@@ -18,7 +18,7 @@ from ...assembly import Assembly
 from ...beams import Flutes, Insert, Segment
 from ...components import COMPONENT_TYPES, Beam
 from ..._toml import TomlDocument, key_path, loads_toml
-from ...errors import FileFormatError, SubstructureError
+from ...errors import SubstructureError
 from ...frf import Frequency
 from ...joints import Joint, JointProvenance, Mass, Sensor, Support
 from ...materials import CATALOG, Material
@@ -32,24 +32,14 @@ class _Reader:
     """Builds an assembly from parsed TOML, naming the key path in every error."""
 
     def __init__(self, doc: TomlDocument):
-        self.source, self.data, self.doc = doc.source, doc.data, doc
+        self.data, self.doc, self.error, self.table = doc.data, doc, doc.error, doc.table
         self.materials: dict[str, Material] = dict(CATALOG)
-
-    def error(self, parts, message: str) -> FileFormatError:
-        return self.doc.error(parts, message)
-
-    def wrap(self, parts, exc: SubstructureError) -> FileFormatError:
-        """A constructor's error with the container's key path merged into its field."""
-        return self.doc.wrap(parts, str(exc))
 
     def call(self, parts, factory, *args, **kwargs):
         try:
             return factory(*args, **kwargs)
-        except SubstructureError as exc:
-            raise self.wrap(parts, exc) from None
-
-    def table(self, value, parts, allowed, required=(), what="a table") -> dict:
-        return self.doc.table(value, parts, allowed, required, what)
+        except SubstructureError as exc:  # the constructor's field merged into the key path
+            raise self.doc.wrap(parts, str(exc)) from None
 
     def array(self, value, parts, what: str) -> list:
         if not isinstance(value, list):
