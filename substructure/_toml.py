@@ -25,10 +25,11 @@ __all__ = ["TomlDocument", "key_path", "loads_toml", "read_toml"]
 _SPACE = re.compile(r"(?:[ \t\r\n]|#[^\n]*)*")  # blanks, line ends and comments between items
 _BLANK = re.compile(r"[ \t]*")
 _BARE = re.compile(r"[A-Za-z0-9_-]+")
-_STRING = {  # the extent of each kind of string (escapes in basic strings; up to two quotes before the closing)
-    '"""': re.compile(r'"""(?:[^"\\]+|\\[\s\S]|"(?!""))*"""(?:"{0,2})'),
-    "'''": re.compile(r"'''(?:[^']+|'(?!''))*'''(?:'{0,2})"),
-    '"': re.compile(r'"(?:[^"\\\n]+|\\.)*"'),
+_STRING = {  # the extent of each kind of string (escapes in basic strings; up to two quotes before the closing;
+    # one way to match each character, so that no text makes the search backtrack more than once over it)
+    '"""': re.compile(r'"""(?:[^"\\]|\\[\s\S]|"(?!""))*"""(?:"{0,2})'),
+    "'''": re.compile(r"'''(?:[^']|'(?!''))*'''(?:'{0,2})"),
+    '"': re.compile(r'"(?:[^"\\\n]|\\.)*"'),
     "'": re.compile(r"'[^'\n]*'"),
 }
 _SCALAR = re.compile(r"[^,\]}#\n]*")  # a number, boolean or date: up to the next delimiter

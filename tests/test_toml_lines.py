@@ -246,3 +246,41 @@ def test_the_old_line_finders_are_gone():
         assert "class _Locator" not in source and "class _Lines" not in source, path
         if path.name not in ("_files.py", "_toml.py"):
             assert "tomllib.loads" not in source, path
+
+
+def _random_document(rng, depth=0):
+    """Random nested data of every kind TOML holds; keys bare, with spaces, dots or accents (quoted when written)."""
+    keys = ["od", "k", "name", "a b", "x.y", "é", "segments", "1", "-z"]
+    scalars = [lambda: int(rng.integers(-9, 9)), lambda: float(rng.normal()), lambda: bool(rng.integers(2)),
+               lambda: rng.choice(["plain", "[[frf]]", "od = 3 # not a comment", "'quoted'", 'say "hi"', "a\nb"])]
+    out = {}
+    for key in rng.choice(keys, size=int(rng.integers(1, 5)), replace=False):
+        kind = rng.integers(5) if depth < 3 else 0
+        if kind == 0:
+            out[str(key)] = scalars[int(rng.integers(len(scalars)))]()
+        elif kind == 1:
+            out[str(key)] = _random_document(rng, depth + 1)
+        elif kind == 2:  # an array of tables
+            out[str(key)] = [_random_document(rng, depth + 1) for _ in range(int(rng.integers(1, 4)))]
+        elif kind == 3:
+            out[str(key)] = [scalars[0]() for _ in range(int(rng.integers(0, 4)))]
+        else:
+            out[str(key)] = [[scalars[0]()], {"in": scalars[3]()}]
+    return out
+
+
+def test_documents_written_by_another_program_have_every_key_on_a_line_that_names_it():
+    """tomli_w (the package's writer) lays random documents out as it likes; every key path the parser finds has
+    a line, and a named key's line holds its name."""
+    import numpy as np
+    import tomli_w
+
+    rng = np.random.default_rng(22)
+    for _ in range(200):
+        text = tomli_w.dumps(_random_document(rng))
+        doc, lines = loads_toml(text, "r.toml"), text.split("\n")
+        for parts in _paths(doc.data):
+            line = doc.line(parts)
+            assert line is not None, (parts, text)
+            if isinstance(parts[-1], str):
+                assert parts[-1] in lines[line - 1], (parts, line, text)
