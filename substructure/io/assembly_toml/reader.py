@@ -1,6 +1,6 @@
 """Reading assembly files: :func:`load_assembly`, :func:`loads_assembly`, :func:`default_assembly`.
 
-The TOML text is parsed by :func:`substructure._toml.loads_toml`, then read table by table into
+The TOML text is parsed by ``substructure._toml.loads_toml``, then read table by table into
 value objects; every problem raises :class:`~substructure.errors.FileFormatError`
 naming the file, the line where it can be found and the key path
 (``components[2].segments[1].od``), what was given and what was expected.
