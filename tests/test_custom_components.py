@@ -109,6 +109,11 @@ def test_wrong_parameters_are_refused_where_they_enter():
         ComponentParameter("m", "kg", 0.5, 0.0, 1.0)
     with pytest.raises(InvalidValueError, match="expected a value >= 0"):
         set_parameters(model, {"components.holder.nut_mass": -0.1})
+    for value in (None, "0.2", True):  # not a number: refused where it enters, for every path
+        with pytest.raises(InvalidValueError, match="expected a number"):
+            set_parameters(model, {"components.holder.nut_mass": value})
+    with pytest.raises(InvalidValueError, match="finite"):
+        set_parameters(model, {"components.holder.nut_mass": float("nan")})
 
 
 @pytest.fixture(scope="module")

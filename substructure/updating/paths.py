@@ -658,6 +658,9 @@ def set_parameters(assembly, values: Mapping[str, float]):
         When a path names nothing in the assembly.
     """
     for path, value in values.items():
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+            raise InvalidValueError(f"parameter {path!r}: got {value!r}; expected a number (SI, or a factor for a "
+                                    "linked parameter)")
         try:
             assembly = _set_one(assembly, path, value)
         except (IndexError, ValueError, AttributeError) as exc:
