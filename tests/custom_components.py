@@ -19,7 +19,7 @@ import attrs
 import numpy as np
 import pint
 
-from substructure import Holder
+from substructure import Holder, Joint
 from substructure.components import ComponentParameter
 from substructure.errors import InvalidValueError, UnknownPointError
 from substructure.points import parse_point
@@ -127,3 +127,16 @@ class LumpedChuck:
         h = np.moveaxis(np.linalg.inv(np.moveaxis(z, -1, 0)), 0, -1)
         idx = [i for r in refs for i in ((0, 1) if self.node_key(r) == "base" else (2, 3))]
         return h[np.ix_(idx, idx)]
+
+
+@attrs.frozen
+class HystereticJoint(Joint):
+    """A joint with structural damping, ``K = k (1 + i eta)`` (docs/extending.md), its loss factor a field."""
+
+    loss_factor: float = attrs.field(default=0.0, kw_only=True)
+
+    def dynamic_stiffness(self, frequency_hz):
+        n = np.size(frequency_hz)
+        k = self.k.values * (1.0 + 1j * self.loss_factor) + 0j
+        c = 2j * np.pi * np.asarray(frequency_hz, dtype=float) * self.c.values[:, :, None] if self.c else 0.0
+        return np.repeat(k[:, :, None], n, axis=2) + c

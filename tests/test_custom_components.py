@@ -248,3 +248,34 @@ def test_a_chuck_of_ones_own_in_a_study(tmp_path, registered):
     rows = {c: table[table["combination"] == c].iloc[0] for c in ("on chuck150", "on chuck900")}
     modes = {c: r["tool_mode_hz"] for c, r in rows.items()}
     assert modes["on chuck900"] < modes["on chuck150"], modes
+
+
+def _hysteretic(model: Assembly, eta: float) -> Assembly:
+    from custom_components import HystereticJoint
+
+    j = model.joint("holder-tool")
+    return model.with_joint(HystereticJoint(j.name, j.between, k=j.k, c=j.c, loss_factor=eta))
+
+
+def test_a_joint_model_of_ones_own_has_its_numbers_by_path_too():
+    model = _hysteretic(default_assembly(), 0.02)
+    params = {p.path: p for p in model_parameters(model)}
+    assert params["joints.holder-tool.loss_factor"].nominal == pytest.approx(0.02)
+    assert "joints.holder-tool.k.yf" in params
+    structure, evaluate = Structure.from_assembly(model), Evaluator(OUT, IN, F.hz)
+    for path, value in (("joints.holder-tool.loss_factor", 0.1), ("joints.holder-tool.k.yf", 2e7),
+                        ("joints.holder-tool.k", 0.5)):
+        changed = set_parameters(model, {path: value})
+        np.testing.assert_allclose(evaluate(apply_path_si(structure, path, value)), changed.frf(OUT, IN, F).data,
+                                   rtol=1e-9, err_msg=path)
+    assert set_parameters(model, {"joints.holder-tool.loss_factor": 0.1}).joint("holder-tool").loss_factor == 0.1
+
+
+def test_a_hysteretic_joint_is_diagnosed_in_its_own_terms():
+    """The FE rig's holder-tool joint with a loss factor of 0.08 (damping that does not grow with frequency);
+    the model's hysteretic joint says 0.02: found as its own loss factor."""
+    frfs = hd.measure(seed=8, ht_loss=0.08)
+    d = diagnose(_hysteretic(hd.nominal_model(), 0.02), frfs)
+    assert d.explained, d.report
+    assert [e.where for e in d.effects] == ["joints.holder-tool.loss_factor"], [repr(e) for e in d.effects]
+    assert d.effects[0].values["value"] == pytest.approx(0.08, rel=0.1)

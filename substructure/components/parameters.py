@@ -89,9 +89,12 @@ class ComponentParameter:
 
 
 def _derived(component: Any) -> tuple[ComponentParameter, ...]:
-    if is_plain_beam(component) or not attrs.has(type(component)):
+    from ..joints import Joint
+
+    if is_plain_beam(component) or not attrs.has(type(component)) or type(component) is Joint:
         return ()
-    base = {f.name for f in attrs.fields(Beam)} if isinstance(component, Beam) else {"name"}
+    base = ({f.name for f in attrs.fields(Beam)} if isinstance(component, Beam) else
+            {f.name for f in attrs.fields(Joint)} if isinstance(component, Joint) else {"name"})
     out = []
     for field in attrs.fields(type(component)):
         if field.name in base or field.name.startswith("_"):

@@ -315,9 +315,13 @@ def model_parameters(assembly) -> list[ModelParameter]:
         out.append(ModelParameter(f"{p}.loss_factor", "dimensionless", m.loss_factor, 1e-5, 0.2, True,
                                   f"loss factor of {name}"))
     for j in assembly.joints:
-        if type(j) is not Joint or j.rigid:
+        if getattr(j, "rigid", False):
             continue
         p = f"joints.{j.name}"
+        out += [ModelParameter(f"{p}.{q.name}", q.unit, q.nominal, q.lower, q.upper, q.log, q.text)
+                for q in own_parameters(j)]
+        if not isinstance(j, Joint):
+            continue
         out += _matrix_parameters(p, j, f"joint {j.name}")
         out.append(_linked(f"{p}.k", "dimensionless", 1.0, 1e-3, 1e3, f"stiffness of joint {j.name}, as a factor"))
         if j.c:

@@ -108,6 +108,8 @@ def apply_path_si(structure, path: str, value: float):
     if head in ("joints", "supports", "sensors", "masses"):
         key = (head, int(parts[1]) if head == "supports" else parts[1])
         i, link = structure.link(key)
+        if head == "joints" and link.custom is not None:  # a joint model of its own: changed as an object
+            return structure.with_link(i, link.evolve(custom=_set_joint(link.custom, parts[2:], value)))
         if head in ("joints", "supports"):
             if parts[2] == "at":
                 return structure.with_link(i, link.evolve(a=(_component_of(link.a), value)))
@@ -408,8 +410,13 @@ def check_path(assembly, path: str) -> list[str]:
             raise _unknown(path, f"no part is made of {name!r} (materials of the parts: {_expected(made)})")
     elif head == "joints":
         _length(path, parts, (3, 4))
-        assembly.joint(parts[1])  # unknown: the joints there are listed
-        _key(path, f"joints.{parts[1]}", parts[2], _MATRIX_KEYS)
+        joint = assembly.joint(parts[1])  # unknown: the joints there are listed
+        from ..components import own_parameters
+
+        own = tuple(p.name for p in own_parameters(joint))
+        if len(parts) == 3 and parts[2] in own:  # a number the joint model adds (a loss factor)
+            return parts
+        _key(path, f"joints.{parts[1]}", parts[2], _MATRIX_KEYS + own)
         if len(parts) == 4:
             _key(path, f"joints.{parts[1]}.{parts[2]}", parts[3], _ENTRIES)
     elif head == "supports":
@@ -547,6 +554,20 @@ def _set_component(comp, path: str, rest: list[str], value: float):
     return attrs.evolve(comp, segments=segs)
 
 
+def _set_joint(joint, rest: list[str], value: float):
+    """One number of a joint set on the object: its ``k`` or ``c`` (an entry, or all as a factor), or a number
+    its model adds (see :func:`substructure.components.own_parameters`)."""
+    from ..components import own_parameters, with_parameter
+
+    if len(rest) == 1 and rest[0] in {p.name for p in own_parameters(joint)}:
+        return with_parameter(joint, rest[0], value)
+    if len(rest) == 1:
+        units = STIFFNESS_UNITS if rest[0] == "k" else DAMPING_UNITS
+        matrix = joint.k if rest[0] == "k" else joint.c
+        return _quiet(lambda: attrs.evolve(joint, **{rest[0]: _scaled_matrix(matrix, value, units)}))
+    return _set_matrix(joint, rest[0], rest[1], value)
+
+
 def _set_one(assembly, path: str, value: float):
     parts = check_path(assembly, path)
     head = parts[0]
@@ -591,14 +612,7 @@ def _set_one(assembly, path: str, value: float):
         mats = tuple(_material_value(m, prop, value) if m.name == name else m for m in assembly.materials)
         return attrs.evolve(assembly, components=tuple(comps), materials=mats)
     if head == "joints" and len(parts) in (3, 4):
-        joint = assembly.joint(parts[1])
-        if len(parts) == 3:
-            units = STIFFNESS_UNITS if parts[2] == "k" else DAMPING_UNITS
-            matrix = joint.k if parts[2] == "k" else joint.c
-            new = _quiet(lambda: attrs.evolve(joint, **{parts[2]: _scaled_matrix(matrix, value, units)}))
-        else:
-            new = _set_matrix(joint, parts[2], parts[3], value)
-        return assembly.with_joint(new)
+        return assembly.with_joint(_set_joint(assembly.joint(parts[1]), parts[2:], value))
     if head == "supports" and len(parts) == 3 and "+" in parts[1]:
         supports = list(assembly.supports)
         for i in (int(x) for x in parts[1].split("+")):
