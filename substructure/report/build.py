@@ -127,6 +127,10 @@ class Report:
         The speed and depth stable for every member of ``band``.
     band_no_recommendation : str or None
         Why there is none over the band, when there is a band.
+    band_depths_m : tuple of float or None
+        Each member's own recommended depth (m), as if its joints were
+        known (None where it has none); empty without a band. Their range
+        (:attr:`depth_range_m`) is what the joints' uncertainty leaves open.
     cutting : dict or None
         The recommendation's cutting speed and feed against the usual range
         (:func:`~substructure.stability.cutting_conditions`, with
@@ -157,7 +161,17 @@ class Report:
     band: Any = None
     band_recommendation: Any = None
     band_no_recommendation: str | None = None
+    band_depths_m: tuple = attrs.field(default=(), converter=tuple)
     cutting: dict | None = None
+
+    @property
+    def depth_range_m(self) -> tuple[float, float] | None:
+        """The lowest and highest recommended depth (m) over the joints' uncertainty, the nominal among them
+        (the nominal depth twice without a band; None without a recommendation)."""
+        if self.recommendation is None:
+            return None
+        depths = [d for d in self.band_depths_m if d is not None] + [self.recommendation.depth_m]
+        return float(min(depths)), float(max(depths))
 
     @property
     def tool(self):
@@ -220,7 +234,8 @@ class Report:
             "stability_band": None if self.band is None else {
                 "members": len(self.band.members),
                 "recommended": None if self.band_recommendation is None else self.band_recommendation.to_json(),
-                "no_recommendation": self.band_no_recommendation},
+                "no_recommendation": self.band_no_recommendation,
+                "depth_range_m": None if self.depth_range_m is None else list(self.depth_range_m)},
             "cutting_data": self.cutting,
         }
 
@@ -379,14 +394,14 @@ def _lobes(structure: Any, band: Any, cut: Any, speeds: Any, method: str, interv
 
 
 def _joint_band(assembly, at, band, chosen, lobes, cut, limits, speeds, method, intervals, margin, tolerance, say):
-    """The lobes over the joints' stated uncertainty and the recommendation stable across them (None, None, None
-    when no joint states an uncertainty)."""
+    """The lobes over the joints' stated uncertainty, the recommendation stable across them (or why none is) and
+    each variant's own recommended depth (None, None, None, () when no joint states an uncertainty)."""
     from ..joint_priors import joint_variants
     from ..stability import (NoRecommendationError, assembly_structure, choose_band, lobes_band, recommend)
 
     variants = joint_variants(assembly)
     if len(variants) < 2:
-        return None, None, None
+        return None, None, None, ()
     say(f"stability band: lobes of {len(variants)} variants of the joints within their uncertainty")
     members = []
     for variant in variants:
@@ -396,10 +411,17 @@ def _joint_band(assembly, at, band, chosen, lobes, cut, limits, speeds, method, 
             structure, used = choose_band(variant.receptance(at, frequency=variant.frequency), band)
         members.append(_lobes(structure, used, cut, speeds, method, intervals, lambda text: None))
     spread = lobes_band(members, nominal=lobes, label="joints within their uncertainty")
+    own = []  # each variant's own recommended depth, as if its joints were known: their range is the uncertainty
+    for member in members:
+        try:
+            own.append(recommend(member, cut, limits, margin=margin, speed_tolerance=tolerance).depth_m)
+        except InvalidValueError:
+            own.append(None)
     try:
-        return spread, recommend(lobes, cut, limits, margin=margin, speed_tolerance=tolerance, band=spread), None
+        robust = recommend(lobes, cut, limits, margin=margin, speed_tolerance=tolerance, band=spread)
+        return spread, robust, None, own
     except NoRecommendationError as exc:
-        return spread, None, " ".join(str(exc).split())
+        return spread, None, " ".join(str(exc).split()), own
 
 
 def _cutting(cut: Any, best: Any, tool: Any, table: Any, material: str | None) -> dict | None:
@@ -539,6 +561,7 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
     modes, fit_error = _modes(structure, notes)
     tool = _tool_of(assembly, at)
     lobes = best = why = spread = robust = robust_why = shop = None
+    own = ()
     if cut is not None:
         milling = hasattr(cut, "radial_depth")
         if milling:
@@ -563,7 +586,7 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
                 best = recommend(lobes, cut, limits, margin=margin, speed_tolerance=speed_tolerance)
             except InvalidValueError as exc:  # the lobes leave nothing to recommend: the report says why
                 why = str(exc)
-            spread, robust, robust_why = _joint_band(assembly, at, band, chosen, lobes, cut, limits, speeds, method,
+            spread, robust, robust_why, own = _joint_band(assembly, at, band, chosen, lobes, cut, limits, speeds, method,
                                                      intervals, margin, speed_tolerance, say)
             shop = _cutting(cut, best, tool, cutting_table, tool_material)
         else:
@@ -589,4 +612,4 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
         recommendation=best, no_recommendation=why, measurements=measurements, diagnosis=diagnosis,
         identifications=identified, identification_errors=failed, notes=notes, sources=sources, created=created,
         version=substructure.__version__, command=command, band=spread, band_recommendation=robust,
-        band_no_recommendation=robust_why, cutting=shop)
+        band_no_recommendation=robust_why, band_depths_m=own, cutting=shop)

@@ -12,7 +12,10 @@ import html
 import math
 from typing import Any
 
-__all__ = ["cutting_lines", "band_lines", "band_table", "provenance_note", "provenance_warnings", "readable"]
+from ..errors import InvalidValueError
+
+__all__ = ["cutting_lines", "band_lines", "band_table", "depth_order", "provenance_note", "provenance_warnings",
+           "readable"]
 
 
 def _esc(value: Any) -> str:
@@ -91,7 +94,62 @@ def band_lines(report: Any) -> list[str]:
             f"variants), <strong>{_num(robust.spindle_speed_rpm, ',.0f')} rpm at "
             f"{_num(robust.depth_m, '.3g', 1e3)} mm</strong> stays stable with the same margin; the nominal "
             f"joints alone give {_num(r.spindle_speed_rpm, ',.0f')} rpm at {_num(r.depth_m, '.3g', 1e3)} mm. Until "
-            "the joints are identified, run at the band's depth.</p>"]
+            "the joints are identified, run at the band's depth.</p>"] + _open_lines(report)
+
+
+def _open_lines(report: Any) -> list[str]:
+    span = report.depth_range_m
+    if not report.band_depths_m or span is None:
+        return []
+    return [f'<p class="band">Each variant alone, its joints taken as known, would recommend from '
+            f"<strong>{_num(span[0], '.3g', 1e3)} to {_num(span[1], '.3g', 1e3)} mm</strong>: the data leave the "
+            "depth that open. Against another holder or tool whose range overlaps this one, the order of the "
+            "recommended depths is <strong>not decided by the data</strong>; tap-test both to rank them.</p>"]
+
+
+def depth_order(first: Any, second: Any, names: tuple[str, str] = ("the first", "the second")) -> dict:
+    """Whether the joints' uncertainty decides which of two assemblies (two holders for one tool) allows the
+    larger recommended depth.
+
+    Each report's range of recommended depths (``Report.depth_range_m``:
+    every variant of its joints within their stated uncertainty, each taken
+    as known) is compared: when the ranges overlap, the order is not decided
+    by the data; when they do not, every variant of one lies above every
+    variant of the other.
+
+    Parameters
+    ----------
+    first, second : Report
+        Reports of the same cut, each with a recommendation (a report
+        without a stability band counts as its nominal depth alone).
+    names : (str, str)
+        How the two are called in the sentence (the holders' names).
+
+    Returns
+    -------
+    dict
+        ``order`` (``"first"`` or ``"second"``, the one with the larger
+        depth, or None when the data do not decide), ``ranges_m`` (the two
+        ranges of depth, m) and ``text`` (one sentence).
+    """
+    ranges = [r.depth_range_m for r in (first, second)]
+    if any(span is None for span in ranges):
+        raise InvalidValueError("depth_order: both reports need a recommended depth (a milling cut and a "
+                                "recommendation)")
+    (lo1, hi1), (lo2, hi2) = ranges
+    shown = [f"{_num(lo, '.3g', 1e3)} to {_num(hi, '.3g', 1e3)} mm" for lo, hi in ranges]
+    if lo1 > hi2 or lo2 > hi1:
+        order = "first" if lo1 > hi2 else "second"
+        big, small = names if order == "first" else names[::-1]
+        text = (f"{big} allows a larger depth than {small} for every variant of the joints within their stated "
+                f"uncertainty ({shown[0]} against {shown[1]}).")
+        text = text[0].upper() + text[1:]
+    else:
+        order = None
+        text = (f"The order of the recommended depths of {names[0]} ({shown[0]}) and {names[1]} ({shown[1]}) is not "
+                "decided by the data: their ranges over the joints' uncertainty overlap; identify the joints (tap "
+                "test) to rank them.")
+    return {"order": order, "ranges_m": [[float(lo), float(hi)] for lo, hi in ranges], "text": text}
 
 
 def band_table(report: Any) -> str:
@@ -124,11 +182,14 @@ def band_table(report: Any) -> str:
     lower = report.band.lower_m
     finite = lower[[math.isfinite(v) for v in lower]]
     low = f" The lowest limit over the band is {_num(min(finite), '.3g', 1e3)} mm." if finite.size else ""
+    span = report.depth_range_m
+    own = (f" Each variant's own recommendation (its joints taken as known) lies between {_num(span[0], '.3g', 1e3)} "
+           f"and {_num(span[1], '.3g', 1e3)} mm." if report.band_depths_m and span is not None else "")
     return ("<h3>The stability band: the joints within their uncertainty</h3>"
             f'<table class="wide"><thead>{head}</thead><tbody>{body}</tbody></table>'
             f'<p class="note">The lobes were computed for {len(report.band.members)} variants of the model, each joint '
             "with a stated uncertainty at its lower end, nominal value and upper end (stiffness and damping "
-            f"together); the band's recommendation holds its margin for every one of them.{low}</p>")
+            f"together); the band's recommendation holds its margin for every one of them.{low}{own}</p>")
 
 
 def provenance_note(joint: Any, rows: list[dict]) -> str:
