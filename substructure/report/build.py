@@ -135,6 +135,8 @@ class Report:
         The recommendation's cutting speed and feed against the usual range
         (:func:`~substructure.stability.cutting_conditions`, with
         ``warnings``); None without a recommendation.
+    band_cutting : dict or None
+        The same for the band's recommendation (None without one).
     """
 
     title: str
@@ -163,6 +165,7 @@ class Report:
     band_no_recommendation: str | None = None
     band_depths_m: tuple = attrs.field(default=(), converter=tuple)
     cutting: dict | None = None
+    band_cutting: dict | None = None
 
     @property
     def depth_range_m(self) -> tuple[float, float] | None:
@@ -235,7 +238,8 @@ class Report:
                 "members": len(self.band.members),
                 "recommended": None if self.band_recommendation is None else self.band_recommendation.to_json(),
                 "no_recommendation": self.band_no_recommendation,
-                "depth_range_m": None if self.depth_range_m is None else list(self.depth_range_m)},
+                "depth_range_m": None if self.depth_range_m is None else list(self.depth_range_m),
+                "cutting_data": self.band_cutting},
             "cutting_data": self.cutting,
         }
 
@@ -562,6 +566,7 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
     tool = _tool_of(assembly, at)
     lobes = best = why = spread = robust = robust_why = shop = None
     own = ()
+    band_shop = None
     if cut is not None:
         milling = hasattr(cut, "radial_depth")
         if milling:
@@ -586,9 +591,10 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
                 best = recommend(lobes, cut, limits, margin=margin, speed_tolerance=speed_tolerance)
             except InvalidValueError as exc:  # the lobes leave nothing to recommend: the report says why
                 why = str(exc)
-            spread, robust, robust_why, own = _joint_band(assembly, at, band, chosen, lobes, cut, limits, speeds, method,
-                                                     intervals, margin, speed_tolerance, say)
+            spread, robust, robust_why, own = _joint_band(assembly, at, band, chosen, lobes, cut, limits, speeds,
+                                                          method, intervals, margin, speed_tolerance, say)
             shop = _cutting(cut, best, tool, cutting_table, tool_material)
+            band_shop = _cutting(cut, robust, tool, cutting_table, tool_material)
         else:
             why = "the recommendation of a speed and depth is for milling cuts; the lobes are shown"
     diagnosis = None
@@ -612,4 +618,4 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
         recommendation=best, no_recommendation=why, measurements=measurements, diagnosis=diagnosis,
         identifications=identified, identification_errors=failed, notes=notes, sources=sources, created=created,
         version=substructure.__version__, command=command, band=spread, band_recommendation=robust,
-        band_no_recommendation=robust_why, band_depths_m=own, cutting=shop)
+        band_no_recommendation=robust_why, band_depths_m=own, cutting=shop, band_cutting=band_shop)

@@ -16,7 +16,8 @@ from typing import Any
 import numpy as np
 
 from . import figures
-from .shop import band_lines, band_table, cutting_lines, provenance_note, provenance_warnings, readable
+from .shop import (band_lines, band_table, cutting_lines, provenance_note, provenance_table, provenance_warnings,
+                   readable)
 from .style import STYLE
 from .text import ENTRY_NAMES, EFFECT_NAMES, assumptions, diagnosis_verdict, joint_findings
 
@@ -130,11 +131,13 @@ def mm(q: Any) -> str:
 
 def _answer(report: Any) -> str:
     parts = []
-    r = report.recommendation
     cut = report.cut
+    # with joints of stated uncertainty, the answer is the speed and depth stable for all of them (shop.band_lines)
+    r = report.recommendation if report.band_recommendation is None else report.band_recommendation
     if r is not None:
-        lines = [f'<p class="big">Run at <strong>{fixed(r.spindle_speed_rpm, ",.0f")} rpm</strong> with an axial '
-                 f"depth of cut of <strong>{fixed(r.depth_m, '.3g', 1e3)} mm</strong>.</p>"]
+        until = "Until the joints are identified, run" if report.band_recommendation is not None else "Run"
+        lines = [f'<p class="big">{until} at <strong>{fixed(r.spindle_speed_rpm, ",.0f")} rpm</strong> with an '
+                 f"axial depth of cut of <strong>{fixed(r.depth_m, '.3g', 1e3)} mm</strong>.</p>"]
         what = f"{esc(_direction(cut))} milling, radial depth {mm(cut.radial_depth)} mm of {mm(cut.diameter)} mm, " \
                f"{cut.teeth} teeth"
         if cut.feed_per_tooth is not None:
@@ -146,7 +149,8 @@ def _answer(report: Any) -> str:
         limit = fixed(r.limit_depth_m, ".3g", 1e3)
         lines.append(f"<p>Safety margin: the depth is {1 - r.reserve:.0%} of the chatter limit, {limit} mm, "
                      f"which is the lowest limit anywhere between {fixed(lo, ',.0f')} and {fixed(hi, ',.0f')} rpm "
-                     f"(speed ±{r.speed_tolerance:.0%}); the depth is set by {esc(r.limited_by)}.</p>")
+                     f"(speed ±{r.speed_tolerance:.0%}){' for every variant of the joints' if until != 'Run' else ''};"
+                     f" the depth is set by {esc(r.limited_by)}.</p>")
         lines += band_lines(report) + cutting_lines(report)
         if r.mrr_m3_per_s is not None:
             power = f"cutting power {fixed(r.power_w, '.2g', 1e-3)} kW"
@@ -490,8 +494,10 @@ def _joints(report: Any) -> str:
     identified = {r.joint: r for r in report.identifications}
     failed = dict(report.identification_errors)
     out = ["<p>A joint is where two parts meet (spindle and holder, holder and tool); its stiffness and damping "
-           "often decide the tool's modes. The model file gives one value per entry, without an uncertainty; "
-           "the tap test gives values with a standard deviation (68 % of repeated tests fall within ± 1).</p>"]
+           "often decide the tool's modes. The model file gives one value per entry, and may say where it comes "
+           "from and how uncertain it is (the table below); the tap test gives values with a standard deviation "
+           "(68 % of repeated tests fall within ± 1).</p>",
+           provenance_table(_provenances(report))]
     if report.identifications and data is not None and diagnosis_verdict(data)[0] != "agrees":
         out.append('<p class="verdict unexplained">Caution: the diagnosis found that the model as given does not '
                    "agree with the tap test. The identified values absorb what the model misses, and their standard "

@@ -14,8 +14,8 @@ from typing import Any
 
 from ..errors import InvalidValueError
 
-__all__ = ["cutting_lines", "band_lines", "band_table", "depth_order", "provenance_note", "provenance_warnings",
-           "readable"]
+__all__ = ["cutting_lines", "band_lines", "band_table", "depth_order", "provenance_note", "provenance_table",
+           "provenance_warnings", "readable"]
 
 
 def _esc(value: Any) -> str:
@@ -42,9 +42,12 @@ def cutting_lines(report: Any) -> list[str]:
     Returns
     -------
     list of str
-        HTML paragraphs (none without a recommendation).
+        HTML paragraphs (none without a recommendation), for the answer's speed: the stability band's when
+        there is one, else the nominal one.
     """
     r, c = report.recommendation, report.cutting
+    if report.band_recommendation is not None:
+        r, c = report.band_recommendation, report.band_cutting
     if r is None or r.cutting_speed_m_per_min is None:
         return []
     vc = r.cutting_speed_m_per_min
@@ -92,9 +95,10 @@ def band_lines(report: Any) -> list[str]:
     r = report.recommendation
     return [f'<p class="band">Stability band: with every joint anywhere within its stated uncertainty ({n} '
             f"variants), <strong>{_num(robust.spindle_speed_rpm, ',.0f')} rpm at "
-            f"{_num(robust.depth_m, '.3g', 1e3)} mm</strong> stays stable with the same margin; the nominal "
-            f"joints alone give {_num(r.spindle_speed_rpm, ',.0f')} rpm at {_num(r.depth_m, '.3g', 1e3)} mm. Until "
-            "the joints are identified, run at the band's depth.</p>"] + _open_lines(report)
+            f"{_num(robust.depth_m, '.3g', 1e3)} mm</strong> stays stable with the same margin. The nominal joint "
+            f"values alone give {_num(r.spindle_speed_rpm, ',.0f')} rpm at {_num(r.depth_m, '.3g', 1e3)} mm, which "
+            "holds only if the joints are exactly as the model says: identify them (tap test) before you run "
+            "deeper than the band's depth.</p>"] + _open_lines(report)
 
 
 def _open_lines(report: Any) -> list[str]:
@@ -103,7 +107,8 @@ def _open_lines(report: Any) -> list[str]:
         return []
     return [f'<p class="band">Each variant alone, its joints taken as known, would recommend from '
             f"<strong>{_num(span[0], '.3g', 1e3)} to {_num(span[1], '.3g', 1e3)} mm</strong>: the data leave the "
-            "depth that open. Against another holder or tool whose range overlaps this one, the order of the "
+            "depth that open (each at its own best speed: the band's depth is smaller because one speed must suit "
+            "every variant). Against another holder or tool whose range overlaps this one, the order of the "
             "recommended depths is <strong>not decided by the data</strong>; tap-test both to rank them.</p>"]
 
 
@@ -216,13 +221,53 @@ def provenance_note(joint: Any, rows: list[dict]) -> str:
              "not stated": "not stated"}.get(kind, kind)
     spread = (f"; within a factor {row['uncertainty']:g} either way" if row["uncertainty"] is not None else
               "; no uncertainty stated")
-    text = f'<p class="provenance">Where the values come from: <strong>{_esc(plain)}</strong>{spread}.'
-    if row["source"]:
-        text += f" Source: {_esc(row['source'])}."
-    text += "</p>"
+    text = f'<p class="provenance">Where the values come from: <strong>{_esc(plain)}</strong>{spread}'
+    text += " (the source in the table above).</p>" if row["source"] else ".</p>"
     if row["warning"]:
         text += f'<p class="verdict unexplained">{_esc(row["warning"])}.</p>'
     return text
+
+
+_PLAIN = {"identified": "Measured: identified from a tap test of this assembly",
+          "predicted": "Predicted from a joint table", "borrowed": "Borrowed from another holder or tool",
+          "not stated": "Not stated"}
+_ROLES = {"holder-tool": "holder – tool", "spindle-holder": "spindle – holder"}
+
+
+def provenance_table(rows: list[dict]) -> str:
+    """A table of where every joint's values come from: measured, predicted or assumed, how uncertain, the source.
+
+    Parameters
+    ----------
+    rows : list of dict
+        :func:`~substructure.joint_priors.joint_provenances` of the report's assembly.
+
+    Returns
+    -------
+    str
+        HTML (empty when the assembly has no elastic joint).
+    """
+    if not rows:
+        return ""
+    body = ""
+    for row in rows:
+        kind, basis = row["kind"], row.get("basis")
+        if kind == "prior":
+            plain = {"measured": "Prior for this type of holder, measured on a similar holder",
+                     "assumed": "Prior for this type of holder, assumed (no measurement of this type)"}.get(
+                         basis, "Prior for this type of holder")
+        else:
+            plain = _PLAIN.get(kind, kind)
+        spread = (f"from 1/{row['uncertainty']:g} to {row['uncertainty']:g} times the values"
+                  if row["uncertainty"] is not None and row["uncertainty"] > 1 else "none stated")
+        where = _ROLES.get(row["role"], "–")
+        flag = ' class="flag"' if row["warning"] else ""
+        body += (f"<tr{flag}><td>{_esc(row['name'])}</td><td>{where}</td><td><strong>{_esc(plain)}</strong></td>"
+                 f"<td>{spread}</td><td class=\"source\">{_esc(row['source']) or '–'}</td></tr>")
+    head = ("<tr><th>Joint</th><th>Between</th><th>Where the values come from</th><th>Uncertainty</th>"
+            "<th>Source</th></tr>")
+    return ('<h3>Where the joint values come from</h3><table class="wide provenance">'
+            f"<thead>{head}</thead><tbody>{body}</tbody></table>")
 
 
 def provenance_warnings(rows: list[dict]) -> list[str]:
