@@ -3,6 +3,7 @@ stability band over the priors' uncertainty, and the report showing both."""
 
 from __future__ import annotations
 
+import html as html_module
 import itertools
 import re
 from pathlib import Path
@@ -182,6 +183,67 @@ def test_the_report_shows_provenance_band_and_cutting_data(banded):
     assert out["stability_band"]["members"] == 9 and out["stability_band"]["recommended"]["depth_m"] > 0
     assert out["cutting_data"]["warnings"] and out["cutting_data"]["speed_in_range"] is False
     assert [j["provenance"]["kind"] for j in out["joints"]] == ["prior", "prior"]
+
+
+def test_the_answer_is_the_bands_speed_and_depth_with_its_cutting_data(banded):
+    """With joints of stated uncertainty the headline is the speed and depth stable across them, and the margin,
+    cutting speed and feed rate are those of that speed (v_c = pi D n, v_f = f_z z n, computed here)."""
+    robust, nominal = banded.band_recommendation, banded.recommendation
+    assert robust.spindle_speed_rpm != nominal.spindle_speed_rpm or robust.depth_m < nominal.depth_m
+    answer = re.sub(r"\s+", " ", re.sub(r"<[^>]+>", "", banded.to_html().split('<section id="stability">')[0]))
+    assert (f"Until the joints are identified, run at {robust.spindle_speed_rpm:,.0f} rpm with an axial depth of cut "
+            f"of {robust.depth_m * 1e3:.3g} mm.") in answer
+    assert f"which is the lowest limit anywhere between {robust.window_rpm[0]:,.0f} and" in answer
+    assert "for every variant of the joints" in answer
+    vc = np.pi * 0.012 * robust.spindle_speed_rpm  # m/min
+    vf = 0.05 * 4 * robust.spindle_speed_rpm  # mm/min
+    assert f"Cutting speed {vc:,.0f} m/min ({vc / 0.3048:,.0f} SFM)" in answer
+    assert f"feed rate {vf:,.0f} mm/min" in answer
+    band = banded.to_json()["stability_band"]
+    assert band["cutting_data"]["cutting_speed_m_per_min"] == pytest.approx(vc)
+    assert banded.to_json()["cutting_data"]["cutting_speed_m_per_min"] == pytest.approx(
+        np.pi * 0.012 * nominal.spindle_speed_rpm)  # the summary's own keys stay the nominal answer's
+    # without a band the headline is the nominal answer, as before
+    from substructure.report import report
+
+    cut, limits = _slotting()
+    plain = report(default_assembly(), cut=cut, limits=limits)
+    assert plain.band is None and plain.band_cutting is None and plain.depth_range_m == (plain.recommendation.depth_m,) * 2
+    assert f"Run at {plain.recommendation.spindle_speed_rpm:,.0f} rpm" in re.sub(r"<[^>]+>", "", plain.to_html())
+
+
+def test_the_table_of_where_the_joint_values_come_from():
+    """One row per elastic joint: measured or assumed as the prior table says, identified, or not stated (marked)."""
+    from substructure.report.shop import provenance_table
+
+    def rows_of(assembly):
+        html = provenance_table(joint_provenances(assembly))
+        return [html_module.unescape(re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", row))).strip()
+                for row in re.findall(r"<tr[^>]*>(.*?)</tr>", html)[1:]], html
+
+    rows, _ = rows_of(catalogue("BT40 shrink-fit"))
+    table = priors_table()
+    assert table["spindle-holder"]["steep-taper"]["basis"] == "measured"
+    assert table["holder-tool"]["shrink-fit"]["basis"] == "assumed"
+    assert rows[0].startswith("spindle-holder spindle – holder Prior for this type of holder, measured on a similar")
+    assert rows[1].startswith("holder-tool holder – tool Prior for this type of holder, assumed (no measurement")
+    assert all("from 1/4 to 4 times the values" in r for r in rows)
+    # a prior whose source is the user's own, not the shipped row: no basis claimed
+    a = catalogue("BT40 ER32")
+    own = a.with_joint(Joint("holder-tool", ("holder.tip", "tool.base"), k={"yf": "2e7 N/m"},
+                             provenance=JointProvenance("prior", "our shop's notes", 3.0)))
+    rows, _ = rows_of(own)
+    assert "Prior for this type of holder from 1/3 to 3 times the values our shop's notes" in rows[1]
+    assert {r["name"]: r["basis"] for r in joint_provenances(own)} == {"spindle-holder": "measured",
+                                                                      "holder-tool": None}
+    # identified, and not stated at a catalogue holder (marked)
+    ident = a.with_joint(Joint("holder-tool", ("holder.tip", "tool.base"), k={"yf": "2e7 N/m"},
+                               provenance=JointProvenance("identified", "tap test 2025-03", 1.1)))
+    rows, _ = rows_of(ident)
+    assert "Measured: identified from a tap test of this assembly from 1/1.1 to 1.1 times" in rows[1]
+    rows, html = rows_of(catalogue("BT40 ER32", priors=False))
+    assert all("Not stated none stated" in r for r in rows) and html.count('<tr class="flag">') == 2
+    assert provenance_table([]) == ""
 
 
 def test_the_report_warns_of_borrowed_joint_values():

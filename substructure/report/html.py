@@ -404,24 +404,30 @@ def _row(label: str, r: Any) -> list[str]:
 
 def _stability(report: Any) -> str:
     lobes, r, cut = report.lobes, report.recommendation, report.cut
+    banded = report.band_recommendation is not None  # then the answer is the band's (see _answer)
+    r = report.band_recommendation if banded else r
     out = []
     if r is not None:
-        rows = [_row("<strong>recommended</strong>", r)] + [_row(f"runner-up {k}", o) for k, o in
-                                                              enumerate(r.runners_up, 1)]
+        head = "<strong>recommended</strong>" + (" for every variant of the joints" if banded else "")
+        rows = [_row(head, r)] + [_row(f"runner-up {k}", o) for k, o in enumerate(r.runners_up, 1)]
         out.append(table(["Choice", "Speed (rpm)", "Axial depth (mm)", "Chatter limit in the window (mm)",
                           "Speed window (rpm)", "Depth set by", "Removal rate (cm³/min)", "Power (kW)",
                           "Torque (N·m)", "Chatter at (Hz)"], rows, cls="wide"))
         out.append(note(f"The depth is at most {1 - r.margin:.0%} of the lowest chatter limit over the speed window "
-                        f"(±{r.speed_tolerance:.0%}); the limit at the recommended speed itself is "
-                        f"{fixed(r.limit_at_speed_m, '.3g', 1e3)} mm. Runners-up are the best of other pockets of "
+                        f"(±{r.speed_tolerance:.0%}){' of every variant' if banded else ''}; the limit at the "
+                        f"recommended speed itself is {fixed(r.limit_at_speed_m, '.3g', 1e3)} mm"
+                        f"{' with the nominal joints' if banded else ''}. Runners-up are the best of other pockets of "
                         "the diagram. " + tech(f"margin {r.margin:g}, speed_tolerance {r.speed_tolerance:g}, "
                                                f"reserve {r.reserve:.3f}, "
                                                f"limiting speed {r.limiting_speed_rpm:.0f} rpm")))
     elif report.no_recommendation:
         out.append(f'<p class="verdict unexplained">No recommendation: {esc(report.no_recommendation)}</p>')
     out.append(band_table(report))
+    below = ("Below the blue curve the cut is stable with the nominal joints, below the purple line with every "
+             "variant of the joints; above, it may chatter." if report.band is not None else
+             "Below the curve the cut is stable, above it chatters.")
     out.append(figure(figures.lobes_figure(report), "stability lobes",
-                      "Below the curve the cut is stable, above it chatters. The star is the recommended speed and "
+                      f"{below} The star is the recommended speed and "
                       "depth, the green box its safe window, the dashed line the limit it keeps its margin from. "
                       + tech("stability lobe diagram; " + ("zero-order approximation (Altintas & Budak 1995)"
                                                            if lobes.method == "zoa" else
@@ -464,13 +470,17 @@ def _stability(report: Any) -> str:
         speeds = lobes.spindle_speed_rpm
         rows = [[fixed(n, ",.0f"), fixed(a, ".3g", 1e3),
                  fixed(lobes.chatter_frequency_hz[int(np.argmin(np.abs(speeds - n)))], ",.0f")] for n, a in tips]
-        out.append("<h3>The tips of the lobes</h3>" + table(["Speed (rpm)", "Chatter limit (mm)", "Chatter at (Hz)"],
-                                                            rows)
+        heading = "The tips of the lobes" + (" (nominal joints)" if report.band is not None else "")
+        out.append(f"<h3>{heading}</h3>" + table(["Speed (rpm)", "Chatter limit (mm)", "Chatter at (Hz)"], rows)
                    + note("The limit itself, with no margin: a speed at the sharp tip of a lobe is stable only "
                           "right there. Use the recommendation above."))
     if lobes.absolute_limit_m is not None and np.isfinite(lobes.absolute_limit_m):
-        out.append(f"<p>Stable at every speed up to {fixed(lobes.absolute_limit_m, '.3g', 1e3)} mm axial depth "
-                   f"(chatter there at {fixed(lobes.absolute_limit_frequency_hz, ',.0f')} Hz). "
+        nominal = "With the nominal joints, stable" if report.band is not None else "Stable"
+        lowest = report.band.lower_m[np.isfinite(report.band.lower_m)] if report.band is not None else ()
+        across = (f" With every variant of the joints, stable at every computed speed up to "
+                  f"{fixed(np.min(lowest), '.3g', 1e3)} mm." if len(lowest) else "")
+        out.append(f"<p>{nominal} at every speed up to {fixed(lobes.absolute_limit_m, '.3g', 1e3)} mm axial depth "
+                   f"(chatter there at {fixed(lobes.absolute_limit_frequency_hz, ',.0f')} Hz).{across} "
                    + tech("absolute limit of the zero-order lobes") + "</p>")
     s = lobes.spindle_speed_rpm
     out.append(note(f"Spindle speeds {fixed(s[0], ',.0f')} to {fixed(s[-1], ',.0f')} rpm, {s.size:,} speeds."))
