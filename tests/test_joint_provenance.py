@@ -208,7 +208,8 @@ def test_the_answer_is_the_bands_speed_and_depth_with_its_cutting_data(banded):
 
     cut, limits = _slotting()
     plain = report(default_assembly(), cut=cut, limits=limits)
-    assert plain.band is None and plain.band_cutting is None and plain.depth_range_m == (plain.recommendation.depth_m,) * 2
+    assert plain.band is None and plain.band_cutting is None
+    assert plain.depth_range_m == (plain.recommendation.depth_m,) * 2
     assert f"Run at {plain.recommendation.spindle_speed_rpm:,.0f} rpm" in re.sub(r"<[^>]+>", "", plain.to_html())
 
 
@@ -386,3 +387,22 @@ def test_depth_order_needs_two_recommendations():
     bare = report(default_assembly())
     with pytest.raises(InvalidValueError, match="recommended depth"):
         depth_order(bare, bare)
+
+
+def test_the_command_says_to_use_the_band_and_what_the_variants_leave_open(tmp_path, capsys):
+    from substructure.cli import main
+    from substructure.report import report
+
+    path = tmp_path / "shrink.toml"
+    path.write_text(dumps_assembly(catalogue("BT40 shrink-fit")), encoding="utf-8")  # the priors, saved
+    cut = ["--radial-depth", "3 mm", "--milling", "down", "--workpiece", "aluminium-7075",
+           "--feed-per-tooth", "0.05 mm"]
+    status = main(["report", str(path), "--out", str(tmp_path / "r.html"), *cut, "--quiet"])
+    text = capsys.readouterr().out
+    assert status == 0 and "Traceback" not in text
+    expected = report(loads_assembly(path.read_text(encoding="utf-8")),
+                      cut=MillingCut.for_workpiece(4, "12 mm", "aluminium-7075", radial_depth="3 mm",
+                                                   feed_per_tooth="0.05 mm", milling="down"))
+    lo, hi = expected.depth_range_m
+    assert f"each variant alone allows {lo * 1e3:.3g} to {hi * 1e3:.3g} mm" in text
+    assert "the order is not decided by the data" in text
