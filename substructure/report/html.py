@@ -16,8 +16,8 @@ from typing import Any
 import numpy as np
 
 from . import figures
-from .shop import (band_lines, band_table, cutting_lines, provenance_note, provenance_table, provenance_warnings,
-                   readable)
+from .shop import (band_lines, band_table, cutting_lines, every_speed_line, lobes_caption, provenance_note,
+                   provenance_table, provenance_warnings, readable)
 from .style import STYLE
 from .text import ENTRY_NAMES, EFFECT_NAMES, assumptions, diagnosis_verdict, joint_findings
 
@@ -423,11 +423,8 @@ def _stability(report: Any) -> str:
     elif report.no_recommendation:
         out.append(f'<p class="verdict unexplained">No recommendation: {esc(report.no_recommendation)}</p>')
     out.append(band_table(report))
-    below = ("Below the blue curve the cut is stable with the nominal joints, below the purple line with every "
-             "variant of the joints; above, it may chatter." if report.band is not None else
-             "Below the curve the cut is stable, above it chatters.")
     out.append(figure(figures.lobes_figure(report), "stability lobes",
-                      f"{below} The star is the recommended speed and "
+                      f"{lobes_caption(report)} The star is the recommended speed and "
                       "depth, the green box its safe window, the dashed line the limit it keeps its margin from. "
                       + tech("stability lobe diagram; " + ("zero-order approximation (Altintas & Budak 1995)"
                                                            if lobes.method == "zoa" else
@@ -474,14 +471,7 @@ def _stability(report: Any) -> str:
         out.append(f"<h3>{heading}</h3>" + table(["Speed (rpm)", "Chatter limit (mm)", "Chatter at (Hz)"], rows)
                    + note("The limit itself, with no margin: a speed at the sharp tip of a lobe is stable only "
                           "right there. Use the recommendation above."))
-    if lobes.absolute_limit_m is not None and np.isfinite(lobes.absolute_limit_m):
-        nominal = "With the nominal joints, stable" if report.band is not None else "Stable"
-        lowest = report.band.lower_m[np.isfinite(report.band.lower_m)] if report.band is not None else ()
-        across = (f" With every variant of the joints, stable at every computed speed up to "
-                  f"{fixed(np.min(lowest), '.3g', 1e3)} mm." if len(lowest) else "")
-        out.append(f"<p>{nominal} at every speed up to {fixed(lobes.absolute_limit_m, '.3g', 1e3)} mm axial depth "
-                   f"(chatter there at {fixed(lobes.absolute_limit_frequency_hz, ',.0f')} Hz).{across} "
-                   + tech("absolute limit of the zero-order lobes") + "</p>")
+    out.append(every_speed_line(report, tech("absolute limit of the zero-order lobes")))
     s = lobes.spindle_speed_rpm
     out.append(note(f"Spindle speeds {fixed(s[0], ',.0f')} to {fixed(s[-1], ',.0f')} rpm, {s.size:,} speeds."))
     return "".join(out)

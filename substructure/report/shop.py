@@ -14,8 +14,8 @@ from typing import Any
 
 from ..errors import InvalidValueError
 
-__all__ = ["cutting_lines", "band_lines", "band_table", "depth_order", "provenance_note", "provenance_table",
-           "provenance_warnings", "readable"]
+__all__ = ["cutting_lines", "band_lines", "band_table", "depth_order", "every_speed_line", "lobes_caption",
+           "provenance_note", "provenance_table", "provenance_warnings", "readable"]
 
 
 def _esc(value: Any) -> str:
@@ -110,6 +110,51 @@ def _open_lines(report: Any) -> list[str]:
             "depth that open (each at its own best speed: the band's depth is smaller because one speed must suit "
             "every variant). Against another holder or tool whose range overlaps this one, the order of the "
             "recommended depths is <strong>not decided by the data</strong>; tap-test both to rank them.</p>"]
+
+
+def every_speed_line(report: Any, technical: str = "") -> str:
+    """The depth stable at every speed: the nominal lobes' and, with a band, the lowest over its variants.
+
+    Parameters
+    ----------
+    report : Report
+        The report (with lobes).
+    technical : str
+        HTML of the technical name, appended.
+
+    Returns
+    -------
+    str
+        An HTML paragraph (empty when the lobes have no finite limit).
+    """
+    lobes = report.lobes
+    if lobes.absolute_limit_m is None or not math.isfinite(lobes.absolute_limit_m):
+        return ""
+    nominal = "With the nominal joints, stable" if report.band is not None else "Stable"
+    lowest = [v for v in (report.band.lower_m if report.band is not None else ()) if math.isfinite(v)]
+    across = (f" With every variant of the joints, stable at every computed speed up to "
+              f"{_num(min(lowest), '.3g', 1e3)} mm." if lowest else "")
+    return (f"<p>{nominal} at every speed up to {_num(lobes.absolute_limit_m, '.3g', 1e3)} mm axial depth (chatter "
+            f"there at {_num(lobes.absolute_limit_frequency_hz, ',.0f')} Hz).{across} {technical}</p>")
+
+
+def lobes_caption(report: Any) -> str:
+    """The first sentence of the lobe figure's caption: which curve is stable for which joints.
+
+    Parameters
+    ----------
+    report : Report
+        The report.
+
+    Returns
+    -------
+    str
+        Plain text.
+    """
+    if report.band is not None:
+        return ("Below the blue curve the cut is stable with the nominal joints, below the purple line with every "
+                "variant of the joints; above, it may chatter.")
+    return "Below the curve the cut is stable, above it chatters."
 
 
 def depth_order(first: Any, second: Any, names: tuple[str, str] = ("the first", "the second")) -> dict:
