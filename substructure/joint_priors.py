@@ -195,8 +195,10 @@ def joint_provenances(assembly: Any) -> list[dict]:
         Per elastic joint: ``name``, ``role`` (or None), ``holder`` (the
         catalogue holder's name, or None), ``kind`` (``identified``,
         ``predicted``, ``borrowed``, ``prior`` or ``"not stated"``),
-        ``source``, ``uncertainty`` and ``warning`` (None, or why the values
-        cannot be trusted for this holder).
+        ``source``, ``uncertainty``, ``basis`` (``"measured"`` or
+        ``"assumed"`` for the shipped prior of the holder's type, from its
+        row of the prior table; None otherwise) and ``warning`` (None, or why
+        the values cannot be trusted for this holder).
     """
     rows = []
     for joint in assembly.joints:
@@ -207,7 +209,12 @@ def joint_provenances(assembly: Any) -> list[dict]:
         p = joint.provenance
         row = {"name": joint.name, "role": found[0] if found else None, "holder": kind["name"] if kind else None,
                "kind": p.kind if p else "not stated", "source": p.source if p else "",
-               "uncertainty": p.uncertainty if p else None, "warning": None}
+               "uncertainty": p.uncertainty if p else None, "basis": None, "warning": None}
+        if p is not None and p.kind == "prior":
+            shipped = prior_for(assembly, joint)  # the shipped prior of this holder type, when it is that one
+            if shipped is not None and shipped.provenance.source == p.source:
+                role, kind_name = found[0], kind["clamp"] if found[0] == "holder-tool" else kind["interface"]
+                row["basis"] = priors_table()[role][kind_name]["basis"]
         if kind is not None and (p is None or p.kind == "borrowed"):
             row["warning"] = (f"the values of joint {joint.name!r} were not identified or predicted for the catalogue "
                               f"holder {kind['name']}" + (": borrowed" if p else ": their provenance is not stated")

@@ -122,3 +122,45 @@ def check_page(html: Path, work: Path, width: int = 1200, height: int = 3000) ->
         total += block.shape[0] * block.shape[1]
     return {"shown": shown, "regions": regions, "ink": float((grey < 245).mean()), "std": float(grey.std()),
             "colour_in_regions": coloured / total if total else 0.0, "png": shown_png}
+
+
+def dump_dom(html: Path, timeout: float = 180.0) -> str:
+    """The page's DOM as the browser built it (``--dump-dom``), serialised as HTML."""
+    exe = browser()
+    if exe is None:
+        raise FileNotFoundError(f"no chromium found; install it with: {INSTALL}")
+    with tempfile.TemporaryDirectory(prefix="substructure-chromium-") as profile:
+        command = [exe, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
+                   "--disable-background-networking", "--disable-component-update", "--disable-sync",
+                   "--disable-extensions", "--disable-default-apps", "--proxy-server=127.0.0.1:9",
+                   "--proxy-bypass-list=<-loopback>", f"--user-data-dir={profile}", "--dump-dom",
+                   html.resolve().as_uri()]
+        done = subprocess.run(command, capture_output=True, text=True, timeout=timeout)
+    if done.returncode != 0 or "<html" not in done.stdout:
+        raise RuntimeError(f"chromium failed ({done.returncode}): {done.stderr[-2000:]}")
+    return done.stdout
+
+
+def element_region(html: Path, shown: np.ndarray, selector: str, work: Path, width: int, height: int,
+                   name: str) -> tuple[tuple, np.ndarray] | None:
+    """Where the elements matching a CSS ``selector`` are drawn on the screenshot ``shown``, and their pixels.
+
+    The page is rendered once more with those elements hidden (``visibility: hidden`` keeps the layout); the
+    bounding box of the pixels that differ is the elements' visible region, saved as ``NAME.png`` in ``work``
+    for a person to look at. None when nothing of them is visible.
+    """
+    from PIL import Image
+
+    hidden = work / (html.stem + f"_without_{name}.html")
+    text = html.read_text(encoding="utf-8")
+    hidden.write_text(text.replace("</head>", f"<style>{selector} {{ visibility: hidden !important; }}</style></head>"),
+                      encoding="utf-8")
+    without = pixels(screenshot(hidden, work / (hidden.stem + ".png"), width, height))
+    differ = np.abs(shown - without).sum(axis=2) > 30
+    rows, cols = np.flatnonzero(differ.any(axis=1)), np.flatnonzero(differ.any(axis=0))
+    if not rows.size:
+        return None
+    box = (int(rows[0]), int(cols[0]), int(rows[-1]) + 1, int(cols[-1]) + 1)
+    crop = shown[box[0]:box[2], box[1]:box[3]]
+    Image.fromarray(crop.astype(np.uint8)).save(work / f"{html.stem}_{name}.png")
+    return box, crop

@@ -9,6 +9,7 @@ person to look at.  See docs/report.md, "Checking it in a browser".
 from __future__ import annotations
 
 import base64
+import functools
 import io
 import os
 import re
@@ -18,8 +19,9 @@ import attrs
 import numpy as np
 import pytest
 
-from browser_check import INSTALL, browser, check_page
-from substructure import Sensor, default_assembly
+from browser_check import INSTALL, browser, check_page, dump_dom, element_region, pixels, screenshot
+from substructure import Holder, Sensor, default_assembly
+from substructure.joint_priors import with_joint_priors
 from substructure.measurements import MeasurementSet
 from substructure.report import report
 from substructure.stability import MachineLimits, MillingCut
@@ -48,8 +50,12 @@ def out(tmp_path):
     return Path(folder)
 
 
+@functools.cache
 def _page():
-    model = default_assembly()
+    """A catalogue holder with the priors of its type (so the page shows where the joint values come from and the
+    stability band), tap-tested with a 2 g accelerometer, with a cut and a machine."""
+    model = with_joint_priors(default_assembly().with_component(
+        Holder.from_catalog("BT40 shrink-fit", bore="12 mm", gauge_length="80 mm")))
     rig = model.attach(Sensor("accelerometer", "tool.tip", "2 g"))
     taps = simulate(rig, ["tool.tip"], frequency=model.frequency, noise=0.015, seed=7, sensors=["accelerometer"],
                     name="tap test")
@@ -102,3 +108,37 @@ def test_a_bare_report_renders_too(out):
     html = report(default_assembly()).save(out / "bare.html", overwrite=True)
     seen = check_page(html, out, width=1000, height=5000)
     assert len(seen["regions"]) == 1 and seen["ink"] > 0.02
+
+
+def test_chromium_shows_the_joint_provenance_and_the_band(out):
+    """The browser's DOM holds the table of where the joint values come from and the stability band, and both are
+    drawn, legible, inside the screenshot (each found by rendering the page again with it hidden)."""
+    result = _page()
+    html = result.save(out / "report.html", overwrite=True)
+    text = " ".join(re.sub(r"<[^>]+>", " ", dump_dom(html)).split())
+    assert "Where the joint values come from" in text
+    assert "holder-tool holder – tool Prior" in text and "spindle-holder spindle – holder Prior" in text  # two rows
+    assert "Prior for this type of holder, assumed (no measurement of this type)" in text  # the shrink-fit joint
+    assert "Prior for this type of holder, measured on a similar holder" in text  # the steep taper
+    assert text.count("from 1/4 to 4 times the values") == 2
+    lo, hi = result.depth_range_m
+    robust, nominal = result.band_recommendation, result.recommendation
+    assert (f"Stability band: with every joint anywhere within its stated uncertainty (9 variants), "
+            f"{robust.spindle_speed_rpm:,.0f} rpm at {robust.depth_m * 1e3:.3g} mm") in text
+    assert (f"The nominal joint values alone give {nominal.spindle_speed_rpm:,.0f} rpm at {nominal.depth_m * 1e3:.3g} "
+            "mm, which holds only if the joints are exactly as the model says") in text
+    # the answer's headline is the band's speed and depth, the one to use until the joints are identified
+    assert (f"Until the joints are identified, run at {robust.spindle_speed_rpm:,.0f} rpm with an axial depth of cut "
+            f"of {robust.depth_m * 1e3:.3g} mm") in text
+    assert f"would recommend from {lo * 1e3:.3g} to {hi * 1e3:.3g} mm" in text and "not decided by the data" in text
+    width, height = 1200, 16000
+    shown = pixels(screenshot(html, out / "report_visible.png", width, height))
+    for selector, name in (("table.provenance", "provenance"), (".band", "band")):
+        found = element_region(html, shown, selector, out, width, height, name)
+        assert found is not None, f"{selector} is not drawn"
+        (top, left, bottom, right), crop = found
+        assert bottom < height - 50 and right <= width  # inside the screenshot, not cut off
+        assert bottom - top > 30 and right - left > 300  # a table or paragraph, not a speck
+        grey = crop.mean(axis=2)
+        assert (grey < 128).mean() > 0.01  # dark text on a light ground: legible
+    assert element_region(html, shown, "table.nothing-of-the-kind", out, width, height, "none") is None

@@ -126,6 +126,9 @@ def run(args: argparse.Namespace) -> int:
         robust = result.band_recommendation
         if robust is not None:
             print(f"  across the joints' uncertainty ({len(result.band.members)} variants): {robust.describe()[0]}")
+            lo, hi = result.depth_range_m
+            print(f"  until the joints are identified, use that; each variant alone allows {lo * 1e3:.3g} to "
+                  f"{hi * 1e3:.3g} mm (against a holder whose range overlaps, the order is not decided by the data)")
         elif result.band_no_recommendation:
             print(f"  across the joints' uncertainty: no recommendation ({result.band_no_recommendation})")
     elif result.no_recommendation:

@@ -21,5 +21,6 @@ Plain words come first, the technical names in small notes, units everywhere.
 """
 
 from .build import DEFAULT_SPEEDS, SUMMARY_KEYS, Report, ToolMode, report, tool_point
+from .shop import depth_order
 
-__all__ = ["Report", "ToolMode", "report", "tool_point", "SUMMARY_KEYS", "DEFAULT_SPEEDS"]
+__all__ = ["Report", "ToolMode", "report", "tool_point", "depth_order", "SUMMARY_KEYS", "DEFAULT_SPEEDS"]

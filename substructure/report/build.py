@@ -25,6 +25,7 @@ import attrs
 import numpy as np
 
 from ..errors import InvalidValueError, SubstructureError
+from ._variants import _cutting, _joint_band, _lobes
 
 __all__ = ["Report", "ToolMode", "report", "tool_point", "SUMMARY_KEYS", "DEFAULT_SPEEDS"]
 
@@ -127,10 +128,16 @@ class Report:
         The speed and depth stable for every member of ``band``.
     band_no_recommendation : str or None
         Why there is none over the band, when there is a band.
+    band_depths_m : tuple of float or None
+        Each member's own recommended depth (m), as if its joints were
+        known (None where it has none); empty without a band. Their range
+        (:attr:`depth_range_m`) is what the joints' uncertainty leaves open.
     cutting : dict or None
         The recommendation's cutting speed and feed against the usual range
         (:func:`~substructure.stability.cutting_conditions`, with
         ``warnings``); None without a recommendation.
+    band_cutting : dict or None
+        The same for the band's recommendation (None without one).
     """
 
     title: str
@@ -157,7 +164,18 @@ class Report:
     band: Any = None
     band_recommendation: Any = None
     band_no_recommendation: str | None = None
+    band_depths_m: tuple = attrs.field(default=(), converter=tuple)
     cutting: dict | None = None
+    band_cutting: dict | None = None
+
+    @property
+    def depth_range_m(self) -> tuple[float, float] | None:
+        """The lowest and highest recommended depth (m) over the joints' uncertainty, the nominal among them
+        (the nominal depth twice without a band; None without a recommendation)."""
+        if self.recommendation is None:
+            return None
+        depths = [d for d in self.band_depths_m if d is not None] + [self.recommendation.depth_m]
+        return float(min(depths)), float(max(depths))
 
     @property
     def tool(self):
@@ -220,7 +238,9 @@ class Report:
             "stability_band": None if self.band is None else {
                 "members": len(self.band.members),
                 "recommended": None if self.band_recommendation is None else self.band_recommendation.to_json(),
-                "no_recommendation": self.band_no_recommendation},
+                "no_recommendation": self.band_no_recommendation,
+                "depth_range_m": None if self.depth_range_m is None else list(self.depth_range_m),
+                "cutting_data": self.band_cutting},
             "cutting_data": self.cutting,
         }
 
@@ -367,58 +387,6 @@ def _joints_to_identify(assembly: Any, identify: Any) -> list[str]:
     return names
 
 
-def _lobes(structure: Any, band: Any, cut: Any, speeds: Any, method: str, intervals: Any, progress: Callable) -> Any:
-    from ..stability import fit_modes, sdm, xy_frf, zoa
-
-    xy = xy_frf(structure)
-    if method == "zoa":
-        progress("lobes: zero-order approximation")
-        return zoa(xy, cut, speeds, band=band)
-    progress("lobes: semi-discretization (modes fitted to the receptance)")
-    return attrs.evolve(sdm(fit_modes(xy), cut, speeds, intervals=intervals), band=band)
-
-
-def _joint_band(assembly, at, band, chosen, lobes, cut, limits, speeds, method, intervals, margin, tolerance, say):
-    """The lobes over the joints' stated uncertainty and the recommendation stable across them (None, None, None
-    when no joint states an uncertainty)."""
-    from ..joint_priors import joint_variants
-    from ..stability import (NoRecommendationError, assembly_structure, choose_band, lobes_band, recommend)
-
-    variants = joint_variants(assembly)
-    if len(variants) < 2:
-        return None, None, None
-    say(f"stability band: lobes of {len(variants)} variants of the joints within their uncertainty")
-    members = []
-    for variant in variants:
-        if isinstance(band, str) and band == "auto":
-            structure, used = assembly_structure(variant, at)
-        else:
-            structure, used = choose_band(variant.receptance(at, frequency=variant.frequency), band)
-        members.append(_lobes(structure, used, cut, speeds, method, intervals, lambda text: None))
-    spread = lobes_band(members, nominal=lobes, label="joints within their uncertainty")
-    try:
-        return spread, recommend(lobes, cut, limits, margin=margin, speed_tolerance=tolerance, band=spread), None
-    except NoRecommendationError as exc:
-        return spread, None, " ".join(str(exc).split())
-
-
-def _cutting(cut: Any, best: Any, tool: Any, table: Any, material: str | None) -> dict | None:
-    """The recommendation's cutting speed and feed against the usual range of the work and tool material."""
-    from ..stability import check_cutting, cutting_conditions, cutting_data
-
-    if best is None:
-        return None
-    wp = getattr(cut, "workpiece", None)
-    if material is None and tool is not None:
-        names = " ".join(s.material.name.lower() for s in getattr(tool, "segments", ()) if s.material is not None)
-        material = next((m for m in ("carbide", "hss") if m in names), None)
-    data = cutting_data(wp, material or "carbide", table) if wp is not None else None
-    out = cutting_conditions(cut, best.spindle_speed_rpm, data)
-    out["tool_material"] = material or ("carbide (assumed)" if wp is not None else None)
-    out["warnings"] = check_cutting(cut, best.spindle_speed_rpm, data)
-    return out
-
-
 def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any = None, *, at: str | None = None,
            speeds: Any = None, band: Any = "auto", method: str = "zoa", intervals: int | None = None,
            margin: float = 0.2, speed_tolerance: float = 0.03, identify: Any = "auto", title: str | None = None,
@@ -539,6 +507,8 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
     modes, fit_error = _modes(structure, notes)
     tool = _tool_of(assembly, at)
     lobes = best = why = spread = robust = robust_why = shop = None
+    own = ()
+    band_shop = None
     if cut is not None:
         milling = hasattr(cut, "radial_depth")
         if milling:
@@ -563,9 +533,10 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
                 best = recommend(lobes, cut, limits, margin=margin, speed_tolerance=speed_tolerance)
             except InvalidValueError as exc:  # the lobes leave nothing to recommend: the report says why
                 why = str(exc)
-            spread, robust, robust_why = _joint_band(assembly, at, band, chosen, lobes, cut, limits, speeds, method,
-                                                     intervals, margin, speed_tolerance, say)
+            spread, robust, robust_why, own = _joint_band(assembly, at, band, chosen, lobes, cut, limits, speeds,
+                                                          method, intervals, margin, speed_tolerance, say)
             shop = _cutting(cut, best, tool, cutting_table, tool_material)
+            band_shop = _cutting(cut, robust, tool, cutting_table, tool_material)
         else:
             why = "the recommendation of a speed and depth is for milling cuts; the lobes are shown"
     diagnosis = None
@@ -589,4 +560,4 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
         recommendation=best, no_recommendation=why, measurements=measurements, diagnosis=diagnosis,
         identifications=identified, identification_errors=failed, notes=notes, sources=sources, created=created,
         version=substructure.__version__, command=command, band=spread, band_recommendation=robust,
-        band_no_recommendation=robust_why, cutting=shop)
+        band_no_recommendation=robust_why, band_depths_m=own, cutting=shop, band_cutting=band_shop)

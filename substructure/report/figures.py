@@ -85,7 +85,8 @@ def lobes_figure(report: Any) -> str:
 
     lobes = report.lobes
     milling = hasattr(report.cut, "radial_depth")
-    fig = lobes.plot(lobes=lobes.method == "zoa", recommendation=report.recommendation,
+    answer = getattr(report, "band_recommendation", None) or report.recommendation  # the band's when there is one
+    fig = lobes.plot(lobes=lobes.method == "zoa", recommendation=answer,
                      title=f"Chatter-free axial depth against spindle speed: {report.cut.describe()}",
                      limits=report.limits if milling else None, cut=report.cut if milling else None)
     ax = fig.axes[0]
@@ -95,6 +96,7 @@ def lobes_figure(report: Any) -> str:
         hi = np.where(np.isfinite(band.upper_m), band.upper_m, np.nan) * 1e3
         ax.fill_between(band.spindle_speed_rpm, lo, hi, color="tab:purple", alpha=0.12, lw=0,
                         label=f"stability band ({len(band.members)} variants of the joints)")
+        ax.plot(band.spindle_speed_rpm, lo, color="tab:purple", lw=1.0, label="lowest limit of the variants")
     handles, labels = ax.get_legend_handles_labels()
     if ax.get_legend() is not None:  # beside the axes: never over the recommendation and its window
         ax.get_legend().remove()

@@ -16,7 +16,8 @@ from typing import Any
 import numpy as np
 
 from . import figures
-from .shop import band_lines, band_table, cutting_lines, provenance_note, provenance_warnings, readable
+from .shop import (band_lines, band_table, cutting_lines, every_speed_line, lobes_caption, provenance_note,
+                   provenance_table, provenance_warnings, readable)
 from .style import STYLE
 from .text import ENTRY_NAMES, EFFECT_NAMES, assumptions, diagnosis_verdict, joint_findings
 
@@ -130,11 +131,13 @@ def mm(q: Any) -> str:
 
 def _answer(report: Any) -> str:
     parts = []
-    r = report.recommendation
     cut = report.cut
+    # with joints of stated uncertainty, the answer is the speed and depth stable for all of them (shop.band_lines)
+    r = report.recommendation if report.band_recommendation is None else report.band_recommendation
     if r is not None:
-        lines = [f'<p class="big">Run at <strong>{fixed(r.spindle_speed_rpm, ",.0f")} rpm</strong> with an axial '
-                 f"depth of cut of <strong>{fixed(r.depth_m, '.3g', 1e3)} mm</strong>.</p>"]
+        until = "Until the joints are identified, run" if report.band_recommendation is not None else "Run"
+        lines = [f'<p class="big">{until} at <strong>{fixed(r.spindle_speed_rpm, ",.0f")} rpm</strong> with an '
+                 f"axial depth of cut of <strong>{fixed(r.depth_m, '.3g', 1e3)} mm</strong>.</p>"]
         what = f"{esc(_direction(cut))} milling, radial depth {mm(cut.radial_depth)} mm of {mm(cut.diameter)} mm, " \
                f"{cut.teeth} teeth"
         if cut.feed_per_tooth is not None:
@@ -146,7 +149,8 @@ def _answer(report: Any) -> str:
         limit = fixed(r.limit_depth_m, ".3g", 1e3)
         lines.append(f"<p>Safety margin: the depth is {1 - r.reserve:.0%} of the chatter limit, {limit} mm, "
                      f"which is the lowest limit anywhere between {fixed(lo, ',.0f')} and {fixed(hi, ',.0f')} rpm "
-                     f"(speed ±{r.speed_tolerance:.0%}); the depth is set by {esc(r.limited_by)}.</p>")
+                     f"(speed ±{r.speed_tolerance:.0%}){' for every variant of the joints' if until != 'Run' else ''};"
+                     f" the depth is set by {esc(r.limited_by)}.</p>")
         lines += band_lines(report) + cutting_lines(report)
         if r.mrr_m3_per_s is not None:
             power = f"cutting power {fixed(r.power_w, '.2g', 1e-3)} kW"
@@ -400,16 +404,19 @@ def _row(label: str, r: Any) -> list[str]:
 
 def _stability(report: Any) -> str:
     lobes, r, cut = report.lobes, report.recommendation, report.cut
+    banded = report.band_recommendation is not None  # then the answer is the band's (see _answer)
+    r = report.band_recommendation if banded else r
     out = []
     if r is not None:
-        rows = [_row("<strong>recommended</strong>", r)] + [_row(f"runner-up {k}", o) for k, o in
-                                                              enumerate(r.runners_up, 1)]
+        head = "<strong>recommended</strong>" + (" for every variant of the joints" if banded else "")
+        rows = [_row(head, r)] + [_row(f"runner-up {k}", o) for k, o in enumerate(r.runners_up, 1)]
         out.append(table(["Choice", "Speed (rpm)", "Axial depth (mm)", "Chatter limit in the window (mm)",
                           "Speed window (rpm)", "Depth set by", "Removal rate (cm³/min)", "Power (kW)",
                           "Torque (N·m)", "Chatter at (Hz)"], rows, cls="wide"))
         out.append(note(f"The depth is at most {1 - r.margin:.0%} of the lowest chatter limit over the speed window "
-                        f"(±{r.speed_tolerance:.0%}); the limit at the recommended speed itself is "
-                        f"{fixed(r.limit_at_speed_m, '.3g', 1e3)} mm. Runners-up are the best of other pockets of "
+                        f"(±{r.speed_tolerance:.0%}){' of every variant' if banded else ''}; the limit at the "
+                        f"recommended speed itself is {fixed(r.limit_at_speed_m, '.3g', 1e3)} mm"
+                        f"{' with the nominal joints' if banded else ''}. Runners-up are the best of other pockets of "
                         "the diagram. " + tech(f"margin {r.margin:g}, speed_tolerance {r.speed_tolerance:g}, "
                                                f"reserve {r.reserve:.3f}, "
                                                f"limiting speed {r.limiting_speed_rpm:.0f} rpm")))
@@ -417,7 +424,7 @@ def _stability(report: Any) -> str:
         out.append(f'<p class="verdict unexplained">No recommendation: {esc(report.no_recommendation)}</p>')
     out.append(band_table(report))
     out.append(figure(figures.lobes_figure(report), "stability lobes",
-                      "Below the curve the cut is stable, above it chatters. The star is the recommended speed and "
+                      f"{lobes_caption(report)} The star is the recommended speed and "
                       "depth, the green box its safe window, the dashed line the limit it keeps its margin from. "
                       + tech("stability lobe diagram; " + ("zero-order approximation (Altintas & Budak 1995)"
                                                            if lobes.method == "zoa" else
@@ -460,14 +467,11 @@ def _stability(report: Any) -> str:
         speeds = lobes.spindle_speed_rpm
         rows = [[fixed(n, ",.0f"), fixed(a, ".3g", 1e3),
                  fixed(lobes.chatter_frequency_hz[int(np.argmin(np.abs(speeds - n)))], ",.0f")] for n, a in tips]
-        out.append("<h3>The tips of the lobes</h3>" + table(["Speed (rpm)", "Chatter limit (mm)", "Chatter at (Hz)"],
-                                                            rows)
+        heading = "The tips of the lobes" + (" (nominal joints)" if report.band is not None else "")
+        out.append(f"<h3>{heading}</h3>" + table(["Speed (rpm)", "Chatter limit (mm)", "Chatter at (Hz)"], rows)
                    + note("The limit itself, with no margin: a speed at the sharp tip of a lobe is stable only "
                           "right there. Use the recommendation above."))
-    if lobes.absolute_limit_m is not None and np.isfinite(lobes.absolute_limit_m):
-        out.append(f"<p>Stable at every speed up to {fixed(lobes.absolute_limit_m, '.3g', 1e3)} mm axial depth "
-                   f"(chatter there at {fixed(lobes.absolute_limit_frequency_hz, ',.0f')} Hz). "
-                   + tech("absolute limit of the zero-order lobes") + "</p>")
+    out.append(every_speed_line(report, tech("absolute limit of the zero-order lobes")))
     s = lobes.spindle_speed_rpm
     out.append(note(f"Spindle speeds {fixed(s[0], ',.0f')} to {fixed(s[-1], ',.0f')} rpm, {s.size:,} speeds."))
     return "".join(out)
@@ -490,8 +494,10 @@ def _joints(report: Any) -> str:
     identified = {r.joint: r for r in report.identifications}
     failed = dict(report.identification_errors)
     out = ["<p>A joint is where two parts meet (spindle and holder, holder and tool); its stiffness and damping "
-           "often decide the tool's modes. The model file gives one value per entry, without an uncertainty; "
-           "the tap test gives values with a standard deviation (68 % of repeated tests fall within ± 1).</p>"]
+           "often decide the tool's modes. The model file gives one value per entry, and may say where it comes "
+           "from and how uncertain it is (the table below); the tap test gives values with a standard deviation "
+           "(68 % of repeated tests fall within ± 1).</p>",
+           provenance_table(_provenances(report))]
     if report.identifications and data is not None and diagnosis_verdict(data)[0] != "agrees":
         out.append('<p class="verdict unexplained">Caution: the diagnosis found that the model as given does not '
                    "agree with the tap test. The identified values absorb what the model misses, and their standard "

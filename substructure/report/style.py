@@ -37,6 +37,9 @@ table.wide { width: 100%; }
 table.keyvalue thead { display: none; }
 table.keyvalue td:first-child { font-weight: 600; background: var(--soft); white-space: nowrap; }
 table.small { font-size: 12px; }
+table.provenance td.source { font-size: 12px; color: var(--muted); }
+table.provenance tr.flag td { background: var(--badbg); }
+.band { border-left: 4px solid var(--warn); padding-left: 10px; }
 figure { margin: 14px 0; }
 figure img { max-width: 100%; height: auto; border: 1px solid var(--line); display: block; }
 figcaption { font-size: 14px; color: var(--muted); margin-top: 4px; }
