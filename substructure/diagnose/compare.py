@@ -27,6 +27,7 @@ import numpy as np
 from ..errors import FrequencyAxisMismatchError, InvalidValueError
 from ..frf import FRF
 from ..smoothing import choose_window, smooth
+from .settings import DEFAULT_SETTINGS
 
 __all__ = [
     "METRIC",
@@ -346,8 +347,8 @@ class Comparison:
 
     @property
     def as_good_as_data(self) -> bool:
-        """True when the error is within 1.5 times the noise floor."""
-        return self.error <= 1.5 * self.noise_floor
+        """True when the error is within 1.5 times the noise floor (``DEFAULT_SETTINGS.explained_error_factor``)."""
+        return self.error <= DEFAULT_SETTINGS.explained_error_factor * self.noise_floor
 
     def plot(self, ax=None):
         """Measured and model FRFs overlaid with the residual below, error bands shaded.
