@@ -34,7 +34,9 @@ FIELDS = [f.name for f in attrs.fields(DiagnoseSettings)]
 # one value out of range for every field (a new field must be added here, or the first test fails)
 OUT_OF_RANGE = {
     "budget": 0.0, "time_limit": -1.0, "max_steps": 0, "most_changes": 0, "screen_lines": 0, "peak_lines": -1,
-    "main_mode_share": 1.5, "shortlist_share": 0.0, "shortlist_max": 0, "tie_chi2": -1.0,
+    "mode_peak_share": 1.0, "mode_prominence": 0.0, "mode_prominence_floors": -1.0, "mode_pairing": 1.0,
+    "error_bands_share": 0.0, "error_bands_width": 1.5, "error_bands_floors": -2.0, "main_mode_share": 1.5,
+    "shortlist_share": 0.0, "shortlist_max": 0, "tie_chi2": -1.0,
     "short_fit_evaluations": 0, "inertia_floor": 0.0, "scan_values": 1, "scan_values_placed": 1,
     "signed_decades": 0.0, "signed_values_min": 1, "body_positions": 1, "section_lengths": (0.5, 1.2),
     "section_starts": 1, "section_ratios": (0.7, -1.0), "named_grid": 1, "named_second": 1, "named_third": 1,

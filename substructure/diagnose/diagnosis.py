@@ -75,7 +75,8 @@ def _catalogue(effects) -> dict:
     return out
 
 
-def _comparisons(lik: Likelihood, ratios, floors) -> tuple[Comparison, ...]:
+def _comparisons(lik: Likelihood, ratios, floors, settings: DiagnoseSettings = DEFAULT_SETTINGS
+                 ) -> tuple[Comparison, ...]:
     out = []
     for m, r, floor in zip(lik.measured, ratios, floors):
         measured = m.frf
@@ -83,9 +84,17 @@ def _comparisons(lik: Likelihood, ratios, floors) -> tuple[Comparison, ...]:
                     measured.inputs)
         out.append(Comparison(model=model, measured=measured, error=float(np.sqrt(np.mean(np.abs(r) ** 2))),
                               noise_floor=floor, frac=frac(model, measured),
-                              modes=pair_modes(model, measured, noise=floor),
-                              bands=error_bands(model, measured, floor=floor)))
+                              modes=_pairs(model, measured, floor, settings),
+                              bands=error_bands(model, measured, settings.error_bands_share, floor=floor,
+                                                width_share=settings.error_bands_width,
+                                                floor_factor=settings.error_bands_floors)))
     return tuple(out)
+
+
+def _pairs(model: FRF, measured: FRF, noise: float, settings: DiagnoseSettings) -> list:
+    """:func:`~substructure.diagnose.compare.pair_modes` with the settings' thresholds."""
+    return pair_modes(model, measured, settings.mode_peak_share, noise=noise, prominence=settings.mode_prominence,
+                      noise_prominence=settings.mode_prominence_floors, pairing=settings.mode_pairing)
 
 
 def _peak_lines(baseline, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> np.ndarray:
@@ -242,7 +251,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     chi2_now = float(lik.whiten(base_ratios) @ lik.whiten(base_ratios))
     n = lik.n
     cons = consistency(lik, base_ratios, 0)
-    baseline = _comparisons(lik, base_ratios, floors)
+    baseline = _comparisons(lik, base_ratios, floors, settings)
     if say:
         say(f"baseline error {e0:.4g} (noise floor {floor:.4g}), chi^2/n = {chi2_now / n:.4g}"
             f"{': consistent with the noise' if cons.consistent else ''}")
@@ -296,7 +305,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         labels = [f"{current[i][0].effect}@{current[i][0].where}:{name}" for i, name in final_fit.names]
         correlation = {"parameters": labels, "matrix": [[_finite(x) for x in row] for row in final_fit.correlation]}
     rivals = _distinct_rivals(assembly, measured, final_effects, outcome, say, settings) if explained else []
-    final = _comparisons(lik, final_ratios, floors)
+    final = _comparisons(lik, final_ratios, floors, settings)
     report = unexplained_report(lik, assembly, current, baseline, cons, final_error, floor, explained, say,
                                 settings) if not explained else ()
     if explained and len(current) > settings.most_changes:  # a composite that only just reaches the noise

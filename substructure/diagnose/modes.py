@@ -112,7 +112,10 @@ def mode_starts(lik0, current, changes, places, settings: DiagnoseSettings = DEF
     except SubstructureError:
         return {}
     model = FRF(measured.frequency, base[:, None, None], measured.outputs, measured.inputs)
-    pairs = [p for p in pair_modes(model, measured, noise=lik0.measured[0].noise.floor) if p.model_hz is not None]
+    pairs = [p for p in pair_modes(model, measured, settings.mode_peak_share, noise=lik0.measured[0].noise.floor,
+                                   prominence=settings.mode_prominence,
+                                   noise_prominence=settings.mode_prominence_floors, pairing=settings.mode_pairing)
+             if p.model_hz is not None]
     f0 = np.array([peak_near(f, base, p.model_hz, settings.mode_locate) or p.model_hz for p in pairs])
     if f0.size == 0:
         return {}

@@ -128,6 +128,27 @@ class DiagnoseSettings:
         Lines kept either side of every measured resonance the model lacks in
         the screening subsample (default 2): a subsample of every k-th line can
         step over such a narrow peak.
+    mode_peak_share : float
+        Measured and model peaks below this share of the highest are left out
+        of the pairing of modes (default 0.02: a fiftieth, below what a tap
+        test's first modes show).
+    mode_prominence : float
+        Least prominence of a peak in ``ln|H|`` (default 0.1: 10 %), so that
+        ripples are not modes ...
+    mode_prominence_floors : float
+        ... and, for a measured peak, at least this many noise floors (default 5.0).
+    mode_pairing : float
+        A measured mode without a model mode within this factor in frequency
+        stays unpaired (default 1.5).
+    error_bands_share : float
+        The bands where the error is are named until they hold this share of it
+        (default 0.5).
+    error_bands_width : float
+        The squared log ratio is smoothed over this share of the band before the
+        error bands are cut (default 0.02) ...
+    error_bands_floors : float
+        ... and a band lies above this many noise floors (default 2.0: noise is
+        not a failure of the model).
     main_mode_share : float
         A paired mode is strong when its measured peak is at least this share
         of the highest (default 0.1); the largest relative shift of the strong
@@ -302,6 +323,13 @@ class DiagnoseSettings:
     most_changes: int = attrs.field(default=2, validator=_count())
     screen_lines: int = attrs.field(default=250, validator=_count())
     peak_lines: int = attrs.field(default=2, validator=_count(0))
+    mode_peak_share: float = attrs.field(default=0.02, validator=_number(0.0, 1.0, lo_open=False, hi_open=True))
+    mode_prominence: float = attrs.field(default=0.1, validator=_number())
+    mode_prominence_floors: float = attrs.field(default=5.0, validator=_number(0.0, lo_open=False))
+    mode_pairing: float = attrs.field(default=1.5, validator=_number(1.0))
+    error_bands_share: float = attrs.field(default=0.5, validator=_number(0.0, 1.0))
+    error_bands_width: float = attrs.field(default=0.02, validator=_number(0.0, 1.0))
+    error_bands_floors: float = attrs.field(default=2.0, validator=_number(0.0, lo_open=False))
     main_mode_share: float = attrs.field(default=0.1, validator=_number(0.0, 1.0))
     shortlist_share: float = attrs.field(default=0.25, validator=_number(0.0, 1.0))
     shortlist_max: int = attrs.field(default=6, validator=_count())
