@@ -201,7 +201,7 @@ class DiagnoseSettings:
     named_second : int
         Positions (all alike) crossed with each size of that grid (default 10).
     named_third : int
-        Values of each of two positions crossed with :attr:`scan_values` sizes
+        Values of each of two positions crossed with ``scan_values`` sizes
         (default 4).
     scale_span : float
         An effect of several log-scale parameters is also scanned with all of
@@ -306,7 +306,7 @@ class DiagnoseSettings:
         ``level_spread`` times it (default 2.0) ...
     level_in_place : float
         ... and every mode within this share of its frequency (or
-        :attr:`in_place_lines`) of the model's (default 0.01).
+        ``in_place_lines``) of the model's (default 0.01).
     report_bands : int
         Most bands the report names where the remaining error lives (default 5).
     band_merge : float
