@@ -138,6 +138,25 @@ def test_the_level_signatures_threshold_in_noise_floors_is_the_setting():
     assert (above, info) == ([], {})
 
 
+def test_the_comparisons_of_the_diagnosis_follow_the_settings():
+    """A tool 4 mm longer shifts every mode: paired by default (within a factor 1.5), unpaired when two modes
+    may differ by a millionth at most; the error bands stop at the first when one covers the share asked for."""
+    from substructure.diagnose.diagnosis import _comparisons
+    from substructure.updating.likelihood import Likelihood, measured_frfs
+
+    measured, _ = measured_frfs(hd.measure(seed=9, tool_length=0.080), None)
+    lik = Likelihood(hd.nominal_model(), measured)
+    floors = [m.noise.floor for m in measured]
+    (default,) = _comparisons(lik, lik.log_ratios([]), floors)
+    (strict,) = _comparisons(lik, lik.log_ratios([]), floors, DiagnoseSettings(mode_pairing=1.000001,
+                                                                                error_bands_share=1e-6))
+    shifts = [abs(math.log(p.model_hz / p.measured_hz)) for p in default.modes if p.model_hz is not None]
+    assert len(shifts) >= 2 and min(shifts) > 1e-6
+    assert [p.measured_hz for p in strict.modes] == [p.measured_hz for p in default.modes]
+    assert all(p.model_hz is None for p in strict.modes)
+    assert len(default.bands) >= 1 and strict.bands == default.bands[:1]
+
+
 def test_an_explicit_budget_wins_over_the_settings_and_the_settings_budget_is_used():
     model = hd.nominal_model()
     data = hd.measure(seed=5, sh_cross=3.0e5, nut=(0.06, 2e-5, 0.04))
