@@ -33,12 +33,12 @@ from __future__ import annotations
 import functools
 import importlib.resources
 import itertools
-import tomllib
 from typing import Any
 
 import attrs
 import numpy as np
 
+from ._toml import loads_toml
 from .errors import InvalidValueError
 from .joints import Joint, JointProvenance
 
@@ -62,7 +62,7 @@ def priors_table() -> dict:
         The parsed ``substructure/data/joint_priors.toml``.
     """
     resource = importlib.resources.files("substructure") / "data" / "joint_priors.toml"
-    return tomllib.loads(resource.read_text(encoding="utf-8"))
+    return loads_toml(resource.read_text(encoding="utf-8"), "joint_priors.toml").data
 
 
 def holder_type(holder: Any) -> dict | None:

@@ -69,7 +69,8 @@ def test_toml_round_trip_and_errors(tmp_path):
         assert list(back.columns[name]) == list(table.columns[name])
     bad = tmp_path / "bad.toml"
     bad.write_text(path.read_text().replace('gauge_length = "65.0 mm"', 'gauge_length = "65.0 kg"'))
-    with pytest.raises(FileFormatError, match=r"bad.toml: joints\[0\].*units that do not match"):
+    with pytest.raises(FileFormatError, match=r"bad\.toml, line 2: joints\[0\]: gauge_length: .*units that do not "
+                       "match"):  # the first row, written inline on line 2
         JointTable.from_toml(bad)
     with pytest.raises(FileFormatError, match="no such file"):
         JointTable.from_toml(tmp_path / "missing.toml")

@@ -310,12 +310,11 @@ def measurement_inputs(path) -> list:
     problem properly.
     """
     from ..errors import SubstructureError
-    from ..io import parse_toml, read_text
+    from .._toml import read_toml
 
     files: list = [path]
     try:
-        data = parse_toml(read_text(path, "measurement set file"), str(path))
-        for table in data.get("frf", []):
+        for table in read_toml(path, "measurement set file").data.get("frf", []):
             if isinstance(table, dict) and isinstance(table.get("file"), str):
                 files.append(Path(path).parent / table["file"])
     except (SubstructureError, AttributeError):

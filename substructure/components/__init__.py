@@ -25,7 +25,11 @@ The protocol a component satisfies (duck-typed, nothing to inherit):
     The receptances between the points, shape ``(2p, 2p, n_freq)``
     (frequency last), DOFs ``(y, theta)`` per point.
 
-One optional member lets batched computations take a shortcut:
+Two optional members: ``parameters()`` names the numbers a type adds to
+its segments (a nut's mass), so that identification and the diagnosis can
+fit them by path (``components.NAME.FIELD``; see :mod:`.parameters`, which
+derives them from the class's own fields when the member is absent); and one
+lets batched computations take a shortcut:
 
 ``plain_beam`` (bool, default False)
     True when the receptances are exactly those of the stepped beam of the
@@ -43,7 +47,9 @@ The package holds one concept per module: ``protocol`` (the registry
 ``COMPONENT_TYPES``, :func:`register_component`, :func:`is_plain_beam`
 and the helpers every component uses), ``beam`` (:class:`Beam`,
 :class:`Spindle`, :class:`Holder`), ``tool`` (:class:`Tool` and
-:meth:`Tool.end_mill`) and ``measured`` (:class:`MeasuredComponent`); every
+:meth:`Tool.end_mill`), ``measured`` (:class:`MeasuredComponent`) and
+``parameters`` (:class:`ComponentParameter`, :func:`own_parameters`,
+:func:`with_parameter`); every
 name is imported from here.
 """
 
@@ -57,6 +63,7 @@ from .beam import Beam, Spindle, component_info  # noqa: E402, F401
 from .holder import Holder  # noqa: E402
 from .tool import Tool  # noqa: E402
 from .measured import MeasuredComponent  # noqa: E402
+from .parameters import ComponentParameter, own_parameters, with_parameter  # noqa: E402
 
 __all__ = [
     "Beam",
@@ -69,4 +76,7 @@ __all__ = [
     "as_frequency",
     "dof_labels",
     "is_plain_beam",
+    "ComponentParameter",
+    "own_parameters",
+    "with_parameter",
 ]

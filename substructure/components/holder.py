@@ -40,12 +40,12 @@ from __future__ import annotations
 import functools
 import importlib.resources
 import math
-import tomllib
 from typing import Any
 
 import attrs
 import pint
 
+from .._toml import loads_toml
 from ..beams import Segment
 from ..errors import InvalidValueError
 from ..sections import Insert, _material
@@ -125,7 +125,7 @@ _COMMON = ("bore", "gauge_length", "clamp_length", "material", "tool_material", 
 @functools.cache
 def _data() -> dict:
     resource = importlib.resources.files("substructure") / "data" / "holders.toml"
-    return tomllib.loads(resource.read_text(encoding="utf-8"))
+    return loads_toml(resource.read_text(encoding="utf-8"), "holders.toml").data
 
 
 def catalog_names() -> tuple[str, ...]:

@@ -36,6 +36,7 @@ import attrs
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from ..components import Beam
 from ..errors import SubstructureError
 from ..updating.elements import AddedMass, GroundSpring, SectionChange, body_bounds, rear_bounds
 from ..updating.fit import Fit, fit, from_u, to_u
@@ -153,7 +154,7 @@ def candidates(assembly, measured_points: Sequence[str], effects: dict, open_wor
         out += [parameter_change(p) for p in model_parameters(assembly)]
         out += material_changes(assembly)
         for comp in assembly.components:
-            if not _plain(comp):
+            if not isinstance(comp, Beam):  # bodies and springs sit along a beam, of any type
                 continue
             lo, hi, mass_max = body_bounds(assembly, comp)
             # the largest rotary inertia: that mass at the radius of twice the widest section (at least the floor)
@@ -164,7 +165,8 @@ def candidates(assembly, measured_points: Sequence[str], effects: dict, open_wor
             if rear is not None:  # a spindle's rear end: a pulley, a rotary union
                 out.append(AddedMass(comp.name, comp.length_m, mass_max, rear, inertia_max, f"{comp.name} rear end"))
             out.append(GroundSpring(comp.name, comp.length_m))
-            out.append(SectionChange(comp.name, comp.length_m))
+            if _plain(comp):  # a section changed in the arrays of a plain beam
+                out.append(SectionChange(comp.name, comp.length_m))
     for name, cls in effects.items():
         try:
             places = cls.places(assembly, list(measured_points))

@@ -8,13 +8,13 @@ the ``measurements`` layer, so that ``MeasurementSet.from_file`` reads without i
 from __future__ import annotations
 
 import os
-import re
 import warnings
 from pathlib import Path
 from typing import Any
 
-from .._files import MAX_DATA_BYTES, parse_toml, read_text
+from .._files import MAX_DATA_BYTES, read_text
 from .._files import check_file as check_readable_file
+from .._toml import TomlDocument, loads_toml
 from ..errors import FileFormatError, SubstructureError, SubstructureWarning
 from ..frf import FRF, QUANTITIES
 from ..frf.files._common import _beyond_physical
@@ -30,48 +30,22 @@ _FRF_KEYS = ("response", "excitation", "file", "record", "quantity", "sensors", 
 _REQUIRED = ("response", "excitation", "file")
 _CSV = (".csv",)
 _UFF = (".uff", ".unv")
-_TABLE = re.compile(r"^\s*\[\[\s*frf\s*\]\]\s*(?:#.*)?$")
 
 
 class _LocatedError(FileFormatError):
     """An error already naming the measurement file and the key path."""
 
 
-class _Lines:
-    """Best-effort line numbers of the keys of a measurement file, for messages."""
-
-    def __init__(self, text: str):
-        self.lines = text.splitlines()
-        self.tables = [n for n, line in enumerate(self.lines) if _TABLE.match(line)]
-
-    def line(self, index: int | None, key: str | None) -> int | None:
-        if index is None:
-            start, end = 0, (self.tables[0] if self.tables else len(self.lines))
-        elif index < len(self.tables):
-            start = self.tables[index]
-            later = [n for n in self.tables if n > start]
-            end = later[0] if later else len(self.lines)
-        else:
-            return None
-        if key is not None:
-            pattern = re.compile(r"^\s*" + re.escape(key) + r"\s*=")
-            for n in range(start, end):
-                if pattern.match(self.lines[n]):
-                    return n + 1
-        return start + 1 if index is not None else None
-
-
 class _Reader:
-    def __init__(self, text: str, base_dir: Path, source: str):
-        self.base_dir, self.source, self.lines = base_dir, source, _Lines(text)
+    def __init__(self, doc: TomlDocument, base_dir: Path):
+        self.base_dir, self.source, self.doc = base_dir, doc.source, doc
+
+    @staticmethod
+    def parts(index: int | None, key: str | None) -> list:
+        return ([] if index is None else ["frf", index]) + ([] if key is None else [key])
 
     def error(self, index: int | None, key: str | None, message: str) -> FileFormatError:
-        line = self.lines.line(index, key)
-        where = f"{self.source}, line {line}" if line else self.source
-        path = "" if index is None else f"frf[{index}]"
-        if key is not None:
-            path = f"{path}.{key}" if path else key
-        return _LocatedError(f"{where}: {path}: {message}" if path else f"{where}: {message}")
+        return self.doc.error(self.parts(index, key), message, _LocatedError)
 
     # -- values ------------------------------------------------------------
     def string(self, table: dict, index: int, key: str) -> str:
@@ -222,9 +196,8 @@ class _Reader:
         averages = self.averages(table, index)
         raw, coherence = self.data(index, file, record, quantity, response, excitation)
         if raw.quantity != "receptance" and raw.frequency.hz[0] == 0.0:
-            line = self.lines.line(index, "file")
             warnings.warn(
-                f"{self.source}{f', line {line}' if line else ''}: frf[{index}].file: {file}: dropped the 0 Hz "
+                f"{self.doc.where(self.parts(index, 'file'))}: frf[{index}].file: {file}: dropped the 0 Hz "
                 f"line: a {raw.quantity} has no receptance at 0 Hz",
                 SubstructureWarning, stacklevel=2,
             )
@@ -300,14 +273,9 @@ def reads_measurements(cls: Any, text: str, base_dir: str | os.PathLike = ".", s
         Naming ``source``, the key path and the data file; see the module
         documentation for the checks.
     """
-    if not isinstance(text, str):
-        raise FileFormatError(f"{source}: got {type(text).__name__}; expected the TOML text as a str")
-    text = text.removeprefix("\ufeff")  # a byte-order mark left by an editor is not part of the document
-    if not text.strip():
-        raise FileFormatError(f"{source}: the file is empty; expected a measurement set (docs/file-formats.md)")
-    data = parse_toml(text, source)
+    doc = loads_toml(text, source, "measurement set")
     try:
-        return _Reader(text, Path(base_dir), source).measurement_set(data, cls)
+        return _Reader(doc, Path(base_dir)).measurement_set(doc.data, cls)
     except _LocatedError as exc:  # the public class, without the internal marker
         raise FileFormatError(str(exc)) from None
 

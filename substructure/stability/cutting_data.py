@@ -20,15 +20,14 @@ The table's ranges are assumed ranges of the published orders of magnitude
 from __future__ import annotations
 
 import importlib.resources
-import os
-import tomllib
 from typing import Any
 
 import attrs
 import numpy as np
 import pint
 
-from ..errors import FileFormatError, InvalidValueError, SubstructureWarning
+from .._toml import TomlDocument, loads_toml, read_toml
+from ..errors import InvalidValueError, SubstructureWarning
 from ..units import quantity
 
 __all__ = ["CuttingData", "CuttingDataWarning", "cutting_data", "load_cutting_data", "cutting_conditions",
@@ -133,32 +132,13 @@ class CuttingData:
                 "default_feed_per_tooth_m": float(self.default_feed_per_tooth.m_as("m")), "source": self.source}
 
 
-def _parse(text: str, source: str) -> tuple[CuttingData, ...]:
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise FileFormatError(f"{source}: invalid TOML: {exc}") from None
-    unknown = [k for k in data if k != "cutting"]
-    if unknown:
-        raise FileFormatError(f"{source}: {unknown[0]}: unknown key; expected [[cutting]] tables")
-    rows = data.get("cutting")
-    if not isinstance(rows, list) or not rows:
-        raise FileFormatError(f"{source}: no [[cutting]] table")
+def _parse(doc: TomlDocument) -> tuple[CuttingData, ...]:
     out = []
-    for i, row in enumerate(rows):
-        where = f"{source}: cutting[{i}]"
-        if not isinstance(row, dict):
-            raise FileFormatError(f"{where}: expected a table")
-        for key in row:
-            if key not in _KEYS:
-                raise FileFormatError(f"{where}.{key}: unknown key; allowed keys: {', '.join(_KEYS)}")
-        for key in _KEYS:
-            if key not in row:
-                raise FileFormatError(f"{where}.{key}: missing; this value is required")
+    for i, row in enumerate(doc.tables("cutting", _KEYS, _KEYS)):
         try:
             out.append(CuttingData(**row))
         except (InvalidValueError, TypeError, ValueError) as exc:
-            raise FileFormatError(f"{where} ({row.get('workpiece')!r}): {exc}") from None
+            raise doc.wrap(["cutting", i], str(exc)) from None
     return tuple(out)
 
 
@@ -182,16 +162,8 @@ def load_cutting_data(path: Any = None) -> tuple[CuttingData, ...]:
     """
     if path is None:
         resource = importlib.resources.files("substructure") / "data" / "cutting_data.toml"
-        return _parse(resource.read_text(encoding="utf-8"), "cutting_data.toml")
-    name = os.fspath(path)
-    try:
-        with open(path, encoding="utf-8-sig") as fh:
-            text = fh.read()
-    except FileNotFoundError:
-        raise FileFormatError(f"{name}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise FileFormatError(f"{name}: cannot read the file ({exc})") from None
-    return _parse(text, name)
+        return _parse(loads_toml(resource.read_text(encoding="utf-8"), "cutting_data.toml"))
+    return _parse(read_toml(path, "cutting-data table"))
 
 
 def cutting_data(workpiece: Any, tool_material: str = "carbide", table: Any = None) -> CuttingData | None:

@@ -28,8 +28,8 @@ from typing import Any
 import attrs
 import pint
 
-from .._files import decode_text, parse_toml, read_bytes
-from ..errors import FileFormatError, InvalidValueError
+from .._toml import TomlDocument, loads_toml, read_toml
+from ..errors import InvalidValueError
 from ..units import Q_, dimensionless, quantity, show_value
 
 __all__ = ["Workpiece", "workpiece", "workpieces", "load_workpieces", "WORKPIECE_KEYS"]
@@ -242,36 +242,18 @@ def _key(name: str) -> str:
     return " ".join(sorted(words))
 
 
-def _parse(text: str, source: str) -> tuple[Workpiece, ...]:
-    data = parse_toml(text, source)
-    unknown = [k for k in data if k != "workpiece"]
-    if unknown:
-        raise FileFormatError(f"{source}: {unknown[0]}: unknown key; expected [[workpiece]] tables")
-    rows = data.get("workpiece")
-    if not isinstance(rows, list) or not rows:
-        raise FileFormatError(f"{source}: no [[workpiece]] table")
-    out = []
-    for i, row in enumerate(rows):
-        where = f"{source}: workpiece[{i}]"
-        if not isinstance(row, dict):
-            raise FileFormatError(f"{where}: expected a table")
-        for key in row:
-            if key not in WORKPIECE_KEYS:
-                raise FileFormatError(f"{where}.{key}: unknown key; allowed keys: {', '.join(WORKPIECE_KEYS)}")
-        for key in ("name", "model", "source"):
-            if key not in row:
-                raise FileFormatError(f"{where}.{key}: missing; this value is required")
+def _parse(doc: TomlDocument) -> tuple[Workpiece, ...]:
+    out: list[Workpiece] = []
+    seen: dict[str, str] = {}
+    for i, row in enumerate(doc.tables("workpiece", WORKPIECE_KEYS, ("name", "model", "source"))):
         try:
             out.append(Workpiece(**row))
         except (InvalidValueError, TypeError, ValueError) as exc:
-            raise FileFormatError(f"{where} ({row.get('name')!r}): {exc}") from None
-    seen: dict[str, str] = {}
-    for w in out:
-        for alias in (w.name, *w.aliases):
-            key = _key(alias)
-            if key in seen and seen[key] != w.name:
-                raise FileFormatError(f"{source}: the name {alias!r} is used by {seen[key]!r} and {w.name!r}")
-            seen[key] = w.name
+            raise doc.wrap(["workpiece", i], str(exc)) from None
+        for key, alias in [("name", out[-1].name)] + [("aliases", a) for a in out[-1].aliases]:
+            if seen.setdefault(_key(alias), out[-1].name) != out[-1].name:
+                raise doc.error(["workpiece", i, key], f"the name {alias!r} is used by {seen[_key(alias)]!r} and "
+                                f"{out[-1].name!r}")
     return tuple(out)
 
 
@@ -293,8 +275,7 @@ def load_workpieces(path: Any) -> tuple[Workpiece, ...]:
     FileFormatError
         Naming the file, the row and the key.
     """
-    name = os.fspath(path)
-    return _parse(decode_text(read_bytes(path, "workpiece table"), name), name)
+    return _parse(read_toml(path, "workpiece table"))
 
 
 def workpieces() -> tuple[Workpiece, ...]:
@@ -306,7 +287,7 @@ def workpieces() -> tuple[Workpiece, ...]:
         Every entry of the project's table.
     """
     resource = importlib.resources.files("substructure") / "data" / "cutting_coefficients.toml"
-    return _parse(resource.read_text(encoding="utf-8"), "cutting_coefficients.toml")
+    return _parse(loads_toml(resource.read_text(encoding="utf-8"), "cutting_coefficients.toml"))
 
 
 def workpiece(name: str, table: Any = None) -> Workpiece:

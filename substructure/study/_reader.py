@@ -25,6 +25,7 @@ import re
 from pathlib import Path
 from typing import Any
 
+from .._toml import TomlDocument, key_path, loads_toml
 from ..errors import FileFormatError, SubstructureError
 
 __all__ = ["read_study", "reads_study", "read_combinations_csv", "TOP_KEYS"]
@@ -40,64 +41,13 @@ _GRID_KEYS = ("frequency", "speeds", "sdm_speeds")
 _COMPUTE_KEYS = ("at", "lobes", "recommend", "band", "samples", "quantiles", "margin", "speed_tolerance", "figures",
                  "frf_files")
 _SURROGATE_KEYS = ("table", "model", "targets", "features")
-_HEADER = re.compile(r"^\s*(\[\[?)\s*([^\[\]#]+?)\s*\]\]?\s*(?:#.*)?$")
-_FIELD = re.compile(r"^([A-Za-z_][A-Za-z0-9_.\[\]]*): (.*)$", re.DOTALL)
-
-
-class _Lines:
-    """Best-effort line numbers of keys in the TOML text, for messages."""
-
-    def __init__(self, text: str):
-        self.lines = text.splitlines()
-        self.headers = []
-        for n, line in enumerate(self.lines):
-            m = _HEADER.match(line)
-            if m:
-                self.headers.append((n, m.group(2).strip().strip("\"'"), m.group(1) == "[["))
-
-    def line(self, parts: list) -> int | None:
-        start, rest = None, list(parts)
-        if len(parts) >= 2 and isinstance(parts[0], str) and isinstance(parts[1], int):
-            heads = [n for n, name, array in self.headers if array and name == parts[0]]
-            if parts[1] < len(heads):
-                start, rest = heads[parts[1]], list(parts[2:])
-        elif parts and isinstance(parts[0], str):
-            heads = [n for n, name, array in self.headers if not array and name == parts[0]]
-            if heads:
-                start, rest = heads[0], list(parts[1:])
-        if start is None:  # a top-level key: the lines before the first table
-            first, end = 0, (self.headers[0][0] if self.headers else len(self.lines))
-        else:
-            later = [n for n, _, _ in self.headers if n > start]
-            first, end = start, (later[0] if later else len(self.lines))
-        keys = [p for p in rest if isinstance(p, str)]
-        for key in dict.fromkeys(reversed(keys)):  # the innermost key first, then its containers
-            pattern = re.compile(r"(?:^|[\s{,])" + re.escape(key) + r"\s*=")
-            for n in range(first, end):
-                if pattern.search(self.lines[n]):
-                    return n + 1
-        return None if start is None else start + 1
-
-
-def _path(parts) -> str:
-    text = ""
-    for p in parts:
-        text += f"[{p}]" if isinstance(p, int) else (f".{p}" if text else str(p))
-    return text
 
 
 class _Reader:
-    def __init__(self, source: str, text: str, data: dict, base: Path):
-        self.source, self.data, self.base, self.lines = source, data, base, _Lines(text)
-        self.inputs: list[str] = [source]
-
-    def where(self, parts) -> str:
-        line = self.lines.line(list(parts))
-        return f"{self.source}, line {line}" if line else self.source
-
-    def error(self, parts, message: str) -> FileFormatError:
-        key = _path(parts)
-        return FileFormatError(f"{self.where(parts)}: {key}: {message}" if key else f"{self.where(parts)}: {message}")
+    def __init__(self, doc: TomlDocument, base: Path):
+        self.source, self.data, self.base, self.doc = doc.source, doc.data, base, doc
+        self.where, self.error, self.table = doc.where, doc.error, doc.table
+        self.inputs: list[str] = [doc.source]
 
     def call(self, parts, factory, *args, **kwargs):
         try:
@@ -105,25 +55,7 @@ class _Reader:
         except FileFormatError:
             raise
         except SubstructureError as exc:
-            message = " ".join(str(exc).split())
-            if message.startswith(self.source):  # it names the file and line already
-                raise FileFormatError(message) from None
-            m = _FIELD.match(message)
-            if m and not message.startswith(self.source):
-                inner = [int(i) if i else k for k, i in re.findall(r"([^.\[\]]+)|\[(\d+)\]", m.group(1))]
-                raise self.error(list(parts) + inner, m.group(2)) from None
-            raise self.error(parts, message) from None
-
-    def table(self, value, parts, allowed, required=()) -> dict:
-        if not isinstance(value, dict):
-            raise self.error(parts, f"got {value!r}; expected a table")
-        for key in value:
-            if key not in allowed:
-                raise self.error(list(parts) + [key], f"unknown key; allowed keys: {', '.join(allowed)}")
-        for key in required:
-            if key not in value:
-                raise self.error(list(parts) + [key], "missing; this value is required")
-        return value
+            raise self.doc.wrap(parts, " ".join(str(exc).split())) from None
 
     def array(self, key: str) -> list:
         value = self.data.get(key, [])
@@ -183,7 +115,7 @@ class _Reader:
         kw = dict(table)
         assembly = table.get("assembly", "default")
         kw["assembly"] = "default" if assembly == "default" else self.file(assembly, parts + ["assembly"])
-        return self.call(parts, Machine, **kw, where=f"{self.where(parts)}: {_path(parts)}")
+        return self.call(parts, Machine, **kw, where=f"{self.where(parts)}: {key_path(parts)}")
 
     def cut(self, table, parts):
         from .spec import Cut
@@ -192,13 +124,13 @@ class _Reader:
         kw = dict(table)
         if "workpiece_table" in table:
             kw["workpiece_table"] = self.file(table["workpiece_table"], parts + ["workpiece_table"])
-        return self.call(parts, Cut, **kw, where=f"{self.where(parts)}: {_path(parts)}")
+        return self.call(parts, Cut, **kw, where=f"{self.where(parts)}: {key_path(parts)}")
 
     def combination(self, table, parts):
         from .spec import Combination
 
         table = self.table(table, parts, _COMBINATION_KEYS, ("name",))
-        return self.call(parts, Combination, **table, where=f"{self.where(parts)}: {_path(parts)}")
+        return self.call(parts, Combination, **table, where=f"{self.where(parts)}: {key_path(parts)}")
 
 
 def reads_study(cls: Any, text: str, source: str = "<string>", base: Any = ".") -> Any:
@@ -220,13 +152,7 @@ def reads_study(cls: Any, text: str, source: str = "<string>", base: Any = ".") 
     Study
         The study.
     """
-    text = text.removeprefix("\ufeff")
-    if not text.strip():
-        raise FileFormatError(f"{source}: the file is empty; expected a study (docs/file-formats.md)")
-    from .._files import parse_toml
-
-    data = parse_toml(text, source)
-    return _Reader(source, text, data, Path(base)).study(cls)
+    return _Reader(loads_toml(text, source, "study"), Path(base)).study(cls)
 
 
 def read_study(cls: Any, path: Any) -> Any:

@@ -536,31 +536,29 @@ class JointTable:
         JointTable
             The table.
         """
-        from ..io import parse_toml, read_text
+        from .._toml import read_toml
 
-        where = str(path)
-        data = parse_toml(read_text(path, "joint table"), where)
-        unknown = set(data) - {"parameters", "features", "joints"}
-        if unknown:
-            raise FileFormatError(f"{where}: unknown keys {sorted(unknown)}; expected parameters, features, joints")
+        doc = read_toml(path, "joint table")
+        data = doc.data
+        doc.table(data, [], ("parameters", "features", "joints"))
         for key in ("parameters", "features", "joints"):
             if key not in data:
-                raise FileFormatError(f"{where}: missing [{key}]")
+                raise doc.error([], f"missing [{key}]")
         for key in ("parameters", "features"):
             if not isinstance(data[key], dict) or not all(isinstance(u, str) for u in data[key].values()):
-                raise FileFormatError(f"{where}: [{key}]: expected NAME = \"unit\" entries")
+                raise doc.error([key], "expected NAME = \"unit\" entries")
         if not isinstance(data["joints"], list) or not all(isinstance(r, dict) for r in data["joints"]):
-            raise FileFormatError(f"{where}: joints: expected [[joints]] tables")
+            raise doc.error(["joints"], "expected [[joints]] tables")
         features = {f: (None if u == "categorical" else u) for f, u in data["features"].items()}
         try:
             table = cls.empty(data["parameters"], features)
         except (InvalidValueError, UnitError) as exc:
-            raise FileFormatError(f"{where}: {exc}") from None
+            raise doc.error([], str(exc)) from None
         for i, row in enumerate(data["joints"]):
             try:
                 table = table.append(row)
             except (InvalidValueError, UnitError) as exc:
-                raise FileFormatError(f"{where}: joints[{i}]: {exc}") from None
+                raise doc.error(["joints", i], str(exc)) from None
         return table
 
     def describe(self) -> str:

@@ -56,7 +56,7 @@ from typing import Mapping
 import attrs
 import numpy as np
 
-from ..components import Spindle, Tool
+from ..components import Spindle, Tool, own_parameters
 from ..errors import InvalidValueError
 from ..joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint
 from ..materials import Material
@@ -74,7 +74,7 @@ from .paths import (
 )
 
 __all__ = ["ParamSpec", "Change", "ModelParameter", "ParameterChange", "ParameterSet", "model_parameters",
-           "material_changes", "parameter_change", "AssemblyParameterChange", "get_parameter", "set_parameters",
+           "material_changes", "parameter_change", "get_parameter", "set_parameters",
            "apply_path_si", "LENGTH_FACTOR", "ENGINEERING_E", "ENGINEERING_RHO", "ENGINEERING_NU", "POSITION_FRACTION",
            "STEP_KEEP"]
 
@@ -100,9 +100,6 @@ class ModelParameter:
     linked : bool
         Several numbers moved as one (an overhang, a component's material, a
         joint's whole stiffness, a set of supports).
-    si : bool
-        It can be set on the SI form of the model (False for the numbers of
-        a component with tapered segments, which fits set on the assembly).
     """
 
     path: str
@@ -113,7 +110,6 @@ class ModelParameter:
     log: bool
     description: str
     linked: bool = False
-    si: bool = True
 
     def spec(self) -> ParamSpec:
         """The fitted parameter ``value``, starting at the nominal value.
@@ -235,11 +231,12 @@ def model_parameters(assembly) -> list[ModelParameter]:
     out: list[ModelParameter] = []
     materials: dict[str, Material] = {}
     for comp in assembly.components:
-        si = _plain(comp)
-        if not si and not _segmented(comp):
-            continue
-        first = len(out)
         base = f"components.{comp.name}"
+        out += [ModelParameter(f"{base}.{p.name}", p.unit, p.nominal, p.lower, p.upper, p.log, p.text)
+                for p in own_parameters(comp)]
+        if not _segmented(comp):
+            continue
+        si = _plain(comp)  # materials are shared by name among the plain beams
         for i, seg in enumerate(comp.segments):
             p = f"{base}.segments.{i}"
             L, od, id_ = seg.length_m, seg.od.m_as("m"), seg.id.m_as("m")
@@ -309,8 +306,6 @@ def model_parameters(assembly) -> list[ModelParameter]:
                 lo, hi = (x / value for x in _within(value, 0.25, 4.0, engineering))
             out.append(_linked(f"{base}.{prop}", "dimensionless", 1.0, lo, hi,
                                f"{text} of {comp.name} only, as a factor"))
-        if not si:  # tapered segments: set on the assembly in fits
-            out[first:] = [attrs.evolve(x, si=False) for x in out[first:]]
     for name, m in materials.items():
         p = f"materials.{name}"
         E, rho = m.E.m_as("Pa"), m.rho_si
@@ -513,15 +508,8 @@ class ParameterChange(Change):
         return apply_path_si(structure, self.where, float(values["value"]))
 
 
-class AssemblyParameterChange(ParameterChange):
-    """A :class:`ParameterChange` of a number the SI form does not hold (a tapered segment's): fits set it
-    on the assembly and rebuild the changed component (slower, the same result)."""
-
-    apply_si = Change.apply_si
-
-
 def parameter_change(parameter: ModelParameter) -> ParameterChange:
-    """The change that corrects a model parameter: on the SI form when it can, else on the assembly.
+    """The change that corrects a model parameter (on the SI form, as every parameter is).
 
     Parameters
     ----------
@@ -531,9 +519,9 @@ def parameter_change(parameter: ModelParameter) -> ParameterChange:
     Returns
     -------
     ParameterChange
-        A :class:`ParameterChange`, or an :class:`AssemblyParameterChange` when ``parameter.si`` is false.
+        A :class:`ParameterChange`.
     """
-    return ParameterChange(parameter) if parameter.si else AssemblyParameterChange(parameter)
+    return ParameterChange(parameter)
 
 
 class ParameterSet(Change):

@@ -48,25 +48,33 @@ def apply_path_si(structure, path: str, value: float):
     parts = path.split(".")
     head = parts[0]
     if head == "components":
-        beam = structure.beam(parts[1])
         rest = parts[2:]
+        if rest == ["supports", "k"]:
+            out = structure
+            for i, link in enumerate(structure.links):
+                if link.key[0] == "supports" and _component_of(link.a) == parts[1]:
+                    out = out.with_link(i, link.evolve(K=link.K * value))
+            return out
+        if parts[1] in structure.opaque:  # a component evaluated by its own methods: changed as an object
+            comp = _set_component(structure.opaque[parts[1]], path, rest, value)
+            out = structure.with_opaque(comp)
+            if rest == ["bore"]:
+                out = _bore_inserts_si(out, path, comp.name, comp.segments[0].od.m_as("m"),
+                                       comp.segments[0].material.name, value)
+            return out
+        beam = structure.beam(parts[1])
         if rest[0] in ("segments", "overhang"):
             return structure.with_beam(_section_checked(path, _geometry(beam, path, rest, value)))
         if rest == ["bore"]:  # every segment without an insert: a coolant bore, a hollow shank
             value = 0.0 if value < 1e-6 else value
             bore = np.where(beam.insert[:, 0] > 0, beam.id, value)
             out = structure.with_beam(_section_checked(path, beam.evolve(id=bore)))
-            # the part's shank clamped in another part (an insert of its material and its diameter) too
-            od, name = float(beam.od[0]), beam.material_names[0]
-            for other in structure.beams.values():
-                if other.name == beam.name:
-                    continue
-                hit = np.array([n == name for n in other.insert_names]) & np.isclose(other.insert[:, 0], od)
-                if hit.any():
-                    ins = other.insert.copy()
-                    ins[hit, 1] = value
-                    out = out.with_beam(_section_checked(path, other.evolve(insert=ins)))
-            return out
+            return _bore_inserts_si(out, path, beam.name, float(beam.od[0]), beam.material_names[0], value)
+        if len(rest) == 1 and rest[0] not in _COMPONENT_KEYS:  # a number the component's type adds
+            source = structure.sources.get(beam.name)
+            if source is None:
+                raise InvalidValueError(f"parameter {path!r}: set a component's own numbers before its segments'")
+            return structure.with_beam(_arrays_of(_set_component(source, path, rest, value)))
         if rest in (["E"], ["rho"], ["loss_factor"]):
             mat = beam.material.copy()
             mat[:, _MAT_COLUMN[rest[0]]] *= value
@@ -75,12 +83,6 @@ def apply_path_si(structure, path: str, value: float):
             mat = beam.material.copy()
             mat[:, _MAT_COLUMN[rest[1]]] = value
             return structure.with_beam(beam.evolve(material=mat))
-        if rest == ["supports", "k"]:
-            out = structure
-            for i, link in enumerate(structure.links):
-                if link.key[0] == "supports" and _component_of(link.a) == parts[1]:
-                    out = out.with_link(i, link.evolve(K=link.K * value))
-            return out
     if head == "materials":
         _key(path, ".".join(parts[:-1]), parts[-1], _MATERIAL_KEYS)
         name, column = ".".join(parts[1:-1]), _MAT_COLUMN[parts[-1]]
@@ -128,6 +130,31 @@ def apply_path_si(structure, path: str, value: float):
         m[(0, 1)[parts[2] == "inertia"], (0, 1)[parts[2] == "inertia"]] = value
         return structure.with_link(i, link.evolve(M=m))
     raise UnknownPointError(f"parameter {path!r}: not a parameter path")
+
+
+def _arrays_of(component):
+    from .structure import BeamArrays
+
+    return BeamArrays.from_beam(component)
+
+
+def _bore_inserts_si(structure, path: str, name: str, od: float, material: str, value: float):
+    """A part's bore made in its shank where another plain beam holds it (an insert of its material and od)."""
+    value = 0.0 if value < 1e-6 else value
+    out = structure
+    for other in structure.beams.values():
+        if other.name == name:
+            continue
+        hit = np.array([n == material for n in other.insert_names]) & np.isclose(other.insert[:, 0], od)
+        if hit.any():
+            ins = other.insert.copy()
+            ins[hit, 1] = value
+            out = out.with_beam(_section_checked(path, other.evolve(insert=ins)))
+    for other in structure.opaque.values():
+        bored = None if other.name == name else _bored_shank(other, material, od, value)
+        if bored is not None:
+            out = out.with_opaque(bored)
+    return out
 
 
 def _geometry(beam, path: str, rest: list[str], value: float):
@@ -204,12 +231,12 @@ def _plain(component) -> bool:
 
 
 def _segmented(component) -> bool:
-    """A beam of plain segments, tapered ones allowed (its numbers can be set on the assembly)."""
+    """A beam of plain segments, tapered ones allowed, whatever physics its type adds (a nut on a holder):
+    its segments' numbers are set on the object."""
     from ..beams import Segment
-    from ..components import Beam, is_plain_beam
+    from ..components import Beam
 
-    return is_plain_beam(component) and isinstance(component, Beam) and all(type(s) is Segment
-                                                                             for s in component.segments)
+    return isinstance(component, Beam) and all(type(s) is Segment for s in component.segments)
 
 
 def bore_segments(comp) -> list[int] | None:
@@ -245,7 +272,7 @@ def _on_beam(assembly, point: str):
         comp = assembly.component(ref.component)
     except UnknownPointError:
         return None, 0.0, 0.0
-    if not _plain(comp):
+    if not _segmented(comp):
         return None, 0.0, 0.0
     return comp.name, comp.position(ref), comp.length_m
 
@@ -340,10 +367,15 @@ def check_path(assembly, path: str) -> list[str]:
         names = sorted(assembly.component_names)
         _key(path, "components", parts[1], names)
         comp = assembly.component(parts[1])
+        from ..components import own_parameters
+
+        rest, where, own = parts[2:], f"components.{parts[1]}", tuple(p.name for p in own_parameters(comp))
+        if len(rest) == 1 and rest[0] in own:  # a number the component's type adds
+            return parts
         if not _segmented(comp):
-            raise _unknown(path, f"{parts[1]!r} is not a stepped beam")
-        rest, where = parts[2:], f"components.{parts[1]}"
-        _key(path, where, rest[0], _COMPONENT_KEYS)
+            why = f"its own parameters are {_expected(own)}" if own else "it names no parameters of its own"
+            raise _unknown(path, f"{parts[1]!r} is not a stepped beam, and {why}")
+        _key(path, where, rest[0], _COMPONENT_KEYS + own)
         if rest[0] == "segments":
             _length(path, rest, (3, 4))
             i = _index(path, rest[1], len(comp.segments), f"segment index of {comp.name!r}")
@@ -439,84 +471,103 @@ def _material_value(material: Material, prop: str, value: float) -> Material:
     return attrs.evolve(material, loss_factor=float(value))
 
 
+def _bored_shank(part, material: str, od: float, value: float):
+    """``part`` with the bore of a shank it holds (an insert of ``material`` and diameter ``od``), or None."""
+    if not _segmented(part):
+        return None
+    bore = _si(value, "m")
+    new = [attrs.evolve(seg, insert=attrs.evolve(seg.insert, id=bore))
+           if seg.insert is not None and seg.insert.material.name == material
+           and abs(seg.insert.od.m_as("m") - od) <= 1e-9 * max(od, 1e-3) else seg
+           for seg in part.segments]
+    return None if new == list(part.segments) else attrs.evolve(part, segments=new)
+
+
+def _set_component(comp, path: str, rest: list[str], value: float):
+    """One number of one component set on the object (``rest``: the path after ``components.C``).
+
+    The one setter of a component's own numbers: the assembly's paths use it, and so does the SI form for
+    a component it evaluates through the component's own methods.
+    """
+    from ..components import own_parameters, with_parameter
+
+    value = float(value)
+    if len(rest) == 1 and rest[0] in {p.name for p in own_parameters(comp)}:
+        return with_parameter(comp, rest[0], value)
+    if not _segmented(comp):
+        raise _unknown(path, f"{comp.name!r} is not a stepped beam")
+    segs = list(comp.segments)
+    if rest[0] == "segments" and len(rest) >= 3:
+        i = int(rest[1])
+        seg = segs[i]
+        what = ".".join(rest[2:])
+        if what in ("length", "od", "id", "od_tip", "id_tip"):
+            if what in ("id", "id_tip") and value < 1e-6:  # a bore under a micrometre is no bore
+                value = 0.0
+            segs[i] = attrs.evolve(seg, **{what: _si(value, "m")})
+        elif what == "end":
+            if i + 1 >= len(segs):
+                raise _unknown(path, f"segment {i} of {comp.name!r} is its last: it has no step to move")
+            start = sum(x.length_m for x in segs[:i])
+            stop = start + seg.length_m + segs[i + 1].length_m
+            if not start < value < stop:
+                raise InvalidValueError(
+                    f"parameter {path!r}: got {value!r} m; expected a place strictly between where segment {i} "
+                    f"begins and segment {i + 1} ends ({start * 1e3:.6g} mm to {stop * 1e3:.6g} mm from the "
+                    f"base of {comp.name!r})")
+            shift = value - start - seg.length_m
+            segs[i] = attrs.evolve(seg, length=_si(seg.length_m + shift, "m"))
+            segs[i + 1] = attrs.evolve(segs[i + 1], length=_si(segs[i + 1].length_m - shift, "m"))
+        elif what in ("insert.od", "insert.id"):
+            segs[i] = attrs.evolve(seg, insert=attrs.evolve(seg.insert, **{what[7:]: _si(value, "m")}))
+        elif what == "flutes.diameter_ratio":
+            segs[i] = attrs.evolve(seg, flutes=attrs.evolve(seg.flutes, diameter_ratio=value))
+        else:
+            raise _unknown(path, f"unknown segment value {what!r}")
+    elif rest == ["bore"]:
+        bore = _si(0.0 if value < 1e-6 else value, "m")  # a bore under a micrometre is no bore
+        segs = [seg if seg.insert is not None else attrs.evolve(seg, id=bore) for seg in segs]
+    elif rest == ["overhang"]:
+        i = _overhang_segment(comp)
+        segs[i] = attrs.evolve(segs[i], length=_si(segs[i].length_m + value - comp.length_m, "m"))
+    elif rest in (["E"], ["rho"], ["loss_factor"]) or (len(rest) == 2 and rest[0] == "material"
+                                                        and rest[1] in _MAT_COLUMN):
+        own, prop = len(rest) == 1, rest[-1]
+        renamed = {}
+        for i, seg in enumerate(segs):
+            m = seg.material
+            if m.name not in renamed:
+                current = {"E": m.E.m_as("Pa"), "rho": m.rho_si, "nu": m.nu, "loss_factor": m.loss_factor}[prop]
+                new = _material_value(m, prop, current * value if own else value)
+                suffix = f"-{comp.name}"
+                renamed[m.name] = attrs.evolve(new, name=m.name if m.name.endswith(suffix) else m.name + suffix)
+            segs[i] = attrs.evolve(seg, material=renamed[m.name])
+    else:
+        raise _unknown(path, "not a parameter path (see substructure.updating.parameters)")
+    return attrs.evolve(comp, segments=segs)
+
+
 def _set_one(assembly, path: str, value: float):
     parts = check_path(assembly, path)
     head = parts[0]
     value = float(value)
     if head == "components" and len(parts) >= 3:
         comp = assembly.component(parts[1])
-        if not _segmented(comp):
-            raise _unknown(path, f"{parts[1]!r} is not a stepped beam")
         rest = parts[2:]
-        segs = list(comp.segments)
-        if rest[0] == "segments" and len(rest) >= 3:
-            i = int(rest[1])
-            seg = segs[i]
-            what = ".".join(rest[2:])
-            if what in ("length", "od", "id", "od_tip", "id_tip"):
-                if what in ("id", "id_tip") and value < 1e-6:  # a bore under a micrometre is no bore
-                    value = 0.0
-                segs[i] = attrs.evolve(seg, **{what: _si(value, "m")})
-            elif what == "end":
-                if i + 1 >= len(segs):
-                    raise _unknown(path, f"segment {i} of {comp.name!r} is its last: it has no step to move")
-                start = sum(x.length_m for x in segs[:i])
-                stop = start + seg.length_m + segs[i + 1].length_m
-                if not start < value < stop:
-                    raise InvalidValueError(
-                        f"parameter {path!r}: got {value!r} m; expected a place strictly between where segment {i} "
-                        f"begins and segment {i + 1} ends ({start * 1e3:.6g} mm to {stop * 1e3:.6g} mm from the "
-                        f"base of {comp.name!r})")
-                shift = value - start - seg.length_m
-                segs[i] = attrs.evolve(seg, length=_si(seg.length_m + shift, "m"))
-                segs[i + 1] = attrs.evolve(segs[i + 1], length=_si(segs[i + 1].length_m - shift, "m"))
-            elif what in ("insert.od", "insert.id"):
-                segs[i] = attrs.evolve(seg, insert=attrs.evolve(seg.insert, **{what[7:]: _si(value, "m")}))
-            elif what == "flutes.diameter_ratio":
-                segs[i] = attrs.evolve(seg, flutes=attrs.evolve(seg.flutes, diameter_ratio=value))
-            else:
-                raise _unknown(path, f"unknown segment value {what!r}")
-            return assembly.with_component(attrs.evolve(comp, segments=segs))
-        if rest == ["bore"]:
-            bore = _si(0.0 if value < 1e-6 else value, "m")  # a bore under a micrometre is no bore
-            segs = [seg if seg.insert is not None else attrs.evolve(seg, id=bore) for seg in segs]
-            out = assembly.with_component(attrs.evolve(comp, segments=segs))
-            # the part's shank clamped in another part (an insert of its material and its diameter) too
-            od, material = comp.segments[0].od.m_as("m"), comp.segments[0].material.name
-            for other in assembly.components:
-                if other.name == comp.name or not _segmented(other):
-                    continue
-                new = [attrs.evolve(seg, insert=attrs.evolve(seg.insert, id=bore))
-                       if seg.insert is not None and seg.insert.material.name == material
-                       and abs(seg.insert.od.m_as("m") - od) <= 1e-9 * max(od, 1e-3) else seg
-                       for seg in other.segments]
-                if new != list(other.segments):
-                    out = out.with_component(attrs.evolve(other, segments=new))
+        if rest != ["supports", "k"]:
+            out = assembly.with_component(_set_component(comp, path, rest, value))
+            if rest == ["bore"]:  # the part's shank clamped in another part (an insert of its material and od)
+                od, material = comp.segments[0].od.m_as("m"), comp.segments[0].material.name
+                for other in assembly.components:
+                    bored = None if other.name == comp.name else _bored_shank(other, material, od, value)
+                    if bored is not None:
+                        out = out.with_component(bored)
             return out
-        if rest == ["overhang"]:
-            i = _overhang_segment(comp)
-            seg = segs[i]
-            segs[i] = attrs.evolve(seg, length=_si(seg.length_m + value - comp.length_m, "m"))
-            return assembly.with_component(attrs.evolve(comp, segments=segs))
-        own = rest in (["E"], ["rho"], ["loss_factor"])
-        if own or (len(rest) == 2 and rest[0] == "material" and rest[1] in _MAT_COLUMN):
-            prop = rest[-1]
-            renamed = {}
-            for i, seg in enumerate(segs):
-                m = seg.material
-                if m.name not in renamed:
-                    current = {"E": m.E.m_as("Pa"), "rho": m.rho_si, "nu": m.nu, "loss_factor": m.loss_factor}[prop]
-                    new = _material_value(m, prop, current * value if own else value)
-                    suffix = f"-{comp.name}"
-                    renamed[m.name] = attrs.evolve(new, name=m.name if m.name.endswith(suffix) else m.name + suffix)
-                segs[i] = attrs.evolve(seg, material=renamed[m.name])
-            return assembly.with_component(attrs.evolve(comp, segments=segs))
-        if rest == ["supports", "k"]:
-            supports = list(assembly.supports)
-            for i, s in enumerate(supports):
-                if _on_beam(assembly, s.at)[0] == comp.name:
-                    supports[i] = _quiet(lambda s=s: attrs.evolve(s, k=_scaled_matrix(s.k, value, STIFFNESS_UNITS)))
-            return attrs.evolve(assembly, supports=tuple(supports))
+        supports = list(assembly.supports)
+        for i, s in enumerate(supports):
+            if _on_beam(assembly, s.at)[0] == comp.name:
+                supports[i] = _quiet(lambda s=s: attrs.evolve(s, k=_scaled_matrix(s.k, value, STIFFNESS_UNITS)))
+        return attrs.evolve(assembly, supports=tuple(supports))
     if head == "materials" and len(parts) >= 3:
         name, prop = ".".join(parts[1:-1]), parts[-1]
         comps = []
@@ -607,6 +658,9 @@ def set_parameters(assembly, values: Mapping[str, float]):
         When a path names nothing in the assembly.
     """
     for path, value in values.items():
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+            raise InvalidValueError(f"parameter {path!r}: got {value!r}; expected a number (SI, or a factor for a "
+                                    "linked parameter)")
         try:
             assembly = _set_one(assembly, path, value)
         except (IndexError, ValueError, AttributeError) as exc:

@@ -49,6 +49,16 @@ def _parse(point: str):
 
 
 @functools.lru_cache(maxsize=4096)
+def _at(component: str, x: float, length: float):
+    """The point at ``x`` metres from a component's base (its ``base`` and ``tip`` by those names)."""
+    if x <= 0.0:
+        return _parse(f"{component}.base").point
+    if x >= length:
+        return _parse(f"{component}.tip").point
+    return _parse(f"{component}@{x * 1e3!r} mm").point
+
+
+@functools.lru_cache(maxsize=4096)
 def _distance_m(point: str) -> float:
     ref = _parse(point)
     return 0.0 if ref.distance is None else float(ref.distance.m_as("m"))
@@ -276,6 +286,11 @@ class LinkSI:
         return self.K[:, :, None] + 1j * w * self.C[:, :, None] - (w * w) * self.M[:, :, None]
 
 
+def _along(component) -> float | None:
+    """The length of a component whose points lie along it (a :class:`Beam` of any kind), else None."""
+    return float(component.length_m) if isinstance(component, Beam) else None
+
+
 def si_beam(component) -> bool:
     """Whether a component can be held as SI arrays: a plain beam of uniform segments.
 
@@ -452,6 +467,24 @@ class Structure:
         sources = {k: v for k, v in self.sources.items() if k != beam.name}
         return Structure(self.assembly, {**self.beams, beam.name: beam}, self.opaque, self.links, self.order, sources)
 
+    def with_opaque(self, component) -> "Structure":
+        """The structure with one component evaluated by its own methods replaced (by name).
+
+        Parameters
+        ----------
+        component : object
+            The new component (a changed copy of one in :attr:`opaque`).
+
+        Returns
+        -------
+        Structure
+            A new structure sharing everything else.
+        """
+        if component.name not in self.opaque:
+            raise UnknownPointError(f"no component {component.name!r} evaluated by its own methods here")
+        return Structure(self.assembly, self.beams, {**self.opaque, component.name: component}, self.links,
+                         self.order, self.sources)
+
     def with_link(self, index: int, link: LinkSI) -> "Structure":
         """The structure with one link replaced.
 
@@ -507,8 +540,9 @@ class Structure:
         """
         if isinstance(point, tuple):
             comp, x = point
-            beam = self.beam(comp)
-            total = beam.total_length
+            total = _along(self.opaque[comp]) if comp in self.opaque else self.beam(comp).total_length
+            if total is None:
+                raise UnknownPointError(f"point {comp}@{x} m: {comp!r} has no length to place a point along")
             if not -1e-9 * total <= x <= total * (1 + 1e-9):
                 raise UnknownPointError(f"point {comp}@{x} m: lies outside {comp!r} ({total * 1e3:.6g} mm long)")
             return comp, min(max(float(x), 0.0), total)
@@ -532,6 +566,8 @@ class Structure:
         for comp in self.opaque.values():
             if ref.component in getattr(comp, "component_names", ()):
                 comp.node_key(ref.point)
+                if _along(comp) is not None and ref.component == comp.name:  # a beam with physics of its own
+                    return comp.name, float(comp.position(ref.point))
                 return comp.name, None
         raise UnknownPointError(f"point {ref}: there is no component {ref.component!r} in this configuration")
 
@@ -591,7 +627,7 @@ class Evaluator:
             xs = [x for x, _ in nodes]
             return self._store((beam.token, tuple(xs)), lambda: beam.receptance(xs, self.f), pin)
         comp = structure.opaque[name]
-        refs = [r for _, r in nodes]
+        refs = [r if r is not None else _at(name, x, comp.length_m) for x, r in nodes]
         # keyed by the object's id, stored with the object itself so that the id cannot be reused while cached;
         # pinned only for the first structure (a component changed by a fit is rebuilt at every evaluation)
         kept = self._store((id(comp), tuple(str(r) for r in refs)),

@@ -1,6 +1,6 @@
 """Reading assembly files: :func:`load_assembly`, :func:`loads_assembly`, :func:`default_assembly`.
 
-The TOML text is parsed with :mod:`tomllib`, then read table by table into
+The TOML text is parsed by ``substructure._toml.loads_toml``, then read table by table into
 value objects; every problem raises :class:`~substructure.errors.FileFormatError`
 naming the file, the line where it can be found and the key path
 (``components[2].segments[1].od``), what was given and what was expected.
@@ -12,14 +12,13 @@ from __future__ import annotations
 
 import importlib.resources
 import os
-import re
-from typing import Any
 
-from .. import parse_toml, read_text
+from .. import read_text
 from ...assembly import Assembly
 from ...beams import Flutes, Insert, Segment
 from ...components import COMPONENT_TYPES, Beam
-from ...errors import FileFormatError, SubstructureError
+from ..._toml import TomlDocument, key_path, loads_toml
+from ...errors import SubstructureError
 from ...frf import Frequency
 from ...joints import Joint, JointProvenance, Mass, Sensor, Support
 from ...materials import CATALOG, Material
@@ -29,132 +28,18 @@ from ._schema import (_CATALOG_KEYS, _COMPONENT_KEYS, _FLUTES_KEYS, _FREQUENCY_K
                       _MASS_KEYS, _MATERIAL_KEYS, _MATRIX_KEYS, _SEGMENT_KEYS, _SENSOR_KEYS, _SUPPORT_KEYS,
                       _TOP_KEYS, MAX_TAPER_STEPS, SIZE_RANGE_M, _extra_fields, _init_fields)
 
-_MISSING = object()
-_FIELD = re.compile(r"^([A-Za-z_][A-Za-z0-9_.\[\]]*): (.*)$", re.DOTALL)
-_HEADER = re.compile(r"^\s*(\[\[?)\s*([^\[\]#]+?)\s*\]\]?\s*(?:#.*)?$")
-
-
-def _path(parts) -> str:
-    text = ""
-    for p in parts:
-        text += f"[{p}]" if isinstance(p, int) else (f".{p}" if text else str(p))
-    return text
-
-
-class _Locator:
-    """Best-effort line numbers of keys in TOML text, for error messages."""
-
-    def __init__(self, text: str):
-        self.lines = text.splitlines()
-        self.headers = []  # (line index, dotted name, is an array of tables)
-        for n, line in enumerate(self.lines):
-            m = _HEADER.match(line)
-            if m:
-                self.headers.append((n, re.sub(r"[\s\"']", "", m.group(2)), m.group(1) == "[["))
-
-    def _section(self, parts):
-        start, rest = None, list(parts)
-        if len(parts) >= 2 and isinstance(parts[0], str) and isinstance(parts[1], int):
-            heads = [n for n, name, array in self.headers if array and name == parts[0]]
-            if parts[1] < len(heads):
-                start, rest = heads[parts[1]], list(parts[2:])
-        else:
-            for size in range(len(parts), 0, -1):
-                if all(isinstance(p, str) for p in parts[:size]):
-                    name = ".".join(parts[:size])
-                    found = [n for n, h, array in self.headers if h == name and not array]
-                    if found:
-                        start, rest = found[0], list(parts[size:])
-                        break
-        following = [n for n, _, _ in self.headers if start is None or n > start]
-        end = following[0] if following else len(self.lines)
-        return start, end, rest
-
-    def _find_key(self, key: str, start: int, end: int, value: Any = _MISSING) -> int | None:
-        pattern = re.compile(r"(?:^|[\s{,.])" + re.escape(key) + r"\s*=")
-        hits = [n for n in range(start, end) if pattern.search(self.lines[n])]
-        if isinstance(value, str):
-            exact = [n for n in hits if f'"{value}"' in self.lines[n] or f"'{value}'" in self.lines[n]]
-            hits = exact or hits
-        return hits[0] if hits else None
-
-    def line(self, parts, value: Any = _MISSING) -> int | None:
-        """1-based line of the key at ``parts`` (a list of names and indices), or None."""
-        header, end, rest = self._section(parts)
-        start = 0 if header is None else header
-        i = 0
-        while i < len(rest):
-            if isinstance(rest[i], str) and i + 1 < len(rest) and isinstance(rest[i + 1], int):
-                key_line = self._find_key(rest[i], start, end)
-                if key_line is None:
-                    break
-                if i + 2 == len(rest):  # an element of an array of values: the key's line
-                    return key_line + 1
-                elements = [n for n in range(key_line, end) if "{" in self.lines[n]]
-                if rest[i + 1] >= len(elements):
-                    return key_line + 1
-                start = elements[rest[i + 1]]
-                end = start + 1
-                i += 2
-            else:
-                i += 1
-        keys = [p for p in rest if isinstance(p, str)]
-        found = self._find_key(keys[-1], start, end, value) if keys else None
-        if found is not None:
-            return found + 1
-        return None if header is None and start == 0 else start + 1
-
-
 class _Reader:
     """Builds an assembly from parsed TOML, naming the key path in every error."""
 
-    def __init__(self, source: str, text: str, data: dict):
-        self.source, self.data, self.locator = source, data, _Locator(text)
+    def __init__(self, doc: TomlDocument):
+        self.data, self.doc, self.error, self.table = doc.data, doc, doc.error, doc.table
         self.materials: dict[str, Material] = dict(CATALOG)
-
-    def _value(self, parts) -> Any:
-        value = self.data
-        for p in parts:
-            try:
-                value = value[p]
-            except (KeyError, IndexError, TypeError):
-                return _MISSING
-        return value
-
-    def error(self, parts, message: str) -> FileFormatError:
-        line = self.locator.line(parts, self._value(parts))
-        where = f"{self.source}, line {line}" if line else self.source
-        key = _path(parts)
-        return FileFormatError(f"{where}: {key}: {message}" if key else f"{where}: {message}")
-
-    def wrap(self, parts, exc: SubstructureError) -> FileFormatError:
-        """A constructor's error with the container's key path merged into its field."""
-        message = str(exc)
-        if message.startswith(self.source):
-            return FileFormatError(message)
-        m = _FIELD.match(message)
-        if not m:
-            return self.error(parts, message)
-        field = [int(i) if i else k for k, i in re.findall(r"([^.\[\]]+)|\[(\d+)\]", m.group(1))]
-        full = m.group(1).startswith(_path(parts) + ".") or m.group(1) == _path(parts)  # a hook's own path
-        return self.error(field if full and parts else list(parts) + field, m.group(2))
 
     def call(self, parts, factory, *args, **kwargs):
         try:
             return factory(*args, **kwargs)
-        except SubstructureError as exc:
-            raise self.wrap(parts, exc) from None
-
-    def table(self, value, parts, allowed, required=(), what="a table") -> dict:
-        if not isinstance(value, dict):
-            raise self.error(parts, f"got {value!r}; expected {what}")
-        for key in value:
-            if key not in allowed:
-                raise self.error(list(parts) + [key], f"unknown key; allowed keys: {', '.join(allowed)}")
-        for key in required:
-            if key not in value:
-                raise self.error(list(parts) + [key], "missing; this value is required")
-        return value
+        except SubstructureError as exc:  # the constructor's field merged into the key path
+            raise self.doc.wrap(parts, str(exc)) from None
 
     def array(self, value, parts, what: str) -> list:
         if not isinstance(value, list):
@@ -222,7 +107,7 @@ class _Reader:
         if "catalog" in table:
             return self.catalog_holder(table, parts, cls)
         if hasattr(cls, "from_toml"):
-            return self.call(parts, cls.from_toml, table, dict(self.materials), _path(parts))
+            return self.call(parts, cls.from_toml, table, dict(self.materials), key_path(parts))
         if not (isinstance(cls, type) and issubclass(cls, Beam)):
             raise self.error(parts + ["type"], f"components of type {kind!r} cannot be described in an assembly file")
         extra = _extra_fields(cls)
@@ -263,7 +148,7 @@ class _Reader:
     def size(self, value, parts) -> None:
         """Refuse a length outside the range the beam model is made for (a wrong unit, or a typo)."""
         try:
-            metres = to_si(value, _path(parts), "m")
+            metres = to_si(value, key_path(parts), "m")
         except SubstructureError:
             return  # the constructor says what is wrong with it
         if metres > 0 and not SIZE_RANGE_M[0] <= metres <= SIZE_RANGE_M[1]:
@@ -393,13 +278,7 @@ def loads_assembly(text: str, source: str = "<string>") -> Assembly:
     Assembly
         The assembly.
     """
-    if not isinstance(text, str):
-        raise FileFormatError(f"{source}: got {type(text).__name__}; expected the TOML text as a str")
-    text = text.removeprefix("\ufeff")  # a byte-order mark left by an editor is not part of the document
-    if not text.strip():
-        raise FileFormatError(f"{source}: the file is empty; expected an assembly (docs/file-formats.md)")
-    data = parse_toml(text, source)
-    return _Reader(source, text, data).assembly()
+    return _Reader(loads_toml(text, source, "assembly")).assembly()
 
 
 def load_assembly(path: str | os.PathLike) -> Assembly:
