@@ -23,58 +23,10 @@ FIGURES = ("where_it_fails.png", "error_fall.png", "after_refinement.png")
 """The figures ``--plot DIR`` writes."""
 
 
-def _values(found) -> str:
-    parts = []
-    for name, spec in found.parameters_json().items():
-        unit = "" if spec["unit"] == "dimensionless" else f" {spec['unit']}"
-        std = f" +- {spec['std']:.2g}" if spec.get("std") is not None else ""
-        nominal = f" (model: {spec['nominal']:.4g})" if spec.get("nominal") is not None else ""
-        parts.append(f"{name} = {spec['value']:.4g}{std}{unit}{nominal}")
-    return ", ".join(parts)
-
-
 def _summary(result, assembly, measurements) -> list[str]:
-    floor = result.noise_floor
-    lines = []
-    if not result.explained:
-        lines += list(result.report)
-    lines.append(f"model {assembly.name!r} against {len(measurements)} measured FRF(s), "
-                 f"{result.band[0]:.0f}-{result.band[1]:.0f} Hz")
-    lines.append(f"error ({result.metric}): {result.baseline_error:.4f}; noise floor of the data: {floor:.4f}")
-    base = result.baseline[0]
-    for m in [m for m in base.modes if m.model_hz is not None][:12]:
-        lines.append(f"  mode at {m.measured_hz:7.0f} Hz measured, {m.model_hz:7.0f} Hz in the model "
-                     f"({m.shift_hz:+.0f} Hz), peak x{m.amplitude_ratio:.2f}")
-    if base.bands:
-        lines.append("  most of the error is in " + ", ".join(f"{lo:.0f}-{hi:.0f} Hz ({share:.0%})"
-                                                           for lo, hi, share in base.bands))
-    if result.missing_effect is None:
-        if result.explained:
-            lines.append("the model is as good as the data allow: nothing is missing")
-        else:
-            lines.append("no candidate explains the difference significantly")
-    else:
-        label = "missing effect" if result.explained else "best partial explanation (partial)"
-        for i, e in enumerate(result.effects):
-            lines.append(f"{label if i == 0 else 'and'}: {e.name} at {e.where}")
-            lines.append(f"  {_values(e)}")
-            lines.append(f"  why: {e.explanation}")
-        if result.ambiguous:
-            alts = "; ".join(f"{a.name} at {a.where} ({_values(a)})" for a, _ in result.ambiguous[:3])
-            lines.append(f"  equally possible: {alts}")
-            if result.suggestion:
-                lines.append(f"  to tell them apart: {result.suggestion}")
-    if len(result.refinement) > 1:
-        lines.append("refinement (watch the error fall):")
-        for step in result.refinement:
-            what = "model as given" if step.added is None else f"+ {step.added.name} at {step.added.where}"
-            lines.append(f"  step {step.step}: {what:50s} error {step.error:.4f}  chi^2/nu {step.chi2_reduced:.4g}")
-    cons = result.consistency
-    verdict = "explained" if result.explained else "not explained"
-    lines.append(f"verdict: {verdict}: final error {result.final_error:.4f} ({result.final_error / floor:.2f} x the "
-                 f"noise floor), chi^2/nu = {cons.chi2_reduced:.4g} (consistent with the noise up to "
-                 f"{cons.threshold:.4g})")
-    return lines
+    from ..diagnose.words import summary
+
+    return summary(result, assembly.name, len(measurements))
 
 
 def run(args: argparse.Namespace) -> int:

@@ -11,11 +11,16 @@
   changes at fitted positions, the catalogue; screening, full fits), starting
   values from mode shifts (``modes``), the refinement by significance with
   elimination and review (``refine``), and the verdict, the signature and the
-  separating measurement (``report``).
+  separating measurement (``report``);
+* :mod:`~substructure.diagnose.settings`: :class:`DiagnoseSettings`, every
+  threshold, grid and budget of a diagnosis, named and overridable;
+* :mod:`~substructure.diagnose.words`: every sentence a diagnosis writes.
 """
 
 from .compare import METRIC, Comparison, compare, error, frac, noise_floor, pair_modes
 from .diagnosis import Candidate, Diagnosis, Found, Step, diagnose
+from .result import Alternatives, Changes, Measures, Verdict
+from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 from .effects import EFFECTS, Effect, Parameter, get_effect, register_effect, registered, registry
 
 # The built-in effects register themselves on import; importing any module of the package runs this first.
@@ -23,6 +28,7 @@ from . import catalogue as _catalogue  # noqa: F401
 
 __all__ = [
     "METRIC", "Comparison", "compare", "error", "frac", "noise_floor", "pair_modes", "Candidate",
-    "Diagnosis", "Found", "Step", "diagnose", "EFFECTS", "Effect", "Parameter", "get_effect", "register_effect",
+    "Diagnosis", "Verdict", "Measures", "Changes", "Alternatives", "DiagnoseSettings", "DEFAULT_SETTINGS", "Found",
+    "Step", "diagnose", "EFFECTS", "Effect", "Parameter", "get_effect", "register_effect",
     "registered", "registry",
 ]

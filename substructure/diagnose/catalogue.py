@@ -34,6 +34,11 @@ from .effects import Effect, Parameter, register_effect
 
 __all__: list[str] = []  # the effects are reached by name through the registry
 
+PASSIVE_SHARE = 0.999
+"""A joint's cross terms are searched up to this share of their passivity bound (``k_ym^2 < k_yf k_tm``), so that
+every value of the search is a passive joint.  A bound of the effect's parameters, as the ranges of the catalogue
+are, not a setting of the diagnosis."""
+
 
 def _quiet_joint(joint: Joint, **kw) -> Joint:
     with warnings.catch_warnings():
@@ -238,8 +243,8 @@ class JointCrossCoupling(_JointEffect):
         Passive cross terms: ``k_ym^2 < k_yf k_tm`` and ``c_ym^2 < c_yf c_tm``.
         """
         joint = assembly.joint(where)
-        k = 0.999 * np.sqrt(max(joint.k.get("yf") * joint.k.get("tm"), 0.0))
-        c = 0.999 * np.sqrt(max(joint.c.get("yf") * joint.c.get("tm"), 0.0))
+        k = PASSIVE_SHARE * np.sqrt(max(joint.k.get("yf") * joint.k.get("tm"), 0.0))
+        c = PASSIVE_SHARE * np.sqrt(max(joint.c.get("yf") * joint.c.get("tm"), 0.0))
         return {"k_ym": (-k, k), "c_ym": (-c, c) if c > 0 else (-1e-12, 1e-12)}
 
 

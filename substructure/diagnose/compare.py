@@ -27,6 +27,7 @@ import numpy as np
 from ..errors import FrequencyAxisMismatchError, InvalidValueError
 from ..frf import FRF
 from ..smoothing import choose_window, smooth
+from .settings import DEFAULT_SETTINGS
 
 __all__ = [
     "METRIC",
@@ -205,13 +206,17 @@ def _peaks(frf: FRF, floor: float, prominence: float) -> tuple[np.ndarray, np.nd
 
 
 def pair_modes(model: FRF, measured: FRF, floor: float = 0.02, window: int | None = None,
-               noise: float | None = None) -> list[ModePair]:
+               noise: float | None = None, prominence: float = 0.1, noise_prominence: float = 5.0,
+               pairing: float = 1.5) -> list[ModePair]:
     """Pair each measured resonance with the nearest model resonance (in log frequency).
 
     Measured peaks are taken on the smoothed data (so that noise ripples are
     not peaks), both above ``floor`` times the highest peak; each model peak
     is used once, nearest first; a measured mode without a model mode within
-    a factor 1.5 in frequency stays unpaired.
+    a factor ``pairing`` in frequency stays unpaired.  A measured mode must
+    stand out of the noise: a prominence in ``ln|H|`` of at least
+    ``prominence`` or ``noise_prominence`` noise floors, whichever is larger
+    (a model mode: ``prominence``).
 
     Parameters
     ----------
@@ -225,6 +230,12 @@ def pair_modes(model: FRF, measured: FRF, floor: float = 0.02, window: int | Non
         Smoothing window [lines].
     noise : float, optional
         The measurement's noise floor when known (estimated from it otherwise).
+    prominence : float
+        Least prominence of a peak in ``ln|H|`` (0.1: 10 %; dimensionless).
+    noise_prominence : float
+        Least prominence of a measured peak in noise floors.
+    pairing : float
+        Largest ratio of the frequencies of two modes paired (dimensionless).
 
     Returns
     -------
@@ -235,14 +246,14 @@ def pair_modes(model: FRF, measured: FRF, floor: float = 0.02, window: int | Non
     w = window or _window(measured)
     # a mode must stand out of the noise: a prominence of 0.1 in ln|H| (10 %) or
     # five times the noise floor, whichever is larger
-    prominence = max(0.1, 5.0 * (noise_floor(measured, window=w) if noise is None else noise))
-    fm, hm = _peaks(smooth(measured, window=w), floor, prominence)
-    fo, ho = _peaks(model, floor, 0.1)
+    least = max(prominence, noise_prominence * (noise_floor(measured, window=w) if noise is None else noise))
+    fm, hm = _peaks(smooth(measured, window=w), floor, least)
+    fo, ho = _peaks(model, floor, prominence)
     candidates = sorted(
         (abs(np.log(a / b)), i, j)
         for i, a in enumerate(fm)
         for j, b in enumerate(fo)
-        if abs(np.log(a / b)) < np.log(1.5)
+        if abs(np.log(a / b)) < np.log(pairing)
     )
     used_i, used_j, match = set(), set(), {}
     for _, i, j in candidates:
@@ -258,12 +269,14 @@ def pair_modes(model: FRF, measured: FRF, floor: float = 0.02, window: int | Non
 
 
 def error_bands(model: FRF, measured: FRF, share: float = 0.5, width_hz: float | None = None,
-                floor: float = 0.0) -> list[tuple[float, float, float]]:
+                floor: float = 0.0, width_share: float = 0.02,
+                floor_factor: float = 2.0) -> list[tuple[float, float, float]]:
     """The frequency bands that carry most of the error: ``[(lo, hi, share_of_error), ...]``.
 
-    The squared log ratio, smoothed over ``width_hz`` (default 2 % of the
-    band), is cut into contiguous regions above its median and above twice
-    the noise ``floor`` (noise is not a failure of the model); the regions are
+    The squared log ratio, smoothed over ``width_hz`` (default
+    ``width_share``, 2 %, of the band), is cut into contiguous regions above
+    its median and above ``floor_factor`` (twice) the noise ``floor`` (noise
+    is not a failure of the model); the regions are
     ranked by their share of the total and returned until ``share`` of the
     error is covered.
 
@@ -279,6 +292,10 @@ def error_bands(model: FRF, measured: FRF, share: float = 0.5, width_hz: float |
         Smoothing width [Hz].
     floor : float
         The noise floor.
+    width_share : float
+        The default smoothing width as a share of the band (dimensionless).
+    floor_factor : float
+        Regions must lie above this many noise floors (dimensionless).
 
     Returns
     -------
@@ -288,10 +305,10 @@ def error_bands(model: FRF, measured: FRF, share: float = 0.5, width_hz: float |
     r2 = np.mean(np.abs(log_ratio(model, measured)) ** 2, axis=(1, 2))
     f = model.frequency.hz
     step = np.median(np.diff(f)) if f.size > 1 else 1.0
-    width = width_hz or 0.02 * (f[-1] - f[0])
+    width = width_hz or width_share * (f[-1] - f[0])
     n = max(1, int(round(width / step)))
     local = np.convolve(r2, np.ones(n) / n, mode="same")
-    above = (local > np.median(local)) & (local > (2.0 * floor) ** 2)
+    above = (local > np.median(local)) & (local > (floor_factor * floor) ** 2)
     total = r2.sum()
     regions = []
     i = 0
@@ -346,8 +363,8 @@ class Comparison:
 
     @property
     def as_good_as_data(self) -> bool:
-        """True when the error is within 1.5 times the noise floor."""
-        return self.error <= 1.5 * self.noise_floor
+        """True when the error is within 1.5 times the noise floor (``DEFAULT_SETTINGS.explained_error_factor``)."""
+        return self.error <= DEFAULT_SETTINGS.explained_error_factor * self.noise_floor
 
     def plot(self, ax=None):
         """Measured and model FRFs overlaid with the residual below, error bands shaded.

@@ -9,7 +9,8 @@ catalogue of effects) by forward selection with the significance test of
 :mod:`substructure.updating.selection`, refits everything added at every
 step, drops at the end what no longer earns its parameters, and says
 ``explained`` only when the final residual is consistent with the noise
-(and, as a plain check, its RMS error within 1.5 times the noise floor).
+(and, as a plain check, its RMS error within ``explained_error_factor``,
+1.5, times the noise floor).
 When it is not, the report says so first, with where the remaining error
 lives and what kind of effect has that signature
 (:mod:`substructure.diagnose.report`).  Explanations the data cannot tell
@@ -17,7 +18,11 @@ apart are reported together, with the measurement that would separate them;
 when they change different parts of the model (``sites``) and a
 measurement would tell them apart, neither is claimed and the data are not
 explained.  The search runs within a budget of model evaluations
-(``BUDGET``), so that the same data give the same answer on any machine.
+(``budget``), so that the same data give the same answer on any machine.
+Every threshold, grid and budget is a field of
+:class:`~substructure.diagnose.settings.DiagnoseSettings`, given as
+``settings``; the sentences of the verdict are written by
+:mod:`substructure.diagnose.words`.
 """
 
 
@@ -37,10 +42,12 @@ from ..updating.selection import INDIFFERENCE, consistency
 from .compare import METRIC, Comparison, frac, pair_modes, error_bands
 from .effects import Effect, registry
 from .refine import refine as refine_model
-from .result import Candidate, Diagnosis, Found, Step, _finite, strict
-from .search import SCREEN_LINES, Budget, candidates
+from . import words
+from .result import Alternatives, Candidate, Changes, Diagnosis, Found, Measures, Step, Verdict, _finite, strict
+from .search import Budget, candidates
+from .settings import DEFAULT_SETTINGS, FROM_SETTINGS, DiagnoseSettings, _FromSettings
 
-__all__ = ["Found", "Candidate", "Step", "Diagnosis", "diagnose", "strict", "sites", "BUDGET"]
+__all__ = ["Found", "Candidate", "Step", "Diagnosis", "diagnose", "strict", "sites"]
 
 
 def _catalogue(effects) -> dict:
@@ -68,7 +75,8 @@ def _catalogue(effects) -> dict:
     return out
 
 
-def _comparisons(lik: Likelihood, ratios, floors) -> tuple[Comparison, ...]:
+def _comparisons(lik: Likelihood, ratios, floors, settings: DiagnoseSettings = DEFAULT_SETTINGS
+                 ) -> tuple[Comparison, ...]:
     out = []
     for m, r, floor in zip(lik.measured, ratios, floors):
         measured = m.frf
@@ -76,17 +84,21 @@ def _comparisons(lik: Likelihood, ratios, floors) -> tuple[Comparison, ...]:
                     measured.inputs)
         out.append(Comparison(model=model, measured=measured, error=float(np.sqrt(np.mean(np.abs(r) ** 2))),
                               noise_floor=floor, frac=frac(model, measured),
-                              modes=pair_modes(model, measured, noise=floor),
-                              bands=error_bands(model, measured, floor=floor)))
+                              modes=_pairs(model, measured, floor, settings),
+                              bands=error_bands(model, measured, settings.error_bands_share, floor=floor,
+                                                width_share=settings.error_bands_width,
+                                                floor_factor=settings.error_bands_floors)))
     return tuple(out)
 
 
-PEAK_LINES = 2
-"""Lines either side of every measured resonance the model lacks kept in the screening subsample."""
+def _pairs(model: FRF, measured: FRF, noise: float, settings: DiagnoseSettings) -> list:
+    """:func:`~substructure.diagnose.compare.pair_modes` with the settings' thresholds."""
+    return pair_modes(model, measured, settings.mode_peak_share, noise=noise, prominence=settings.mode_prominence,
+                      noise_prominence=settings.mode_prominence_floors, pairing=settings.mode_pairing)
 
 
-def _peak_lines(baseline) -> np.ndarray:
-    """Positions of the lines within :data:`PEAK_LINES` of every measured resonance the model as given lacks
+def _peak_lines(baseline, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> np.ndarray:
+    """Positions of the lines within ``settings.peak_lines`` of every measured resonance the model as given lacks
     (no model mode paired with it): a subsample of every k-th line can step over such a narrow peak (a
     suspension mode between two of its lines), and there a candidate's fit on the subsample says nothing about
     all lines.  Paired modes are left to the mode starts (:mod:`substructure.diagnose.modes`): their lines
@@ -98,7 +110,7 @@ def _peak_lines(baseline) -> np.ndarray:
             if p.model_hz is not None:  # a paired mode: its shift is followed by the mode starts
                 continue
             i = int(np.argmin(np.abs(hz - p.measured_hz)))
-            keep += range(max(0, i - PEAK_LINES), min(hz.size, i + PEAK_LINES + 1))
+            keep += range(max(0, i - settings.peak_lines), min(hz.size, i + settings.peak_lines + 1))
     return np.unique(np.array(keep, dtype=int))
 
 
@@ -121,20 +133,14 @@ def _passive(lik: Likelihood, changes) -> bool:
     return True
 
 
-def _main_shift(comparison: Comparison) -> float:
+def _main_shift(comparison: Comparison, share: float) -> float:
     pairs = [m for m in comparison.modes if m.model_hz is not None]
     if not pairs:
         return 0.0
     top = max(m.measured_amplitude for m in pairs)
-    strong = [m for m in pairs if m.measured_amplitude >= 0.1 * top] or pairs
+    strong = [m for m in pairs if m.measured_amplitude >= share * top] or pairs
     best = max(strong, key=lambda m: abs(m.model_hz / m.measured_hz - 1))
     return float(best.model_hz / best.measured_hz - 1)
-
-
-BUDGET = 3000
-"""Default budget of the search, in model evaluations of all lines (about 30 s for 3 FRFs of 2,500 lines on one
-core of a 2-core machine): once spent no step is added and a step fits only its best candidate on all lines (the
-checks after the forward search always run); the result and the JSON say so (``search``)."""
 
 
 def _refuse_rotations(measurements) -> None:
@@ -161,8 +167,11 @@ def _refuse_rotations(measurements) -> None:
 
 
 def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", band=None,
-             refine: bool = True, max_steps: int = 4, progress: bool | Callable[[str], None] = False,
-             open_world: bool = True, budget: float | None = BUDGET, time_limit: float | None = None) -> Diagnosis:
+             refine: bool = True, max_steps: int | _FromSettings = FROM_SETTINGS,
+             progress: bool | Callable[[str], None] = False, open_world: bool = True,
+             budget: float | None | _FromSettings = FROM_SETTINGS,
+             time_limit: float | None | _FromSettings = FROM_SETTINGS,
+             settings: DiagnoseSettings | None = None) -> Diagnosis:
     """Diagnose what an assembly model is missing against measurements.
 
     Parameters
@@ -181,7 +190,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     refine : bool
         Run the forward selection to the end (else one step).
     max_steps : int
-        Most changes the refinement adds.
+        Most changes the refinement adds (default: ``settings.max_steps``, 4).
     progress : bool or callable
         Report progress (to standard error when True).
     open_world : bool
@@ -189,12 +198,18 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         positions besides the catalogue (default True).
     budget : float or None
         Budget of the search in model evaluations of all lines (default
-        ``BUDGET``; None: no limit): the same data give the same answer
-        on any machine.  When it cuts the search, ``Diagnosis.search["cut"]``
-        is true and, unless the data are explained, the report says so.
+        ``settings.budget``, 3000; None: no limit): the same data give the
+        same answer on any machine.  When it cuts the search,
+        ``Diagnosis.search["cut"]`` is true and, unless the data are
+        explained, the report says so.
     time_limit : float or None
-        A limit in wall-clock seconds as well (default None; with one, the
-        answer may depend on the machine's speed).
+        A limit in wall-clock seconds as well (default ``settings.time_limit``,
+        None; with one, the answer may depend on the machine's speed).
+    settings : DiagnoseSettings, optional
+        Every threshold, grid and budget of the search and the report
+        (default :data:`~substructure.diagnose.settings.DEFAULT_SETTINGS`);
+        ``max_steps``, ``budget`` and ``time_limit`` given here win over its
+        fields of the same names.
 
     Returns
     -------
@@ -203,10 +218,21 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     """
     from .report import Explanation, separation, unexplained_report, values_text
 
+    if settings is None:
+        settings = DEFAULT_SETTINGS
+    elif not isinstance(settings, DiagnoseSettings):
+        raise InvalidValueError(f"settings: got {settings!r}; expected a DiagnoseSettings (or None: the defaults)")
     for name, value, what in (("budget", budget, "model evaluations"), ("time_limit", time_limit, "seconds")):
-        if value is not None and not (isinstance(value, (int, float)) and not isinstance(value, bool)
-                                      and math.isfinite(value) and value > 0):
+        if value is not None and value is not FROM_SETTINGS and not (
+                isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+                and value > 0):
             raise InvalidValueError(f"{name}: got {value!r}; expected a positive number of {what} (or None: no limit)")
+    if max_steps is not FROM_SETTINGS and not (isinstance(max_steps, int) and not isinstance(max_steps, bool)
+                                               and max_steps >= 1):
+        raise InvalidValueError(f"max_steps: got {max_steps!r}; expected a whole number >= 1")
+    budget = settings.budget if isinstance(budget, _FromSettings) else budget
+    time_limit = settings.time_limit if isinstance(time_limit, _FromSettings) else time_limit
+    max_steps = settings.max_steps if isinstance(max_steps, _FromSettings) else max_steps
     meter = Budget(budget, time_limit)
     catalogue = _catalogue(effects)
     if progress is True:
@@ -225,17 +251,18 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     chi2_now = float(lik.whiten(base_ratios) @ lik.whiten(base_ratios))
     n = lik.n
     cons = consistency(lik, base_ratios, 0)
-    baseline = _comparisons(lik, base_ratios, floors)
+    baseline = _comparisons(lik, base_ratios, floors, settings)
     if say:
         say(f"baseline error {e0:.4g} (noise floor {floor:.4g}), chi^2/n = {chi2_now / n:.4g}"
             f"{': consistent with the noise' if cons.consistent else ''}")
     points = [lbl for m in measured for lbl in (m.frf.outputs[0], m.frf.inputs[0])]
-    cands = candidates(assembly, points, catalogue, open_world, _main_shift(baseline[0]), say)
-    lacking = _peak_lines(baseline)
-    screen_lik = lik.subsample(max(1, lik.lines.size // SCREEN_LINES), keep=lacking)
+    cands = candidates(assembly, points, catalogue, open_world, _main_shift(baseline[0], settings.main_mode_share),
+                       say, settings)
+    lacking = _peak_lines(baseline, settings)
+    screen_lik = lik.subsample(max(1, lik.lines.size // settings.screen_lines), keep=lacking)
     limit = 0 if cons.consistent else (max_steps if refine else 1)
     outcome = refine_model(lik, screen_lik, cands, limit, lambda changes: _passive(lik, changes), say, meter,
-                           lacking=bool(len(lacking)))
+                           lacking=bool(len(lacking)), settings=settings)
     current = outcome.current
     p_now = sum(len(c.specs) for c, _ in current)
     steps = [Step(0, None, e0, chi2_now / n)]
@@ -255,7 +282,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     final_ratios = lik.log_ratios(current)
     cons = consistency(lik, final_ratios, p_now)
     final_error = _rms(final_ratios)
-    explained = bool(cons.consistent and final_error <= 1.5 * floor)
+    explained = bool(cons.consistent and final_error <= settings.explained_error_factor * floor)
     hits = bound_hits(current, final_fit)
     final_effects = tuple(Found(c, v, {k: x for k, x in (final_fit.std[i] if final_fit else {}).items()
                                        if (i, k) not in {(h[0], h[1]) for h in hits}})
@@ -272,64 +299,54 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     names = tuple(dict.fromkeys(a.name for a, _ in ambiguous))
     sep = None
     if missing is not None and ambiguous:
-        sep = separation(assembly, measured, missing, ambiguous[0][0], say)
+        sep = separation(assembly, measured, missing, ambiguous[0][0], say, settings=settings)
     correlation = {}
     if final_fit is not None and final_fit.p > 1:
         labels = [f"{current[i][0].effect}@{current[i][0].where}:{name}" for i, name in final_fit.names]
         correlation = {"parameters": labels, "matrix": [[_finite(x) for x in row] for row in final_fit.correlation]}
-    rivals = _distinct_rivals(assembly, measured, final_effects, outcome, say) if explained else []
-    final = _comparisons(lik, final_ratios, floors)
-    report = unexplained_report(lik, assembly, current, baseline, cons, final_error, floor, explained, say) \
-        if not explained else ()
-    if explained and len(current) > MOST_CHANGES:  # a composite that only just reaches the noise
+    rivals = _distinct_rivals(assembly, measured, final_effects, outcome, say, settings) if explained else []
+    final = _comparisons(lik, final_ratios, floors, settings)
+    report = unexplained_report(lik, assembly, current, baseline, cons, final_error, floor, explained, say,
+                                settings) if not explained else ()
+    if explained and len(current) > settings.most_changes:  # a composite that only just reaches the noise
         explained = False
-        names = ", ".join(f"{c.effect} at {c.place(v)}" for c, v in current)
-        report = [f"unexplained: no candidate explains the data with at most {MOST_CHANGES} changes; "
-                  f"{len(current)} together reach the noise ({names}): several changes that each buy a small "
-                  "improvement are the mark of one effect the search lacks, not of several effects",
-                  "the best (composite) explanation is reported as partial: "
-                  + ", ".join(repr(e) for e in final_effects)]
+        report = [words.too_many_changes(settings.most_changes, [f"{c.effect} at {c.place(v)}" for c, v in current]),
+                  words.partial("composite", final_effects)]
     if hits:  # a value on the bound of its search is not a measurement: never an explanation
-        words = "; ".join(bound_text(current, hit) for hit in hits)
+        texts = [bound_text(current, hit) for hit in hits]
         if explained:
             explained = False
-            report = [f"unexplained: no candidate explains the data within the bounds of its search: {words}; "
-                      "a value on its bound is not a measurement (the data ask for more than the change "
-                      "allows: the mark of another effect, missing)",
-                      "the best (bounded) explanation is reported as partial: "
-                      + ", ".join(repr(e) for e in final_effects)]
+            report = [words.bounded(texts), words.partial("bounded", final_effects)]
         else:
-            report = list(report) + [f"on the bound of its search (not a measurement): {words}"]
+            report = list(report) + [words.on_bound(texts)]
     if rivals:  # consistent with the noise, but not uniquely: claim neither
         explained = False
         kept = Explanation(final_effects)
         keys = sorted(f.change.key for f in final_effects)
-        report = [f"unexplained: no candidate explains the data uniquely: {kept.name} at {kept.where} and "
-                  f"{rival.name} at {rival.where} both leave a residual consistent with the noise (their BIC "
-                  f"differ by at most {INDIFFERENCE:g}) but "
-                  + ("are the same change at other values ("
-                     + "; ".join(values_text(f.change, f.values) for f in rival.founds) + ")"
-                     if sorted(f.change.key for f in rival.founds) == keys else "change different parts")
+        report = [words.not_unique(kept.name, kept.where, rival.name, rival.where, INDIFFERENCE,
+                                   [values_text(f.change, f.values) for f in rival.founds]
+                                   if sorted(f.change.key for f in rival.founds) == keys else None)
                   for rival, _ in rivals[:1]]
-        report += [f"to tell them apart: {sep['text']}" for rival, sep in rivals]
-        report.append("the best (ambiguous) explanation is reported as partial: "
-                      + ", ".join(repr(e) for e in final_effects))
+        report += [words.tell_apart(sep["text"]) for rival, sep in rivals]
+        report.append(words.partial("ambiguous", final_effects))
         sep = sep or rivals[0][1]
         names = tuple(dict.fromkeys(list(names) + [r.name for r, _ in rivals]))
     search = {**outcome.search, "evaluations": round(meter.used(), 1), "budget": budget,
               "time_limit_s": time_limit, "seconds": round(meter.elapsed(), 3)}
     if search["cut"] and not explained:
-        report = list(report) + [f"the search was cut by its budget ({search['cut_at']}); a larger budget "
-                                 "(--budget, --time-limit) may find more"]
+        report = list(report) + [words.budget_cut(search["cut_at"])]
     return Diagnosis(
-        metric=METRIC, baseline_error=e0, noise_floor=floor, explained=explained,
-        missing_effect=None if missing is None else missing.name,
-        missing_where=None if missing is None else missing.where,
-        ambiguous_with=names, suggestion=None if sep is None else sep["text"],
-        candidates=tuple(first), refinement=tuple(steps), band=band, baseline=baseline, final=final,
-        refined_assembly=refined, final_effects=final_effects, consistency=cons, ambiguous=tuple(ambiguous),
-        separation=sep, report=tuple(report), correlation=correlation, final_error=final_error,
-        rivals=tuple(rivals), search=search,
+        verdict=Verdict(explained=explained, report=tuple(report),
+                        missing_effect=None if missing is None else missing.name,
+                        missing_where=None if missing is None else missing.where),
+        measures=Measures(metric=METRIC, band=band, noise_floor=floor, baseline_error=e0, final_error=final_error,
+                          consistency=cons, correlation=correlation, baseline=baseline, final=final),
+        changes=Changes(final_effects=final_effects, refined_assembly=refined, candidates=tuple(first),
+                        refinement=tuple(steps)),
+        alternatives=Alternatives(ambiguous=tuple(ambiguous), ambiguous_with=names,
+                                  suggestion=None if sep is None else sep["text"], separation=sep,
+                                  rivals=tuple(rivals)),
+        search=search, settings=settings,
     )
 
 
@@ -387,11 +404,8 @@ def sites(assembly, change, values) -> frozenset:
     return frozenset(out)
 
 
-RIVALS_CHECKED = 3
-"""Most rival explanations whose separation is computed for the verdict."""
-
-
-def _distinct_rivals(assembly, measured, final_effects, outcome, say) -> list:
+def _distinct_rivals(assembly, measured, final_effects, outcome, say,
+                     settings: DiagnoseSettings = DEFAULT_SETTINGS) -> list:
     """Rival explanations inside the indifference region that are different structures.
 
     A rival is a whole explanation of the parsimony check
@@ -403,7 +417,8 @@ def _distinct_rivals(assembly, measured, final_effects, outcome, say) -> list:
     cross FRF at the ends, quarter points and middles of the components)
     would tell the two apart (``chi^2 > INDIFFERENCE`` over the band);
     otherwise it is an equivalent description (a joint's stiffness as a
-    named effect or as its matrix entry) and the preferred one stands.
+    named effect or as its matrix entry) and the preferred one stands.  At
+    most ``settings.rivals_checked`` rivals are checked.
 
     Returns
     -------
@@ -424,24 +439,19 @@ def _distinct_rivals(assembly, measured, final_effects, outcome, say) -> list:
     kept = Explanation(final_effects)
     kept_sites = frozenset().union(*(sites(assembly, f.change, f.values) for f in final_effects))
     out = []
-    for _, founds in pool[:RIVALS_CHECKED]:
+    for _, founds in pool[:settings.rivals_checked]:
         rival = Explanation(founds)
         same_changes = {f.change.key for f in founds} == keys
         if not same_changes and frozenset().union(*(sites(assembly, f.change, f.values) for f in founds)) == kept_sites:
             continue  # the same parts changed: an equivalent description
         rival = Explanation(founds)
-        sep = separation(assembly, measured, kept, rival, say, contact_only=True)
+        sep = separation(assembly, measured, kept, rival, say, contact_only=True, settings=settings)
         if sep is not None and sep["chi2"] > INDIFFERENCE:
             if say:
                 say(f"rival explanation {rival.name} at {rival.where}: {sep['text']}")
             out.append((rival, sep))
     return out
 
-
-MOST_CHANGES = 2
-"""Most changes an explanation may hold: two effects at once (a reground tool and a forgotten sensor) are
-found together; three or more that together only just reach the noise are the mark of one effect the search
-lacks, and the verdict says so."""
 
 PHYSICAL_ENDS = ("position", "start", "inset", "inset_tip", "length", "end")
 """Parameters whose bounds are the ends of a component (a body at the tip, a section over the whole tool):
@@ -499,8 +509,7 @@ def bound_text(current, hit) -> str:
     i, name, value, bound, side = hit
     change = current[i][0]
     unit = next((sp.unit for sp in change.specs if sp.name == name), "")
-    return (f"{change.effect} at {change.where}: {name} = {value:.4g} {unit}, "
-            f"the {side} bound of its search ({bound:.4g} {unit})")
+    return words.bound_text(change.effect, change.where, name, value, unit, side, bound)
 
 
 def _std_of(result, change) -> dict:

@@ -18,7 +18,8 @@ with secant slopes (steps limited to a factor ``e^1.5`` on log scales); the
 iterates become extra starting points of the screening scan.  When every paired mode is within two lines of the
 model's, there is nothing to predict from and no extra start is made.  Elements are linearised at every other
 screening place from where they do nothing (a zero mass, a zero spring), with three trials around the
-prediction; a section change's three parameters are left to its scan.
+prediction; a section change's three parameters are left to its scan.  The windows, steps and factors are
+fields of :class:`~substructure.diagnose.settings.DiagnoseSettings`.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from ..frf import FRF
 from ..updating.elements import SectionChange
 from ..updating.fit import from_u, to_u
 from .compare import pair_modes
+from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
 __all__ = ["mode_starts", "peak_near"]
 
@@ -82,7 +84,7 @@ def _null(change) -> dict | None:
     return None
 
 
-def mode_starts(lik0, current, changes, places) -> dict:
+def mode_starts(lik0, current, changes, places, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> dict:
     """Extra starting points of the screening scan, predicted from the mode shifts.
 
     Parameters
@@ -95,6 +97,8 @@ def mode_starts(lik0, current, changes, places) -> dict:
         The candidates.
     places : callable
         ``places(change) -> list of dict``: the screening places of a change.
+    settings : DiagnoseSettings
+        The windows, steps and factors of the starts.
 
     Returns
     -------
@@ -108,13 +112,16 @@ def mode_starts(lik0, current, changes, places) -> dict:
     except SubstructureError:
         return {}
     model = FRF(measured.frequency, base[:, None, None], measured.outputs, measured.inputs)
-    pairs = [p for p in pair_modes(model, measured, noise=lik0.measured[0].noise.floor) if p.model_hz is not None]
-    f0 = np.array([peak_near(f, base, p.model_hz, 0.02) or p.model_hz for p in pairs])
+    pairs = [p for p in pair_modes(model, measured, settings.mode_peak_share, noise=lik0.measured[0].noise.floor,
+                                   prominence=settings.mode_prominence,
+                                   noise_prominence=settings.mode_prominence_floors, pairing=settings.mode_pairing)
+             if p.model_hz is not None]
+    f0 = np.array([peak_near(f, base, p.model_hz, settings.mode_locate) or p.model_hz for p in pairs])
     if f0.size == 0:
         return {}
     measured_hz = np.array([p.measured_hz for p in pairs])
     step = float(f[1] - f[0]) if f.size > 1 else 1.0
-    if np.all(np.abs(np.array([p.measured_hz for p in pairs]) - f0) < 2 * step):
+    if np.all(np.abs(np.array([p.measured_hz for p in pairs]) - f0) < settings.in_place_lines * step):
         return {}  # the modes sit where the model has them: nothing to predict from
     out: dict = {}
     for change in changes:
@@ -124,7 +131,7 @@ def mode_starts(lik0, current, changes, places) -> dict:
         null = _null(change)
         main = change.specs[0]
         where = places(change)
-        if len(where) > 5:  # elements: every other screening place
+        if len(where) > settings.mode_start_places:  # elements: every other screening place
             where = where[::2]
         for place in where:
             values = dict(place)
@@ -132,23 +139,24 @@ def mode_starts(lik0, current, changes, places) -> dict:
                 if null is not None:  # an element: linear in its main value, from zero
                     zero = {**values, **{k: v for k, v in null.items() if k not in ("position", "start", "length")}}
                     ref = lik0.predict(list(current) + [(change, zero)])[0]
-                    f_ref = np.array([peak_near(f, ref, v, 0.05) or np.nan for v in f0])
-                    step = 0.01 * (main.upper - main.lower) if not main.log else main.upper * 1e-3
+                    f_ref = np.array([peak_near(f, ref, v, settings.mode_follow) or np.nan for v in f0])
+                    step = settings.element_probe_linear * (main.upper - main.lower) if not main.log \
+                        else main.upper * settings.element_probe_log
                     probe = {**zero, main.name: zero[main.name] + step}
                     moved = lik0.predict(list(current) + [(change, probe)])[0]
-                    f1 = np.array([peak_near(f, moved, v, 0.05) or np.nan for v in f_ref])
+                    f1 = np.array([peak_near(f, moved, v, settings.mode_follow) or np.nan for v in f_ref])
                     s = (np.log(f1) - np.log(f_ref)) / step
                     dd = np.log(measured_hz / f_ref)
                     ok = np.isfinite(s) & np.isfinite(dd)
                     if not ok.any() or float(s[ok] @ s[ok]) <= 0:
                         continue
                     value = zero[main.name] + float(s[ok] @ dd[ok]) / float(s[ok] @ s[ok])
-                    for factor in (0.6, 1.0, 1.5):
+                    for factor in settings.element_factors:
                         v = zero[main.name] + factor * (value - zero[main.name])
                         if main.lower <= v <= main.upper:
                             trials.append({**values, main.name: float(v)})
                 else:
-                    trials += _secant(lik0, current, change, values, f, f0, measured_hz)
+                    trials += _secant(lik0, current, change, values, f, f0, measured_hz, settings)
             except (SubstructureError, ValueError, FloatingPointError):
                 continue
         if trials:
@@ -161,20 +169,21 @@ def _modes(lik0, changes, f, previous, width=0.12):
     return np.array([peak_near(f, h, v, width) or np.nan if np.isfinite(v) else np.nan for v in previous])
 
 
-def _secant(lik0, current, change, values, f, f0, measured_hz, iterations: int = 3) -> list[dict]:
+def _secant(lik0, current, change, values, f, f0, measured_hz, settings: DiagnoseSettings) -> list[dict]:
     """Where the main parameter puts the modes: secant iterations on ``ln f`` (mode frequencies move
     smoothly but not linearly: a stiff joint's modes hardly move until it is soft enough)."""
     main = change.specs[0]
     u_prev = to_u(main, values[main.name])
-    f_prev = _modes(lik0, list(current) + [(change, values)], f, f0, 0.05)
-    u = u_prev + 0.02
+    first = settings.secant_first_step
+    f_prev = _modes(lik0, list(current) + [(change, values)], f, f0, settings.mode_follow)
+    u = u_prev + first
     out = []
     lo, hi = (np.log(main.lower), np.log(main.upper)) if main.log else (main.lower / (0.1 * (main.upper - main.lower)),
                                                                         main.upper / (0.1 * (main.upper - main.lower)))
-    for _ in range(iterations + 1):
+    for _ in range(settings.secant_iterations + 1):
         trial = {**values, main.name: from_u(main, u)}
-        f_now = _modes(lik0, list(current) + [(change, trial)], f, f_prev)
-        if out or u != u_prev + 0.02:
+        f_now = _modes(lik0, list(current) + [(change, trial)], f, f_prev, settings.mode_window)
+        if out or u != u_prev + first:
             out.append(trial)
         s = (np.log(f_now) - np.log(f_prev)) / (u - u_prev)
         d = np.log(measured_hz / f_now)
@@ -182,8 +191,8 @@ def _secant(lik0, current, change, values, f, f0, measured_hz, iterations: int =
         if not ok.any() or float(s[ok] @ s[ok]) <= 0:
             break
         a = float(s[ok] @ d[ok]) / float(s[ok] @ s[ok])
-        a = float(np.clip(a, -1.5, 1.5)) if main.log else a
-        if abs(a) < 1e-4:
+        a = float(np.clip(a, -settings.secant_max_step, settings.secant_max_step)) if main.log else a
+        if abs(a) < settings.secant_tolerance:
             break
         u_prev, f_prev = u, f_now
         u = float(np.clip(u + a, lo, hi))

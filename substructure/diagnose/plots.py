@@ -100,7 +100,8 @@ def plot_history(diagnosis, ax=None):
         label = "model as given" if s.added is None else f"+ {s.added.name}\n({s.added.where})"
         ax.annotate(plain_text(label), (s.step, s.error), textcoords="offset points", xytext=(6, 6), fontsize="x-small")
     ax.axhline(diagnosis.noise_floor, color="tab:green", ls="--", label="noise floor")
-    ax.axhline(1.5 * diagnosis.noise_floor, color="tab:green", ls=":", label="1.5 x noise floor")
+    factor = diagnosis.settings.explained_error_factor
+    ax.axhline(factor * diagnosis.noise_floor, color="tab:green", ls=":", label=f"{factor:g} x noise floor")
     ax.set_xticks(x)
     ax.set_xlabel("refinement step")
     ax.set_ylabel(f"error ({diagnosis.metric})")

@@ -29,7 +29,8 @@ best candidate on all lines.  The checks after it always run (the parsimony
 check costs a few dozen evaluations: at most six short fits on the
 screening lines and two on all lines); a forward path that the budget cut
 short is exactly when a pair from fair starts is most likely to explain
-better.
+better.  The sizes of the pools and the budgets of the short fits are fields
+of :class:`~substructure.diagnose.settings.DiagnoseSettings`.
 """
 
 from __future__ import annotations
@@ -49,6 +50,7 @@ from .modes import mode_starts
 from ..updating.fit import to_u
 from .scan import places, trials
 from .search import Budget, Scored, choose, full_fits, physical, preference, rank, screen, shortlist
+from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
 __all__ = ["Outcome", "refine"]
 
@@ -114,7 +116,8 @@ def _prune(lik, current, chi2_now, say):
     return current, chi2_now, dropped
 
 
-def _review(lik, current, chi2_now, steps_fitted, steps_inside, dropped, passive, say):
+def _review(lik, current, chi2_now, steps_fitted, steps_inside, dropped, passive, say,
+            settings: DiagnoseSettings = DEFAULT_SETTINGS):
     """Alternatives of each kept change; preferred ones replace it (see the module docstring)."""
     n = lik.n
     alternatives: dict = {}
@@ -126,7 +129,7 @@ def _review(lik, current, chi2_now, steps_fitted, steps_inside, dropped, passive
                 and preference(s.change) < preference(change)]
         pool.sort(key=lambda s: (preference(s.change), s.chi2))
         found = []
-        for s in pool[:3]:
+        for s in pool[:settings.review_pool]:
             trial = current[:i] + [(s.change, s.values)] + current[i + 1:]
             if s.fit is None and s.start is not None:  # screened only: with the values it screened at
                 trial = [(c, dict(v)) for c, v in s.start[:i]] + [(s.change, s.values)] + current[i + 1:]
@@ -186,19 +189,15 @@ def _history(lik, current, final: Fit, tried: int):
     return history
 
 
-PAIR_POOL = 4
-"""Singles of the first step (best first) whose pairs are fitted from fair starts in the parsimony check."""
+def _distinct(screen_lik, singles, count: int, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> list:
+    """The best ``count`` singles that change the model in different ways.
 
-
-SAME_DIRECTION = 0.995
-"""Two singles whose changes of the residual (on the screening lines) have a cosine above this are one
-explanation under two names (a joint's stiffness and its ``k.yf`` entry; an overhang and its free segment's
-length): only one enters the pair pool, under the name :func:`~substructure.diagnose.search.preference` puts
-first."""
-
-
-def _distinct(screen_lik, singles, count: int) -> list:
-    """The best ``count`` singles that change the model in different ways (see :data:`SAME_DIRECTION`)."""
+    Two singles whose changes of the residual (on the screening lines) have
+    a cosine above ``settings.same_direction`` are one explanation under
+    two names (a joint's stiffness and its ``k.yf`` entry; an overhang and
+    its free segment's length): only one enters the pool, under the name
+    :func:`~substructure.diagnose.search.preference` puts first.
+    """
     try:
         r0 = screen_lik.residual([])
     except (ValueError, ArithmeticError, SubstructureError):
@@ -215,7 +214,7 @@ def _distinct(screen_lik, singles, count: int) -> list:
         if not np.isfinite(norm) or norm == 0.0:
             continue
         d = d / norm
-        same = [k for k, e in enumerate(directions) if abs(float(d @ e)) > SAME_DIRECTION]
+        same = [k for k, e in enumerate(directions) if abs(float(d @ e)) > settings.same_direction]
         if same:  # one explanation under two names: the preferred name stands for it (an overhang, not a length)
             k = same[0]
             if preference(s.change) < preference(pool[k].change):
@@ -230,17 +229,18 @@ def _bic(chi2: float, p: int, n: int, s2: float) -> float:
     return chi2 / s2 + p * math.log(n)
 
 
-def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say):
+def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
+               settings: DiagnoseSettings = DEFAULT_SETTINGS):
     """The kept explanation against the best single and best pair ones fitted from fair starts.
 
     Forward selection extends its first choice; when that choice was wrong,
     later steps compensate and the path ends at several changes that a
     single or a pair of other changes explains as well.  Here every single
     of the first step (fitted from its own scan on all lines) and every pair
-    of the ``PAIR_POOL`` best of them that change the model in different
-    ways and of the changes the path kept (:func:`_distinct`; fitted from
-    the two changes' values, first on
-    the screening lines, the best two on all lines) is
+    of the ``settings.pair_pool`` best of them that change the model in
+    different ways and of the changes the path kept (:func:`_distinct`;
+    fitted from the two changes' values, first on the screening lines, the
+    best ``settings.pairs_fitted`` on all lines) is
     compared with the kept explanation by BIC (``chi^2 / s^2 + p ln n``,
     ``s^2`` the misfit scale of the best of them).  Of those within
     :data:`~substructure.updating.selection.INDIFFERENCE` of the lowest BIC
@@ -265,9 +265,9 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say):
         # first step ranked too low to fit, found later once another had taken its share, pairs too)
         kept_path = [SimpleNamespace(change=c, values=dict(v), fit=SimpleNamespace(changes=[(c, dict(v))]))
                      for c, v in current]
-        pool = _distinct(screen_lik, singles, PAIR_POOL)
+        pool = _distinct(screen_lik, singles, settings.pair_pool, settings)
         keys = {s.change.key for s in pool}
-        pool += [k for k in _distinct(screen_lik, kept_path, len(kept_path)) if k.change.key not in keys]
+        pool += [k for k in _distinct(screen_lik, kept_path, len(kept_path), settings) if k.change.key not in keys]
         trials = []
         for i in range(len(pool)):
             for j in range(i + 1, len(pool)):
@@ -276,11 +276,11 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say):
                     continue
                 pair = [(a.change, dict(a.values)), (b.change, dict(b.values))]
                 try:
-                    trials.append((fit(screen_lik, pair, max_nfev=40).chi2, pair))
+                    trials.append((fit(screen_lik, pair, max_nfev=settings.pair_screen_evaluations).chi2, pair))
                 except (ValueError, ArithmeticError, SubstructureError):
                     continue
         trials.sort(key=lambda t: t[0])
-        for _, pair in trials[:2]:
+        for _, pair in trials[:settings.pairs_fitted]:
             try:
                 result = fit(lik, pair)
             except (ValueError, ArithmeticError, SubstructureError):
@@ -304,28 +304,26 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say):
     return kept, kept_chi2, rivals
 
 
-OTHER_STARTS = 2
-"""Starts, per change kept that has a place among its parameters (:data:`PLACING`), from which other values of
-the same change are fitted (:func:`_other_values`)."""
 PLACING = ("position", "start", "inset", "inset_tip")
 """Parameters that place a change along a component: where a second minimum lives (a body either side of a
 symmetric point, springs further in at another stiffness)."""
-OTHER_APART = 0.05
-"""Values of a change count as other values when some parameter differs by more than three of its standard
-deviations and by more than this share of its range (on its fitted scale)."""
 
 
-def _other_values(lik, screen_lik, current, final: Fit, passive, say) -> list:
+def _other_values(lik, screen_lik, current, final: Fit, passive, say,
+                  settings: DiagnoseSettings = DEFAULT_SETTINGS) -> list:
     """The same changes at other values that explain the data as well: a second minimum.
 
     A fit finds the minimum its start leads to; springs that hold a body
     whose modes sit below the band, say, fit as well at another stiffness
     with other positions.  For each change kept, its screening trials
     (with the other changes at their final values) are evaluated on the
-    subsample; the :data:`OTHER_STARTS` best that lie away from the kept
-    values start fits of every change on all lines.  A result inside the
-    indifference region whose values of that change lie apart
-    (:data:`OTHER_APART`) is the same explanation at other values: a rival.
+    subsample; the ``settings.other_starts`` best that lie away from the
+    kept values start fits of every change on all lines (changes with a
+    place among their parameters, :data:`PLACING`, only).  A result inside
+    the indifference region whose values of that change lie apart (some
+    parameter by more than ``settings.other_apart_std`` standard deviations
+    and ``settings.other_apart`` of its range on its fitted scale) is the
+    same explanation at other values: a rival.
 
     Returns
     -------
@@ -349,12 +347,13 @@ def _other_values(lik, screen_lik, current, final: Fit, passive, say) -> list:
                 sd = std.get(spec.name)
                 sd_u = abs(to_u(spec, values[spec.name] + sd) - kept_u[spec.name]) if sd and np.isfinite(sd) and \
                     spec.lower <= values[spec.name] + sd <= spec.upper else 0.0
-                if abs(u - kept_u[spec.name]) > max(3 * sd_u, OTHER_APART * span[spec.name]):
+                if abs(u - kept_u[spec.name]) > max(settings.other_apart_std * sd_u,
+                                                    settings.other_apart * span[spec.name]):
                     return True
             return False
 
         scored = []
-        for trial in trials(change):
+        for trial in trials(change, settings=settings):
             vals = {**values, **{k: v for k, v in trial.items() if k in values}}
             if not apart(vals):
                 continue
@@ -365,7 +364,7 @@ def _other_values(lik, screen_lik, current, final: Fit, passive, say) -> list:
             if np.isfinite(chi2):
                 scored.append((chi2, vals))
         scored.sort(key=lambda t: t[0])
-        for _, vals in scored[:OTHER_STARTS]:
+        for _, vals in scored[:settings.other_starts]:
             try:
                 result = fit(lik, current[:i] + [(change, vals)] + current[i + 1:])
             except (ValueError, ArithmeticError, SubstructureError):
@@ -385,7 +384,8 @@ def _other_values(lik, screen_lik, current, final: Fit, passive, say) -> list:
 
 
 def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
-           budget: Budget | None = None, lacking: bool = False) -> Outcome:
+           budget: Budget | None = None, lacking: bool = False,
+           settings: DiagnoseSettings = DEFAULT_SETTINGS) -> Outcome:
     """Forward selection, then elimination, review and history (see the module docstring).
 
     Parameters
@@ -408,6 +408,8 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     lacking : bool
         The data hold a resonance the model lacks (a suspension mode): the
         first step crosses the sizes and positions of springs.
+    settings : DiagnoseSettings
+        The grids, pools and budgets of the search.
 
     Returns
     -------
@@ -448,10 +450,11 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
                 f"{screen_lik.lines.size} of {lik.lines.size} lines")
         # the current changes refitted on the subsample too: candidates are compared with that
         chi2_s = fit(screen_lik, current).chi2 if current else screen_lik.chi2([])
-        extra = mode_starts(lik0, current, remaining, places)
-        scored = screen(screen_lik, current, remaining, chi2_s, n, say, extra, cross=lacking and not current)
+        extra = mode_starts(lik0, current, remaining, lambda change: places(change, settings), settings)
+        scored = screen(screen_lik, current, remaining, chi2_s, n, say, extra, cross=lacking and not current,
+                        settings=settings)
         chosen = []
-        for s in shortlist(scored, chi2_s, screen_lik.n, n, _p(current)):
+        for s in shortlist(scored, chi2_s, screen_lik.n, n, _p(current), settings):
             # the screened values checked on all lines (noise fitted on the subsample does not carry over)
             start = list(s.start if s.start is not None else current)
             chi2_all = lik.chi2(start + [(s.change, s.values)])
@@ -462,7 +465,8 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
                 # spacing (a mode just below the first line moves the lowest lines only): a short fit on all
                 # lines from the screened values decides
                 try:
-                    short = fit(lik, start + [(s.change, s.values)], max_nfev=5 * (_p(current) + s.k + 1))
+                    short = fit(lik, start + [(s.change, s.values)],
+                                max_nfev=settings.short_fit_evaluations * (_p(current) + s.k + 1))
                 except (ValueError, ArithmeticError, SubstructureError):
                     continue
                 if significance(chi2_now, short.chi2, s.k, n, _p(current) + s.k).significant:
@@ -488,7 +492,7 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
         # the review's pool: what was fitted, and what screened nearly as well as the choice
         winner = next((x for x in scored if x.change.key == best.change.key), None)
         near = [x for x in scored if winner is not None and x.change.key not in {r.change.key for r in ranked}
-                and chi2_s - x.chi2 >= 0.9 * (chi2_s - winner.chi2)]
+                and chi2_s - x.chi2 >= settings.review_near_share * (chi2_s - winner.chi2)]
         steps_fitted[best.change.key] = [s for s in ranked if s is not best] + near
         steps_inside[best.change.key] = inside
         path.append((best.fit, best.change, sig.statistic, sig.threshold))
@@ -504,11 +508,12 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     alternatives: dict = {}
     if current:
         current, chi2_now, alternatives = _review(lik, current, chi2_now, steps_fitted, steps_inside, dropped,
-                                                  passive, say)
+                                                  passive, say, settings)
     rivals: list = []
     if len(current) >= 2:
         before = [c.key for c, _ in current]
-        current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say)
+        current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
+                                               settings)
         if len(current) > 1 and sorted(c.key for c, _ in current) != pruned:
             # what the review and the parsimony check put in must each still earn its place
             current, chi2_now, late = _prune(lik, current, chi2_now, say)
@@ -522,5 +527,5 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
         current = [(c, dict(v)) for c, v in final.changes]
     history = path if unchanged else (_history(lik, current, final, tried) if current else [])
     if final is not None:
-        rivals = list(rivals) + _other_values(lik, screen_lik, current, final, passive, say)
+        rivals = list(rivals) + _other_values(lik, screen_lik, current, final, passive, say, settings)
     return Outcome(current, final, history, first_scored, first_fitted, alternatives, rivals, search)

@@ -21,6 +21,10 @@ in place: a calibration or unit error, not the structure.
 the ends, quarter points and middle of every beam component; with a
 non-contact sensor when one explanation belongs to the test) by how much
 two explanations differ there relative to the noise of the data.
+
+The numbers (the finite-difference factor, the shares, the bands) are fields
+of :class:`~substructure.diagnose.settings.DiagnoseSettings`; the sentences
+are written by :mod:`substructure.diagnose.words`.
 """
 
 from __future__ import annotations
@@ -32,35 +36,21 @@ from ..errors import SubstructureError
 from ..measurements import model_of_measurement
 from ..updating.parameters import set_parameters
 from ..updating.selection import INDIFFERENCE
+from . import words
+from .settings import DEFAULT_SETTINGS, DiagnoseSettings
+from .words import values_text
 
-__all__ = ["unexplained_report", "separation", "signature", "level_signature", "LEVEL_BANDS", "values_text"]
-
-
-def values_text(change, values) -> str:
-    """``name = value unit, ...`` of a change's values, for reports.
-
-    Parameters
-    ----------
-    change : Change
-        The change (its ``specs`` give names and units).
-    values : dict
-        Its values (SI).
-
-    Returns
-    -------
-    str
-        The values, four significant digits each.
-    """
-    return ", ".join(f"{s.name} = {values[s.name]:.4g} {s.unit}".replace(" dimensionless", "") for s in change.specs)
+__all__ = ["unexplained_report", "separation", "signature", "level_signature", "values_text"]
 
 
 def _plain_beams(assembly):
     return [c for c in assembly.components if si_beam(c)]
 
 
-def _peak(f: np.ndarray, h: np.ndarray, near: float) -> float | None:
-    """The resonance of ``|h|`` nearest ``near`` (within 15 %), by a parabola through the top three lines."""
-    window = np.flatnonzero((f > 0.85 * near) & (f < 1.15 * near))
+def _peak(f: np.ndarray, h: np.ndarray, near: float, width: float = 0.15) -> float | None:
+    """The resonance of ``|h|`` nearest ``near`` (within ``width``, relative), by a parabola through the top
+    three lines."""
+    window = np.flatnonzero((f > (1.0 - width) * near) & (f < (1.0 + width) * near))
     if window.size < 3:
         return None
     a = np.log(np.abs(h[window]))
@@ -92,7 +82,7 @@ def _knobs(assembly) -> list[tuple[str, str, str]]:
     return out
 
 
-def signature(model, measured_frf, pairs) -> tuple[list[str], dict]:
+def signature(model, measured_frf, pairs, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> tuple[list[str], dict]:
     """Name the modes and the kind of change their shifts point to.
 
     Parameters
@@ -103,6 +93,8 @@ def signature(model, measured_frf, pairs) -> tuple[list[str], dict]:
         One measured entry.
     pairs : list of ModePair
         Measured modes paired with the model's.
+    settings : DiagnoseSettings
+        ``signature_step``, ``signature_window``, ``signature_share``, ``in_place_lines``.
 
     Returns
     -------
@@ -116,7 +108,8 @@ def signature(model, measured_frf, pairs) -> tuple[list[str], dict]:
     if not paired:
         return [], {}
     base = model.frf(out, inp, measured_frf.frequency).data[:, 0, 0]
-    f0 = [_peak(f, base, p.model_hz) for p in paired]
+    width = settings.signature_window
+    f0 = [_peak(f, base, p.model_hz, width) for p in paired]
     keep = [i for i, v in enumerate(f0) if v is not None]
     if not keep:
         return [], {}
@@ -126,12 +119,12 @@ def signature(model, measured_frf, pairs) -> tuple[list[str], dict]:
     sens, names = [], []
     for path, kind, text in _knobs(model):
         try:
-            changed = set_parameters(model, {path: 1.05})
+            changed = set_parameters(model, {path: settings.signature_step})
             h = changed.frf(out, inp, measured_frf.frequency).data[:, 0, 0]
         except (SubstructureError, ValueError):
             continue
-        f1 = np.array([_peak(f, h, v) or v for v in f0])
-        sens.append(np.log(f1 / f0) / np.log(1.05))
+        f1 = np.array([_peak(f, h, v, width) or v for v in f0])
+        sens.append(np.log(f1 / f0) / np.log(settings.signature_step))
         names.append((path, kind, text))
     if not sens:
         return [], {}
@@ -148,12 +141,10 @@ def signature(model, measured_frf, pairs) -> tuple[list[str], dict]:
         where_strain = max(strain)[1] if strain else "?"
         where_motion = max(motion)[1] if motion else "?"
         mode_names.append(where_strain)
-        rel = d[i]
-        state = "within two lines" if abs(p.measured_hz - f0[i]) < 2 * step else \
-            f"{abs(rel):.1%} {'lower' if rel < 0 else 'higher'} in the measurement"
-        lines.append(f"mode at {f0[i]:.0f} Hz in the model (strain mostly in the {where_strain}, motion mostly "
-                     f"in the {where_motion}): {state}")
-    moved = np.abs(np.array([p.measured_hz for p in paired]) - f0) >= 2 * step
+        in_place = abs(p.measured_hz - f0[i]) < settings.in_place_lines * step
+        lines.append(words.mode_line(f0[i], where_strain, where_motion, None if in_place else float(d[i]),
+                                     settings.in_place_lines))
+    moved = np.abs(np.array([p.measured_hz for p in paired]) - f0) >= settings.in_place_lines * step
     if not moved.any():
         return lines, {"modes": [{"model_hz": float(v), "measured_hz": float(p.measured_hz), "strain": n}
                                  for v, p, n in zip(f0, paired, mode_names)]}
@@ -170,37 +161,27 @@ def signature(model, measured_frf, pairs) -> tuple[list[str], dict]:
                 best = (share, a, path, kind, text)
     info = {"modes": [{"model_hz": float(v), "measured_hz": float(p.measured_hz), "strain": n}
                       for v, p, n in zip(f0, paired, mode_names)]}
-    if best is not None and best[0] > 0.5:
+    if best is not None and best[0] > settings.signature_share:
         share, a, path, kind, text = best
-        if kind == "stiffness":
-            what = f"{text} {'lower' if a < 0 else 'higher'} than the model"
-            alt = " (or mass added where that part moves)" if a < 0 else ""
-        else:
-            what = f"{text} {'higher' if a > 0 else 'lower'} than the model"
-            alt = f" (or softness near the {text.replace('the mass of the ', '')})" if a > 0 else ""
-        lower = [f"{f0[i]:.0f} Hz" for i in range(len(f0)) if moved[i] and d[i] < 0]
-        higher = [f"{f0[i]:.0f} Hz" for i in range(len(f0)) if moved[i] and d[i] > 0]
-        pattern = "; ".join(x for x in (f"lower in the measurement: {', '.join(lower)}" if lower else "",
-                                        f"higher: {', '.join(higher)}" if higher else "") if x)
-        lines.append(f"signature: {pattern}; this pattern matches {what}{alt}, which accounts for {share:.0%} "
-                     "of the mode shifts")
+        lower = [float(f0[i]) for i in range(len(f0)) if moved[i] and d[i] < 0]
+        higher = [float(f0[i]) for i in range(len(f0)) if moved[i] and d[i] > 0]
+        lines.append(words.signature_line(lower, higher, text, kind, a, share))
         info["knob"] = {"path": path, "kind": kind, "factor": float(np.exp(a)), "share": share}
     return lines, info
 
 
-LEVEL_BANDS = 8
-"""Bands of equal numbers of lines over which :func:`level_signature` compares the level of the data."""
-
-
-def level_signature(baseline, floor: float) -> tuple[list[str], dict]:
+def level_signature(baseline, floor: float, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> tuple[list[str], dict]:
     """A measurement that is a constant factor times the model everywhere, with the modes in place.
 
     Per measured FRF, the ratio ``r = ln |H_measured / H_model|`` of the
     model as given, its median ``m`` over all lines and its medians over
-    :data:`LEVEL_BANDS` bands of lines.  When for every FRF ``|m|`` is above
-    twice the noise floor, every band's median has the sign of ``m`` and
-    lies between half and twice it, and every paired mode is within 1 %
-    (or two lines) of the model's, the FRFs differ from the model by a scale: what a
+    ``settings.level_bands`` bands of lines.  When for every FRF ``|m|`` is
+    above ``settings.level_floors`` (two) noise floors, every band's median
+    has the sign of ``m`` and lies between ``1 / settings.level_spread`` and
+    ``settings.level_spread`` (half and twice) times it, and every paired
+    mode is within ``settings.level_in_place`` (1 %, or
+    ``settings.in_place_lines`` lines) of the model's, the FRFs differ from
+    the model by a scale: what a
     calibration or unit error does (the hammer's or the sensor's
     sensitivity, g taken for m/s^2), and what a change of the structure
     does only by scaling every mass and stiffness alike.
@@ -211,6 +192,8 @@ def level_signature(baseline, floor: float) -> tuple[list[str], dict]:
         The model as given against each measured FRF.
     floor : float
         The noise floor (``rms_log_ratio`` of a perfect model).
+    settings : DiagnoseSettings
+        The bands and thresholds of the test.
 
     Returns
     -------
@@ -224,30 +207,28 @@ def level_signature(baseline, floor: float) -> tuple[list[str], dict]:
         with np.errstate(divide="ignore", invalid="ignore"):
             r = np.log(np.abs(c.measured.data[:, 0, 0]) / np.abs(c.model.data[:, 0, 0]))
         ok = np.isfinite(r)
-        if ok.sum() < 4 * LEVEL_BANDS:
+        if ok.sum() < 4 * settings.level_bands:  # at least four lines a band
             return [], {}
         r = r[ok]
         m = float(np.median(r))
-        bands = np.array([np.median(b) for b in np.array_split(r, LEVEL_BANDS)])
+        bands = np.array([np.median(b) for b in np.array_split(r, settings.level_bands)])
         step = float(f[1] - f[0]) if f.size > 1 else 1.0
         # a peak picked on noisy lines moves by a few lines: "in place" is within 1 % (or two lines)
-        in_place = all(p.model_hz is not None and abs(p.model_hz - p.measured_hz) <= max(2 * step, 0.01 * p.model_hz)
-                       for p in c.modes)
-        if not (in_place and c.modes and abs(m) > 2 * floor and np.all(bands / m > 0.5) and np.all(bands / m < 2.0)):
+        in_place = all(p.model_hz is not None and abs(p.model_hz - p.measured_hz)
+                       <= max(settings.in_place_lines * step, settings.level_in_place * p.model_hz) for p in c.modes)
+        spread = settings.level_spread
+        if not (in_place and c.modes and abs(m) > settings.level_floors * floor and np.all(bands / m > 1.0 / spread)
+                and np.all(bands / m < spread)):
             return [], {}
         factors.append((str(c.measured.outputs[0]), str(c.measured.inputs[0]), float(np.exp(m))))
     if not factors:
         return [], {}
-    text = "; ".join(f"{o} / {i}: {x:.3g} times" for o, i, x in factors)
-    line = (f"signature: the measurement is a constant factor times the model over the whole band with every mode "
-            f"in place ({text}): a calibration or unit error (the hammer's or the sensor's sensitivity, g taken "
-            f"for m/s^2) scales an FRF like this, while a change of the structure would have to scale every mass "
-            f"and stiffness alike; check the calibration before the model")
-    return [line], {"level": [{"response": o, "excitation": i, "factor": x} for o, i, x in factors]}
+    return [words.level_line(factors)], {"level": [{"response": o, "excitation": i, "factor": x}
+                                                   for o, i, x in factors]}
 
 
 def unexplained_report(lik, assembly, current, baseline, cons, final_error: float, floor: float,
-                       explained: bool, say=None) -> list[str]:
+                       explained: bool, say=None, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> list[str]:
     """The lines of the verdict when the data are not explained (see the module docstring).
 
     Parameters
@@ -270,46 +251,43 @@ def unexplained_report(lik, assembly, current, baseline, cons, final_error: floa
         The verdict.
     say : callable, optional
         Progress.
+    settings : DiagnoseSettings
+        The numbers of the signatures and of the bands named.
 
     Returns
     -------
     list of str
         The report, the verdict first.
     """
-    lines = [f"unexplained: no candidate explains the data; the best model found leaves an error of "
-             f"{final_error:.4g}, {final_error / floor:.2g} times the noise floor ({floor:.4g}); "
-             f"chi^2/nu = {cons.chi2_reduced:.4g} where the noise allows {cons.threshold:.4g}"]
+    lines = [words.unexplained(final_error, floor, cons.chi2_reduced, cons.threshold)]
+    near = settings.band_merge
     merged = []
     for b in cons.bands:
         label = lik.measured[b.item].label
         for i, (lab, lo, hi, share) in enumerate(merged):
-            if lab == label and (b.lo_hz <= hi * 1.05 and b.hi_hz >= lo * 0.95):
+            if lab == label and (b.lo_hz <= hi * (1.0 + near) and b.hi_hz >= lo * (1.0 - near)):
                 merged[i] = (lab, min(lo, b.lo_hz), max(hi, b.hi_hz), share + b.share)
                 break
         else:
             merged.append((label, b.lo_hz, b.hi_hz, b.share))
     merged.sort(key=lambda m: -m[3])
     if merged:
-        lines.append("the remaining error lives in: " + "; ".join(
-            f"{lab} {lo:.0f}-{hi:.0f} Hz ({share:.0%})" for lab, lo, hi, share in merged[:5]))
+        lines.append(words.error_lives(merged[:settings.report_bands]))
     elif cons.chi2_reduced > cons.threshold:
-        lines.append("the remaining error is spread over the band (no single band stands out)")
+        lines.append(words.error_spread())
     if current:
-        parts = []
-        for c, v in current:
-            vals = values_text(c, v)
-            parts.append(f"{c.effect} at {c.place(v)} ({vals})")
-        lines.append("best partial explanation (partial): " + "; ".join(parts))
+        lines.append(words.best_partial([(c.effect, c.place(v), values_text(c, v)) for c, v in current]))
     else:
-        lines.append("no candidate improves the model significantly")
+        lines.append(words.nothing_improves())
     try:  # the signature of the data against the model as given: what kind of change is missing
         first = lik.measured[0]
-        sig_lines, _ = signature(model_of_measurement(assembly, first.measurement), first.frf, baseline[0].modes)
+        sig_lines, _ = signature(model_of_measurement(assembly, first.measurement), first.frf, baseline[0].modes,
+                                 settings)
         lines += sig_lines
     except (SubstructureError, ValueError) as exc:
         if say:
             say(f"signature skipped: {exc}")
-    lines += level_signature(baseline, floor)[0]
+    lines += level_signature(baseline, floor, settings)[0]
     return lines
 
 
@@ -356,7 +334,8 @@ class Explanation:
         return assembly
 
 
-def separation(assembly, measured, a, b, say=None, contact_only: bool = False) -> dict | None:
+def separation(assembly, measured, a, b, say=None, contact_only: bool = False,
+               settings: DiagnoseSettings = DEFAULT_SETTINGS) -> dict | None:
     """The measurement that best tells two explanations apart.
 
     Parameters
@@ -372,6 +351,8 @@ def separation(assembly, measured, a, b, say=None, contact_only: bool = False) -
     contact_only : bool
         Only measurements with the test's sensors on, as in the data (no
         non-contact variant): do the two explanations differ as structures?
+    settings : DiagnoseSettings
+        ``separation_every``: the lines the predictions are compared on.
 
     Returns
     -------
@@ -382,7 +363,7 @@ def separation(assembly, measured, a, b, say=None, contact_only: bool = False) -
     """
     first = measured[0]
     f = first.frf.frequency
-    sub = f.hz[::4]
+    sub = f.hz[::settings.separation_every]
     config = model_of_measurement(assembly, first.measurement)
     v_typ = float(np.median(0.5 * (first.noise.var_re + first.noise.var_im)))
     excitation = str(first.frf.inputs[0]).split(":")[0]
@@ -424,13 +405,6 @@ def separation(assembly, measured, a, b, say=None, contact_only: bool = False) -
     if best is None:
         return None
     value, resp, exc, non_contact = best
-    kind = "point FRF" if resp == exc else "cross FRF"
-    how = " with a non-contact sensor (laser vibrometer)" if non_contact else ""
-    if value <= INDIFFERENCE:
-        text = (f"no measurement at the ends, quarter points and middles of the components tells {a.name} at "
-                f"{a.where} from {b.name} at {b.where}: they are equivalent descriptions of these data")
-    else:
-        text = (f"measure the {kind} {resp} / {exc}{how}: {a.name} at {a.where} and {b.name} at {b.where} "
-                f"differ there by chi^2 = {value:.3g} over the band (above {INDIFFERENCE:g} tells them apart)")
+    text = words.separation_text(a.name, a.where, b.name, b.where, value, INDIFFERENCE, resp, exc, non_contact)
     return {"response": f"{resp}:y", "excitation": f"{exc}:y", "non_contact": non_contact, "chi2": value,
             "text": text}

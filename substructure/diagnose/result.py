@@ -7,6 +7,17 @@ are the first step's candidates and the refinement's steps; :class:`Diagnosis`
 holds the verdict and writes the JSON of the project's file-format page
 (:func:`strict` keeps it strict JSON).  :func:`substructure.diagnose.diagnose`
 makes them.
+
+A :class:`Diagnosis` is a few records a reader can find their way in:
+``verdict`` (:class:`Verdict`: explained or not, the report's lines, the
+missing effect), ``measures`` (:class:`Measures`: the error measure, the noise
+floor, the errors before and after, the consistency test, the comparisons),
+``changes`` (:class:`Changes`: the changes kept, the refined model, the
+candidates, the steps) and ``alternatives`` (:class:`Alternatives`: the
+explanations as good, and the measurement that separates them), with the
+search's record and the settings it ran with.  Every field of a record is
+also read from the diagnosis under its own name (``d.explained``,
+``d.noise_floor``, ``d.final_effects``, ...).
 """
 
 from __future__ import annotations
@@ -18,8 +29,9 @@ import numpy as np
 
 from ..assembly import Assembly
 from .compare import Comparison
+from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
-__all__ = ["Found", "Candidate", "Step", "Diagnosis", "strict"]
+__all__ = ["Found", "Candidate", "Step", "Verdict", "Measures", "Changes", "Alternatives", "Diagnosis", "strict"]
 
 
 def _finite(x):
@@ -229,88 +241,187 @@ class Step:
 
 
 @attrs.frozen
-class Diagnosis:
-    """What :func:`diagnose` found.  ``to_json`` gives the JSON of docs/file-formats.md.
+class Verdict:
+    """What a diagnosis concludes.
+
+    Parameters
+    ----------
+    explained : bool
+        The final residual is consistent with the noise (and within
+        ``explained_error_factor`` noise floors), with one explanation of at
+        most ``most_changes`` changes, none on the bound of its search.
+    report : tuple of str
+        The verdict's lines when the data are not explained (the first says so).
+    missing_effect : str or None
+        The first change of the refinement.
+    missing_where : str or None
+        Where it acts.
+    """
+
+    explained: bool
+    report: tuple[str, ...] = ()
+    missing_effect: str | None = None
+    missing_where: str | None = None
+
+
+@attrs.frozen
+class Measures:
+    """How far model and measurement are apart, before and after, against the noise.
 
     Parameters
     ----------
     metric : str
         ``"rms_log_ratio"``.
-    baseline_error : float
-        The error of the model as given (dimensionless).
-    noise_floor : float
-        The error a perfect model would show, from the data's own noise.
-    explained : bool
-        The final residual is consistent with the noise (and within 1.5 floors).
-    missing_effect : str or None
-        The first change of the refinement.
-    missing_where : str or None
-        Where it acts.
-    ambiguous_with : tuple of str
-        Names of the alternatives inside the indifference region.
-    suggestion : str or None
-        The measurement that would tell the first change from its first alternative.
-    candidates : tuple of Candidate
-        The first step's candidates, best first.
-    refinement : tuple of Step
-        Step 0 (the model as given), then one per change kept.
     band : tuple of float
         The band used ``(lo, hi)`` [Hz].
+    noise_floor : float
+        The error a perfect model would show, from the data's own noise (dimensionless).
+    baseline_error : float
+        The error of the model as given (dimensionless).
+    final_error : float
+        The error of the final model (dimensionless).
+    consistency : Consistency
+        The test of the final model.
+    correlation : dict
+        ``parameters`` and ``matrix`` of the final fit's correlations.
     baseline : tuple of Comparison
         Every measurement against the model as given.
     final : tuple of Comparison
         Every measurement against the final model.
-    refined_assembly : Assembly
-        The model with the changes kept.
+    """
+
+    metric: str
+    band: tuple[float, float]
+    noise_floor: float
+    baseline_error: float
+    final_error: float = float("nan")
+    consistency: object = attrs.field(default=None, eq=False)
+    correlation: dict = attrs.field(factory=dict, eq=False)
+    baseline: tuple[Comparison, ...] = attrs.field(default=(), eq=False)
+    final: tuple[Comparison, ...] = attrs.field(default=(), eq=False)
+
+
+@attrs.frozen
+class Changes:
+    """What the search found and tried.
+
+    Parameters
+    ----------
     final_effects : tuple of Found
         The changes kept, with their final values and standard deviations.
-    consistency : Consistency
-        The test of the final model.
+    refined_assembly : Assembly
+        The model with the changes kept.
+    candidates : tuple of Candidate
+        The first step's candidates, best first.
+    refinement : tuple of Step
+        Step 0 (the model as given), then one per change kept.
+    """
+
+    final_effects: tuple = attrs.field(eq=False)
+    refined_assembly: Assembly = attrs.field(eq=False)
+    candidates: tuple[Candidate, ...] = ()
+    refinement: tuple[Step, ...] = ()
+
+
+@attrs.frozen
+class Alternatives:
+    """Explanations the data do not tell from the one found, and the measurement that would.
+
+    Parameters
+    ----------
     ambiguous : tuple of (Found, float)
-        The alternatives with their errors.
+        Alternatives of the first change inside the indifference region, with their errors.
+    ambiguous_with : tuple of str
+        Their names (and those of the rivals).
+    suggestion : str or None
+        The measurement that would tell the first change from its first alternative.
     separation : dict or None
         ``response``, ``excitation``, ``non_contact``, ``chi2``, ``text``.
-    report : tuple of str
-        The verdict's lines when the data are not explained.
-    correlation : dict
-        ``parameters`` and ``matrix`` of the final fit's correlations.
-    final_error : float
-        The error of the final model.
     rivals : tuple of (Explanation, dict)
-        Whole explanations as good as the one reported (inside the
-        indifference region) that are different structures, each with the
-        measurement that separates it; when there are any, ``explained`` is
-        false.
+        Whole explanations as good as the one reported that are different
+        structures, each with the measurement that separates it; when there
+        are any, the verdict is not explained.
+    """
+
+    ambiguous: tuple = attrs.field(default=(), eq=False)
+    ambiguous_with: tuple[str, ...] = ()
+    suggestion: str | None = None
+    separation: dict | None = attrs.field(default=None, eq=False)
+    rivals: tuple = attrs.field(default=(), eq=False)
+
+
+def _read(record: str, name: str):
+    """A read-only property of the diagnosis that reads ``name`` of one of its records."""
+    kind = {"verdict": Verdict, "measures": Measures, "changes": Changes, "alternatives": Alternatives}[record]
+
+    def get(self):
+        return getattr(getattr(self, record), name)
+
+    get.__doc__ = f"``{record}.{name}``: see :class:`{kind.__name__}`."
+    return property(get)
+
+
+@attrs.frozen
+class Diagnosis:
+    """What :func:`diagnose` found, in records.  ``to_json`` gives the JSON of docs/file-formats.md.
+
+    Every field of the records is also an attribute of the diagnosis
+    (read-only): ``explained``, ``report``, ``missing_effect``,
+    ``missing_where`` (of ``verdict``); ``metric``, ``band``,
+    ``noise_floor``, ``baseline_error``, ``final_error``, ``consistency``,
+    ``correlation``, ``baseline``, ``final`` (of ``measures``);
+    ``final_effects``, ``refined_assembly``, ``candidates``, ``refinement``
+    (of ``changes``); ``ambiguous``, ``ambiguous_with``, ``suggestion``,
+    ``separation``, ``rivals`` (of ``alternatives``).
+
+    Parameters
+    ----------
+    verdict : Verdict
+        Explained or not, and the report's lines.
+    measures : Measures
+        The errors against the noise, before and after.
+    changes : Changes
+        The changes kept, the refined model, the candidates and the steps.
+    alternatives : Alternatives
+        Explanations as good as the one found, and what separates them.
     search : dict
         What the search did: ``candidates``, ``steps_screened``,
         ``full_fits``, ``evaluations`` (model evaluations of all lines),
         ``budget``, ``time_limit_s``, ``seconds``, ``cut`` (the budget
         stopped part of it) and ``cut_at`` (where).
+    settings : DiagnoseSettings
+        The settings the diagnosis ran with.
     """
 
-    metric: str
-    baseline_error: float
-    noise_floor: float
-    explained: bool
-    missing_effect: str | None
-    missing_where: str | None
-    ambiguous_with: tuple[str, ...]
-    suggestion: str | None
-    candidates: tuple[Candidate, ...]
-    refinement: tuple[Step, ...]
-    band: tuple[float, float]
-    baseline: tuple[Comparison, ...] = attrs.field(eq=False)
-    final: tuple[Comparison, ...] = attrs.field(eq=False)
-    refined_assembly: Assembly = attrs.field(eq=False)
-    final_effects: tuple = attrs.field(default=(), eq=False)
-    consistency: object = attrs.field(default=None, eq=False)
-    ambiguous: tuple = attrs.field(default=(), eq=False)
-    separation: dict | None = attrs.field(default=None, eq=False)
-    report: tuple[str, ...] = ()
-    correlation: dict = attrs.field(factory=dict, eq=False)
-    final_error: float = float("nan")
-    rivals: tuple = attrs.field(default=(), eq=False)
+    verdict: Verdict
+    measures: Measures
+    changes: Changes
+    alternatives: Alternatives = attrs.field(factory=Alternatives)
     search: dict = attrs.field(factory=dict, eq=False)
+    settings: DiagnoseSettings = attrs.field(default=DEFAULT_SETTINGS, eq=False)
+
+    explained = _read("verdict", "explained")
+    report = _read("verdict", "report")
+    missing_effect = _read("verdict", "missing_effect")
+    missing_where = _read("verdict", "missing_where")
+    metric = _read("measures", "metric")
+    band = _read("measures", "band")
+    noise_floor = _read("measures", "noise_floor")
+    baseline_error = _read("measures", "baseline_error")
+    final_error = _read("measures", "final_error")
+    consistency = _read("measures", "consistency")
+    correlation = _read("measures", "correlation")
+    baseline = _read("measures", "baseline")
+    final = _read("measures", "final")
+    final_effects = _read("changes", "final_effects")
+    refined_assembly = _read("changes", "refined_assembly")
+    candidates = _read("changes", "candidates")
+    refinement = _read("changes", "refinement")
+    ambiguous = _read("alternatives", "ambiguous")
+    ambiguous_with = _read("alternatives", "ambiguous_with")
+    suggestion = _read("alternatives", "suggestion")
+    separation = _read("alternatives", "separation")
+    rivals = _read("alternatives", "rivals")
 
     @property
     def effects(self) -> list[Found]:
@@ -358,6 +469,7 @@ class Diagnosis:
                                     for f in r.founds], "separation": sep} for r, sep in self.rivals],
             "search": dict(self.search),
             "report": list(self.report),
+            "settings": self.settings.to_json(),
             "modes": [
                 {"measured_hz": m.measured_hz, "model_hz": m.model_hz, "shift_hz": m.shift_hz,
                  "amplitude_ratio": m.amplitude_ratio}

@@ -21,7 +21,9 @@ passes the significance test of :mod:`substructure.updating.selection`;
 the search stops when the model is consistent with the noise, when nothing
 passes, or after ``max_steps``.  Which candidates get full fits depends on
 each one's own screened improvement, never on a count, so a registered
-effect can only add a candidate, not push a built-in one out.
+effect can only add a candidate, not push a built-in one out.  The numbers
+(lines of the subsample, the share, the polish's budget) are fields of
+:class:`~substructure.diagnose.settings.DiagnoseSettings`.
 """
 
 from __future__ import annotations
@@ -43,13 +45,9 @@ from ..updating.structure import si_beam
 from ..updating.selection import INDIFFERENCE, bic, significance
 from .effects import EffectChange, effect_change
 from .scan import trials as _trials
+from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
-__all__ = ["Scored", "Budget", "candidates", "screen", "full_fits", "SCREEN_LINES", "SHORTLIST_SHARE"]
-
-SCREEN_LINES = 250
-"""Lines per FRF in the screening subsample (about)."""
-SHORTLIST_SHARE = 0.25
-"""A candidate gets a full fit when its screened improvement is at least this share of the best one."""
+__all__ = ["Scored", "Budget", "candidates", "screen", "full_fits"]
 
 
 class Budget:
@@ -125,7 +123,8 @@ def _plain(component) -> bool:
 
 
 def candidates(assembly, measured_points: Sequence[str], effects: dict, open_world: bool = True,
-               shift: float = 0.0, progress: Callable | None = None) -> list[Change]:
+               shift: float = 0.0, progress: Callable | None = None,
+               settings: DiagnoseSettings = DEFAULT_SETTINGS) -> list[Change]:
     """Every candidate change of a diagnosis (see the module docstring).
 
     Parameters
@@ -142,6 +141,8 @@ def candidates(assembly, measured_points: Sequence[str], effects: dict, open_wor
         Relative shift of the main mode (starting values of effects).
     progress : callable, optional
         Told about effects that cannot act at a place.
+    settings : DiagnoseSettings
+        The diagnosis's settings (``inertia_floor``).
 
     Returns
     -------
@@ -156,9 +157,9 @@ def candidates(assembly, measured_points: Sequence[str], effects: dict, open_wor
             if not isinstance(comp, Beam):  # bodies and springs sit along a beam, of any type
                 continue
             lo, hi, mass_max = body_bounds(assembly, comp)
-            # the largest rotary inertia: that mass at the radius of twice the widest section (at least 1e-3)
+            # the largest rotary inertia: that mass at the radius of twice the widest section (at least the floor)
             widest = max(float(s.od.m_as("m")) for s in comp.segments)
-            inertia_max = max(1e-3, mass_max * widest**2)
+            inertia_max = max(settings.inertia_floor, mass_max * widest**2)
             out.append(AddedMass(comp.name, comp.length_m, mass_max, (lo, hi), inertia_max))
             rear = rear_bounds(assembly, comp)
             if rear is not None:  # a spindle's rear end: a pulley, a rotary union
@@ -211,7 +212,8 @@ class Scored:
 
 
 def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2_now: float, n_full: int,
-           progress: Callable | None = None, extra: dict | None = None, cross: bool = False) -> list[Scored]:
+           progress: Callable | None = None, extra: dict | None = None, cross: bool = False,
+           settings: DiagnoseSettings = DEFAULT_SETTINGS) -> list[Scored]:
     """Screen candidates on a subsample: a scan with the changes already added held, then local fits.
 
     Every candidate's main parameter is scanned over its range (at each
@@ -240,13 +242,15 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
         More trials per candidate key (from :func:`substructure.diagnose.modes.mode_starts`).
     cross : bool
         Cross the sizes and positions of springs (:func:`substructure.diagnose.scan.trials`).
+    settings : DiagnoseSettings
+        The grids, the polish and the shortlist's numbers.
 
     Returns
     -------
     list of Scored
         The candidates that improve the model, best first (local fits first).
     """
-    basis = _basis(likelihood, current)
+    basis = _basis(likelihood, current, settings)
 
     def chi2_of(changes_now) -> float:
         w = likelihood.residual(changes_now)
@@ -260,7 +264,7 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
             progress(f"scanned {n}/{len(changes)} candidates")
         best_chi2, best = math.inf, None
         try:
-            for trial in _trials(change, first=cross) + list((extra or {}).get(change.key, ())):
+            for trial in _trials(change, first=cross, settings=settings) + list((extra or {}).get(change.key, ())):
                 chi2 = chi2_of(list(current) + [(change, trial)])
                 if chi2 < best_chi2:
                     best_chi2, best = chi2, trial
@@ -271,12 +275,13 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
         if best is not None and best_chi2 <= chi2_now * (1 + 1e-9):  # at its nominal value: the polish may still gain
             scanned.append(Scored(change, dict(best), float(best_chi2), start=list(current)))
     scanned.sort(key=lambda s: s.chi2)
-    scanned = [s for s in _polish(scanned, chi2_of, current) if s.chi2 < chi2_now]
+    scanned = [s for s in _polish(scanned, chi2_of, current, settings) if s.chi2 < chi2_now]
     local = []
     p_now = sum(len(c.specs) for c, _ in current)
-    for s in shortlist(scanned, chi2_now, likelihood.n, n_full, p_now):
+    for s in shortlist(scanned, chi2_now, likelihood.n, n_full, p_now, settings):
         try:
-            result = fit(likelihood, list(current) + [(s.change, s.values)], max_nfev=5 * (p_now + s.k + 1))
+            result = fit(likelihood, list(current) + [(s.change, s.values)],
+                         max_nfev=settings.short_fit_evaluations * (p_now + s.k + 1))
         except (SubstructureError, ValueError, FloatingPointError):
             continue
         if result.chi2 < s.chi2:
@@ -288,14 +293,7 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
     return [s for s in local + [s for s in scanned if s.change.key not in done] if s.chi2 < chi2_now]
 
 
-POLISH_POINTS = 3
-"""The refinement of the :data:`BRENT` best candidates evaluates points a third and two thirds of a grid step
-either side of the scan's best before Brent's (the others: the slope there, and Brent's down it)."""
-BRENT = 24
-"""Candidates (best scanned first) refined by points and Brent's; the others by their slope (see :func:`_polish`)."""
-
-
-def _polish(scanned: list, chi2_of, current) -> list:
+def _polish(scanned: list, chi2_of, current, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> list:
     """Every scanned candidate's main parameter refined around its best trial (on its fitted scale).
 
     A grid of nine values over decades misses minima narrower than its
@@ -303,24 +301,24 @@ def _polish(scanned: list, chi2_of, current) -> list:
     grid, and moves the modes by many bandwidths on the way), and a change
     smaller than a step scans no better than the model as it is.  So every
     candidate (those whose scan found nothing better too) is refined, the
-    other values held: the :data:`BRENT` best by evaluations at points
-    between their best trial and the grid's neighbours
-    (:data:`POLISH_POINTS`) and a bounded scalar minimisation (Brent's, at
-    most eight evaluations) around the best of those; the others by the
-    slope at their best trial and Brent's down it, when it descends.  The
-    order is then by the refined ``chi^2``.
+    other values held: the ``settings.brent_candidates`` best by evaluations
+    at points between their best trial and the grid's neighbours
+    (``settings.polish_points`` per step) and a bounded scalar minimisation
+    (Brent's, at most ``settings.brent_evaluations`` evaluations) around the
+    best of those; the others by the slope at their best trial and Brent's
+    down it, when it descends.  The order is then by the refined ``chi^2``.
     """
-    out = [_refined(s, chi2_of, current, thorough=k < BRENT) for k, s in enumerate(scanned)]
+    out = [_refined(s, chi2_of, current, k < settings.brent_candidates, settings) for k, s in enumerate(scanned)]
     out.sort(key=lambda x: x.chi2)
     return out
 
 
-def _refined(s: Scored, chi2_of, current, thorough: bool) -> Scored:
+def _refined(s: Scored, chi2_of, current, thorough: bool, settings: DiagnoseSettings) -> Scored:
     """One candidate of :func:`_polish` refined."""
     main = s.change.specs[0]
     u0 = to_u(main, s.values[main.name])
     lo_u, hi_u = to_u(main, main.lower), to_u(main, main.upper)
-    step = (hi_u - lo_u) / 8.0
+    step = (hi_u - lo_u) / float(settings.scan_values - 1)  # a step of the scan's grid
     lo, hi = max(lo_u, u0 - step), min(hi_u, u0 + step)
     if not hi > lo:
         return s
@@ -336,8 +334,9 @@ def _refined(s: Scored, chi2_of, current, thorough: bool) -> Scored:
     if thorough:
         # points between the scan's best and the grid's neighbours (scanned already) first: the landscape can
         # hold several minima where a model peak crosses the lines; Brent's around the best of them
-        sub = step / POLISH_POINTS
-        pts = [u for u in u0 + sub * np.arange(-POLISH_POINTS + 1, POLISH_POINTS) if lo < u < hi and u != u0]
+        sub = step / settings.polish_points
+        pts = [u for u in u0 + sub * np.arange(-settings.polish_points + 1, settings.polish_points)
+               if lo < u < hi and u != u0]
         costs = [cost(u) for u in pts]
         if costs and min(costs) < best_c:
             j = int(np.argmin(costs))
@@ -346,13 +345,14 @@ def _refined(s: Scored, chi2_of, current, thorough: bool) -> Scored:
     else:
         # the slope at the scan's best, then Brent's down it (a change smaller than a grid step scans no
         # better than the model, but the slope shows it)
-        tiny = step / 20.0
+        tiny = step / float(settings.slope_divisions)
         down = [(c, u) for c, u in ((cost(u), u) for u in (u0 - tiny, u0 + tiny) if lo <= u <= hi) if c < best_c]
         if down:
             best_c, best_u = min(down)
             bracket = (lo, u0) if best_u < u0 else (u0, hi)
     if bracket is not None and bracket[1] > bracket[0]:
-        r = minimize_scalar(cost, bounds=bracket, method="bounded", options={"maxiter": 8, "xatol": 1e-3})
+        r = minimize_scalar(cost, bounds=bracket, method="bounded",
+                            options={"maxiter": settings.brent_evaluations, "xatol": settings.brent_tolerance})
         if np.isfinite(r.fun) and r.fun < best_c:
             best_u, best_c = float(r.x), float(r.fun)
     if np.isfinite(best_c) and best_c < s.chi2:
@@ -360,7 +360,7 @@ def _refined(s: Scored, chi2_of, current, thorough: bool) -> Scored:
     return s
 
 
-def _basis(likelihood, current) -> np.ndarray | None:
+def _basis(likelihood, current, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> np.ndarray | None:
     """An orthonormal basis of the Jacobian of the changes already added (None without any)."""
     if not current:
         return None
@@ -369,7 +369,7 @@ def _basis(likelihood, current) -> np.ndarray | None:
     for i, (c, v) in enumerate(current):
         for spec in c.specs:
             u = to_u(spec, v[spec.name])
-            h = 1e-4 * max(1.0, abs(u))
+            h = settings.jacobian_step * max(1.0, abs(u))
             moved = [(x, dict(y)) for x, y in current]
             moved[i][1][spec.name] = from_u(spec, u + h)
             if moved[i][1][spec.name] == v[spec.name]:
@@ -380,18 +380,15 @@ def _basis(likelihood, current) -> np.ndarray | None:
     return q[:, keep]
 
 
-SHORTLIST_MAX = 6
-"""Most candidates of one kind (built-in, or registered by users) fitted further in one step."""
-
-
-def shortlist(scored: Sequence[Scored], chi2_now: float, n_lines: int, n_full: int, p_now: int) -> list[Scored]:
+def shortlist(scored: Sequence[Scored], chi2_now: float, n_lines: int, n_full: int, p_now: int,
+              settings: DiagnoseSettings = DEFAULT_SETTINGS) -> list[Scored]:
     """The screened candidates worth fitting further.
 
     A candidate qualifies when its improvement is at least
-    :data:`SHORTLIST_SHARE` of the best one and, less the ``k`` that fitting
-    its ``k`` parameters to noise gains and scaled to all lines, could pass
-    the significance test; of those, at most :data:`SHORTLIST_MAX` of
-    the built-in candidates and as many of users' registered effects (so
+    ``settings.shortlist_share`` of the best one and, less the ``k`` that
+    fitting its ``k`` parameters to noise gains and scaled to all lines, could
+    pass the significance test; of those, at most ``settings.shortlist_max``
+    of the built-in candidates and as many of users' registered effects (so
     that registering effects never pushes a built-in candidate out).
 
     Parameters
@@ -406,6 +403,8 @@ def shortlist(scored: Sequence[Scored], chi2_now: float, n_lines: int, n_full: i
         Residuals on all lines.
     p_now : int
         Parameters of the current model.
+    settings : DiagnoseSettings
+        ``shortlist_share``, ``shortlist_max`` and ``tie_chi2``.
 
     Returns
     -------
@@ -417,28 +416,28 @@ def shortlist(scored: Sequence[Scored], chi2_now: float, n_lines: int, n_full: i
     scale = n_full / max(n_lines, 1)
     gain = chi2_now - scored[0].chi2
     out, counts = [], {True: 0, False: 0}
-    for s in _ties_by_preference(scored):
+    for s in _ties_by_preference(scored, settings.tie_chi2):
         own = chi2_now - s.chi2
-        if own < SHORTLIST_SHARE * gain:
+        if own < settings.shortlist_share * gain:
             continue
         # scaled to all lines, less what fitting k parameters to noise gains on the subsample
         if not significance((chi2_now - s.k) * scale, s.chi2 * scale, s.k, n_full, p_now + s.k).significant:
             continue
         user = not _builtin(s.change)
-        if counts[user] >= SHORTLIST_MAX:
+        if counts[user] >= settings.shortlist_max:
             continue
         counts[user] += 1
         out.append(s)
     return out
 
 
-def _ties_by_preference(scored: Sequence[Scored]) -> list[Scored]:
-    """Best first; candidates that screened alike (within one unit of chi^2) in order of preference."""
+def _ties_by_preference(scored: Sequence[Scored], tie: float) -> list[Scored]:
+    """Best first; candidates that screened alike (within ``tie`` of chi^2) in order of preference."""
     ordered = sorted(scored, key=lambda s: s.chi2)
     out, i = [], 0
     while i < len(ordered):
         j = i + 1
-        while j < len(ordered) and ordered[j].chi2 - ordered[i].chi2 <= 1.0:
+        while j < len(ordered) and ordered[j].chi2 - ordered[i].chi2 <= tie:
             j += 1
         out += sorted(ordered[i:j], key=lambda s: (preference(s.change), s.chi2))
         i = j

@@ -320,9 +320,10 @@ def _params(parameters: Any) -> str:
     return "<br />".join(bits) or "–"
 
 
+# "settings" (every threshold and grid the diagnosis ran with) is there to reproduce it, not for the reader
 _SHOWN = {"metric", "baseline_error", "noise_floor", "missing_effect", "ambiguous_with", "candidates", "refinement",
           "missing_where", "suggestion", "band_hz", "final_error", "final_effects", "modes", "error_bands_hz",
-          "explained"}
+          "explained", "settings"}
 
 
 def _diagnosis(report: Any) -> str:

@@ -1,0 +1,472 @@
+"""The words of a diagnosis: every sentence it writes for a user, from numbers and names.
+
+The verdict's lines (``Diagnosis.report``), the text of a value on the bound
+of its search, the separating measurement, the signature of the modes and
+of a calibration error, and the command's summary are written here and only
+here; the modules that decide (:mod:`~substructure.diagnose.diagnosis`,
+:mod:`~substructure.diagnose.report`) hand over numbers and names.  Each
+function returns plain text (one line, or a list of lines); none computes
+anything a decision depends on.  Progress lines (``progress=True``) are not
+part of the result and stay beside the work they report.
+"""
+
+from __future__ import annotations
+
+from typing import Iterable, Sequence
+
+__all__ = [
+    "UNEXPLAINED", "values_text", "bound_text", "partial", "too_many_changes", "bounded", "on_bound",
+    "not_unique", "tell_apart", "budget_cut", "unexplained", "error_lives", "error_spread", "best_partial",
+    "nothing_improves", "mode_line", "signature_line", "level_line", "separation_text", "parameter_values",
+    "summary",
+]
+
+UNEXPLAINED = "unexplained: no candidate explains the data"
+"""How the first line of every unexplained verdict begins."""
+
+
+def values_text(change, values) -> str:
+    """``name = value unit, ...`` of a change's values, for reports.
+
+    Parameters
+    ----------
+    change : Change
+        The change (its ``specs`` give names and units).
+    values : dict
+        Its values (SI).
+
+    Returns
+    -------
+    str
+        The values, four significant digits each.
+    """
+    return ", ".join(f"{s.name} = {values[s.name]:.4g} {s.unit}".replace(" dimensionless", "") for s in change.specs)
+
+
+def bound_text(effect: str, where: str, name: str, value: float, unit: str, side: str, bound: float) -> str:
+    """One fitted value on the bound of its search, in words.
+
+    Parameters
+    ----------
+    effect, where : str
+        The change's effect and place.
+    name : str
+        The parameter.
+    value : float
+        Its value (SI, in ``unit``).
+    unit : str
+        Its unit.
+    side : str
+        ``"lower"`` or ``"upper"``.
+    bound : float
+        The bound (SI, in ``unit``).
+
+    Returns
+    -------
+    str
+        E.g. ``"joint-damping at holder-tool: c_yf = 240 N*s/m, the upper bound of its search (240 N*s/m)"``.
+    """
+    return f"{effect} at {where}: {name} = {value:.4g} {unit}, the {side} bound of its search ({bound:.4g} {unit})"
+
+
+def partial(kind: str, effects: Iterable) -> str:
+    """The note that an explanation the verdict does not claim is reported as partial.
+
+    Parameters
+    ----------
+    kind : str
+        Why it is not claimed: ``"composite"``, ``"bounded"``, ``"ambiguous"``.
+    effects : iterable of Found
+        Its changes (written by their ``repr``).
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    return f"the best ({kind}) explanation is reported as partial: " + ", ".join(repr(e) for e in effects)
+
+
+def too_many_changes(most: int, places: Sequence[str]) -> str:
+    """The verdict when the noise is reached only with more changes than an explanation may hold.
+
+    Parameters
+    ----------
+    most : int
+        Most changes an explanation may hold (``DiagnoseSettings.most_changes``).
+    places : sequence of str
+        ``"effect at place"`` of each change.
+
+    Returns
+    -------
+    str
+        The verdict's first line.
+    """
+    return (f"{UNEXPLAINED} with at most {most} changes; {len(places)} together reach the noise "
+            f"({', '.join(places)}): several changes that each buy a small improvement are the mark of one effect "
+            "the search lacks, not of several effects")
+
+
+def bounded(hits: Sequence[str]) -> str:
+    """The verdict when the explanation holds a value on the bound of its search.
+
+    Parameters
+    ----------
+    hits : sequence of str
+        Each value on its bound (:func:`bound_text`).
+
+    Returns
+    -------
+    str
+        The verdict's first line.
+    """
+    return (f"{UNEXPLAINED} within the bounds of its search: {'; '.join(hits)}; a value on its bound is not a "
+            "measurement (the data ask for more than the change allows: the mark of another effect, missing)")
+
+
+def on_bound(hits: Sequence[str]) -> str:
+    """The note, in an unexplained verdict, of values on the bounds of their search.
+
+    Parameters
+    ----------
+    hits : sequence of str
+        Each value on its bound (:func:`bound_text`).
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    return f"on the bound of its search (not a measurement): {'; '.join(hits)}"
+
+
+def not_unique(kept_name: str, kept_where: str, rival_name: str, rival_where: str, indifference: float,
+               same_change_values: Sequence[str] | None) -> str:
+    """The verdict when two explanations that are different structures fit alike.
+
+    Parameters
+    ----------
+    kept_name, kept_where : str
+        The explanation the search kept.
+    rival_name, rival_where : str
+        Its rival.
+    indifference : float
+        The BIC difference within which the data do not decide.
+    same_change_values : sequence of str or None
+        When the rival is the same change at other values, those values
+        (:func:`values_text` per change); None when it changes other parts.
+
+    Returns
+    -------
+    str
+        The verdict's first line.
+    """
+    how = ("are the same change at other values (" + "; ".join(same_change_values) + ")"
+           if same_change_values is not None else "change different parts")
+    return (f"{UNEXPLAINED} uniquely: {kept_name} at {kept_where} and {rival_name} at {rival_where} both leave a "
+            f"residual consistent with the noise (their BIC differ by at most {indifference:g}) but {how}")
+
+
+def tell_apart(text: str) -> str:
+    """The line naming the measurement that separates two explanations.
+
+    Parameters
+    ----------
+    text : str
+        The measurement (:func:`separation_text`).
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    return f"to tell them apart: {text}"
+
+
+def budget_cut(where: str) -> str:
+    """The note that the search's budget cut it short.
+
+    Parameters
+    ----------
+    where : str
+        Where it was cut.
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    return f"the search was cut by its budget ({where}); a larger budget (--budget, --time-limit) may find more"
+
+
+def unexplained(final_error: float, floor: float, chi2_reduced: float, threshold: float) -> str:
+    """The first line of the verdict when no candidate reaches the noise.
+
+    Parameters
+    ----------
+    final_error : float
+        The best model's error (``rms_log_ratio``).
+    floor : float
+        The noise floor.
+    chi2_reduced : float
+        Its ``chi^2 / nu``.
+    threshold : float
+        What the noise allows.
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    return (f"{UNEXPLAINED}; the best model found leaves an error of {final_error:.4g}, {final_error / floor:.2g} "
+            f"times the noise floor ({floor:.4g}); chi^2/nu = {chi2_reduced:.4g} where the noise allows "
+            f"{threshold:.4g}")
+
+
+def error_lives(bands: Sequence[tuple[str, float, float, float]]) -> str:
+    """Where the remaining error lives.
+
+    Parameters
+    ----------
+    bands : sequence of (label, lo, hi, share)
+        FRF label, band edges [Hz] and share of the error, largest first.
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    return "the remaining error lives in: " + "; ".join(f"{lab} {lo:.0f}-{hi:.0f} Hz ({share:.0%})"
+                                                        for lab, lo, hi, share in bands)
+
+
+def error_spread() -> str:
+    """The line when no band of lines stands out.
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    return "the remaining error is spread over the band (no single band stands out)"
+
+
+def best_partial(parts: Sequence[tuple[str, str, str]]) -> str:
+    """The best partial explanation of an unexplained verdict.
+
+    Parameters
+    ----------
+    parts : sequence of (effect, place, values)
+        Each change with its values (:func:`values_text`).
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    return "best partial explanation (partial): " + "; ".join(f"{e} at {p} ({v})" for e, p, v in parts)
+
+
+def nothing_improves() -> str:
+    """The line when no candidate improves the model significantly.
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    return "no candidate improves the model significantly"
+
+
+def mode_line(model_hz: float, strain: str, motion: str, relative: float | None, in_place_lines: int = 2) -> str:
+    """One mode of the model against the measurement.
+
+    Parameters
+    ----------
+    model_hz : float
+        The model's mode [Hz].
+    strain, motion : str
+        Where its strain and its motion mostly are.
+    relative : float or None
+        ``ln(f_measured / f_model)``; None when the mode is in place.
+    in_place_lines : int
+        Within how many lines a mode is in place.
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    lines = "two" if in_place_lines == 2 else str(in_place_lines)
+    state = f"within {lines} lines" if relative is None else \
+        f"{abs(relative):.1%} {'lower' if relative < 0 else 'higher'} in the measurement"
+    return f"mode at {model_hz:.0f} Hz in the model (strain mostly in the {strain}, motion mostly in the {motion}): " \
+           f"{state}"
+
+
+def signature_line(lower: Sequence[float], higher: Sequence[float], text: str, kind: str, factor: float,
+                   share: float) -> str:
+    """The signature: which change would move the modes as measured.
+
+    Parameters
+    ----------
+    lower, higher : sequence of float
+        The model's modes [Hz] lower, higher in the measurement.
+    text : str
+        The knob (``"the stiffness of the tool"``).
+    kind : str
+        ``"stiffness"`` or ``"mass"``.
+    factor : float
+        The least-squares amplitude ``a`` of the knob's pattern (its sign says which way).
+    share : float
+        Share of the mode shifts it accounts for.
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    if kind == "stiffness":
+        what = f"{text} {'lower' if factor < 0 else 'higher'} than the model"
+        alt = " (or mass added where that part moves)" if factor < 0 else ""
+    else:
+        what = f"{text} {'higher' if factor > 0 else 'lower'} than the model"
+        alt = f" (or softness near the {text.replace('the mass of the ', '')})" if factor > 0 else ""
+    low = [f"{f:.0f} Hz" for f in lower]
+    high = [f"{f:.0f} Hz" for f in higher]
+    pattern = "; ".join(x for x in (f"lower in the measurement: {', '.join(low)}" if low else "",
+                                    f"higher: {', '.join(high)}" if high else "") if x)
+    return f"signature: {pattern}; this pattern matches {what}{alt}, which accounts for {share:.0%} of the mode shifts"
+
+
+def level_line(factors: Sequence[tuple[str, str, float]]) -> str:
+    """The signature of a calibration or unit error.
+
+    Parameters
+    ----------
+    factors : sequence of (response, excitation, factor)
+        Per FRF, the factor of the measurement over the model.
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    text = "; ".join(f"{o} / {i}: {x:.3g} times" for o, i, x in factors)
+    return (f"signature: the measurement is a constant factor times the model over the whole band with every mode "
+            f"in place ({text}): a calibration or unit error (the hammer's or the sensor's sensitivity, g taken "
+            f"for m/s^2) scales an FRF like this, while a change of the structure would have to scale every mass "
+            f"and stiffness alike; check the calibration before the model")
+
+
+def separation_text(a_name: str, a_where: str, b_name: str, b_where: str, value: float, indifference: float,
+                    response: str, excitation: str, non_contact: bool) -> str:
+    """The measurement that tells two explanations apart, or that none does.
+
+    Parameters
+    ----------
+    a_name, a_where, b_name, b_where : str
+        The two explanations.
+    value : float
+        ``chi^2`` of their difference at the best measurement.
+    indifference : float
+        Above this the measurement tells them apart.
+    response, excitation : str
+        The best measurement's points.
+    non_contact : bool
+        With a non-contact sensor.
+
+    Returns
+    -------
+    str
+        One sentence.
+    """
+    if value <= indifference:
+        return (f"no measurement at the ends, quarter points and middles of the components tells {a_name} at "
+                f"{a_where} from {b_name} at {b_where}: they are equivalent descriptions of these data")
+    kind = "point FRF" if response == excitation else "cross FRF"
+    how = " with a non-contact sensor (laser vibrometer)" if non_contact else ""
+    return (f"measure the {kind} {response} / {excitation}{how}: {a_name} at {a_where} and {b_name} at {b_where} "
+            f"differ there by chi^2 = {value:.3g} over the band (above {indifference:g} tells them apart)")
+
+
+def parameter_values(found) -> str:
+    """A found change's values with their standard deviations and the model's values, for the summary.
+
+    Parameters
+    ----------
+    found : Found
+        The change with its values.
+
+    Returns
+    -------
+    str
+        ``name = value +- std unit (model: nominal), ...``.
+    """
+    parts = []
+    for name, spec in found.parameters_json().items():
+        unit = "" if spec["unit"] == "dimensionless" else f" {spec['unit']}"
+        std = f" +- {spec['std']:.2g}" if spec.get("std") is not None else ""
+        nominal = f" (model: {spec['nominal']:.4g})" if spec.get("nominal") is not None else ""
+        parts.append(f"{name} = {spec['value']:.4g}{std}{unit}{nominal}")
+    return ", ".join(parts)
+
+
+def summary(result, model_name: str, measured: int) -> list[str]:
+    """The summary ``substructure diagnose`` prints: the verdict first when unexplained, then the numbers.
+
+    Parameters
+    ----------
+    result : Diagnosis
+        The diagnosis.
+    model_name : str
+        The assembly's name.
+    measured : int
+        Number of measured FRFs.
+
+    Returns
+    -------
+    list of str
+        The lines.
+    """
+    floor = result.noise_floor
+    lines = []
+    if not result.explained:
+        lines += list(result.report)
+    lines.append(f"model {model_name!r} against {measured} measured FRF(s), "
+                 f"{result.band[0]:.0f}-{result.band[1]:.0f} Hz")
+    lines.append(f"error ({result.metric}): {result.baseline_error:.4f}; noise floor of the data: {floor:.4f}")
+    base = result.baseline[0]
+    for m in [m for m in base.modes if m.model_hz is not None][:12]:
+        lines.append(f"  mode at {m.measured_hz:7.0f} Hz measured, {m.model_hz:7.0f} Hz in the model "
+                     f"({m.shift_hz:+.0f} Hz), peak x{m.amplitude_ratio:.2f}")
+    if base.bands:
+        lines.append("  most of the error is in " + ", ".join(f"{lo:.0f}-{hi:.0f} Hz ({share:.0%})"
+                                                           for lo, hi, share in base.bands))
+    if result.missing_effect is None:
+        if result.explained:
+            lines.append("the model is as good as the data allow: nothing is missing")
+        else:
+            lines.append("no candidate explains the difference significantly")
+    else:
+        label = "missing effect" if result.explained else "best partial explanation (partial)"
+        for i, e in enumerate(result.effects):
+            lines.append(f"{label if i == 0 else 'and'}: {e.name} at {e.where}")
+            lines.append(f"  {parameter_values(e)}")
+            lines.append(f"  why: {e.explanation}")
+        if result.ambiguous:
+            alts = "; ".join(f"{a.name} at {a.where} ({parameter_values(a)})" for a, _ in result.ambiguous[:3])
+            lines.append(f"  equally possible: {alts}")
+            if result.suggestion:
+                lines.append(f"  to tell them apart: {result.suggestion}")
+    if len(result.refinement) > 1:
+        lines.append("refinement (watch the error fall):")
+        for step in result.refinement:
+            what = "model as given" if step.added is None else f"+ {step.added.name} at {step.added.where}"
+            lines.append(f"  step {step.step}: {what:50s} error {step.error:.4f}  chi^2/nu {step.chi2_reduced:.4g}")
+    cons = result.consistency
+    verdict = "explained" if result.explained else "not explained"
+    lines.append(f"verdict: {verdict}: final error {result.final_error:.4f} ({result.final_error / floor:.2f} x the "
+                 f"noise floor), chi^2/nu = {cons.chi2_reduced:.4g} (consistent with the noise up to "
+                 f"{cons.threshold:.4g})")
+    return lines
