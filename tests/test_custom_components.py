@@ -180,7 +180,7 @@ def test_a_lumped_chuck_through_every_command(tmp_path, registered, capsys):
     model, truth = _lumped_model(), _lumped_model(nose_mass=0.55)
     save_assembly(model, tmp_path / "model.toml")
     save_assembly(truth, tmp_path / "truth.toml")
-    grid = Frequency.from_range("20 Hz", "5000 Hz", "4 Hz")
+    grid = Frequency.from_range("20 Hz", "5000 Hz", "10 Hz")
     data = simulate(truth, ["tool.tip", "tool.tip-20 mm"], frequency=grid, noise=0.01, seed=3)
     taps = write_measurement_set(data, tmp_path / "taps")
     out = tmp_path / "out"

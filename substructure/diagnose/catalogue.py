@@ -15,7 +15,6 @@ written here.
 
 from __future__ import annotations
 
-import warnings
 from typing import ClassVar
 
 import attrs
@@ -24,11 +23,12 @@ import numpy as np
 from ..assembly import Assembly
 from ..beams import Flutes
 from ..components import Beam, Tool
-from ..errors import InvalidValueError, NonPassiveJointWarning, UnknownPointError
+from ..errors import InvalidValueError, UnknownPointError
 from ..joints import Joint, Sensor, Support
 from ..points import parse_point
 from ..units import format_quantity, ureg
 from ..updating.elements import split_beam, split_segments
+from ..updating.paths import apply_path_si, set_parameters
 from ..updating.structure import LinkSI
 from .effects import Effect, Parameter, register_effect
 
@@ -38,12 +38,6 @@ PASSIVE_SHARE = 0.999
 """A joint's cross terms are searched up to this share of their passivity bound (``k_ym^2 < k_yf k_tm``), so that
 every value of the search is a passive joint.  A bound of the effect's parameters, as the ranges of the catalogue
 are, not a setting of the diagnosis."""
-
-
-def _quiet_joint(joint: Joint, **kw) -> Joint:
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", NonPassiveJointWarning)
-        return joint.with_parameters(**kw)
 
 
 def _elastic_joints(assembly: Assembly) -> list[str]:
@@ -144,31 +138,20 @@ class _JointEffect(Effect):
             out[p.name] = float(np.clip(nominal if nominal > 0 else p.start, p.lower, p.upper))
         return out
 
+    def _paths(self) -> dict:
+        """The values as parameter paths of the joint (``k_ym`` sets ``k.ym`` and ``k.tf``: one number)."""
+        return {f"joints.{self.where}.{name[0]}.{name.split('_', 1)[1]}": value for name, value in self.values.items()}
+
     def apply(self, assembly):
-        joint = assembly.joint(self.where)
-        k, c = {}, {}
-        for name, value in self.values.items():
-            kind, entry = name.split("_", 1)
-            target, units = (k, {"yf": "N/m", "tm": "N*m/rad", "ym": "N"}) if kind == "k" else (
-                c, {"yf": "N*s/m", "tm": "N*m*s/rad", "ym": "N*s"})
-            for e in (("ym", "tf") if entry == "ym" else (entry,)):
-                unit = units[entry] if e != "tf" else ("N/rad" if kind == "k" else "N*s/rad")
-                target[e] = _si(value, unit)
-        return assembly.with_joint(_quiet_joint(joint, k=k, c=c))
+        return set_parameters(assembly, self._paths())
 
     def apply_si(self, structure):
-        i, link = structure.link(("joints", self.where))
+        _, link = structure.link(("joints", self.where))
         if link.rigid or link.custom is not None:
             raise UnknownPointError(f"joint {self.where!r} has no stiffness matrix here")
-        K, C = link.K.copy(), link.C.copy()
-        for name, value in self.values.items():
-            kind, entry = name.split("_", 1)
-            m = K if kind == "k" else C
-            if entry == "ym":
-                m[0, 1] = m[1, 0] = value
-            else:
-                m[(0, 1)[entry == "tm"], (0, 1)[entry == "tm"]] = value
-        return structure.with_link(i, link.evolve(K=K, C=C))
+        for path, value in self._paths().items():
+            structure = apply_path_si(structure, path, float(value))
+        return structure
 
 
 @register_effect

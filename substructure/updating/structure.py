@@ -473,7 +473,7 @@ class Structure:
         Parameters
         ----------
         component : object
-            The new component (a changed copy of one in :attr:`opaque`).
+            The new component (a changed copy of one in ``opaque``).
 
         Returns
         -------
