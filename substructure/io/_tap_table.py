@@ -1,0 +1,167 @@
+"""The numeric table of a text tap record: the fast parse of its rows, with the line and column of any bad cell.
+
+A block of rows (bytes, one sample per line, ``ncols`` cells split by one
+separator, or by runs of whitespace) is parsed in pieces of about
+:data:`CHUNK_BYTES` by ``numpy.fromstring`` after structural checks that
+are whole-array operations (the separators and the numbers on each line, no
+cell holding two numbers).  A piece that fails a check is read again line by
+line in Python, which names the first bad line and cell; a piece that
+passes is exactly what the line-by-line reading would give.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+
+import numpy as np
+
+from ..errors import FileFormatError
+
+CHUNK_BYTES = 8 * 2**20
+"""Bytes of rows parsed at once (the working arrays stay a few times this size)."""
+
+_WS = np.array([32, 9, 13], dtype=np.uint8)
+
+
+def split_cells(line: str, sep: str | None) -> list[str]:
+    """The cells of one line: split at ``sep``, or at runs of whitespace for ``None``."""
+    return line.split() if sep is None else line.split(sep)
+
+
+def _slow(text: str, first_line: int, ncols: int, sep: str | None, decimal_comma: bool, labels: list[str],
+          name: str) -> np.ndarray:
+    """Rows read line by line; raises at the first line or cell that is not a row of ``ncols`` numbers."""
+    rows = []
+    for k, line in enumerate(text.split("\n")):
+        stripped = line.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        cells = split_cells(line.rstrip("\r"), sep)
+        if sep is not None and len(cells) == ncols + 1 and not cells[-1].strip():
+            cells = cells[:-1]  # a separator at the end of every row, as some exports write
+        if len(cells) != ncols:
+            raise FileFormatError(f"{name}, line {first_line + k}: {len(cells)} value(s); expected {ncols} "
+                                  f"({', '.join(labels)})")
+        values = []
+        for label, cell in zip(labels, cells):
+            text_cell = cell.replace(",", ".") if decimal_comma else cell
+            try:
+                values.append(float(text_cell))
+            except ValueError:
+                raise FileFormatError(f"{name}, line {first_line + k}: column {label!r} is {cell.strip()!r}; "
+                                      "expected a number") from None
+        rows.append(values)
+    return np.array(rows, dtype=np.float64).reshape(-1, ncols)
+
+
+def _fast(chunk: bytes, ncols: int, sep: str | None, decimal_comma: bool) -> np.ndarray | None:
+    """The rows of ``chunk`` (ending with a newline) by whole-array checks and ``numpy.fromstring``, or None."""
+    b = np.frombuffer(chunk, dtype=np.uint8)
+    if b.size == 0 or (b >= 128).any():
+        return None
+    newlines = np.flatnonzero(b == 10)
+    lines = newlines.size
+    sep_byte = None if sep is None else ord(sep)
+    trailing = False
+    if sep is not None and sep_byte is not None:
+        where = np.flatnonzero(b == sep_byte)
+        per_line = np.bincount(np.searchsorted(newlines, where), minlength=lines)[:lines]
+        if not (per_line == ncols - 1).all():
+            last = newlines - 1
+            last = np.where((last >= 0) & (b[np.maximum(last, 0)] == 13), last - 1, last)
+            trailing = bool((per_line == ncols).all() and (last >= 0).all() and (b[last] == sep_byte).all())
+            if not trailing:
+                return None
+        # a cell with two numbers in it ('1 2') could hide an empty cell elsewhere on its line
+        inner = rb"[^\s%s][ \t]+[^\s%s]" if sep != "\t" else rb"[^\s%s][ ]+[^\s%s]"
+        if re.search(inner % (re.escape(sep.encode()), re.escape(sep.encode())), chunk):
+            return None
+        body = chunk.replace(sep.encode(), b" ")
+    else:
+        body = chunk
+    if decimal_comma:
+        body = body.replace(b",", b".")
+    # the numbers on each line: starts of runs of non-blank bytes
+    blank = np.isin(np.frombuffer(body, dtype=np.uint8), _WS) | (np.frombuffer(body, dtype=np.uint8) == 10)
+    starts = np.flatnonzero(~blank & np.concatenate(([True], blank[:-1])))
+    tokens = np.bincount(np.searchsorted(newlines, starts), minlength=lines)[:lines]
+    if not (tokens == ncols).all():
+        return None
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        try:
+            values = np.fromstring(body, dtype=np.float64, sep=" ")  # text mode, not deprecated
+        except (ValueError, DeprecationWarning):
+            return None
+    if values.size != lines * ncols:
+        return None
+    return values.reshape(lines, ncols)
+
+
+def parse_rows(data: bytes, first_line: int, ncols: int, sep: str | None, decimal_comma: bool,
+               labels: list[str], name: str) -> np.ndarray:
+    """The numbers of a block of rows, shape ``(rows, ncols)``.
+
+    Parameters
+    ----------
+    data : bytes
+        The rows, from the start of a line.
+    first_line : int
+        The file's line number (1-based) of the first row, for messages.
+    ncols : int
+        Cells per row.
+    sep : str or None
+        The separator (one character), or None for runs of whitespace.
+    decimal_comma : bool
+        Whether cells write ``0,5`` for 0.5 (never with ``sep=","``).
+    labels : list of str
+        The columns' names, for messages.
+    name : str
+        The file, for messages.
+
+    Returns
+    -------
+    numpy.ndarray
+        The table; blank lines and ``#`` lines are skipped.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the line (and the column): a row of another length, a cell
+        that is not a number.
+    """
+    data = data.rstrip()
+    if not data:
+        return np.empty((0, ncols))
+    data += b"\n"
+    pieces, start, line = [], 0, first_line
+    while start < len(data):
+        end = data.find(b"\n", min(start + CHUNK_BYTES, len(data) - 1)) + 1
+        chunk = data[start:end]
+        table = _fast(chunk, ncols, sep, decimal_comma)
+        if table is None:
+            table = _slow(chunk.decode("utf-8", errors="replace"), line, ncols, sep, decimal_comma, labels, name)
+        pieces.append(table)
+        line += chunk.count(b"\n")
+        start = end
+    return pieces[0] if len(pieces) == 1 else np.concatenate(pieces)
+
+
+def finite_rows(table: np.ndarray, first_line: int, labels: list[str], name: str, data: bytes) -> None:
+    """Raise naming the line and column of the first NaN or infinite cell of ``table`` (rows of ``data``)."""
+    bad = ~np.isfinite(table)
+    if not bad.any():
+        return
+    row, column = np.argwhere(bad)[0]
+    # the line of that row: rows are the lines of data that are neither blank nor comments
+    line, seen = first_line, -1
+    for k, text in enumerate(data.split(b"\n")):
+        stripped = text.strip()
+        if stripped and not stripped.startswith(b"#"):
+            seen += 1
+            if seen == row:
+                line = first_line + k
+                break
+    raise FileFormatError(f"{name}, line {line}: column {labels[column]!r} is {table[row, column]}; "
+                          "expected a finite number (a gap in the acquisition?)")
