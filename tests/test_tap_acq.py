@@ -383,3 +383,16 @@ def test_the_command_reads_every_layout_to_the_same_frf(tmp_path, capsys):
     assert code == 2 and "--force-column applies to columns of a text record" in err
     code, _, err = run(capsys, "tap", export, "--force-record", "1")
     assert code == 2 and "use --force-column and --response-column" in err
+
+
+def test_times_written_with_few_digits_are_the_uniform_clock_and_a_lost_sample_is_refused(tmp_path):
+    n, fs = 4096, 51200.0
+    t, f, a = np.arange(n) / fs, np.ones(n), np.zeros(n)
+    path = tmp_path / "six.csv"  # six decimals, as LabVIEW and many exports write: steps of 1.9e-5 and 2.0e-5 s
+    path.write_text("time [s],force [N],acceleration [g]\n" + rows([t, f, a], fmt="{:.6f}"))
+    record = read_tap_csv(path)
+    assert record.sample_rate == pytest.approx(fs, rel=1e-6) and np.allclose(record.time, t, rtol=0, atol=1e-8)
+    lost = np.delete(t, 2000)  # one sample lost: the clock jumps a whole step
+    path.write_text("time [s],force [N],acceleration [g]\n" + rows([lost, f[1:], a[1:]], fmt="{:.6f}"))
+    with pytest.raises(FileFormatError, match=r"six.csv: column 'time', sample 2000: step"):
+        read_tap_csv(path)

@@ -21,9 +21,6 @@ from ..errors import FileFormatError
 CHUNK_BYTES = 8 * 2**20
 """Bytes of rows parsed at once (the working arrays stay a few times this size)."""
 
-_WS = np.array([32, 9, 13], dtype=np.uint8)
-
-
 def split_cells(line: str, sep: str | None) -> list[str]:
     """The cells of one line: split at ``sep``, or at runs of whitespace for ``None``."""
     return line.split() if sep is None else line.split(sep)
@@ -58,7 +55,7 @@ def _slow(text: str, first_line: int, ncols: int, sep: str | None, decimal_comma
 def _fast(chunk: bytes, ncols: int, sep: str | None, decimal_comma: bool) -> np.ndarray | None:
     """The rows of ``chunk`` (ending with a newline) by whole-array checks and ``numpy.fromstring``, or None."""
     b = np.frombuffer(chunk, dtype=np.uint8)
-    if b.size == 0 or (b >= 128).any():
+    if b.size == 0 or not chunk.isascii():
         return None
     newlines = np.flatnonzero(b == 10)
     lines = newlines.size
@@ -73,21 +70,25 @@ def _fast(chunk: bytes, ncols: int, sep: str | None, decimal_comma: bool) -> np.
             trailing = bool((per_line == ncols).all() and (last >= 0).all() and (b[last] == sep_byte).all())
             if not trailing:
                 return None
-        # a cell with two numbers in it ('1 2') could hide an empty cell elsewhere on its line
-        inner = rb"[^\s%s][ \t]+[^\s%s]" if sep != "\t" else rb"[^\s%s][ ]+[^\s%s]"
-        if re.search(inner % (re.escape(sep.encode()), re.escape(sep.encode())), chunk):
-            return None
-        body = chunk.replace(sep.encode(), b" ")
+        s = sep.encode()
+        if b" " not in chunk and (sep == "\t" or b"\t" not in chunk):
+            # no blanks: a cell is empty only between two separators or at a line's ends
+            if s + s in chunk or b"\n" + s in chunk or chunk.startswith(s) or (
+                    not trailing and (s + b"\n" in chunk or s + b"\r" in chunk)):
+                return None
+            body = chunk.replace(s, b" ")
+        else:
+            if _blank_inside_a_cell(b, sep_byte):  # '1 2' would hide an empty cell elsewhere on its line
+                return None
+            body = chunk.replace(s, b" ")
+            if not _numbers_per_line(body, newlines, ncols):
+                return None
     else:
         body = chunk
+        if not _numbers_per_line(body, newlines, ncols):
+            return None
     if decimal_comma:
         body = body.replace(b",", b".")
-    # the numbers on each line: starts of runs of non-blank bytes
-    blank = np.isin(np.frombuffer(body, dtype=np.uint8), _WS) | (np.frombuffer(body, dtype=np.uint8) == 10)
-    starts = np.flatnonzero(~blank & np.concatenate(([True], blank[:-1])))
-    tokens = np.bincount(np.searchsorted(newlines, starts), minlength=lines)[:lines]
-    if not (tokens == ncols).all():
-        return None
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         try:
@@ -97,6 +98,32 @@ def _fast(chunk: bytes, ncols: int, sep: str | None, decimal_comma: bool) -> np.
     if values.size != lines * ncols:
         return None
     return values.reshape(lines, ncols)
+
+
+def _blank_inside_a_cell(b: np.ndarray, sep_byte: int) -> bool:
+    """Whether a run of blanks stands between two characters of one cell (not next to a separator or line end)."""
+    blank = (b == 32) | ((b == 9) & (sep_byte != 9))
+    where = np.flatnonzero(blank)
+    if not where.size:
+        return False
+    starts = where[(where == 0) | ~blank[np.maximum(where - 1, 0)]]
+    ends = where[(where == b.size - 1) | ~blank[np.minimum(where + 1, b.size - 1)]]
+    before = np.where(starts > 0, b[np.maximum(starts - 1, 0)], 10)
+    after = np.where(ends < b.size - 1, b[np.minimum(ends + 1, b.size - 1)], 10)
+
+    def edge(c):
+        return (c == sep_byte) | (c == 10) | (c == 13)
+
+    return bool((~edge(before) & ~edge(after)).any())
+
+
+def _numbers_per_line(body: bytes, newlines: np.ndarray, ncols: int) -> bool:
+    """Whether every line of ``body`` holds ``ncols`` runs of non-blank bytes."""
+    x = np.frombuffer(body, dtype=np.uint8)
+    blank = (x == 32) | (x == 9) | (x == 13) | (x == 10)
+    starts = np.flatnonzero(~blank & np.concatenate(([True], blank[:-1])))
+    tokens = np.bincount(np.searchsorted(newlines, starts), minlength=newlines.size)[:newlines.size]
+    return bool((tokens == ncols).all())
 
 
 def parse_rows(data: bytes, first_line: int, ncols: int, sep: str | None, decimal_comma: bool,

@@ -143,7 +143,7 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
     used = [k for k in (t_col, f_col, r_col) if k is not None]
     finite_rows(table[:, used], first_line, [labels[k] for k in used], name, block)
     if t_col is not None:
-        time_s = table[:, t_col] * (1.0 * parsed[t_col]).m_as("s")
+        time_s = _regular(table[:, t_col] * (1.0 * parsed[t_col]).m_as("s"))
         if rate is not None and time_s.size > 1 and time_s[-1] > time_s[0]:
             from_time = (time_s.size - 1) / (time_s[-1] - time_s[0])
             if abs(from_time - rate[0]) > TIME_STEP_TOLERANCE * rate[0]:
@@ -154,6 +154,32 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
         time_s = np.arange(table.shape[0]) / rate[0]
     return _record(name, time_s, table[:, f_col], parsed[f_col], labels[f_col], table[:, r_col], parsed[r_col],
                    labels[r_col], sensitivity, hammer_sensitivity, quantity)
+
+
+ROUNDED_TIME_TOLERANCE = 0.25
+"""Largest distance, in time steps, of a written time from the uniform grid fitted to them all
+(times written with few digits, e.g. six decimals at 51.2 kHz); farther (a lost or repeated sample) is refused."""
+
+
+def _regular(time_s: np.ndarray) -> np.ndarray:
+    """The uniform grid fitted to the times when every time lies within a quarter step of it.
+
+    Times rounded to the digits a file writes (0.000020 for 1.953125e-05 s)
+    make uneven steps of a uniform clock; the grid is what was sampled.  A
+    time farther from the grid is left as written, for the record's own
+    check to refuse.
+    """
+    n = time_s.size
+    if n < 3 or not time_s[-1] > time_s[0]:
+        return time_s
+    k = np.arange(n, dtype=np.float64)
+    step = float(np.dot(k - k.mean(), time_s - time_s.mean()) / np.dot(k - k.mean(), k - k.mean()))
+    grid = (time_s.mean() - step * k.mean()) + k * step  # the least-squares line: the rounding averages out
+    if not step > 0:
+        return time_s
+    if np.max(np.abs(time_s - grid)) <= ROUNDED_TIME_TOLERANCE * step:
+        return grid
+    return time_s
 
 
 def _head(data: bytes, name: str) -> tuple[list[tuple[int, str]], int, int]:
