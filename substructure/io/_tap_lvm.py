@@ -110,8 +110,8 @@ def read_segments(data: bytes, name: str) -> list[Segment]:
         x_cols = [j for j, n in enumerate(names) if n == "X_Value"]
         if x_columns == "No" and x_cols:
             raise FileFormatError(f"{where}: an X_Value column where the file header says X_Columns No")
-        table = parse_rows(data[body_start:body_end], data.count(b"\n", 0, body_start) + 1, len(names), sep,
-                           decimal_comma, names, name)
+        table = parse_rows(data, data.count(b"\n", 0, body_start) + 1, len(names), sep, decimal_comma, names, name,
+                           body_start, body_end)
         steps = tags.get("Delta_X")
         if not steps:
             raise FileFormatError(f"{where}: no Delta_X; expected the time step of the channels")

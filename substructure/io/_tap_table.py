@@ -127,13 +127,14 @@ def _numbers_per_line(body: bytes, newlines: np.ndarray, ncols: int) -> bool:
 
 
 def parse_rows(data: bytes, first_line: int, ncols: int, sep: str | None, decimal_comma: bool,
-               labels: list[str], name: str) -> np.ndarray:
+               labels: list[str], name: str, start: int = 0, end: int | None = None) -> np.ndarray:
     """The numbers of a block of rows, shape ``(rows, ncols)``.
 
     Parameters
     ----------
     data : bytes
-        The rows, from the start of a line.
+        The file's bytes; the rows are ``data[start:end]``, from the start of
+        a line (only pieces of :data:`CHUNK_BYTES` are copied).
     first_line : int
         The file's line number (1-based) of the first row, for messages.
     ncols : int
@@ -146,6 +147,8 @@ def parse_rows(data: bytes, first_line: int, ncols: int, sep: str | None, decima
         The columns' names, for messages.
     name : str
         The file, for messages.
+    start, end : int, optional
+        The block's first byte and the byte after its last (default: all).
 
     Returns
     -------
@@ -158,37 +161,44 @@ def parse_rows(data: bytes, first_line: int, ncols: int, sep: str | None, decima
         Naming the line (and the column): a row of another length, a cell
         that is not a number.
     """
-    data = data.rstrip()
-    if not data:
-        return np.empty((0, ncols))
-    data += b"\n"
-    pieces, start, line = [], 0, first_line
-    while start < len(data):
-        end = data.find(b"\n", min(start + CHUNK_BYTES, len(data) - 1)) + 1
-        chunk = data[start:end]
+    end = len(data) if end is None else end
+    while end > start and data[end - 1] in b" \t\r\n":
+        end -= 1
+    pieces, line = [], first_line
+    while start < end:
+        stop = data.find(b"\n", min(start + CHUNK_BYTES, end - 1), end)
+        stop = end if stop < 0 else stop + 1
+        chunk = data[start:stop]
+        chunk = chunk if chunk.endswith(b"\n") else chunk + b"\n"
         table = _fast(chunk, ncols, sep, decimal_comma)
         if table is None:
             table = _slow(chunk.decode("utf-8", errors="replace"), line, ncols, sep, decimal_comma, labels, name)
         pieces.append(table)
         line += chunk.count(b"\n")
-        start = end
+        start = stop
+    if not pieces:
+        return np.empty((0, ncols))
     return pieces[0] if len(pieces) == 1 else np.concatenate(pieces)
 
 
-def finite_rows(table: np.ndarray, first_line: int, labels: list[str], name: str, data: bytes) -> None:
-    """Raise naming the line and column of the first NaN or infinite cell of ``table`` (rows of ``data``)."""
+def finite_rows(table: np.ndarray, first_line: int, labels: list[str], name: str, data: bytes,
+                start: int = 0) -> None:
+    """Raise naming the line and column of the first NaN or infinite cell of ``table`` (rows from ``data[start:]``)."""
     bad = ~np.isfinite(table)
     if not bad.any():
         return
     row, column = np.argwhere(bad)[0]
-    # the line of that row: rows are the lines of data that are neither blank nor comments
-    line, seen = first_line, -1
-    for k, text in enumerate(data.split(b"\n")):
-        stripped = text.strip()
-        if stripped and not stripped.startswith(b"#"):
+    # the line of that row: rows are the lines that are neither blank nor comments
+    line, seen, pos = first_line, -1, start
+    while pos < len(data):
+        stop = data.find(b"\n", pos)
+        stop = len(data) if stop < 0 else stop
+        text = data[pos:stop].strip()
+        if text and not text.startswith(b"#"):
             seen += 1
             if seen == row:
-                line = first_line + k
                 break
+        line += 1
+        pos = stop + 1
     raise FileFormatError(f"{name}, line {line}: column {labels[column]!r} is {table[row, column]}; "
                           "expected a finite number (a gap in the acquisition?)")

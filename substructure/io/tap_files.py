@@ -100,7 +100,8 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
     elif data[:3] == b"\xef\xbb\xbf":
         data = data[3:]
     head, start, first_line = _head(data, name)
-    row = data[start:data.find(b"\n", start) if b"\n" in data[start:] else len(data)].decode("utf-8", "replace")
+    row_end = data.find(b"\n", start)
+    row = data[start:len(data) if row_end < 0 else row_end].decode("utf-8", "replace").rstrip("\r")
     sep = line_separator(row)
     decimal_comma = sep in ("\t", ";")
     ncols = len([c for c in (row.split() if sep is None else row.split(sep))]) - \
@@ -138,10 +139,9 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
                                   "(separated by commas, semicolons or tabs; or the units in a row under the names)")
         if errors[k]:
             raise FileFormatError(f"{name}, line {columns.line}: {errors[k]} (column {labels[k]!r})")
-    block = data[start:]
-    table = parse_rows(block, first_line, ncols, sep, decimal_comma, labels, name)
+    table = parse_rows(data, first_line, ncols, sep, decimal_comma, labels, name, start)
     used = [k for k in (t_col, f_col, r_col) if k is not None]
-    finite_rows(table[:, used], first_line, [labels[k] for k in used], name, block)
+    finite_rows(table[:, used], first_line, [labels[k] for k in used], name, data, start)
     if t_col is not None:
         time_s = _regular(table[:, t_col] * (1.0 * parsed[t_col]).m_as("s"))
         if rate is not None and time_s.size > 1 and time_s[-1] > time_s[0]:
