@@ -127,8 +127,9 @@ def test_more_channels_chosen_by_name_or_index_or_by_their_units(tmp_path):
     path = tmp_path / "four.csv"
     path.write_text("time [s],hammer [N],Accel 1 [g],Accel 2 [g],Trigger [V]\n"
                     + rows([t, f, a / G, b / G, np.zeros_like(t)]))
-    with pytest.raises(FileFormatError, match=r"four.csv, line 1: 2 response columns .*1: time \[s\]; 2: hammer \[N\]; "
-                                              r"3: Accel 1 \[g\]; 4: Accel 2 \[g\]; 5: Trigger \[V\].*--response-column"):
+    with pytest.raises(FileFormatError, match=r"four.csv, line 1: 2 response columns .*1: time \[s\]; "
+                                              r"2: hammer \[N\]; 3: Accel 1 \[g\]; 4: Accel 2 \[g\]; "
+                                              r"5: Trigger \[V\].*--response-column"):
         read_tap_csv(path)
     assert np.allclose(read_tap_csv(path, response_column="accel 2").response, b)
     assert np.allclose(read_tap_csv(path, response_column=3).response, a)
@@ -216,7 +217,9 @@ def lvm(segments, x_columns="One", sep="\t", decimal=".", units=("N", "g")):
            f"Multi_Headings{s}No", f"X_Columns{s}{x_columns}", f"Time_Pref{s}Relative", f"Operator{s}bench",
            f"Date{s}2026/03/01", f"Time{s}10:00:00.000", f"***End_of_Header***{s}", ""]
     for x0, dt, force, accel in segments:
-        num = (lambda v: f"{v:.16E}".replace(".", decimal))
+        def num(v):
+            return f"{v:.16E}".replace(".", decimal)
+
         out += [f"Channels{s}2{s}", f"Samples{s}{force.size}{s}{force.size}{s}",
                 f"Date{s}2026/03/01{s}2026/03/01{s}", f"Time{s}10:00:00.000{s}10:00:00.000{s}",
                 f"X_Dimension{s}Time{s}Time{s}", f"X0{s}{num(x0)}{s}{num(x0)}{s}",

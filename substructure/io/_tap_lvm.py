@@ -128,9 +128,9 @@ def read_segments(data: bytes, name: str) -> list[Segment]:
             for j in x_cols:
                 worst = int(np.argmax(np.abs(table[:, j] - expected)))
                 if abs(table[worst, j] - expected[worst]) > 0.5 * delta_x:
-                    raise FileFormatError(f"{where}: X_Value {float(table[worst, j])!r} on row {worst + 1} where X0 + "
-                                          f"n Delta_X is {float(expected[worst])!r}; expected the x column of a uniform "
-                                          "time axis")
+                    raise FileFormatError(f"{where}: X_Value {float(table[worst, j])!r} on row {worst + 1} where "
+                                          f"X0 + n Delta_X is {float(expected[worst])!r}; expected the x column of a "
+                                          "uniform time axis")
         units = [_unit(u) for u in tags.get("Y_Unit_Label", [])]
         channel_names, channel_units = [], []
         for pos, j in enumerate(keep):

@@ -11,7 +11,6 @@ passes is exactly what the line-by-line reading would give.
 
 from __future__ import annotations
 
-import re
 import warnings
 
 import numpy as np

@@ -26,8 +26,8 @@ from .._files import decode_text
 from ..errors import FileFormatError, SubstructureError
 from ..tap.records import RESPONSE_QUANTITIES, TIME_STEP_TOLERANCE, TapRecord, channel_to_si, unit_of
 from . import check_readable_file, read_bytes
-from ._tap_columns import (MAX_PREAMBLE_LINES, NO_UNIT, Columns, choose, header_cells, is_row, is_unit_row, line_separator,
-                           name_and_unit, rate_from_lines)
+from ._tap_columns import (MAX_PREAMBLE_LINES, NO_UNIT, Columns, choose, header_cells, is_row, is_unit_row,
+                           line_separator, name_and_unit, rate_from_lines)
 from ._tap_table import finite_rows, parse_rows
 
 __all__ = ["read_tap_csv", "read_tap_lvm", "read_tap_uff", "MAX_RECORD_BYTES"]
@@ -529,5 +529,6 @@ def _check_abscissa(name: str, k: int, record: dict) -> None:
         mean = (x[-1] - x[0]) / (x.size - 1)
         if not mean > 0 or np.any(np.abs(step - mean) > TIME_STEP_TOLERANCE * mean):
             worst = int(np.argmax(np.abs(step - mean))) + 1
-            raise FileFormatError(f"{name}, record {k}: uneven abscissa (sample {worst}: step {float(step[worst - 1])!r} s, "
-                                  f"mean {float(mean)!r} s); expected uniform sampling in time")
+            raise FileFormatError(f"{name}, record {k}: uneven abscissa (sample {worst}: step "
+                                  f"{float(step[worst - 1])!r} s, mean {float(mean)!r} s); expected uniform sampling "
+                                  "in time")
