@@ -30,7 +30,7 @@ from ._tap_columns import (MAX_PREAMBLE_LINES, NO_UNIT, Columns, choose, header_
                            line_separator, name_and_unit, rate_from_lines)
 from ._tap_table import finite_rows, parse_rows
 
-__all__ = ["read_tap_csv", "read_tap_lvm", "read_tap_uff", "MAX_RECORD_BYTES"]
+__all__ = ["read_tap_csv", "read_tap_lvm", "read_tap_uff", "MAX_RECORD_BYTES", "ROUNDED_TIME_TOLERANCE"]
 
 MAX_RECORD_BYTES = 2**31
 """The largest tap record file read (2 GiB: ten minutes of three channels at 51.2 kHz written as text)."""
@@ -251,7 +251,7 @@ def _quantity_of(unit: Any) -> str | None:
     return None
 
 
-def option_rate(sample_rate: Any) -> float:
+def _option_rate(sample_rate: Any) -> float:
     """The ``sample_rate`` option in Hz: a quantity or text with its unit (``"51.2 kHz"``), or a number in Hz."""
     from ..errors import InvalidValueError
     from ..units import frequency_hz
@@ -272,7 +272,7 @@ def _stated_rate(preamble: list[tuple[int, str]], name: str, decimal_comma: bool
     stated = rate_from_lines(preamble, name, decimal_comma)
     if sample_rate is None:
         return None if stated is None else (stated[0], f"line {stated[1]}")
-    hz = option_rate(sample_rate)
+    hz = _option_rate(sample_rate)
     if stated is not None and abs(stated[0] - hz) > 1e-6 * hz:
         raise FileFormatError(f"{name}, line {stated[1]}: the file says {stated[0]:.10g} Hz, --sample-rate "
                               f"{hz:.10g} Hz; leave the option out or fix the file")
@@ -350,9 +350,9 @@ def read_tap_lvm(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
     for group in groups:
         seg = group[0]
         hz = 1.0 / seg.delta_x
-        if sample_rate is not None and abs(option_rate(sample_rate) - hz) > 1e-6 * hz:
+        if sample_rate is not None and abs(_option_rate(sample_rate) - hz) > 1e-6 * hz:
             raise FileFormatError(f"{name}, line {seg.columns.line}: Delta_X {seg.delta_x!r} s is {hz:.10g} Hz, "
-                                  f"--sample-rate {option_rate(sample_rate):.10g} Hz; leave the option out or fix "
+                                  f"--sample-rate {_option_rate(sample_rate):.10g} Hz; leave the option out or fix "
                                   "the file")
         parsed, dims, errors = _units(seg.columns, name)
         _, f_col, r_col = choose(seg.columns, parsed, dims, name, force_column, response_column, True)
