@@ -227,17 +227,19 @@ def lvm(segments, x_columns="One", sep="\t", decimal=".", units=("N", "g")):
         if units:
             out.append(f"Y_Unit_Label{s}{units[0]}{s}{units[1]}{s}")
         out.append(f"***End_of_Header***{s}")
-        names = (["X_Value"] if x_columns == "One" else []) + ["Hammer", "Accel"] + ["Comment"]
-        out.append(s.join(names))
         x = x0 + np.arange(force.size) * dt
-        cols = ([x] if x_columns == "One" else []) + [force, accel]
+        names = {"One": ["X_Value", "Hammer", "Accel"], "No": ["Hammer", "Accel"],
+                 "Multi": ["X_Value", "Hammer", "X_Value", "Accel"]}[x_columns] + ["Comment"]
+        out.append(s.join(names))
+        cols = {"One": [x, force, accel], "No": [force, accel], "Multi": [x, force, x, accel]}[x_columns]
         body = rows(cols, sep=s, fmt="{:.6f}", decimal_comma=decimal == ",")
         out += body.splitlines()
         out.append("")
     return "\r\n".join(out) + "\r\n"
 
 
-@pytest.mark.parametrize("x_columns, sep, decimal", [("One", "\t", "."), ("No", "\t", ","), ("One", ",", ".")])
+@pytest.mark.parametrize("x_columns, sep, decimal", [("One", "\t", "."), ("No", "\t", ","), ("One", ",", "."),
+                                                    ("Multi", "\t", ".")])
 def test_lvm_one_segment(tmp_path, x_columns, sep, decimal):
     t, f, a = samples()
     f, a = np.round(f, 6), np.round(a / G, 6)
@@ -400,3 +402,20 @@ def test_times_written_with_few_digits_are_the_uniform_clock_and_a_lost_sample_i
     path.write_text("time [s],force [N],acceleration [g]\n" + rows([lost, f[1:], a[1:]], fmt="{:.6f}"))
     with pytest.raises(FileFormatError, match=r"six.csv: column 'time', sample 2000: step"):
         read_tap_csv(path)
+
+
+def test_blanks_after_separators_quoted_names_and_a_separator_ending_every_line(tmp_path):
+    t, f, a = samples()
+    path = tmp_path / "spaced.csv"
+    path.write_text('"Time [s]", "Force [N]", "Acceleration [g]",\n' + rows([t, f, a], sep=", ").replace("\n", ",\n"))
+    record = read_tap_csv(path)
+    assert np.allclose(record.time, t, rtol=0, atol=1e-15) and np.array_equal(record.force, f)
+    assert np.allclose(record.response, a * G, rtol=1e-12, atol=0)
+
+
+def test_a_sample_rate_without_its_unit_is_refused_on_the_command_line(tmp_path, capsys):
+    _, f, a = samples()
+    path = tmp_path / "bare.csv"
+    path.write_text("force [N],acceleration [m/s^2]\n" + rows([f, a]))
+    code, _, err = run(capsys, "tap", path, "--sample-rate", "10240")
+    assert code == 1 and "--sample-rate" in err and "10240" in err

@@ -309,10 +309,15 @@ def read_tap_lvm(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
         (``Separator`` Tab or Comma, ``Decimal_Separator``, ``X_Columns`` No,
         One or Multi; each segment's ``Delta_X`` gives the time step, its
         ``Y_Unit_Label`` or the column names the units).
-    sensitivity, hammer_sensitivity, quantity, force_column, response_column
-        As for :func:`read_tap_csv`.
+    sensitivity, hammer_sensitivity : str or pint.Quantity, optional
+        As for :func:`read_tap_csv` (``"10.2 mV/g"``, ``"2.25 mV/N"``).
+    quantity : {"acceleration", "velocity", "displacement"}, optional
+        What the response is; it must agree with the channel's unit.
     sample_rate : str, pint.Quantity or float, optional
         Checked against the file's ``Delta_X`` (Hz; ``"51.2 kHz"``).
+    force_column, response_column : int or str, optional
+        The channels by name or 1-based index (the x column not counted), as
+        for :func:`read_tap_csv`.
 
     Returns
     -------
