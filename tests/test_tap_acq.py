@@ -419,3 +419,11 @@ def test_a_sample_rate_without_its_unit_is_refused_on_the_command_line(tmp_path,
     path.write_text("force [N],acceleration [m/s^2]\n" + rows([f, a]))
     code, _, err = run(capsys, "tap", path, "--sample-rate", "10240")
     assert code == 1 and "--sample-rate" in err and "10240" in err
+
+
+def test_rows_that_start_with_a_clock_time_are_refused_as_such(tmp_path):
+    path = tmp_path / "clock.csv"
+    path.write_text("Time;Force [N];Acceleration [g]\n" + "".join(f"10:00:00.{k:03d};1,5;0,25\n" for k in range(50)))
+    with pytest.raises(FileFormatError, match=r"clock.csv, line 2: the first cell '10:00:00.000' is not a number "
+                                              r"\(a clock time or a date\?\)"):
+        read_tap_csv(path)

@@ -50,14 +50,16 @@ def is_number(cell: str, decimal_comma: bool) -> bool:
     return bool(_NUMBER.match(cell.replace(",", ".") if decimal_comma else cell))
 
 
-def is_row(line: str) -> bool:
-    """Whether a line is a row of numbers: its first cell and at least half of its cells are numbers."""
+def is_row(line: str, first: bool = True) -> bool:
+    """Whether a line is a row of numbers: its first cell (unless not ``first``) and half of its cells are numbers."""
     sep = line_separator(line)
     cells = [c for c in (line.split() if sep is None else line.split(sep))]
     if sep is not None and len(cells) > 1 and not cells[-1].strip():
         cells = cells[:-1]
     decimal_comma = sep in ("\t", ";")
     numbers = [is_number(c, decimal_comma) for c in cells]
+    if not first:
+        return len(cells) > 1 and 2 * sum(numbers[1:]) > len(numbers)
     return bool(cells) and numbers[0] and 2 * sum(numbers) >= len(numbers)
 
 

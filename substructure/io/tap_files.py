@@ -186,6 +186,7 @@ def _head(data: bytes, name: str) -> tuple[list[tuple[int, str]], int, int]:
     """The lines above the first row of numbers, the byte offset of that row and its line number."""
     head: list[tuple[int, str]] = []
     pos, number = 0, 0
+    not_first: tuple[int, str] | None = None
     while pos < len(data):
         end = data.find(b"\n", pos)
         end = len(data) if end < 0 else end
@@ -198,6 +199,8 @@ def _head(data: bytes, name: str) -> tuple[list[tuple[int, str]], int, int]:
         stripped = text.strip()
         if stripped and not stripped.startswith("#") and is_row(text):
             return head, pos, number
+        if stripped and not stripped.startswith("#") and not_first is None and is_row(text, first=False):
+            not_first = number, text  # numbers after a first cell that is not one: a clock time, a date?
         head.append((number, text))
         if number >= MAX_PREAMBLE_LINES:
             break
@@ -206,6 +209,12 @@ def _head(data: bytes, name: str) -> tuple[list[tuple[int, str]], int, int]:
     if not content:
         raise FileFormatError(f"{name}: the file is empty; expected a header such as "
                               "'time [s],force [N],acceleration [m/s^2]' and one row per sample")
+    if not_first is not None:
+        sep = line_separator(not_first[1])
+        cell = (not_first[1].split() if sep is None else not_first[1].split(sep))[0].strip()
+        raise FileFormatError(f"{name}, line {not_first[0]}: the first cell {cell!r} is not a number (a clock time "
+                              "or a date?); expected rows of numbers: a time in s, or no time column and the sample "
+                              "rate (--sample-rate)")
     if number >= MAX_PREAMBLE_LINES:
         raise FileFormatError(f"{name}: no row of numbers in the first {MAX_PREAMBLE_LINES} lines; expected a "
                               "header and one row per sample")
