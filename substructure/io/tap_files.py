@@ -28,25 +28,14 @@ from ..tap.records import RESPONSE_QUANTITIES, TIME_STEP_TOLERANCE, TapRecord, c
 from . import check_readable_file, read_bytes
 from ._tap_columns import (MAX_PREAMBLE_LINES, NO_UNIT, Columns, choose, header_cells, is_row, is_unit_row,
                            line_separator, name_and_unit, rate_from_lines)
+from ._tap_build import (RESPONSES, ROUNDED_TIME_TOLERANCE, build_record, check_quantity_option, option_rate,
+                         regular, units_of_columns)
 from ._tap_table import finite_rows, parse_rows
 
 __all__ = ["read_tap_csv", "read_tap_lvm", "read_tap_uff", "MAX_RECORD_BYTES", "ROUNDED_TIME_TOLERANCE"]
 
 MAX_RECORD_BYTES = 2**31
 """The largest tap record file read (2 GiB: ten minutes of three channels at 51.2 kHz written as text)."""
-_RESPONSES = ("acceleration", "velocity", "displacement")
-
-
-def _check_quantity_option(quantity: str | None, found: str, where: str) -> None:
-    if quantity is None:
-        return
-    if quantity not in RESPONSE_QUANTITIES:
-        raise FileFormatError(f"quantity: got {quantity!r}; expected one of {', '.join(RESPONSE_QUANTITIES)}")
-    if quantity != found:
-        raise FileFormatError(f"{where} holds {'an' if found[0] in 'aeiou' else 'a'} {found}, and the quantity "
-                              f"option says {quantity}; leave the option out or fix the file")
-
-
 def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensitivity: Any = None,
                  quantity: str | None = None, sample_rate: Any = None, force_column: Any = None,
                  response_column: Any = None) -> TapRecord:
@@ -127,7 +116,7 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
         raise FileFormatError(f"{name}, line {columns.line}: the header names {len(columns.names)} columns "
                               f"({', '.join(columns.labels)}), the first row (line {first_line}) has {ncols} values")
     rate = _stated_rate([(n, t.lstrip("#")) for n, t in head if n < preamble_end], name, decimal_comma, sample_rate)
-    parsed, dims, errors = _units(columns, name)
+    parsed, dims, errors = units_of_columns(columns, name)
     t_col, f_col, r_col = choose(columns, parsed, dims, name, force_column, response_column, rate is not None)
     labels = columns.labels
     for k in (t_col, f_col, r_col):
@@ -143,7 +132,7 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
     used = [k for k in (t_col, f_col, r_col) if k is not None]
     finite_rows(table[:, used], first_line, [labels[k] for k in used], name, data, start)
     if t_col is not None:
-        time_s = _regular(table[:, t_col] * (1.0 * parsed[t_col]).m_as("s"))
+        time_s = regular(table[:, t_col] * (1.0 * parsed[t_col]).m_as("s"))
         if rate is not None and time_s.size > 1 and time_s[-1] > time_s[0]:
             from_time = (time_s.size - 1) / (time_s[-1] - time_s[0])
             if abs(from_time - rate[0]) > TIME_STEP_TOLERANCE * rate[0]:
@@ -152,34 +141,8 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
     else:
         assert rate is not None
         time_s = np.arange(table.shape[0]) / rate[0]
-    return _record(name, time_s, table[:, f_col], parsed[f_col], labels[f_col], table[:, r_col], parsed[r_col],
+    return build_record(name, time_s, table[:, f_col], parsed[f_col], labels[f_col], table[:, r_col], parsed[r_col],
                    labels[r_col], sensitivity, hammer_sensitivity, quantity)
-
-
-ROUNDED_TIME_TOLERANCE = 0.25
-"""Largest distance, in time steps, of a written time from the uniform grid fitted to them all
-(times written with few digits, e.g. six decimals at 51.2 kHz); farther (a lost or repeated sample) is refused."""
-
-
-def _regular(time_s: np.ndarray) -> np.ndarray:
-    """The uniform grid fitted to the times when every time lies within a quarter step of it.
-
-    Times rounded to the digits a file writes (0.000020 for 1.953125e-05 s)
-    make uneven steps of a uniform clock; the grid is what was sampled.  A
-    time farther from the grid is left as written, for the record's own
-    check to refuse.
-    """
-    n = time_s.size
-    if n < 3 or not time_s[-1] > time_s[0]:
-        return time_s
-    k = np.arange(n, dtype=np.float64)
-    step = float(np.dot(k - k.mean(), time_s - time_s.mean()) / np.dot(k - k.mean(), k - k.mean()))
-    grid = (time_s.mean() - step * k.mean()) + k * step  # the least-squares line: the rounding averages out
-    if not step > 0:
-        return time_s
-    if np.max(np.abs(time_s - grid)) <= ROUNDED_TIME_TOLERANCE * step:
-        return grid
-    return time_s
 
 
 def _head(data: bytes, name: str) -> tuple[list[tuple[int, str]], int, int]:
@@ -226,84 +189,17 @@ def _columns(cells: list[str], line: int) -> Columns:
     return Columns([n for n, _ in pairs], [u for _, u in pairs], line)
 
 
-def _units(columns: Columns, name: str) -> tuple[list[Any], list[str | None], list[str | None]]:
-    """Each column's pint unit, its quantity and the message of a unit pint cannot read (None when read)."""
-    parsed: list[Any] = []
-    dims: list[str | None] = []
-    errors: list[str | None] = []
-    for label, unit in zip(columns.labels, columns.units):
-        if unit is None:
-            parsed.append(None)
-            dims.append(None)
-            errors.append(None)
-            continue
-        try:
-            u = unit_of(unit, label)
-        except SubstructureError as exc:
-            message = str(exc)
-            parsed.append(None)
-            dims.append(None)
-            errors.append(message[message.find("cannot read"):])
-            continue
-        parsed.append(u)
-        dims.append(_quantity_of(u))
-        errors.append(None)
-    return parsed, dims, errors
-
-
-def _quantity_of(unit: Any) -> str | None:
-    q = 1.0 * unit
-    for dim, kind in (("[time]", "time"), ("[force]", "force"), ("[electric_potential]", "voltage"),
-                      ("[acceleration]", "acceleration"), ("[velocity]", "velocity"), ("[length]", "displacement")):
-        if q.check(dim):
-            return kind
-    return None
-
-
-def _option_rate(sample_rate: Any) -> float:
-    """The ``sample_rate`` option in Hz: a quantity or text with its unit (``"51.2 kHz"``), or a number in Hz."""
-    from ..errors import InvalidValueError
-    from ..units import frequency_hz
-
-    if isinstance(sample_rate, (int, float, np.integer, np.floating)) and not isinstance(sample_rate, bool):
-        hz = float(sample_rate)
-    else:
-        hz = frequency_hz(sample_rate, "sample rate (--sample-rate)")
-    if not np.isfinite(hz) or hz <= 0:
-        raise InvalidValueError(f"sample rate (--sample-rate): got {sample_rate!r}; expected a positive rate, "
-                                "e.g. '51.2 kHz'")
-    return hz
-
-
 def _stated_rate(preamble: list[tuple[int, str]], name: str, decimal_comma: bool,
                  sample_rate: Any) -> tuple[float, str] | None:
     """The sample rate (Hz) and what states it: the option, the preamble, both when they agree, or None."""
     stated = rate_from_lines(preamble, name, decimal_comma)
     if sample_rate is None:
         return None if stated is None else (stated[0], f"line {stated[1]}")
-    hz = _option_rate(sample_rate)
+    hz = option_rate(sample_rate)
     if stated is not None and abs(stated[0] - hz) > 1e-6 * hz:
         raise FileFormatError(f"{name}, line {stated[1]}: the file says {stated[0]:.10g} Hz, --sample-rate "
                               f"{hz:.10g} Hz; leave the option out or fix the file")
     return hz, "--sample-rate"
-
-
-def _record(name: str, time_s: np.ndarray, force_values: np.ndarray, force_unit: Any, force_label: str,
-            response_values: np.ndarray, response_unit: Any, response_label: str, sensitivity: Any,
-            hammer_sensitivity: Any, quantity: str | None) -> TapRecord:
-    """The record in SI units from two channels in their units; unit errors name the file and the column."""
-    try:
-        force, _ = channel_to_si(force_values, force_unit, f"{name}: column {force_label!r}", ("force",),
-                                 hammer_sensitivity, "hammer sensitivity (--hammer-sensitivity)")
-        response, found = channel_to_si(response_values, response_unit, f"{name}: column {response_label!r}",
-                                        _RESPONSES, sensitivity, "sensitivity (--sensitivity)")
-        _check_quantity_option(quantity, found, f"{name}: column {response_label!r}")
-        return TapRecord(time_s, force, response, found, name, force_label, response_label)
-    except FileFormatError:
-        raise
-    except SubstructureError as exc:
-        message = str(exc)
-        raise FileFormatError(message if message.startswith(name) else f"{name}: {message}") from None
 
 
 def read_tap_lvm(path: str | os.PathLike, sensitivity: Any = None, hammer_sensitivity: Any = None,
@@ -364,11 +260,11 @@ def read_tap_lvm(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
     for group in groups:
         seg = group[0]
         hz = 1.0 / seg.delta_x
-        if sample_rate is not None and abs(_option_rate(sample_rate) - hz) > 1e-6 * hz:
+        if sample_rate is not None and abs(option_rate(sample_rate) - hz) > 1e-6 * hz:
             raise FileFormatError(f"{name}, line {seg.columns.line}: Delta_X {seg.delta_x!r} s is {hz:.10g} Hz, "
-                                  f"--sample-rate {_option_rate(sample_rate):.10g} Hz; leave the option out or fix "
+                                  f"--sample-rate {option_rate(sample_rate):.10g} Hz; leave the option out or fix "
                                   "the file")
-        parsed, dims, errors = _units(seg.columns, name)
+        parsed, dims, errors = units_of_columns(seg.columns, name)
         _, f_col, r_col = choose(seg.columns, parsed, dims, name, force_column, response_column, True)
         labels = seg.columns.labels
         for k in (f_col, r_col):
@@ -387,7 +283,7 @@ def read_tap_lvm(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
                                   "a finite number (a gap in the acquisition?)")
         start = seg.x0 if abs(seg.x0) < 1e6 else 0.0  # an absolute time stamp (seconds since 1904) is not kept
         time_s = start + np.arange(table.shape[0]) * seg.delta_x
-        records.append(_record(name, time_s, table[:, f_col], parsed[f_col], labels[f_col], table[:, r_col],
+        records.append(build_record(name, time_s, table[:, f_col], parsed[f_col], labels[f_col], table[:, r_col],
                                parsed[r_col], labels[r_col], sensitivity, hammer_sensitivity, quantity))
     return records
 
@@ -474,7 +370,7 @@ def read_tap_uff(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
             and unit(kinds.index(None)) is not None:
         # two records, one of them known by its type or unit, the other in volts or unlabelled: the other channel
         known = 0 if kinds[0] is not None else 1
-        kinds[1 - known] = ("force" if kinds[known] in _RESPONSES else "response") if kinds[known] else None
+        kinds[1 - known] = ("force" if kinds[known] in RESPONSES else "response") if kinds[known] else None
     if force_record is None:
         found = [k for k, q in enumerate(kinds) if q == "force"]
         if len(found) != 1:
@@ -482,7 +378,7 @@ def read_tap_uff(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
                                   "give the force record's index (--force-record, 0-based)")
         force_record = found[0]
     if response_record is None:
-        found = [k for k, q in enumerate(kinds) if (q in _RESPONSES or q == "response") and k != force_record]
+        found = [k for k, q in enumerate(kinds) if (q in RESPONSES or q == "response") and k != force_record]
         if len(found) != 1:
             raise FileFormatError(f"{name}: {len(found)} response records among {len(records)} type-58 records; "
                                   "give the response record's index (--response-record, 0-based)")
@@ -504,17 +400,17 @@ def read_tap_uff(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
                                  hammer_sensitivity, "hammer sensitivity (--hammer-sensitivity)")
         r_unit = unit(response_record)
         if r_unit is None:
-            said = kinds[response_record] if kinds[response_record] in _RESPONSES else quantity
+            said = kinds[response_record] if kinds[response_record] in RESPONSES else quantity
             if said is None:
                 raise FileFormatError(f"{name}: {labels[1]} has neither a unit label nor a specific data type; "
                                       "give the quantity (--quantity)")
             r_unit = unit_of(RESPONSE_QUANTITIES[said][0], name)
         response, found_q = channel_to_si(np.real(np.asarray(r_set["data"])), r_unit, f"{name}: {labels[1]}",
-                                          _RESPONSES, sensitivity, "sensitivity (--sensitivity)")
-        if kinds[response_record] in _RESPONSES and kinds[response_record] != found_q:
+                                          RESPONSES, sensitivity, "sensitivity (--sensitivity)")
+        if kinds[response_record] in RESPONSES and kinds[response_record] != found_q:
             raise FileFormatError(f"{name}: {labels[1]}: the specific data type says {kinds[response_record]}, the "
                                   f"sensitivity makes it {found_q}")
-        _check_quantity_option(quantity, found_q, f"{name}: {labels[1]}")
+        check_quantity_option(quantity, found_q, f"{name}: {labels[1]}")
         return TapRecord(t, force, response, found_q, name, labels[0], labels[1])
     except FileFormatError:
         raise
