@@ -427,3 +427,40 @@ def test_rows_that_start_with_a_clock_time_are_refused_as_such(tmp_path):
     with pytest.raises(FileFormatError, match=r"clock.csv, line 2: the first cell '10:00:00.000' is not a number "
                                               r"\(a clock time or a date\?\)"):
         read_tap_csv(path)
+
+
+# -- 6. MATLAB files -------------------------------------------------------------------------------------------------
+
+def test_matlab_vectors_with_their_units(tmp_path):
+    from scipy.io import savemat
+
+    from substructure.io.tap_files import read_tap_mat
+
+    t, f, a = samples()
+    path = tmp_path / "tap.mat"
+    savemat(path, {"time": t, "force": f, "force_unit": "N", "acc": a / G, "acc_unit": "g", "trigger": 0 * t})
+    record = read_tap_mat(path)
+    assert np.array_equal(record.force, f) and np.allclose(record.response, a, rtol=1e-12, atol=0)
+    assert record.sample_rate == FS and record.response_column == "acc [g]"
+    savemat(path, {"fs": FS, "hammer": f * 2.25, "hammer_unit": "mV", "acc1": a, "acc2": -a, "acc1_unit": "m/s^2",
+                   "acc2_unit": "m/s^2"})
+    with pytest.raises(FileFormatError, match=r"tap.mat: 2 response columns .*--response-column"):
+        read_tap_mat(path, hammer_sensitivity="2.25 mV/N")
+    record = read_tap_mat(path, hammer_sensitivity="2.25 mV/N", response_column="acc2")
+    assert np.allclose(record.force, f) and np.array_equal(record.response, -a) and record.sample_rate == FS
+    with pytest.raises(FileFormatError, match=r"variable 'fs' says 10240 Hz, --sample-rate 20000 Hz"):
+        read_tap_mat(path, hammer_sensitivity="2.25 mV/N", response_column="acc2", sample_rate="20 kHz")
+    savemat(path, {"t": t, "force": f, "acc": a})
+    with pytest.raises(FileFormatError, match=r"tap.mat: variable 'force' has no unit; add a text variable force_unit"):
+        read_tap_mat(path)
+    savemat(path, {"force": f, "force_unit": "N", "acc": a, "acc_unit": "g"})
+    with pytest.raises(FileFormatError, match=r"tap.mat: no column in units of time .* a scalar variable fs"):
+        read_tap_mat(path)
+    path.write_bytes(b"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: Mon Mar  2 10:00:00 2026 HDF5 schema 1.00 ."
+                     + b" " * 400 + b"\x89HDF\r\n\x1a\n" + b"\0" * 64)
+    with pytest.raises(FileFormatError, match=r"tap.mat: a MATLAB 7.3 file \(HDF5\), which is not read; save it again "
+                                              r"as version 7"):
+        read_tap_mat(path)
+    path.write_bytes(b"not a MATLAB file at all" * 10)
+    with pytest.raises(FileFormatError, match=r"tap.mat: cannot read the MATLAB file"):
+        read_tap_mat(path)

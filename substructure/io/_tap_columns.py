@@ -112,7 +112,7 @@ class Columns:
 
     names: list[str]
     units: list[str | None]
-    line: int
+    line: int | None  # None for a file without lines (a MATLAB file)
 
     @property
     def labels(self) -> list[str]:
@@ -202,14 +202,16 @@ def pick(option: Any, columns: Columns, what: str, flag: str, name: str) -> int:
 
 
 def choose(columns: Columns, parsed: list[Any], dims: list[str | None], name: str, force_column: Any,
-           response_column: Any, has_rate: bool) -> tuple[int | None, int, int]:
+           response_column: Any, has_rate: bool,
+           rate_hint: str = "a preamble line such as 'Sample rate: 51200 Hz' or 'dt: 1.953125e-05 s'",
+           ) -> tuple[int | None, int, int]:
     """The time (or None), force and response columns of a header.
 
     ``parsed`` holds each column's pint unit (None when the header has none
     or pint cannot read it), ``dims`` its quantity (``time``, ``force``,
     ``voltage``, ``acceleration``, ``velocity``, ``displacement`` or None).
     """
-    where = f"{name}, line {columns.line}"
+    where = name if columns.line is None else f"{name}, line {columns.line}"
     labels = columns.labels
     listing = "; ".join(f"{k + 1}: {label}" for k, label in enumerate(labels))
     times = [k for k, d in enumerate(dims) if d == "time" or (columns.units[k] is None
@@ -252,6 +254,5 @@ def choose(columns: Columns, parsed: list[Any], dims: list[str | None], name: st
             chosen_resp = responses[0]
     if t_col is None and not has_rate:
         raise FileFormatError(f"{where}: no column in units of time ({', '.join(labels)}) and no sample rate; "
-                              "give the rate with --sample-rate (e.g. '51.2 kHz', sample_rate=) or a preamble "
-                              "line such as 'Sample rate: 51200 Hz' or 'dt: 1.953125e-05 s'")
+                              f"give the rate with --sample-rate (e.g. '51.2 kHz', sample_rate=) or {rate_hint}")
     return t_col, chosen_force, chosen_resp

@@ -32,7 +32,7 @@ from ._tap_build import (RESPONSES, ROUNDED_TIME_TOLERANCE, build_record, check_
                          regular, units_of_columns)
 from ._tap_table import finite_rows, parse_rows
 
-__all__ = ["read_tap_csv", "read_tap_lvm", "read_tap_uff", "MAX_RECORD_BYTES", "ROUNDED_TIME_TOLERANCE"]
+__all__ = ["read_tap_csv", "read_tap_lvm", "read_tap_mat", "read_tap_uff", "MAX_RECORD_BYTES", "ROUNDED_TIME_TOLERANCE"]
 
 MAX_RECORD_BYTES = 2**31
 """The largest tap record file read (2 GiB: ten minutes of three channels at 51.2 kHz written as text)."""
@@ -286,6 +286,51 @@ def read_tap_lvm(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
         records.append(build_record(name, time_s, table[:, f_col], parsed[f_col], labels[f_col], table[:, r_col],
                                parsed[r_col], labels[r_col], sensitivity, hammer_sensitivity, quantity))
     return records
+
+
+def read_tap_mat(path: str | os.PathLike, sensitivity: Any = None, hammer_sensitivity: Any = None,
+                 quantity: str | None = None, sample_rate: Any = None, force_column: Any = None,
+                 response_column: Any = None) -> TapRecord:
+    """Read a tap record from a MATLAB file (``.mat``, versions 4 to 7; 7.3 is refused with how to re-save).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file: vectors of samples by name (a time vector ``time`` or
+        ``t``, in s unless ``time_unit`` says otherwise), each force and
+        response vector with its unit in a text variable ``<name>_unit``
+        (``force_unit = 'N'``, ``acc_unit = 'g'``, ``'mV'`` with a
+        sensitivity); without a time vector, a scalar ``fs`` or
+        ``sample_rate`` (Hz) or ``dt`` (s).
+    sensitivity, hammer_sensitivity : str or pint.Quantity, optional
+        As for :func:`read_tap_csv` (``"10.2 mV/g"``, ``"2.25 mV/N"``).
+    quantity : {"acceleration", "velocity", "displacement"}, optional
+        What the response is; it must agree with its unit.
+    sample_rate : str, pint.Quantity or float, optional
+        Samples per second (``"51.2 kHz"``; a plain number in Hz), checked
+        against the file's rate or time vector when it has one.
+    force_column, response_column : int or str, optional
+        The force and response vectors by name or 1-based index among the
+        file's vectors, when their units do not tell.
+
+    Returns
+    -------
+    TapRecord
+        In SI units; ``source`` is the file name.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the file and the variable: a version 7.3 file, no vectors, a
+        force or response without its unit, no or several candidates for a
+        channel, no time vector and no sample rate, contradicting rates,
+        NaN samples, vectors of different lengths.
+    """
+    from ._tap_mat import mat_record
+
+    data = read_bytes(path, "tap record", MAX_RECORD_BYTES)
+    return mat_record(path, data, sensitivity, hammer_sensitivity, quantity, sample_rate, force_column,
+                      response_column)
 
 
 _FORCE_TYPES = (9, 13)
