@@ -251,6 +251,18 @@ def test_lvm_one_segment(tmp_path, x_columns, sep, decimal):
     assert record.force_column == "Hammer [N]" and record.response_column == "Accel [g]"
 
 
+def test_lvm_without_a_line_of_names(tmp_path):
+    t, f, a = samples()
+    f, a = np.round(f, 6), np.round(a, 6)
+    text = lvm([(0.0, 1 / FS, f, a)], units=("N", "m/s^2"))
+    text = text.replace("X_Value\tHammer\tAccel\tComment\r\n", "")
+    path = tmp_path / "bare.lvm"
+    path.write_text(text, newline="")
+    (record,) = read_tap_lvm(path)
+    assert np.array_equal(record.force, f) and np.array_equal(record.response, a)
+    assert record.force_column == "channel 1 [N]"
+
+
 def test_lvm_segments_join_when_contiguous_and_split_when_not(tmp_path):
     _, f, a = samples(3000)
     dt = 1 / FS

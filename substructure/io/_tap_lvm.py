@@ -18,7 +18,7 @@ import attrs
 import numpy as np
 
 from ..errors import FileFormatError
-from ._tap_columns import Columns, name_and_unit
+from ._tap_columns import Columns, is_number, name_and_unit
 from ._tap_table import parse_rows
 
 _MARK = b"***End_of_Header***"
@@ -102,9 +102,14 @@ def read_segments(data: bytes, name: str) -> list[Segment]:
         names = [c.strip() for c in data[names_start:names_end].decode("utf-8", "replace").rstrip("\r").split(sep)]
         while names and (not names[-1] or names[-1] == "Comment"):
             names.pop()
+        body_start = names_end + 1
+        names_line = data.count(b"\n", 0, names_start) + 1
+        if names and all(is_number(c, decimal_comma) for c in names):  # no line of names: the rows start at once
+            body_start, names_line = names_start, line_of
+            x_named = x_columns == "One"
+            names = (["X_Value"] if x_named else []) + [f"channel {j + 1}" for j in range(len(names) - x_named)]
         # the rows end where the next segment's header starts: its first line of tags
         end = marks[k + 2] if k + 2 < len(marks) else len(data)
-        body_start = names_end + 1
         tag_line = _TAG_LINE.search(data, body_start, end) if end != len(data) else None
         body_end = tag_line.start() if tag_line else end
         x_cols = [j for j, n in enumerate(names) if n == "X_Value"]
@@ -137,7 +142,7 @@ def read_segments(data: bytes, name: str) -> list[Segment]:
             plain, unit = name_and_unit(names[j])
             channel_names.append(plain)
             channel_units.append(unit or (units[pos] if pos < len(units) else None))
-        segments.append(Segment(Columns(channel_names, channel_units, data.count(b"\n", 0, names_start) + 1),
+        segments.append(Segment(Columns(channel_names, channel_units, names_line),
                                 table[:, keep], delta_x, x0, data.count(b"\n", 0, body_start) + 1))
         seg_start = body_end
     return segments
