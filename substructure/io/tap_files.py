@@ -141,8 +141,8 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
     else:
         assert rate is not None
         time_s = np.arange(table.shape[0]) / rate[0]
-    return build_record(name, time_s, table[:, f_col], parsed[f_col], labels[f_col], table[:, r_col], parsed[r_col],
-                   labels[r_col], sensitivity, hammer_sensitivity, quantity)
+    return build_record(name, time_s, table[:, f_col], parsed[f_col], labels[f_col], table[:, r_col],
+                        parsed[r_col], labels[r_col], sensitivity, hammer_sensitivity, quantity)
 
 
 def _head(data: bytes, name: str) -> tuple[list[tuple[int, str]], int, int]:
@@ -284,7 +284,7 @@ def read_tap_lvm(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
         start = seg.x0 if abs(seg.x0) < 1e6 else 0.0  # an absolute time stamp (seconds since 1904) is not kept
         time_s = start + np.arange(table.shape[0]) * seg.delta_x
         records.append(build_record(name, time_s, table[:, f_col], parsed[f_col], labels[f_col], table[:, r_col],
-                               parsed[r_col], labels[r_col], sensitivity, hammer_sensitivity, quantity))
+                                    parsed[r_col], labels[r_col], sensitivity, hammer_sensitivity, quantity))
     return records
 
 
