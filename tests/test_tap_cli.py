@@ -114,7 +114,7 @@ def test_tap_errors_name_the_file(records, tmp_path, capsys):
     assert code == 2 and "--measurements needs --out" in err
     code, _, err = run(capsys, "tap", paths[0], "--sensitivity", "10 mV/g")
     assert code == 1 and "already in" in err and "tap1.csv" in err
-    code, _, err = run(capsys, "tap", tmp_path / "x.txt")
+    code, _, err = run(capsys, "tap", tmp_path / "x.xlsx")
     assert code == 2 and "expected a tap record in a .csv, .uff or .unv file" in err
 
 

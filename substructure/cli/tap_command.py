@@ -8,20 +8,33 @@ from pathlib import Path
 
 from ._common import UsageError, band_range_arg, check_outputs, check_plot, figures, print_json, save_figure
 
-_RECORD_SUFFIXES = (".csv", ".uff", ".unv")
+_TEXT_SUFFIXES = (".csv", ".txt", ".dat", ".asc")
+_UFF_SUFFIXES = (".uff", ".unv", ".uf")
+_RECORD_SUFFIXES = _TEXT_SUFFIXES + (".lvm", ".mat") + _UFF_SUFFIXES
 
 
-def _read(path: str, args: argparse.Namespace):
-    from ..io.tap_files import read_tap_csv, read_tap_uff
+def _read(path: str, args: argparse.Namespace) -> list:
+    from ..io.tap_files import read_tap_csv, read_tap_lvm, read_tap_mat, read_tap_uff
 
     suffix = Path(path).suffix.lower()
-    if suffix == ".csv":
-        if args.force_record is not None or args.response_record is not None:
-            raise UsageError("--force-record and --response-record choose records of a universal file, "
-                             f"not columns of {path}")
-        return read_tap_csv(path, args.sensitivity, args.hammer_sensitivity, args.quantity)
-    return read_tap_uff(path, args.sensitivity, args.hammer_sensitivity, args.quantity, args.force_record,
-                        args.response_record)
+    columns = dict(sample_rate=args.sample_rate, force_column=args.force_column,
+                   response_column=args.response_column)
+    if suffix in _UFF_SUFFIXES:
+        for option, value in (("--force-column", args.force_column), ("--response-column", args.response_column),
+                              ("--sample-rate", args.sample_rate)):
+            if value is not None:
+                raise UsageError(f"{option} applies to columns of a text record, not to {path}: a universal file "
+                                 "gives its records' sampling, and --force-record, --response-record choose them")
+        return [read_tap_uff(path, args.sensitivity, args.hammer_sensitivity, args.quantity, args.force_record,
+                             args.response_record)]
+    if args.force_record is not None or args.response_record is not None:
+        raise UsageError("--force-record and --response-record choose records of a universal file, "
+                         f"not columns of {path} (use --force-column and --response-column)")
+    if suffix == ".mat":
+        return [read_tap_mat(path, args.sensitivity, args.hammer_sensitivity, args.quantity, **columns)]
+    if suffix == ".lvm":
+        return read_tap_lvm(path, args.sensitivity, args.hammer_sensitivity, args.quantity, **columns)
+    return [read_tap_csv(path, args.sensitivity, args.hammer_sensitivity, args.quantity, **columns)]
 
 
 def _set_text(name: str, response: str, excitation: str, file: str, averages: int) -> str:
@@ -39,7 +52,8 @@ def run(args: argparse.Namespace) -> int:
 
     for path in args.records:
         if Path(path).suffix.lower() not in _RECORD_SUFFIXES:
-            raise UsageError(f"{path}: expected a tap record in a .csv, .uff or .unv file")
+            raise UsageError(f"{path}: expected a tap record in a .csv, .uff or .unv file (or text in .txt, "
+                             ".dat or .asc, a LabVIEW .lvm file, a MATLAB .mat file, a .uf universal file)")
     if args.out and Path(args.out).suffix.lower() != ".csv":
         raise UsageError(f"argument --out: {args.out!r}: expected a .csv file (frequency_hz,real,imag,coherence)")
     if args.measurements:
@@ -56,7 +70,7 @@ def run(args: argparse.Namespace) -> int:
     check_plot(args.plot)
     check_outputs([("--out", args.out), ("--measurements", args.measurements), ("--plot", args.plot)],
                   args.records, args.overwrite)
-    records = [_read(path, args) for path in args.records]
+    records = [record for path in args.records for record in _read(path, args)]
     result = process_taps(records, args.estimator, tap_length=args.tap_length,
                           pre_trigger=PRE_TRIGGER_S if args.pre_trigger is None else args.pre_trigger,
                           exponential=not args.no_exponential_window, tau=args.tau, band=args.band,
@@ -127,7 +141,9 @@ def add_parser(commands) -> None:
     """Add the ``tap`` subcommand to the subparsers ``commands``."""
     tap = commands.add_parser("tap", help="time records of hammer taps to an FRF with coherence")
     tap.add_argument("records", nargs="+", metavar="RECORD",
-                     help="tap records: CSV (time [s],force [N],acceleration [m/s^2]) or UFF type-58 time records")
+                     help="tap records: CSV or text (time [s],force [N],acceleration [m/s^2], a preamble "
+                     "allowed), LabVIEW .lvm, MATLAB .mat (vectors with <name>_unit texts), or UFF type-58 time "
+                     "records")
     tap.add_argument("--out", metavar="FRF.csv", help="write the receptance with its coherence column")
     tap.add_argument("--measurements", metavar="SET.toml", help="write a measurement set naming --out")
     tap.add_argument("--response", metavar="POINT", help="the response point of the measurement set")
@@ -142,6 +158,15 @@ def add_parser(commands) -> None:
                      "e.g. '10.2 mV/g'")
     tap.add_argument("--hammer-sensitivity", metavar="VALUE",
                      help="hammer sensitivity for a force channel in volts, e.g. '2.25 mV/N'")
+    tap.add_argument("--sample-rate", metavar="VALUE",
+                     help="text and .mat records without a time column: samples per second, e.g. '51.2 kHz' "
+                     "(refused when the file states another rate)")
+    tap.add_argument("--force-column", metavar="NAME|INDEX",
+                     help="text, .lvm and .mat records: the force column (or vector) by name or 1-based index, "
+                     "when the file has more than one candidate")
+    tap.add_argument("--response-column", metavar="NAME|INDEX",
+                     help="text, .lvm and .mat records: the response column (or vector) by name or 1-based index "
+                     "(a second accelerometer, a trigger channel)")
     tap.add_argument("--force-record", type=int, metavar="N", help="UFF: 0-based index of the force record")
     tap.add_argument("--response-record", type=int, metavar="N", help="UFF: 0-based index of the response record")
     tap.add_argument("--tap-length", type=float, metavar="SECONDS",

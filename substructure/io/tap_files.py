@@ -18,44 +18,42 @@ when a file holds more.
 from __future__ import annotations
 
 import os
-import re
 from typing import Any
 
 import numpy as np
 
+from .._files import decode_text
 from ..errors import FileFormatError, SubstructureError
-from ..tap.records import RESPONSE_QUANTITIES, TapRecord, channel_to_si, unit_of
-from . import check_readable_file, read_text
+from ..tap.records import RESPONSE_QUANTITIES, TIME_STEP_TOLERANCE, TapRecord, channel_to_si, unit_of
+from . import check_readable_file, read_bytes
+from ._tap_columns import (MAX_PREAMBLE_LINES, NO_UNIT, Columns, choose, header_cells, is_row, is_unit_row,
+                           line_separator, name_and_unit, rate_from_lines)
+from ._tap_build import (RESPONSES, ROUNDED_TIME_TOLERANCE, build_record, check_quantity_option, option_rate,
+                         regular, units_of_columns)
+from ._tap_table import finite_rows, parse_rows
 
-__all__ = ["read_tap_csv", "read_tap_uff"]
+__all__ = ["read_tap_csv", "read_tap_lvm", "read_tap_mat", "read_tap_uff", "MAX_RECORD_BYTES", "ROUNDED_TIME_TOLERANCE"]
 
-_COLUMN = re.compile(r"^\s*([^\[\]]*?)\s*\[\s*([^\[\]]*?)\s*\]\s*$")
-_COLUMN_PARENS = re.compile(r"^\s*([^()\[\]]*?)\s*\(\s*([^()\[\]]*?)\s*\)\s*$")  # 'time (s)', as exports write it
-_RESPONSES = ("acceleration", "velocity", "displacement")
-
-
-def _check_quantity_option(quantity: str | None, found: str, where: str) -> None:
-    if quantity is None:
-        return
-    if quantity not in RESPONSE_QUANTITIES:
-        raise FileFormatError(f"quantity: got {quantity!r}; expected one of {', '.join(RESPONSE_QUANTITIES)}")
-    if quantity != found:
-        raise FileFormatError(f"{where} holds {'an' if found[0] in 'aeiou' else 'a'} {found}, and the quantity "
-                              f"option says {quantity}; leave the option out or fix the file")
-
-
+MAX_RECORD_BYTES = 2**31
+"""The largest tap record file read (2 GiB: ten minutes of three channels at 51.2 kHz written as text)."""
 def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensitivity: Any = None,
-                 quantity: str | None = None) -> TapRecord:
-    """Read a CSV file of one tap record (or a long record of several taps).
+                 quantity: str | None = None, sample_rate: Any = None, force_column: Any = None,
+                 response_column: Any = None) -> TapRecord:
+    """Read a CSV or text file of one tap record (or a long record of several taps).
 
     Parameters
     ----------
     path : str or path-like
         The file: header ``time [s],force [N],acceleration [m/s^2]`` (units
-        in brackets, or in parentheses ``time (s)``; columns separated by
+        in brackets, in parentheses ``time (s)``, ``Force/N``, ``Force in
+        N``, or in a row of their own under the names; columns separated by
         commas, or by semicolons or tabs with decimal commas allowed in the
-        cells; the response may be ``[g]``, velocity ``[m/s]``,
-        ``[mm/s]``, displacement ``[m]``, ``[um]``, or a voltage).
+        cells, or by whitespace; the response may be ``[g]``, velocity
+        ``[m/s]``, ``[mm/s]``, displacement ``[m]``, ``[um]``, or a
+        voltage).  Metadata lines may stand before the header (the header is
+        the last line above the first row of numbers); without a time
+        column, the sample rate comes from such a line (``Sample rate: 51200
+        Hz``, ``dt: 1.953125e-05 s``) or from ``sample_rate``.
     sensitivity : str or pint.Quantity, optional
         The response sensor's sensitivity, e.g. ``"10.2 mV/g"``: required
         for a response column in ``mV`` or ``V``, refused otherwise.
@@ -63,6 +61,13 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
         The hammer's, e.g. ``"2.25 mV/N"``, for a force column in volts.
     quantity : {"acceleration", "velocity", "displacement"}, optional
         What the response is; it must agree with the column's unit.
+    sample_rate : str, pint.Quantity or float, optional
+        Samples per second, e.g. ``"51.2 kHz"`` (a plain number is in Hz):
+        for a file without a time column; when the file states a rate or
+        has a time column too, they must agree.
+    force_column, response_column : int or str, optional
+        The force and response columns by name or 1-based index, for files
+        of more than one candidate (a second response channel, a trigger).
 
     Returns
     -------
@@ -73,89 +78,259 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
     ------
     FileFormatError
         Naming the file, the line and the column: an empty file, a column
-        without a unit, columns that are not one time, one force and one
-        response, a cell that is not a number, NaN samples, a contradiction
-        between the header and the options.
+        without a unit, columns that are not one time (or a sample rate),
+        one force and one response, a cell that is not a number, NaN
+        samples, a contradiction between the header and the options.
     """
     name = os.fspath(path)
-    lines = read_text(path).splitlines()
-    numbered = [(k + 1, line) for k, line in enumerate(lines) if line.strip() and not line.lstrip().startswith("#")]
-    if not numbered:
+    data = read_bytes(path, "tap record", MAX_RECORD_BYTES)
+    if data[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        data = decode_text(data, name).encode("utf-8")
+    elif data[:3] == b"\xef\xbb\xbf":
+        data = data[3:]
+    head, start, first_line = _head(data, name)
+    row_end = data.find(b"\n", start)
+    row = data[start:len(data) if row_end < 0 else row_end].decode("utf-8", "replace").rstrip("\r")
+    sep = line_separator(row)
+    decimal_comma = sep in ("\t", ";")
+    ncols = len([c for c in (row.split() if sep is None else row.split(sep))]) - \
+        (1 if sep is not None and len(row.split(sep)) > 1 and not row.split(sep)[-1].strip() else 0)
+    content = [(n, t) for n, t in head if t.strip() and not t.lstrip().startswith("#")]
+    if not content:
+        raise FileFormatError(f"{name}, line {first_line}: numbers with no header above them; expected a header "
+                              "naming each column, e.g. 'time [s],force [N],acceleration [m/s^2]'")
+    h_line, h_text = content[-1]
+    cells = header_cells(h_text.lstrip("\ufeff"), sep, ncols)
+    preamble_end = h_line
+    if len(content) > 1 and is_unit_row(cells):
+        above = header_cells(content[-2][1].lstrip("\ufeff"), sep, ncols)
+        if len(above) == len(cells) and all(name_and_unit(c)[1] is None for c in above):
+            columns = Columns(above, [None if c.strip("[]() ").lower() in NO_UNIT else c.strip("[]() ")
+                                     for c in cells], content[-2][0])
+            preamble_end = content[-2][0]
+        else:
+            columns = _columns(cells, h_line)
+    else:
+        columns = _columns(cells, h_line)
+    if len(columns.names) != ncols:
+        raise FileFormatError(f"{name}, line {columns.line}: the header names {len(columns.names)} columns "
+                              f"({', '.join(columns.labels)}), the first row (line {first_line}) has {ncols} values")
+    rate = _stated_rate([(n, t.lstrip("#")) for n, t in head if n < preamble_end], name, decimal_comma, sample_rate)
+    parsed, dims, errors = units_of_columns(columns, name)
+    t_col, f_col, r_col = choose(columns, parsed, dims, name, force_column, response_column, rate is not None)
+    labels = columns.labels
+    for k in (t_col, f_col, r_col):
+        if k is None:
+            continue
+        if columns.units[k] is None:
+            raise FileFormatError(f"{name}, line {columns.line}: column {k + 1} {columns.names[k]!r} has no unit in "
+                                  "brackets; expected e.g. 'time [s]', 'force [N]', 'acceleration [m/s^2]' "
+                                  "(separated by commas, semicolons or tabs; or the units in a row under the names)")
+        if errors[k]:
+            raise FileFormatError(f"{name}, line {columns.line}: {errors[k]} (column {labels[k]!r})")
+    table = parse_rows(data, first_line, ncols, sep, decimal_comma, labels, name, start)
+    used = [k for k in (t_col, f_col, r_col) if k is not None]
+    finite_rows(table[:, used], first_line, [labels[k] for k in used], name, data, start)
+    if t_col is not None:
+        time_s = regular(table[:, t_col] * (1.0 * parsed[t_col]).m_as("s"))
+        if rate is not None and time_s.size > 1 and time_s[-1] > time_s[0]:
+            from_time = (time_s.size - 1) / (time_s[-1] - time_s[0])
+            if abs(from_time - rate[0]) > TIME_STEP_TOLERANCE * rate[0]:
+                raise FileFormatError(f"{name}: the time column {labels[t_col]!r} is sampled at {from_time:.10g} "
+                                      f"Hz, {rate[1]} says {rate[0]:.10g} Hz; leave the option out or fix the file")
+    else:
+        assert rate is not None
+        time_s = np.arange(table.shape[0]) / rate[0]
+    return build_record(name, time_s, table[:, f_col], parsed[f_col], labels[f_col], table[:, r_col],
+                        parsed[r_col], labels[r_col], sensitivity, hammer_sensitivity, quantity)
+
+
+def _head(data: bytes, name: str) -> tuple[list[tuple[int, str]], int, int]:
+    """The lines above the first row of numbers, the byte offset of that row and its line number."""
+    head: list[tuple[int, str]] = []
+    pos, number = 0, 0
+    not_first: tuple[int, str] | None = None
+    while pos < len(data):
+        end = data.find(b"\n", pos)
+        end = len(data) if end < 0 else end
+        number += 1
+        try:
+            text = data[pos:end].decode("utf-8").rstrip("\r")
+        except UnicodeDecodeError as exc:
+            raise FileFormatError(f"{name}, line {number}: not UTF-8 text (byte {pos + exc.start}: "
+                                  f"{data[pos + exc.start:pos + exc.start + 1]!r}); save the file as UTF-8") from None
+        stripped = text.strip()
+        if stripped and not stripped.startswith("#") and is_row(text):
+            return head, pos, number
+        if stripped and not stripped.startswith("#") and not_first is None and is_row(text, first=False):
+            not_first = number, text  # numbers after a first cell that is not one: a clock time, a date?
+        head.append((number, text))
+        if number >= MAX_PREAMBLE_LINES:
+            break
+        pos = end + 1
+    content = [t for _, t in head if t.strip() and not t.lstrip().startswith("#")]
+    if not content:
         raise FileFormatError(f"{name}: the file is empty; expected a header such as "
                               "'time [s],force [N],acceleration [m/s^2]' and one row per sample")
-    header_line, header = numbered[0]
-    header = header.lstrip("\ufeff")
-    # the separator the header uses: a comma, or (acquisition systems of decimal-comma locales) a semicolon
-    # or a tab, whose cells may then write 0,5 for 0.5
-    sep = "," if "," in header else ";" if ";" in header else "\t" if "\t" in header else ","
-    names, units = [], []
-    for k, cell in enumerate(header.split(sep)):
-        match = _COLUMN.match(cell) or _COLUMN_PARENS.match(cell)
-        if not match or not match.group(1) or not match.group(2):
-            raise FileFormatError(f"{name}, line {header_line}: column {k + 1} {cell.strip()!r} has no unit in "
-                                  "brackets; expected e.g. 'time [s]', 'force [N]', 'acceleration [m/s^2]' "
-                                  "(separated by commas, semicolons or tabs)")
-        names.append(match.group(1))
-        units.append(match.group(2))
-    labels = [f"{n} [{u}]" for n, u in zip(names, units)]
-    if len(names) != 3:
-        raise FileFormatError(f"{name}, line {header_line}: {len(names)} columns ({', '.join(labels)}); expected "
-                              "three: time, force and one response")
-    parsed = []
-    for label, unit in zip(labels, units):
-        try:
-            parsed.append(unit_of(unit, f"{name}: column {label!r}"))
-        except SubstructureError as exc:
-            raise FileFormatError(f"{name}, line {header_line}: {str(exc).split(': ', 2)[-1]} (column {label!r})") \
-                from None
-    times = [k for k, u in enumerate(parsed) if (1.0 * u).check("[time]")]
-    if len(times) != 1:
-        raise FileFormatError(f"{name}, line {header_line}: {len(times)} columns in units of time "
-                              f"({', '.join(labels)}); expected one, e.g. 'time [s]'")
-    forces = [k for k, u in enumerate(parsed) if k not in times and (
-        (1.0 * u).check("[force]") or names[k].lower() in ("force", "hammer"))]
-    if len(forces) != 1:
-        raise FileFormatError(f"{name}, line {header_line}: {len(forces)} force columns ({', '.join(labels)}); "
-                              "expected one column in N (or named 'force' or 'hammer', in mV with a hammer "
-                              "sensitivity)")
-    (t_col,), (f_col,) = times, forces
-    r_col = ({0, 1, 2} - {t_col, f_col}).pop()
-    rows = numbered[1:]
-    if not rows:
-        raise FileFormatError(f"{name}: a header and no samples; expected one row per sample")
-    cells = [line.split(sep) if sep == "," else line.replace(",", ".").split(sep) for _, line in rows]
-    for (number, line), row in zip(rows, cells):
-        if len(row) != 3:
-            raise FileFormatError(f"{name}, line {number}: {len(row)} value(s); expected 3 ({', '.join(labels)})")
-    try:
-        table = np.array(cells, dtype=np.float64)
-    except ValueError:
-        for (number, _), row in zip(rows, cells):
-            for label, cell in zip(labels, row):
-                try:
-                    float(cell)
-                except ValueError:
-                    raise FileFormatError(f"{name}, line {number}: column {label!r} is {cell.strip()!r}; "
-                                          "expected a number") from None
-        raise  # pragma: no cover
-    bad = ~np.isfinite(table)
-    if bad.any():
-        row, column = np.argwhere(bad)[0]
-        raise FileFormatError(f"{name}, line {rows[row][0]}: column {labels[column]!r} is {table[row, column]}; "
-                              "expected a finite number (a gap in the acquisition?)")
-    try:
-        time_s = table[:, t_col] * (1.0 * parsed[t_col]).m_as("s")
-        force, _ = channel_to_si(table[:, f_col], parsed[f_col], f"{name}: column {labels[f_col]!r}", ("force",),
-                                 hammer_sensitivity, "hammer sensitivity (--hammer-sensitivity)")
-        response, found = channel_to_si(table[:, r_col], parsed[r_col], f"{name}: column {labels[r_col]!r}",
-                                        _RESPONSES, sensitivity, "sensitivity (--sensitivity)")
-        _check_quantity_option(quantity, found, f"{name}: column {labels[r_col]!r}")
-        return TapRecord(time_s, force, response, found, name, labels[f_col], labels[r_col])
-    except FileFormatError:
-        raise
-    except SubstructureError as exc:
-        message = str(exc)
-        raise FileFormatError(message if message.startswith(name) else f"{name}: {message}") from None
+    if not_first is not None:
+        sep = line_separator(not_first[1])
+        cell = (not_first[1].split() if sep is None else not_first[1].split(sep))[0].strip()
+        raise FileFormatError(f"{name}, line {not_first[0]}: the first cell {cell!r} is not a number (a clock time "
+                              "or a date?); expected rows of numbers: a time in s, or no time column and the sample "
+                              "rate (--sample-rate)")
+    if number >= MAX_PREAMBLE_LINES:
+        raise FileFormatError(f"{name}: no row of numbers in the first {MAX_PREAMBLE_LINES} lines; expected a "
+                              "header and one row per sample")
+    raise FileFormatError(f"{name}: a header and no samples; expected one row per sample")
+
+
+def _columns(cells: list[str], line: int) -> Columns:
+    pairs = [name_and_unit(c) for c in cells]
+    return Columns([n for n, _ in pairs], [u for _, u in pairs], line)
+
+
+def _stated_rate(preamble: list[tuple[int, str]], name: str, decimal_comma: bool,
+                 sample_rate: Any) -> tuple[float, str] | None:
+    """The sample rate (Hz) and what states it: the option, the preamble, both when they agree, or None."""
+    stated = rate_from_lines(preamble, name, decimal_comma)
+    if sample_rate is None:
+        return None if stated is None else (stated[0], f"line {stated[1]}")
+    hz = option_rate(sample_rate)
+    if stated is not None and abs(stated[0] - hz) > 1e-6 * hz:
+        raise FileFormatError(f"{name}, line {stated[1]}: the file says {stated[0]:.10g} Hz, --sample-rate "
+                              f"{hz:.10g} Hz; leave the option out or fix the file")
+    return hz, "--sample-rate"
+
+
+def read_tap_lvm(path: str | os.PathLike, sensitivity: Any = None, hammer_sensitivity: Any = None,
+                 quantity: str | None = None, sample_rate: Any = None, force_column: Any = None,
+                 response_column: Any = None) -> list[TapRecord]:
+    """Read a LabVIEW measurement file (``.lvm``): one record per run of contiguous segments.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file: the text format of LabVIEW's Write Measurement File
+        (``Separator`` Tab or Comma, ``Decimal_Separator``, ``X_Columns`` No,
+        One or Multi; each segment's ``Delta_X`` gives the time step, its
+        ``Y_Unit_Label`` or the column names the units).
+    sensitivity, hammer_sensitivity : str or pint.Quantity, optional
+        As for :func:`read_tap_csv` (``"10.2 mV/g"``, ``"2.25 mV/N"``).
+    quantity : {"acceleration", "velocity", "displacement"}, optional
+        What the response is; it must agree with the channel's unit.
+    sample_rate : str, pint.Quantity or float, optional
+        Checked against the file's ``Delta_X`` (Hz; ``"51.2 kHz"``).
+    force_column, response_column : int or str, optional
+        The channels by name or 1-based index (the x column not counted), as
+        for :func:`read_tap_csv`.
+
+    Returns
+    -------
+    list of TapRecord
+        Segments of the same channels whose ``X0`` continues the previous
+        segment's time axis are one record; a segment that starts anew
+        (another acquisition, a tap of its own) is a record of its own.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the file, the segment or line and the column, as for
+        :func:`read_tap_csv`, and for a file that is not a LabVIEW
+        measurement file or a segment without ``Delta_X``.
+    """
+    from ._tap_lvm import read_segments
+
+    name = os.fspath(path)
+    data = read_bytes(path, "tap record", MAX_RECORD_BYTES)
+    if data[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        data = decode_text(data, name).encode("utf-8")
+    elif data[:3] == b"\xef\xbb\xbf":
+        data = data[3:]
+    segments = read_segments(data, name)
+    groups: list[list[Any]] = []
+    for seg in segments:
+        last = groups[-1][-1] if groups else None
+        if last is not None and seg.columns.names == last.columns.names and seg.columns.units == last.columns.units \
+                and abs(seg.delta_x - last.delta_x) <= 1e-9 * last.delta_x \
+                and abs(seg.x0 - (last.x0 + last.table.shape[0] * last.delta_x)) <= 0.5 * last.delta_x:
+            groups[-1].append(seg)
+        else:
+            groups.append([seg])
+    records = []
+    for group in groups:
+        seg = group[0]
+        hz = 1.0 / seg.delta_x
+        if sample_rate is not None and abs(option_rate(sample_rate) - hz) > 1e-6 * hz:
+            raise FileFormatError(f"{name}, line {seg.columns.line}: Delta_X {seg.delta_x!r} s is {hz:.10g} Hz, "
+                                  f"--sample-rate {option_rate(sample_rate):.10g} Hz; leave the option out or fix "
+                                  "the file")
+        parsed, dims, errors = units_of_columns(seg.columns, name)
+        _, f_col, r_col = choose(seg.columns, parsed, dims, name, force_column, response_column, True)
+        labels = seg.columns.labels
+        for k in (f_col, r_col):
+            if seg.columns.units[k] is None:
+                raise FileFormatError(f"{name}, line {seg.columns.line}: channel {labels[k]!r} has no unit; "
+                                      "expected a Y_Unit_Label line in the segment header (e.g. N, g, m/s^2, mV) "
+                                      "or the unit in the name, e.g. 'Force (N)'")
+            if errors[k]:
+                raise FileFormatError(f"{name}, line {seg.columns.line}: {errors[k]} (channel {labels[k]!r})")
+        table = np.concatenate([s.table for s in group]) if len(group) > 1 else seg.table
+        bad = ~np.isfinite(table[:, [f_col, r_col]])
+        if bad.any():
+            row, col = np.argwhere(bad)[0]
+            raise FileFormatError(f"{name}, segment starting on line {seg.first_line}, row {row + 1}: channel "
+                                  f"{labels[(f_col, r_col)[col]]!r} is {table[row, (f_col, r_col)[col]]}; expected "
+                                  "a finite number (a gap in the acquisition?)")
+        start = seg.x0 if abs(seg.x0) < 1e6 else 0.0  # an absolute time stamp (seconds since 1904) is not kept
+        time_s = start + np.arange(table.shape[0]) * seg.delta_x
+        records.append(build_record(name, time_s, table[:, f_col], parsed[f_col], labels[f_col], table[:, r_col],
+                                    parsed[r_col], labels[r_col], sensitivity, hammer_sensitivity, quantity))
+    return records
+
+
+def read_tap_mat(path: str | os.PathLike, sensitivity: Any = None, hammer_sensitivity: Any = None,
+                 quantity: str | None = None, sample_rate: Any = None, force_column: Any = None,
+                 response_column: Any = None) -> TapRecord:
+    """Read a tap record from a MATLAB file (``.mat``, versions 4 to 7; 7.3 is refused with how to re-save).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file: vectors of samples by name (a time vector ``time`` or
+        ``t``, in s unless ``time_unit`` says otherwise), each force and
+        response vector with its unit in a text variable ``<name>_unit``
+        (``force_unit = 'N'``, ``acc_unit = 'g'``, ``'mV'`` with a
+        sensitivity); without a time vector, a scalar ``fs`` or
+        ``sample_rate`` (Hz) or ``dt`` (s).
+    sensitivity, hammer_sensitivity : str or pint.Quantity, optional
+        As for :func:`read_tap_csv` (``"10.2 mV/g"``, ``"2.25 mV/N"``).
+    quantity : {"acceleration", "velocity", "displacement"}, optional
+        What the response is; it must agree with its unit.
+    sample_rate : str, pint.Quantity or float, optional
+        Samples per second (``"51.2 kHz"``; a plain number in Hz), checked
+        against the file's rate or time vector when it has one.
+    force_column, response_column : int or str, optional
+        The force and response vectors by name or 1-based index among the
+        file's vectors, when their units do not tell.
+
+    Returns
+    -------
+    TapRecord
+        In SI units; ``source`` is the file name.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the file and the variable: a version 7.3 file, no vectors, a
+        force or response without its unit, no or several candidates for a
+        channel, no time vector and no sample rate, contradicting rates,
+        NaN samples, vectors of different lengths.
+    """
+    from ._tap_mat import mat_record
+
+    data = read_bytes(path, "tap record", MAX_RECORD_BYTES)
+    return mat_record(path, data, sensitivity, hammer_sensitivity, quantity, sample_rate, force_column,
+                      response_column)
 
 
 _FORCE_TYPES = (9, 13)
@@ -195,7 +370,7 @@ def read_tap_uff(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
     """
     import pyuff
 
-    name = check_readable_file(path, "tap record")
+    name = check_readable_file(path, "tap record", MAX_RECORD_BYTES)
     try:
         sets = pyuff.UFF(name).read_sets()
     except Exception as exc:  # pyuff raises many kinds for broken files
@@ -233,7 +408,14 @@ def read_tap_uff(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
                                   f"{records[k].get('ordinate_axis_units_lab')!r} says {by_unit}; fix one")
         return by_type or by_unit
 
+    for k, r in enumerate(records):
+        _check_abscissa(name, k, r)
     kinds = [kind(k) for k in range(len(records))]
+    if len(records) == 2 and force_record is None and response_record is None and kinds.count(None) == 1 \
+            and unit(kinds.index(None)) is not None:
+        # two records, one of them known by its type or unit, the other in volts or unlabelled: the other channel
+        known = 0 if kinds[0] is not None else 1
+        kinds[1 - known] = ("force" if kinds[known] in RESPONSES else "response") if kinds[known] else None
     if force_record is None:
         found = [k for k, q in enumerate(kinds) if q == "force"]
         if len(found) != 1:
@@ -241,7 +423,7 @@ def read_tap_uff(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
                                   "give the force record's index (--force-record, 0-based)")
         force_record = found[0]
     if response_record is None:
-        found = [k for k, q in enumerate(kinds) if q in _RESPONSES and k != force_record]
+        found = [k for k, q in enumerate(kinds) if (q in RESPONSES or q == "response") and k != force_record]
         if len(found) != 1:
             raise FileFormatError(f"{name}: {len(found)} response records among {len(records)} type-58 records; "
                                   "give the response record's index (--response-record, 0-based)")
@@ -263,20 +445,45 @@ def read_tap_uff(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
                                  hammer_sensitivity, "hammer sensitivity (--hammer-sensitivity)")
         r_unit = unit(response_record)
         if r_unit is None:
-            said = kinds[response_record] or quantity
+            said = kinds[response_record] if kinds[response_record] in RESPONSES else quantity
             if said is None:
                 raise FileFormatError(f"{name}: {labels[1]} has neither a unit label nor a specific data type; "
                                       "give the quantity (--quantity)")
             r_unit = unit_of(RESPONSE_QUANTITIES[said][0], name)
         response, found_q = channel_to_si(np.real(np.asarray(r_set["data"])), r_unit, f"{name}: {labels[1]}",
-                                          _RESPONSES, sensitivity, "sensitivity (--sensitivity)")
-        if kinds[response_record] in _RESPONSES and kinds[response_record] != found_q:
+                                          RESPONSES, sensitivity, "sensitivity (--sensitivity)")
+        if kinds[response_record] in RESPONSES and kinds[response_record] != found_q:
             raise FileFormatError(f"{name}: {labels[1]}: the specific data type says {kinds[response_record]}, the "
                                   f"sensitivity makes it {found_q}")
-        _check_quantity_option(quantity, found_q, f"{name}: {labels[1]}")
+        check_quantity_option(quantity, found_q, f"{name}: {labels[1]}")
         return TapRecord(t, force, response, found_q, name, labels[0], labels[1])
     except FileFormatError:
         raise
     except SubstructureError as exc:
         message = str(exc)
         raise FileFormatError(message if message.startswith(name) else f"{name}: {message}") from None
+
+
+def _check_abscissa(name: str, k: int, record: dict) -> None:
+    """Refuse a record whose abscissa is not time (by its data type or unit label) or not uniformly spaced."""
+    spec = int(record.get("abscissa_spec_data_type", 0) or 0)
+    label = str(record.get("abscissa_axis_units_lab", "") or "").strip()
+    if spec not in (0, 17):
+        raise FileFormatError(f"{name}, record {k}: abscissa of specific data type {spec}; expected 17 (time) "
+                              "or 0: a tap record is sampled in time")
+    if label and label.upper() not in ("NONE", "N/A", "NA", "-"):
+        try:
+            time_like = (1.0 * unit_of(label, f"{name}, record {k}")).check("[time]")
+        except SubstructureError:
+            time_like = False
+        if not time_like:
+            raise FileFormatError(f"{name}, record {k}: abscissa in {label!r}; expected a time in s")
+    x = np.asarray(record.get("x", []), dtype=np.float64)
+    if x.size > 2:
+        step = np.diff(x)
+        mean = (x[-1] - x[0]) / (x.size - 1)
+        if not mean > 0 or np.any(np.abs(step - mean) > TIME_STEP_TOLERANCE * mean):
+            worst = int(np.argmax(np.abs(step - mean))) + 1
+            raise FileFormatError(f"{name}, record {k}: uneven abscissa (sample {worst}: step "
+                                  f"{float(step[worst - 1])!r} s, mean {float(mean)!r} s); expected uniform sampling "
+                                  "in time")

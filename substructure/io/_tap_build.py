@@ -1,0 +1,119 @@
+"""What the tap record readers share: the quantity of a unit, the sample rate option, rounded times, the record.
+
+Private to :mod:`substructure.io.tap_files` and its helper modules.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..errors import FileFormatError, SubstructureError
+from ..tap.records import RESPONSE_QUANTITIES, TapRecord, channel_to_si, unit_of
+from ._tap_columns import Columns
+
+RESPONSES = ("acceleration", "velocity", "displacement")
+
+
+def check_quantity_option(quantity: str | None, found: str, where: str) -> None:
+    if quantity is None:
+        return
+    if quantity not in RESPONSE_QUANTITIES:
+        raise FileFormatError(f"quantity: got {quantity!r}; expected one of {', '.join(RESPONSE_QUANTITIES)}")
+    if quantity != found:
+        raise FileFormatError(f"{where} holds {'an' if found[0] in 'aeiou' else 'a'} {found}, and the quantity "
+                              f"option says {quantity}; leave the option out or fix the file")
+
+
+ROUNDED_TIME_TOLERANCE = 0.25
+"""Largest distance, in time steps, of a written time from the uniform grid fitted to them all
+(times written with few digits, e.g. six decimals at 51.2 kHz); farther (a lost or repeated sample) is refused."""
+
+
+def regular(time_s: np.ndarray) -> np.ndarray:
+    """The uniform grid fitted to the times when every time lies within a quarter step of it.
+
+    Times rounded to the digits a file writes (0.000020 for 1.953125e-05 s)
+    make uneven steps of a uniform clock; the grid is what was sampled.  A
+    time farther from the grid is left as written, for the record's own
+    check to refuse.
+    """
+    n = time_s.size
+    if n < 3 or not time_s[-1] > time_s[0]:
+        return time_s
+    k = np.arange(n, dtype=np.float64)
+    step = float(np.dot(k - k.mean(), time_s - time_s.mean()) / np.dot(k - k.mean(), k - k.mean()))
+    grid = (time_s.mean() - step * k.mean()) + k * step  # the least-squares line: the rounding averages out
+    if not step > 0:
+        return time_s
+    if np.max(np.abs(time_s - grid)) <= ROUNDED_TIME_TOLERANCE * step:
+        return grid
+    return time_s
+
+
+def units_of_columns(columns: Columns, name: str) -> tuple[list[Any], list[str | None], list[str | None]]:
+    """Each column's pint unit, its quantity and the message of a unit pint cannot read (None when read)."""
+    parsed: list[Any] = []
+    dims: list[str | None] = []
+    errors: list[str | None] = []
+    for label, unit in zip(columns.labels, columns.units):
+        if unit is None:
+            parsed.append(None)
+            dims.append(None)
+            errors.append(None)
+            continue
+        try:
+            u = unit_of(unit, label)
+        except SubstructureError as exc:
+            message = str(exc)
+            parsed.append(None)
+            dims.append(None)
+            errors.append(message[message.find("cannot read"):])
+            continue
+        parsed.append(u)
+        dims.append(quantity_of(u))
+        errors.append(None)
+    return parsed, dims, errors
+
+
+def quantity_of(unit: Any) -> str | None:
+    q = 1.0 * unit
+    for dim, kind in (("[time]", "time"), ("[force]", "force"), ("[electric_potential]", "voltage"),
+                      ("[acceleration]", "acceleration"), ("[velocity]", "velocity"), ("[length]", "displacement")):
+        if q.check(dim):
+            return kind
+    return None
+
+
+def option_rate(sample_rate: Any) -> float:
+    """The ``sample_rate`` option in Hz: a quantity or text with its unit (``"51.2 kHz"``), or a number in Hz."""
+    from ..errors import InvalidValueError
+    from ..units import frequency_hz
+
+    if isinstance(sample_rate, (int, float, np.integer, np.floating)) and not isinstance(sample_rate, bool):
+        hz = float(sample_rate)
+    else:
+        hz = frequency_hz(sample_rate, "sample rate (--sample-rate)")
+    if not np.isfinite(hz) or hz <= 0:
+        raise InvalidValueError(f"sample rate (--sample-rate): got {sample_rate!r}; expected a positive rate, "
+                                "e.g. '51.2 kHz'")
+    return hz
+
+
+def build_record(name: str, time_s: np.ndarray, force_values: np.ndarray, force_unit: Any, force_label: str,
+            response_values: np.ndarray, response_unit: Any, response_label: str, sensitivity: Any,
+            hammer_sensitivity: Any, quantity: str | None) -> TapRecord:
+    """The record in SI units from two channels in their units; unit errors name the file and the column."""
+    try:
+        force, _ = channel_to_si(force_values, force_unit, f"{name}: column {force_label!r}", ("force",),
+                                 hammer_sensitivity, "hammer sensitivity (--hammer-sensitivity)")
+        response, found = channel_to_si(response_values, response_unit, f"{name}: column {response_label!r}",
+                                        RESPONSES, sensitivity, "sensitivity (--sensitivity)")
+        check_quantity_option(quantity, found, f"{name}: column {response_label!r}")
+        return TapRecord(time_s, force, response, found, name, force_label, response_label)
+    except FileFormatError:
+        raise
+    except SubstructureError as exc:
+        message = str(exc)
+        raise FileFormatError(message if message.startswith(name) else f"{name}: {message}") from None

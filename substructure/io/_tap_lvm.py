@@ -1,0 +1,148 @@
+"""The structure of a LabVIEW measurement file (``.lvm``): its header, its segments and their tables.
+
+The text format National Instruments documents for the Write/Read LabVIEW
+Measurement File Express VIs: a file header from ``LabVIEW Measurement``
+to ``***End_of_Header***`` (tags ``Separator`` ``Tab`` or ``Comma``,
+``Decimal_Separator``, ``X_Columns`` ``No``, ``One`` or ``Multi``), then
+segments, each a header of tags with one value per channel (``Channels``,
+``Samples``, ``Y_Unit_Label``, ``X_Dimension``, ``X0``, ``Delta_X``) ended
+by ``***End_of_Header***``, a line naming the columns (``X_Value`` when the
+file has an x column, the channels, ``Comment``) and the rows.
+"""
+
+from __future__ import annotations
+
+import re
+
+import attrs
+import numpy as np
+
+from ..errors import FileFormatError
+from ._tap_columns import Columns, is_number, name_and_unit
+from ._tap_table import parse_rows
+
+_MARK = b"***End_of_Header***"
+_TAG_LINE = re.compile(rb"^[ \t]*(?![-+]?(?:nan|inf)(?:inity)?\b)[A-Za-z_*]", re.M | re.I)  # not NaN, Inf
+_UNIT_WORDS = {"volts": "V", "volt": "V", "millivolts": "mV", "newtons": "N", "newton": "N", "seconds": "s",
+               "second": "s", "sec": "s"}
+
+
+@attrs.frozen
+class Segment:
+    """One segment: its columns (the x column dropped), their numbers, its time step, start and first line."""
+
+    columns: Columns
+    table: np.ndarray
+    delta_x: float
+    x0: float
+    first_line: int
+
+
+def _tags(text: str, sep: str) -> dict[str, list[str]]:
+    tags: dict[str, list[str]] = {}
+    for line in text.splitlines():
+        cells = [c.strip() for c in line.split(sep)]
+        if cells and cells[0]:
+            tags[cells[0]] = [c for c in cells[1:] if c]
+    return tags
+
+
+def _number(text: str, decimal_comma: bool, where: str) -> float:
+    try:
+        return float(text.replace(",", ".") if decimal_comma else text)
+    except ValueError:
+        raise FileFormatError(f"{where} is {text!r}; expected a number") from None
+
+
+def _unit(label: str) -> str | None:
+    label = label.strip()
+    if not label or label.lower() in ("none", "eu", "-"):
+        return None
+    return _UNIT_WORDS.get(label.lower(), label)
+
+
+def read_segments(data: bytes, name: str) -> list[Segment]:
+    """The segments of a LabVIEW measurement file, each with its channels' names and units.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the file and the line: no ``LabVIEW Measurement`` header, a
+        separator or x-column setting it does not know, a segment without
+        ``Delta_X``, different ``Delta_X`` for the channels of one segment, an
+        x column that disagrees with ``X0`` and ``Delta_X``, a bad row.
+    """
+    if not data.lstrip().startswith(b"LabVIEW Measurement"):
+        raise FileFormatError(f"{name}, line 1: expected 'LabVIEW Measurement' (the first line of a .lvm file)")
+    marks = [m.start() for m in re.finditer(re.escape(_MARK), data)]
+    if len(marks) < 2:
+        raise FileFormatError(f"{name}: {len(marks)} '***End_of_Header***' marker(s); expected one after the file "
+                              "header and one after each segment header")
+    header = data[:marks[0]].decode("utf-8", "replace")
+    first = _tags(header, "\t") if "\t" in header else _tags(header, ",")
+    separator = (first.get("Separator") or ["Tab"])[0]
+    if separator not in ("Tab", "Comma"):
+        raise FileFormatError(f"{name}: Separator {separator!r}; expected Tab or Comma")
+    sep = "\t" if separator == "Tab" else ","
+    decimal_comma = (first.get("Decimal_Separator") or ["."])[0] == ","
+    if decimal_comma and sep == ",":
+        raise FileFormatError(f"{name}: Separator Comma with Decimal_Separator ','; the cells cannot be split")
+    x_columns = (first.get("X_Columns") or ["One"])[0]
+    if x_columns not in ("No", "One", "Multi"):
+        raise FileFormatError(f"{name}: X_Columns {x_columns!r}; expected No, One or Multi")
+    segments = []
+    seg_start = marks[0] + len(_MARK)
+    for k, mark in enumerate(marks[1:]):
+        line_of = data.count(b"\n", 0, mark) + 1
+        tags = _tags(data[seg_start:mark].decode("utf-8", "replace"), sep)
+        where = f"{name}, segment {k + 1} (header ending on line {line_of})"
+        names_start = data.find(b"\n", mark) + 1
+        names_end = data.find(b"\n", names_start)
+        names_end = len(data) if names_end < 0 else names_end
+        names = [c.strip() for c in data[names_start:names_end].decode("utf-8", "replace").rstrip("\r").split(sep)]
+        while names and (not names[-1] or names[-1] == "Comment"):
+            names.pop()
+        body_start = names_end + 1
+        names_line = data.count(b"\n", 0, names_start) + 1
+        if names and all(is_number(c, decimal_comma) for c in names):  # no line of names: the rows start at once
+            body_start, names_line = names_start, line_of
+            x_named = x_columns == "One"
+            names = (["X_Value"] if x_named else []) + [f"channel {j + 1}" for j in range(len(names) - x_named)]
+        # the rows end where the next segment's header starts: its first line of tags
+        end = marks[k + 2] if k + 2 < len(marks) else len(data)
+        tag_line = _TAG_LINE.search(data, body_start, end) if end != len(data) else None
+        body_end = tag_line.start() if tag_line else end
+        x_cols = [j for j, n in enumerate(names) if n == "X_Value"]
+        if x_columns == "No" and x_cols:
+            raise FileFormatError(f"{where}: an X_Value column where the file header says X_Columns No")
+        table = parse_rows(data, data.count(b"\n", 0, body_start) + 1, len(names), sep, decimal_comma, names, name,
+                           body_start, body_end)
+        steps = tags.get("Delta_X")
+        if not steps:
+            raise FileFormatError(f"{where}: no Delta_X; expected the time step of the channels")
+        deltas = {_number(v, decimal_comma, f"{where}: Delta_X") for v in steps}
+        if len(deltas) != 1:
+            raise FileFormatError(f"{where}: Delta_X {', '.join(steps)}; expected one time step for all channels")
+        delta_x = deltas.pop()
+        if not delta_x > 0:
+            raise FileFormatError(f"{where}: Delta_X {steps[0]}; expected a positive time step")
+        x0 = _number((tags.get("X0") or ["0"])[0], decimal_comma, f"{where}: X0")
+        keep = [j for j in range(len(names)) if j not in x_cols]
+        if x_cols and table.shape[0]:
+            expected = x0 + np.arange(table.shape[0]) * delta_x
+            for j in x_cols:
+                worst = int(np.argmax(np.abs(table[:, j] - expected)))
+                if abs(table[worst, j] - expected[worst]) > 0.5 * delta_x:
+                    raise FileFormatError(f"{where}: X_Value {float(table[worst, j])!r} on row {worst + 1} where "
+                                          f"X0 + n Delta_X is {float(expected[worst])!r}; expected the x column of a "
+                                          "uniform time axis")
+        units = [_unit(u) for u in tags.get("Y_Unit_Label", [])]
+        channel_names, channel_units = [], []
+        for pos, j in enumerate(keep):
+            plain, unit = name_and_unit(names[j])
+            channel_names.append(plain)
+            channel_units.append(unit or (units[pos] if pos < len(units) else None))
+        segments.append(Segment(Columns(channel_names, channel_units, names_line),
+                                table[:, keep], delta_x, x0, data.count(b"\n", 0, body_start) + 1))
+        seg_start = body_end
+    return segments

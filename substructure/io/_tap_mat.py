@@ -1,0 +1,129 @@
+"""MATLAB files of tap records (``.mat``, versions 4 to 7 as ``scipy.io.loadmat`` reads them).
+
+A MATLAB file holds numbers without units, so the rules are names: vectors
+of samples (the time ``time`` or ``t`` in s unless a unit is given, the
+force and the response), their units in text variables ``<name>_unit``
+(``force_unit = 'N'``, ``acc_unit = 'g'``), and, without a time vector, the
+sample rate in a scalar ``fs``, ``sample_rate``, ``sampling_rate``,
+``sampling_frequency`` (Hz) or the step in ``dt`` (s).  A force or response
+vector without its unit is refused: nothing says whether it is in N or kN,
+m/s^2 or g.  Version 7.3 files are HDF5 and refused with how to re-save them.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import re
+from typing import Any
+
+import numpy as np
+
+from ..errors import FileFormatError
+from ..tap.records import TIME_STEP_TOLERANCE, TapRecord, unit_of
+from ._tap_build import build_record, option_rate, regular, units_of_columns
+from ._tap_columns import Columns, choose
+
+_TIME = re.compile(r"^(time|t|zeit|time_s)$", re.I)
+_RATE = re.compile(r"^(fs|sample_?rate|sampling_?rate|sampling_?frequency|samplerate)$", re.I)
+_STEP = re.compile(r"^(dt|delta_?t|delta_?x|increment|sample_?interval)$", re.I)
+_UNIT_SUFFIX = re.compile(r"^(.+?)_(unit|units|unit_label)$", re.I)
+
+
+def _text(value: Any) -> str | None:
+    if isinstance(value, str):
+        return value.strip()
+    array = np.asarray(value)
+    if array.dtype.kind == "U" and array.size == 1:
+        return str(array.item()).strip()
+    return None
+
+
+def mat_record(path: str | os.PathLike, data: bytes, sensitivity: Any, hammer_sensitivity: Any,
+               quantity: str | None, sample_rate: Any, force_column: Any, response_column: Any) -> TapRecord:
+    """A tap record from the bytes of a MATLAB file (see the module's rules); the options as for text records."""
+    from scipy import io as sio
+
+    name = os.fspath(path)
+    if b"MATLAB 7.3 MAT-file" in data[:128] or data[512:520] == b"\x89HDF\r\n\x1a\n":
+        raise FileFormatError(f"{name}: a MATLAB 7.3 file (HDF5), which is not read; save it again as version 7 "
+                              "(in MATLAB: save(file, '-v7'); in Python: scipy.io.savemat)")
+    try:
+        content = sio.loadmat(io.BytesIO(data), squeeze_me=True, chars_as_strings=True)
+    except Exception as exc:  # scipy raises several kinds for files that are not MATLAB files
+        raise FileFormatError(f"{name}: cannot read the MATLAB file ({exc}); expected a .mat file of version 4 "
+                              "to 7") from None
+    variables = {k: v for k, v in content.items() if not k.startswith("__")}
+    units: dict[str, str] = {}
+    for key, value in variables.items():
+        match = _UNIT_SUFFIX.match(key)
+        text = _text(value)
+        if match and text is not None:
+            units[match.group(1).lower()] = text
+    vectors: dict[str, np.ndarray] = {}
+    scalars: dict[str, float] = {}
+    for key, value in variables.items():
+        array = np.asarray(value)
+        if array.dtype.kind not in "iuf":
+            continue
+        if array.ndim == 1 and array.size >= 2:
+            vectors[key] = array.astype(np.float64)
+        elif array.ndim == 0:
+            scalars[key] = float(array)
+    if not vectors:
+        raise FileFormatError(f"{name}: no vector of real numbers among the variables "
+                              f"({', '.join(variables) or 'none'}); expected time, force and response vectors")
+    names = list(vectors)
+    columns = Columns(names, [units.get(n.lower()) or ("s" if _TIME.match(n) else None) for n in names], None)
+    stated = None
+    for key, value in scalars.items():
+        for pattern, default, to_hz in ((_RATE, "Hz", lambda q: q.m_as("Hz")), (_STEP, "s", lambda q: 1 / q.m_as("s"))):
+            if pattern.match(key):
+                unit = unit_of(units.get(key.lower(), default), f"{name}: variable {key!r}")
+                try:
+                    hz = float(to_hz(value * unit))
+                except Exception:
+                    raise FileFormatError(f"{name}: variable {key!r} in {units.get(key.lower())!r}; expected "
+                                          f"{'a rate in Hz' if default == 'Hz' else 'a step in s'}") from None
+                if not np.isfinite(hz) or hz <= 0:
+                    raise FileFormatError(f"{name}: variable {key!r} is {value!r}; expected a positive sample rate")
+                if stated is not None and abs(stated[0] - hz) > 1e-6 * hz:
+                    raise FileFormatError(f"{name}: variables {stated[1]!r} and {key!r} give {stated[0]:.10g} Hz and "
+                                          f"{hz:.10g} Hz; the file contradicts itself")
+                stated = (hz, key)
+    if sample_rate is not None:
+        hz = option_rate(sample_rate)
+        if stated is not None and abs(stated[0] - hz) > 1e-6 * hz:
+            raise FileFormatError(f"{name}: variable {stated[1]!r} says {stated[0]:.10g} Hz, --sample-rate "
+                                  f"{hz:.10g} Hz; leave the option out or fix the file")
+        stated = (hz, "--sample-rate")
+    parsed, dims, errors = units_of_columns(columns, name)
+    t_col, f_col, r_col = choose(columns, parsed, dims, name, force_column, response_column, stated is not None,
+                                 "a scalar variable fs (Hz) or dt (s)")
+    labels = columns.labels
+    for k in (t_col, f_col, r_col):
+        if k is None:
+            continue
+        if columns.units[k] is None:
+            raise FileFormatError(f"{name}: variable {names[k]!r} has no unit; add a text variable "
+                                  f"{names[k]}_unit (e.g. 'N', 'g', 'm/s^2', 'mV') to the file")
+        if errors[k]:
+            raise FileFormatError(f"{name}: {errors[k]} (variable {names[k] + '_unit'!r})")
+        bad = ~np.isfinite(vectors[names[k]])
+        if bad.any():
+            j = int(np.argmax(bad))
+            raise FileFormatError(f"{name}: variable {names[k]!r}, sample {j + 1}: {float(vectors[names[k]][j])!r}; "
+                                  "expected a finite number (a gap in the acquisition?)")
+    force, response = vectors[names[f_col]], vectors[names[r_col]]
+    if t_col is not None:
+        time_s = regular(vectors[names[t_col]] * (1.0 * parsed[t_col]).m_as("s"))
+        if stated is not None and time_s.size > 1 and time_s[-1] > time_s[0]:
+            from_time = (time_s.size - 1) / (time_s[-1] - time_s[0])
+            if abs(from_time - stated[0]) > TIME_STEP_TOLERANCE * stated[0]:
+                raise FileFormatError(f"{name}: the time vector {names[t_col]!r} is sampled at {from_time:.10g} Hz, "
+                                      f"{stated[1]} says {stated[0]:.10g} Hz; leave the option out or fix the file")
+    else:
+        assert stated is not None
+        time_s = np.arange(force.size) / stated[0]
+    return build_record(name, time_s, force, parsed[f_col], labels[f_col], response, parsed[r_col], labels[r_col],
+                        sensitivity, hammer_sensitivity, quantity)

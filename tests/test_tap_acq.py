@@ -1,0 +1,478 @@
+"""Tap records as acquisition systems write them: preambles, unit rows, no time column, extra channels, LabVIEW
+.lvm files, binary UFF 58b; each layout written here after the system's documented form and read against the
+same samples (and the plain CSV's FRF)."""
+
+from __future__ import annotations
+
+import gc
+import json
+import warnings
+
+import numpy as np
+import pytest
+
+from substructure.cli import main
+from substructure.datasets import impact_records
+from substructure.errors import FileFormatError
+from substructure.io import _tap_table
+from substructure.io.tap_files import read_tap_csv, read_tap_lvm, read_tap_uff
+
+FS = 10240.0
+G = 9.80665
+
+
+def samples(n=2048, seed=1):
+    """Force (N), acceleration (m/s^2) of a fixed random record and the time axis, rounded as files write them."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / FS
+    f = np.round(rng.normal(0.0, 20.0, n), 6)
+    a = np.round(rng.normal(0.0, 3.0, n), 6)
+    return t, f, a
+
+
+def rows(columns, sep=",", fmt="{!r}", decimal_comma=False):
+    lines = []
+    for row in np.column_stack(columns):
+        cells = [fmt.format(float(v)) for v in row]
+        if decimal_comma:
+            cells = [c.replace(".", ",") for c in cells]
+        lines.append(sep.join(cells))
+    return "\n".join(lines) + "\n"
+
+
+# -- 1. a preamble, units in a row or in the names ---------------------------------------------------------------
+
+def test_a_preamble_and_a_row_of_units_under_the_names(tmp_path):
+    t, f, a = samples()
+    path = tmp_path / "export.csv"
+    path.write_text("Sample rate: 10240 Hz\nDate: 2026-03-01 10:00:00\nChannel 1: Force, hammer 086C03\n"
+                    "Channel 2: Accel, 352C23\n\nTime,Force,Accel\ns,N,g\n" + rows([t, f, a / G]))
+    record = read_tap_csv(path)
+    assert np.allclose(record.time, t, rtol=0, atol=1e-12) and np.array_equal(record.force, f)
+    assert np.allclose(record.response, a, rtol=1e-9, atol=1e-12) and record.quantity == "acceleration"
+    assert record.force_column == "Force [N]" and record.response_column == "Accel [g]"
+
+
+@pytest.mark.parametrize("header", [
+    "Time (s)\tForce (N)\tAcceleration (m/s^2)",
+    "Time [s]\tForce [N]\tAcceleration [m/s²]",
+    "Time/s\tForce/N\tAcceleration/(m/s^2)",
+    "Time in s\tForce in N\tAcceleration in m/s^2",
+])
+def test_units_in_the_names_in_every_form(tmp_path, header):
+    t, f, a = samples()
+    path = tmp_path / "named.txt"
+    path.write_text("Title\tImpact 3\nOperator\tJS\n" + header + "\n" + rows([t, f, a], sep="\t", decimal_comma=True))
+    record = read_tap_csv(path)
+    assert np.allclose(record.time, t, atol=1e-12) and np.array_equal(record.force, f)
+    assert np.allclose(record.response, a, rtol=1e-12, atol=0)
+
+
+def test_whitespace_columns_with_comment_lines(tmp_path):
+    t, f, a = samples()
+    path = tmp_path / "pulse.asc"
+    path.write_text("# exported 2026-03-01\nTime [s]   Force [N]   Acceleration [m/s^2]\n" + rows([t, f, a], sep="   "))
+    record = read_tap_csv(path)
+    assert np.array_equal(record.force, f) and np.array_equal(record.response, a)
+
+
+# -- 2. no time column ----------------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("line", [
+    "Sample rate: 10.24 kHz", "Sampling frequency = 10240 Hz", "Fs;10240", "Fs [Hz];10240", "dt: 9.765625e-05 s",
+    "Delta_X\t9.765625E-5\t9.765625E-5", "Increment;9,765625e-5", "Sample interval: 97.65625 us",
+    "Sample rate: 10240 S/s", "# Sampling rate: 10240",
+])
+def test_the_sample_rate_from_the_preamble(tmp_path, line):
+    _, f, a = samples()
+    path = tmp_path / "nt.csv"
+    path.write_text(line + "\nForce [N];Acceleration [g]\n" + rows([f, a / G], sep=";", decimal_comma=True))
+    record = read_tap_csv(path)
+    assert record.sample_rate == FS and np.allclose(record.time, np.arange(f.size) / FS, rtol=1e-12, atol=0)
+    assert np.array_equal(record.force, f)
+
+
+def test_the_sample_rate_option_agrees_or_is_refused(tmp_path):
+    t, f, a = samples()
+    bare = tmp_path / "bare.csv"
+    bare.write_text("force [N],acceleration [m/s^2]\n" + rows([f, a]))
+    with pytest.raises(FileFormatError, match=r"bare.csv, line 1: no column in units of time .* --sample-rate"):
+        read_tap_csv(bare)
+    assert read_tap_csv(bare, sample_rate="10.24 kHz").sample_rate == FS
+    assert read_tap_csv(bare, sample_rate=FS).sample_rate == FS
+    stated = tmp_path / "stated.csv"
+    stated.write_text("Sample rate: 10240 Hz\n" + bare.read_text())
+    assert read_tap_csv(stated, sample_rate="10240 Hz").sample_rate == FS
+    with pytest.raises(FileFormatError, match=r"stated.csv, line 1: the file says 10240 Hz, --sample-rate 20480 Hz"):
+        read_tap_csv(stated, sample_rate="20.48 kHz")
+    timed = tmp_path / "timed.csv"
+    timed.write_text("time [s],force [N],acceleration [m/s^2]\n" + rows([t, f, a]))
+    with pytest.raises(FileFormatError, match=r"sampled at 10240 Hz, --sample-rate says 12800 Hz"):
+        read_tap_csv(timed, sample_rate="12.8 kHz")
+    both = tmp_path / "both.csv"
+    both.write_text("Sample rate: 10240 Hz\ndt: 1e-4 s\n" + bare.read_text())
+    with pytest.raises(FileFormatError, match=r"both.csv, lines 1 and 2: .* the preamble contradicts itself"):
+        read_tap_csv(both)
+    odd = tmp_path / "odd.csv"
+    odd.write_text("Sample rate: 10240 zorks\n" + bare.read_text())
+    with pytest.raises(FileFormatError, match=r"odd.csv, line 1: cannot read the unit 'zorks'"):
+        read_tap_csv(odd)
+
+
+# -- 3. more than three columns ------------------------------------------------------------------------------------
+
+def test_more_channels_chosen_by_name_or_index_or_by_their_units(tmp_path):
+    t, f, a = samples()
+    b = -2.0 * a
+    path = tmp_path / "four.csv"
+    path.write_text("time [s],hammer [N],Accel 1 [g],Accel 2 [g],Trigger [V]\n"
+                    + rows([t, f, a / G, b / G, np.zeros_like(t)]))
+    with pytest.raises(FileFormatError, match=r"four.csv, line 1: 2 response columns .*1: time \[s\]; "
+                                              r"2: hammer \[N\]; 3: Accel 1 \[g\]; 4: Accel 2 \[g\]; "
+                                              r"5: Trigger \[V\].*--response-column"):
+        read_tap_csv(path)
+    assert np.allclose(read_tap_csv(path, response_column="accel 2").response, b)
+    assert np.allclose(read_tap_csv(path, response_column=3).response, a)
+    assert np.allclose(read_tap_csv(path, response_column="Accel 1 [g]").response, a)
+    with pytest.raises(FileFormatError, match=r"--response-column 'Accel 3' names no columns"):
+        read_tap_csv(path, response_column="Accel 3")
+    with pytest.raises(FileFormatError, match=r"--force-column 9: the file has 5 columns"):
+        read_tap_csv(path, force_column=9, response_column=3)
+    with pytest.raises(FileFormatError, match=r"--force-column names the time column"):
+        read_tap_csv(path, force_column=1, response_column=3)
+    trigger = tmp_path / "trigger.csv"  # one force, one response by their units; the trigger and a status column left
+    trigger.write_text("time [s],Trigger [V],force [N],status,acceleration [m/s^2]\n"
+                       + rows([t, np.zeros_like(t), f, np.ones_like(t), a]))
+    record = read_tap_csv(trigger)
+    assert np.array_equal(record.force, f) and np.array_equal(record.response, a)
+    two = tmp_path / "two.csv"
+    two.write_text("time [s],force 1 [N],force 2 [N],acceleration [g]\n" + rows([t, f, f, a]))
+    with pytest.raises(FileFormatError, match=r"two.csv, line 1: 2 force columns .*--force-column"):
+        read_tap_csv(two)
+    assert np.array_equal(read_tap_csv(two, force_column="force 2").force, f)
+
+
+# -- the numeric rows: whole-array parse, exact errors -------------------------------------------------------------
+
+def test_the_fast_parse_reads_every_row_and_never_falls_back_on_a_good_file(tmp_path, monkeypatch):
+    rng = np.random.default_rng(7)
+    table = rng.normal(size=(20000, 4)) * 10.0 ** rng.integers(-8, 8, size=(20000, 4))
+    path = tmp_path / "big.csv"
+    np.savetxt(path, table, delimiter=",", header="time [s],force [N],acceleration [g],x [V]", comments="")
+    monkeypatch.setattr(_tap_table, "CHUNK_BYTES", 4096)  # many pieces, each cut at a line
+
+    def no_fallback(*args, **kwargs):
+        raise AssertionError("fell back to the line-by-line reading")
+
+    monkeypatch.setattr(_tap_table, "_slow", no_fallback)
+    data = path.read_bytes()
+    parsed = _tap_table.parse_rows(data, 2, 4, ",", False, list("tfax"), "big.csv", data.index(b"\n") + 1)
+    assert np.array_equal(parsed, np.loadtxt(path, delimiter=",", skiprows=1))  # numpy's own text reader
+    crlf = path.read_bytes().replace(b"\n", b";\r\n").split(b"\r\n", 1)[1]  # CRLF, a separator at each row's end
+    parsed = _tap_table.parse_rows(crlf.replace(b",", b";"), 2, 4, ";", False, list("tfax"), "big.csv")
+    assert np.array_equal(parsed, table)
+
+
+@pytest.mark.parametrize("bad, message", [
+    ("1 2,3,4", r"line 1502: column 'time \[s\]' is '1 2'"),
+    ("1,,2", r"line 1502: column 'force \[N\]' is ''"),
+    ("1,2,3,4", r"line 1502: 4 value\(s\); expected 3"),
+    ("1,2,0x3", r"line 1502: column 'acceleration \[m/s\^2\]' is '0x3'"),
+    ("1,2,3µ", r"line 1502: column 'acceleration \[m/s\^2\]' is '3µ'"),
+    ("1,nan,3", r"line 1502: column 'force \[N\]' is nan; expected a finite number"),
+])
+def test_a_bad_cell_deep_in_a_large_file_is_named_by_its_line(tmp_path, monkeypatch, bad, message):
+    monkeypatch.setattr(_tap_table, "CHUNK_BYTES", 2048)
+    t, f, a = samples(3000)
+    lines = rows([t, f, a]).splitlines()
+    lines[1500] = bad  # line 1502 of the file: the header is line 1
+    path = tmp_path / "deep.csv"
+    path.write_text("time [s],force [N],acceleration [m/s^2]\n" + "\n".join(lines) + "\n", encoding="utf-8")
+    with pytest.raises(FileFormatError, match="deep.csv, " + message):
+        read_tap_csv(path)
+
+
+def test_layout_errors_name_the_line(tmp_path):
+    cases = {
+        "0,1,2\n1,2,3\n": r"line 1: numbers with no header above them",
+        "Time,Force,Accel\n0,1,2\n": r"line 1: column 1 'Time' has no unit",
+        "time [s],force [N],acceleration [g]\n0,1,2,3\n": r"line 1: the header names 3 columns .* \(line 2\) has 4",
+        "Title: x\n" * 2001: r"no row of numbers in the first 2000 lines",
+        "Sample rate: fast\nforce [N],acceleration [g]\n0,1\n": r"line 1: 'Sample rate' without a number",
+    }
+    for text, message in cases.items():
+        path = tmp_path / "l.csv"
+        path.write_text(text)
+        with pytest.raises(FileFormatError, match="l.csv.*" + message):
+            read_tap_csv(path)
+
+
+# -- 4. LabVIEW measurement files ----------------------------------------------------------------------------------
+
+def lvm(segments, x_columns="One", sep="\t", decimal=".", units=("N", "g")):
+    """A .lvm file as LabVIEW's Write Measurement File writes it (header, segment headers, rows)."""
+    s = sep
+    out = [f"LabVIEW Measurement{s}", f"Writer_Version{s}2", f"Reader_Version{s}2",
+           f"Separator{s}{'Tab' if sep == chr(9) else 'Comma'}", f"Decimal_Separator{s}{decimal}",
+           f"Multi_Headings{s}No", f"X_Columns{s}{x_columns}", f"Time_Pref{s}Relative", f"Operator{s}bench",
+           f"Date{s}2026/03/01", f"Time{s}10:00:00.000", f"***End_of_Header***{s}", ""]
+    for x0, dt, force, accel in segments:
+        def num(v):
+            return f"{v:.16E}".replace(".", decimal)
+
+        out += [f"Channels{s}2{s}", f"Samples{s}{force.size}{s}{force.size}{s}",
+                f"Date{s}2026/03/01{s}2026/03/01{s}", f"Time{s}10:00:00.000{s}10:00:00.000{s}",
+                f"X_Dimension{s}Time{s}Time{s}", f"X0{s}{num(x0)}{s}{num(x0)}{s}",
+                f"Delta_X{s}{num(dt)}{s}{num(dt)}{s}"]
+        if units:
+            out.append(f"Y_Unit_Label{s}{units[0]}{s}{units[1]}{s}")
+        out.append(f"***End_of_Header***{s}")
+        x = x0 + np.arange(force.size) * dt
+        names = {"One": ["X_Value", "Hammer", "Accel"], "No": ["Hammer", "Accel"],
+                 "Multi": ["X_Value", "Hammer", "X_Value", "Accel"]}[x_columns] + ["Comment"]
+        out.append(s.join(names))
+        cols = {"One": [x, force, accel], "No": [force, accel], "Multi": [x, force, x, accel]}[x_columns]
+        body = rows(cols, sep=s, fmt="{:.6f}", decimal_comma=decimal == ",")
+        out += body.splitlines()
+        out.append("")
+    return "\r\n".join(out) + "\r\n"
+
+
+@pytest.mark.parametrize("x_columns, sep, decimal", [("One", "\t", "."), ("No", "\t", ","), ("One", ",", "."),
+                                                    ("Multi", "\t", ".")])
+def test_lvm_one_segment(tmp_path, x_columns, sep, decimal):
+    t, f, a = samples()
+    f, a = np.round(f, 6), np.round(a / G, 6)
+    path = tmp_path / "tap.lvm"
+    path.write_text(lvm([(0.0, 1 / FS, f, a)], x_columns, sep, decimal), newline="")
+    (record,) = read_tap_lvm(path)
+    assert record.sample_rate == FS and np.allclose(record.time, t, rtol=1e-12, atol=1e-15)
+    assert np.array_equal(record.force, f) and np.allclose(record.response, a * G, rtol=1e-12, atol=0)
+    assert record.force_column == "Hammer [N]" and record.response_column == "Accel [g]"
+
+
+def test_lvm_without_a_line_of_names(tmp_path):
+    t, f, a = samples()
+    f, a = np.round(f, 6), np.round(a, 6)
+    text = lvm([(0.0, 1 / FS, f, a)], units=("N", "m/s^2"))
+    text = text.replace("X_Value\tHammer\tAccel\tComment\r\n", "")
+    path = tmp_path / "bare.lvm"
+    path.write_text(text, newline="")
+    (record,) = read_tap_lvm(path)
+    assert np.array_equal(record.force, f) and np.array_equal(record.response, a)
+    assert record.force_column == "channel 1 [N]"
+
+
+def test_lvm_segments_join_when_contiguous_and_split_when_not(tmp_path):
+    _, f, a = samples(3000)
+    dt = 1 / FS
+    path = tmp_path / "loop.lvm"  # a loop that wrote 1000 samples per call: one record
+    path.write_text(lvm([(k * 1000 * dt, dt, f[k * 1000:(k + 1) * 1000], a[k * 1000:(k + 1) * 1000])
+                         for k in range(3)]), newline="")
+    (record,) = read_tap_lvm(path)
+    assert np.array_equal(record.force, f) and len(record) == 3000
+    path = tmp_path / "taps.lvm"  # one acquisition per tap, each starting at 0: three records
+    path.write_text(lvm([(0.0, dt, f[k * 1000:(k + 1) * 1000], a[k * 1000:(k + 1) * 1000]) for k in range(3)]),
+                    newline="")
+    records = read_tap_lvm(path)
+    assert len(records) == 3 and np.array_equal(records[2].force, f[2000:])
+
+
+def test_lvm_errors(tmp_path):
+    _, f, a = samples()
+    path = tmp_path / "e.lvm"
+    path.write_text(lvm([(0.0, 1 / FS, f, a)], units=None), newline="")
+    with pytest.raises(FileFormatError, match=r"e.lvm, line 22: channel 'Hammer' has no unit; expected a Y_Unit_Label"):
+        read_tap_lvm(path)
+    text = lvm([(0.0, 1 / FS, f, a)])
+    path.write_text(text.replace("Delta_X", "Delta_Y"), newline="")
+    with pytest.raises(FileFormatError, match=r"e.lvm, segment 1 \(header ending on line 22\): no Delta_X"):
+        read_tap_lvm(path)
+    path.write_text(text.replace("\r\n0.010742\t", "\r\n0.020000\t"), newline="")
+    with pytest.raises(FileFormatError, match=r"X_Value 0.02 on row 111 where X0 \+ n Delta_X is 0.0107"):
+        read_tap_lvm(path)
+    path.write_text("Time,Force\n", newline="")
+    with pytest.raises(FileFormatError, match=r"e.lvm, line 1: expected 'LabVIEW Measurement'"):
+        read_tap_lvm(path)
+    path.write_text(text, newline="")
+    with pytest.raises(FileFormatError, match=r"Delta_X .* is 10240 Hz, --sample-rate 10000 Hz"):
+        read_tap_lvm(path, sample_rate="10 kHz")
+
+
+# -- 5. UFF ----------------------------------------------------------------------------------------------------------
+
+def write_uff(path, channels, binary=0, abscissa_spec=17, abscissa_label="s", x=None):
+    import pyuff
+
+    with warnings.catch_warnings():  # pyuff's binary writer leaves its file to the garbage collector
+        warnings.simplefilter("ignore", ResourceWarning)
+        _write_uff(pyuff, path, channels, binary, abscissa_spec, abscissa_label, x)
+        gc.collect()
+    return path
+
+
+def _write_uff(pyuff, path, channels, binary, abscissa_spec, abscissa_label, x):
+    uff = pyuff.UFF(str(path))
+    n = channels[0][0].size
+    uniform = x is None
+    x = np.arange(n) / FS if x is None else x
+    for k, (data, spec, unit) in enumerate(channels):
+        uff.write_sets(pyuff.prepare_58(
+            binary=binary, func_type=1, rsp_node=k + 1, rsp_dir=3, ref_node=1, ref_dir=3, data=data, x=x,
+            num_pts=n, abscissa_spacing=1 if uniform else 0, abscissa_min=0.0, abscissa_inc=1 / FS,
+            abscissa_spec_data_type=abscissa_spec, ordinate_spec_data_type=spec, ordinate_axis_units_lab=unit,
+            id1=f"channel {k + 1}", orddenom_spec_data_type=0, orddenom_axis_units_lab="",
+            abscissa_axis_units_lab=abscissa_label, z_axis_spec_data_type=0, z_axis_axis_units_lab=""), mode="add")
+
+
+def test_binary_uff_58b_and_units_in_the_labels_alone(tmp_path):
+    _, f, a = samples()
+    path = write_uff(tmp_path / "b.uff", [(a / G, 0, "g"), (f, 0, "N")], binary=1)
+    assert b"58b" in path.read_bytes()[:200]
+    record = read_tap_uff(path)
+    assert np.allclose(record.force, f, rtol=1e-6) and np.allclose(record.response, a, rtol=1e-6, atol=1e-6)
+    volts = write_uff(tmp_path / "mv.uff", [(f * 2.25, 0, "mV"), (a / G, 0, "g")], binary=1)
+    record = read_tap_uff(volts, hammer_sensitivity="2.25 mV/N")
+    assert np.allclose(record.force, f, rtol=1e-6) and record.quantity == "acceleration"
+    volts = write_uff(tmp_path / "mv2.uff", [(f, 0, "N"), (a / G * 10.2, 0, "mV")])
+    record = read_tap_uff(volts, sensitivity="10.2 mV/g")
+    assert np.allclose(record.response, a, rtol=1e-5, atol=1e-6)
+
+
+def test_uff_abscissa_not_time_or_uneven_is_refused(tmp_path):
+    _, f, a = samples()
+    path = write_uff(tmp_path / "hz.uff", [(a, 12, "m/s^2"), (f, 13, "N")], abscissa_spec=18, abscissa_label="Hz")
+    with pytest.raises(FileFormatError, match=r"hz.uff, record 0: abscissa of specific data type 18"):
+        read_tap_uff(path)
+    path = write_uff(tmp_path / "lab.uff", [(a, 12, "m/s^2"), (f, 13, "N")], abscissa_spec=0, abscissa_label="Hz")
+    with pytest.raises(FileFormatError, match=r"lab.uff, record 0: abscissa in 'Hz'; expected a time"):
+        read_tap_uff(path)
+    x = np.arange(f.size) / FS
+    x[100:] += 0.5 / FS
+    path = write_uff(tmp_path / "uneven.uff", [(a, 12, "m/s^2"), (f, 13, "N")], x=x)
+    import pyuff
+
+    if np.allclose(np.diff(pyuff.UFF(str(path)).read_sets(0)["x"]), 1 / FS):
+        pytest.skip("pyuff rewrites x from the spacing")  # pragma: no cover
+    with pytest.raises(FileFormatError, match=r"uneven.uff, record 0: uneven abscissa"):
+        read_tap_uff(path)
+
+
+# -- the command, on the shipped real records written as acquisition systems write them -------------------------
+
+def run(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_the_command_reads_every_layout_to_the_same_frf(tmp_path, capsys):
+    r = impact_records()[0]
+    plain = tmp_path / "plain.csv"
+    plain.write_text("time [s],force [N],acceleration [m/s^2]\n" + rows([r.time, r.force, r.response], fmt="{!r}"))
+    code, out, err = run(capsys, "tap", plain, "--json")
+    assert code == 0, err
+    expected = json.loads(out)
+    fs = r.sample_rate
+    export = tmp_path / "export.txt"
+    export.write_text(f"Sampling frequency: {fs:g} Hz\nTrigger\tstatus\tForce\tAccel\n-\t-\tN\tm/s^2\n"
+                      + rows([np.zeros_like(r.force), np.ones_like(r.force), r.force, r.response], sep="\t",
+                             fmt="{!r}", decimal_comma=True))
+    labview = tmp_path / "tap.lvm"
+    text = lvm([(0.0, 1 / fs, r.force, r.response / G)])
+    labview.write_text(text, newline="")
+    for path, extra in ((export, ["--force-column", "Force", "--response-column", "4"]),
+                        (export, ["--sample-rate", f"{fs / 1000:g} kHz"])):
+        code, out, err = run(capsys, "tap", path, "--json", *extra)
+        assert code == 0, err
+        got = json.loads(out)
+        assert got["frequency_hz"] == expected["frequency_hz"]
+        assert np.allclose(got["real"], expected["real"], rtol=1e-9, atol=1e-12 * np.max(np.abs(expected["real"])))
+    code, out, err = run(capsys, "tap", labview, "--json")
+    assert code == 0, err
+    got = json.loads(out)  # the .lvm rows keep six decimals (LabVIEW's default): the FRF to that rounding
+    band = (np.array(got["frequency_hz"]) > 20) & (np.array(got["frequency_hz"]) < 5000)
+    scale = np.max(np.abs(expected["real"]))
+    assert np.allclose(np.array(got["real"])[band], np.array(expected["real"])[band], atol=1e-3 * scale)
+    code, _, err = run(capsys, "tap", export, "--sample-rate", "1 kHz")
+    assert code == 1 and "export.txt, line 1: the file says 25600 Hz, --sample-rate 1000 Hz" in err
+    uff = write_uff(tmp_path / "t.uff", [(r.force, 13, "N"), (r.response, 12, "m/s^2")])
+    code, _, err = run(capsys, "tap", uff, "--force-column", "1")
+    assert code == 2 and "--force-column applies to columns of a text record" in err
+    code, _, err = run(capsys, "tap", export, "--force-record", "1")
+    assert code == 2 and "use --force-column and --response-column" in err
+
+
+def test_times_written_with_few_digits_are_the_uniform_clock_and_a_lost_sample_is_refused(tmp_path):
+    n, fs = 4096, 51200.0
+    t, f, a = np.arange(n) / fs, np.ones(n), np.zeros(n)
+    path = tmp_path / "six.csv"  # six decimals, as LabVIEW and many exports write: steps of 1.9e-5 and 2.0e-5 s
+    path.write_text("time [s],force [N],acceleration [g]\n" + rows([t, f, a], fmt="{:.6f}"))
+    record = read_tap_csv(path)
+    assert record.sample_rate == pytest.approx(fs, rel=1e-6) and np.allclose(record.time, t, rtol=0, atol=1e-8)
+    lost = np.delete(t, 2000)  # one sample lost: the clock jumps a whole step
+    path.write_text("time [s],force [N],acceleration [g]\n" + rows([lost, f[1:], a[1:]], fmt="{:.6f}"))
+    with pytest.raises(FileFormatError, match=r"six.csv: column 'time', sample 2000: step"):
+        read_tap_csv(path)
+
+
+def test_blanks_after_separators_quoted_names_and_a_separator_ending_every_line(tmp_path):
+    t, f, a = samples()
+    path = tmp_path / "spaced.csv"
+    path.write_text('"Time [s]", "Force [N]", "Acceleration [g]",\n' + rows([t, f, a], sep=", ").replace("\n", ",\n"))
+    record = read_tap_csv(path)
+    assert np.allclose(record.time, t, rtol=0, atol=1e-15) and np.array_equal(record.force, f)
+    assert np.allclose(record.response, a * G, rtol=1e-12, atol=0)
+
+
+def test_a_sample_rate_without_its_unit_is_refused_on_the_command_line(tmp_path, capsys):
+    _, f, a = samples()
+    path = tmp_path / "bare.csv"
+    path.write_text("force [N],acceleration [m/s^2]\n" + rows([f, a]))
+    code, _, err = run(capsys, "tap", path, "--sample-rate", "10240")
+    assert code == 1 and "--sample-rate" in err and "10240" in err
+
+
+def test_rows_that_start_with_a_clock_time_are_refused_as_such(tmp_path):
+    path = tmp_path / "clock.csv"
+    path.write_text("Time;Force [N];Acceleration [g]\n" + "".join(f"10:00:00.{k:03d};1,5;0,25\n" for k in range(50)))
+    with pytest.raises(FileFormatError, match=r"clock.csv, line 2: the first cell '10:00:00.000' is not a number "
+                                              r"\(a clock time or a date\?\)"):
+        read_tap_csv(path)
+
+
+# -- 6. MATLAB files -------------------------------------------------------------------------------------------------
+
+def test_matlab_vectors_with_their_units(tmp_path):
+    from scipy.io import savemat
+
+    from substructure.io.tap_files import read_tap_mat
+
+    t, f, a = samples()
+    path = tmp_path / "tap.mat"
+    savemat(path, {"time": t, "force": f, "force_unit": "N", "acc": a / G, "acc_unit": "g", "trigger": 0 * t})
+    record = read_tap_mat(path)
+    assert np.array_equal(record.force, f) and np.allclose(record.response, a, rtol=1e-12, atol=0)
+    assert record.sample_rate == FS and record.response_column == "acc [g]"
+    savemat(path, {"fs": FS, "hammer": f * 2.25, "hammer_unit": "mV", "acc1": a, "acc2": -a, "acc1_unit": "m/s^2",
+                   "acc2_unit": "m/s^2"})
+    with pytest.raises(FileFormatError, match=r"tap.mat: 2 response columns .*--response-column"):
+        read_tap_mat(path, hammer_sensitivity="2.25 mV/N")
+    record = read_tap_mat(path, hammer_sensitivity="2.25 mV/N", response_column="acc2")
+    assert np.allclose(record.force, f) and np.array_equal(record.response, -a) and record.sample_rate == FS
+    with pytest.raises(FileFormatError, match=r"variable 'fs' says 10240 Hz, --sample-rate 20000 Hz"):
+        read_tap_mat(path, hammer_sensitivity="2.25 mV/N", response_column="acc2", sample_rate="20 kHz")
+    savemat(path, {"t": t, "force": f, "acc": a})
+    with pytest.raises(FileFormatError, match=r"tap.mat: variable 'force' has no unit; add a text variable force_unit"):
+        read_tap_mat(path)
+    savemat(path, {"force": f, "force_unit": "N", "acc": a, "acc_unit": "g"})
+    with pytest.raises(FileFormatError, match=r"tap.mat: no column in units of time .* a scalar variable fs"):
+        read_tap_mat(path)
+    path.write_bytes(b"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: Mon Mar  2 10:00:00 2026 HDF5 schema 1.00 ."
+                     + b" " * 400 + b"\x89HDF\r\n\x1a\n" + b"\0" * 64)
+    with pytest.raises(FileFormatError, match=r"tap.mat: a MATLAB 7.3 file \(HDF5\), which is not read; save it again "
+                                              r"as version 7"):
+        read_tap_mat(path)
+    path.write_bytes(b"not a MATLAB file at all" * 10)
+    with pytest.raises(FileFormatError, match=r"tap.mat: cannot read the MATLAB file"):
+        read_tap_mat(path)
