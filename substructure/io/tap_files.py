@@ -34,8 +34,10 @@ from ._tap_table import finite_rows, parse_rows
 
 __all__ = ["read_tap_csv", "read_tap_lvm", "read_tap_mat", "read_tap_uff", "MAX_RECORD_BYTES", "ROUNDED_TIME_TOLERANCE"]
 
-MAX_RECORD_BYTES = 2**31
-"""The largest tap record file read (2 GiB: ten minutes of three channels at 51.2 kHz written as text)."""
+MAX_RECORD_BYTES = 2**29
+"""The largest tap record file read (512 MiB: minutes of three channels at 51.2 kHz written as text; the
+reading needs about four times the file's size in memory, so a larger file is refused rather than let run
+the machine out of memory)."""
 def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensitivity: Any = None,
                  quantity: str | None = None, sample_rate: Any = None, force_column: Any = None,
                  response_column: Any = None) -> TapRecord:
