@@ -32,7 +32,7 @@ from pathlib import Path
 import attrs
 
 from substructure import Segment, Sensor, Tool, default_assembly, load_assembly, save_assembly
-from substructure.diagnose import Effect, Parameter, compare, diagnose, register_effect
+from substructure.diagnose import Effect, Parameter, compare, diagnose, registered
 from substructure.measurements import MeasurementSet
 from substructure.synthetic import simulate
 
@@ -182,7 +182,9 @@ save(d2.final[0].plot(), "04e_after_refinement.png")
 # -------------------------
 # A heavy clamping nut on the holder face is not in the catalogue. An effect
 # is a class: its parameters (name, SI unit, bounds, start), where it may act,
-# and how it changes an assembly. register_effect makes diagnose consider it.
+# and how it changes an assembly. ``registered`` makes diagnose consider it
+# inside a ``with`` block (``register_effect``, as a class decorator, for
+# good: then every later diagnosis in the process considers it too).
 print("7. (f) A user-defined effect: a clamping nut on the holder face")
 nut_rig = model.attach(Sensor("nut", "holder.tip", "150 g"))
 taps3 = tap_test(nut_rig, ["nut"], seed=6)
@@ -191,7 +193,6 @@ print(f"    the catalogue only: explained {d3.explained}")
 print(f"    | {d3.report[0] if d3.report else ''}")
 
 
-@register_effect
 class ClampingNut(Effect):
     name = "clamping-nut"
     parameters = (Parameter("mass", "kg", 0.01, 1.0, 0.1),)
@@ -206,7 +207,8 @@ class ClampingNut(Effect):
         return assembly.attach(Sensor("clamping-nut", self.where, f"{self.values['mass']!r} kg"))
 
 
-d4 = diagnose(model, taps3)
+with registered(ClampingNut):
+    d4 = diagnose(model, taps3)
 show_candidates(d4, n=3)
 print(f"    missing effect: {d4.missing_effect} at {d4.missing_where}; why: {d4.candidates[0].effect.explanation}")
 show_refinement(d4)

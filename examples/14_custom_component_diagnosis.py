@@ -93,7 +93,8 @@ taps = simulate(truth, ["tool.tip", "tool.tip-20 mm"], frequency=grid, noise=0.0
 found = diagnose(chuck, taps, progress=False)
 print("(c) explained:", found.explained)
 for effect in found.effects:
-    print(f"    {effect.where} = {effect.values['value'] * 1e3:.1f} g")
+    size = effect.values.get("value")
+    print(f"    {effect.where} = {size * 1e3:.1f} g" if size is not None else f"    {effect!r}")
 
 # %%
 # (d) The built-in equivalent
