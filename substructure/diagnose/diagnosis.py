@@ -318,6 +318,10 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         names = tuple(dict.fromkeys(list(names) + [r.name for r, _ in rivals]))
     search = {**outcome.search, "evaluations": round(meter.used(), 1), "budget": budget,
               "time_limit_s": time_limit, "seconds": round(meter.elapsed(), 3)}
+    if not explained:  # the changes the cross-validation dropped, said where the verdict is read
+        report = list(report) + [f"dropped {r['effect']} at {r['where']}: did not predict held-back lines "
+                                 f"(their chi^2 {r['chi2_with']:.1f} with it, {r['chi2_without']:.1f} without)"
+                                 for r in search.get("held_back", []) if not r["predicts"]]
     if search["cut"] and not explained:
         report = list(report) + [f"the search was cut by its budget ({search['cut_at']}); a larger budget "
                                  "(--budget, --time-limit) may find more"]

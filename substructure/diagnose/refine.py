@@ -43,9 +43,11 @@ import numpy as np
 
 from ..errors import SubstructureError
 from ..updating.fit import Fit, fit
-from ..updating.selection import INDIFFERENCE, significance
+from ..updating.selection import INDIFFERENCE, consistency, significance
 from ..updating.likelihood import Likelihood
+from .crossval import fold_masks, held_back_chi2
 from .modes import mode_starts
+from .pairs import OTHER_FIRSTS, other_paths
 from ..updating.fit import to_u
 from .scan import places, trials
 from .search import Budget, Scored, choose, full_fits, physical, preference, rank, screen, shortlist
@@ -93,7 +95,7 @@ def _p(changes) -> int:
     return sum(len(c.specs) for c, _ in changes)
 
 
-def _prune(lik, current, chi2_now, say):
+def _prune(lik, current, chi2_now, say, refits: dict | None = None):
     n = lik.n
     dropped: list = []
     while len(current) > 1:
@@ -101,6 +103,8 @@ def _prune(lik, current, chi2_now, say):
         worst = None
         for i in range(len(current)):
             refit = fit(lik, current[:i] + current[i + 1:])
+            if refits is not None:  # kept for the cross-validation: the explanation without change i
+                refits[frozenset(c.key for c, _ in refit.changes)] = refit
             sig = significance(refit.chi2, chi2_now, len(current[i][0].specs), n, p, 1)
             if not sig.significant and (worst is None or sig.statistic < worst[0]):
                 worst = (sig.statistic, i, refit)
@@ -186,6 +190,11 @@ def _history(lik, current, final: Fit, tried: int):
     return history
 
 
+OTHER_PATHS_AFTER = 2
+"""Most changes of a forward path that reached the noise before pairs from other first changes are searched
+(:mod:`substructure.diagnose.pairs`); the diagnosis's ``MOST_CHANGES``."""
+
+
 PAIR_POOL = 4
 """Singles of the first step (best first) whose pairs are fitted from fair starts in the parsimony check."""
 
@@ -230,7 +239,7 @@ def _bic(chi2: float, p: int, n: int, s2: float) -> float:
     return chi2 / s2 + p * math.log(n)
 
 
-def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say):
+def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say, more=()):
     """The kept explanation against the best single and best pair ones fitted from fair starts.
 
     Forward selection extends its first choice; when that choice was wrong,
@@ -287,6 +296,7 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say):
                 continue
             if all(physical(c, v) for c, v in result.changes) and passive(result.changes):
                 options.append(([(c, dict(v)) for c, v in result.changes], result.chi2))
+    options += [(pair, chi2) for pair, chi2 in more if sorted(c.key for c, _ in pair) != keys_now]
     best_chi2 = min(chi2 for _, chi2 in options)
     p_best = next(_p(ch) for ch, chi2 in options if chi2 == best_chi2)
     s2 = max(1.0, best_chi2 / max(n - p_best, 1))
@@ -384,6 +394,51 @@ def _other_values(lik, screen_lik, current, final: Fit, passive, say) -> list:
     return out
 
 
+def _cross_validate(lik, current, final: Fit, refits: dict, say):
+    """Drop the kept changes that do not predict held-back lines (:mod:`substructure.diagnose.crossval`).
+
+    Each change's explanation is compared with the one without it (the others refitted on all lines, from the
+    elimination's fits when it made them; a single change against the model as given) on the held-back
+    ``chi^2`` summed over the folds; of the changes that do not predict better, the one that predicts worst is
+    dropped and the rest checked again.
+
+    Returns
+    -------
+    (list, Fit or None, list of dict)
+        The changes kept, their fit, and per change checked ``effect``, ``where``, ``chi2_with``,
+        ``chi2_without`` (held-back ``chi^2`` summed over the folds) and ``predicts``.
+    """
+    masks = fold_masks(lik)
+    records: list = []
+    while current:
+        with_it = float(held_back_chi2(lik, current, masks).sum())
+        rounds, worst = [], None
+        for i, (change, values) in enumerate(current):
+            rest = current[:i] + current[i + 1:]
+            refit = None
+            if rest:
+                refit = refits.get(frozenset(c.key for c, _ in rest))
+                if refit is None:
+                    refit = refits[frozenset(c.key for c, _ in rest)] = fit(lik, rest)
+            without = float(held_back_chi2(lik, refit.changes if refit is not None else [], masks).sum())
+            record = {"effect": change.effect, "where": change.place(values), "chi2_with": with_it,
+                      "chi2_without": without, "predicts": bool(with_it < without)}
+            rounds.append(record)
+            if not record["predicts"] and (worst is None or with_it - without > worst[0]):
+                worst = (with_it - without, i, refit, record)
+        if worst is None:
+            records += rounds
+            break
+        _, i, refit, record = worst
+        if say:
+            say(f"dropped {record['effect']} at {record['where']}: did not predict held-back lines (chi^2 of "
+                f"the held-back lines {record['chi2_with']:.1f} with it, {record['chi2_without']:.1f} without)")
+        records.append(record)
+        current = [(c, dict(v)) for c, v in refit.changes] if refit is not None else []
+        final = refit
+    return current, final, records
+
+
 def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
            budget: Budget | None = None, lacking: bool = False) -> Outcome:
     """Forward selection, then elimination, review and history (see the module docstring).
@@ -415,7 +470,8 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
         The changes kept and what the report needs.
     """
     n = lik.n
-    search = {"candidates": len(cands), "steps_screened": 0, "full_fits": 0, "cut": False, "cut_at": None}
+    search = {"candidates": len(cands), "steps_screened": 0, "full_fits": 0, "cut": False, "cut_at": None,
+              "held_back": []}
     lik0 = Likelihood(lik.assembly, lik.measured[:1])
     if budget is not None:
         budget.watch(lik, screen_lik, lik0)
@@ -498,8 +554,9 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
             say(f"step {len(current)}: added {best.change.effect} at {best.change.place(best.values)}, "
                 f"chi^2/nu = {chi2_now / max(n - _p(current), 1):.4g}")
     dropped: list = []
+    refits = {frozenset(c.key for c, _ in f.changes): f for f, _, _, _ in path}  # fits of subsets, all lines
     if len(current) > 1:
-        current, chi2_now, dropped = _prune(lik, current, chi2_now, say)
+        current, chi2_now, dropped = _prune(lik, current, chi2_now, say, refits)
     pruned = sorted(c.key for c, _ in current)
     alternatives: dict = {}
     if current:
@@ -508,10 +565,17 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     rivals: list = []
     if len(current) >= 2:
         before = [c.key for c, _ in current]
-        current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say)
+        more = []
+        if len(current) > OTHER_PATHS_AFTER or not consistency(lik, lik.log_ratios(current), _p(current)).consistent:
+            # the path did not reach the noise with two changes: its first choice may be the wrong one
+            # the path's own first change (or the same change under another name) is not started from again
+            singles = [s for s in first_fitted if s.fit is not None]
+            firsts = [s for s in _distinct(screen_lik, singles, OTHER_FIRSTS + 1) if s.change.key != path[0][1].key]
+            more = other_paths(lik, screen_lik, lik0, firsts[:OTHER_FIRSTS], cands, passive, say)
+        current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say, more)
         if len(current) > 1 and sorted(c.key for c, _ in current) != pruned:
             # what the review and the parsimony check put in must each still earn its place
-            current, chi2_now, late = _prune(lik, current, chi2_now, say)
+            current, chi2_now, late = _prune(lik, current, chi2_now, say, refits)
             dropped += late
         if [c.key for c, _ in current] != before:
             alternatives = {c.key: [] for c, _ in current}
@@ -520,6 +584,12 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     final = path[-1][0] if unchanged and path else (fit(lik, current) if current else None)
     if final is not None:
         current = [(c, dict(v)) for c, v in final.changes]
+        current, final, search["held_back"] = _cross_validate(lik, current, final, refits, say)
+        gone = set(kept) - {c.key for c, _ in current}
+        if gone:  # a change that did not predict held-back lines: the history and the rivals without it
+            unchanged = False
+            alternatives = {k: v for k, v in alternatives.items() if k not in gone}
+            rivals = [r for r in rivals if not gone & {c.key for c, _ in r[0]}]
     history = path if unchanged else (_history(lik, current, final, tried) if current else [])
     if final is not None:
         rivals = list(rivals) + _other_values(lik, screen_lik, current, final, passive, say)

@@ -1,0 +1,145 @@
+"""Cross-validation of the changes kept: each must predict lines that were not fitted.
+
+Significance says a change lowers ``chi^2`` by more than its parameters
+buy; it does not say that the change describes the structure rather than
+the lines it was fitted to.  Here each kept change is tested on data that
+were held back: the lines of the band are cut into :data:`CV_BLOCKS`
+contiguous blocks, and block ``b`` goes to fold ``b mod`` :data:`CV_FOLDS`,
+so that each fold holds back a few contiguous stretches spread across the
+band (the same lines of every measured FRF).  Contiguous blocks, because
+neighbouring lines of a tap test are correlated (windows, smoothing, a
+resonance spans many lines): a model fitted to every other line would
+"predict" the lines between from their neighbours.
+
+For each fold the explanation with the change and the one without it (the
+others refitted on all lines) are refitted on the lines kept, starting from
+their values fitted on all lines, by one Gauss-Newton step on the Jacobian
+of all lines (computed once and restricted to the lines kept), halved until
+it lowers ``chi^2`` on those lines (:data:`CV_HALVINGS`); the refitted model
+then predicts the held-back lines and is scored by their ``chi^2`` with the
+same likelihood and noise model as every other decision.  The sums over the
+folds are compared: a change whose explanation does not predict the
+held-back lines better than the explanation without it is dropped.  A
+single change is compared with the model as given (nothing to refit).
+
+The refits from the values fitted on all lines are the classical first-order
+approximation of cross-validation: a quarter of the lines moves the optimum
+by a fraction of its standard deviation, which one Gauss-Newton step
+follows to second order; the test suite checks it against full refits.
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+from ..errors import SubstructureError
+from ..updating.fit import from_u, to_u
+
+__all__ = ["CV_FOLDS", "CV_BLOCKS", "fold_masks", "held_back_chi2"]
+
+CV_FOLDS = 4
+"""Folds of the cross-validation: each holds back about a quarter of the lines."""
+CV_BLOCKS = 20
+"""Contiguous blocks of lines the band is cut into (5 % of the band each); block ``b`` is held back in fold
+``b mod CV_FOLDS``, so that every fold holds back stretches spread across the band."""
+CV_RESOLVED = 1.0
+"""Smallest singular value of the whitened Jacobian (on the fitted scale: a log, or a tenth of the range) whose
+direction a fold's refit moves; below it the data fix the direction to worse than a factor e (or a tenth of the
+range), and the refit keeps the value fitted on all lines."""
+CV_HALVINGS = 3
+"""Halvings of a fold's Gauss-Newton step before the refit keeps the values fitted on all lines."""
+
+
+def fold_masks(likelihood, folds: int = CV_FOLDS, blocks: int = CV_BLOCKS) -> list[np.ndarray]:
+    """Which residuals each fold holds back (see the module docstring).
+
+    Parameters
+    ----------
+    likelihood : Likelihood
+        The data (its residual vector: real parts, then imaginary parts, per measured FRF).
+    folds : int
+        Number of folds.
+    blocks : int
+        Contiguous blocks of lines, dealt to the folds in turn.
+
+    Returns
+    -------
+    list of ndarray of bool
+        One mask over the residual vector per fold; every residual is held back in exactly one fold.
+    """
+    n_lines = likelihood.lines.size
+    blocks = max(folds, min(blocks, n_lines))
+    block = np.minimum(np.arange(n_lines) * blocks // n_lines, blocks - 1)
+    per_residual = np.tile(block % folds, 2 * len(likelihood.measured))
+    return [per_residual == k for k in range(folds)]
+
+
+def _slots(changes) -> list:
+    return [(i, spec) for i, (c, _) in enumerate(changes) for spec in c.specs]
+
+
+def _model(changes, slots, u) -> list:
+    out = [(c, dict(v)) for c, v in changes]
+    for (i, spec), ui in zip(slots, u):
+        out[i][1][spec.name] = from_u(spec, ui)
+    return out
+
+
+def held_back_chi2(likelihood, changes: Sequence[tuple], masks: Sequence[np.ndarray]) -> np.ndarray:
+    """``chi^2`` of each fold's held-back lines, predicted by the explanation refitted without them.
+
+    Parameters
+    ----------
+    likelihood : Likelihood
+        All lines.
+    changes : sequence of (Change, dict)
+        The explanation, with its values fitted on all lines (SI).
+    masks : sequence of ndarray of bool
+        The folds (:func:`fold_masks`).
+
+    Returns
+    -------
+    ndarray
+        Per fold, the held-back ``chi^2`` [-] (for the model as given, with no changes, the ``chi^2`` of
+        those lines: there is nothing to refit).
+    """
+    changes = [(c, dict(v)) for c, v in changes]
+    r0 = likelihood.residual(changes)
+    slots = _slots(changes)
+    if not slots:
+        return np.array([float(r0[m] @ r0[m]) for m in masks])
+    u0 = np.array([to_u(spec, changes[i][1][spec.name]) for i, spec in slots])
+    lo = np.array([to_u(spec, spec.lower) for _, spec in slots])
+    hi = np.array([to_u(spec, spec.upper) for _, spec in slots])
+    jac = np.empty((r0.size, u0.size))
+    for j in range(u0.size):  # forward differences, as the fits take them; backwards at an upper bound
+        h = 1e-6 * max(1.0, abs(u0[j]))
+        if u0[j] + h > hi[j]:
+            h = -h
+        u = u0.copy()
+        u[j] += h
+        jac[:, j] = (likelihood.residual(_model(changes, slots, u)) - r0) / h
+    out = []
+    for held in masks:
+        kept = ~held
+        chi2_kept = float(r0[kept] @ r0[kept])
+        # directions the lines kept do not determine (a standard deviation above one unit of the fitted
+        # scale) stay where all lines put them: they carry no information on the held-back lines either
+        left, sv, right = np.linalg.svd(jac[kept], full_matrices=False)
+        resolved = sv >= CV_RESOLVED
+        step = right[resolved].T @ ((left[:, resolved].T @ -r0[kept]) / sv[resolved])
+        best = r0
+        for _ in range(CV_HALVINGS + 1):
+            u = np.clip(u0 + step, lo, hi)
+            try:
+                r = likelihood.residual(_model(changes, slots, u))
+            except (SubstructureError, ValueError, FloatingPointError):
+                r = None
+            if r is not None and np.all(np.isfinite(r)) and float(r[kept] @ r[kept]) < chi2_kept:
+                best = r
+                break
+            step = step / 2.0
+        out.append(float(best[held] @ best[held]))
+    return np.array(out)
