@@ -13,8 +13,7 @@ import pytest
 import hidden_data as hd
 from substructure import FRF, Frequency
 from substructure.diagnose import diagnose
-from substructure.diagnose.crossval import CV_BLOCKS, CV_FOLDS, fold_masks, held_back_chi2
-from substructure.diagnose.refine import _cross_validate
+from substructure.diagnose.crossval import CV_BLOCKS, CV_FOLDS, cross_validate, fold_masks, held_back_chi2
 from substructure.updating import set_parameters
 from substructure.updating.fit import fit
 from substructure.updating.likelihood import Likelihood, measured_frfs
@@ -88,7 +87,7 @@ def test_a_change_fitted_to_a_calibration_jump_is_significant_but_is_dropped():
     result = fit(lik, [(change, {})])
     chi2_0 = lik.chi2([])
     assert significance(chi2_0, result.chi2, 1, lik.n, 1, 80).significant
-    current, final, records = _cross_validate(lik, list(result.changes), result, {}, None)
+    current, final, records = cross_validate(lik, list(result.changes), result, {}, None)
     assert current == [] and final is None
     (record,) = records
     assert not record["predicts"] and record["chi2_with"] > record["chi2_without"]
@@ -99,7 +98,7 @@ def test_a_true_change_predicts_the_lines_held_back():
     truth = set_parameters(MODEL, {"joints.holder-tool.k.yf": 0.9 * 1.43e7})
     lik = _likelihood(truth, seed=5)
     result = fit(lik, [(_change("joints.holder-tool.k.yf"), {})])
-    current, final, records = _cross_validate(lik, list(result.changes), result, {}, None)
+    current, final, records = cross_validate(lik, list(result.changes), result, {}, None)
     assert [c.key for c, _ in current] == [c.key for c, _ in result.changes] and final is result
     (record,) = records
     assert record["predicts"] and record["chi2_with"] < 0.1 * record["chi2_without"]

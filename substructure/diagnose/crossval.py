@@ -35,9 +35,9 @@ from typing import Sequence
 import numpy as np
 
 from ..errors import SubstructureError
-from ..updating.fit import from_u, to_u
+from ..updating.fit import fit, from_u, to_u
 
-__all__ = ["CV_FOLDS", "CV_BLOCKS", "fold_masks", "held_back_chi2"]
+__all__ = ["CV_FOLDS", "CV_BLOCKS", "fold_masks", "held_back_chi2", "cross_validate"]
 
 CV_FOLDS = 4
 """Folds of the cross-validation: each holds back about a quarter of the lines."""
@@ -143,3 +143,61 @@ def held_back_chi2(likelihood, changes: Sequence[tuple], masks: Sequence[np.ndar
             step = step / 2.0
         out.append(float(best[held] @ best[held]))
     return np.array(out)
+
+
+def cross_validate(lik, current: list, final, refits: dict, say=None):
+    """Drop the kept changes that do not predict held-back lines (:mod:`substructure.diagnose.crossval`).
+
+    Each change's explanation is compared with the one without it (the others refitted on all lines, from the
+    elimination's fits when it made them; a single change against the model as given) on the held-back
+    ``chi^2`` summed over the folds; of the changes that do not predict better, the one that predicts worst is
+    dropped and the rest checked again.
+
+    Parameters
+    ----------
+    lik : Likelihood
+        All lines.
+    current : list of (Change, dict)
+        The changes kept, with their values fitted on all lines (SI).
+    final : Fit
+        Their joint fit.
+    refits : dict
+        Fits on all lines of subsets of the changes, by the frozenset of their keys (filled as needed).
+    say : callable, optional
+        Progress.
+
+    Returns
+    -------
+    (list, Fit or None, list of dict)
+        The changes kept, their fit, and per change checked ``effect``, ``where``, ``chi2_with``,
+        ``chi2_without`` (held-back ``chi^2`` summed over the folds) and ``predicts``.
+    """
+    masks = fold_masks(lik)
+    records: list = []
+    while current:
+        with_it = float(held_back_chi2(lik, current, masks).sum())
+        rounds, worst = [], None
+        for i, (change, values) in enumerate(current):
+            rest = current[:i] + current[i + 1:]
+            refit = None
+            if rest:
+                refit = refits.get(frozenset(c.key for c, _ in rest))
+                if refit is None:
+                    refit = refits[frozenset(c.key for c, _ in rest)] = fit(lik, rest)
+            without = float(held_back_chi2(lik, refit.changes if refit is not None else [], masks).sum())
+            record = {"effect": change.effect, "where": change.place(values), "chi2_with": with_it,
+                      "chi2_without": without, "predicts": bool(with_it < without)}
+            rounds.append(record)
+            if not record["predicts"] and (worst is None or with_it - without > worst[0]):
+                worst = (with_it - without, i, refit, record)
+        if worst is None:
+            records += rounds
+            break
+        _, i, refit, record = worst
+        if say:
+            say(f"dropped {record['effect']} at {record['where']}: did not predict held-back lines (chi^2 of "
+                f"the held-back lines {record['chi2_with']:.1f} with it, {record['chi2_without']:.1f} without)")
+        records.append(record)
+        current = [(c, dict(v)) for c, v in refit.changes] if refit is not None else []
+        final = refit
+    return current, final, records

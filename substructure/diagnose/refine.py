@@ -18,7 +18,13 @@ any change is left alone.  Then
   BIC with every single candidate of the first step and the best pairs
   fitted from the values of the best singles that change the model in
   different ways, not only extensions of the greedy path; the lowest BIC
-  is kept, those within the indifference region are its rivals;
+  is kept, those within the indifference region are its rivals; when the
+  forward path did not reach the noise with two changes, pairs found by
+  second steps from other singles join them
+  (:mod:`substructure.diagnose.pairs`);
+* the cross-validation drops a kept change whose explanation does not
+  predict held-back lines better than the one without it
+  (:mod:`substructure.diagnose.crossval`);
 * the history is rebuilt from the changes kept, in the order that lowers
   ``chi^2`` most at each step, so that the "error fall" shows the final
   explanation.
@@ -45,7 +51,7 @@ from ..errors import SubstructureError
 from ..updating.fit import Fit, fit
 from ..updating.selection import INDIFFERENCE, consistency, significance
 from ..updating.likelihood import Likelihood
-from .crossval import fold_masks, held_back_chi2
+from .crossval import cross_validate
 from .modes import mode_starts
 from .pairs import OTHER_FIRSTS, other_paths
 from ..updating.fit import to_u
@@ -394,51 +400,6 @@ def _other_values(lik, screen_lik, current, final: Fit, passive, say) -> list:
     return out
 
 
-def _cross_validate(lik, current, final: Fit, refits: dict, say):
-    """Drop the kept changes that do not predict held-back lines (:mod:`substructure.diagnose.crossval`).
-
-    Each change's explanation is compared with the one without it (the others refitted on all lines, from the
-    elimination's fits when it made them; a single change against the model as given) on the held-back
-    ``chi^2`` summed over the folds; of the changes that do not predict better, the one that predicts worst is
-    dropped and the rest checked again.
-
-    Returns
-    -------
-    (list, Fit or None, list of dict)
-        The changes kept, their fit, and per change checked ``effect``, ``where``, ``chi2_with``,
-        ``chi2_without`` (held-back ``chi^2`` summed over the folds) and ``predicts``.
-    """
-    masks = fold_masks(lik)
-    records: list = []
-    while current:
-        with_it = float(held_back_chi2(lik, current, masks).sum())
-        rounds, worst = [], None
-        for i, (change, values) in enumerate(current):
-            rest = current[:i] + current[i + 1:]
-            refit = None
-            if rest:
-                refit = refits.get(frozenset(c.key for c, _ in rest))
-                if refit is None:
-                    refit = refits[frozenset(c.key for c, _ in rest)] = fit(lik, rest)
-            without = float(held_back_chi2(lik, refit.changes if refit is not None else [], masks).sum())
-            record = {"effect": change.effect, "where": change.place(values), "chi2_with": with_it,
-                      "chi2_without": without, "predicts": bool(with_it < without)}
-            rounds.append(record)
-            if not record["predicts"] and (worst is None or with_it - without > worst[0]):
-                worst = (with_it - without, i, refit, record)
-        if worst is None:
-            records += rounds
-            break
-        _, i, refit, record = worst
-        if say:
-            say(f"dropped {record['effect']} at {record['where']}: did not predict held-back lines (chi^2 of "
-                f"the held-back lines {record['chi2_with']:.1f} with it, {record['chi2_without']:.1f} without)")
-        records.append(record)
-        current = [(c, dict(v)) for c, v in refit.changes] if refit is not None else []
-        final = refit
-    return current, final, records
-
-
 def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
            budget: Budget | None = None, lacking: bool = False) -> Outcome:
     """Forward selection, then elimination, review and history (see the module docstring).
@@ -584,7 +545,7 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     final = path[-1][0] if unchanged and path else (fit(lik, current) if current else None)
     if final is not None:
         current = [(c, dict(v)) for c, v in final.changes]
-        current, final, search["held_back"] = _cross_validate(lik, current, final, refits, say)
+        current, final, search["held_back"] = cross_validate(lik, current, final, refits, say)
         gone = set(kept) - {c.key for c, _ in current}
         if gone:  # a change that did not predict held-back lines: the history and the rivals without it
             unchanged = False
