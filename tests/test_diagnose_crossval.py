@@ -91,6 +91,7 @@ def test_a_change_fitted_to_a_calibration_jump_is_significant_but_is_dropped():
     assert current == [] and final is None
     (record,) = records
     assert not record["predicts"] and record["chi2_with"] > record["chi2_without"]
+    assert record["refitted"]  # dropped on full refits, not on one step
     assert record["chi2_without"] == pytest.approx(chi2_0)  # the model as given predicts every fold as it is
 
 
