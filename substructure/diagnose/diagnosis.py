@@ -333,6 +333,9 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         names = tuple(dict.fromkeys(list(names) + [r.name for r, _ in rivals]))
     search = {**outcome.search, "evaluations": round(meter.used(), 1), "budget": budget,
               "time_limit_s": time_limit, "seconds": round(meter.elapsed(), 3)}
+    if not explained:  # the changes the cross-validation dropped, said where the verdict is read
+        report = list(report) + [words.held_back(r["effect"], r["where"], r["chi2_with"], r["chi2_without"])
+                                 for r in search.get("held_back", []) if not r["predicts"]]
     if search["cut"] and not explained:
         report = list(report) + [words.budget_cut(search["cut_at"])]
     return Diagnosis(

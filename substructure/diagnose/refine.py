@@ -18,7 +18,13 @@ any change is left alone.  Then
   BIC with every single candidate of the first step and the best pairs
   fitted from the values of the best singles that change the model in
   different ways, not only extensions of the greedy path; the lowest BIC
-  is kept, those within the indifference region are its rivals;
+  is kept, those within the indifference region are its rivals; when the
+  forward path did not reach the noise with two changes, pairs found by
+  second steps from other singles join them
+  (:mod:`substructure.diagnose.pairs`);
+* the cross-validation drops a kept change whose explanation does not
+  predict held-back lines better than the one without it
+  (:mod:`substructure.diagnose.crossval`);
 * the history is rebuilt from the changes kept, in the order that lowers
   ``chi^2`` most at each step, so that the "error fall" shows the final
   explanation.
@@ -44,9 +50,11 @@ import numpy as np
 
 from ..errors import SubstructureError
 from ..updating.fit import Fit, fit
-from ..updating.selection import INDIFFERENCE, significance
+from ..updating.selection import INDIFFERENCE, consistency, significance
 from ..updating.likelihood import Likelihood
+from .crossval import cross_validate
 from .modes import mode_starts
+from .pairs import OTHER_FIRSTS, other_paths
 from ..updating.fit import to_u
 from .scan import places, trials
 from .search import Budget, Scored, choose, full_fits, physical, preference, rank, screen, shortlist
@@ -95,7 +103,7 @@ def _p(changes) -> int:
     return sum(len(c.specs) for c, _ in changes)
 
 
-def _prune(lik, current, chi2_now, say):
+def _prune(lik, current, chi2_now, say, refits: dict | None = None):
     n = lik.n
     dropped: list = []
     while len(current) > 1:
@@ -103,6 +111,8 @@ def _prune(lik, current, chi2_now, say):
         worst = None
         for i in range(len(current)):
             refit = fit(lik, current[:i] + current[i + 1:])
+            if refits is not None:  # kept for the cross-validation: the explanation without change i
+                refits[frozenset(c.key for c, _ in refit.changes)] = refit
             sig = significance(refit.chi2, chi2_now, len(current[i][0].specs), n, p, 1)
             if not sig.significant and (worst is None or sig.statistic < worst[0]):
                 worst = (sig.statistic, i, refit)
@@ -230,7 +240,7 @@ def _bic(chi2: float, p: int, n: int, s2: float) -> float:
 
 
 def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
-               settings: DiagnoseSettings = DEFAULT_SETTINGS):
+               settings: DiagnoseSettings = DEFAULT_SETTINGS, more=()):
     """The kept explanation against the best single and best pair ones fitted from fair starts.
 
     Forward selection extends its first choice; when that choice was wrong,
@@ -287,6 +297,7 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
                 continue
             if all(physical(c, v) for c, v in result.changes) and passive(result.changes):
                 options.append(([(c, dict(v)) for c, v in result.changes], result.chi2))
+    options += [(pair, chi2) for pair, chi2 in more if sorted(c.key for c, _ in pair) != keys_now]
     best_chi2 = min(chi2 for _, chi2 in options)
     p_best = next(_p(ch) for ch, chi2 in options if chi2 == best_chi2)
     s2 = max(1.0, best_chi2 / max(n - p_best, 1))
@@ -417,7 +428,8 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
         The changes kept and what the report needs.
     """
     n = lik.n
-    search = {"candidates": len(cands), "steps_screened": 0, "full_fits": 0, "cut": False, "cut_at": None}
+    search = {"candidates": len(cands), "steps_screened": 0, "full_fits": 0, "cut": False, "cut_at": None,
+              "held_back": []}
     lik0 = Likelihood(lik.assembly, lik.measured[:1])
     if budget is not None:
         budget.watch(lik, screen_lik, lik0)
@@ -502,8 +514,9 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
             say(f"step {len(current)}: added {best.change.effect} at {best.change.place(best.values)}, "
                 f"chi^2/nu = {chi2_now / max(n - _p(current), 1):.4g}")
     dropped: list = []
+    refits = {frozenset(c.key for c, _ in f.changes): f for f, _, _, _ in path}  # fits of subsets, all lines
     if len(current) > 1:
-        current, chi2_now, dropped = _prune(lik, current, chi2_now, say)
+        current, chi2_now, dropped = _prune(lik, current, chi2_now, say, refits)
     pruned = sorted(c.key for c, _ in current)
     alternatives: dict = {}
     if current:
@@ -512,11 +525,20 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     rivals: list = []
     if len(current) >= 2:
         before = [c.key for c, _ in current]
+        more = []
+        if len(current) > settings.most_changes or not consistency(lik, lik.log_ratios(current),
+                                                                   _p(current)).consistent:
+            # the path did not reach the noise with two changes: its first choice may be the wrong one
+            # the path's own first change (or the same change under another name) is not started from again
+            singles = [s for s in first_fitted if s.fit is not None]
+            firsts = [s for s in _distinct(screen_lik, singles, OTHER_FIRSTS + 1, settings)
+                      if s.change.key != path[0][1].key]
+            more = other_paths(lik, screen_lik, lik0, firsts[:OTHER_FIRSTS], cands, passive, say, settings)
         current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
-                                               settings)
+                                               settings, more)
         if len(current) > 1 and sorted(c.key for c, _ in current) != pruned:
             # what the review and the parsimony check put in must each still earn its place
-            current, chi2_now, late = _prune(lik, current, chi2_now, say)
+            current, chi2_now, late = _prune(lik, current, chi2_now, say, refits)
             dropped += late
         if [c.key for c, _ in current] != before:
             alternatives = {c.key: [] for c, _ in current}
@@ -525,6 +547,12 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     final = path[-1][0] if unchanged and path else (fit(lik, current) if current else None)
     if final is not None:
         current = [(c, dict(v)) for c, v in final.changes]
+        current, final, search["held_back"] = cross_validate(lik, current, final, refits, say)
+        gone = set(kept) - {c.key for c, _ in current}
+        if gone:  # a change that did not predict held-back lines: the history and the rivals without it
+            unchanged = False
+            alternatives = {k: v for k, v in alternatives.items() if k not in gone}
+            rivals = [r for r in rivals if not gone & {c.key for c, _ in r[0]}]
     history = path if unchanged else (_history(lik, current, final, tried) if current else [])
     if final is not None:
         rivals = list(rivals) + _other_values(lik, screen_lik, current, final, passive, say, settings)

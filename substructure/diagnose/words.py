@@ -183,6 +183,25 @@ def tell_apart(text: str) -> str:
     return f"to tell them apart: {text}"
 
 
+def held_back(effect: str, where: str, chi2_with: float, chi2_without: float) -> str:
+    """A change the cross-validation dropped (:mod:`substructure.diagnose.crossval`).
+
+    Parameters
+    ----------
+    effect, where : str
+        The change's effect and place.
+    chi2_with, chi2_without : float
+        ``chi^2`` of the held-back lines predicted with the change and without it.
+
+    Returns
+    -------
+    str
+        One line of the report.
+    """
+    return (f"dropped {effect} at {where}: did not predict held-back lines (their chi^2 {chi2_with:.1f} with it, "
+            f"{chi2_without:.1f} without)")
+
+
 def budget_cut(where: str) -> str:
     """The note that the search's budget cut it short.
 

@@ -1,0 +1,100 @@
+"""Pairs of changes found from other first changes than the forward path's.
+
+The parsimony check (:func:`substructure.diagnose.refine.refine`) pairs the
+best singles of the first step.  A pair whose members are each weak alone
+is missed that way: a holder-tool joint 0.6 times as stiff with flutes at the
+tip, where a section change over the whole tool explains more alone than
+either, and the flutes (one effect of the two) are not among the best
+singles at all; or a reground tool with a forgotten sensor fitted below 2 kHz,
+where the sensor alone explains little.  Forward selection then extends the
+wrong first choice, and later steps compensate with changes that do not
+exist.
+
+So when the forward path did not reach the noise with at most
+two changes (``DiagnoseSettings.most_changes``),
+:func:`other_paths` repeats its second step from each of the
+:data:`OTHER_FIRSTS` best other singles of the first step that change the
+model in different ways: every candidate is screened with that single held
+(and refitted to first order, as the forward step does), the
+:data:`SECONDS` best of the shortlist are fitted on all lines with it, and
+the one :func:`~substructure.diagnose.search.choose` takes (the preferred
+name among those the data cannot tell apart) makes a pair.  The pairs join
+the parsimony check's explanations, where the fewest changes, then the
+preferred names, are kept among those the data do not decide between.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+from ..errors import SubstructureError
+from .modes import mode_starts
+from .scan import places
+from .search import choose, full_fits, physical, rank, screen, shortlist
+from .settings import DEFAULT_SETTINGS, DiagnoseSettings
+
+__all__ = ["OTHER_FIRSTS", "SECONDS", "other_paths"]
+
+OTHER_FIRSTS = 3
+"""Singles of the first step (best first, changing the model in different ways) from which a second step is
+screened when the forward path did not reach the noise with at most two changes."""
+SECONDS = 3
+"""Shortlisted second changes fitted on all lines with each of those singles."""
+
+
+def _p(changes) -> int:
+    return sum(len(c.specs) for c, _ in changes)
+
+
+def other_paths(lik, screen_lik, lik0, firsts: list, cands: list, passive: Callable, say=None,
+                settings: DiagnoseSettings = DEFAULT_SETTINGS) -> list:
+    """Pairs of changes from other first changes (see the module docstring).
+
+    Parameters
+    ----------
+    lik : Likelihood
+        All lines.
+    screen_lik : Likelihood
+        The screening subsample.
+    lik0 : Likelihood
+        The first measured FRF on all lines (for the starts from mode shifts).
+    firsts : list of Scored
+        Fitted singles of the first step to start from, best first.
+    cands : list of Change
+        Every candidate.
+    passive : callable
+        ``passive(changes) -> bool``.
+    say : callable, optional
+        Progress.
+    settings : DiagnoseSettings
+        The diagnosis's settings.
+
+    Returns
+    -------
+    list of (list of (Change, dict), float)
+        Each pair with its values and ``chi^2`` on all lines.
+    """
+    n = lik.n
+    out = []
+    for first in firsts:
+        held = [(c, dict(v)) for c, v in first.fit.changes]
+        keys = {c.key for c, _ in held}
+        remaining = [c for c in cands if c.key not in keys]
+        if say:
+            say(f"pairs: a second change screened with {first.change.effect} at {first.change.place(first.values)}")
+        try:
+            chi2_s = screen_lik.chi2(held)
+            starts = mode_starts(lik0, held, remaining, lambda change: places(change, settings), settings)
+            scored = screen(screen_lik, held, remaining, chi2_s, n, None, starts, settings=settings)
+        except (ValueError, ArithmeticError, SubstructureError):
+            continue
+        chosen = shortlist(scored, chi2_s, screen_lik.n, n, _p(held), settings)[:SECONDS]
+        done = [s for s in full_fits(lik, held, chosen) if physical(s.change, s.values) and passive(s.fit.changes)]
+        if not done:
+            continue
+        best, _, _ = choose(rank(done, n, _p(held)), n, _p(held))
+        pair = [(c, dict(v)) for c, v in best.fit.changes]
+        if all(physical(c, v) for c, v in pair):
+            out.append((pair, best.chi2))
+    return out
+
