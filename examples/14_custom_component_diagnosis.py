@@ -9,8 +9,9 @@ through its ``receptance_matrix``; the numbers its class adds are model
 parameters like any other, by path (``components.holder.nut_mass``), so the
 diagnosis can find that the nut is not what the model says.
 
-Steps: (a) the class, and its receptances checked against the plain holder
-with the nut as a ``Mass`` (the engine's own coupling); (b) its parameters
+Steps: (a) the class (the nut added by structural modification, thesis
+eq. 5.3), and its receptances checked against the plain holder with the nut
+as a ``Mass`` (the engine's own coupling); (b) its parameters
 by path; (c) a tap test of the chuck with a 350 g nut where the model says
 150 g, diagnosed; (d) the same with the built-in equivalent (a plain holder
 and a ``Mass``): the same answer, with as many model evaluations; (e) the
@@ -23,7 +24,8 @@ Figures are written to $SUBSTRUCTURE_EXAMPLES_OUT (default: out/examples).
 # (a) A chuck with its nut
 # ------------------------
 # The nut is added to the beam's free-free receptances by structural
-# modification, :math:`H - H_{:,t} Z (I + H_{t,t} Z)^{-1} H_{t,:}` with
+# modification, as thesis eq. 5.3 adds a mass to an FRF:
+# :math:`H - H_{:,t} Z (I + H_{t,t} Z)^{-1} H_{t,:}` with
 # :math:`Z = -\omega^2 \mathrm{diag}(m, 0)`, the 2x2 inverse written out so
 # that every frequency line is computed at once.
 import os
