@@ -3,7 +3,9 @@
 :func:`refine` runs the steps of :mod:`substructure.diagnose.search` until
 no candidate passes the significance test (or ``max_steps``), refitting
 every change added at every step; a model consistent with the noise before
-any change is left alone.  Then
+any change is left alone, and one that a step made consistent with the
+noise gets no further step (what is left is at the noise's level: a change
+found in it would be fitted to the noise, stacked on the explanation).  Then
 
 * backward elimination drops a change whose removal (the others refitted)
   is not significant: an early change that a later one made redundant;
@@ -453,6 +455,10 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     while len(current) < max_steps:
         if spent():
             cut(f"no step {len(current) + 1} screened")
+            break
+        if current and consistency(lik, lik.log_ratios(current), _p(current)).consistent:
+            if say:
+                say(f"step {len(current) + 1}: the model is consistent with the noise: no further step")
             break
         search["steps_screened"] += 1
         keys = {c.key for c, _ in current}
