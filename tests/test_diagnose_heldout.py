@@ -205,3 +205,23 @@ def test_the_reground_tool_fitted_below_2_khz_predicts_above_it(reground_below_2
     d, truth = reground_below_2khz
     _predicts(d, truth, ((("tool.tip:y", "tool.tip:y"), ABOVE_2K), (("tool.tip:y", "tool.tip:y"), BEYOND),
                          (("tool.tip:theta", "tool.tip:theta"), ALL), (("tool.tip:y", "tool.tip:theta"), ALL)))
+
+
+@pytest.fixture(scope="module")
+def stiffer_joint():
+    """The holder-tool joint 1.6 times as stiff in translation as the model says (a shrink-fit where the model
+    has a collet's value): a joint stiffer than given, not softer."""
+    frfs = hd.measure(seed=12, ht_scale=1.6)
+    truth = set_parameters(hd.nominal_model(), {"joints.holder-tool.k.yf": 1.6 * 1.43e7})
+    return diagnose(hd.nominal_model(), frfs), truth
+
+
+def test_a_stiffer_joint_is_the_joint_and_no_more(stiffer_joint):
+    d, truth = stiffer_joint
+    assert d.explained, d.report
+    (joint,) = d.effects
+    assert (joint.name, joint.where) in (("joint-stiffness", "holder-tool"),
+                                         ("model-parameter", "joints.holder-tool.k.yf"))
+    assert joint.values.get("k_yf", joint.values.get("value")) == pytest.approx(1.6 * 1.43e7, rel=0.05)
+    _predicts(d, truth, ((("tool.tip:y", "tool.tip:y"), BEYOND), (("tool.tip:theta", "tool.tip:theta"), ALL),
+                         (("holder.tip:y", "tool.tip:y"), ALL)))
