@@ -3,7 +3,7 @@
 This module is the *second method* used by the test-suite to check the
 library's closed-form Timoshenko receptances and its receptance-coupling
 engine.  It deliberately imports nothing from ``substructure``; all inputs are
-SI floats.  Conventions follow ``/work/shared/conventions.md``: DOFs per node
+SI floats.  Conventions follow ``docs/conventions.md``: DOFs per node
 ``(y, theta)``, loads ``(f, m)``, ``x(t) = X exp(i omega t)``, loss factor as a
 complex modulus on both E and G, Cowper (1966) shear coefficient.
 
