@@ -476,3 +476,30 @@ def test_matlab_vectors_with_their_units(tmp_path):
     path.write_bytes(b"not a MATLAB file at all" * 10)
     with pytest.raises(FileFormatError, match=r"tap.mat: cannot read the MATLAB file"):
         read_tap_mat(path)
+
+
+# -- text of Windows programs ------------------------------------------------------------------------------------
+
+def test_a_header_in_windows_1252_is_read_with_a_warning_as_the_utf8_one(tmp_path):
+    """m/s² written by a Windows program (byte 0xB2): the same record as the UTF-8 file, and a warning naming the
+    line; bytes that are not Windows-1252 either are refused as before."""
+    t, f, a = samples()
+    text = "Sample rate: 10240 Hz\nTime [s];Force [N];Acceleration [m/s²]\n" + rows([t, f, a], sep=";",
+                                                                                    decimal_comma=True)
+    utf8, windows, neither = tmp_path / "u.csv", tmp_path / "w.csv", tmp_path / "x.csv"
+    utf8.write_text(text, encoding="utf-8")
+    windows.write_bytes(text.encode("cp1252"))
+    neither.write_bytes(text.encode("cp1252").replace(b"\xb2", b"\x81"))
+    expected = read_tap_csv(utf8)
+    with pytest.warns(UserWarning, match=r"w.csv, line 2: not UTF-8; read as Windows-1252"):
+        got = read_tap_csv(windows)
+    assert np.array_equal(got.response, expected.response) and got.response_column == expected.response_column
+    with pytest.raises(FileFormatError, match=r"x.csv, line 2: not UTF-8 text .*save the file as UTF-8"):
+        read_tap_csv(neither)
+    t, f, a = samples()
+    f, a = np.round(f, 6), np.round(a, 6)
+    path = tmp_path / "tap.lvm"
+    path.write_bytes(lvm([(0.0, 1 / FS, f, a)], units=("N", "m/s²")).encode("cp1252"))
+    with pytest.warns(UserWarning, match="not UTF-8; read as Windows-1252"):
+        (record,) = read_tap_lvm(path)
+    assert np.allclose(record.response, a, rtol=1e-12, atol=0) and record.response_column == "Accel [m/s²]"

@@ -13,11 +13,12 @@ file has an x column, the channels, ``Comment``) and the rows.
 from __future__ import annotations
 
 import re
+import warnings
 
 import attrs
 import numpy as np
 
-from ..errors import FileFormatError
+from ..errors import FileFormatError, SubstructureWarning
 from ._tap_columns import Columns, is_number, name_and_unit
 from ._tap_table import parse_rows
 
@@ -37,6 +38,19 @@ class Segment:
     x0: float
     first_line: int
 
+
+
+def _utf8(raw: bytes) -> bool:
+    try:
+        raw.decode("utf-8")
+    except UnicodeDecodeError:
+        return False
+    return True
+
+
+def _text(raw: bytes) -> str:
+    """Header text: UTF-8, else Windows-1252 (what LabVIEW writes on Windows), said once by the reader."""
+    return raw.decode("utf-8") if _utf8(raw) else raw.decode("cp1252", "replace")
 
 def _tags(text: str, sep: str) -> dict[str, list[str]]:
     tags: dict[str, list[str]] = {}
@@ -78,7 +92,10 @@ def read_segments(data: bytes, name: str) -> list[Segment]:
     if len(marks) < 2:
         raise FileFormatError(f"{name}: {len(marks)} '***End_of_Header***' marker(s); expected one after the file "
                               "header and one after each segment header")
-    header = data[:marks[0]].decode("utf-8", "replace")
+    if not _utf8(data[:data.find(b"\n", marks[-1]) + 1 or len(data)]):
+        warnings.warn(f"{name}: the headers are not UTF-8; read as Windows-1252, the text of Windows programs "
+                      "(units such as m/s\u00b2); save the file as UTF-8 to be sure", SubstructureWarning, stacklevel=3)
+    header = _text(data[:marks[0]])
     first = _tags(header, "\t") if "\t" in header else _tags(header, ",")
     separator = (first.get("Separator") or ["Tab"])[0]
     if separator not in ("Tab", "Comma"):
@@ -94,12 +111,12 @@ def read_segments(data: bytes, name: str) -> list[Segment]:
     seg_start = marks[0] + len(_MARK)
     for k, mark in enumerate(marks[1:]):
         line_of = data.count(b"\n", 0, mark) + 1
-        tags = _tags(data[seg_start:mark].decode("utf-8", "replace"), sep)
+        tags = _tags(_text(data[seg_start:mark]), sep)
         where = f"{name}, segment {k + 1} (header ending on line {line_of})"
         names_start = data.find(b"\n", mark) + 1
         names_end = data.find(b"\n", names_start)
         names_end = len(data) if names_end < 0 else names_end
-        names = [c.strip() for c in data[names_start:names_end].decode("utf-8", "replace").rstrip("\r").split(sep)]
+        names = [c.strip() for c in _text(data[names_start:names_end]).rstrip("\r").split(sep)]
         while names and (not names[-1] or names[-1] == "Comment"):
             names.pop()
         body_start = names_end + 1

@@ -18,12 +18,13 @@ when a file holds more.
 from __future__ import annotations
 
 import os
+import warnings
 from typing import Any
 
 import numpy as np
 
 from .._files import decode_text
-from ..errors import FileFormatError, SubstructureError
+from ..errors import FileFormatError, SubstructureError, SubstructureWarning
 from ..tap.records import RESPONSE_QUANTITIES, TIME_STEP_TOLERANCE, TapRecord, channel_to_si, unit_of
 from . import check_readable_file, read_bytes
 from ._tap_columns import (MAX_PREAMBLE_LINES, NO_UNIT, Columns, choose, header_cells, is_row, is_unit_row,
@@ -147,6 +148,19 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
                         parsed[r_col], labels[r_col], sensitivity, hammer_sensitivity, quantity)
 
 
+def _windows_text(line: bytes, name: str, number: int, pos: int, bad: int) -> str:
+    """A header line that is not UTF-8, read as Windows-1252 with a warning (what the acquisition programs of
+    Windows write: ``m/s²``, ``°C``), or refused when it is not that either."""
+    try:
+        text = line.decode("cp1252").rstrip("\r")
+    except UnicodeDecodeError:
+        raise FileFormatError(f"{name}, line {number}: not UTF-8 text (byte {pos + bad}: {line[bad:bad + 1]!r}); "
+                              "save the file as UTF-8") from None
+    warnings.warn(f"{name}, line {number}: not UTF-8; read as Windows-1252, the text of Windows programs "
+                  f"({text.strip()[:80]!r}); save the file as UTF-8 to be sure", SubstructureWarning, stacklevel=3)
+    return text
+
+
 def _head(data: bytes, name: str) -> tuple[list[tuple[int, str]], int, int]:
     """The lines above the first row of numbers, the byte offset of that row and its line number."""
     head: list[tuple[int, str]] = []
@@ -159,8 +173,7 @@ def _head(data: bytes, name: str) -> tuple[list[tuple[int, str]], int, int]:
         try:
             text = data[pos:end].decode("utf-8").rstrip("\r")
         except UnicodeDecodeError as exc:
-            raise FileFormatError(f"{name}, line {number}: not UTF-8 text (byte {pos + exc.start}: "
-                                  f"{data[pos + exc.start:pos + exc.start + 1]!r}); save the file as UTF-8") from None
+            text = _windows_text(data[pos:end], name, number, pos, exc.start)
         stripped = text.strip()
         if stripped and not stripped.startswith("#") and is_row(text):
             return head, pos, number
