@@ -132,14 +132,17 @@ def own_parameters(component: Any) -> tuple[ComponentParameter, ...]:
     Raises
     ------
     InvalidValueError
-        When ``parameters()`` gives something other than
+        When ``parameters()`` fails or gives something other than
         :class:`ComponentParameter` entries with distinct names.
     """
     hook = getattr(component, "parameters", None)
     if not callable(hook):
         return _derived(component)
-    found = tuple(hook())
     name = getattr(component, "name", "?")
+    try:
+        found = tuple(hook())
+    except Exception as exc:  # a component type of one's own: its error named with it, not a bare traceback
+        raise InvalidValueError(f"component {name!r}: its parameters() failed ({type(exc).__name__}: {exc})") from exc
     if not all(isinstance(p, ComponentParameter) for p in found):
         raise InvalidValueError(f"component {name!r}: parameters() must give ComponentParameter entries, got "
                                 f"{[type(p).__name__ for p in found]}")
