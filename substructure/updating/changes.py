@@ -55,7 +55,9 @@ class Change:
     form, for fits) and :meth:`apply` (on the assembly, for the result).
     Either may raise :class:`~substructure.errors.UnknownPointError` when the
     change has no place in a configuration (e.g. a component taken off); it
-    is then skipped there.
+    is then skipped there.  A subclass's :meth:`apply_si`, :meth:`apply` and
+    :meth:`place` without a docstring of their own are documented by the
+    protocol's (the class's docstring says what its change does).
     """
 
     effect: ClassVar[str] = ""
@@ -63,6 +65,13 @@ class Change:
     where: str = ""
     specs: tuple = ()
     test_only: ClassVar[bool] = False
+
+    def __init_subclass__(cls, **kwargs) -> None:
+        super().__init_subclass__(**kwargs)
+        for name in ("apply_si", "apply", "place"):
+            method = vars(cls).get(name)
+            if method is not None and not method.__doc__:
+                method.__doc__ = getattr(Change, name).__doc__
 
     @property
     def key(self) -> tuple[str, str]:

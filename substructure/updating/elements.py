@@ -140,23 +140,14 @@ class _OnComponent(Change):
         self.length = float(length)
 
     def place(self, values) -> str:
-        """Where it sits with these values.
-
-        Parameters
-        ----------
-        values : mapping of str to float
-                The change's values by parameter name (SI).
-
-        Returns
-        -------
-        str
-            A point (or range) name such as ``holder@55 mm``.
-        """
         return f"{self.component}@{_mm(values['position'])}"
 
 
 class AddedMass(_OnComponent):
     """A rigid body at a fitted position along a beam component.
+
+    Fitted as a mass link on the SI form; written back as a permanent
+    :class:`~substructure.joints.Mass` named ``diagnosed-COMPONENT-mass``.
 
     Parameters
     ----------
@@ -192,45 +183,12 @@ class AddedMass(_OnComponent):
         )
 
     def apply_si(self, structure, values):
-        """The structure with the body as a mass link at its position.
-
-        Parameters
-        ----------
-        structure : Structure
-            The SI form of one test configuration.
-        values : mapping of str to float
-                The change's values by parameter name (SI).
-
-        Returns
-        -------
-        Structure
-            The changed structure.
-        """
         link = LinkSI(("added", f"mass-{self.component}-{len(structure.links)}"),
                       (self.component, float(values["position"])),
                       M=np.diag([values["mass"], values["inertia"]]))
         return structure.add_link(link)
 
     def apply(self, assembly, values):
-        """The assembly with the body as a permanent :class:`~substructure.joints.Mass`.
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model.
-        values : mapping of str to float
-                The change's values by parameter name (SI).
-
-        Returns
-        -------
-        Assembly
-            A new assembly.
-
-        Raises
-        ------
-        UnknownPointError
-            When the component is not in this assembly.
-        """
         if self.component not in assembly.component_names:
             raise UnknownPointError(f"no component {self.component!r}")
         name = unique_name([m.name for m in assembly.masses], f"diagnosed-{self.component}-mass")
@@ -240,6 +198,9 @@ class AddedMass(_OnComponent):
 
 class GroundSpring(_OnComponent):
     """A translational spring to the ground at a fitted position along a beam component.
+
+    Fitted as a link to the ground; written back as a
+    :class:`~substructure.joints.Support` named ``diagnosed-COMPONENT-spring``.
 
     Parameters
     ----------
@@ -261,44 +222,11 @@ class GroundSpring(_OnComponent):
         )
 
     def apply_si(self, structure, values):
-        """The structure with the spring as a link to the ground.
-
-        Parameters
-        ----------
-        structure : Structure
-            The SI form of one test configuration.
-        values : mapping of str to float
-                The change's values by parameter name (SI).
-
-        Returns
-        -------
-        Structure
-            The changed structure.
-        """
         link = LinkSI(("added", f"spring-{self.component}-{len(structure.links)}"),
                       (self.component, float(values["position"])), K=np.diag([values["k_yf"], 0.0]))
         return structure.add_link(link)
 
     def apply(self, assembly, values):
-        """The assembly with the spring as a :class:`~substructure.joints.Support`.
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model.
-        values : mapping of str to float
-                The change's values by parameter name (SI).
-
-        Returns
-        -------
-        Assembly
-            A new assembly.
-
-        Raises
-        ------
-        UnknownPointError
-            When the component is not in this assembly.
-        """
         if self.component not in assembly.component_names:
             raise UnknownPointError(f"no component {self.component!r}")
         name = unique_name([s.name for s in assembly.supports if s.name], f"diagnosed-{self.component}-spring")
@@ -390,6 +318,8 @@ def split_segments(component, start: float, stop: float, change):
 class SectionChange(_OnComponent):
     """The outer diameter scaled over a fitted range of a beam component (a neck, a collar).
 
+    Written back with the component's segments split at the range's ends.
+
     Parameters
     ----------
     component : str
@@ -412,61 +342,16 @@ class SectionChange(_OnComponent):
         )
 
     def place(self, values) -> str:
-        """Where it sits with these values.
-
-        Parameters
-        ----------
-        values : mapping of str to float
-                The change's values by parameter name (SI).
-
-        Returns
-        -------
-        str
-            A point (or range) name such as ``holder@55 mm``.
-        """
         stop = min(self.length, values["start"] + values["length"])
         return f"{self.component}@{_mm(values['start'])}-{_mm(stop)}"
 
     def apply_si(self, structure, values):
-        """The structure with the beam's section scaled over the range.
-
-        Parameters
-        ----------
-        structure : Structure
-            The SI form of one test configuration.
-        values : mapping of str to float
-                The change's values by parameter name (SI).
-
-        Returns
-        -------
-        Structure
-            The changed structure.
-        """
         beam = structure.beam(self.component)
         start = float(values["start"])
         return structure.with_beam(split_beam(beam, start, start + float(values["length"]),
                                               od_factor=float(values["diameter_ratio"])))
 
     def apply(self, assembly, values):
-        """The assembly with the component's segments split and the range's diameter scaled.
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model.
-        values : mapping of str to float
-                The change's values by parameter name (SI).
-
-        Returns
-        -------
-        Assembly
-            A new assembly.
-
-        Raises
-        ------
-        UnknownPointError
-            When the component is not in this assembly.
-        """
         import attrs
 
         comp = assembly.component(self.component)

@@ -455,79 +455,6 @@ def get_parameter(assembly, path: str) -> float:
 # The same on the SI form
 
 
-class ParameterChange(Change):
-    """A correction of one model parameter (effect ``model-parameter``, ``where`` its path).
-
-    Parameters
-    ----------
-    parameter : ModelParameter
-        The parameter, with its bounds.
-    """
-
-    effect = "model-parameter"
-    explanation = "a number of the model is off: the fit corrects it"
-
-    def __init__(self, parameter: ModelParameter):
-        self.parameter = parameter
-        self.where = parameter.path
-        self.specs = (parameter.spec(),)
-
-    def apply(self, assembly, values):
-        """The assembly with the parameter set to ``values['value']``.
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model.
-        values : mapping of str to float
-                The change's values by parameter name (SI).
-
-        Returns
-        -------
-        Assembly
-            A new assembly.
-
-        Raises
-        ------
-        UnknownPointError
-            When the component is not in this assembly.
-        """
-        return set_parameters(assembly, {self.where: values["value"]})
-
-    def apply_si(self, structure, values):
-        """The structure with the parameter set to ``values['value']``.
-
-        Parameters
-        ----------
-        structure : Structure
-            The SI form of one test configuration.
-        values : mapping of str to float
-                The change's values by parameter name (SI).
-
-        Returns
-        -------
-        Structure
-            The changed structure.
-        """
-        return apply_path_si(structure, self.where, float(values["value"]))
-
-
-def parameter_change(parameter: ModelParameter) -> ParameterChange:
-    """The change that corrects a model parameter (on the SI form, as every parameter is).
-
-    Parameters
-    ----------
-    parameter : ModelParameter
-        The parameter.
-
-    Returns
-    -------
-    ParameterChange
-        A :class:`ParameterChange`.
-    """
-    return ParameterChange(parameter)
-
-
 class ParameterSet(Change):
     """Several model parameters fitted together, each under a short name (e.g. a joint's entries).
 
@@ -553,44 +480,42 @@ class ParameterSet(Change):
             raise InvalidValueError(f"parameters {unknown} have no path")
 
     def apply(self, assembly, values):
-        """The assembly with every parameter set.
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model.
-        values : mapping of str to float
-                The change's values by parameter name (SI).
-
-        Returns
-        -------
-        Assembly
-            A new assembly.
-
-        Raises
-        ------
-        UnknownPointError
-            When the component is not in this assembly.
-        """
         return set_parameters(assembly, {self.paths[k]: v for k, v in values.items()})
 
     def apply_si(self, structure, values):
-        """The structure with every parameter set.
-
-        Parameters
-        ----------
-        structure : Structure
-            The SI form of one test configuration.
-        values : mapping of str to float
-                The change's values by parameter name (SI).
-
-        Returns
-        -------
-        Structure
-            The changed structure.
-        """
         for k, v in values.items():
             structure = apply_path_si(structure, self.paths[k], float(v))
         return structure
 
 
+class ParameterChange(ParameterSet):
+    """A correction of one model parameter (effect ``model-parameter``, ``where`` its path).
+
+    Parameters
+    ----------
+    parameter : ModelParameter
+        The parameter, with its bounds.
+    """
+
+    effect = "model-parameter"
+    explanation = "a number of the model is off: the fit corrects it"
+
+    def __init__(self, parameter: ModelParameter):
+        super().__init__("model-parameter", parameter.path, {"value": parameter.path}, (parameter.spec(),))
+        self.parameter = parameter
+
+
+def parameter_change(parameter: ModelParameter) -> ParameterChange:
+    """The change that corrects a model parameter (on the SI form, as every parameter is).
+
+    Parameters
+    ----------
+    parameter : ModelParameter
+        The parameter.
+
+    Returns
+    -------
+    ParameterChange
+        A :class:`ParameterChange`.
+    """
+    return ParameterChange(parameter)
