@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 from substructure import default_assembly, loads_assembly
 from substructure.errors import SubstructureError
 from substructure.updating import get_parameter, set_parameters
+from substructure.updating.paths import check_path
 
 MODEL = default_assembly()
 
@@ -38,6 +39,11 @@ def test_any_path_and_value_give_a_result_or_a_clear_error(path, value):
         changed = set_parameters(MODEL, {path: value})
     except SubstructureError as exc:
         assert str(exc)
+        try:
+            check_path(MODEL, path)
+        except SubstructureError:
+            return
+        assert repr(path) in str(exc), f"a value refused at a path that exists does not name the path: {exc}"
         return
     # accepted: the value reads back where it was written (linked parameters are factors of 1 after)
     if isinstance(value, (int, float)) and math.isfinite(float(value)):

@@ -421,6 +421,7 @@ def check_path(assembly, path: str) -> list[str]:
             _key(path, f"joints.{parts[1]}.{parts[2]}", parts[3], _ENTRIES)
     elif head == "supports":
         count = len(assembly.supports)
+        _length(path, parts, (3, 4))
         if "+" in parts[1]:
             _length(path, parts, (3,))
             for text in parts[1].split("+"):
@@ -677,9 +678,11 @@ def set_parameters(assembly, values: Mapping[str, float]):
                                     "linked parameter)")
         try:
             assembly = _set_one(assembly, path, value)
-        except (IndexError, ValueError, AttributeError) as exc:
-            if isinstance(exc, InvalidValueError):
+        except InvalidValueError as exc:  # the value refused where the object checks it: named with its path
+            if f"{path!r}" in str(exc):
                 raise
+            raise InvalidValueError(f"parameter {path!r} = {value!r}: {exc}") from None
+        except (IndexError, ValueError, AttributeError) as exc:
             raise _unknown(path, f"cannot be set ({exc})") from None
     return assembly
 
