@@ -30,7 +30,7 @@ import numpy as np
 
 from .assembly import Assembly, expand_points
 from .beams import stepped_beam_receptance_batch
-from .components import is_plain_beam
+from .components import is_plain_beam, receptances
 from .coupling import Link, couple_substructures
 from .errors import InvalidValueError
 from .frf import FRF, Frequency
@@ -173,7 +173,7 @@ def sweep(
             if k[0] in const_groups and k not in needed:
                 needed.append(k)
         blocks0 = [
-            ([(gi, ii) for ii in range(len(refs0[gi]))], owners_of[gi][0].receptance_matrix(refs0[gi], f))
+            ([(gi, ii) for ii in range(len(refs0[gi]))], receptances(owners_of[gi][0], refs0[gi], f))
             for gi in sorted(const_groups)
         ]
         links_s = [
@@ -209,7 +209,7 @@ def sweep(
             else:
                 refs_c = [[r for _, r in plans[c][0][gi][1]] for c in chunk]
                 y = np.concatenate(
-                    [owners[c].receptance_matrix(rc, f) for c, rc in zip(chunk, refs_c)], axis=-1
+                    [receptances(owners[c], rc, f) for c, rc in zip(chunk, refs_c)], axis=-1
                 )
             blocks.append((keys, y))
         links = []

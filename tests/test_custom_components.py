@@ -250,6 +250,42 @@ def test_a_type_that_cannot_take_part_is_refused_with_what_it_lacks():
                  joints=(Joint("j", ("spindle.tip", "holder.base"), rigid=True),))
 
 
+def _broken(kind):
+    """A chuck of one's own whose receptance_matrix breaks the protocol in one way."""
+    import attrs
+
+    @attrs.frozen
+    class Broken(NutChuck):
+        def receptance_matrix(self, refs, frequency_hz):
+            if kind == "raises":
+                raise KeyError("nut")
+            h = super().receptance_matrix(refs, frequency_hz)
+            if kind == "shape":
+                return h[:, :, :-1]
+            h[..., 2] = np.nan  # one line of the band
+            return h
+
+    return default_assembly().with_component(Broken("holder", default_assembly().component("holder").segments))
+
+
+@pytest.mark.parametrize("kind, message", [
+    ("raises", r"component 'holder' \(Broken\): receptance_matrix failed \(KeyError: 'nut'\)"),
+    ("shape", r"component 'holder' \(Broken\): receptance_matrix gave an array of shape \(4, 4, 4\); "
+              r"expected \(4, 4, 5\)"),
+    ("nan", r"component 'holder' \(Broken\): receptance_matrix gave values that are not finite on 1 of 5 lines "
+            r"\(the first at 300 Hz\)"),
+])
+def test_a_type_breaking_the_protocol_is_named_where_its_receptances_enter(kind, message):
+    model = _broken(kind)
+    grid = Frequency.from_hz([100.0, 200.0, 300.0, 400.0, 500.0])
+    with pytest.raises(InvalidValueError, match=message):  # the FRF of the assembly
+        model.frf("tool.tip", "tool.tip", grid)
+    with pytest.raises(InvalidValueError, match=message):  # the prepared FRF of sweeps and fits
+        model.prepare("tool.tip", frequency=grid)
+    with pytest.raises(InvalidValueError, match=message):  # the SI form's evaluator (diagnosis, identification)
+        Evaluator(["tool.tip"], ["tool.tip"], grid.hz)(Structure.from_assembly(model))
+
+
 def test_a_chuck_of_ones_own_in_a_study(tmp_path, registered):
     """study: a machine whose holder is the custom chuck; a heavier nut moves its tool-point mode down."""
     from study_files import write_study

@@ -16,6 +16,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from ..components.protocol import receptances
 from ..coupling import Link, couple_substructures
 from ..errors import AssemblyError, InvalidValueError
 from ..points import DOFS, PointRef, parse_point
@@ -126,7 +127,7 @@ def couple(groups, out_keys, links, f: np.ndarray) -> np.ndarray:
         DOFs ``(y, theta)`` per key: m/N, m/(N m), rad/N and rad/(N m).
     """
     blocks = [
-        ([k for k, _ in items], owner.receptance_matrix([ref for _, ref in items], f))
+        ([k for k, _ in items], receptances(owner, [ref for _, ref in items], f))
         for owner, items in groups
     ]
     coupling_links = [

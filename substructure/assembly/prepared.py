@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._blocks import CHUNK_LINES, by_chunks
+from ..components.protocol import receptances
 from ..coupling import Link, couple_substructures
 from ..errors import InvalidValueError, UnknownPointError
 from ..frf import FRF
@@ -52,7 +53,7 @@ class PreparedFRF:
         self._groups = groups
         self._blocks = [
             ([k for k, _ in items],
-             by_chunks(lambda ff, o=owner, r=[ref for _, ref in items]: o.receptance_matrix(r, ff), f))
+             by_chunks(lambda ff, o=owner, r=[ref for _, ref in items]: receptances(o, r, ff), f))
             for owner, items in groups
         ]
         self._rows = [2 * i + d for i, d in out_idx]
@@ -112,7 +113,7 @@ class PreparedFRF:
                     )
                 i = names[name]
                 refs = [ref for _, ref in self._groups[i][1]]
-                blocks_all[i] = (blocks_all[i][0], by_chunks(lambda ff: comp.receptance_matrix(refs, ff), f_all))
+                blocks_all[i] = (blocks_all[i][0], by_chunks(lambda ff: receptances(comp, refs, ff), f_all))
         known = {o.name for _, _, o, _ in self._links if not isinstance(o, (Sensor, Support, Mass))}
         unknown = set(joints) - known
         if unknown:

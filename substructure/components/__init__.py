@@ -55,7 +55,7 @@ name is imported from here.
 
 from __future__ import annotations
 
-from .protocol import COMPONENT_TYPES, as_frequency, dof_labels, is_plain_beam, register_component
+from .protocol import COMPONENT_TYPES, as_frequency, dof_labels, is_plain_beam, receptances, register_component
 
 # in this order, so that COMPONENT_TYPES lists the types as it always has: beam, spindle,
 # holder, tool, measured; component_info is for Assembly.describe
@@ -76,6 +76,7 @@ __all__ = [
     "as_frequency",
     "dof_labels",
     "is_plain_beam",
+    "receptances",
     "ComponentParameter",
     "own_parameters",
     "with_parameter",

@@ -4,7 +4,8 @@
 classes for assembly files; :func:`as_frequency` and :func:`dof_labels` are
 what every component's ``receptance`` needs; :func:`is_plain_beam` tells
 batched computations when a component's receptances are those of its
-segments alone.
+segments alone; :func:`receptances` is the checked call of a component's
+``receptance_matrix`` every computation makes.
 """
 
 from __future__ import annotations
@@ -15,11 +16,11 @@ import numpy as np
 import pint
 
 from ..beams import Segment
-from ..errors import InvalidValueError
+from ..errors import InvalidValueError, SubstructureError
 from ..frf import FRF, Frequency
 from ..points import DOFS
 
-__all__ = ["COMPONENT_TYPES", "register_component", "as_frequency", "dof_labels", "is_plain_beam"]
+__all__ = ["COMPONENT_TYPES", "register_component", "as_frequency", "dof_labels", "is_plain_beam", "receptances"]
 
 COMPONENT_TYPES: dict[str, type] = {}
 """Registered component types by their ``type`` name in assembly files."""
@@ -146,3 +147,52 @@ def is_plain_beam(component: Any) -> bool:
         return False
     segments = getattr(component, "segments", None)
     return isinstance(segments, tuple) and bool(segments) and all(isinstance(s, Segment) for s in segments)
+
+
+def receptances(component: Any, refs: list, frequency_hz: np.ndarray) -> np.ndarray:
+    """``component.receptance_matrix(refs, frequency_hz)``, checked when the component's type is one of one's own.
+
+    A type defined outside the package is held to the protocol where its
+    receptances enter a computation: an error it raises, an array of another
+    shape than ``(2q, 2q, n)`` for ``q`` points and ``n`` lines, or a value
+    that is not finite is refused naming the component and its type (not a
+    bare traceback, nor a coupling error far from the cause).
+
+    Parameters
+    ----------
+    component : object
+        The component (or a group of components with one ``receptance_matrix``).
+    refs : list of PointRef
+        Its points.
+    frequency_hz : ndarray
+        Frequencies [Hz].
+
+    Returns
+    -------
+    ndarray
+        Complex receptances, shape ``(2q, 2q, n)``.
+
+    Raises
+    ------
+    InvalidValueError
+        When a component type of one's own breaks the protocol.
+    """
+    if type(component).__module__.split(".")[0] == __name__.split(".")[0]:  # the package's own types
+        return component.receptance_matrix(refs, frequency_hz)
+    who = f"component {getattr(component, 'name', '?')!r} ({type(component).__name__})"
+    try:
+        h = np.asarray(component.receptance_matrix(refs, frequency_hz))
+    except SubstructureError:
+        raise
+    except Exception as exc:  # a type of one's own: its error named with it
+        raise InvalidValueError(f"{who}: receptance_matrix failed ({type(exc).__name__}: {exc})") from exc
+    f = np.asarray(frequency_hz, dtype=float)
+    expected = (2 * len(refs), 2 * len(refs), f.size)
+    if h.shape != expected:
+        raise InvalidValueError(f"{who}: receptance_matrix gave an array of shape {h.shape}; expected {expected} "
+                                f"(2 DOFs per point for {len(refs)} point(s), one slice per frequency line)")
+    bad = ~np.isfinite(h).all(axis=(0, 1))
+    if bad.any():
+        raise InvalidValueError(f"{who}: receptance_matrix gave values that are not finite on {int(bad.sum())} of "
+                                f"{f.size} lines (the first at {f[bad][0]:g} Hz)")
+    return h

@@ -31,7 +31,7 @@ from typing import Sequence
 import numpy as np
 
 from ..beams import Segment, shear_coefficient, stepped_beam_receptance_si
-from ..components import Beam, is_plain_beam
+from ..components import Beam, is_plain_beam, receptances
 from ..coupling import Link, couple_substructures
 from ..errors import AssemblyError, InvalidValueError, UnknownPointError
 from ..joints import Joint
@@ -631,7 +631,7 @@ class Evaluator:
         # keyed by the object's id, stored with the object itself so that the id cannot be reused while cached;
         # pinned only for the first structure (a component changed by a fit is rebuilt at every evaluation)
         kept = self._store((id(comp), tuple(str(r) for r in refs)),
-                           lambda: (comp, comp.receptance_matrix(refs, self.f)), pin)
+                           lambda: (comp, receptances(comp, refs, self.f)), pin)
         return kept[1]
 
     def __call__(self, structure: Structure) -> np.ndarray:
