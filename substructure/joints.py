@@ -25,12 +25,13 @@ import attrs
 import numpy as np
 import pint
 
+from ._blocks import checked_block
 from .errors import InvalidValueError, NonPassiveJointWarning, NonReciprocalWarning
 from .points import check_name, parse_point
 from .units import format_quantity, magnitude_in, quantity
 
 __all__ = ["JointMatrix", "Joint", "JointProvenance", "PROVENANCE_KINDS", "Support", "Sensor", "Mass",
-           "STIFFNESS_UNITS", "DAMPING_UNITS"]
+           "STIFFNESS_UNITS", "DAMPING_UNITS", "dynamic_stiffness"]
 
 PROVENANCE_KINDS = ("identified", "predicted", "borrowed", "prior")
 """Where a joint's values come from: identified from a test of this assembly; predicted from a joint table
@@ -555,3 +556,32 @@ class Mass:
         out[0, 0] = -w2 * self.mass_kg
         out[1, 1] = -w2 * self.inertia_si
         return out
+
+
+def dynamic_stiffness(link, frequency_hz) -> np.ndarray:
+    """``link.dynamic_stiffness(frequency_hz)``, checked when the joint model is one of one's own.
+
+    Every computation takes a joint's (support's, body's) dynamic stiffness
+    through here: a joint model defined outside the package that raises,
+    gives another shape than ``(2, 2, n)`` or values that are not finite is
+    refused naming the joint and its type.
+
+    Parameters
+    ----------
+    link : Joint, Support, Sensor, Mass or a joint model of one's own
+        What connects or hangs on points.
+    frequency_hz : ndarray
+        Frequencies [Hz].
+
+    Returns
+    -------
+    ndarray
+        Complex, shape ``(2, 2, n)``.
+
+    Raises
+    ------
+    InvalidValueError
+        When a joint model of one's own breaks the protocol.
+    """
+    return checked_block(link, "joint", "dynamic_stiffness", lambda: link.dynamic_stiffness(frequency_hz), 2,
+                         frequency_hz)

@@ -34,6 +34,7 @@ from .components import is_plain_beam, receptances
 from .coupling import Link, couple_substructures
 from .errors import InvalidValueError
 from .frf import FRF, Frequency
+from .joints import dynamic_stiffness
 
 __all__ = ["SweepResult", "sweep"]
 
@@ -177,7 +178,7 @@ def sweep(
             for gi in sorted(const_groups)
         ]
         links_s = [
-            canonical_link(li, None if getattr(links0[li][2], "rigid", False) else links0[li][2].dynamic_stiffness(f))
+            canonical_link(li, None if getattr(links0[li][2], "rigid", False) else dynamic_stiffness(links0[li][2], f))
             for li in const_links
         ]
         shared_block = (needed, couple_substructures(blocks0, links_s, needed)) if needed else None
@@ -223,10 +224,10 @@ def sweep(
                 stiffness = None
             elif _same(objs):
                 if li not in constant_links:
-                    constant_links[li] = objs[0].dynamic_stiffness(f)
+                    constant_links[li] = dynamic_stiffness(objs[0], f)
                 stiffness = np.tile(constant_links[li], (1, 1, n_c))
             else:
-                stiffness = np.concatenate([objs[c].dynamic_stiffness(f) for c in chunk], axis=-1)
+                stiffness = np.concatenate([dynamic_stiffness(objs[c], f) for c in chunk], axis=-1)
             links.append(canonical_link(li, stiffness))
         y = couple_substructures(blocks, links, out_keys)
         y = y[np.ix_(rows, cols)].reshape(len(rows), len(cols), n_c, n_f)

@@ -12,6 +12,7 @@ type registered as a plugin would).
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -24,6 +25,7 @@ from substructure.components import COMPONENT_TYPES, ComponentParameter, own_par
 from substructure.diagnose import diagnose
 from substructure.errors import InvalidValueError, UnknownPointError
 from substructure.io.assembly_toml import dumps_assembly, loads_assembly, save_assembly
+from substructure.sweep import sweep
 from substructure.synthetic import simulate, write_measurement_set
 from substructure.updating import AddedMass, Evaluator, Structure, model_parameters, set_parameters
 from substructure.updating.paths import apply_path_si
@@ -250,38 +252,56 @@ def test_a_type_that_cannot_take_part_is_refused_with_what_it_lacks():
                  joints=(Joint("j", ("spindle.tip", "holder.base"), rigid=True),))
 
 
-def _broken(kind):
-    """A chuck of one's own whose receptance_matrix breaks the protocol in one way."""
+def _broken(kind, what):
+    """A chuck (or a joint model) of one's own whose receptances (dynamic stiffness) break the protocol."""
     import attrs
+
+    from custom_components import HystereticJoint
+
+    def broken(h):
+        if kind == "raises":
+            raise KeyError("nut")
+        if kind == "shape":
+            return h[:, :, :-1]
+        h = h.copy()
+        h[..., 2] = np.nan  # one line of the band
+        return h
 
     @attrs.frozen
     class Broken(NutChuck):
         def receptance_matrix(self, refs, frequency_hz):
-            if kind == "raises":
-                raise KeyError("nut")
-            h = super().receptance_matrix(refs, frequency_hz)
-            if kind == "shape":
-                return h[:, :, :-1]
-            h[..., 2] = np.nan  # one line of the band
-            return h
+            return broken(super().receptance_matrix(refs, frequency_hz))
 
-    return default_assembly().with_component(Broken("holder", default_assembly().component("holder").segments))
+    @attrs.frozen
+    class BrokenJoint(HystereticJoint):
+        def dynamic_stiffness(self, frequency_hz):
+            return broken(super().dynamic_stiffness(frequency_hz))
+
+    model = default_assembly()
+    if what == "component":
+        return model.with_component(Broken("holder", model.component("holder").segments)), "component 'holder' (Broken)"
+    joint = model.joint("holder-tool")
+    return model.with_joint(BrokenJoint(joint.name, joint.between, k=joint.k.as_dict(), c=joint.c.as_dict())), \
+        "joint 'holder-tool' (BrokenJoint)"
 
 
+@pytest.mark.parametrize("what, member, rows", [("component", "receptance_matrix", 4),
+                                                ("joint", "dynamic_stiffness", 2)])
 @pytest.mark.parametrize("kind, message", [
-    ("raises", r"component 'holder' \(Broken\): receptance_matrix failed \(KeyError: 'nut'\)"),
-    ("shape", r"component 'holder' \(Broken\): receptance_matrix gave an array of shape \(4, 4, 4\); "
-              r"expected \(4, 4, 5\)"),
-    ("nan", r"component 'holder' \(Broken\): receptance_matrix gave values that are not finite on 1 of 5 lines "
-            r"\(the first at 300 Hz\)"),
+    ("raises", r"{member} failed \(KeyError: 'nut'\)"),
+    ("shape", r"{member} gave an array of shape \({rows}, {rows}, 4\); expected \({rows}, {rows}, 5\)"),
+    ("nan", r"{member} gave values that are not finite on 1 of 5 lines \(the first at 300 Hz\)"),
 ])
-def test_a_type_breaking_the_protocol_is_named_where_its_receptances_enter(kind, message):
-    model = _broken(kind)
+def test_a_type_breaking_the_protocol_is_named_where_its_arrays_enter(kind, message, what, member, rows):
+    model, who = _broken(kind, what)
+    message = re.escape(who) + ": " + message.format(member=member, rows=rows)
     grid = Frequency.from_hz([100.0, 200.0, 300.0, 400.0, 500.0])
     with pytest.raises(InvalidValueError, match=message):  # the FRF of the assembly
         model.frf("tool.tip", "tool.tip", grid)
     with pytest.raises(InvalidValueError, match=message):  # the prepared FRF of sweeps and fits
-        model.prepare("tool.tip", frequency=grid)
+        model.prepare("tool.tip", frequency=grid).evaluate()
+    with pytest.raises(InvalidValueError, match=message):  # a sweep of variants
+        sweep([model, model], "tool.tip", frequency=grid)
     with pytest.raises(InvalidValueError, match=message):  # the SI form's evaluator (diagnosis, identification)
         Evaluator(["tool.tip"], ["tool.tip"], grid.hz)(Structure.from_assembly(model))
 

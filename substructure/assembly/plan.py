@@ -19,6 +19,7 @@ import numpy as np
 from ..components.protocol import receptances
 from ..coupling import Link, couple_substructures
 from ..errors import AssemblyError, InvalidValueError
+from ..joints import dynamic_stiffness
 from ..points import DOFS, PointRef, parse_point
 
 __all__ = ["expand_points", "plan", "couple"]
@@ -131,7 +132,7 @@ def couple(groups, out_keys, links, f: np.ndarray) -> np.ndarray:
         for owner, items in groups
     ]
     coupling_links = [
-        Link(ka, kb, None if getattr(obj, "rigid", False) else obj.dynamic_stiffness(f), label)
+        Link(ka, kb, None if getattr(obj, "rigid", False) else dynamic_stiffness(obj, f), label)
         for ka, kb, obj, label in links
     ]
     return couple_substructures(blocks, coupling_links, out_keys)

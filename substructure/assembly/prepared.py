@@ -15,7 +15,7 @@ from ..components.protocol import receptances
 from ..coupling import Link, couple_substructures
 from ..errors import InvalidValueError, UnknownPointError
 from ..frf import FRF
-from ..joints import Mass, Sensor, Support
+from ..joints import Mass, Sensor, Support, dynamic_stiffness
 from .plan import expand_points
 
 __all__ = ["PreparedFRF"]
@@ -126,7 +126,7 @@ class PreparedFRF:
             sl = slice(start, min(n, start + CHUNK_LINES))
             blocks = [(keys, y[..., sl]) for keys, y in blocks_all]
             links = [
-                Link(ka, kb, None if getattr(o, "rigid", False) else o.dynamic_stiffness(f[sl]), label)
+                Link(ka, kb, None if getattr(o, "rigid", False) else dynamic_stiffness(o, f[sl]), label)
                 for (ka, kb, _, label), o in zip(self._links, objs)
             ]
             parts.append(couple_substructures(blocks, links, self._out_keys))

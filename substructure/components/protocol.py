@@ -16,7 +16,8 @@ import numpy as np
 import pint
 
 from ..beams import Segment
-from ..errors import InvalidValueError, SubstructureError
+from .._blocks import checked_block
+from ..errors import InvalidValueError
 from ..frf import FRF, Frequency
 from ..points import DOFS
 
@@ -153,10 +154,10 @@ def receptances(component: Any, refs: list, frequency_hz: np.ndarray) -> np.ndar
     """``component.receptance_matrix(refs, frequency_hz)``, checked when the component's type is one of one's own.
 
     A type defined outside the package is held to the protocol where its
-    receptances enter a computation: an error it raises, an array of another
-    shape than ``(2q, 2q, n)`` for ``q`` points and ``n`` lines, or a value
-    that is not finite is refused naming the component and its type (not a
-    bare traceback, nor a coupling error far from the cause).
+    receptances enter a computation (the check of ``checked_block``):
+    an error it raises, an array of another shape than ``(2q, 2q, n)`` for
+    ``q`` points and ``n`` lines, or a value that is not finite is refused
+    naming the component and its type.
 
     Parameters
     ----------
@@ -177,22 +178,5 @@ def receptances(component: Any, refs: list, frequency_hz: np.ndarray) -> np.ndar
     InvalidValueError
         When a component type of one's own breaks the protocol.
     """
-    if type(component).__module__.split(".")[0] == __name__.split(".")[0]:  # the package's own types
-        return component.receptance_matrix(refs, frequency_hz)
-    who = f"component {getattr(component, 'name', '?')!r} ({type(component).__name__})"
-    try:
-        h = np.asarray(component.receptance_matrix(refs, frequency_hz))
-    except SubstructureError:
-        raise
-    except Exception as exc:  # a type of one's own: its error named with it
-        raise InvalidValueError(f"{who}: receptance_matrix failed ({type(exc).__name__}: {exc})") from exc
-    f = np.asarray(frequency_hz, dtype=float)
-    expected = (2 * len(refs), 2 * len(refs), f.size)
-    if h.shape != expected:
-        raise InvalidValueError(f"{who}: receptance_matrix gave an array of shape {h.shape}; expected {expected} "
-                                f"(2 DOFs per point for {len(refs)} point(s), one slice per frequency line)")
-    bad = ~np.isfinite(h).all(axis=(0, 1))
-    if bad.any():
-        raise InvalidValueError(f"{who}: receptance_matrix gave values that are not finite on {int(bad.sum())} of "
-                                f"{f.size} lines (the first at {f[bad][0]:g} Hz)")
-    return h
+    return checked_block(component, "component", "receptance_matrix",
+                         lambda: component.receptance_matrix(refs, frequency_hz), 2 * len(refs), frequency_hz)

@@ -34,7 +34,7 @@ from ..beams import Segment, shear_coefficient, stepped_beam_receptance_si
 from ..components import Beam, is_plain_beam, receptances
 from ..coupling import Link, couple_substructures
 from ..errors import AssemblyError, InvalidValueError, UnknownPointError
-from ..joints import Joint
+from ..joints import Joint, dynamic_stiffness
 from ..points import DOFS, parse_point
 
 __all__ = ["BeamArrays", "LinkSI", "Structure", "Evaluator", "si_beam"]
@@ -281,7 +281,7 @@ class LinkSI:
         if self.rigid:
             return None
         if self.custom is not None:
-            return self.custom.dynamic_stiffness(frequency_hz)
+            return dynamic_stiffness(self.custom, frequency_hz)
         w = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
         return self.K[:, :, None] + 1j * w * self.C[:, :, None] - (w * w) * self.M[:, :, None]
 
