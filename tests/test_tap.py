@@ -51,7 +51,7 @@ def tap(peak=50.0, start=0.01, quantity="displacement", source="tap", **kw):
 
 def test_h1_is_the_closed_form_of_the_windowed_system():
     records = [tap(peak) for peak in (40.0, 55.0, 70.0)]
-    result = process_taps(records)
+    result = process_taps(records, exponential=True)
     s = 2j * np.pi * result.frf.frequency.hz + 1.0 / result.tau  # exp(-t/tau): every pole shifted by -1/tau
     expected = receptance(s) * held(result.frf.frequency.hz)
     band = (result.frf.frequency.hz > 20) & (result.frf.frequency.hz < 1500)
@@ -74,8 +74,23 @@ def test_without_exponential_window_h1_is_the_closed_form():
     assert result.tau is None
 
 
+def test_the_window_is_applied_only_when_the_response_has_not_died_out():
+    """1 s holds 25 decay times of the 400 Hz mode (1 %): no window; 50 ms holds one: windowed, saying why."""
+    whole = process_taps([tap(peak) for peak in (40.0, 55.0)])
+    assert whole.tau is None and whole.window.startswith("none: the response died out within every tap")
+    hz = whole.frf.frequency.hz
+    band = (hz > 20) & (hz < 1500)
+    expected = receptance(2j * np.pi * hz) * held(hz)  # no window: the system itself
+    assert np.abs(whole.frf.data[band, 0, 0] / expected[band] - 1.0).max() < 2e-3
+    short = process_taps([tap(peak, n=512) for peak in (40.0, 55.0)])
+    assert short.tau is not None and "had not died out by the end of tap 2 (0.3 of its peak" in short.window
+    assert process_taps([tap(peak, n=512) for peak in (40.0, 55.0)], exponential=False).tau is None
+    forced = process_taps([tap(peak) for peak in (40.0, 55.0)], exponential=True)
+    assert forced.tau is not None and forced.window == "asked for"
+
+
 def test_acceleration_is_converted_to_receptance():
-    result = process_taps([tap(quantity="acceleration")])
+    result = process_taps([tap(quantity="acceleration")], exponential=True)
     hz = result.frf.frequency.hz
     s = 2j * np.pi * hz + 1.0 / result.tau
     expected = s**2 * receptance(s) / (2j * np.pi * hz) ** 2  # accelerance of the windowed system / (i omega)^2
@@ -200,7 +215,7 @@ def test_one_long_record_of_five_taps_is_split_in_five():
         f += half_sine(40.0 + 10 * k, start=0.05 + k * 1.0, n=n)[1]
     x = simulate(f)
     record = TapRecord(t, f, x, "displacement", "long.csv")
-    result = process_taps(record, tap_length=0.9, pre_trigger=0.01)
+    result = process_taps(record, tap_length=0.9, pre_trigger=0.01, exponential=True)
     assert [tp.kept for tp in result.taps] == [True] * 5
     assert [round(tp.start_s, 3) for tp in result.taps] == [0.04, 1.04, 2.04, 3.04, 4.04]
     assert [round(tp.peak_force) for tp in result.taps] == [40, 50, 60, 70, 80]

@@ -73,7 +73,8 @@ def run(args: argparse.Namespace) -> int:
     records = [record for path in args.records for record in _read(path, args)]
     result = process_taps(records, args.estimator, tap_length=args.tap_length,
                           pre_trigger=PRE_TRIGGER_S if args.pre_trigger is None else args.pre_trigger,
-                          exponential=not args.no_exponential_window, tau=args.tau, band=args.band,
+                          exponential=True if args.exponential_window else False if args.no_exponential_window
+                          else None, tau=args.tau, band=args.band,
                           hammer_band_db=HAMMER_BAND_DB if args.hammer_band_db is None else args.hammer_band_db)
     peaks = result.peaks()
     written = []
@@ -118,19 +119,21 @@ def run(args: argparse.Namespace) -> int:
     gamma = result.coherence[usable] if usable.any() else result.coherence
     print(f"coherence within the band: median {np.median(gamma):.4f}, minimum {np.min(gamma):.4f}")
     if result.tau is None:
-        print("exponential window: none")
+        print(f"exponential window: {result.window}")
     else:
-        print(f"exponential window: tau = {result.tau:.4g} s (adds a damping ratio 1/(tau omega) to every mode)")
+        print(f"exponential window: tau = {result.tau:.4g} s, {result.window}; it adds a damping ratio "
+              "1/(tau omega) to every mode")
     shown = list(zip(peaks, added))
     print(f"peaks within the band ({result.measured.quantity}):" if shown else "peaks: none within the band")
     for k, (f, z) in enumerate(shown):
-        line = f"  {f:10.6g} Hz   window's added damping ratio {z:.2e}"
+        line = f"  {f:10.6g} Hz" + ("" if result.tau is None else f"   window's added damping ratio {z:.2e}")
         if damping is not None:
             d = damping[k]
             line += ("; half-power damping not found (peak too narrow or too close to another)"
                      if d["damping_ratio"] is None else
-                     f"; half-power damping ratio {d['damping_ratio']:.3e}, without the window's "
-                     f"{d['damping_ratio_corrected']:.3e}")
+                     f"; half-power damping ratio {d['damping_ratio']:.3e}" + ("" if result.tau is None else
+                                                                              f", without the window's "
+                                                                              f"{d['damping_ratio_corrected']:.3e}"))
         print(line)
     for path in written:
         print(f"wrote {path}")
@@ -175,7 +178,11 @@ def add_parser(commands) -> None:
                      help="time kept before the force's trigger crossing (default 0.005 s, tap.PRE_TRIGGER_S)")
     tap.add_argument("--tau", type=float, metavar="SECONDS",
                      help="time constant of the exponential window (default: 1%% left at the end of the tap)")
-    tap.add_argument("--no-exponential-window", action="store_true", help="no exponential window")
+    window = tap.add_mutually_exclusive_group()
+    window.add_argument("--exponential-window", action="store_true",
+                        help="an exponential window on both channels even when the response dies out within the tap "
+                             "(default: only when it does not)")
+    window.add_argument("--no-exponential-window", action="store_true", help="no exponential window")
     tap.add_argument("--correct-window-damping", action="store_true",
                      help="also each peak's half-power damping ratio, and the same less the window's 1/(tau omega)")
     tap.add_argument("--hammer-band-db", type=float, metavar="DB",

@@ -24,13 +24,18 @@ from .detect import (CLIP_RUN, DOUBLE_HIT_FRACTION, NO_HIT_FACTOR, PRE_TRIGGER_S
 from .records import RESPONSE_QUANTITIES, TapRecord
 
 __all__ = ["process_taps", "TapResult", "Tap", "ESTIMATORS", "EXP_WINDOW_END", "FORCE_WINDOW_EXTRA",
-           "HAMMER_BAND_DB", "PEAK_PROMINENCE", "HALF_POWER_LINES", "added_damping"]
+           "HAMMER_BAND_DB", "PEAK_PROMINENCE", "HALF_POWER_LINES", "DECAYED_SHARE", "added_damping"]
 
 ESTIMATORS = ("H1", "H2", "Hv")
 """The FRF estimators: H1 = Gfx/Gff (noise on the response), H2 = Gxx/Gxf (noise on the force), Hv (both)."""
 
 EXP_WINDOW_END = 0.01
 """The exponential window's value at the end of the tap when its time constant is not given."""
+
+DECAYED_SHARE = 3e-3
+"""A response has died out by the end of a tap when its RMS over the tap's last 5 % is at most this share of its
+peak, or at most three times its RMS before the hit (its noise): the exponential window is then not needed, and
+not applied unless asked for (it would add the damping ratio ``1 / (tau omega)`` to every mode for nothing)."""
 
 FORCE_WINDOW_EXTRA = 1.0
 """The force window stays open this many pulse widths after the pulse ends."""
@@ -136,6 +141,8 @@ class TapResult:
         Samples per second (Hz).
     tap_samples : int
         Samples per tap.
+    window : str
+        Why the exponential window was (or was not) applied, in words.
     """
 
     frf: FRF
@@ -149,6 +156,7 @@ class TapResult:
     force_spectra_db: np.ndarray
     sample_rate: float
     tap_samples: int
+    window: str = ""
 
     @property
     def averages(self) -> int:
@@ -260,7 +268,8 @@ class TapResult:
         -------
         dict
             Keys ``taps``, ``rejected``, ``estimator``, ``averages``, ``frequency_hz``,
-            ``real``, ``imag``, ``coherence``, ``tau_s``, ``hammer_band_hz``, ``per_tap``.
+            ``real``, ``imag``, ``coherence``, ``tau_s``, ``window`` (why the window was or was
+            not applied), ``hammer_band_hz``, ``per_tap``.
         """
         values = self.frf.data[:, 0, 0]
         return {
@@ -273,6 +282,7 @@ class TapResult:
             "imag": values.imag.tolist(),
             "coherence": self.coherence.tolist(),
             "tau_s": self.tau,
+            "window": self.window,
             "hammer_band_hz": self.hammer_band_hz,
             "hammer_band_db": self.hammer_band_db,
             "per_tap": [{"tap": t.number, "file": t.source, "start_s": t.start_s, "peak_force_n": t.peak_force,
@@ -319,7 +329,7 @@ def process_taps(
     *,
     tap_length: Any = None,
     pre_trigger: float = PRE_TRIGGER_S,
-    exponential: bool = True,
+    exponential: bool | None = None,
     tau: float | None = None,
     window_end: float = EXP_WINDOW_END,
     force_window_extra: float = FORCE_WINDOW_EXTRA,
@@ -348,11 +358,16 @@ def process_taps(
         ``scipy.fft.prev_fast_len``).
     pre_trigger : float
         Time kept before the trigger crossing, in s.
-    exponential : bool
-        Whether to apply the exponential window to both channels.
+    exponential : bool or None
+        Whether to apply the exponential window to both channels; None
+        (default): only when the response has not died out by the end of
+        every tap (see :data:`DECAYED_SHARE`): a window adds the damping
+        ratio ``1 / (tau omega)`` to every mode, which a comparison with a
+        model sees.
     tau : float, optional
-        Its time constant in s; default such that it falls to ``window_end``
-        at the end of the tap.
+        Its time constant in s (given: the window is applied unless
+        ``exponential`` is False); default such that it falls to
+        ``window_end`` at the end of the tap.
     window_end : float
         See ``tau`` (dimensionless, in (0, 1)).
     force_window_extra : float
@@ -474,6 +489,13 @@ def process_taps(
         if p >= 8:
             x[i] -= x[i, :p].mean()
     f = f * force_window[rows]
+    why = _decay(x, pre_rows, [taps[cuts[r][2]].number for r in rows])
+    if exponential is None and tau is None:
+        exponential = not why.startswith("none")
+    elif exponential or exponential is None:
+        exponential, why = True, "asked for"
+    else:
+        why = "none: not asked for"
     if exponential:
         if tau is None:
             if not 0.0 < window_end < 1.0:
@@ -515,4 +537,24 @@ def process_taps(
     spectra = 10.0 * np.log10(np.maximum(np.abs(F[:, keep]) ** 2, 1e-300))
     hammer_band = float(_band_end(gff[None, :], hz, hammer_band_db)[0])
     return TapResult(measured.to_receptance(), measured, coherence[keep], estimator, tuple(taps), tau,
-                     hammer_band, float(hammer_band_db), spectra, rate, length)
+                     hammer_band, float(hammer_band_db), spectra, rate, length, why)
+
+
+def _decay(x: np.ndarray, pre: np.ndarray, numbers: list[int]) -> str:
+    """Whether the responses ``x`` (one kept tap a row) died out by the end of their taps, in words.
+
+    "none: ..." when every tap's RMS over its last 5 % (at least 16 samples) is at most
+    :data:`DECAYED_SHARE` of its peak or three times its RMS before the hit; else why a window is needed.
+    """
+    tail = max(16, x.shape[1] // 20)
+    end = np.sqrt(np.mean(x[:, -tail:] ** 2, axis=1))
+    peak = np.max(np.abs(x), axis=1)
+    noise = np.array([np.sqrt(np.mean(row[:p] ** 2)) if p >= 8 else 0.0 for row, p in zip(x, pre.tolist())])
+    share = end / np.maximum(peak, 1e-300)
+    alive = end > np.maximum(DECAYED_SHARE * peak, 3.0 * noise)
+    if not alive.any():
+        return (f"none: the response died out within every tap (its RMS over the last {tail} samples at most "
+                f"{share.max():.2g} of its peak)")
+    k = int(np.argmax(np.where(alive, share, -1.0)))
+    return (f"the response had not died out by the end of tap {numbers[k]} ({share[k]:.2g} of its peak over its "
+            f"last {tail} samples): a longer record would need none")
