@@ -65,6 +65,13 @@ def test_tap_writes_frf_with_coherence_and_a_set_that_reads_back(records, tmp_pa
                        "--excitation", "tool.tip", "--overwrite")
     assert code == 0, err
     assert load_measurements(toml).measurements[0].response == "holder.tip:y"
+    assert "exponential window" not in toml.read_text()  # none was applied
+    # windowed on request: the set says so in a comment, and reads back as before
+    code, _, err = run(capsys, "tap", *paths, "--out", out, "--measurements", toml, "--response", "tool.tip",
+                       "--excitation", "tool.tip", "--overwrite", "--exponential-window")
+    assert code == 0, err
+    assert toml.read_text().startswith("# measured through an exponential window, tau = 0.217 s")
+    assert load_measurements(toml).measurements[0].averages == 5
 
 
 def test_tap_json(records, capsys):

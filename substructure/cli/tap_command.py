@@ -37,11 +37,15 @@ def _read(path: str, args: argparse.Namespace) -> list:
     return [read_tap_csv(path, args.sensitivity, args.hammer_sensitivity, args.quantity, **columns)]
 
 
-def _set_text(name: str, response: str, excitation: str, file: str, averages: int) -> str:
+def _set_text(name: str, response: str, excitation: str, file: str, averages: int, tau: float | None) -> str:
     import tomli_w
 
-    return tomli_w.dumps({"name": name, "frf": [{"response": response, "excitation": excitation, "file": file,
+    text = tomli_w.dumps({"name": name, "frf": [{"response": response, "excitation": excitation, "file": file,
                                                  "quantity": "receptance", "averages": averages}]})
+    if tau is None:
+        return text
+    return (f"# measured through an exponential window, tau = {tau:.4g} s: it adds the damping ratio 1/(tau omega) to "
+            "every mode,\n# which a model compared with this FRF lacks (a longer record needs no window)\n" + text)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -85,7 +89,7 @@ def run(args: argparse.Namespace) -> int:
         relative = os.path.relpath(os.path.abspath(args.out), os.path.dirname(os.path.abspath(args.measurements)))
         name = args.name or f"tap test: {response} / {excitation}"
         write_text(args.measurements, _set_text(name, response, excitation, Path(relative).as_posix(),
-                                                result.averages), overwrite=args.overwrite)
+                                                result.averages, result.tau), overwrite=args.overwrite)
         written.append(args.measurements)
     if args.plot:
         figures()
