@@ -133,6 +133,34 @@ def _frf(n=5):
     return FRF.single(Frequency.from_hz(np.arange(1.0, n + 1)), np.full(n, 1e-7 + 0j), "tool.tip:y", "tool.tip:y")
 
 
+@pytest.mark.parametrize("argv, message", [
+    (["--tau", "inf"], "argument --tau: got inf; expected a finite number > 0"),
+    (["--tau", "0"], "argument --tau: got 0.0; expected a finite number > 0"),
+    (["--tap-length", "nan"], "argument --tap-length: got nan; expected a finite number > 0"),
+    (["--pre-trigger", "-1"], "argument --pre-trigger: got -1.0; expected a finite number >= 0"),
+    (["--hammer-band-db", "-5"], "argument --hammer-band-db: got -5.0; expected a finite number > 0"),
+    (["--no-exponential-window", "--tau", "0.1"], "--tau sets the exponential window's time constant; it cannot "
+                                                  "go with --no-exponential-window"),
+])
+def test_tap_options_out_of_range_are_refused_by_name(records, tmp_path, capsys, argv, message):
+    _, paths = records
+    code, _, err = run(capsys, "tap", paths[0], "--out", tmp_path / "frf.csv", *argv)
+    assert code != 0 and message in err and not (tmp_path / "frf.csv").exists()
+
+
+def test_process_taps_refuses_settings_out_of_range():
+    records = impact_records()[:2]
+    from substructure.tap import process_taps
+
+    for kw, message in ((dict(tap_length=float("nan")), "tap_length: got nan s; expected a finite number > 0"),
+                        (dict(pre_trigger=-0.1), "pre_trigger: got -0.1 s; expected a finite number >= 0"),
+                        (dict(tau=float("inf")), "tau: got inf s; expected a finite number > 0"),
+                        (dict(hammer_band_db=0.0), "hammer_band_db: got 0.0 dB; expected a finite number > 0"),
+                        (dict(tau=0.1, exponential=False), "a time constant asks for the window")):
+        with pytest.raises(InvalidValueError, match=message):
+            process_taps(records, **kw)
+
+
 def test_measurement_coherence_and_averages_are_checked():
     m = Measurement("tool.tip", "tool.tip", _frf(), coherence=[0.5, 0.9, 1.0, 0.0, 1.0 + 1e-12], averages=10)
     assert m.coherence[-1] == 1.0 and m.averages == 10 and not m.coherence.flags.writeable

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import os
 from pathlib import Path
 
@@ -74,6 +75,12 @@ def run(args: argparse.Namespace) -> int:
     check_plot(args.plot)
     check_outputs([("--out", args.out), ("--measurements", args.measurements), ("--plot", args.plot)],
                   args.records, args.overwrite)
+    for option, value, zero in (("--tap-length", args.tap_length, False), ("--pre-trigger", args.pre_trigger, True),
+                                ("--tau", args.tau, False), ("--hammer-band-db", args.hammer_band_db, False)):
+        if value is not None and not (math.isfinite(value) and (value > 0 or (zero and value == 0))):
+            raise UsageError(f"argument {option}: got {value!r}; expected a finite number {'>= 0' if zero else '> 0'}")
+    if args.no_exponential_window and args.tau is not None:
+        raise UsageError("--tau sets the exponential window's time constant; it cannot go with --no-exponential-window")
     records = [record for path in args.records for record in _read(path, args)]
     result = process_taps(records, args.estimator, tap_length=args.tap_length,
                           pre_trigger=PRE_TRIGGER_S if args.pre_trigger is None else args.pre_trigger,

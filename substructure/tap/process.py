@@ -315,6 +315,20 @@ def _records(records: Any) -> tuple[TapRecord, ...]:
     return items
 
 
+def _check_settings(**settings: tuple[Any, str, bool]) -> None:
+    """Each ``name=(value, unit, zero_allowed)`` a finite number above 0 (or at 0 where allowed), or None."""
+    for name, (value, unit, zero) in settings.items():
+        if value is None:
+            continue
+        try:
+            x = float(value)
+        except (TypeError, ValueError):
+            x = float("nan")
+        if isinstance(value, bool) or not np.isfinite(x) or x < 0 or (x == 0 and not zero):
+            expected = "a finite number >= 0" if zero else "a finite number > 0"
+            raise InvalidValueError(f"{name}: got {value!r}{' ' + unit if unit else ''}; expected {expected}")
+
+
 def _band_end(power: np.ndarray, hz: np.ndarray, drop_db: float) -> np.ndarray:
     """Per row of ``power`` (lines last, 0 Hz first): the first frequency below the low-frequency level - drop."""
     reference = power[..., 1:4].mean(axis=-1, keepdims=True)
@@ -397,6 +411,12 @@ def process_taps(
         When a record's force looks like a response (naming file and columns).
     """
     items = _records(records)
+    _check_settings(tap_length=(tap_length, "s", False), pre_trigger=(pre_trigger, "s", True),
+                    tau=(tau, "s", False), window_end=(window_end, "", False),
+                    force_window_extra=(force_window_extra, "pulse widths", True),
+                    hammer_band_db=(hammer_band_db, "dB", False))
+    if exponential is False and tau is not None:
+        raise InvalidValueError(f"tau: got {tau!r} s with exponential=False; a time constant asks for the window")
     if estimator not in ESTIMATORS:
         raise InvalidValueError(f"estimator: got {estimator!r}; expected one of {', '.join(ESTIMATORS)}")
     rate = items[0].sample_rate
