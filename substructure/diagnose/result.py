@@ -25,8 +25,8 @@ from __future__ import annotations
 import math
 
 import attrs
-import numpy as np
 
+from .._json import strict
 from ..assembly import Assembly
 from .compare import Comparison
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
@@ -40,32 +40,6 @@ def _finite(x):
         return None
     x = float(x)
     return x if math.isfinite(x) else None
-
-
-def strict(value):
-    """A JSON-ready copy with every NaN or infinity replaced by None (numpy numbers made plain).
-
-    Parameters
-    ----------
-    value : object
-        Dicts, lists, tuples, numbers, strings.
-
-    Returns
-    -------
-    object
-        The same structure, safe for ``json.dumps(..., allow_nan=False)``.
-    """
-    if isinstance(value, dict):
-        return {str(k): strict(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [strict(v) for v in value]
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
-    if isinstance(value, (int, np.integer)):
-        return int(value)
-    if isinstance(value, (float, np.floating)):
-        return _finite(value)
-    return value
 
 
 class Found:

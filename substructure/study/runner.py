@@ -38,6 +38,7 @@ import warnings
 from pathlib import Path
 from typing import Any
 
+from .._json import json_text
 from ..errors import InvalidValueError, OutputExistsError, SubstructureWarning
 
 __all__ = ["run_study", "Progress", "parse_scheduler", "json_text", "RESULT_FORMAT"]
@@ -264,39 +265,6 @@ def _rows_problem(rows: Any, task: dict) -> str:
                 + (f", repeated: {', '.join(doubled)}" if doubled else "")
                 + ("" if keys == {task["key"]} else f", rows of other combinations ({len(keys - {task['key']})})"))
     return ""
-
-
-def _plain(value: Any) -> Any:
-    """JSON types only: non-finite floats as ``None``, numpy numbers as Python's."""
-    import math
-
-    if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    if isinstance(value, bool) or value is None or isinstance(value, str):
-        return value
-    if hasattr(value, "item") and not isinstance(value, (int, float)):  # numpy scalars
-        value = value.item()
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    return value
-
-
-def json_text(value: Any) -> str:
-    """Strict JSON (no NaN or Infinity: ``null``) of plain data.
-
-    Parameters
-    ----------
-    value : object
-        Dicts, lists, strings, numbers, ``None``.
-
-    Returns
-    -------
-    str
-        The JSON text; floats keep every digit.
-    """
-    return json.dumps(_plain(value), allow_nan=False)
 
 
 def _write_frf(data: dict, path: Path) -> None:
