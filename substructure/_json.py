@@ -42,6 +42,14 @@ def strict(value: Any) -> Any:
     raise TypeError(f"JSON output: a {type(value).__name__} is not a JSON value")
 
 
+def finite(x: Any) -> float | None:
+    """``x`` as a float, or None for None, NaN and infinities (a number of strict JSON)."""
+    if x is None:
+        return None
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
 def json_text(value: Any) -> str:
     """Strict JSON of ``value`` (:func:`strict`): never ``NaN`` or ``Infinity``, which JSON does not have; floats
     keep every digit."""

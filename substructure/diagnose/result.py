@@ -22,24 +22,15 @@ also read from the diagnosis under its own name (``d.explained``,
 
 from __future__ import annotations
 
-import math
 
 import attrs
 
-from .._json import strict
+from .._json import finite as _finite, strict
 from ..assembly import Assembly
 from .compare import Comparison
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
 __all__ = ["Found", "Candidate", "Step", "Verdict", "Measures", "Changes", "Alternatives", "Diagnosis", "strict"]
-
-
-def _finite(x):
-    """A JSON-safe number: None for NaN and infinities."""
-    if x is None:
-        return None
-    x = float(x)
-    return x if math.isfinite(x) else None
 
 
 class Found:
