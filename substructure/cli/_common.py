@@ -153,6 +153,12 @@ def figures() -> None:
     matplotlib.use("Agg")
 
 
+def draw_to(path: str | os.PathLike, overwrite: bool, make: Callable[[], Any]) -> None:
+    """Make a figure with ``make()`` on the file-only backend (:func:`figures`) and save it to ``path``."""
+    figures()
+    save_figure(make(), path, overwrite)
+
+
 def save_plot(frf: FRF, path: str | os.PathLike, title: str, overwrite: bool = True) -> None:
     """Plot an FRF (magnitude and phase) with a title to an image file."""
     figures()
