@@ -394,30 +394,7 @@ def _dashboard(client, progress: Progress) -> None:
 
 def run_study(study, client: Any = None, out: Any = None, scheduler: str | None = None, resume: bool = False,
               overwrite: bool = False, progress: Any = True):
-    """Run a study (see :meth:`substructure.study.Study.run`).
-
-    Parameters
-    ----------
-    study : Study
-        The study.
-    client : dask.distributed.Client, optional
-        Its cluster runs the tasks.
-    out : str or path, optional
-        Output directory.
-    scheduler : str, optional
-        ``processes:N``, ``local:N``, an address or ``serial``.
-    resume : bool
-        Keep finished combinations of ``out``.
-    overwrite : bool
-        Replace a study's files in ``out``.
-    progress : bool or file
-        Progress lines on standard error, a file, or none.
-
-    Returns
-    -------
-    pandas.DataFrame
-        The table.
-    """
+    """Run a study: :meth:`substructure.study.Study.run`, whose documentation gives the arguments."""
     if resume and overwrite:
         raise InvalidValueError("resume and overwrite: choose one (resume keeps finished combinations, overwrite "
                                 "computes everything anew)")
