@@ -78,9 +78,9 @@ def check_file(path, what: str = "file", limit: int = MAX_TEXT_BYTES) -> str:
         The file to read.
     what : str
         What the file is, for the message (e.g. ``"universal file"``).
-    limit : int
-        The largest size allowed, in bytes (:data:`MAX_TEXT_BYTES` or
-        :data:`MAX_DATA_BYTES`).
+    limit : int, default MAX_TEXT_BYTES
+        The largest size allowed, in bytes (:data:`MAX_TEXT_BYTES` for
+        tables and TOML files, :data:`MAX_DATA_BYTES` for FRF data files).
 
     Returns
     -------

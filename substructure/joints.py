@@ -425,53 +425,13 @@ def _inertia(value) -> pint.Quantity:
 
 
 @attrs.frozen
-class Sensor:
-    """A body on the structure during a test: an accelerometer, a magnet, a laser target.
-
-    Parameters
-    ----------
-    name : str
-        Name of the sensor (measurement records list it by this name).
-    at : str
-        The point, e.g. ``"tool.tip"``.
-    mass : quantity or str
-        ``"0 g"`` for a non-contact sensor (laser vibrometer).
-    inertia : quantity or str, default "0 kg*m^2"
-        Rotary inertia about the bending axis.
-    always_on : bool, default False
-        On the structure in every test, whether a measurement record lists
-        it or not (a body the records do not mention, e.g. one found by a
-        diagnosis).  Still a sensor: ``Assembly.without_sensors()`` takes it
-        off for predictions of the machine in the cut.
-    """
+class _Body:
+    """A rigid body at a point (the fields and the dynamic stiffness that :class:`Sensor` and :class:`Mass` share)."""
 
     name: str = attrs.field(converter=check_name)
     at: str = attrs.field(converter=_point)
     mass: pint.Quantity = attrs.field(converter=_mass)
     inertia: pint.Quantity = attrs.field(default="0 kg*m^2", converter=_inertia)
-    always_on: bool = attrs.field(default=False)
-
-    def __attrs_post_init__(self) -> None:
-        if not isinstance(self.always_on, bool):
-            raise InvalidValueError(f"always_on: got {self.always_on!r}; expected true or false")
-
-    @classmethod
-    def laser(cls, name: str, at: str) -> "Sensor":
-        """A non-contact sensor: no mass.
-
-        Parameters
-        ----------
-        name : str
-            The sensor's name.
-        at : str
-            The point it measures.
-
-        Returns
-        -------
-        Sensor
-            A sensor of 0 g.
-        """
-        return cls(name, at, "0 g")
 
     @property
     def mass_kg(self) -> float:
@@ -504,7 +464,53 @@ class Sensor:
 
 
 @attrs.frozen
-class Mass:
+class Sensor(_Body):
+    """A body on the structure during a test: an accelerometer, a magnet, a laser target.
+
+    Parameters
+    ----------
+    name : str
+        Name of the sensor (measurement records list it by this name).
+    at : str
+        The point, e.g. ``"tool.tip"``.
+    mass : quantity or str
+        ``"0 g"`` for a non-contact sensor (laser vibrometer).
+    inertia : quantity or str, default "0 kg*m^2"
+        Rotary inertia about the bending axis.
+    always_on : bool, default False
+        On the structure in every test, whether a measurement record lists
+        it or not (a body the records do not mention, e.g. one found by a
+        diagnosis).  Still a sensor: ``Assembly.without_sensors()`` takes it
+        off for predictions of the machine in the cut.
+    """
+
+    always_on: bool = attrs.field(default=False)
+
+    def __attrs_post_init__(self) -> None:
+        if not isinstance(self.always_on, bool):
+            raise InvalidValueError(f"always_on: got {self.always_on!r}; expected true or false")
+
+    @classmethod
+    def laser(cls, name: str, at: str) -> "Sensor":
+        """A non-contact sensor: no mass.
+
+        Parameters
+        ----------
+        name : str
+            The sensor's name.
+        at : str
+            The point it measures.
+
+        Returns
+        -------
+        Sensor
+            A sensor of 0 g.
+        """
+        return cls(name, at, "0 g")
+
+
+@attrs.frozen
+class Mass(_Body):
     """A rigid body permanently on the structure: a clamping nut, a balancing ring.
 
     Unlike a :class:`Sensor`, which is on the structure only in the tests
@@ -522,40 +528,6 @@ class Mass:
     inertia : quantity or str, default "0 kg*m^2"
         Rotary inertia about the bending axis.
     """
-
-    name: str = attrs.field(converter=check_name)
-    at: str = attrs.field(converter=_point)
-    mass: pint.Quantity = attrs.field(converter=_mass)
-    inertia: pint.Quantity = attrs.field(default="0 kg*m^2", converter=_inertia)
-
-    @property
-    def mass_kg(self) -> float:
-        """Mass in kg."""
-        return float(self.mass.m_as("kg"))
-
-    @property
-    def inertia_si(self) -> float:
-        """Rotary inertia in kg m^2."""
-        return float(self.inertia.m_as("kg*m^2"))
-
-    def dynamic_stiffness(self, frequency_hz: np.ndarray) -> np.ndarray:
-        """``-omega^2 diag(m, J)``, shape ``(2, 2, n_freq)``.
-
-        Parameters
-        ----------
-        frequency_hz : ndarray
-            Frequency lines [Hz].
-
-        Returns
-        -------
-        ndarray, shape (2, 2, n_freq)
-            The dynamic stiffness [N/m, N m/rad].
-        """
-        w2 = (2.0 * np.pi * np.asarray(frequency_hz, dtype=float)) ** 2
-        out = np.zeros((2, 2, w2.size), dtype=complex)
-        out[0, 0] = -w2 * self.mass_kg
-        out[1, 1] = -w2 * self.inertia_si
-        return out
 
 
 def dynamic_stiffness(link, frequency_hz) -> np.ndarray:

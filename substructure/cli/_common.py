@@ -8,13 +8,13 @@ functions that need them, so that a command pays for what it uses.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Iterable
 
+from .._json import json_text, strict  # noqa: F401 (strict: read from here as before)
 from .._text import plain_text
 from ..errors import SubstructureError
 
@@ -67,39 +67,6 @@ class Parser(argparse.ArgumentParser):
 def one_line(text: str) -> str:
     """The text on one line, runs of white space made one space."""
     return " ".join(str(text).split())
-
-
-def strict(value: Any) -> Any:
-    """``value`` made of JSON types only: NaN and infinities become ``null``, numpy values plain ones."""
-    import numpy as np
-
-    if isinstance(value, dict):
-        return {str(k): strict(v) for k, v in value.items()}
-    if isinstance(value, np.ndarray):
-        value = value.tolist()
-    if isinstance(value, (list, tuple)):
-        if all(type(v) is float for v in value):  # a long list of numbers (an FRF): one pass
-            return [v if math.isfinite(v) else None for v in value]
-        return [strict(v) for v in value]
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
-    if isinstance(value, (int, np.integer)):
-        return int(value)
-    if isinstance(value, (float, np.floating)):
-        value = float(value)
-        return value if math.isfinite(value) else None
-    if isinstance(value, complex):
-        raise TypeError(f"JSON output: a complex number {value!r}; give real and imaginary parts")
-    if value is None or isinstance(value, str):
-        return value
-    if isinstance(value, os.PathLike):
-        return os.fspath(value)
-    raise TypeError(f"JSON output: a {type(value).__name__} is not a JSON value")
-
-
-def json_text(value: Any) -> str:
-    """Strict JSON of ``value`` (:func:`strict`): never ``NaN`` or ``Infinity``, which JSON does not have."""
-    return json.dumps(strict(value), allow_nan=False)
 
 
 def print_json(value: Any) -> int:
@@ -184,6 +151,12 @@ def figures() -> None:
     import matplotlib
 
     matplotlib.use("Agg")
+
+
+def draw_to(path: str | os.PathLike, overwrite: bool, make: Callable[[], Any]) -> None:
+    """Make a figure with ``make()`` on the file-only backend (:func:`figures`) and save it to ``path``."""
+    figures()
+    save_figure(make(), path, overwrite)
 
 
 def save_plot(frf: FRF, path: str | os.PathLike, title: str, overwrite: bool = True) -> None:

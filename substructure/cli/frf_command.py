@@ -9,13 +9,12 @@ from ._common import (
     UsageError,
     check_outputs,
     check_plot,
-    figures,
+    draw_to,
     grid_arg,
     grid_text,
     peak_table,
     point_arg,
     print_json,
-    save_figure,
     write_frf,
 )
 
@@ -42,9 +41,8 @@ def run(args: argparse.Namespace) -> int:
         write_frf(frf, args.out, args.overwrite)
         written.append(args.out)
     if args.plot:
-        figures()
-        fig = frf.plot(kind=args.kind, unit=args.unit, title=f"{assembly.name}: {at} / {to}")
-        save_figure(fig, args.plot, args.overwrite)
+        draw_to(args.plot, args.overwrite, lambda: frf.plot(kind=args.kind, unit=args.unit,
+                                                            title=f"{assembly.name}: {at} / {to}"))
         written.append(args.plot)
     if args.json:
         values = frf.data[:, 0, 0]

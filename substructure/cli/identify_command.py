@@ -10,10 +10,9 @@ from ._common import (
     check_outputs,
     check_plot,
     count_arg,
-    figures,
+    draw_to,
     measurement_inputs,
     print_json,
-    save_figure,
 )
 
 
@@ -35,9 +34,7 @@ def run(args: argparse.Namespace) -> int:
     report = identify_joint(assembly, measurements, args.joint, band=args.band, parameters=parameters,
                             bootstrap=args.bootstrap)
     if args.plot:
-        figures()
-        fig = report.plot()
-        save_figure(fig, args.plot, args.overwrite)
+        draw_to(args.plot, args.overwrite, report.plot)
     if args.json:
         return print_json(report.to_json())
     lo, hi = report.band

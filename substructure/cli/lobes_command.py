@@ -7,7 +7,7 @@ import re
 import warnings
 
 from ..errors import SubstructureError
-from ._common import UsageError, check_outputs, check_plot, figures, grid_text, point_arg, print_json, save_figure
+from ._common import UsageError, check_outputs, check_plot, draw_to, grid_text, point_arg, print_json
 from ._cutting import (
     MILLING_DEFAULT_NOTE,
     add_cut_options,
@@ -117,10 +117,9 @@ def run(args: argparse.Namespace) -> int:
         notes.append(f"no recommendation: {why}")
     shop = cutting_check(args, cut, tool, best, notes) if isinstance(cut, MillingCut) else None
     if args.plot:
-        figures()
-        fig = lobes.plot(lobes=args.method == "zoa", recommendation=best, title=f"Stability lobes: {cut.describe()}",
-                         limits=limits, cut=cut if isinstance(cut, MillingCut) else None)
-        save_figure(fig, args.plot, args.overwrite)
+        draw_to(args.plot, args.overwrite, lambda: lobes.plot(
+            lobes=args.method == "zoa", recommendation=best, title=f"Stability lobes: {cut.describe()}",
+            limits=limits, cut=cut if isinstance(cut, MillingCut) else None))
     if args.json:
         out = lobes.to_json()
         out["recommended"] = None if best is None else best.to_json()

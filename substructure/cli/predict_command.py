@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._common import UsageError, check_outputs, check_plot, count_arg, figures, point_arg, print_json, save_figure
+from ._common import UsageError, check_outputs, check_plot, count_arg, draw_to, point_arg, print_json
 
 
 def _features(text: str) -> dict[str, str]:
@@ -39,9 +39,7 @@ def run(args: argparse.Namespace) -> int:
         target = args.target or next(iter(table.parameters))
         cv = cross_validate(surrogate, table, target, args.cross_validate)
         if args.plot:
-            figures()
-            fig = cv.plot()
-            save_figure(fig, args.plot, args.overwrite)
+            draw_to(args.plot, args.overwrite, cv.plot)
         if args.json:
             return print_json(cv.to_json())
         print(f"{args.model}, {args.cross_validate} on {args.table}: {len(cv.folds)} folds, {target} [{cv.unit}]")
@@ -64,9 +62,7 @@ def run(args: argparse.Namespace) -> int:
         band = predict_frf_band(load_assembly(args.assembly), args.joint, prediction, at=point_arg(args.at),
                                 n_samples=args.samples)
         if args.plot:
-            figures()
-            fig = band.plot(label=f"{args.model} prediction")
-            save_figure(fig, args.plot, args.overwrite)
+            draw_to(args.plot, args.overwrite, lambda: band.plot(label=f"{args.model} prediction"))
     if args.json:
         out = {"model": args.model, "features": features, "parameters": result}
         if band is not None:

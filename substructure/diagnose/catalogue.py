@@ -74,27 +74,8 @@ class SensorMass(Effect):
 
     @classmethod
     def starting_values(cls, assembly, where, shift):
-        """Starting values at a place.
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model.
-        where : str
-            The place.
-        shift : float
-            Relative shift of the main mode, ``f_model / f_measured - 1``.
-
-        Returns
-        -------
-        dict of str to float
-            A value per parameter (SI).
-
-        Notes
-        -----
-        From the main mode's relative shift: a tip mode drops as ``sqrt(1 + dm / m_eff)``
-        with a quarter of the component's mass moving (model above measurement: a tip mass).
-        """
+        """From the main mode's relative shift: a tip mode drops as ``sqrt(1 + dm / m_eff)``
+        with a quarter of the component's mass moving (model above measurement: a tip mass)."""
         out = {p.name: p.start for p in cls.parameters}
         try:
             body = assembly.component(parse_point(where).component)
@@ -207,24 +188,7 @@ class JointCrossCoupling(_JointEffect):
 
     @classmethod
     def bounds(cls, assembly, where):
-        """Bounds of each parameter at this place.
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model.
-        where : str
-            The place.
-
-        Returns
-        -------
-        dict of str to (float, float)
-            ``(lower, upper)`` per parameter, within the class's.
-
-        Notes
-        -----
-        Passive cross terms: ``k_ym^2 < k_yf k_tm`` and ``c_ym^2 < c_yf c_tm``.
-        """
+        """Passive cross terms: ``k_ym^2 < k_yf k_tm`` and ``c_ym^2 < c_yf c_tm``."""
         joint = assembly.joint(where)
         k = PASSIVE_SHARE * np.sqrt(max(joint.k.get("yf") * joint.k.get("tm"), 0.0))
         c = PASSIVE_SHARE * np.sqrt(max(joint.c.get("yf") * joint.c.get("tm"), 0.0))
@@ -371,21 +335,7 @@ class SupportSprings(Effect):
         return [f"{heaviest.name}.base,{heaviest.name}.tip"]
 
     def apply(self, assembly):
-        """The assembly with the effect applied (a new assembly in normal form).
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model (or one test configuration of it).
-
-        Returns
-        -------
-        Assembly
-            The changed model.
-
-        Notes
-        -----
-        Two equal springs (``k_yf`` each) near the two points of ``where`` (the ends of a component in
+        """Two equal springs (``k_yf`` each) near the two points of ``where`` (the ends of a component in
         either order, ``"spindle.base,spindle.tip"``), ``inset`` of its length in from the first end named
         and ``inset_tip`` from the second.
         """

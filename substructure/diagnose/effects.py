@@ -349,52 +349,15 @@ class EffectChange(Change):
         self.specs = tuple(specs)
 
     def instance(self, values) -> Effect:
-        """The effect with these values.
-
-        Parameters
-        ----------
-        values : mapping of str to float
-            The effect's values (SI).
-
-        Returns
-        -------
-        Effect
-            An instance at this change's place.
-        """
+        """The effect at this change's place with these values (SI)."""
         return self.cls(self.where, **{k: float(v) for k, v in values.items()})
 
     def apply(self, assembly, values):
-        """The assembly with the effect applied.
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model.
-        values : mapping of str to float
-            The effect's values (SI).
-
-        Returns
-        -------
-        Assembly
-            The changed model.
-        """
+        """The assembly with the effect applied (:meth:`Change.apply`)."""
         return self.instance(values).apply(assembly)
 
     def apply_si(self, structure, values):
-        """The SI structure with the effect applied (the effect's ``apply_si``).
-
-        Parameters
-        ----------
-        structure : Structure
-            The SI form of one test configuration.
-        values : mapping of str to float
-            The effect's values (SI).
-
-        Returns
-        -------
-        Structure
-            The changed structure.
-        """
+        """The SI structure with the effect applied (the effect's ``apply_si``, :meth:`Change.apply_si`)."""
         return self.instance(values).apply_si(structure)
 
 
@@ -403,24 +366,8 @@ def _has_si(cls) -> bool:
 
 
 def effect_change(cls: type, where: str, assembly: Assembly, shift: float = 0.0) -> Change:
-    """An :class:`EffectChange`, or one fitted through ``apply`` when the effect has no SI form.
-
-    Parameters
-    ----------
-    cls : type
-        The effect class.
-    where : str
-        Its place.
-    assembly : Assembly
-        The model.
-    shift : float
-        Relative shift of the main mode.
-
-    Returns
-    -------
-    Change
-        The change.
-    """
+    """An :class:`EffectChange` (arguments as there), or one fitted through ``apply`` when the effect has no SI
+    form."""
     change = EffectChange(cls, where, assembly, shift)
     if not _has_si(cls):
         change.__class__ = _AssemblyOnlyEffect

@@ -317,18 +317,7 @@ class Explanation:
         self.change = self
 
     def apply(self, assembly):
-        """The assembly with every change applied.
-
-        Parameters
-        ----------
-        assembly : Assembly
-            The model.
-
-        Returns
-        -------
-        Assembly
-            The changed model.
-        """
+        """The assembly with every change applied (as :meth:`Found.apply`)."""
         for f in self.founds:
             assembly = f.apply(assembly)
         return assembly

@@ -22,50 +22,15 @@ also read from the diagnosis under its own name (``d.explained``,
 
 from __future__ import annotations
 
-import math
 
 import attrs
-import numpy as np
 
+from .._json import finite as _finite, strict
 from ..assembly import Assembly
 from .compare import Comparison
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
 __all__ = ["Found", "Candidate", "Step", "Verdict", "Measures", "Changes", "Alternatives", "Diagnosis", "strict"]
-
-
-def _finite(x):
-    """A JSON-safe number: None for NaN and infinities."""
-    if x is None:
-        return None
-    x = float(x)
-    return x if math.isfinite(x) else None
-
-
-def strict(value):
-    """A JSON-ready copy with every NaN or infinity replaced by None (numpy numbers made plain).
-
-    Parameters
-    ----------
-    value : object
-        Dicts, lists, tuples, numbers, strings.
-
-    Returns
-    -------
-    object
-        The same structure, safe for ``json.dumps(..., allow_nan=False)``.
-    """
-    if isinstance(value, dict):
-        return {str(k): strict(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [strict(v) for v in value]
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
-    if isinstance(value, (int, np.integer)):
-        return int(value)
-    if isinstance(value, (float, np.floating)):
-        return _finite(value)
-    return value
 
 
 class Found:

@@ -15,6 +15,7 @@ from typing import Sequence
 import attrs
 import numpy as np
 
+from .._json import finite as _finite
 from .._text import plain_text
 from ..assembly import Assembly
 from ..coupling import remove_mass
@@ -28,11 +29,6 @@ from .closed_form import ClosedFormResult, closed_form, joint_sides
 __all__ = ["IdentificationReport", "identify_joint"]
 
 _ENTRIES = ("yf", "ym", "tf", "tm")
-
-
-def _finite(x):
-    x = float(x)
-    return x if np.isfinite(x) else None
 
 
 @attrs.frozen

@@ -19,6 +19,7 @@ from .. import _files
 from .._files import (  # noqa: F401 (in the lowest layer, so that frf's files read and write through them)
     _mode_for_new_files,
     check_file,
+    check_file as check_readable_file,  # the public name, for readers that hand the name to pyuff
     check_writable,
     parse_toml,
     read_bytes,
@@ -41,32 +42,3 @@ __public_submodules__ = ("assembly_toml", "frf_files", "measurements", "tap_file
 __all__ = ["read_text", "read_bytes", "parse_toml", "MAX_TEXT_BYTES", "MAX_DATA_BYTES", "check_readable_file",
            "replacing", "write_text", "write_bytes", "check_writable"]
 
-
-def check_readable_file(path, what: str = "file", limit: int = MAX_TEXT_BYTES) -> str:
-    """The path's name, after checking that it is a regular file of at most ``limit`` bytes.
-
-    For readers that hand the name to another library (pyuff); see
-    ``substructure._files.check_file``.
-
-    Parameters
-    ----------
-    path : str or path-like
-        The file to read.
-    what : str
-        What the file is, for the message (e.g. ``"universal file"``).
-    limit : int, default MAX_TEXT_BYTES
-        The largest size allowed, in bytes (:data:`MAX_TEXT_BYTES` for
-        tables and TOML files, :data:`MAX_DATA_BYTES` for FRF data files).
-
-    Returns
-    -------
-    str
-        ``os.fspath(path)``.
-
-    Raises
-    ------
-    FileFormatError
-        Naming the path, for a missing path, a directory, anything else that
-        is not a regular file (a FIFO, a device) and a file over the cap.
-    """
-    return check_file(path, what, limit)

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import FileFormatError, SubstructureError
-from ..tap.records import RESPONSE_QUANTITIES, TapRecord, channel_to_si, unit_of
+from ..tap.records import RESPONSE_QUANTITIES, TIME_STEP_TOLERANCE, TapRecord, channel_to_si, unit_of
 from ._tap_columns import Columns
 
 RESPONSES = ("acceleration", "velocity", "displacement")
@@ -49,6 +49,23 @@ def regular(time_s: np.ndarray) -> np.ndarray:
         return time_s
     if np.max(np.abs(time_s - grid)) <= ROUNDED_TIME_TOLERANCE * step:
         return grid
+    return time_s
+
+
+def time_axis(time: tuple | None, stated: tuple | None, n: int, name: str) -> np.ndarray:
+    """Sample times [s] from ``time = (values, unit, what)``, a time column or vector (rounded times made
+    :func:`regular`), checked against a stated ``(rate [Hz], what states it)``; without one, ``n`` samples at the
+    stated rate."""
+    if time is None:
+        assert stated is not None
+        return np.arange(n) / stated[0]
+    values, unit, what = time
+    time_s = regular(values * (1.0 * unit).m_as("s"))
+    if stated is not None and time_s.size > 1 and time_s[-1] > time_s[0]:
+        from_time = (time_s.size - 1) / (time_s[-1] - time_s[0])
+        if abs(from_time - stated[0]) > TIME_STEP_TOLERANCE * stated[0]:
+            raise FileFormatError(f"{name}: {what} is sampled at {from_time:.10g} Hz, {stated[1]} says "
+                                  f"{stated[0]:.10g} Hz; leave the option out or fix the file")
     return time_s
 
 

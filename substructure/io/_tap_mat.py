@@ -20,8 +20,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import FileFormatError
-from ..tap.records import TIME_STEP_TOLERANCE, TapRecord, unit_of
-from ._tap_build import build_record, option_rate, regular, units_of_columns
+from ..tap.records import TapRecord, unit_of
+from ._tap_build import build_record, option_rate, time_axis, units_of_columns
 from ._tap_columns import Columns, choose
 
 _TIME = re.compile(r"^(time|t|zeit|time_s)$", re.I)
@@ -115,15 +115,7 @@ def mat_record(path: str | os.PathLike, data: bytes, sensitivity: Any, hammer_se
             raise FileFormatError(f"{name}: variable {names[k]!r}, sample {j + 1}: {float(vectors[names[k]][j])!r}; "
                                   "expected a finite number (a gap in the acquisition?)")
     force, response = vectors[names[f_col]], vectors[names[r_col]]
-    if t_col is not None:
-        time_s = regular(vectors[names[t_col]] * (1.0 * parsed[t_col]).m_as("s"))
-        if stated is not None and time_s.size > 1 and time_s[-1] > time_s[0]:
-            from_time = (time_s.size - 1) / (time_s[-1] - time_s[0])
-            if abs(from_time - stated[0]) > TIME_STEP_TOLERANCE * stated[0]:
-                raise FileFormatError(f"{name}: the time vector {names[t_col]!r} is sampled at {from_time:.10g} Hz, "
-                                      f"{stated[1]} says {stated[0]:.10g} Hz; leave the option out or fix the file")
-    else:
-        assert stated is not None
-        time_s = np.arange(force.size) / stated[0]
+    time = None if t_col is None else (vectors[names[t_col]], parsed[t_col], f"the time vector {names[t_col]!r}")
+    time_s = time_axis(time, stated, force.size, name)
     return build_record(name, time_s, force, parsed[f_col], labels[f_col], response, parsed[r_col], labels[r_col],
                         sensitivity, hammer_sensitivity, quantity)

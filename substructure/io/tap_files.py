@@ -30,7 +30,7 @@ from . import check_readable_file, read_bytes
 from ._tap_columns import (MAX_PREAMBLE_LINES, NO_UNIT, Columns, choose, header_cells, is_row, is_unit_row,
                            line_separator, name_and_unit, rate_from_lines)
 from ._tap_build import (RESPONSES, ROUNDED_TIME_TOLERANCE, build_record, check_quantity_option, option_rate,
-                         regular, units_of_columns)
+                         time_axis, units_of_columns)
 from ._tap_table import finite_rows, parse_rows
 
 __all__ = ["read_tap_csv", "read_tap_lvm", "read_tap_mat", "read_tap_uff", "MAX_RECORD_BYTES", "ROUNDED_TIME_TOLERANCE"]
@@ -134,16 +134,8 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
     table = parse_rows(data, first_line, ncols, sep, decimal_comma, labels, name, start)
     used = [k for k in (t_col, f_col, r_col) if k is not None]
     finite_rows(table[:, used], first_line, [labels[k] for k in used], name, data, start)
-    if t_col is not None:
-        time_s = regular(table[:, t_col] * (1.0 * parsed[t_col]).m_as("s"))
-        if rate is not None and time_s.size > 1 and time_s[-1] > time_s[0]:
-            from_time = (time_s.size - 1) / (time_s[-1] - time_s[0])
-            if abs(from_time - rate[0]) > TIME_STEP_TOLERANCE * rate[0]:
-                raise FileFormatError(f"{name}: the time column {labels[t_col]!r} is sampled at {from_time:.10g} "
-                                      f"Hz, {rate[1]} says {rate[0]:.10g} Hz; leave the option out or fix the file")
-    else:
-        assert rate is not None
-        time_s = np.arange(table.shape[0]) / rate[0]
+    time = None if t_col is None else (table[:, t_col], parsed[t_col], f"the time column {labels[t_col]!r}")
+    time_s = time_axis(time, rate, table.shape[0], name)
     return build_record(name, time_s, table[:, f_col], parsed[f_col], labels[f_col], table[:, r_col],
                         parsed[r_col], labels[r_col], sensitivity, hammer_sensitivity, quantity)
 

@@ -246,33 +246,7 @@ class _Reader:
 
 
 def reads_measurements(cls: Any, text: str, base_dir: str | os.PathLike = ".", source: str = "<string>") -> Any:
-    """Read a measurement set from TOML text.
-
-    Parameters
-    ----------
-    cls : type
-        The class of the set (:class:`~substructure.measurements.MeasurementSet` or a subclass).
-    text : str
-        The TOML document (docs/file-formats.md, "Measurement set").
-    base_dir : str or path-like
-        Directory that relative data file paths start from.
-    source : str
-        Name of the text in error messages, e.g. the file name.
-
-    Returns
-    -------
-    MeasurementSet
-        Measurements in the order of the ``[[frf]]`` tables, receptances.
-        ``Measurement.quantity`` is the quantity the file gave (for a
-        UFF record without ``quantity``: the one the record states, by
-        default receptance).
-
-    Raises
-    ------
-    FileFormatError
-        Naming ``source``, the key path and the data file; see the module
-        documentation for the checks.
-    """
+    """A measurement set of class ``cls`` from TOML text (:func:`substructure.io.measurements.loads_measurements`)."""
     doc = loads_toml(text, source, "measurement set")
     try:
         return _Reader(doc, Path(base_dir)).measurement_set(doc.data, cls)
@@ -281,20 +255,7 @@ def reads_measurements(cls: Any, text: str, base_dir: str | os.PathLike = ".", s
 
 
 def read_measurements(cls: Any, path: str | os.PathLike) -> Any:
-    """Read a measurement file; data file paths are relative to it (see :func:`reads_measurements`).
-
-    Parameters
-    ----------
-    cls : type
-        The class of the set (:class:`~substructure.measurements.MeasurementSet` or a subclass).
-    path : str or os.PathLike
-        The measurement set file (TOML).
-
-    Returns
-    -------
-    MeasurementSet
-        The measurements, their FRFs read; errors name the file and the key.
-    """
+    """A measurement set of class ``cls`` from a file (:func:`substructure.io.measurements.load_measurements`)."""
     name = os.fspath(path)
     text = read_text(path, "measurement set file")
     return reads_measurements(cls, text, base_dir=Path(name).parent, source=name)

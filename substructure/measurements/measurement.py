@@ -12,7 +12,8 @@ import attrs
 import numpy as np
 
 from ..errors import InvalidValueError, SubstructureError, UnknownPointError
-from ..frf import FRF, QUANTITIES
+from ..frf import FRF
+from ..frf._fields import _check_quantity
 from ..points import check_name, parse_point
 
 __all__ = ["Measurement", "MeasurementSetError", "MissingMeasurementError", "dof_label", "Configuration"]
@@ -110,11 +111,6 @@ def _optional_record(value: Any) -> int | None:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
         raise InvalidValueError(f"record: got {value!r}; expected a 0-based record index (an integer >= 0)")
     return int(value)
-
-
-def _check_quantity(instance: Any, attribute: Any, value: Any) -> None:
-    if value not in QUANTITIES:
-        raise InvalidValueError(f"quantity: got {value!r}; expected one of {', '.join(QUANTITIES)}")
 
 
 def _coherence(value: Any) -> np.ndarray | None:

@@ -134,42 +134,12 @@ class _Reader:
 
 
 def reads_study(cls: Any, text: str, source: str = "<string>", base: Any = ".") -> Any:
-    """Read a study from TOML text.
-
-    Parameters
-    ----------
-    cls : type
-        The study class (:class:`~substructure.study.Study` or a subclass).
-    text : str
-        The study file's text.
-    source : str
-        Its name in messages.
-    base : str or path
-        The folder that relative file names are relative to.
-
-    Returns
-    -------
-    Study
-        The study.
-    """
+    """A study of class ``cls`` from TOML text (:func:`substructure.study.reader.loads_study`)."""
     return _Reader(loads_toml(text, source, "study"), Path(base)).study(cls)
 
 
 def read_study(cls: Any, path: Any) -> Any:
-    """Read a study file (TOML).
-
-    Parameters
-    ----------
-    cls : type
-        The study class (:class:`~substructure.study.Study` or a subclass).
-    path : str or path
-        The study file.
-
-    Returns
-    -------
-    Study
-        The study; relative file names in it are relative to its folder.
-    """
+    """A study of class ``cls`` from a file (:func:`substructure.study.reader.load_study`)."""
     from ..io import read_text
 
     name = os.fspath(path)

@@ -38,6 +38,7 @@ import warnings
 from pathlib import Path
 from typing import Any
 
+from .._json import json_text
 from ..errors import InvalidValueError, OutputExistsError, SubstructureWarning
 
 __all__ = ["run_study", "Progress", "parse_scheduler", "json_text", "RESULT_FORMAT"]
@@ -266,39 +267,6 @@ def _rows_problem(rows: Any, task: dict) -> str:
     return ""
 
 
-def _plain(value: Any) -> Any:
-    """JSON types only: non-finite floats as ``None``, numpy numbers as Python's."""
-    import math
-
-    if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    if isinstance(value, bool) or value is None or isinstance(value, str):
-        return value
-    if hasattr(value, "item") and not isinstance(value, (int, float)):  # numpy scalars
-        value = value.item()
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    return value
-
-
-def json_text(value: Any) -> str:
-    """Strict JSON (no NaN or Infinity: ``null``) of plain data.
-
-    Parameters
-    ----------
-    value : object
-        Dicts, lists, strings, numbers, ``None``.
-
-    Returns
-    -------
-    str
-        The JSON text; floats keep every digit.
-    """
-    return json.dumps(_plain(value), allow_nan=False)
-
-
 def _write_frf(data: dict, path: Path) -> None:
     import numpy as np
 
@@ -426,30 +394,7 @@ def _dashboard(client, progress: Progress) -> None:
 
 def run_study(study, client: Any = None, out: Any = None, scheduler: str | None = None, resume: bool = False,
               overwrite: bool = False, progress: Any = True):
-    """Run a study (see :meth:`substructure.study.Study.run`).
-
-    Parameters
-    ----------
-    study : Study
-        The study.
-    client : dask.distributed.Client, optional
-        Its cluster runs the tasks.
-    out : str or path, optional
-        Output directory.
-    scheduler : str, optional
-        ``processes:N``, ``local:N``, an address or ``serial``.
-    resume : bool
-        Keep finished combinations of ``out``.
-    overwrite : bool
-        Replace a study's files in ``out``.
-    progress : bool or file
-        Progress lines on standard error, a file, or none.
-
-    Returns
-    -------
-    pandas.DataFrame
-        The table.
-    """
+    """Run a study: :meth:`substructure.study.Study.run`, whose documentation gives the arguments."""
     if resume and overwrite:
         raise InvalidValueError("resume and overwrite: choose one (resume keeps finished combinations, overwrite "
                                 "computes everything anew)")

@@ -76,9 +76,6 @@ COLUMNS = (
     ("key", "str", "the name of the combination's files in the output directory"),
 )
 
-_KINDS = {name: kind for name, kind, _ in COLUMNS}
-
-
 def empty_row() -> dict:
     """A row with every column missing (``None``).
 

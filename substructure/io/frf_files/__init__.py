@@ -26,8 +26,8 @@ The code is in ``substructure.frf.files``, one format per module: ``csv_files`` 
 ``uff_writer`` (:func:`write_uff`), ``uff_reader`` (:func:`read_uff`) and ``uff_units`` (what a
 type-58 record holds: its labels, quantity, units and abscissa), with ``_common`` for the checks
 and codes they share.  It sits in the ``frf`` layer so that ``FRF.to_csv``, ``FRF.from_uff`` and
-the other methods read and write without importing ``io``; every name is imported from here, and
-the module names under ``substructure.io.frf_files`` still work.
+the other methods read and write without importing ``io``; every name is imported from here
+(``substructure.io.frf_files.uff_units`` keeps its old place as well).
 """
 
 from __future__ import annotations
