@@ -166,7 +166,8 @@ def _blk(y: np.ndarray, i: int, j: int) -> np.ndarray:
     return y[2 * i : 2 * i + 2, 2 * j : 2 * j + 2]
 
 
-def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object]) -> np.ndarray:
+def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object], memo=None,
+                         tokens: tuple | None = None) -> np.ndarray:
     """Couple substructures through links and return the receptances at ``outputs``.
 
     Parameters
@@ -178,6 +179,15 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
         Joints, supports and modifications, applied in order.
     outputs : sequence of keys
         Points whose receptances are wanted (in this order).
+    memo : mapping, optional
+        Coupled clusters of earlier calls, kept by the caller between calls
+        (``get`` and item assignment; the caller bounds its size): a step
+        whose two clusters and link are those of an earlier step is taken
+        from it, not computed again (the same inputs give the same result).
+    tokens : (sequence, sequence), optional
+        With ``memo``: a hashable identity of each block's receptances and of
+        each link's stiffness (None: not the same as any other; nothing
+        coupled with it is reused).
 
     Returns
     -------
@@ -200,8 +210,12 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
     n = blocks[0][1].shape[-1]
     clusters: dict[int, tuple[list, np.ndarray]] = {}
     where: dict[object, int] = {}
+    # what each cluster was computed from (None: not reusable); only with a memo
+    made: dict[int, object] = {}
+    block_tokens, link_tokens = tokens if memo is not None and tokens is not None else ((), ())
     for cid, (keys, y) in enumerate(blocks):
         clusters[cid] = (list(keys), _kernels.c_array(y, complex))
+        made[cid] = block_tokens[cid] if cid < len(block_tokens) else None
         for k in keys:
             where[k] = cid
     # the points each link and the outputs need, from the last link backwards
@@ -231,6 +245,18 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
             kept = [(0, i) for i, k in enumerate(ka) if k in needed]
             kept += [(1, i) for i, k in enumerate(kb) if k in needed]
             new_keys = [(ka, kb)[src][i] for src, i in kept]
+        key = None
+        link_token = link_tokens[step] if step < len(link_tokens) else None
+        parts = (made[ca], None if cb is None else made[cb], link_token)
+        if parts[0] is not None and (cb is None or parts[1] is not None) and link_token is not None:
+            key = (parts, link.a, link.b, tuple(new_keys))
+            found = memo.get(key)
+            if found is not None:
+                cid = min(ca, cb if cb is not None else ca)
+                clusters[cid], made[cid] = (new_keys, found), key
+                for k in new_keys:
+                    where[k] = cid
+                continue
         rigid = link.stiffness is None
         stiffness = _NO_STIFFNESS if rigid else _kernels.c_array(link.stiffness, complex)
         if stiffness.shape[:2] != (2, 2) or stiffness.shape[-1] not in (1, n) or stiffness.ndim != 3:
@@ -247,7 +273,9 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
                 "flexibility"
             )
         cid = min(ca, cb if cb is not None else ca)
-        clusters[cid] = (new_keys, out)
+        clusters[cid], made[cid] = (new_keys, out), key
+        if key is not None:
+            memo[key] = out
         for k in new_keys:
             where[k] = cid
     result = np.zeros((2 * len(outputs), 2 * len(outputs), n), dtype=complex)

@@ -273,3 +273,36 @@ def test_a_tapered_tool_takes_part_as_it_is():
     for value in (0.0095, 0.0085, 0.0095):  # rebuilt and dropped at each evaluation, as in a fit: never stale
         got = evaluator(change.apply_si(structure, {"value": value}))
         np.testing.assert_allclose(got, change.apply(tapered, {"value": value}).frf(OUT, IN, F).data, rtol=1e-10)
+
+
+def test_the_coupling_steps_an_evaluator_reuses_give_what_a_fresh_evaluator_gives(monkeypatch):
+    """Coupling steps whose components and links are unchanged are taken from earlier evaluations: the same
+    numbers, bit for bit, as an evaluator that computes everything, in any order of structures, and fewer
+    coupling steps computed."""
+    from substructure import _kernels
+
+    model = _rich_model()
+    structure = Structure.from_assembly(model)
+    tip_mass = AddedMass("tool", 0.076, 0.05, (0.0, 0.076), 1e-6)
+    section = SectionChange("tool", 0.076)
+    variants = [structure,
+                tip_mass.apply_si(structure, {"mass": 0.002, "position": 0.07, "inertia": 0.0}),
+                tip_mass.apply_si(structure, {"mass": 0.004, "position": 0.07, "inertia": 0.0}),
+                section.apply_si(structure, {"diameter_ratio": 0.8, "start": 0.03, "length": 0.04}),
+                apply_path_si(structure, "joints.holder-tool.k.yf", 3e7),
+                apply_path_si(structure, "sensors.acc.mass", 0.005)]
+    calls = []
+    couple = _kernels.couple_link
+    monkeypatch.setattr(_kernels, "couple_link", lambda *a: calls.append(1) or couple(*a))
+    fresh = [Evaluator(OUT, IN, F)(s) for s in variants]
+    computed = len(calls)
+    calls.clear()
+    evaluator = Evaluator(OUT, IN, F)
+    for order in (range(len(variants)), reversed(range(len(variants))), [1, 3, 1, 2, 0, 2]):
+        for i in order:
+            assert np.array_equal(evaluator(variants[i]), fresh[i]), i
+    assert len(calls) < computed  # three times as many evaluations
+    # a different mass where the memo holds a coupled cluster with the first one: not the stale numbers
+    ref = tip_mass.apply(model, {"mass": 0.003, "position": 0.07, "inertia": 0.0}).frf(OUT, IN, F).data
+    got = evaluator(tip_mass.apply_si(structure, {"mass": 0.003, "position": 0.07, "inertia": 0.0}))
+    assert np.abs(got - ref).max() <= 1e-10 * np.abs(ref).max()

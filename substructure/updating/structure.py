@@ -34,6 +34,7 @@ from ..beams import Segment, shear_coefficient, stepped_beam_receptance_si
 from ..components import Beam, is_plain_beam
 from ..coupling import Link, couple_substructures
 from ..errors import AssemblyError, InvalidValueError, UnknownPointError
+from .._memo import Recent, Same
 from ..joints import Joint
 from ..points import DOFS, parse_point
 
@@ -572,6 +573,13 @@ class Structure:
         raise UnknownPointError(f"point {ref}: there is no component {ref.component!r} in this configuration")
 
 
+def _link_token(link: "LinkSI"):
+    """What a link's dynamic stiffness is computed from (None for a joint model of its own)."""
+    if link.custom is not None:
+        return None
+    return (link.rigid, link.K.tobytes(), link.C.tobytes(), link.M.tobytes())
+
+
 class Evaluator:
     """Receptances between fixed points on fixed lines, for structures of one assembly.
 
@@ -584,9 +592,15 @@ class Evaluator:
     cache : int
         How many changed component receptances to keep (besides those of
         the first structure evaluated, which are always kept).
+    memo_bytes : int
+        Most bytes of coupled clusters and links' dynamic stiffnesses kept
+        from earlier evaluations: a coupling step whose inputs are those of
+        an earlier one (the components and links a change did not touch) is
+        not computed again.
     """
 
-    def __init__(self, outputs: Sequence[str], inputs: Sequence[str], frequency_hz: np.ndarray, cache: int = 12):
+    def __init__(self, outputs: Sequence[str], inputs: Sequence[str], frequency_hz: np.ndarray, cache: int = 12,
+                 memo_bytes: int = 32 * 2**20):
         self.outputs = tuple(outputs)
         self.inputs = tuple(inputs)
         self.f = np.asarray(frequency_hz, dtype=float)
@@ -605,6 +619,8 @@ class Evaluator:
         self._pinned: dict = {}
         self._lru: OrderedDict = OrderedDict()
         self._size = cache
+        self._memo = Recent(memo_bytes)
+        self._stiffness = Recent(memo_bytes // 8)
 
     def _store(self, key, compute, pin: bool):
         if key in self._pinned:
@@ -621,18 +637,29 @@ class Evaluator:
                 self._lru.popitem(last=False)
         return y
 
-    def _receptance(self, structure: Structure, name: str, nodes: list, pin: bool) -> np.ndarray:
+    def _receptance(self, structure: Structure, name: str, nodes: list, pin: bool) -> tuple[np.ndarray, object]:
+        """A component's receptances at the nodes, and what identifies them (for the coupling's memo)."""
         if name in structure.beams:
             beam = structure.beams[name]
             xs = [x for x, _ in nodes]
-            return self._store((beam.token, tuple(xs)), lambda: beam.receptance(xs, self.f), pin)
+            key = (beam.token, tuple(xs))  # a token is never reused
+            return self._store(key, lambda: beam.receptance(xs, self.f), pin), key
         comp = structure.opaque[name]
         refs = [r if r is not None else _at(name, x, comp.length_m) for x, r in nodes]
         # keyed by the object's id, stored with the object itself so that the id cannot be reused while cached;
         # pinned only for the first structure (a component changed by a fit is rebuilt at every evaluation)
-        kept = self._store((id(comp), tuple(str(r) for r in refs)),
-                           lambda: (comp, comp.receptance_matrix(refs, self.f)), pin)
-        return kept[1]
+        key = (id(comp), tuple(str(r) for r in refs))
+        kept = self._store(key, lambda: (comp, comp.receptance_matrix(refs, self.f)), pin)
+        return kept[1], (Same(comp), key[1])
+
+    def _dynamic_stiffness(self, link: "LinkSI", token) -> np.ndarray | None:
+        if token is None or link.rigid:
+            return link.dynamic_stiffness(self.f)
+        found = self._stiffness.get(token)
+        if found is None:
+            found = link.dynamic_stiffness(self.f)
+            self._stiffness[token] = found
+        return found
 
     def __call__(self, structure: Structure) -> np.ndarray:
         """The receptances ``(n_freq, n_out, n_in)`` of ``structure``."""
@@ -664,15 +691,18 @@ class Evaluator:
             if ka == kb:
                 raise AssemblyError(f"{link.key[0][:-1]} {link.key[1]!r} connects a point to itself")
             links.append((ka, kb, link))
-        blocks = []
+        blocks, block_tokens = [], []
         for comp in structure.order:
             if comp not in nodes:
                 continue
             items = sorted(nodes[comp].items(), key=lambda kv: (kv[1][0] is None, kv[1][0] or 0.0, str(kv[0])))
-            blocks.append(([k for k, _ in items], self._receptance(structure, comp, [v for _, v in items], pin)))
-        coupling = [Link(ka, kb, link.dynamic_stiffness(self.f), f"{link.key[0][:-1]} {link.key[1]!r}")
-                    for ka, kb, link in links]
-        y = couple_substructures(blocks, coupling, out_keys)
+            y, token = self._receptance(structure, comp, [v for _, v in items], pin)
+            blocks.append(([k for k, _ in items], y))
+            block_tokens.append(token)
+        link_tokens = [_link_token(link) for _, _, link in links]
+        coupling = [Link(ka, kb, self._dynamic_stiffness(link, token), f"{link.key[0][:-1]} {link.key[1]!r}")
+                    for (ka, kb, link), token in zip(links, link_tokens)]
+        y = couple_substructures(blocks, coupling, out_keys, self._memo, (block_tokens, link_tokens))
         rows = [2 * p + d for p, d in self._dofs[: self._n_out]]
         cols = [2 * p + d for p, d in self._dofs[self._n_out:]]
         return np.moveaxis(y[np.ix_(rows, cols)], -1, 0)
