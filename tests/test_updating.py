@@ -306,3 +306,26 @@ def test_the_coupling_steps_an_evaluator_reuses_give_what_a_fresh_evaluator_give
     ref = tip_mass.apply(model, {"mass": 0.003, "position": 0.07, "inertia": 0.0}).frf(OUT, IN, F).data
     got = evaluator(tip_mass.apply_si(structure, {"mass": 0.003, "position": 0.07, "inertia": 0.0}))
     assert np.abs(got - ref).max() <= 1e-10 * np.abs(ref).max()
+
+
+def test_the_structures_a_likelihood_keeps_give_what_applying_the_changes_gives(clean):
+    """The structure after the same changes with the same values is kept between evaluations (the changes
+    already added, during a scan): the same residuals, bit for bit, as a likelihood that applies every change
+    every time, and a values dict changed in place after a call is not taken for the old values."""
+    model = hd.nominal_model()
+    measured = measured_frfs([_noisy(clean, 0.015, 0.5, 1e-3, 0)])[0]
+    joint = ParameterChange(next(p for p in model_parameters(model) if p.path == "joints.holder-tool.k.yf"))
+    section = SectionChange("tool", model.component("tool").length_m)
+    body = AddedMass("tool", model.component("tool").length_m, 0.05, (0.0, model.component("tool").length_m), 1e-6)
+    held = {"diameter_ratio": 0.8, "start": 0.03, "length": 0.04}
+    lists = [[(section, held), (body, {"mass": m, "position": 0.05, "inertia": 0.0})] for m in (0.002, 0.004)]
+    lists += [[(joint, {"value": 1.2e7}), (section, held)], [(section, held)], [(joint, {"value": 1.2e7})]]
+    kept = Likelihood(model, measured)
+    for changes in lists + lists[::-1]:
+        assert np.array_equal(kept.residual(changes), Likelihood(model, measured).residual(changes))
+    values = {"diameter_ratio": 0.8, "start": 0.03, "length": 0.04}
+    first = kept.residual([(section, values)])
+    values["diameter_ratio"] = 0.9  # the same dict, another value
+    second = kept.residual([(section, values)])
+    assert np.array_equal(second, Likelihood(model, measured).residual([(section, {**held, "diameter_ratio": 0.9})]))
+    assert not np.array_equal(first, second)

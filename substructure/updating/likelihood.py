@@ -20,12 +20,14 @@ there, others (registered effects without one) on the assembly.
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from typing import Sequence
 
 import attrs
 import numpy as np
 
 from ..errors import InvalidValueError, UnknownPointError
+from .._memo import Same
 from ..frf import FRF
 from ..measurements import model_of_measurement
 from .noise import NoiseModel, estimate_noise
@@ -36,6 +38,10 @@ __all__ = ["Measured", "Likelihood", "measured_frfs", "LOG_RATIO_PENALTY"]
 
 LOG_RATIO_PENALTY = 10.0
 """The log ratio used where a model value is zero or not finite [-]."""
+
+APPLIED_KEPT = 16
+"""Structures with changes applied kept per configuration from recent evaluations (by the changes and their
+values, in order): the changes already added are applied once per scan, not once per trial."""
 
 
 @attrs.frozen
@@ -149,15 +155,34 @@ class _Group:
         inputs = list(dict.fromkeys(m.frf.inputs[0] for _, m in items))
         self.entries = [(outputs.index(m.frf.outputs[0]), inputs.index(m.frf.inputs[0])) for _, m in items]
         self.evaluator = Evaluator(outputs, inputs, first.frf.frequency.hz[lines])
+        self._applied: OrderedDict = OrderedDict()
 
     def structure_with(self, changes: Sequence[tuple]) -> Structure:
         if all(_has_si(c) for c, _ in changes):
             s = self.structure
+            key: tuple | None = ()
             for change, values in changes:
+                # the structure after the same changes with the same values is kept from a recent evaluation:
+                # the changes already added, held during a scan (its beams keep their receptances' token)
+                found = None
+                if key is not None:
+                    key += ((Same(change), tuple(sorted(values.items()))),)
+                    try:
+                        found = self._applied.get(key)
+                    except TypeError:  # values that are not plain numbers: these changes applied every time
+                        key = None
+                if found is not None:
+                    self._applied.move_to_end(key)
+                    s = found
+                    continue
                 try:
                     s = change.apply_si(s, values)
                 except UnknownPointError:  # no place for it in this configuration
-                    continue
+                    pass
+                if key is not None:
+                    self._applied[key] = s
+                    while len(self._applied) > APPLIED_KEPT:
+                        self._applied.popitem(last=False)
             return s
         a = self.assembly
         for change, values in changes:
