@@ -71,7 +71,7 @@ def _ring(od, id_, E, nu, rho, eta):
     inertia = math.pi / 64.0 * (od**4 - id_**4)
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(od > 0, id_ / np.where(od > 0, od, 1.0), 0.0)
-    kappa = np.array([shear_coefficient(float(n), float(m)) for n, m in zip(np.atleast_1d(nu), np.atleast_1d(ratio))])
+    kappa = shear_coefficient(np.atleast_1d(np.asarray(nu, dtype=float)), np.atleast_1d(np.asarray(ratio, dtype=float)))
     damp = 1.0 + 1j * eta
     return E * damp * inertia, kappa * (E / (2.0 * (1.0 + nu))) * damp * area, rho * area, rho * inertia
 
@@ -101,7 +101,7 @@ class BeamArrays:
     """
 
     __slots__ = ("name", "length", "od", "id", "ratio", "material", "material_names", "insert", "insert_names",
-                 "token", "_sections")
+                 "token", "_sections", "_total")
 
     def __init__(self, name, length, od, id, ratio, material, material_names, insert, insert_names):
         self.name = name
@@ -115,6 +115,7 @@ class BeamArrays:
         self.insert_names = tuple(insert_names)
         self.token = next(_TOKENS)
         self._sections = None
+        self._total = None
 
     @classmethod
     def from_beam(cls, beam: Beam) -> "BeamArrays":
@@ -168,7 +169,9 @@ class BeamArrays:
     @property
     def total_length(self) -> float:
         """Length of the beam [m]."""
-        return float(self.length.sum())
+        if self._total is None:  # the arrays are not changed in place (a change makes a new BeamArrays)
+            self._total = float(self.length.sum())
+        return self._total
 
     def sections(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(EI, kGA, rhoA, rhoI)`` per segment, layers (inserts) summed.
