@@ -1,5 +1,6 @@
 """The model-updating core: parameters by path, the SI evaluation, noise, fits, the tests of selection."""
 
+import re
 import warnings
 
 import numpy as np
@@ -329,3 +330,32 @@ def test_the_structures_a_likelihood_keeps_give_what_applying_the_changes_gives(
     second = kept.residual([(section, values)])
     assert np.array_equal(second, Likelihood(model, measured).residual([(section, {**held, "diameter_ratio": 0.9})]))
     assert not np.array_equal(first, second)
+
+
+def test_models_evaluated_together_give_what_each_gives_alone(clean):
+    """A scan's trials evaluated together (their lines side by side in one coupling) give the residuals of
+    one-by-one evaluations bit for bit, the places of the trials alike or not; a model that cannot be evaluated
+    raises the error the one-by-one evaluation raises, with the models before it counted."""
+    model = hd.nominal_model()
+    measured = measured_frfs([_noisy(clean, 0.015, 0.5, 1e-3, 1)])[0]
+    joint = ParameterChange(next(p for p in model_parameters(model) if p.path == "joints.holder-tool.k.yf"))
+    length = model.component("tool").length_m
+    body = AddedMass("tool", length, 0.05, (0.0, length), 1e-6)
+    held = [(SectionChange("tool", length), {"diameter_ratio": 0.8, "start": 0.03, "length": 0.04})]
+    lists = [held + [(body, {"mass": m, "position": x, "inertia": 0.0})] for x in (0.02, 0.05) for m in (1e-3, 4e-3)]
+    lists += [held + [(joint, {"value": v})] for v in (5e6, 1e7, 3e7)] + [[(joint, {"value": 2e7})], []]
+    together = Likelihood(model, measured)
+    got = together.residuals(lists)
+    alone = Likelihood(model, measured)
+    assert together.evaluations == len(lists)
+    for changes, w in zip(lists, got):
+        assert np.array_equal(w, alone.residual(changes))
+    assert not np.array_equal(got[0], got[1]) and not np.array_equal(got[0], got[2])
+    od = ParameterChange(next(p for p in model_parameters(model) if p.path == "components.tool.segments.0.od"))
+    outside = held + [(od, {"value": -0.01})]  # a negative diameter
+    with pytest.raises(InvalidValueError) as one:
+        Likelihood(model, measured).residual(outside)
+    counted = Likelihood(model, measured)
+    with pytest.raises(type(one.value), match=re.escape(str(one.value))):
+        counted.residuals(lists[:2] + [outside] + lists[2:])
+    assert counted.evaluations == 3

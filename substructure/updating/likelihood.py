@@ -196,6 +196,10 @@ class _Group:
         y = self.evaluator(self.structure_with(changes))
         return [y[:, i, j] for i, j in self.entries]
 
+    def predict_many(self, lists) -> list[list[np.ndarray]]:
+        ys = self.evaluator.many([self.structure_with(changes) for changes in lists])
+        return [[y[:, i, j] for i, j in self.entries] for y in ys]
+
 
 class Likelihood:
     """``chi^2`` of models (the assembly with changes) against measured FRFs.
@@ -282,8 +286,11 @@ class Likelihood:
         list of ndarray
             Complex log ratios, one array per measured FRF.
         """
+        return self._ratios(self.predict(changes))
+
+    def _ratios(self, predicted: list) -> list[np.ndarray]:
         out = []
-        for model, data in zip(self.predict(changes), self.data):
+        for model, data in zip(predicted, self.data):
             with np.errstate(divide="ignore", invalid="ignore"):
                 r = np.log(model / data)
             bad = ~np.isfinite(r)
@@ -325,6 +332,41 @@ class Likelihood:
             The residuals.
         """
         return self.whiten(self.log_ratios(changes))
+
+    def residuals(self, lists: Sequence[Sequence[tuple]]) -> list[np.ndarray]:
+        """The residuals of several models, as :meth:`residual` gives each in turn (the same numbers).
+
+        The models are evaluated together (``Evaluator.many`` of
+        :mod:`substructure.updating.structure`: the trials of a scan cost one
+        coupling, not one each).  When one of them cannot be
+        evaluated, they are evaluated one by one: the error is the one
+        :meth:`residual` raises for the first such model, after the models
+        before it were counted.
+
+        Parameters
+        ----------
+        lists : sequence of sequence of (Change, dict)
+            Each model's changes with their values (SI), applied in order.
+
+        Returns
+        -------
+        list of ndarray
+            The residuals of each model.
+        """
+        lists = [list(changes) for changes in lists]
+        try:
+            per_group = [g.predict_many(lists) for g in self.groups]
+        except Exception:  # noqa: BLE001 - one by one, so that the error is the first model's, as with residual
+            return [self.residual(changes) for changes in lists]
+        self.evaluations += len(lists)
+        out = []
+        for k in range(len(lists)):
+            predicted: list = [None] * len(self.measured)
+            for g, ys in zip(self.groups, per_group):
+                for i, y in zip(g.indices, ys[k]):
+                    predicted[i] = y
+            out.append(self.whiten(self._ratios(predicted)))
+        return out
 
     def chi2(self, changes: Sequence[tuple] = ()) -> float:
         """``chi^2`` of the model (``-2 ln L`` up to a constant).

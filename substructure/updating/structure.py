@@ -666,6 +666,59 @@ class Evaluator:
 
     def __call__(self, structure: Structure) -> np.ndarray:
         """The receptances ``(n_freq, n_out, n_in)`` of ``structure``."""
+        blocks, coupling, out_keys, tokens = self._prepare(structure)
+        return self._pick(couple_substructures(blocks, coupling, out_keys, self._memo, tokens))
+
+    def many(self, structures: Sequence[Structure]) -> list[np.ndarray]:
+        """The receptances of several structures, each as :meth:`__call__` gives it (the same numbers).
+
+        Structures whose points and links sit at the same places (the trials
+        of a scan that change sizes, not places) are coupled together: their
+        lines side by side in one call of the engine, which treats every
+        line alike.
+
+        Parameters
+        ----------
+        structures : sequence of Structure
+            Structures of this evaluator's assembly.
+
+        Returns
+        -------
+        list of ndarray
+            ``(n_freq, n_out, n_in)`` per structure, in order.
+        """
+        prepared = [self._prepare(s) for s in structures]
+        groups: dict = {}
+        for i, (blocks, coupling, out_keys, _) in enumerate(prepared):
+            layout = (tuple(tuple(keys) for keys, _ in blocks),
+                      tuple((c.a, c.b, c.stiffness is None) for c in coupling), tuple(out_keys))
+            groups.setdefault(layout, []).append(i)
+        out: list = [None] * len(prepared)
+        n = self.f.size
+        for members in groups.values():
+            if len(members) == 1:
+                blocks, coupling, out_keys, tokens = prepared[members[0]]
+                out[members[0]] = self._pick(couple_substructures(blocks, coupling, out_keys, self._memo, tokens))
+                continue
+            first = prepared[members[0]]
+            blocks = [(keys, np.concatenate([prepared[i][0][b][1] for i in members], axis=-1))
+                      for b, (keys, _) in enumerate(first[0])]
+            coupling = [Link(c.a, c.b, None if c.stiffness is None else np.concatenate(
+                [np.broadcast_to(prepared[i][1][k].stiffness, (2, 2, n)) for i in members], axis=-1), c.label)
+                        for k, c in enumerate(first[1])]
+            # a block or link the same in every structure keeps its token (coupling steps of only such are reused
+            # from earlier batches of as many structures)
+            same = [[prepared[i][3][part][k] for i in members] for part in (0, 1) for k in range(len(first[3][part]))]
+            tokens = [("batch", len(members), t[0]) if t[0] is not None and all(x == t[0] for x in t[1:]) else None
+                      for t in same]
+            y = couple_substructures(blocks, coupling, first[2], self._memo,
+                                     (tokens[:len(first[3][0])], tokens[len(first[3][0]):]))
+            for j, i in enumerate(members):
+                out[i] = self._pick(y[..., j * n:(j + 1) * n])
+        return out
+
+    def _prepare(self, structure: Structure):
+        """The blocks, links, output points and memo tokens of one structure, for the engine."""
         pin = not self._pinned  # the first structure's components are kept for good
         nodes: dict[str, dict] = {}
         keys = {}
@@ -705,7 +758,10 @@ class Evaluator:
         link_tokens = [_link_token(link) for _, _, link in links]
         coupling = [Link(ka, kb, self._dynamic_stiffness(link, token), f"{link.key[0][:-1]} {link.key[1]!r}")
                     for (ka, kb, link), token in zip(links, link_tokens)]
-        y = couple_substructures(blocks, coupling, out_keys, self._memo, (block_tokens, link_tokens))
+        return blocks, coupling, out_keys, (block_tokens, link_tokens)
+
+    def _pick(self, y: np.ndarray) -> np.ndarray:
+        """The outputs' and inputs' entries of the engine's result, frequency first."""
         rows = [2 * p + d for p, d in self._dofs[: self._n_out]]
         cols = [2 * p + d for p, d in self._dofs[self._n_out:]]
         return np.moveaxis(y[np.ix_(rows, cols)], -1, 0)
