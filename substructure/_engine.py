@@ -167,7 +167,7 @@ def _blk(y: np.ndarray, i: int, j: int) -> np.ndarray:
 
 
 def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object], memo=None,
-                         tokens: tuple | None = None) -> np.ndarray:
+                         tokens: tuple | None = None, copies: int = 1, lines: int | None = None) -> np.ndarray:
     """Couple substructures through links and return the receptances at ``outputs``.
 
     Parameters
@@ -188,11 +188,20 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
         With ``memo``: a hashable identity of each block's receptances and of
         each link's stiffness (None: not the same as any other; nothing
         coupled with it is reused).
+    copies : int
+        Several models coupled at once, their lines side by side: a block or
+        stiffness of ``copies * lines`` lines differs between them, one of
+        ``lines`` lines (or a stiffness of one) is the same in every one;
+        steps of only such are computed once and repeated where they meet
+        one that differs (each line computed as alone).
+    lines : int, optional
+        The lines of one model (needed with ``copies`` above 1).
 
     Returns
     -------
     ndarray ``(2p, 2p, n)``
-        Zero between points of substructures that end up unconnected.
+        Zero between points of substructures that end up unconnected
+        (``n = copies * lines`` with copies).
 
     Notes
     -----
@@ -207,7 +216,12 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
     """
     from . import _kernels
 
-    n = blocks[0][1].shape[-1]
+    n = blocks[0][1].shape[-1] if copies == 1 else int(lines)
+    full = n * copies
+
+    def spread(y):  # an array the same in every copy, repeated for each (the kernel's inputs and outputs)
+        return y if copies == 1 or y.shape[-1] != n else np.tile(y, copies)
+
     clusters: dict[int, tuple[list, np.ndarray]] = {}
     where: dict[object, int] = {}
     # what each cluster was computed from (None: not reusable); only with a memo
@@ -259,10 +273,14 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
                 continue
         rigid = link.stiffness is None
         stiffness = _NO_STIFFNESS if rigid else _kernels.c_array(link.stiffness, complex)
-        if stiffness.shape[:2] != (2, 2) or stiffness.shape[-1] not in (1, n) or stiffness.ndim != 3:
+        if stiffness.shape[:2] != (2, 2) or stiffness.shape[-1] not in (1, n, full) or stiffness.ndim != 3:
             raise ValueError(
                 f"{link.label or 'a link'}: stiffness of shape {stiffness.shape}; expected (2, 2, {n}) or (2, 2, 1)"
             )
+        if copies > 1 and full in (ya.shape[-1], yb.shape[-1], stiffness.shape[-1]):
+            # a step with a part that differs between the copies: every part for every copy, not kept
+            ya, yb, stiffness, key = spread(ya), (spread(yb) if yb is not ya else None), spread(stiffness), None
+            yb = ya if yb is None else yb
         src = np.array([p for p, _ in kept], dtype=np.int64)
         idx = np.array([i for _, i in kept], dtype=np.int64)
         out, finite = _kernels.couple_link(ya, yb, a[0], a[1], b[0], b[1], src, idx, stiffness, rigid)
@@ -278,11 +296,11 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
             memo[key] = out
         for k in new_keys:
             where[k] = cid
-    result = np.zeros((2 * len(outputs), 2 * len(outputs), n), dtype=complex)
+    result = np.zeros((2 * len(outputs), 2 * len(outputs), full), dtype=complex)
     for i, ki in enumerate(outputs):
         ci = where[ki]
         keys_i, y_i = clusters[ci]
         for j, kj in enumerate(outputs):
             if where[kj] == ci:
-                result[2 * i : 2 * i + 2, 2 * j : 2 * j + 2] = _blk(y_i, keys_i.index(ki), keys_i.index(kj))
+                result[2 * i : 2 * i + 2, 2 * j : 2 * j + 2] = spread(_blk(y_i, keys_i.index(ki), keys_i.index(kj)))
     return result

@@ -670,7 +670,7 @@ class Evaluator:
         return self._pick(couple_substructures(blocks, coupling, out_keys, self._memo, tokens))
 
     def many(self, structures: Sequence[Structure]) -> list[np.ndarray]:
-        """The receptances of several structures, each as :meth:`__call__` gives it (the same numbers).
+        """The receptances of several structures, each as calling the evaluator with it gives them (the same numbers).
 
         Structures whose points and links sit at the same places (the trials
         of a scan that change sizes, not places) are coupled together: their
@@ -701,18 +701,29 @@ class Evaluator:
                 out[members[0]] = self._pick(couple_substructures(blocks, coupling, out_keys, self._memo, tokens))
                 continue
             first = prepared[members[0]]
-            blocks = [(keys, np.concatenate([prepared[i][0][b][1] for i in members], axis=-1))
-                      for b, (keys, _) in enumerate(first[0])]
-            coupling = [Link(c.a, c.b, None if c.stiffness is None else np.concatenate(
-                [np.broadcast_to(prepared[i][1][k].stiffness, (2, 2, n)) for i in members], axis=-1), c.label)
-                        for k, c in enumerate(first[1])]
-            # a block or link the same in every structure keeps its token (coupling steps of only such are reused
-            # from earlier batches of as many structures)
-            same = [[prepared[i][3][part][k] for i in members] for part in (0, 1) for k in range(len(first[3][part]))]
-            tokens = [("batch", len(members), t[0]) if t[0] is not None and all(x == t[0] for x in t[1:]) else None
-                      for t in same]
-            y = couple_substructures(blocks, coupling, first[2], self._memo,
-                                     (tokens[:len(first[3][0])], tokens[len(first[3][0]):]))
+            # a block or link the same in every structure (by its token) is given once: the steps of only such
+            # are computed once (and reused as in single evaluations), the others for every structure
+            blocks, block_tokens = [], []
+            for b, (keys, y) in enumerate(first[0]):
+                token = first[3][0][b]
+                if all(prepared[i][3][0][b] == token for i in members):
+                    blocks.append((keys, y))
+                    block_tokens.append(token)
+                else:
+                    blocks.append((keys, np.concatenate([prepared[i][0][b][1] for i in members], axis=-1)))
+                    block_tokens.append(None)
+            coupling, link_tokens = [], []
+            for k, c in enumerate(first[1]):
+                token = first[3][1][k]
+                if c.stiffness is None or (token is not None and all(prepared[i][3][1][k] == token for i in members)):
+                    coupling.append(c)
+                    link_tokens.append(token)
+                else:
+                    coupling.append(Link(c.a, c.b, np.concatenate(
+                        [np.broadcast_to(prepared[i][1][k].stiffness, (2, 2, n)) for i in members], axis=-1), c.label))
+                    link_tokens.append(None)
+            y = couple_substructures(blocks, coupling, first[2], self._memo, (block_tokens, link_tokens),
+                                     copies=len(members), lines=n)
             for j, i in enumerate(members):
                 out[i] = self._pick(y[..., j * n:(j + 1) * n])
         return out
