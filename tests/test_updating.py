@@ -332,7 +332,7 @@ def test_the_structures_a_likelihood_keeps_give_what_applying_the_changes_gives(
     assert not np.array_equal(first, second)
 
 
-def test_models_evaluated_together_give_what_each_gives_alone(clean):
+def test_models_evaluated_together_give_what_each_gives_alone(clean, monkeypatch):
     """A scan's trials evaluated together (their lines side by side in one coupling) give the residuals of
     one-by-one evaluations bit for bit, the places of the trials alike or not; a model that cannot be evaluated
     raises the error the one-by-one evaluation raises, with the models before it counted."""
@@ -344,8 +344,16 @@ def test_models_evaluated_together_give_what_each_gives_alone(clean):
     held = [(SectionChange("tool", length), {"diameter_ratio": 0.8, "start": 0.03, "length": 0.04})]
     lists = [held + [(body, {"mass": m, "position": x, "inertia": 0.0})] for x in (0.02, 0.05) for m in (1e-3, 4e-3)]
     lists += [held + [(joint, {"value": v})] for v in (5e6, 1e7, 3e7)] + [[(joint, {"value": 2e7})], []]
+    # the tool differs between these (the spindle and holder coupled once for all of them)
+    lists += [[(held[0][0], {**held[0][1], "diameter_ratio": r}), (joint, {"value": 2e7})] for r in (0.7, 0.9, 1.1)]
     together = Likelihood(model, measured)
+    from substructure.updating import structure as si_structure
+
+    calls = []
+    engine = si_structure.couple_substructures
+    monkeypatch.setattr(si_structure, "couple_substructures", lambda *a, **k: calls.append(1) or engine(*a, **k))
     got = together.residuals(lists)
+    assert len(calls) <= 6  # together (not one by one after a failure): one call per layout of points and links
     alone = Likelihood(model, measured)
     assert together.evaluations == len(lists)
     for changes, w in zip(lists, got):
