@@ -166,7 +166,8 @@ def _blk(y: np.ndarray, i: int, j: int) -> np.ndarray:
     return y[2 * i : 2 * i + 2, 2 * j : 2 * j + 2]
 
 
-def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object]) -> np.ndarray:
+def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object], memo=None,
+                         tokens: tuple | None = None, copies: int = 1, lines: int | None = None) -> np.ndarray:
     """Couple substructures through links and return the receptances at ``outputs``.
 
     Parameters
@@ -178,11 +179,29 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
         Joints, supports and modifications, applied in order.
     outputs : sequence of keys
         Points whose receptances are wanted (in this order).
+    memo : mapping, optional
+        Coupled clusters of earlier calls, kept by the caller between calls
+        (``get`` and item assignment; the caller bounds its size): a step
+        whose two clusters and link are those of an earlier step is taken
+        from it, not computed again (the same inputs give the same result).
+    tokens : (sequence, sequence), optional
+        With ``memo``: a hashable identity of each block's receptances and of
+        each link's stiffness (None: not the same as any other; nothing
+        coupled with it is reused).
+    copies : int
+        Several models coupled at once, their lines side by side: a block or
+        stiffness of ``copies * lines`` lines differs between them, one of
+        ``lines`` lines (or a stiffness of one) is the same in every one;
+        steps of only such are computed once and repeated where they meet
+        one that differs (each line computed as alone).
+    lines : int, optional
+        The lines of one model (needed with ``copies`` above 1).
 
     Returns
     -------
     ndarray ``(2p, 2p, n)``
-        Zero between points of substructures that end up unconnected.
+        Zero between points of substructures that end up unconnected
+        (``n = copies * lines`` with copies).
 
     Notes
     -----
@@ -197,11 +216,22 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
     """
     from . import _kernels
 
-    n = blocks[0][1].shape[-1]
+    if copies > 1 and lines is None:
+        raise ValueError("couple_substructures: copies > 1 needs the lines of one copy")
+    n = blocks[0][1].shape[-1] if copies == 1 or lines is None else int(lines)
+    full = n * copies
+
+    def spread(y):  # an array the same in every copy, repeated for each (the kernel's inputs and outputs)
+        return y if copies == 1 or y.shape[-1] != n else np.tile(y, copies)
+
     clusters: dict[int, tuple[list, np.ndarray]] = {}
     where: dict[object, int] = {}
+    # what each cluster was computed from (None: not reusable); only with a memo
+    made: dict[int, object] = {}
+    block_tokens, link_tokens = tokens if memo is not None and tokens is not None else ((), ())
     for cid, (keys, y) in enumerate(blocks):
         clusters[cid] = (list(keys), _kernels.c_array(y, complex))
+        made[cid] = block_tokens[cid] if cid < len(block_tokens) else None
         for k in keys:
             where[k] = cid
     # the points each link and the outputs need, from the last link backwards
@@ -231,12 +261,29 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
             kept = [(0, i) for i, k in enumerate(ka) if k in needed]
             kept += [(1, i) for i, k in enumerate(kb) if k in needed]
             new_keys = [(ka, kb)[src][i] for src, i in kept]
+        key = None
+        link_token = link_tokens[step] if step < len(link_tokens) else None
+        parts = (made[ca], None if cb is None else made[cb], link_token)
+        if parts[0] is not None and (cb is None or parts[1] is not None) and link_token is not None:
+            key = (parts, link.a, link.b, tuple(new_keys))
+            found = memo.get(key)
+            if found is not None:
+                cid = min(ca, cb if cb is not None else ca)
+                clusters[cid], made[cid] = (new_keys, found), key
+                for k in new_keys:
+                    where[k] = cid
+                continue
         rigid = link.stiffness is None
         stiffness = _NO_STIFFNESS if rigid else _kernels.c_array(link.stiffness, complex)
-        if stiffness.shape[:2] != (2, 2) or stiffness.shape[-1] not in (1, n) or stiffness.ndim != 3:
+        if stiffness.shape[:2] != (2, 2) or stiffness.shape[-1] not in (1, n, full) or stiffness.ndim != 3:
             raise ValueError(
                 f"{link.label or 'a link'}: stiffness of shape {stiffness.shape}; expected (2, 2, {n}) or (2, 2, 1)"
             )
+        if copies > 1 and full in (ya.shape[-1], yb.shape[-1], stiffness.shape[-1]):
+            # a step with a part that differs between the copies: every part for every copy, not kept
+            same = yb is ya
+            ya, stiffness, key = spread(ya), spread(stiffness), None
+            yb = ya if same else spread(yb)
         src = np.array([p for p, _ in kept], dtype=np.int64)
         idx = np.array([i for _, i in kept], dtype=np.int64)
         out, finite = _kernels.couple_link(ya, yb, a[0], a[1], b[0], b[1], src, idx, stiffness, rigid)
@@ -247,14 +294,16 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
                 "flexibility"
             )
         cid = min(ca, cb if cb is not None else ca)
-        clusters[cid] = (new_keys, out)
+        clusters[cid], made[cid] = (new_keys, out), key
+        if key is not None:
+            memo[key] = out
         for k in new_keys:
             where[k] = cid
-    result = np.zeros((2 * len(outputs), 2 * len(outputs), n), dtype=complex)
+    result = np.zeros((2 * len(outputs), 2 * len(outputs), full), dtype=complex)
     for i, ki in enumerate(outputs):
         ci = where[ki]
         keys_i, y_i = clusters[ci]
         for j, kj in enumerate(outputs):
             if where[kj] == ci:
-                result[2 * i : 2 * i + 2, 2 * j : 2 * j + 2] = _blk(y_i, keys_i.index(ki), keys_i.index(kj))
+                result[2 * i : 2 * i + 2, 2 * j : 2 * j + 2] = spread(_blk(y_i, keys_i.index(ki), keys_i.index(kj)))
     return result

@@ -258,7 +258,8 @@ def test_support_springs_measure_inset_from_the_first_end_named():
     from substructure import InvalidValueError
     from substructure.diagnose.effects import registry
     from substructure.points import parse_point
-    from substructure.updating.structure import Evaluator, Structure
+    from substructure.updating.evaluator import Evaluator
+    from substructure.updating.structure import Structure
 
     springs = registry()["support-springs"]
     model = hd.nominal_model()

@@ -1,5 +1,6 @@
 """The model-updating core: parameters by path, the SI evaluation, noise, fits, the tests of selection."""
 
+import re
 import warnings
 
 import numpy as np
@@ -18,7 +19,8 @@ from substructure.updating.parameters import (ParameterChange, apply_path_si, ge
                                               material_changes, model_parameters, parameter_change,
                                               set_parameters)
 from substructure.updating.selection import consistency, indifferent, significance
-from substructure.updating.structure import Evaluator, Structure
+from substructure.updating.evaluator import Evaluator
+from substructure.updating.structure import Structure
 
 F = np.linspace(20.0, 5000.0, 400)
 OUT, IN = ["tool.tip:y", "holder.tip:y", "spindle@100 mm:y"], ["tool.tip:y"]
@@ -273,3 +275,96 @@ def test_a_tapered_tool_takes_part_as_it_is():
     for value in (0.0095, 0.0085, 0.0095):  # rebuilt and dropped at each evaluation, as in a fit: never stale
         got = evaluator(change.apply_si(structure, {"value": value}))
         np.testing.assert_allclose(got, change.apply(tapered, {"value": value}).frf(OUT, IN, F).data, rtol=1e-10)
+
+
+def test_the_coupling_steps_an_evaluator_reuses_give_what_a_fresh_evaluator_gives(monkeypatch):
+    """Coupling steps whose components and links are unchanged are taken from earlier evaluations: the same
+    numbers, bit for bit, as an evaluator that computes everything, in any order of structures, and fewer
+    coupling steps computed."""
+    from substructure import _kernels
+
+    model = _rich_model()
+    structure = Structure.from_assembly(model)
+    tip_mass = AddedMass("tool", 0.076, 0.05, (0.0, 0.076), 1e-6)
+    section = SectionChange("tool", 0.076)
+    variants = [structure,
+                tip_mass.apply_si(structure, {"mass": 0.002, "position": 0.07, "inertia": 0.0}),
+                tip_mass.apply_si(structure, {"mass": 0.004, "position": 0.07, "inertia": 0.0}),
+                section.apply_si(structure, {"diameter_ratio": 0.8, "start": 0.03, "length": 0.04}),
+                apply_path_si(structure, "joints.holder-tool.k.yf", 3e7),
+                apply_path_si(structure, "sensors.acc.mass", 0.005)]
+    calls = []
+    couple = _kernels.couple_link
+    monkeypatch.setattr(_kernels, "couple_link", lambda *a: calls.append(1) or couple(*a))
+    fresh = [Evaluator(OUT, IN, F)(s) for s in variants]
+    computed = len(calls)
+    calls.clear()
+    evaluator = Evaluator(OUT, IN, F)
+    for order in (range(len(variants)), reversed(range(len(variants))), [1, 3, 1, 2, 0, 2]):
+        for i in order:
+            assert np.array_equal(evaluator(variants[i]), fresh[i]), i
+    assert len(calls) < computed  # three times as many evaluations
+    # a different mass where the memo holds a coupled cluster with the first one: not the stale numbers
+    ref = tip_mass.apply(model, {"mass": 0.003, "position": 0.07, "inertia": 0.0}).frf(OUT, IN, F).data
+    got = evaluator(tip_mass.apply_si(structure, {"mass": 0.003, "position": 0.07, "inertia": 0.0}))
+    assert np.abs(got - ref).max() <= 1e-10 * np.abs(ref).max()
+
+
+def test_the_structures_a_likelihood_keeps_give_what_applying_the_changes_gives(clean):
+    """The structure after the same changes with the same values is kept between evaluations (the changes
+    already added, during a scan): the same residuals, bit for bit, as a likelihood that applies every change
+    every time, and a values dict changed in place after a call is not taken for the old values."""
+    model = hd.nominal_model()
+    measured = measured_frfs([_noisy(clean, 0.015, 0.5, 1e-3, 0)])[0]
+    joint = ParameterChange(next(p for p in model_parameters(model) if p.path == "joints.holder-tool.k.yf"))
+    section = SectionChange("tool", model.component("tool").length_m)
+    body = AddedMass("tool", model.component("tool").length_m, 0.05, (0.0, model.component("tool").length_m), 1e-6)
+    held = {"diameter_ratio": 0.8, "start": 0.03, "length": 0.04}
+    lists = [[(section, held), (body, {"mass": m, "position": 0.05, "inertia": 0.0})] for m in (0.002, 0.004)]
+    lists += [[(joint, {"value": 1.2e7}), (section, held)], [(section, held)], [(joint, {"value": 1.2e7})]]
+    kept = Likelihood(model, measured)
+    for changes in lists + lists[::-1]:
+        assert np.array_equal(kept.residual(changes), Likelihood(model, measured).residual(changes))
+    values = {"diameter_ratio": 0.8, "start": 0.03, "length": 0.04}
+    first = kept.residual([(section, values)])
+    values["diameter_ratio"] = 0.9  # the same dict, another value
+    second = kept.residual([(section, values)])
+    assert np.array_equal(second, Likelihood(model, measured).residual([(section, {**held, "diameter_ratio": 0.9})]))
+    assert not np.array_equal(first, second)
+
+
+def test_models_evaluated_together_give_what_each_gives_alone(clean, monkeypatch):
+    """A scan's trials evaluated together (their lines side by side in one coupling) give the residuals of
+    one-by-one evaluations bit for bit, the places of the trials alike or not; a model that cannot be evaluated
+    raises the error the one-by-one evaluation raises, with the models before it counted."""
+    model = hd.nominal_model()
+    measured = measured_frfs([_noisy(clean, 0.015, 0.5, 1e-3, 1)])[0]
+    joint = ParameterChange(next(p for p in model_parameters(model) if p.path == "joints.holder-tool.k.yf"))
+    length = model.component("tool").length_m
+    body = AddedMass("tool", length, 0.05, (0.0, length), 1e-6)
+    held = [(SectionChange("tool", length), {"diameter_ratio": 0.8, "start": 0.03, "length": 0.04})]
+    lists = [held + [(body, {"mass": m, "position": x, "inertia": 0.0})] for x in (0.02, 0.05) for m in (1e-3, 4e-3)]
+    lists += [held + [(joint, {"value": v})] for v in (5e6, 1e7, 3e7)] + [[(joint, {"value": 2e7})], []]
+    # the tool differs between these (the spindle and holder coupled once for all of them)
+    lists += [[(held[0][0], {**held[0][1], "diameter_ratio": r}), (joint, {"value": 2e7})] for r in (0.7, 0.9, 1.1)]
+    together = Likelihood(model, measured)
+    from substructure.updating import structure as si_structure
+
+    calls = []
+    engine = si_structure.couple_substructures
+    monkeypatch.setattr(si_structure, "couple_substructures", lambda *a, **k: calls.append(1) or engine(*a, **k))
+    got = together.residuals(lists)
+    assert len(calls) <= 6  # together (not one by one after a failure): one call per layout of points and links
+    alone = Likelihood(model, measured)
+    assert together.evaluations == len(lists)
+    for changes, w in zip(lists, got):
+        assert np.array_equal(w, alone.residual(changes))
+    assert not np.array_equal(got[0], got[1]) and not np.array_equal(got[0], got[2])
+    od = ParameterChange(next(p for p in model_parameters(model) if p.path == "components.tool.segments.0.od"))
+    outside = held + [(od, {"value": -0.01})]  # a negative diameter
+    with pytest.raises(InvalidValueError) as one:
+        Likelihood(model, measured).residual(outside)
+    counted = Likelihood(model, measured)
+    with pytest.raises(type(one.value), match=re.escape(str(one.value))):
+        counted.residuals(lists[:2] + [outside] + lists[2:])
+    assert counted.evaluations == 3

@@ -252,11 +252,13 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
     """
     basis = _basis(likelihood, current, settings)
 
-    def chi2_of(changes_now) -> float:
-        w = likelihood.residual(changes_now)
+    def projected(w) -> float:
         if basis is not None:  # the changes already added, refitted to first order
             w = w - basis @ (basis.T @ w)
         return float(w @ w)
+
+    def chi2_of(changes_now) -> float:
+        return projected(likelihood.residual(changes_now))
 
     scanned = []
     for n, change in enumerate(changes, start=1):
@@ -264,8 +266,10 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
             progress(f"scanned {n}/{len(changes)} candidates")
         best_chi2, best = math.inf, None
         try:
-            for trial in _trials(change, first=cross, settings=settings) + list((extra or {}).get(change.key, ())):
-                chi2 = chi2_of(list(current) + [(change, trial)])
+            tried = _trials(change, first=cross, settings=settings) + list((extra or {}).get(change.key, ()))
+            # evaluated together (the same numbers as one by one)
+            for trial, w in zip(tried, likelihood.residuals([list(current) + [(change, t)] for t in tried])):
+                chi2 = projected(w)
                 if chi2 < best_chi2:
                     best_chi2, best = chi2, trial
         except (SubstructureError, ValueError, FloatingPointError) as exc:

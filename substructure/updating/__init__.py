@@ -35,7 +35,8 @@ from .parameters import (ModelParameter, ParameterChange, ParameterSet, get_para
                          set_parameters)
 from .paths import apply_path_si
 from .selection import Consistency, Significance, consistency, indifferent, significance
-from .structure import Evaluator, Structure
+from .evaluator import Evaluator
+from .structure import Structure
 
 __all__ = [
     "Change", "ParamSpec", "AddedMass", "GroundSpring", "SectionChange", "Fit", "fit", "Likelihood", "Measured",

@@ -20,22 +20,29 @@ there, others (registered effects without one) on the assembly.
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from typing import Sequence
 
 import attrs
 import numpy as np
 
 from ..errors import InvalidValueError, UnknownPointError
+from .._memo import Same
 from ..frf import FRF
 from ..measurements import model_of_measurement
 from .noise import NoiseModel, estimate_noise
 from .parameters import Change
-from .structure import Evaluator, Structure
+from .evaluator import Evaluator
+from .structure import Structure
 
 __all__ = ["Measured", "Likelihood", "measured_frfs", "LOG_RATIO_PENALTY"]
 
 LOG_RATIO_PENALTY = 10.0
 """The log ratio used where a model value is zero or not finite [-]."""
+
+APPLIED_KEPT = 16
+"""Structures with changes applied kept per configuration from recent evaluations (by the changes and their
+values, in order): the changes already added are applied once per scan, not once per trial."""
 
 
 @attrs.frozen
@@ -149,15 +156,34 @@ class _Group:
         inputs = list(dict.fromkeys(m.frf.inputs[0] for _, m in items))
         self.entries = [(outputs.index(m.frf.outputs[0]), inputs.index(m.frf.inputs[0])) for _, m in items]
         self.evaluator = Evaluator(outputs, inputs, first.frf.frequency.hz[lines])
+        self._applied: OrderedDict = OrderedDict()
 
     def structure_with(self, changes: Sequence[tuple]) -> Structure:
         if all(_has_si(c) for c, _ in changes):
             s = self.structure
+            key: tuple | None = ()
             for change, values in changes:
+                # the structure after the same changes with the same values is kept from a recent evaluation:
+                # the changes already added, held during a scan (its beams keep their receptances' token)
+                found = None
+                if key is not None:
+                    key += ((Same(change), tuple(sorted(values.items()))),)
+                    try:
+                        found = self._applied.get(key)
+                    except TypeError:  # values that are not plain numbers: these changes applied every time
+                        key = None
+                if found is not None:
+                    self._applied.move_to_end(key)
+                    s = found
+                    continue
                 try:
                     s = change.apply_si(s, values)
                 except UnknownPointError:  # no place for it in this configuration
-                    continue
+                    pass
+                if key is not None:
+                    self._applied[key] = s
+                    while len(self._applied) > APPLIED_KEPT:
+                        self._applied.popitem(last=False)
             return s
         a = self.assembly
         for change, values in changes:
@@ -170,6 +196,10 @@ class _Group:
     def predict(self, changes) -> list[np.ndarray]:
         y = self.evaluator(self.structure_with(changes))
         return [y[:, i, j] for i, j in self.entries]
+
+    def predict_many(self, lists) -> list[list[np.ndarray]]:
+        ys = self.evaluator.many([self.structure_with(changes) for changes in lists])
+        return [[y[:, i, j] for i, j in self.entries] for y in ys]
 
 
 class Likelihood:
@@ -257,8 +287,11 @@ class Likelihood:
         list of ndarray
             Complex log ratios, one array per measured FRF.
         """
+        return self._ratios(self.predict(changes))
+
+    def _ratios(self, predicted: list) -> list[np.ndarray]:
         out = []
-        for model, data in zip(self.predict(changes), self.data):
+        for model, data in zip(predicted, self.data):
             with np.errstate(divide="ignore", invalid="ignore"):
                 r = np.log(model / data)
             bad = ~np.isfinite(r)
@@ -300,6 +333,41 @@ class Likelihood:
             The residuals.
         """
         return self.whiten(self.log_ratios(changes))
+
+    def residuals(self, lists: Sequence[Sequence[tuple]]) -> list[np.ndarray]:
+        """The residuals of several models, as :meth:`residual` gives each in turn (the same numbers).
+
+        The models are evaluated together (``Evaluator.many`` of
+        :mod:`substructure.updating.structure`: the trials of a scan cost one
+        coupling, not one each).  When one of them cannot be
+        evaluated, they are evaluated one by one: the error is the one
+        :meth:`residual` raises for the first such model, after the models
+        before it were counted.
+
+        Parameters
+        ----------
+        lists : sequence of sequence of (Change, dict)
+            Each model's changes with their values (SI), applied in order.
+
+        Returns
+        -------
+        list of ndarray
+            The residuals of each model.
+        """
+        lists = [list(changes) for changes in lists]
+        try:
+            per_group = [g.predict_many(lists) for g in self.groups]
+        except Exception:  # noqa: BLE001 - one by one, so that the error is the first model's, as with residual
+            return [self.residual(changes) for changes in lists]
+        self.evaluations += len(lists)
+        out = []
+        for k in range(len(lists)):
+            predicted: list = [None] * len(self.measured)
+            for g, ys in zip(self.groups, per_group):
+                for i, y in zip(g.indices, ys[k]):
+                    predicted[i] = y
+            out.append(self.whiten(self._ratios(predicted)))
+        return out
 
     def chi2(self, changes: Sequence[tuple] = ()) -> float:
         """``chi^2`` of the model (``-2 ln L`` up to a constant).

@@ -9,15 +9,7 @@ stiffness, damping and mass matrices.  Changing a number returns a new
 structure that shares every array it did not change; no units are parsed
 and no value objects are rebuilt.
 
-:class:`Evaluator` computes the receptances between fixed outputs and
-inputs on fixed frequency lines for any structure of the same assembly: the
-receptances of components that did not change are reused (identified by the
-arrays object they hold), the others are computed by
-:func:`substructure.beams.stepped_beam_receptance_si`, and the coupling runs
-in the engine of :mod:`substructure.coupling`.  Components that are not
-plain stepped beams (measured components, subassemblies, subclasses with
-their own receptances) take part unchanged through their own
-``receptance_matrix``.
+Its evaluation is :class:`~substructure.updating.evaluator.Evaluator`'s.
 """
 
 from __future__ import annotations
@@ -25,19 +17,17 @@ from __future__ import annotations
 import functools
 import itertools
 import math
-from collections import OrderedDict
 from typing import Sequence
 
 import numpy as np
 
 from ..beams import Segment, shear_coefficient, stepped_beam_receptance_si
-from ..components import Beam, is_plain_beam, receptances
-from ..coupling import Link, couple_substructures
-from ..errors import AssemblyError, InvalidValueError, UnknownPointError
+from ..components import Beam, is_plain_beam
+from ..errors import UnknownPointError
 from ..joints import Joint, dynamic_stiffness
-from ..points import DOFS, parse_point
+from ..points import parse_point
 
-__all__ = ["BeamArrays", "LinkSI", "Structure", "Evaluator", "si_beam"]
+__all__ = ["BeamArrays", "LinkSI", "Structure", "si_beam"]
 
 _TOKENS = itertools.count(1)
 
@@ -70,7 +60,7 @@ def _ring(od, id_, E, nu, rho, eta):
     inertia = math.pi / 64.0 * (od**4 - id_**4)
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(od > 0, id_ / np.where(od > 0, od, 1.0), 0.0)
-    kappa = np.array([shear_coefficient(float(n), float(m)) for n, m in zip(np.atleast_1d(nu), np.atleast_1d(ratio))])
+    kappa = shear_coefficient(np.atleast_1d(np.asarray(nu, dtype=float)), np.atleast_1d(np.asarray(ratio, dtype=float)))
     damp = 1.0 + 1j * eta
     return E * damp * inertia, kappa * (E / (2.0 * (1.0 + nu))) * damp * area, rho * area, rho * inertia
 
@@ -100,7 +90,7 @@ class BeamArrays:
     """
 
     __slots__ = ("name", "length", "od", "id", "ratio", "material", "material_names", "insert", "insert_names",
-                 "token", "_sections")
+                 "token", "_sections", "_total")
 
     def __init__(self, name, length, od, id, ratio, material, material_names, insert, insert_names):
         self.name = name
@@ -114,6 +104,7 @@ class BeamArrays:
         self.insert_names = tuple(insert_names)
         self.token = next(_TOKENS)
         self._sections = None
+        self._total = None
 
     @classmethod
     def from_beam(cls, beam: Beam) -> "BeamArrays":
@@ -167,7 +158,9 @@ class BeamArrays:
     @property
     def total_length(self) -> float:
         """Length of the beam [m]."""
-        return float(self.length.sum())
+        if self._total is None:  # the arrays are not changed in place (a change makes a new BeamArrays)
+            self._total = float(self.length.sum())
+        return self._total
 
     def sections(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(EI, kGA, rhoA, rhoI)`` per segment, layers (inserts) summed.
@@ -570,109 +563,3 @@ class Structure:
                     return comp.name, float(comp.position(ref.point))
                 return comp.name, None
         raise UnknownPointError(f"point {ref}: there is no component {ref.component!r} in this configuration")
-
-
-class Evaluator:
-    """Receptances between fixed points on fixed lines, for structures of one assembly.
-
-    Parameters
-    ----------
-    outputs, inputs : sequence of str
-        DOF labels (``"tool.tip:y"``); a label without a DOF stands for ``y``.
-    frequency_hz : ndarray
-        The frequency lines [Hz].
-    cache : int
-        How many changed component receptances to keep (besides those of
-        the first structure evaluated, which are always kept).
-    """
-
-    def __init__(self, outputs: Sequence[str], inputs: Sequence[str], frequency_hz: np.ndarray, cache: int = 12):
-        self.outputs = tuple(outputs)
-        self.inputs = tuple(inputs)
-        self.f = np.asarray(frequency_hz, dtype=float)
-        if self.f.size == 0 or np.any(self.f <= 0):
-            raise InvalidValueError("frequency: a model evaluation needs lines above 0 Hz (free-free components "
-                                    "have no static receptance); crop the data, e.g. from 1 Hz")
-        refs = [_parse(p) for p in self.outputs + self.inputs]
-        self._points = []
-        self._dofs = []
-        for r in refs:
-            point = str(r.point)
-            if point not in self._points:
-                self._points.append(point)
-            self._dofs.append((self._points.index(point), DOFS.index(r.dof or "y")))
-        self._n_out = len(self.outputs)
-        self._pinned: dict = {}
-        self._lru: OrderedDict = OrderedDict()
-        self._size = cache
-
-    def _store(self, key, compute, pin: bool):
-        if key in self._pinned:
-            return self._pinned[key]
-        if key in self._lru:
-            self._lru.move_to_end(key)
-            return self._lru[key]
-        y = compute()
-        if pin:
-            self._pinned[key] = y
-        else:
-            self._lru[key] = y
-            while len(self._lru) > self._size:
-                self._lru.popitem(last=False)
-        return y
-
-    def _receptance(self, structure: Structure, name: str, nodes: list, pin: bool) -> np.ndarray:
-        if name in structure.beams:
-            beam = structure.beams[name]
-            xs = [x for x, _ in nodes]
-            return self._store((beam.token, tuple(xs)), lambda: beam.receptance(xs, self.f), pin)
-        comp = structure.opaque[name]
-        refs = [r if r is not None else _at(name, x, comp.length_m) for x, r in nodes]
-        # keyed by the object's id, stored with the object itself so that the id cannot be reused while cached;
-        # pinned only for the first structure (a component changed by a fit is rebuilt at every evaluation)
-        kept = self._store((id(comp), tuple(str(r) for r in refs)),
-                           lambda: (comp, receptances(comp, refs, self.f)), pin)
-        return kept[1]
-
-    def __call__(self, structure: Structure) -> np.ndarray:
-        """The receptances ``(n_freq, n_out, n_in)`` of ``structure``."""
-        pin = not self._pinned  # the first structure's components are kept for good
-        nodes: dict[str, dict] = {}
-        keys = {}
-
-        def node(point):
-            if not isinstance(point, tuple) and point in keys:
-                return keys[point]
-            comp, x = structure.position(point)
-            if x is None:
-                ref = _parse(point).point
-                owner = structure.opaque[comp]
-                k = (comp, owner.node_key(ref))
-                nodes.setdefault(comp, {}).setdefault(k, (None, ref))
-            else:
-                k = (comp, round(x, 12))
-                nodes.setdefault(comp, {}).setdefault(k, (x, None))
-            if not isinstance(point, tuple):
-                keys[point] = k
-            return k
-
-        out_keys = [node(p) for p in self._points]
-        links = []
-        for link in structure.links:
-            ka = node(link.a)
-            kb = None if link.b is None else node(link.b)
-            if ka == kb:
-                raise AssemblyError(f"{link.key[0][:-1]} {link.key[1]!r} connects a point to itself")
-            links.append((ka, kb, link))
-        blocks = []
-        for comp in structure.order:
-            if comp not in nodes:
-                continue
-            items = sorted(nodes[comp].items(), key=lambda kv: (kv[1][0] is None, kv[1][0] or 0.0, str(kv[0])))
-            blocks.append(([k for k, _ in items], self._receptance(structure, comp, [v for _, v in items], pin)))
-        coupling = [Link(ka, kb, link.dynamic_stiffness(self.f), f"{link.key[0][:-1]} {link.key[1]!r}")
-                    for ka, kb, link in links]
-        y = couple_substructures(blocks, coupling, out_keys)
-        rows = [2 * p + d for p, d in self._dofs[: self._n_out]]
-        cols = [2 * p + d for p, d in self._dofs[self._n_out:]]
-        return np.moveaxis(y[np.ix_(rows, cols)], -1, 0)

@@ -1,0 +1,230 @@
+"""The fast evaluation of the SI form: receptances between fixed points on fixed lines, for model updating.
+
+:class:`Evaluator` computes the receptances between fixed outputs and
+inputs on fixed frequency lines for any :class:`~substructure.updating.structure.Structure`
+of the same assembly: the receptances of components that did not change are
+reused (identified by the arrays object they hold), the others are computed
+by :func:`substructure.beams.stepped_beam_receptance_si`, and the coupling
+runs in the engine of :mod:`substructure.coupling`, its steps reused where a
+change did not touch them.  Components that are not plain stepped beams
+(measured components, subassemblies, subclasses with their own receptances)
+take part unchanged through their own ``receptance_matrix``.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+from typing import Sequence
+
+import numpy as np
+
+from .._memo import Recent, Same
+from ..components import receptances
+from ..coupling import Link, couple_substructures
+from ..errors import AssemblyError, InvalidValueError
+from ..points import DOFS
+from .structure import LinkSI, Structure, _at, _parse
+
+__all__ = ["Evaluator"]
+
+
+def _link_token(link: "LinkSI"):
+    """What a link's dynamic stiffness is computed from (None for a joint model of its own)."""
+    if link.custom is not None:
+        return None
+    return (link.rigid, link.K.tobytes(), link.C.tobytes(), link.M.tobytes())
+
+
+class Evaluator:
+    """Receptances between fixed points on fixed lines, for structures of one assembly.
+
+    Parameters
+    ----------
+    outputs, inputs : sequence of str
+        DOF labels (``"tool.tip:y"``); a label without a DOF stands for ``y``.
+    frequency_hz : ndarray
+        The frequency lines [Hz].
+    cache : int
+        How many changed component receptances to keep (besides those of
+        the first structure evaluated, which are always kept).
+    memo_bytes : int
+        Most bytes of coupled clusters and links' dynamic stiffnesses kept
+        from earlier evaluations: a coupling step whose inputs are those of
+        an earlier one (the components and links a change did not touch) is
+        not computed again.
+    """
+
+    def __init__(self, outputs: Sequence[str], inputs: Sequence[str], frequency_hz: np.ndarray, cache: int = 12,
+                 memo_bytes: int = 32 * 2**20):
+        self.outputs = tuple(outputs)
+        self.inputs = tuple(inputs)
+        self.f = np.asarray(frequency_hz, dtype=float)
+        if self.f.size == 0 or np.any(self.f <= 0):
+            raise InvalidValueError("frequency: a model evaluation needs lines above 0 Hz (free-free components "
+                                    "have no static receptance); crop the data, e.g. from 1 Hz")
+        refs = [_parse(p) for p in self.outputs + self.inputs]
+        self._points = []
+        self._dofs = []
+        for r in refs:
+            point = str(r.point)
+            if point not in self._points:
+                self._points.append(point)
+            self._dofs.append((self._points.index(point), DOFS.index(r.dof or "y")))
+        self._n_out = len(self.outputs)
+        self._pinned: dict = {}
+        self._lru: OrderedDict = OrderedDict()
+        self._size = cache
+        self._memo = Recent(memo_bytes)
+        self._stiffness = Recent(memo_bytes // 8)
+
+    def _store(self, key, compute, pin: bool):
+        if key in self._pinned:
+            return self._pinned[key]
+        if key in self._lru:
+            self._lru.move_to_end(key)
+            return self._lru[key]
+        y = compute()
+        if pin:
+            self._pinned[key] = y
+        else:
+            self._lru[key] = y
+            while len(self._lru) > self._size:
+                self._lru.popitem(last=False)
+        return y
+
+    def _receptance(self, structure: Structure, name: str, nodes: list, pin: bool) -> tuple[np.ndarray, object]:
+        """A component's receptances at the nodes, and what identifies them (for the coupling's memo)."""
+        if name in structure.beams:
+            beam = structure.beams[name]
+            xs = [x for x, _ in nodes]
+            key = (beam.token, tuple(xs))  # a token is never reused
+            return self._store(key, lambda: beam.receptance(xs, self.f), pin), key
+        comp = structure.opaque[name]
+        refs = [r if r is not None else _at(name, x, comp.length_m) for x, r in nodes]
+        # keyed by the object's id, stored with the object itself so that the id cannot be reused while cached;
+        # pinned only for the first structure (a component changed by a fit is rebuilt at every evaluation)
+        key = (id(comp), tuple(str(r) for r in refs))
+        kept = self._store(key, lambda: (comp, receptances(comp, refs, self.f)), pin)
+        return kept[1], (Same(comp), key[1])
+
+    def _dynamic_stiffness(self, link: "LinkSI", token) -> np.ndarray | None:
+        if token is None or link.rigid:
+            return link.dynamic_stiffness(self.f)
+        found = self._stiffness.get(token)
+        if found is None:
+            found = link.dynamic_stiffness(self.f)
+            self._stiffness[token] = found
+        return found
+
+    def __call__(self, structure: Structure) -> np.ndarray:
+        """The receptances ``(n_freq, n_out, n_in)`` of ``structure``."""
+        blocks, coupling, out_keys, tokens = self._prepare(structure)
+        return self._pick(couple_substructures(blocks, coupling, out_keys, self._memo, tokens))
+
+    def many(self, structures: Sequence[Structure]) -> list[np.ndarray]:
+        """The receptances of several structures, each as calling the evaluator with it gives them (the same numbers).
+
+        Structures whose points and links sit at the same places (the trials
+        of a scan that change sizes, not places) are coupled together: their
+        lines side by side in one call of the engine, which treats every
+        line alike.
+
+        Parameters
+        ----------
+        structures : sequence of Structure
+            Structures of this evaluator's assembly.
+
+        Returns
+        -------
+        list of ndarray
+            ``(n_freq, n_out, n_in)`` per structure, in order.
+        """
+        prepared = [self._prepare(s) for s in structures]
+        groups: dict = {}
+        for i, (blocks, coupling, out_keys, _) in enumerate(prepared):
+            layout = (tuple(tuple(keys) for keys, _ in blocks),
+                      tuple((c.a, c.b, c.stiffness is None) for c in coupling), tuple(out_keys))
+            groups.setdefault(layout, []).append(i)
+        out: list = [None] * len(prepared)
+        n = self.f.size
+        for members in groups.values():
+            if len(members) == 1:
+                blocks, coupling, out_keys, tokens = prepared[members[0]]
+                out[members[0]] = self._pick(couple_substructures(blocks, coupling, out_keys, self._memo, tokens))
+                continue
+            first = prepared[members[0]]
+            # a block or link the same in every structure (by its token) is given once: the steps of only such
+            # are computed once (and reused as in single evaluations), the others for every structure
+            blocks, block_tokens = [], []
+            for b, (keys, y) in enumerate(first[0]):
+                token = first[3][0][b]
+                if all(prepared[i][3][0][b] == token for i in members):
+                    blocks.append((keys, y))
+                    block_tokens.append(token)
+                else:
+                    blocks.append((keys, np.concatenate([prepared[i][0][b][1] for i in members], axis=-1)))
+                    block_tokens.append(None)
+            coupling, link_tokens = [], []
+            for k, c in enumerate(first[1]):
+                token = first[3][1][k]
+                if c.stiffness is None or (token is not None and all(prepared[i][3][1][k] == token for i in members)):
+                    coupling.append(c)
+                    link_tokens.append(token)
+                else:
+                    coupling.append(Link(c.a, c.b, np.concatenate(
+                        [np.broadcast_to(prepared[i][1][k].stiffness, (2, 2, n)) for i in members], axis=-1), c.label))
+                    link_tokens.append(None)
+            y = couple_substructures(blocks, coupling, first[2], self._memo, (block_tokens, link_tokens),
+                                     copies=len(members), lines=n)
+            for j, i in enumerate(members):
+                out[i] = self._pick(y[..., j * n:(j + 1) * n])
+        return out
+
+    def _prepare(self, structure: Structure):
+        """The blocks, links, output points and memo tokens of one structure, for the engine."""
+        pin = not self._pinned  # the first structure's components are kept for good
+        nodes: dict[str, dict] = {}
+        keys = {}
+
+        def node(point):
+            if not isinstance(point, tuple) and point in keys:
+                return keys[point]
+            comp, x = structure.position(point)
+            if x is None:
+                ref = _parse(point).point
+                owner = structure.opaque[comp]
+                k = (comp, owner.node_key(ref))
+                nodes.setdefault(comp, {}).setdefault(k, (None, ref))
+            else:
+                k = (comp, round(x, 12))
+                nodes.setdefault(comp, {}).setdefault(k, (x, None))
+            if not isinstance(point, tuple):
+                keys[point] = k
+            return k
+
+        out_keys = [node(p) for p in self._points]
+        links = []
+        for link in structure.links:
+            ka = node(link.a)
+            kb = None if link.b is None else node(link.b)
+            if ka == kb:
+                raise AssemblyError(f"{link.key[0][:-1]} {link.key[1]!r} connects a point to itself")
+            links.append((ka, kb, link))
+        blocks, block_tokens = [], []
+        for comp in structure.order:
+            if comp not in nodes:
+                continue
+            items = sorted(nodes[comp].items(), key=lambda kv: (kv[1][0] is None, kv[1][0] or 0.0, str(kv[0])))
+            y, token = self._receptance(structure, comp, [v for _, v in items], pin)
+            blocks.append(([k for k, _ in items], y))
+            block_tokens.append(token)
+        link_tokens = [_link_token(link) for _, _, link in links]
+        coupling = [Link(ka, kb, self._dynamic_stiffness(link, token), f"{link.key[0][:-1]} {link.key[1]!r}")
+                    for (ka, kb, link), token in zip(links, link_tokens)]
+        return blocks, coupling, out_keys, (block_tokens, link_tokens)
+
+    def _pick(self, y: np.ndarray) -> np.ndarray:
+        """The outputs' and inputs' entries of the engine's result, frequency first."""
+        rows = [2 * p + d for p, d in self._dofs[: self._n_out]]
+        cols = [2 * p + d for p, d in self._dofs[self._n_out:]]
+        return np.moveaxis(y[np.ix_(rows, cols)], -1, 0)
