@@ -348,11 +348,11 @@ def test_models_evaluated_together_give_what_each_gives_alone(clean, monkeypatch
     # the tool differs between these (the spindle and holder coupled once for all of them)
     lists += [[(held[0][0], {**held[0][1], "diameter_ratio": r}), (joint, {"value": 2e7})] for r in (0.7, 0.9, 1.1)]
     together = Likelihood(model, measured)
-    from substructure.updating import structure as si_structure
+    from substructure.updating import evaluator as si_evaluator
 
     calls = []
-    engine = si_structure.couple_substructures
-    monkeypatch.setattr(si_structure, "couple_substructures", lambda *a, **k: calls.append(1) or engine(*a, **k))
+    engine = si_evaluator.couple_substructures
+    monkeypatch.setattr(si_evaluator, "couple_substructures", lambda *a, **k: calls.append(1) or engine(*a, **k))
     got = together.residuals(lists)
     assert len(calls) <= 6  # together (not one by one after a failure): one call per layout of points and links
     alone = Likelihood(model, measured)
