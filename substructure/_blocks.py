@@ -13,6 +13,10 @@ The hot path of a model evaluation (beam receptances and the coupling of an
 assembly) runs in the compiled kernels of :mod:`substructure._kernels`; these
 numpy forms serve the FRF-level operations (decoupling, modification), the
 closed-form identification and the segment dynamic stiffness.
+
+:func:`checked_block` is the check of the arrays a component or joint type
+of one's own gives, where they enter a computation (their shape
+``(r, r, n_freq)`` is the one this module works on).
 """
 
 from __future__ import annotations

@@ -76,3 +76,10 @@ def test_a_body_the_model_lacks_is_found_through_the_tap_test(model):
     assert effect.where == "tool.tip" and effect.name == "sensor-mass"
     mass, std = effect.values["mass"], effect.std["mass"]
     assert abs(mass - 0.004) < max(3 * std, 2e-4), (mass, std)
+    # the refined model on what it was not fitted to: the holder's tip and the tool's rotation, above the band
+    grid = Frequency.from_hz(np.linspace(5000.0, 8000.0, 301))
+    for out, inp in (("holder.tip", "holder.tip"), ("tool.tip:theta", "tool.tip")):
+        true = truth.frf(out, inp, grid).data[:, 0, 0]
+        before = np.abs(np.log(model.frf(out, inp, grid).data[:, 0, 0] / true)).max()
+        after = np.abs(np.log(d.refined_assembly.frf(out, inp, grid).data[:, 0, 0] / true)).max()
+        assert after < 0.2 * before, (out, before, after)

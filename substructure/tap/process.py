@@ -509,13 +509,13 @@ def process_taps(
         if p >= 8:
             x[i] -= x[i, :p].mean()
     f = f * force_window[rows]
-    why = _decay(x, pre_rows, [taps[cuts[r][2]].number for r in rows])
+    decayed, why = _decay(x, pre_rows, [taps[cuts[r][2]].number for r in rows])
     if exponential is None and tau is None:
-        exponential = not why.startswith("none")
-    elif exponential or exponential is None:
-        exponential, why = True, "asked for"
-    else:
+        exponential = not decayed
+    elif exponential is False:
         why = "none: not asked for"
+    else:  # asked for: exponential=True, or a time constant given
+        exponential, why = True, "asked for"
     if exponential:
         if tau is None:
             if not 0.0 < window_end < 1.0:
@@ -560,11 +560,11 @@ def process_taps(
                      hammer_band, float(hammer_band_db), spectra, rate, length, why)
 
 
-def _decay(x: np.ndarray, pre: np.ndarray, numbers: list[int]) -> str:
-    """Whether the responses ``x`` (one kept tap a row) died out by the end of their taps, in words.
+def _decay(x: np.ndarray, pre: np.ndarray, numbers: list[int]) -> tuple[bool, str]:
+    """Whether the responses ``x`` (one kept tap a row) died out by the end of their taps, and why, in words.
 
-    "none: ..." when every tap's RMS over its last 5 % (at least 16 samples) is at most
-    :data:`DECAYED_SHARE` of its peak or three times its RMS before the hit; else why a window is needed.
+    They did when every tap's RMS over its last 5 % (at least 16 samples) is at most :data:`DECAYED_SHARE` of
+    its peak or three times its RMS before the hit; else the words say which tap needs the window.
     """
     tail = max(16, x.shape[1] // 20)
     end = np.sqrt(np.mean(x[:, -tail:] ** 2, axis=1))
@@ -573,8 +573,8 @@ def _decay(x: np.ndarray, pre: np.ndarray, numbers: list[int]) -> str:
     share = end / np.maximum(peak, 1e-300)
     alive = end > np.maximum(DECAYED_SHARE * peak, 3.0 * noise)
     if not alive.any():
-        return (f"none: the response died out within every tap (its RMS over the last {tail} samples at most "
-                f"{share.max():.2g} of its peak)")
+        return True, (f"none: the response died out within every tap (its RMS over the last {tail} samples at "
+                      f"most {share.max():.2g} of its peak)")
     k = int(np.argmax(np.where(alive, share, -1.0)))
-    return (f"the response had not died out by the end of tap {numbers[k]} ({share[k]:.2g} of its peak over its "
-            f"last {tail} samples): a longer record would need none")
+    return False, (f"the response had not died out by the end of tap {numbers[k]} ({share[k]:.2g} of its peak over "
+                   f"its last {tail} samples): a longer record would need none")
