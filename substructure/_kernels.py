@@ -95,6 +95,8 @@ def c_array(a, dtype) -> np.ndarray:
     ndarray
         ``a`` itself when it already has the layout and dtype, else a copy.
     """
+    if type(a) is np.ndarray and a.dtype == dtype and a.flags.c_contiguous and a.flags.writeable:
+        return a  # the common case, without np.require's general checks (a kernel call takes several arrays)
     return np.require(a, dtype=dtype, requirements=("C", "W"))
 
 

@@ -472,24 +472,31 @@ def stepped_beam_receptance_si(
     if np.any(np.diff(sorted_pos) <= 0):
         raise InvalidValueError("positions: expected distinct positions")
     lengths = np.asarray(lengths, dtype=float)
-    sections = [Section(complex(a), complex(b), float(c), float(d)) for a, b, c, d in zip(ei, kga, rhoa, rhoi)]
     ends = np.concatenate([[0.0], np.cumsum(lengths)])
     cuts = np.unique(np.concatenate([ends, sorted_pos]))
     omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float).reshape(-1)
     from . import _kernels
 
+    ei, kga = (_kernels.c_array(np.asarray(v, complex).reshape(-1, 1), complex) for v in (ei, kga))
+    rhoa, rhoi = (_kernels.c_array(np.asarray(v, float).reshape(-1, 1), float) for v in (rhoa, rhoi))
     _, k_max = _kernels.segment_coefficients(  # every segment's largest wavenumber, in one call
-        _kernels.c_array(np.asarray(ei, complex).reshape(1, -1), complex),
-        _kernels.c_array(np.asarray(kga, complex).reshape(1, -1), complex),
-        _kernels.c_array(np.asarray(rhoa, float).reshape(1, -1), float),
-        _kernels.c_array(np.asarray(rhoi, float).reshape(1, -1), float), float(np.max(omega)) if omega.size else 0.0)
-    intervals, phases = [], []
-    for x0, x1 in zip(cuts[:-1], cuts[1:]):
-        k = int(np.clip(np.searchsorted(ends, 0.5 * (x0 + x1)) - 1, 0, len(sections) - 1))
-        intervals.append((sections[k], float(x1 - x0)))
-        phases.append(float(k_max[0, k]) * float(x1 - x0))
-    nodes = [int(i) for i in np.searchsorted(cuts, sorted_pos)]
-    return _chain_receptance(intervals, nodes, omega, phases, place=[int(i) for i in order])
+        ei.reshape(1, -1), kga.reshape(1, -1), rhoa.reshape(1, -1), rhoi.reshape(1, -1),
+        float(np.max(omega)) if omega.size else 0.0)
+    widths = np.diff(cuts)
+    seg = np.clip(np.searchsorted(ends, 0.5 * (cuts[:-1] + cuts[1:])) - 1, 0, lengths.size - 1)
+    phases = k_max[0, seg] * widths
+    nodes = np.searchsorted(cuts, sorted_pos)
+    if phases.max() <= _CHUNK_KL and np.cumsum(phases)[-1] <= _CHUNK_KL:
+        # one transfer-matrix chain (the usual case): the kernel takes the arrays as they are
+        return _kernels.chain_receptance(
+            _kernels.c_array(omega, float), ei[seg], kga[seg], rhoa[seg], rhoi[seg], widths.reshape(-1, 1),
+            np.zeros(seg.size, dtype=bool), np.arange(seg.size, dtype=np.int64), nodes.astype(np.int64),
+            order.astype(np.int64))
+    sections = [Section(complex(a), complex(b), float(c), float(d))
+                for a, b, c, d in zip(ei[:, 0], kga[:, 0], rhoa[:, 0], rhoi[:, 0])]
+    intervals = [(sections[k], float(w)) for k, w in zip(seg, widths)]
+    return _chain_receptance(intervals, [int(i) for i in nodes], omega, [float(x) for x in phases],
+                             place=[int(i) for i in order])
 
 
 def stepped_beam_receptance_batch(

@@ -292,8 +292,12 @@ class Likelihood:
     def _ratios(self, predicted: list) -> list[np.ndarray]:
         out = []
         for model, data in zip(predicted, self.data):
-            with np.errstate(divide="ignore", invalid="ignore"):
-                r = np.log(model / data)
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+                q = model / data
+                # ln|q| + i arg q: the complex logarithm's value (to rounding), several times faster than np.log
+                r = np.empty_like(q)
+                r.real = np.log(np.abs(q))
+                r.imag = np.arctan2(q.imag, q.real)
             bad = ~np.isfinite(r)
             if bad.any():
                 r = np.where(bad, LOG_RATIO_PENALTY * (1 + 1j), r)
