@@ -235,6 +235,26 @@ def test_the_consistency_test_accepts_the_truth_and_rejects_a_one_percent_error(
         assert any(b.lo_hz <= worst <= b.hi_hz for b in off.bands)
 
 
+def test_a_failing_band_s_share_of_the_error_is_a_fraction_where_chi2_is_below_its_mean(clean):
+    """The rest of the band quieter than its noise (chi^2 < nu) and one block far off: the share reported
+    for the block is its part of the error, not its excess over chi^2 - nu (which is negative here: the
+    share was 1e300 times the excess)."""
+    model = hd.nominal_model()
+    lik = Likelihood(model, measured_frfs([_noisy(clean, 0.015, 0.5, 1e-3, 0)])[0])
+    (r,) = lik.log_ratios([])
+    quiet = 0.5 * r  # a quarter of the noise's chi^2 everywhere
+    lines = slice(r.size // 2, r.size // 2 + 30)
+    quiet[lines] += 0.04 + 0.04j  # thirty lines 4 % and 0.04 rad off
+    c = consistency(lik, [quiet], 0)
+    assert c.chi2_reduced < 1.0 and not c.consistent and c.bands
+    shares = [b.share for b in c.bands]
+    assert all(0.0 < s <= 1.0 for s in shares) and sum(shares) <= 1.0 + 1e-12
+    f = clean.frequency.hz[lines]
+    top = c.bands[0]
+    assert top.lo_hz <= f[-1] and f[0] <= top.hi_hz
+    assert top.share > 0.5
+
+
 def test_significance_and_indifference_follow_their_definitions():
     n = 10000
     assert significance(1000.0, 1000.0 - 2 * np.log(n) - 1, 2, n, 2).significant

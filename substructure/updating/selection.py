@@ -94,7 +94,9 @@ class Band:
     threshold : float
         What the test allows there.
     share : float
-        The block's share of the excess ``chi^2`` over the noise.
+        The block's share of the excess ``chi^2`` over the noise: its
+        ``chi^2`` above its degrees of freedom over the sum of that of every
+        block (between 0 and 1).
     """
 
     item: int
@@ -164,17 +166,18 @@ def consistency(likelihood, ratios: Sequence[np.ndarray], p: int) -> Consistency
             stop = starts[k + 1] if k + 1 < len(starts) else z.size
             blocks.append((item, slice(start, stop), f))
     m_blocks = max(len(blocks), 1)
-    excess_total = max(chi2 - nu, 1e-300)
+    # each block's chi^2 above its degrees of freedom; a share is of the sum of these (so the shares of all
+    # blocks add up to 1 even where the blocks below their mean make chi^2 - nu smaller than one block's excess)
+    excess = [max(2.0 * float(z2[item][sl].sum()) - 2 * z2[item][sl].size, 0.0) for item, sl, _ in blocks]
+    excess_total = max(sum(excess), 1e-300)
     failing = []
-    for item, sl, f in blocks:
+    for (item, sl, f), over in zip(blocks, excess):
         z = z2[item][sl]
-        k = 2 * z.size
         # widened, as the global test is, by how well the noise itself is known
         bound = _block_bound(z.size, CONSISTENCY_ALPHA / m_blocks) * (1.0 + _Z * float(errs[item]))
         ratio = float(np.minimum(z, LINE_CAP).mean())
         if ratio > bound:
-            failing.append(Band(item, float(f[sl][0]), float(f[sl][-1]), ratio, bound,
-                                float(max(2 * z.sum() - k, 0.0) / excess_total)))
+            failing.append(Band(item, float(f[sl][0]), float(f[sl][-1]), ratio, bound, over / excess_total))
     failing.sort(key=lambda b: -b.share)
     return Consistency(bool(reduced <= threshold and not failing), reduced, threshold, tuple(failing))
 
