@@ -255,6 +255,37 @@ def test_a_failing_band_s_share_of_the_error_is_a_fraction_where_chi2_is_below_i
     assert top.share > 0.5
 
 
+def test_the_band_bound_of_scores_whose_variance_is_estimated_follows_the_f_distribution():
+    """A line's score over a variance known to nu degrees of freedom is F(2, nu): the capped mean has
+    the closed form 2 (1 - 1 / (1 + c / 2)) for nu = 4, and blocks of such scores exceed the bound at
+    its level (Monte Carlo), while the exponential's bound would be exceeded far more often."""
+    from substructure.updating.selection import LINE_CAP, _block_bound, _line_moments
+
+    c = LINE_CAP
+    mean4, _ = _line_moments(np.array([4.0]), 1)
+    assert mean4 == pytest.approx(2.0 * (1.0 - 1.0 / (1.0 + c / 2.0)), rel=2e-3)
+    big, _ = _line_moments(np.array([1e7]), 1)
+    assert big == pytest.approx(1.0 - np.exp(-c), rel=1e-9)
+    rng = np.random.default_rng(5)
+    size, alpha, trials = 48, 0.01, 20000
+    scores = 0.5 * rng.chisquare(2, (trials, size)) / (rng.chisquare(4, (trials, size)) / 4.0)
+    means = np.minimum(scores, c).mean(axis=1)
+    rate = float(np.mean(means > _block_bound(size, alpha, np.full(size, 4.0))))
+    assert 0.4 * alpha < rate < 2.0 * alpha, rate
+    assert float(np.mean(means > _block_bound(size, alpha))) > 0.5
+
+
+def test_the_noise_of_a_few_taps_has_the_degrees_of_freedom_of_its_coherence(clean):
+    measured = _noisy(clean, 0.015, 0.5, 1e-3, 0)
+    rng = np.random.default_rng(2)
+    coherence = np.clip(1.0 - 1e-3 * rng.chisquare(4, clean.frequency.n) / 4.0, 0.0, 1.0)
+    few = estimate_noise(measured, coherence=coherence, averages=3)
+    none = estimate_noise(measured)
+    assert none.dof is None
+    assert few.dof is not None and np.all(few.dof >= 4.0 - 1e-9)
+    assert np.all(few.select(np.arange(5)).dof == few.dof[:5])
+
+
 def test_significance_and_indifference_follow_their_definitions():
     n = 10000
     assert significance(1000.0, 1000.0 - 2 * np.log(n) - 1, 2, n, 2).significant

@@ -111,6 +111,13 @@ class NoiseModel:
     linear : tuple, optional
         ``(H / S(H), v_re, v_im)`` on the lines drowned in additive noise
         (NaN elsewhere), for :meth:`line_scores`.
+    dof : ndarray, shape (n_lines,), optional
+        Per line, the degrees of freedom of the variance (Satterthwaite's):
+        ``2 (n - 1) / s^2`` where the share ``s`` of it comes from the
+        coherence of ``n`` taps, whose estimate at one line scatters like
+        ``chi^2`` with ``2 (n - 1)`` degrees of freedom; infinite where no
+        part does.  A line's score then follows ``F(2, dof)`` rather than
+        the exponential (:func:`substructure.updating.selection.consistency`).
     """
 
     var_re: np.ndarray = attrs.field(eq=False, repr=False)
@@ -124,6 +131,7 @@ class NoiseModel:
     outliers: int = 0
     coherence_factor: float | None = None
     linear: tuple | None = attrs.field(default=None, eq=False, repr=False)
+    dof: np.ndarray | None = attrs.field(default=None, eq=False, repr=False)
 
     @property
     def floor(self) -> float:
@@ -145,8 +153,9 @@ class NoiseModel:
         """
         local = None if self.local_scale is None else self.local_scale[mask]
         linear = None if self.linear is None else tuple(part[mask] for part in self.linear)
+        dof = None if self.dof is None else self.dof[mask]
         return attrs.evolve(self, var_re=self.var_re[mask], var_im=self.var_im[mask], scatter=self.scatter[mask],
-                            local_scale=local, linear=linear)
+                            local_scale=local, linear=linear, dof=dof)
 
     def line_scores(self, ratios: np.ndarray, lines=None) -> np.ndarray:
         """Per line, half the squared whitened residual (exponential with mean 1 for noise).
@@ -440,7 +449,15 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     spread = float(np.std(blocks, ddof=1) / np.sqrt(len(blocks))) if len(blocks) > 1 else 1.0
     scatter = np.where(keep, zf, np.nan)
     coherence_factor = float(0.5 * coef[3] / coh_scale) if coh is not None else None
+    dof = None
+    if coh is not None:
+        # the share of each line's variance that the coherence of a few taps gives, and the variance's degrees
+        # of freedom from it (the other parts are fitted to many lines: known by comparison)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            share = np.clip(0.5 * coef[3] * g[1] * local / (0.5 * (var_re + var_im)), 0.0, 1.0)
+            dof = np.where(usable & (share > 0), 2.0 * (int(averages) - 1) / np.maximum(share, 1e-12) ** 2, np.inf)
+        dof = np.where(np.isfinite(dof), dof, np.inf)
     return NoiseModel(var_re, var_im, (float(coef[0]), float(coef[1])), float(coef[2]) / scale,
                       max(spread, float(np.sqrt(1.0 / max(idx.size, 1)))), w, scatter,
                       local_scale=local, outliers=int(spike.sum()), coherence_factor=coherence_factor,
-                      linear=(hs, lin_re, lin_im))
+                      linear=(hs, lin_re, lin_im), dof=dof)

@@ -15,7 +15,9 @@ in every band:
   mean of the line scores (half the squared whitened residual,
   :meth:`NoiseModel.line_scores`), each capped at :data:`LINE_CAP`, stays
   below the upper ``0.001 / M`` quantile of its distribution (Bonferroni
-  over the ``M`` blocks), widened by ``1 + z e`` as the global test is.
+  over the ``M`` blocks), widened by ``1 + z e`` as the global test is; a
+  line whose variance is estimated with ``nu`` degrees of freedom (the
+  coherence of a few taps, :attr:`NoiseModel.dof`) scores ``F(2, nu)``.
 
 **Significance of a change** (:func:`significance`).  A change with ``k``
 parameters that lowers ``chi^2`` from ``chi2_0`` to ``chi2_1`` enters only
@@ -37,6 +39,7 @@ would separate them.
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Sequence
 
@@ -63,20 +66,55 @@ while a missing effect, which moves many lines, still does."""
 _Z = 3.090232306167813  # one-sided 0.1 %
 
 
-def _block_bound(size: int, alpha: float) -> float:
+def _block_bound(size: int, alpha: float, dof: np.ndarray | None = None) -> float:
     """Upper ``alpha`` quantile of the mean of ``size`` line scores capped at :data:`LINE_CAP`.
 
-    A line score of noise is exponential with mean 1; capped at ``c`` it has mean
-    ``1 - exp(-c)`` and second moment ``2 - 2 (1 + c) exp(-c)``.  The sum of ``size`` of them
-    is taken as the gamma distribution of the same mean and variance (it is bounded and
-    skewed to the right, as the gamma is).
+    A line score of noise is exponential with mean 1 where its variance is known; capped at
+    ``c`` it has mean ``1 - exp(-c)`` and second moment ``2 - 2 (1 + c) exp(-c)``.  Where the
+    variance is estimated with ``dof`` degrees of freedom (from the coherence of a few taps,
+    :attr:`~substructure.updating.noise.NoiseModel.dof`), the score follows ``F(2, dof)``,
+    heavier-tailed (a mean of 2 for 3 taps).  The sum of the ``size`` capped scores is taken as
+    the gamma distribution of the same mean and variance (it is bounded and skewed to the
+    right, as the gamma is).
     """
-    c = LINE_CAP
-    mean = 1.0 - math.exp(-c)
-    var = 2.0 - 2.0 * (1.0 + c) * math.exp(-c) - mean * mean
-    shape = size * mean * mean / var
+    mean, var = _line_moments(dof, size)
+    shape = mean * mean / var
     scale = var / mean
     return float(gamma_dist.isf(alpha, shape, scale=scale)) / size
+
+
+_NU_GRID = np.geomspace(1.0, 1e6, 241)
+
+
+@functools.lru_cache(maxsize=1)
+def _capped_f_table(cap: float = LINE_CAP) -> tuple[np.ndarray, np.ndarray]:
+    """Mean and variance of ``min(F, cap)`` for ``F ~ F(2, nu)`` on :data:`_NU_GRID` (by quadrature).
+
+    A line's score ``0.5 (chi^2_2)`` over a variance known to ``nu`` degrees of freedom is
+    ``F(2, nu)``: ``P(F > x) = (1 + 2 x / nu)^(-nu / 2)``, the exponential as ``nu`` grows.
+    """
+    x = np.linspace(0.0, cap, 4001)
+    tail = (1.0 + 2.0 * x[None, :] / _NU_GRID[:, None]) ** (-_NU_GRID[:, None] / 2.0)
+    mean = np.trapezoid(tail, x, axis=1)
+    second = np.trapezoid(2.0 * x[None, :] * tail, x, axis=1)
+    return mean, second - mean * mean
+
+
+def _line_moments(dof: np.ndarray | None, size: int) -> tuple[float, float]:
+    """Sum of the means and of the variances of ``size`` capped line scores with these degrees of freedom."""
+    c = LINE_CAP
+    m_inf = 1.0 - math.exp(-c)
+    v_inf = 2.0 - 2.0 * (1.0 + c) * math.exp(-c) - m_inf * m_inf
+    if dof is None:
+        return size * m_inf, size * v_inf
+    nu = np.asarray(dof, dtype=float)
+    finite = np.isfinite(nu) & (nu < _NU_GRID[-1])
+    mean_t, var_t = _capped_f_table()
+    where = np.log(np.clip(nu[finite], _NU_GRID[0], _NU_GRID[-1]))
+    means = np.interp(where, np.log(_NU_GRID), mean_t)
+    variances = np.interp(where, np.log(_NU_GRID), var_t)
+    rest = size - int(finite.sum())
+    return float(means.sum()) + rest * m_inf, float(variances.sum()) + rest * v_inf
 
 
 @attrs.frozen
@@ -174,7 +212,9 @@ def consistency(likelihood, ratios: Sequence[np.ndarray], p: int) -> Consistency
     for (item, sl, f), over in zip(blocks, excess):
         z = z2[item][sl]
         # widened, as the global test is, by how well the noise itself is known
-        bound = _block_bound(z.size, CONSISTENCY_ALPHA / m_blocks) * (1.0 + _Z * float(errs[item]))
+        dof = likelihood.measured[item].noise.dof
+        dof = None if dof is None else dof[likelihood.lines][sl]
+        bound = _block_bound(z.size, CONSISTENCY_ALPHA / m_blocks, dof) * (1.0 + _Z * float(errs[item]))
         ratio = float(np.minimum(z, LINE_CAP).mean())
         if ratio > bound:
             failing.append(Band(item, float(f[sl][0]), float(f[sl][-1]), ratio, bound, over / excess_total))
