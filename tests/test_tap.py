@@ -128,6 +128,33 @@ def test_output_noise_lowers_coherence_and_h1_stays_unbiased():
     assert np.median(h1.coherence[(hz > 300) & (hz < 500)]) > 0.99  # at the mode: a strong response
 
 
+def test_the_hammer_s_noise_before_the_pulse_is_outside_the_force_window():
+    """The force window opens one pulse width before the trigger crossing: the hammer channel's samples
+    before it (the pre-trigger's noise) do not enter the FRF.  Shuffled among themselves (the same median
+    and spread: the same trigger and baseline), they leave H1 the same to the last bit; shuffled within
+    the window, they do not."""
+    rng = np.random.default_rng(8)
+    records = []
+    for k, peak in enumerate((40.0, 55.0, 50.0)):
+        t, f = half_sine(peak, start=0.05)
+        x = simulate(f)
+        records.append(TapRecord(t, f + rng.normal(0.0, 1e-3 * peak, N), x + rng.normal(0.0, 1e-9, N),
+                                 "displacement", f"tap {k}"))
+    base = process_taps(records, exponential=False).frf.data
+    hit = int(0.05 * FS)  # the pulse rises from this sample; each tap starts 5 ms (51 samples) before it
+
+    def shuffled(lo, hi):
+        out = []
+        for r in records:
+            force = r.force.copy()
+            force[lo:hi] = rng.permutation(force[lo:hi])
+            out.append(TapRecord(r.time, force, r.response, r.quantity, r.source))
+        return process_taps(out, exponential=False).frf.data
+
+    assert np.array_equal(shuffled(hit - 45, hit - 12), base)  # before the window (a pulse is ~6 samples)
+    assert not np.array_equal(shuffled(hit - 5, hit), base)  # inside it
+
+
 def test_input_noise_biases_h1_down_and_not_h2():
     records = _noisy(30, in_noise=0.3)
     kw = dict(exponential=False, force_window_extra=1e9)  # keep the force's noise over the whole tap

@@ -26,7 +26,8 @@ T = 0.5  # s per record
 PAD = 8  # the impulse response computed over PAD records: it has died out long before
 
 
-def _taps(truth, seed: int, peaks=(60.0, 75.0, 90.0, 70.0, 80.0), length: float = T):
+def _taps(truth, seed: int, peaks=(60.0, 75.0, 90.0, 70.0, 80.0), length: float = T, force_noise: float = 1e-4,
+          response_noise: float = 1e-4):
     n, m = int(FS * T), int(FS * length)  # simulated over T, kept: length
     f = np.fft.rfftfreq(PAD * n, 1.0 / FS)
     accelerance = np.empty(f.size, complex)
@@ -40,8 +41,8 @@ def _taps(truth, seed: int, peaks=(60.0, 75.0, 90.0, 70.0, 80.0), length: float 
         start, width = 0.005, 0.25e-3
         force = np.where((t >= start) & (t <= start + width), peak * np.sin(np.pi * (t - start) / width), 0.0)
         response = np.fft.irfft(np.fft.rfft(force) * accelerance, PAD * n)[:m]
-        force = force[:m] + rng.normal(0.0, 1e-4 * peak, m)
-        response = response + rng.normal(0.0, 1e-4 * np.abs(response).max(), m)
+        force = force[:m] + rng.normal(0.0, force_noise * peak, m)
+        response = response + rng.normal(0.0, response_noise * np.abs(response).max(), m)
         records.append(TapRecord(t[:m], force, response, "acceleration", f"tap {k + 1}"))
     return records
 
@@ -96,3 +97,31 @@ def test_an_exact_model_is_consistent_with_three_taps(model):
         assert result.averages == 3
         d = diagnose(model, [measured], progress=False)
         assert d.explained and d.effects == [], (seed, d.report)
+
+
+def test_an_exact_model_is_consistent_with_six_taps(model):
+    """Six taps: the hammer channel's noise in the pre-trigger, left in the force window, was a smooth
+    random error of H1 over hundreds of hertz, largest relative to the response's noise at the tool mode
+    (3.8 kHz), where 5 of 20 such tap tests failed a band; the window now opens a pulse width before
+    the trigger."""
+    peaks = (60.0, 75.0, 90.0, 70.0, 80.0, 65.0)
+    for seed in range(10):
+        measured, _ = _measured(_taps(model, seed=seed, peaks=peaks))
+        d = diagnose(model, [measured], progress=False)
+        assert d.explained and d.effects == [], (seed, d.report)
+
+
+def test_lines_drowned_in_the_response_noise_are_read_linearly(model):
+    """Ten times more noise on the accelerometer: below 250 Hz the coherence is near 0 and the log of H1
+    is biased; those lines are read in the linear domain (as lines drowned in a noise floor are), so the
+    exact model is consistent (before: 0 of 10 such tests), and a 4 g body is still found at its mass."""
+    for seed in range(4):
+        measured, _ = _measured(_taps(model, seed=seed, peaks=(60.0, 75.0, 90.0), response_noise=1e-3))
+        assert np.median(measured.coherence[measured.frf.frequency.hz < 250.0]) < 0.5
+        d = diagnose(model, [measured], progress=False)
+        assert d.explained and d.effects == [], (seed, d.report)
+    truth = model.attach(Mass("sensor", "tool.tip", "4 g"))
+    measured, _ = _measured(_taps(truth, seed=4, peaks=(60.0, 75.0, 90.0), response_noise=1e-3))
+    d = diagnose(model, [measured], progress=False)
+    assert d.explained and len(d.effects) == 1, d.report
+    assert abs(d.effects[0].values["mass"] - 0.004) < 3e-4

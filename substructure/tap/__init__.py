@@ -21,14 +21,15 @@ Files are read by :mod:`substructure.io.tap_files` (``read_tap_csv``,
 
 from .detect import (CLIP_REACH, CLIP_RUN, CLIP_TOLERANCE, CREST_FACTOR_PULSE, DOUBLE_HIT_FRACTION, NO_HIT_FACTOR,
                      PRE_TRIGGER_S, TRIGGER_FRACTION, SwappedChannelsError)
-from .process import (DECAYED_SHARE, ESTIMATORS, EXP_WINDOW_END, FORCE_WINDOW_EXTRA, HALF_POWER_LINES, HAMMER_BAND_DB,
-                      PEAK_PROMINENCE, Tap, TapResult, added_damping, process_taps)
+from .process import (DECAYED_SHARE, ESTIMATORS, EXP_WINDOW_END, FORCE_WINDOW_BEFORE, FORCE_WINDOW_EXTRA,
+                      HALF_POWER_LINES, HAMMER_BAND_DB, PEAK_PROMINENCE, Tap, TapResult, added_damping, process_taps)
 from .records import RESPONSE_QUANTITIES, TapRecord, channel_to_si, unit_of
 
 __all__ = [
     "TapRecord", "process_taps", "TapResult", "Tap", "added_damping", "channel_to_si", "unit_of",
     "SwappedChannelsError", "ESTIMATORS", "RESPONSE_QUANTITIES", "TRIGGER_FRACTION", "NO_HIT_FACTOR",
     "DOUBLE_HIT_FRACTION", "CLIP_RUN", "CLIP_TOLERANCE", "CLIP_REACH", "PRE_TRIGGER_S", "CREST_FACTOR_PULSE",
-    "EXP_WINDOW_END", "FORCE_WINDOW_EXTRA", "HAMMER_BAND_DB", "PEAK_PROMINENCE", "HALF_POWER_LINES", "DECAYED_SHARE",
+    "EXP_WINDOW_END", "FORCE_WINDOW_EXTRA", "FORCE_WINDOW_BEFORE", "HAMMER_BAND_DB", "PEAK_PROMINENCE",
+    "HALF_POWER_LINES", "DECAYED_SHARE",
 ]
 

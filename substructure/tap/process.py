@@ -24,7 +24,8 @@ from .detect import (CLIP_RUN, DOUBLE_HIT_FRACTION, NO_HIT_FACTOR, PRE_TRIGGER_S
 from .records import RESPONSE_QUANTITIES, TapRecord
 
 __all__ = ["process_taps", "TapResult", "Tap", "ESTIMATORS", "EXP_WINDOW_END", "FORCE_WINDOW_EXTRA",
-           "HAMMER_BAND_DB", "PEAK_PROMINENCE", "HALF_POWER_LINES", "DECAYED_SHARE", "added_damping"]
+           "FORCE_WINDOW_BEFORE", "HAMMER_BAND_DB", "PEAK_PROMINENCE", "HALF_POWER_LINES", "DECAYED_SHARE",
+           "added_damping"]
 
 ESTIMATORS = ("H1", "H2", "Hv")
 """The FRF estimators: H1 = Gfx/Gff (noise on the response), H2 = Gxx/Gxf (noise on the force), Hv (both)."""
@@ -39,6 +40,11 @@ not applied unless asked for (it would add the damping ratio ``1 / (tau omega)``
 
 FORCE_WINDOW_EXTRA = 1.0
 """The force window stays open this many pulse widths after the pulse ends."""
+
+FORCE_WINDOW_BEFORE = 1.0
+"""The force window opens this many pulse widths before the force crosses the trigger level (the pulse's rise
+below that level is kept; the pre-trigger's noise before it is not: left in, it is a smooth random error of H1
+over hundreds of hertz, largest relative to the response's noise at the resonances)."""
 
 HALF_POWER_LINES = 3
 """A half-power bandwidth narrower than this many lines gives no damping ratio (the grid cannot resolve it)."""
@@ -487,7 +493,8 @@ def process_taps(
                           "(an overload: a larger range, or a softer tap)")
         taps[index] = attrs.evolve(tap, reason=reason)
         close = min(pulse.end + int(np.ceil(force_window_extra * (pulse.end - pulse.start))) + 1, length)
-        force_window[row, :close] = 1.0
+        open_ = max(pulse.start - int(np.ceil(FORCE_WINDOW_BEFORE * (pulse.end - pulse.start))) - 1, 0)
+        force_window[row, open_:close] = 1.0
         trigger[row] = pulse.start * dt
         baseline[row] = pulse.baseline
         if reason is None:

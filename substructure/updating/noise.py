@@ -40,8 +40,9 @@ the coherence of an H1 estimate over ``n`` taps adds the term
 (:data:`LOCAL_LINES` lines, taken only where it lies :data:`LOCAL_Z`
 standard errors above the model); a line beyond the tail of even the local
 model gets its own squared residual as variance; and the lines where the
-additive term of the log variance exceeds :data:`NOISE_DOMINATED` are read
-in the linear domain by :meth:`NoiseModel.line_scores`.  See
+additive terms of the log variance (the floor's and the coherence's: the
+response's noise is additive) exceed :data:`NOISE_DOMINATED` are read in
+the linear domain by :meth:`NoiseModel.line_scores`.  See
 docs/diagnose.md, "The noise model".
 """
 
@@ -415,9 +416,10 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     own = np.abs(q_local) ** 2 / (1.0 - h0) ** 2
     v_re = np.where(spike, np.maximum(v_re, own), v_re)
     v_im = np.where(spike, np.maximum(v_im, own), v_im)
-    # lines where the additive noise is as large as the signal: the log of the data is biased
-    # and heavy-tailed there, and the tests read the residual in the linear domain
-    additive_share = 0.5 * coef[2] * g[0] * local
+    # lines where the additive noise (the floor's, and the response's noise that the coherence term
+    # carries) is as large as the signal: the log of the data is biased and heavy-tailed there, and
+    # the tests read the residual in the linear domain
+    additive_share = 0.5 * (coef[2:] @ g) * local
     linear = usable & (additive_share > NOISE_DOMINATED)
     with np.errstate(invalid="ignore", divide="ignore"):
         hs = np.where(linear, h / s, 0.0)
