@@ -215,6 +215,30 @@ def test_clipped_channels_are_rejected():
     assert result.averages == 1
 
 
+def test_a_dead_response_channel_is_said_dead_not_clipped():
+    """A response that is the same number throughout (a sensor not connected) is no overload."""
+    rng = np.random.default_rng(3)
+    t, f = half_sine(50.0)
+    for level in (0.0, 2.5):
+        records = [TapRecord(t, f + rng.normal(0.0, 1e-3, N), np.full(N, level), "displacement", f"tap {k}")
+                   for k in range(2)]
+        with pytest.raises(InvalidValueError, match="dead channel: column 'response' is"):
+            process_taps(records)
+
+
+def test_a_hit_at_the_end_of_the_record_is_said_so_not_swapped():
+    """A hit in the record's last samples: the response has hardly begun; it is not a swapped record."""
+    rng = np.random.default_rng(4)
+    t, f = half_sine(50.0, start=(N - 3) / FS)
+    record = TapRecord(t, f + rng.normal(0.0, 1e-3, N), simulate(f), "displacement", "late.csv")
+    with pytest.raises(InvalidValueError, match=r"late.csv: the hit in column 'force' comes at t = 0.99"):
+        process_taps([record])
+    with pytest.raises(SwappedChannelsError):  # swapped, with the hit early: still said swapped
+        t, f = half_sine(50.0)
+        x = simulate(f)
+        process_taps([TapRecord(t, x * 1e7, f * 1e-7, "displacement", "early.csv")])
+
+
 def test_a_force_within_its_noise_is_no_hit():
     rng = np.random.default_rng(7)
     t = np.arange(N) / FS

@@ -282,6 +282,15 @@ def check_swapped(force: np.ndarray, response: np.ndarray, dt: float, source: st
     """
     c_force, c_response = crest_factor(force), crest_factor(response)
     if c_response > CREST_FACTOR_PULSE and c_response > c_force:
+        # a hit in the record's last 5 %: the response has hardly begun, and a pulse in both columns says
+        # nothing about which is which
+        k = int(np.argmax(np.abs(force - np.median(force))))
+        if k >= 0.95 * force.size:
+            raise InvalidValueError(
+                f"{source}: the hit in column {force_column!r} comes at t = {k * dt:.4g} s, "
+                f"{(force.size - k) * dt:.3g} s before the record ends: the response after it is not recorded "
+                "(record longer after the trigger)"
+            )
         raise SwappedChannelsError(
             f"{source}: column {force_column!r} does not look like a hammer's force and column "
             f"{response_column!r} does: the force's peak is {c_force:.3g} times its RMS, the response's "

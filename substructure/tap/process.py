@@ -487,6 +487,9 @@ def process_taps(
                       f"{pulse.peak_force:.3g} N had ended)")
         for name, channel in ((record.force_column, force[row]), (record.response_column, response[row])):
             run, where = longest_flat_run(channel)
+            if reason is None and channel.max() == channel.min():  # not an overload: nothing was measured
+                reason = (f"dead channel: column {name!r} is {channel[0]:.4g} throughout the tap (a sensor not "
+                          "connected, not powered, or a wrong channel)")
             if reason is None and run >= clip_run:
                 value = channel.max() if where == "maximum" else channel.min()
                 reason = (f"clipped: column {name!r} stays at its {where} ({value:.4g}) for {run} samples "
