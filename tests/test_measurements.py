@@ -177,6 +177,10 @@ def tip_file(tmp_path, model):
         (GOOD + 'sensors = "accelerometer"\n', r"line 5: frf\[0\]\.sensors: .*expected an array"),
         (GOOD + 'removed = ["tool", "tool"]\n', r"frf\[0\]\.removed: 'tool' given more than once"),
         (GOOD + "record = 1\n", r"frf\[0\]\.record: a CSV file \(tip\.csv\) holds one FRF"),
+        (GOOD + "window_tau_s = -0.2\n", r"line 5: frf\[0\]\.window_tau_s: got -0\.2; expected the exponential "
+                                        r"window's time constant in s"),
+        (GOOD + 'window_tau_s = "0.2 s"\n', r"line 5: frf\[0\]\.window_tau_s: got '0\.2 s'"),
+        (GOOD + "window_tau_s = nan\n", r"line 5: frf\[0\]\.window_tau_s: got nan"),
         (GOOD.replace("tip.csv", "tip.txt"), r"frf\[0\]\.file: 'tip\.txt': unknown kind of file"),
         (GOOD + GOOD, r"line 5: frf\[1\]: measures tool\.tip:y / tool\.tip:y in the same configuration as frf\[0\]"),
         ("name = [", r"invalid TOML"),
@@ -184,6 +188,17 @@ def tip_file(tmp_path, model):
 )
 def test_file_errors_name_file_line_and_key(tmp_path, tip_file, text, pattern):
     assert re.search(pattern, error_of(tmp_path, text))
+
+
+def test_a_window_s_time_constant_reads_into_the_measurement(tmp_path, tip_file):
+    path = tmp_path / "set.toml"
+    path.write_text(GOOD + "window_tau_s = 0.25\n")
+    (m,) = load_measurements(path).measurements
+    assert m.window_tau == 0.25 and m.crop(100, 200).window_tau == 0.25
+    path.write_text(GOOD)
+    assert load_measurements(path).measurements[0].window_tau is None
+    with pytest.raises(InvalidValueError, match="window_tau: got 0; expected the exponential window's time constant"):
+        Measurement.from_frf(m.frf, "tool.tip", "tool.tip", window_tau=0)
 
 
 def test_missing_data_file(tmp_path):

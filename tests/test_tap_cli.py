@@ -66,12 +66,15 @@ def test_tap_writes_frf_with_coherence_and_a_set_that_reads_back(records, tmp_pa
     assert code == 0, err
     assert load_measurements(toml).measurements[0].response == "holder.tip:y"
     assert "exponential window" not in toml.read_text()  # none was applied
+    assert load_measurements(toml).measurements[0].window_tau is None
     # windowed on request: the set says so in a comment, and reads back as before
     code, _, err = run(capsys, "tap", *paths, "--out", out, "--measurements", toml, "--response", "tool.tip",
                        "--excitation", "tool.tip", "--overwrite", "--exponential-window")
     assert code == 0, err
     assert toml.read_text().startswith("# measured through an exponential window, tau = 0.217 s")
     assert load_measurements(toml).measurements[0].averages == 5
+    # and in a key the diagnosis reads (its report says what the window adds)
+    assert abs(load_measurements(toml).measurements[0].window_tau - 0.2171) < 1e-3
 
 
 def test_tap_json(records, capsys):

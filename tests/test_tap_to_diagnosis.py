@@ -125,3 +125,17 @@ def test_lines_drowned_in_the_response_noise_are_read_linearly(model):
     d = diagnose(model, [measured], progress=False)
     assert d.explained and len(d.effects) == 1, d.report
     assert abs(d.effects[0].values["mass"] - 0.004) < 3e-4
+
+
+def test_a_windowed_measurement_is_said_so_in_the_report(model):
+    """A measurement taken through an exponential window (the measurement set's window_tau_s) carries
+    damping no model has: the report says so, with the damping ratio it adds, whatever the verdict."""
+    import attrs
+
+    measured, _ = _measured(_taps(model, seed=3))
+    d = diagnose(model, [attrs.evolve(measured, window_tau=0.2)], progress=False)
+    (line,) = [r for r in d.report if "exponential window" in r]
+    middle = float(np.median(measured.frf.frequency.hz))
+    assert line.startswith("tool.tip:y / tool.tip:y was measured through an exponential window (tau = 0.2 s)")
+    assert f"{1 / (0.2 * 2 * np.pi * middle):.2g} at {middle:.4g} Hz" in line
+    assert not [r for r in diagnose(model, [measured], progress=False).report if "window" in r]

@@ -41,8 +41,11 @@ def _read(path: str, args: argparse.Namespace) -> list:
 def _set_text(name: str, response: str, excitation: str, file: str, averages: int, tau: float | None) -> str:
     import tomli_w
 
-    text = tomli_w.dumps({"name": name, "frf": [{"response": response, "excitation": excitation, "file": file,
-                                                 "quantity": "receptance", "averages": averages}]})
+    frf = {"response": response, "excitation": excitation, "file": file, "quantity": "receptance",
+           "averages": averages}
+    if tau is not None:
+        frf["window_tau_s"] = float(tau)
+    text = tomli_w.dumps({"name": name, "frf": [frf]})
     if tau is None:
         return text
     return (f"# measured through an exponential window, tau = {tau:.4g} s: it adds the damping ratio 1/(tau omega) to "

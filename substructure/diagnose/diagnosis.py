@@ -338,6 +338,11 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
                                  for r in search.get("held_back", []) if not r["predicts"]]
     if search["cut"] and not explained:
         report = list(report) + [words.budget_cut(search["cut_at"])]
+    for m in lik.measured:  # a fact of the data, whatever the verdict
+        tau = getattr(m.measurement, "window_tau", None)
+        if tau is not None:
+            middle = float(np.median(m.frf.frequency.hz))
+            report = list(report) + [words.windowed(m.measurement.describe(), tau, middle)]
     return Diagnosis(
         verdict=Verdict(explained=explained, report=tuple(report),
                         missing_effect=None if missing is None else missing.name,

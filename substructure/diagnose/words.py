@@ -12,11 +12,12 @@ part of the result and stay beside the work they report.
 
 from __future__ import annotations
 
+import math
 from typing import Iterable, Sequence
 
 __all__ = [
     "UNEXPLAINED", "values_text", "bound_text", "partial", "too_many_changes", "bounded", "on_bound",
-    "not_unique", "tell_apart", "budget_cut", "unexplained", "error_lives", "error_spread", "best_partial",
+    "not_unique", "tell_apart", "budget_cut", "windowed", "unexplained", "error_lives", "error_spread", "best_partial",
     "nothing_improves", "mode_line", "signature_line", "level_line", "separation_text", "parameter_values",
     "summary",
 ]
@@ -216,6 +217,29 @@ def budget_cut(where: str) -> str:
         One line.
     """
     return f"the search was cut by its budget ({where}); a larger budget (--budget, --time-limit) may find more"
+
+
+def windowed(which: str, tau: float, f_hz: float) -> str:
+    """The note that a measurement was taken through an exponential window (its modes carry damping no model has).
+
+    Parameters
+    ----------
+    which : str
+        The measurement (``response / excitation``).
+    tau : float
+        The window's time constant [s].
+    f_hz : float
+        A frequency at which to quote the added damping ratio [Hz].
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    return (f"{which} was measured through an exponential window (tau = {tau:.4g} s): it adds the damping ratio "
+            f"1/(tau omega) to every mode ({1.0 / (tau * 2.0 * math.pi * f_hz):.2g} at {f_hz:.4g} Hz), "
+            "which the model lacks; damping found here may be the window's (taps long enough for the response to "
+            "die out need no window)")
 
 
 def unexplained(final_error: float, floor: float, chi2_reduced: float, threshold: float) -> str:

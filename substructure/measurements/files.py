@@ -7,6 +7,8 @@ the ``measurements`` layer, so that ``MeasurementSet.from_file`` reads without i
 
 from __future__ import annotations
 
+import math
+
 import os
 import warnings
 from pathlib import Path
@@ -26,7 +28,7 @@ from .measurement import Measurement, dof_label
 __all__ = ["read_measurements", "reads_measurements"]
 
 _TOP_KEYS = ("name", "frf")
-_FRF_KEYS = ("response", "excitation", "file", "record", "quantity", "sensors", "removed", "averages")
+_FRF_KEYS = ("response", "excitation", "file", "record", "quantity", "sensors", "removed", "averages", "window_tau_s")
 _REQUIRED = ("response", "excitation", "file")
 _CSV = (".csv",)
 _UFF = (".uff", ".unv")
@@ -92,6 +94,15 @@ class _Reader:
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
             raise self.error(index, "averages", f"got {value!r}; expected the number of averages (an integer >= 1)")
         return value
+
+    def window_tau(self, table: dict, index: int) -> float | None:
+        if "window_tau_s" not in table:
+            return None
+        value = table["window_tau_s"]
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+            raise self.error(index, "window_tau_s", f"got {value!r}; expected the exponential window's time "
+                                                    "constant in s (a number > 0)")
+        return float(value)
 
     def record(self, table: dict, index: int) -> int | None:
         if "record" not in table:
@@ -193,7 +204,7 @@ class _Reader:
         file = self.string(table, index, "file")
         quantity, record = self.quantity(table, index), self.record(table, index)
         sensors, removed = self.names(table, index, "sensors"), self.names(table, index, "removed")
-        averages = self.averages(table, index)
+        averages, tau = self.averages(table, index), self.window_tau(table, index)
         raw, coherence = self.data(index, file, record, quantity, response, excitation)
         if raw.quantity != "receptance" and raw.frequency.hz[0] == 0.0:
             warnings.warn(
@@ -209,7 +220,7 @@ class _Reader:
             raise self.error(index, "file", f"{self.base_dir / file}: {exc}") from None
         try:
             return Measurement(response, excitation, receptance, raw.quantity, sensors, removed, file, record,
-                               coherence, averages)
+                               coherence, averages, tau)
         except SubstructureError as exc:  # pragma: no cover - every field was checked above
             raise self.error(index, None, str(exc)) from None
 

@@ -145,6 +145,16 @@ def _optional_averages(value: Any) -> int | None:
     return int(value)
 
 
+def _optional_tau(value: Any) -> float | None:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not np.isfinite(value) or value <= 0:
+        raise InvalidValueError(f"window_tau: got {value!r}; expected the exponential window's time constant in s "
+                                "(a finite number > 0), or None for no window")
+    return float(value)
+
+
 def _same_array(a: Any, b: Any) -> bool:
     if a is None or b is None:
         return a is b
@@ -208,6 +218,11 @@ class Measurement:
         :mod:`substructure.tap`); read-only.
     averages : int, optional
         The number of taps averaged into the FRF (>= 1).
+    window_tau : float, optional
+        The time constant [s] of the exponential window the taps were
+        measured through (None: no window).  The window adds the damping
+        ratio ``1 / (tau omega)`` to every measured mode, which no model
+        has: the diagnosis says so in its report.
     """
 
     response: str = attrs.field(converter=lambda value: dof_label(value, "response"))
@@ -222,12 +237,13 @@ class Measurement:
         default=None, converter=_coherence, validator=_check_coherence, eq=attrs.cmp_using(eq=_same_array)
     )
     averages: int | None = attrs.field(default=None, converter=_optional_averages)
+    window_tau: float | None = attrs.field(default=None, converter=_optional_tau)
 
     @classmethod
     def from_frf(
         cls, frf: FRF, response: str, excitation: str, *, sensors: Sequence[str] = (),
         removed: Sequence[str] = (), file: str | None = None, record: int | None = None,
-        coherence: Any = None, averages: int | None = None,
+        coherence: Any = None, averages: int | None = None, window_tau: float | None = None,
     ) -> "Measurement":
         """A measurement from a one-entry FRF of any quantity.
 
@@ -255,6 +271,8 @@ class Measurement:
             The coherence (dimensionless, in [0, 1]) on the FRF's lines.
         averages : int, optional
             The number of averages (>= 1).
+        window_tau : float, optional
+            The exponential window's time constant [s], when there was one.
 
         Returns
         -------
@@ -269,7 +287,8 @@ class Measurement:
                 f"frf: got {frf.shape[1]}x{frf.shape[2]} entries; expected one FRF (select one entry first)"
             )
         receptance = frf.with_labels((out,), (inp,)).to_receptance()
-        return cls(out, inp, receptance, frf.quantity, sensors, removed, file, record, coherence, averages)
+        return cls(out, inp, receptance, frf.quantity, sensors, removed, file, record, coherence, averages,
+                   window_tau)
 
     def crop(self, lo: Any = None, hi: Any = None) -> "Measurement":
         """The measurement restricted to ``lo <= f <= hi``, its coherence on the same lines.
