@@ -11,6 +11,9 @@ in every band:
 * globally, ``chi^2 / nu <= 1 + z sqrt(2 / nu + e^2)``, ``z = 3.09``
   (one-sided 0.1 %), where ``e`` is the relative standard error of the
   noise variance estimated from the data (:attr:`NoiseModel.scale_error`);
+  where lines have an estimated variance (:attr:`NoiseModel.dof`), those
+  enter capped at :data:`LINE_CAP` and the sum is compared with its mean
+  and variance from the lines' distributions;
 * in each block of lines (2 % of the band, at least 20 lines, per FRF), the
   mean of the line scores (half the squared whitened residual,
   :meth:`NoiseModel.line_scores`), each capped at :data:`LINE_CAP`, stays
@@ -193,6 +196,20 @@ def consistency(likelihood, ratios: Sequence[np.ndarray], p: int) -> Consistency
     e = float(np.sqrt(np.sum((sizes * errs) ** 2)) / sizes.sum())
     threshold = 1.0 + _Z * math.sqrt(2.0 / nu + e * e)
     reduced = chi2 / nu
+    dofs = [None if m.noise.dof is None else m.noise.dof[likelihood.lines] for m in likelihood.measured]
+    if any(d is not None and np.isfinite(d).any() for d in dofs):
+        # lines whose variance is estimated (F(2, nu) scores, heavy-tailed: infinite variance for nu <= 4)
+        # enter capped, against the capped scores' mean and variance; the others as they are
+        total, mean, var = 0.0, 0.0, 0.0
+        for z, d in zip(z2, dofs):
+            est = np.zeros(z.size, dtype=bool) if d is None else np.isfinite(d)
+            total += float(z[~est].sum()) + float(np.minimum(z[est], LINE_CAP).sum())
+            m_est, v_est = _line_moments(d[est], int(est.sum())) if est.any() else (0.0, 0.0)
+            mean += int((~est).sum()) + m_est
+            var += int((~est).sum()) + v_est
+        expected = max(2.0 * mean - p, 1.0)
+        reduced = 2.0 * total / expected
+        threshold = 1.0 + _Z * math.sqrt(4.0 * var / expected**2 + e * e)
     blocks = []
     for item, (z, m) in enumerate(zip(z2, likelihood.measured)):
         size = max(20, int(round(0.02 * z.size)))
