@@ -47,6 +47,20 @@ def test_the_si_beam_receptance_is_the_segments_one():
     np.testing.assert_allclose(got, ref, rtol=1e-12, atol=1e-15 * np.abs(ref).max())
 
 
+def test_the_si_beam_receptance_of_a_long_beam_cut_into_chains_is_the_segments_one():
+    """A beam whose k L exceeds one chain's limit at the highest line takes the SI form's other path (cut
+    into chains joined by the coupling engine); it must still equal the segments' receptance."""
+    segs = [Segment("250 mm", "40 mm", "10 mm"), Segment("200 mm", "25 mm"), Segment("150 mm", "12 mm")]
+    f = np.linspace(50.0, 20000.0, 300)
+    positions = [0.6, 0.0, 0.31, 0.45]
+    ref = stepped_beam_receptance(segs, positions, f)
+    sec = [s.section() for s in segs]
+    got = stepped_beam_receptance_si(np.array([s.EI for s in sec]), np.array([s.kGA for s in sec]),
+                                     np.array([s.rhoA for s in sec]), np.array([s.rhoI for s in sec]),
+                                     np.array([s.length_m for s in segs]), positions, f)
+    np.testing.assert_allclose(got, ref, rtol=1e-9, atol=1e-12 * np.abs(ref).max())
+
+
 def test_every_parameter_moves_the_si_form_as_it_moves_the_assembly():
     model = _rich_model()
     params = model_parameters(model)

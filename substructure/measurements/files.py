@@ -7,8 +7,6 @@ the ``measurements`` layer, so that ``MeasurementSet.from_file`` reads without i
 
 from __future__ import annotations
 
-import math
-
 import os
 import warnings
 from pathlib import Path
@@ -17,13 +15,13 @@ from typing import Any
 from .._files import MAX_DATA_BYTES, read_text
 from .._files import check_file as check_readable_file
 from .._toml import TomlDocument, loads_toml
-from ..errors import FileFormatError, SubstructureError, SubstructureWarning
+from ..errors import FileFormatError, InvalidValueError, SubstructureError, SubstructureWarning
 from ..frf import FRF, QUANTITIES
 from ..frf.files._common import _beyond_physical
 from ..frf.files.csv_files import _read_csv
 from ..frf.files.uff_reader import read_uff
 from ..points import check_name
-from .measurement import Measurement, dof_label
+from .measurement import Measurement, _optional_tau, dof_label
 
 __all__ = ["read_measurements", "reads_measurements"]
 
@@ -99,10 +97,11 @@ class _Reader:
         if "window_tau_s" not in table:
             return None
         value = table["window_tau_s"]
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+        try:
+            return _optional_tau(value)  # what a measurement takes, said with the file's key
+        except InvalidValueError:
             raise self.error(index, "window_tau_s", f"got {value!r}; expected the exponential window's time "
-                                                    "constant in s (a number > 0)")
-        return float(value)
+                                                    "constant in s (a number > 0)") from None
 
     def record(self, table: dict, index: int) -> int | None:
         if "record" not in table:
