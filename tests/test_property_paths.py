@@ -15,8 +15,8 @@ from hypothesis import strategies as st
 
 from substructure import default_assembly, loads_assembly
 from substructure.errors import SubstructureError
-from substructure.updating import get_parameter, set_parameters
-from substructure.updating.paths import check_path
+from substructure.updating import Structure, get_parameter, set_parameters
+from substructure.updating.paths import apply_path_si, check_path
 
 MODEL = default_assembly()
 
@@ -49,6 +49,26 @@ def test_any_path_and_value_give_a_result_or_a_clear_error(path, value):
     if isinstance(value, (int, float)) and math.isfinite(float(value)):
         got = get_parameter(changed, path)
         assert math.isfinite(got)
+
+
+STRUCTURE = Structure.from_assembly(MODEL)
+
+
+@settings(max_examples=300, suppress_health_check=[HealthCheck.too_slow])
+@given(path=_PATHS)
+def test_the_si_form_reads_a_path_as_the_assembly_does(path):
+    # one parser: a path the assembly refuses is refused on the SI form with the same error and message
+    # (asked twice: the second answer comes from the SI form's memory of paths already read)
+    try:
+        check_path(MODEL, path)
+    except SubstructureError as exc:
+        for _ in range(2):
+            try:
+                apply_path_si(STRUCTURE, path, 1.0)
+            except SubstructureError as si_exc:
+                assert (type(si_exc), str(si_exc)) == (type(exc), str(exc))
+            else:
+                raise AssertionError(f"the SI form took {path!r}, which the assembly refuses ({exc})")
 
 
 @settings(max_examples=200, suppress_health_check=[HealthCheck.too_slow])

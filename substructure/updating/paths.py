@@ -1,11 +1,15 @@
-"""Model parameters set by their path in the assembly file: on an assembly and on the SI form.
+"""Model parameters set by their path in the assembly file: one parser, two forms of the model.
 
-:func:`set_parameters` changes numbers of an
-:class:`~substructure.assembly.Assembly` by path (the result is a normal
-model that saves as usual); :func:`apply_path_si` is its counterpart on
-:class:`~substructure.updating.structure.Structure`: the same paths, the
-same values, without building any object (the tests check that both give
-the same FRFs to rounding).  The paths are listed by
+A path is read once, against the assembly (:func:`check_path`: every key must
+name something, else the error lists the keys that exist), into a *target*:
+what it names (a component's number, a material, a joint's or a support's
+matrix, a body).  The table :data:`_SETTERS` holds, for each kind of target,
+how to set it on an :class:`~substructure.assembly.Assembly`
+(:func:`set_parameters`: a normal model that saves as usual) and on its SI
+form :class:`~substructure.updating.structure.Structure`
+(:func:`apply_path_si`: the same paths and values without building any
+object, the fits' fast path; the tests check that both give the same FRFs to
+rounding).  The paths are listed by
 :func:`substructure.updating.parameters.model_parameters`.
 """
 
@@ -26,112 +30,6 @@ __all__ = ["apply_path_si", "set_parameters", "check_path"]
 
 
 _MAT_COLUMN = {"E": 0, "nu": 1, "rho": 2, "loss_factor": 3}
-
-
-def apply_path_si(structure, path: str, value: float):
-    """Set the parameter at ``path`` on an SI structure (see :func:`set_parameters`).
-
-    Parameters
-    ----------
-    structure : Structure
-        The SI form of a configuration.
-    path : str
-        The parameter's path.
-    value : float
-        The value (SI, or a factor for linked parameters).
-
-    Returns
-    -------
-    Structure
-        The changed structure.
-    """
-    parts = path.split(".")
-    head = parts[0]
-    if head == "components":
-        rest = parts[2:]
-        if rest == ["supports", "k"]:
-            out = structure
-            for i, link in enumerate(structure.links):
-                if link.key[0] == "supports" and _component_of(link.a) == parts[1]:
-                    out = out.with_link(i, link.evolve(K=link.K * value))
-            return out
-        if parts[1] in structure.opaque:  # a component evaluated by its own methods: changed as an object
-            comp = _set_component(structure.opaque[parts[1]], path, rest, value)
-            out = structure.with_opaque(comp)
-            if rest == ["bore"]:
-                out = _bore_inserts_si(out, path, comp.name, comp.segments[0].od.m_as("m"),
-                                       comp.segments[0].material.name, value)
-            return out
-        beam = structure.beam(parts[1])
-        if rest[0] in ("segments", "overhang"):
-            return structure.with_beam(_section_checked(path, _geometry(beam, path, rest, value)))
-        if rest == ["bore"]:  # every segment without an insert: a coolant bore, a hollow shank
-            value = 0.0 if value < 1e-6 else value
-            bore = np.where(beam.insert[:, 0] > 0, beam.id, value)
-            out = structure.with_beam(_section_checked(path, beam.evolve(id=bore)))
-            return _bore_inserts_si(out, path, beam.name, float(beam.od[0]), beam.material_names[0], value)
-        if len(rest) == 1 and rest[0] not in _COMPONENT_KEYS:  # a number the component's type adds
-            source = structure.sources.get(beam.name)
-            if source is None:
-                raise InvalidValueError(f"parameter {path!r}: set a component's own numbers before its segments'")
-            return structure.with_beam(_arrays_of(_set_component(source, path, rest, value)))
-        if rest in (["E"], ["rho"], ["loss_factor"]):
-            mat = beam.material.copy()
-            mat[:, _MAT_COLUMN[rest[0]]] *= value
-            return structure.with_beam(beam.evolve(material=mat))
-        if len(rest) == 2 and rest[0] == "material" and rest[1] in _MAT_COLUMN:
-            mat = beam.material.copy()
-            mat[:, _MAT_COLUMN[rest[1]]] = value
-            return structure.with_beam(beam.evolve(material=mat))
-    if head == "materials":
-        _key(path, ".".join(parts[:-1]), parts[-1], _MATERIAL_KEYS)
-        name, column = ".".join(parts[1:-1]), _MAT_COLUMN[parts[-1]]
-        out, found = structure, False
-        for beam in structure.beams.values():
-            hit = np.array([n == name for n in beam.material_names])
-            ins_hit = np.array([n == name for n in beam.insert_names])
-            if hit.any() or ins_hit.any():
-                mat, ins = beam.material.copy(), beam.insert.copy()
-                mat[hit, column] = value
-                ins[ins_hit, 2 + column] = value
-                out = out.with_beam(beam.evolve(material=mat, insert=ins))
-                found = True
-        if not found:
-            raise UnknownPointError(f"no part made of {name!r} in this configuration")
-        return out
-    if head == "supports" and "+" in parts[1]:
-        out = structure
-        for index in (int(x) for x in parts[1].split("+")):
-            i, link = out.link(("supports", index))
-            out = out.with_link(i, link.evolve(K=link.K * value))
-        return out
-    if head in ("joints", "supports", "sensors", "masses"):
-        key = (head, int(parts[1]) if head == "supports" else parts[1])
-        i, link = structure.link(key)
-        if head == "joints" and link.custom is not None:  # a joint model of its own: changed as an object
-            return structure.with_link(i, link.evolve(custom=_set_joint(link.custom, parts[2:], value)))
-        if head in ("joints", "supports"):
-            if parts[2] == "at":
-                return structure.with_link(i, link.evolve(a=(_component_of(link.a), value)))
-            if len(parts) == 3:
-                _key(path, ".".join(parts[:2]), parts[2], _MATRIX_KEYS)
-                which = parts[2].upper()
-                return structure.with_link(i, link.evolve(**{which: getattr(link, which) * value}))
-            kind, entry = parts[2], parts[3]
-            _key(path, ".".join(parts[:2]), kind, _MATRIX_KEYS)
-            _key(path, ".".join(parts[:3]), entry, _ENTRIES)
-            m = getattr(link, kind.upper()).copy()
-            if entry in ("ym", "tf"):  # one number (reciprocity): either sets both
-                m[0, 1] = m[1, 0] = value
-            else:
-                m[(0, 1)[entry == "tm"], (0, 1)[entry == "tm"]] = value
-            return structure.with_link(i, link.evolve(**{kind.upper(): m}))
-        if parts[2] == "at":
-            return structure.with_link(i, link.evolve(a=(_component_of(link.a), value)))
-        m = link.M.copy()
-        m[(0, 1)[parts[2] == "inertia"], (0, 1)[parts[2] == "inertia"]] = value
-        return structure.with_link(i, link.evolve(M=m))
-    raise UnknownPointError(f"parameter {path!r}: not a parameter path")
 
 
 def _arrays_of(component):
@@ -361,19 +259,24 @@ def check_path(assembly, path: str) -> list[str]:
         ``tm``, a material value other than ``E``, ``rho``, ``nu``,
         ``loss_factor``: keys are case-sensitive).
     """
+    return _resolve(assembly, path)[0]
+
+
+def _resolve(assembly, path: str) -> tuple[list[str], tuple]:
+    """The path's keys and its target, ``(kind, *what)``, a key of :data:`_SETTERS` and its arguments."""
     parts = _parts(path)
     head = parts[0]
     _key(path, "", head, _HEADS)
     if head == "components":
         _length(path, parts, range(3, 7))
-        names = sorted(assembly.component_names)
-        _key(path, "components", parts[1], names)
+        _key(path, "components", parts[1], sorted(assembly.component_names))
         comp = assembly.component(parts[1])
         from ..components import own_parameters
 
         rest, where, own = parts[2:], f"components.{parts[1]}", tuple(p.name for p in own_parameters(comp))
+        target = ("component", comp.name, tuple(rest))
         if len(rest) == 1 and rest[0] in own:  # a number the component's type adds
-            return parts
+            return parts, target
         if not _segmented(comp):
             why = f"its own parameters are {_expected(own)}" if own else "it names no parameters of its own"
             raise _unknown(path, f"{parts[1]!r} is not a stepped beam, and {why}")
@@ -393,6 +296,9 @@ def check_path(assembly, path: str) -> list[str]:
         elif rest[0] == "supports":
             _length(path, rest, (2,))
             _key(path, f"{where}.supports", rest[1], ("k",))
+            on_it = tuple(("supports", i) for i, s in enumerate(assembly.supports)
+                          if _on_beam(assembly, s.at)[0] == comp.name)
+            return parts, ("link", on_it, ("k",))
         else:
             _length(path, rest, (1,))
             from ..components import Tool
@@ -402,46 +308,44 @@ def check_path(assembly, path: str) -> list[str]:
             if rest[0] == "bore" and bore_segments(comp) is None:
                 raise _unknown(path, f"{comp.name!r} has no common bore (its segments without an insert, none "
                                      "tapered, with one bore diameter have)")
-    elif head == "materials":
+        return parts, target
+    if head == "materials":
         _length(path, parts, range(3, 100))
         _key(path, ".".join(parts[:-1]), parts[-1], _MATERIAL_KEYS)
         name, made = ".".join(parts[1:-1]), _materials_of_parts(assembly)
         if name not in made:
             raise _unknown(path, f"no part is made of {name!r} (materials of the parts: {_expected(made)})")
-    elif head == "joints":
+        return parts, ("material", name, parts[-1])
+    if head == "joints":
         _length(path, parts, (3, 4))
         joint = assembly.joint(parts[1])  # unknown: the joints there are listed
         from ..components import own_parameters
 
         own = tuple(p.name for p in own_parameters(joint))
-        if len(parts) == 3 and parts[2] in own:  # a number the joint model adds (a loss factor)
-            return parts
-        _key(path, f"joints.{parts[1]}", parts[2], _MATRIX_KEYS + own)
-        if len(parts) == 4:
-            _key(path, f"joints.{parts[1]}.{parts[2]}", parts[3], _ENTRIES)
-    elif head == "supports":
+        if not (len(parts) == 3 and parts[2] in own):  # else a number the joint model adds (a loss factor)
+            _key(path, f"joints.{parts[1]}", parts[2], _MATRIX_KEYS + own)
+            if len(parts) == 4:
+                _key(path, f"joints.{parts[1]}.{parts[2]}", parts[3], _ENTRIES)
+        return parts, ("link", (("joints", joint.name),), tuple(parts[2:]))
+    if head == "supports":
         count = len(assembly.supports)
         _length(path, parts, (3, 4))
         if "+" in parts[1]:
             _length(path, parts, (3,))
-            for text in parts[1].split("+"):
-                _index(path, text, count, "support index")
+            indices = tuple(_index(path, text, count, "support index") for text in parts[1].split("+"))
             _key(path, f"supports.{parts[1]}", parts[2], ("k",))
         else:
-            _length(path, parts, (3, 4))
-            _index(path, parts[1], count, "support index")
+            indices = (_index(path, parts[1], count, "support index"),)
             where = f"supports.{parts[1]}"
             _key(path, where, parts[2], ("at",) if len(parts) == 3 else _MATRIX_KEYS)
             if len(parts) == 4:
                 _key(path, f"{where}.{parts[2]}", parts[3], _ENTRIES)
-    else:
-        _length(path, parts, (3,))
-        names = [s.name for s in getattr(assembly, head)]
-        _key(path, head, parts[1], names)
-        _key(path, f"{head}.{parts[1]}", parts[2], ("mass", "inertia", "at") if head == "masses" else
-             ("mass", "inertia"))
-    return parts
-
+        return parts, ("link", tuple(("supports", i) for i in indices), tuple(parts[2:]))
+    _length(path, parts, (3,))
+    _key(path, head, parts[1], [s.name for s in getattr(assembly, head)])
+    _key(path, f"{head}.{parts[1]}", parts[2], ("mass", "inertia", "at") if head == "masses" else
+         ("mass", "inertia"))
+    return parts, ("link", ((head, parts[1]),), (parts[2],))
 
 
 def _quiet(build):
@@ -569,85 +473,177 @@ def _set_joint(joint, rest: list[str], value: float):
     return _set_matrix(joint, rest[0], rest[1], value)
 
 
-def _set_one(assembly, path: str, value: float):
-    parts = check_path(assembly, path)
-    head = parts[0]
-    value = float(value)
-    if head == "components" and len(parts) >= 3:
-        comp = assembly.component(parts[1])
-        rest = parts[2:]
-        if rest != ["supports", "k"]:
-            out = assembly.with_component(_set_component(comp, path, rest, value))
-            if rest == ["bore"]:  # the part's shank clamped in another part (an insert of its material and od)
-                od, material = comp.segments[0].od.m_as("m"), comp.segments[0].material.name
-                for other in assembly.components:
-                    bored = None if other.name == comp.name else _bored_shank(other, material, od, value)
-                    if bored is not None:
-                        out = out.with_component(bored)
-            return out
-        supports = list(assembly.supports)
-        for i, s in enumerate(supports):
-            if _on_beam(assembly, s.at)[0] == comp.name:
-                supports[i] = _quiet(lambda s=s: attrs.evolve(s, k=_scaled_matrix(s.k, value, STIFFNESS_UNITS)))
-        return attrs.evolve(assembly, supports=tuple(supports))
-    if head == "materials" and len(parts) >= 3:
-        name, prop = ".".join(parts[1:-1]), parts[-1]
-        comps = []
-        found = False
-        for comp in assembly.components:
-            if not _plain(comp):
-                comps.append(comp)
-                continue
-            segs = list(comp.segments)
-            for i, seg in enumerate(segs):
-                if seg.material.name == name:
-                    segs[i] = _with_material(segs[i], _material_value(seg.material, prop, value), False)
-                    found = True
-                if seg.insert is not None and seg.insert.material.name == name:
-                    segs[i] = _with_material(segs[i], _material_value(seg.insert.material, prop, value), True)
-                    found = True
-            comps.append(attrs.evolve(comp, segments=segs))
-        if not found:
-            raise _unknown(path, f"no part is made of {name!r} (materials of the parts: "
-                                 f"{_expected(_materials_of_parts(assembly))})")
-        mats = tuple(_material_value(m, prop, value) if m.name == name else m for m in assembly.materials)
-        return attrs.evolve(assembly, components=tuple(comps), materials=mats)
-    if head == "joints" and len(parts) in (3, 4):
-        return assembly.with_joint(_set_joint(assembly.joint(parts[1]), parts[2:], value))
-    if head == "supports" and len(parts) == 3 and "+" in parts[1]:
-        supports = list(assembly.supports)
-        for i in (int(x) for x in parts[1].split("+")):
-            s = supports[i]
-            supports[i] = _quiet(lambda s=s: attrs.evolve(s, k=_scaled_matrix(s.k, value, STIFFNESS_UNITS)))
-        return attrs.evolve(assembly, supports=tuple(supports))
-    if head == "supports" and len(parts) in (3, 4):
-        i = int(parts[1])
-        supports = list(assembly.supports)
-        s = supports[i]
-        if parts[2] == "at":
-            comp, _, _ = _on_beam(assembly, s.at)
-            supports[i] = attrs.evolve(s, at=f"{comp}@{_si(value, 'm')}")
-        else:
-            supports[i] = _set_matrix(s, parts[2], parts[3], value)
-        return attrs.evolve(assembly, supports=tuple(supports))
-    if head in ("sensors", "masses") and len(parts) == 3:
+# ---------------------------------------------------------------------------
+# Setting a target: on the assembly (objects) and on the SI form (arrays)
+
+
+def _component_obj(assembly, path: str, name: str, rest: tuple, value: float):
+    comp = assembly.component(name)
+    out = assembly.with_component(_set_component(comp, path, list(rest), value))
+    if rest == ("bore",):  # the part's shank clamped in another part (an insert of its material and od)
+        od, material = comp.segments[0].od.m_as("m"), comp.segments[0].material.name
+        for other in assembly.components:
+            bored = None if other.name == name else _bored_shank(other, material, od, value)
+            if bored is not None:
+                out = out.with_component(bored)
+    return out
+
+
+def _component_si(structure, path: str, name: str, rest: tuple, value: float):
+    if name in structure.opaque:  # a component evaluated by its own methods: changed as an object
+        comp = _set_component(structure.opaque[name], path, list(rest), value)
+        out = structure.with_opaque(comp)
+        if rest == ("bore",):
+            seg = comp.segments[0]
+            out = _bore_inserts_si(out, path, name, seg.od.m_as("m"), seg.material.name, value)
+        return out
+    beam = structure.beam(name)
+    if rest[0] in ("segments", "overhang"):
+        return structure.with_beam(_section_checked(path, _geometry(beam, path, list(rest), value)))
+    if rest == ("bore",):  # every segment without an insert: a coolant bore, a hollow shank
+        value = 0.0 if value < 1e-6 else value
+        bore = np.where(beam.insert[:, 0] > 0, beam.id, value)
+        out = structure.with_beam(_section_checked(path, beam.evolve(id=bore)))
+        return _bore_inserts_si(out, path, name, float(beam.od[0]), beam.material_names[0], value)
+    if rest[0] in _COMPONENT_KEYS:  # its material: E, rho, loss_factor as factors, material.X as values
+        mat, column = beam.material.copy(), _MAT_COLUMN[rest[-1]]
+        mat[:, column] = mat[:, column] * value if len(rest) == 1 else value
+        return structure.with_beam(beam.evolve(material=mat))
+    source = structure.sources.get(name)  # a number the component's type adds
+    if source is None:
+        raise InvalidValueError(f"parameter {path!r}: set a component's own numbers before its segments'")
+    return structure.with_beam(_arrays_of(_set_component(source, path, list(rest), value)))
+
+
+def _material_obj(assembly, path: str, name: str, prop: str, value: float):
+    comps = []
+    for comp in assembly.components:
+        if not _plain(comp):
+            comps.append(comp)
+            continue
+        segs = list(comp.segments)
+        for i, seg in enumerate(segs):
+            if seg.material.name == name:
+                segs[i] = _with_material(segs[i], _material_value(seg.material, prop, value), False)
+            if seg.insert is not None and seg.insert.material.name == name:
+                segs[i] = _with_material(segs[i], _material_value(seg.insert.material, prop, value), True)
+        comps.append(attrs.evolve(comp, segments=segs))
+    mats = tuple(_material_value(m, prop, value) if m.name == name else m for m in assembly.materials)
+    return attrs.evolve(assembly, components=tuple(comps), materials=mats)
+
+
+def _material_si(structure, path: str, name: str, prop: str, value: float):
+    out, column = structure, _MAT_COLUMN[prop]
+    for beam in structure.beams.values():
+        hit = np.array([n == name for n in beam.material_names])
+        ins_hit = np.array([n == name for n in beam.insert_names])
+        if hit.any() or ins_hit.any():
+            mat, ins = beam.material.copy(), beam.insert.copy()
+            mat[hit, column] = value
+            ins[ins_hit, 2 + column] = value
+            out = out.with_beam(beam.evolve(material=mat, insert=ins))
+    return out
+
+
+def _link_obj(assembly, path: str, keys: tuple, rest: tuple, value: float):
+    """A joint's, a support's or a body's number set on the objects (``keys``: the links it names)."""
+    for head, key in keys:
+        if head == "joints":
+            assembly = assembly.with_joint(_set_joint(assembly.joint(key), list(rest), value))
+            continue
         items = list(getattr(assembly, head))
-        names = [s.name for s in items]
-        if parts[1] not in names:
-            raise _unknown(path, f"no {head[:-1]} {parts[1]!r}")
-        i = names.index(parts[1])
+        i = key if head == "supports" else [s.name for s in items].index(key)
         s = items[i]
-        if parts[2] == "mass":
+        if rest == ("at",):
+            items[i] = attrs.evolve(s, at=f"{_on_beam(assembly, s.at)[0]}@{_si(value, 'm')}")
+        elif rest == ("mass",):
             items[i] = attrs.evolve(s, mass=_si(value, "kg"))
-        elif parts[2] == "inertia":
+        elif rest == ("inertia",):
             items[i] = attrs.evolve(s, inertia=_si(value, "kg*m^2"))
-        elif parts[2] == "at" and head == "masses":
-            comp, _, _ = _on_beam(assembly, s.at)
-            items[i] = attrs.evolve(s, at=f"{comp}@{_si(value, 'm')}")
+        elif rest == ("k",):  # supports named together: their stiffness as one factor
+            items[i] = _quiet(lambda s=s: attrs.evolve(s, k=_scaled_matrix(s.k, value, STIFFNESS_UNITS)))
         else:
-            raise _unknown(path, f"unknown value {parts[2]!r}")
-        return attrs.evolve(assembly, **{head: tuple(items)})
-    raise _unknown(path, "not a parameter path (see substructure.updating.parameters)")
+            items[i] = _set_matrix(s, rest[0], rest[1], value)
+        assembly = attrs.evolve(assembly, **{head: tuple(items)})
+    return assembly
+
+
+def _link_si(structure, path: str, keys: tuple, rest: tuple, value: float):
+    for key in keys:
+        i, link = structure.link(key)
+        if link.custom is not None:  # a joint model of its own: changed as an object
+            link = link.evolve(custom=_set_joint(link.custom, list(rest), value))
+        elif rest == ("at",):
+            link = link.evolve(a=(_component_of(link.a), value))
+        elif rest[0] in ("mass", "inertia"):
+            m, j = link.M.copy(), int(rest[0] == "inertia")
+            m[j, j] = value
+            link = link.evolve(M=m)
+        elif len(rest) == 1:  # the whole matrix as a factor
+            which = rest[0].upper()
+            link = link.evolve(**{which: getattr(link, which) * value})
+        else:
+            m, j = getattr(link, rest[0].upper()).copy(), int(rest[1] == "tm")
+            if rest[1] in ("ym", "tf"):  # one number (reciprocity): either sets both
+                m[0, 1] = m[1, 0] = value
+            else:
+                m[j, j] = value
+            link = link.evolve(**{rest[0].upper(): m})
+        structure = structure.with_link(i, link)
+    return structure
+
+
+_SETTERS = {
+    "component": (_component_obj, _component_si),
+    "material": (_material_obj, _material_si),
+    "link": (_link_obj, _link_si),
+}
+"""The one table of what a path names: how to set it on an assembly and on its SI form."""
+
+_RESOLVED: dict = {}
+"""Targets of paths already read, by the assembly they were read against (the fits set the same paths on
+structures of the same configuration thousands of times)."""
+
+
+def _target_of(assembly, path: str) -> tuple:
+    hit = _RESOLVED.get((id(assembly), path))
+    if hit is None or hit[0] is not assembly:
+        try:
+            target = _resolve(assembly, path)[1]
+        except (InvalidValueError, UnknownPointError) as exc:  # refused again at each call, as the first time
+            target = exc
+        if len(_RESOLVED) >= 256:
+            _RESOLVED.clear()
+        hit = _RESOLVED[(id(assembly), path)] = (assembly, target)
+    if isinstance(hit[1], Exception):
+        raise hit[1].with_traceback(None)
+    return hit[1]
+
+
+def apply_path_si(structure, path: str, value: float):
+    """Set the parameter at ``path`` on an SI structure (see :func:`set_parameters`).
+
+    Parameters
+    ----------
+    structure : Structure
+        The SI form of a configuration.
+    path : str
+        The parameter's path, read against the structure's assembly.
+    value : float
+        The value (SI, or a factor for linked parameters).
+
+    Returns
+    -------
+    Structure
+        The changed structure.
+
+    Raises
+    ------
+    UnknownPointError
+        When the path names nothing in the configuration.
+    """
+    kind, *what = _target_of(structure.assembly, path)
+    return _SETTERS[kind][1](structure, path, *what, value)
 
 
 def set_parameters(assembly, values: Mapping[str, float]):
@@ -677,7 +673,8 @@ def set_parameters(assembly, values: Mapping[str, float]):
             raise InvalidValueError(f"parameter {path!r}: got {value!r}; expected a number (SI, or a factor for a "
                                     "linked parameter)")
         try:
-            assembly = _set_one(assembly, path, value)
+            kind, *what = _resolve(assembly, path)[1]
+            assembly = _SETTERS[kind][0](assembly, path, *what, float(value))
         except InvalidValueError as exc:  # the value refused where the object checks it: named with its path
             if f"{path!r}" in str(exc):
                 raise
