@@ -15,7 +15,7 @@ from substructure.cli import main
 from substructure.datasets import impact_records
 from substructure.errors import FileFormatError
 from substructure.io import _tap_table
-from substructure.io.tap_files import read_tap_csv, read_tap_lvm, read_tap_uff
+from substructure.io.tap_files import read_tap_csv, read_tap_lvm, read_tap_uff, read_taps_uff
 
 FS = 10240.0
 G = 9.80665
@@ -357,6 +357,37 @@ def test_uff_abscissa_not_time_or_uneven_is_refused(tmp_path):
     with pytest.raises(FileFormatError, match=r"uneven.uff, record 0: uneven abscissa"):
         read_tap_uff(path)
 
+
+
+def test_a_universal_file_of_several_taps_reads_as_one_tap_each(tmp_path, capsys):
+    taps = impact_records()[:3]  # the shipped real taps, as an acquisition system exports a test's hits
+    # (times written as x values with five digits, as pyuff writes them: the uniform clock read back)
+    t = taps[0].time
+    interleaved = [ch for r in taps for ch in ((r.force, 13, "N"), (r.response / G, 0, "g"))]
+    blocked = [(r.force, 13, "N") for r in taps] + [(r.response / G, 0, "g") for r in taps]
+    for name, channels in (("interleaved.uff", interleaved), ("blocked.uff", blocked)):
+        got = read_taps_uff(write_uff(tmp_path / name, channels, x=t))
+        assert len(got) == 3 and [g.source[-7:] for g in got] == ["(tap 1)", "(tap 2)", "(tap 3)"]
+        for g, r in zip(got, taps):
+            scale = np.abs(r.response).max()
+            assert np.allclose(g.force, r.force, rtol=1e-6, atol=1e-9 * np.abs(r.force).max())
+            assert np.allclose(g.response, r.response, rtol=1e-6, atol=1e-9 * scale)
+    # the command averages a file's taps as it does the same taps in files of their own
+    one_each = [write_uff(tmp_path / f"tap{k}.uff", [(r.force, 13, "N"), (r.response / G, 0, "g")], x=t)
+                for k, r in enumerate(taps)]
+    code, out, err = run(capsys, "tap", *one_each, "--json")
+    assert code == 0, err
+    expected = json.loads(out)
+    code, out, err = run(capsys, "tap", tmp_path / "interleaved.uff", "--json")
+    assert code == 0, err
+    got = json.loads(out)
+    assert got["averages"] == expected["averages"] == 3 and got["real"] == expected["real"]
+    # one tap of them chosen by its records; counts that do not pair are refused with what to give
+    chosen = read_tap_uff(tmp_path / "interleaved.uff", force_record=2, response_record=3)
+    assert np.allclose(chosen.force, taps[1].force, rtol=1e-6, atol=1e-9 * np.abs(taps[1].force).max())
+    odd = write_uff(tmp_path / "odd.uff", interleaved + [(taps[0].response / G, 0, "g")], x=t)
+    with pytest.raises(FileFormatError, match=r"odd.uff: 3 force records among 7 type-58 records; give the force "):
+        read_taps_uff(odd)
 
 # -- the command, on the shipped real records written as acquisition systems write them -------------------------
 

@@ -15,7 +15,7 @@ _RECORD_SUFFIXES = _TEXT_SUFFIXES + (".lvm", ".mat") + _UFF_SUFFIXES
 
 
 def _read(path: str, args: argparse.Namespace) -> list:
-    from ..io.tap_files import read_tap_csv, read_tap_lvm, read_tap_mat, read_tap_uff
+    from ..io.tap_files import read_tap_csv, read_tap_lvm, read_tap_mat, read_tap_uff, read_taps_uff
 
     suffix = Path(path).suffix.lower()
     columns = dict(sample_rate=args.sample_rate, force_column=args.force_column,
@@ -26,6 +26,8 @@ def _read(path: str, args: argparse.Namespace) -> list:
             if value is not None:
                 raise UsageError(f"{option} applies to columns of a text record, not to {path}: a universal file "
                                  "gives its records' sampling, and --force-record, --response-record choose them")
+        if args.force_record is None and args.response_record is None:  # every tap of the file
+            return read_taps_uff(path, args.sensitivity, args.hammer_sensitivity, args.quantity)
         return [read_tap_uff(path, args.sensitivity, args.hammer_sensitivity, args.quantity, args.force_record,
                              args.response_record)]
     if args.force_record is not None or args.response_record is not None:
@@ -160,7 +162,7 @@ def add_parser(commands) -> None:
     tap.add_argument("records", nargs="+", metavar="RECORD",
                      help="tap records: CSV or text (time [s],force [N],acceleration [m/s^2], a preamble "
                      "allowed), LabVIEW .lvm, MATLAB .mat (vectors with <name>_unit texts), or UFF type-58 time "
-                     "records")
+                     "records (a force and a response record per tap)")
     tap.add_argument("--out", metavar="FRF.csv", help="write the receptance with its coherence column")
     tap.add_argument("--measurements", metavar="SET.toml", help="write a measurement set naming --out")
     tap.add_argument("--response", metavar="POINT", help="the response point of the measurement set")
@@ -184,7 +186,8 @@ def add_parser(commands) -> None:
     tap.add_argument("--response-column", metavar="NAME|INDEX",
                      help="text, .lvm and .mat records: the response column (or vector) by name or 1-based index "
                      "(a second accelerometer, a trigger channel)")
-    tap.add_argument("--force-record", type=int, metavar="N", help="UFF: 0-based index of the force record")
+    tap.add_argument("--force-record", type=int, metavar="N",
+                     help="UFF: 0-based index of the force record (one tap; default: every tap of the file)")
     tap.add_argument("--response-record", type=int, metavar="N", help="UFF: 0-based index of the response record")
     tap.add_argument("--tap-length", type=float, metavar="SECONDS",
                      help="cut long records into taps of this length (default: one tap per record)")

@@ -30,10 +30,11 @@ from . import check_readable_file, read_bytes
 from ._tap_columns import (MAX_PREAMBLE_LINES, NO_UNIT, Columns, choose, header_cells, is_row, is_unit_row,
                            line_separator, name_and_unit, rate_from_lines)
 from ._tap_build import (RESPONSES, ROUNDED_TIME_TOLERANCE, build_record, check_quantity_option, option_rate,
-                         time_axis, units_of_columns)
+                         regular, time_axis, units_of_columns)
 from ._tap_table import finite_rows, parse_rows
 
-__all__ = ["read_tap_csv", "read_tap_lvm", "read_tap_mat", "read_tap_uff", "MAX_RECORD_BYTES", "ROUNDED_TIME_TOLERANCE"]
+__all__ = ["read_tap_csv", "read_tap_lvm", "read_tap_mat", "read_tap_uff", "read_taps_uff",
+           "MAX_RECORD_BYTES", "ROUNDED_TIME_TOLERANCE"]
 
 MAX_RECORD_BYTES = 2**29
 """The largest tap record file read (512 MiB: minutes of three channels at 51.2 kHz written as text; the
@@ -375,6 +376,55 @@ def read_tap_uff(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
         contradicts the specific data type or the options, different time
         axes.
     """
+    name, records, kinds = _uff_records(path)
+    pair = _uff_pair(name, records, kinds, force_record, response_record)
+    return _uff_tap(name, records, kinds, pair, sensitivity, hammer_sensitivity, quantity)
+
+
+def read_taps_uff(path: str | os.PathLike, sensitivity: Any = None, hammer_sensitivity: Any = None,
+                  quantity: str | None = None) -> list[TapRecord]:
+    """Read every tap of a universal file: its force records paired in order with its response records.
+
+    A file of one tap reads as :func:`read_tap_uff` does.  A file of several
+    taps holds as many force records as response records (a force and its
+    response after each other, or all forces first): the k-th force record
+    and the k-th response record are the k-th tap, and must share their
+    time axis.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+    sensitivity, hammer_sensitivity : str or pint.Quantity, optional
+        As for :func:`read_tap_csv`, for records whose unit label is a voltage.
+    quantity : {"acceleration", "velocity", "displacement"}, optional
+        What the responses are (as for :func:`read_tap_uff`).
+
+    Returns
+    -------
+    list of TapRecord
+        One a tap, in the file's order.
+
+    Raises
+    ------
+    FileFormatError
+        As :func:`read_tap_uff`; also for counts of force and response
+        records that do not pair (then choose one tap with
+        :func:`read_tap_uff`'s ``force_record`` and ``response_record``).
+    """
+    name, records, kinds = _uff_records(path)
+    forces = [k for k, q in enumerate(kinds) if q == "force"]
+    responses = [k for k, q in enumerate(kinds) if q in RESPONSES or q == "response"]
+    if len(forces) < 2 or len(forces) != len(responses):
+        return [_uff_tap(name, records, kinds, _uff_pair(name, records, kinds, None, None), sensitivity,
+                         hammer_sensitivity, quantity)]
+    return [_uff_tap(name, records, kinds, pair, sensitivity, hammer_sensitivity, quantity, tap=k + 1)
+            for k, pair in enumerate(zip(forces, responses))]
+
+
+def _uff_records(path) -> tuple[str, list[dict], list[str | None]]:
+    """The file's name, its type-58 records (each checked a time record) and what each holds by its data type
+    or unit label (``force``, a response quantity, ``response`` or None: not known)."""
     import pyuff
 
     name = check_readable_file(path, "tap record", MAX_RECORD_BYTES)
@@ -390,39 +440,44 @@ def read_tap_uff(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
         if int(r.get("func_type", 0)) != 1:
             raise FileFormatError(f"{name}, record {k}: function type {r.get('func_type')}; expected 1 (time "
                                   "response): a tap record holds the time signals, not an FRF")
-
-    def unit(k: int):
-        label = str(records[k].get("ordinate_axis_units_lab", "") or "").strip()
-        if not label or label.upper() in ("NONE", "N/A", "NA", "-"):
-            return None
-        try:
-            return unit_of(label, f"{name}, record {k}")
-        except SubstructureError as exc:
-            raise FileFormatError(str(exc)) from None
-
-    def kind(k: int) -> str | None:
-        spec = int(records[k].get("ordinate_spec_data_type", 0))
-        u = unit(k)
-        by_type = "force" if spec in _FORCE_TYPES else _RESPONSE_TYPES.get(spec)
-        by_unit = None
-        if u is not None:
-            for q in ("force", "acceleration", "velocity", "displacement"):
-                if (1.0 * u).check({"force": "[force]", "acceleration": "[acceleration]", "velocity": "[velocity]",
-                                    "displacement": "[length]"}[q]):
-                    by_unit = q
-        if by_type and by_unit and by_type != by_unit:
-            raise FileFormatError(f"{name}, record {k}: the specific data type says {by_type}, the unit label "
-                                  f"{records[k].get('ordinate_axis_units_lab')!r} says {by_unit}; fix one")
-        return by_type or by_unit
-
     for k, r in enumerate(records):
         _check_abscissa(name, k, r)
-    kinds = [kind(k) for k in range(len(records))]
-    if len(records) == 2 and force_record is None and response_record is None and kinds.count(None) == 1 \
-            and unit(kinds.index(None)) is not None:
+    kinds = [_uff_kind(name, records, k) for k in range(len(records))]
+    if len(records) == 2 and kinds.count(None) == 1 and _uff_unit(name, records, kinds.index(None)) is not None:
         # two records, one of them known by its type or unit, the other in volts or unlabelled: the other channel
         known = 0 if kinds[0] is not None else 1
         kinds[1 - known] = ("force" if kinds[known] in RESPONSES else "response") if kinds[known] else None
+    return name, records, kinds
+
+
+def _uff_unit(name: str, records: list[dict], k: int):
+    label = str(records[k].get("ordinate_axis_units_lab", "") or "").strip()
+    if not label or label.upper() in ("NONE", "N/A", "NA", "-"):
+        return None
+    try:
+        return unit_of(label, f"{name}, record {k}")
+    except SubstructureError as exc:
+        raise FileFormatError(str(exc)) from None
+
+
+def _uff_kind(name: str, records: list[dict], k: int) -> str | None:
+    spec = int(records[k].get("ordinate_spec_data_type", 0))
+    u = _uff_unit(name, records, k)
+    by_type = "force" if spec in _FORCE_TYPES else _RESPONSE_TYPES.get(spec)
+    by_unit = None
+    if u is not None:
+        for q in ("force", "acceleration", "velocity", "displacement"):
+            if (1.0 * u).check({"force": "[force]", "acceleration": "[acceleration]", "velocity": "[velocity]",
+                                "displacement": "[length]"}[q]):
+                by_unit = q
+    if by_type and by_unit and by_type != by_unit:
+        raise FileFormatError(f"{name}, record {k}: the specific data type says {by_type}, the unit label "
+                              f"{records[k].get('ordinate_axis_units_lab')!r} says {by_unit}; fix one")
+    return by_type or by_unit
+
+
+def _uff_pair(name: str, records: list[dict], kinds: list, force_record, response_record) -> tuple[int, int]:
+    """The indices of the force and the response record: given, or the one candidate of each."""
     if force_record is None:
         found = [k for k, q in enumerate(kinds) if q == "force"]
         if len(found) != 1:
@@ -439,18 +494,26 @@ def read_tap_uff(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
         if not 0 <= k < len(records):
             raise FileFormatError(f"{name}: {option} {k}: the file holds {len(records)} type-58 records "
                                   f"(0 to {len(records) - 1})")
+    return force_record, response_record
+
+
+def _uff_tap(name: str, records: list[dict], kinds: list, pair: tuple[int, int], sensitivity: Any,
+             hammer_sensitivity: Any, quantity: str | None, tap: int | None = None) -> TapRecord:
+    """The record of the force and the response records ``pair`` (``tap``: its number among the file's taps)."""
+    force_record, response_record = pair
     f_set, r_set = records[force_record], records[response_record]
+    where = "" if tap is None else f" (tap {tap})"
     t = np.asarray(f_set["x"], dtype=np.float64)
     if np.asarray(r_set["x"]).shape != t.shape or not np.allclose(r_set["x"], t, rtol=1e-9, atol=1e-12):
-        raise FileFormatError(f"{name}: records {force_record} and {response_record} have different time axes; "
-                              "expected both channels sampled together")
+        raise FileFormatError(f"{name}: records {force_record} and {response_record}{where} have different time "
+                              "axes; expected both channels sampled together")
     labels = [f"record {force_record} ({str(f_set.get('id1', '')).strip() or 'force'})",
               f"record {response_record} ({str(r_set.get('id1', '')).strip() or 'response'})"]
     try:
-        f_unit = unit(force_record) or unit_of("N", name)
+        f_unit = _uff_unit(name, records, force_record) or unit_of("N", name)
         force, _ = channel_to_si(np.real(np.asarray(f_set["data"])), f_unit, f"{name}: {labels[0]}", ("force",),
                                  hammer_sensitivity, "hammer sensitivity (--hammer-sensitivity)")
-        r_unit = unit(response_record)
+        r_unit = _uff_unit(name, records, response_record)
         if r_unit is None:
             said = kinds[response_record] if kinds[response_record] in RESPONSES else quantity
             if said is None:
@@ -463,7 +526,7 @@ def read_tap_uff(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
             raise FileFormatError(f"{name}: {labels[1]}: the specific data type says {kinds[response_record]}, the "
                                   f"sensitivity makes it {found_q}")
         check_quantity_option(quantity, found_q, f"{name}: {labels[1]}")
-        return TapRecord(t, force, response, found_q, name, labels[0], labels[1])
+        return TapRecord(t, force, response, found_q, name + where, labels[0], labels[1])
     except FileFormatError:
         raise
     except SubstructureError as exc:
@@ -485,7 +548,7 @@ def _check_abscissa(name: str, k: int, record: dict) -> None:
             time_like = False
         if not time_like:
             raise FileFormatError(f"{name}, record {k}: abscissa in {label!r}; expected a time in s")
-    x = np.asarray(record.get("x", []), dtype=np.float64)
+    x = record["x"] = regular(np.asarray(record.get("x", []), dtype=np.float64))  # times written rounded: the clock
     if x.size > 2:
         step = np.diff(x)
         mean = (x[-1] - x[0]) / (x.size - 1)
