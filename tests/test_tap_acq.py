@@ -509,6 +509,47 @@ def test_matlab_vectors_with_their_units(tmp_path):
         read_tap_mat(path)
 
 
+
+def test_matlab_matrices_of_a_tap_a_column(tmp_path, capsys):
+    from scipy.io import savemat
+
+    from substructure.io.tap_files import read_tap_mat, read_taps_mat
+
+    taps = impact_records()[:3]  # the shipped real taps, as a MATLAB acquisition returns them: a tap a column
+    fs, n = taps[0].sample_rate, taps[0].time.size
+    forces, accs = np.column_stack([r.force for r in taps]), np.column_stack([r.response for r in taps])
+    path = tmp_path / "taps.mat"
+    for layout in (lambda m: m, lambda m: m.T):  # samples down the columns, or along the rows
+        savemat(path, {"fs": fs, "force": layout(forces), "force_unit": "N", "acc": layout(accs / G), "acc_unit": "g"})
+        got = read_taps_mat(path)
+        assert [r.source[-7:] for r in got] == ["(tap 1)", "(tap 2)", "(tap 3)"]
+        for g, r in zip(got, taps):
+            assert np.array_equal(g.force, r.force) and np.allclose(g.response, r.response, rtol=1e-12, atol=0)
+            assert g.sample_rate == fs and np.allclose(g.time, r.time - r.time[0], rtol=0, atol=1e-12)
+    with pytest.raises(FileFormatError, match=r"taps.mat: the force and the response are matrices of 3 taps; read "
+                                              r"them with read_taps_mat"):
+        read_tap_mat(path)
+    # the command averages them as the same taps in files of their own
+    one_each = []
+    for k, r in enumerate(taps):
+        one_each.append(tmp_path / f"tap{k}.mat")
+        savemat(one_each[-1], {"fs": fs, "force": r.force, "force_unit": "N", "acc": r.response / G, "acc_unit": "g"})
+    code, out, err = run(capsys, "tap", *one_each, "--json")
+    assert code == 0, err
+    expected = json.loads(out)
+    code, out, err = run(capsys, "tap", path, "--json")
+    assert code == 0, err
+    assert json.loads(out)["real"] == expected["real"] and expected["averages"] == 3
+    # a response missing for a tap, a gap in one tap: refused naming them
+    savemat(path, {"fs": fs, "force": forces, "force_unit": "N", "acc": accs[:, :2], "acc_unit": "m/s^2"})
+    with pytest.raises(FileFormatError, match=rf"the force 'force' holds 3 tap\(s\) of {n} samples, the response "
+                                              rf"'acc' 2 of {n}"):
+        read_taps_mat(path)
+    forces[700, 1] = np.nan
+    savemat(path, {"fs": fs, "force": forces, "force_unit": "N", "acc": accs, "acc_unit": "m/s^2"})
+    with pytest.raises(FileFormatError, match=r"variable 'force', tap 2, sample 701: nan"):
+        read_taps_mat(path)
+
 # -- text of Windows programs ------------------------------------------------------------------------------------
 
 def test_a_header_in_windows_1252_is_read_with_a_warning_as_the_utf8_one(tmp_path):

@@ -15,7 +15,7 @@ _RECORD_SUFFIXES = _TEXT_SUFFIXES + (".lvm", ".mat") + _UFF_SUFFIXES
 
 
 def _read(path: str, args: argparse.Namespace) -> list:
-    from ..io.tap_files import read_tap_csv, read_tap_lvm, read_tap_mat, read_tap_uff, read_taps_uff
+    from ..io.tap_files import read_tap_csv, read_tap_lvm, read_taps_mat, read_tap_uff, read_taps_uff
 
     suffix = Path(path).suffix.lower()
     columns = dict(sample_rate=args.sample_rate, force_column=args.force_column,
@@ -34,7 +34,7 @@ def _read(path: str, args: argparse.Namespace) -> list:
         raise UsageError("--force-record and --response-record choose records of a universal file, "
                          f"not columns of {path} (use --force-column and --response-column)")
     if suffix == ".mat":
-        return [read_tap_mat(path, args.sensitivity, args.hammer_sensitivity, args.quantity, **columns)]
+        return read_taps_mat(path, args.sensitivity, args.hammer_sensitivity, args.quantity, **columns)
     if suffix == ".lvm":
         return read_tap_lvm(path, args.sensitivity, args.hammer_sensitivity, args.quantity, **columns)
     return [read_tap_csv(path, args.sensitivity, args.hammer_sensitivity, args.quantity, **columns)]
@@ -161,8 +161,8 @@ def add_parser(commands) -> None:
     tap = commands.add_parser("tap", help="time records of hammer taps to an FRF with coherence")
     tap.add_argument("records", nargs="+", metavar="RECORD",
                      help="tap records: CSV or text (time [s],force [N],acceleration [m/s^2], a preamble "
-                     "allowed), LabVIEW .lvm, MATLAB .mat (vectors with <name>_unit texts), or UFF type-58 time "
-                     "records (a force and a response record per tap)")
+                     "allowed), LabVIEW .lvm, MATLAB .mat (vectors, or matrices of a tap a column, with "
+                     "<name>_unit texts), or UFF type-58 time records (a force and a response record per tap)")
     tap.add_argument("--out", metavar="FRF.csv", help="write the receptance with its coherence column")
     tap.add_argument("--measurements", metavar="SET.toml", help="write a measurement set naming --out")
     tap.add_argument("--response", metavar="POINT", help="the response point of the measurement set")

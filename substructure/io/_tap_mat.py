@@ -7,7 +7,8 @@ force and the response), their units in text variables ``<name>_unit``
 sample rate in a scalar ``fs``, ``sample_rate``, ``sampling_rate``,
 ``sampling_frequency`` (Hz) or the step in ``dt`` (s).  A force or response
 vector without its unit is refused: nothing says whether it is in N or kN,
-m/s^2 or g.  Version 7.3 files are HDF5 and refused with how to re-save them.
+m/s^2 or g.  A force and a response matrix of one shape hold several taps, one a
+column.  Version 7.3 files are HDF5 and refused with how to re-save them.
 """
 
 from __future__ import annotations
@@ -40,8 +41,11 @@ def _text(value: Any) -> str | None:
 
 
 def mat_record(path: str | os.PathLike, data: bytes, sensitivity: Any, hammer_sensitivity: Any,
-               quantity: str | None, sample_rate: Any, force_column: Any, response_column: Any) -> TapRecord:
-    """A tap record from the bytes of a MATLAB file (see the module's rules); the options as for text records."""
+               quantity: str | None, sample_rate: Any, force_column: Any, response_column: Any) -> list[TapRecord]:
+    """The tap records of the bytes of a MATLAB file (see the module's rules); the options as for text records.
+
+    A force and a response that are matrices of the same shape hold a tap a column (samples along the longer
+    side, as MATLAB's acquisition functions return them): a record each."""
     from scipy import io as sio
 
     name = os.fspath(path)
@@ -62,16 +66,20 @@ def mat_record(path: str | os.PathLike, data: bytes, sensitivity: Any, hammer_se
             units[match.group(1).lower()] = text
     vectors: dict[str, np.ndarray] = {}
     scalars: dict[str, float] = {}
+    taps: dict[str, np.ndarray] = {}  # matrices of one channel, a tap a column (samples along the longer side)
     for key, value in variables.items():
         array = np.asarray(value)
         if array.dtype.kind not in "iuf":
             continue
         if array.ndim == 1 and array.size >= 2:
             vectors[key] = array.astype(np.float64)
+        elif array.ndim == 2 and min(array.shape) >= 1 and max(array.shape) >= 2:
+            taps[key] = (array if array.shape[0] >= array.shape[1] else array.T).astype(np.float64)
+            vectors[key] = taps[key][:, 0]
         elif array.ndim == 0:
             scalars[key] = float(array)
     if not vectors:
-        raise FileFormatError(f"{name}: no vector of real numbers among the variables "
+        raise FileFormatError(f"{name}: no vector or matrix of real numbers among the variables "
                               f"({', '.join(variables) or 'none'}); expected time, force and response vectors")
     names = list(vectors)
     columns = Columns(names, [units.get(n.lower()) or ("s" if _TIME.match(n) else None) for n in names], None)
@@ -109,13 +117,23 @@ def mat_record(path: str | os.PathLike, data: bytes, sensitivity: Any, hammer_se
                                   f"{names[k]}_unit (e.g. 'N', 'g', 'm/s^2', 'mV') to the file")
         if errors[k]:
             raise FileFormatError(f"{name}: {errors[k]} (variable {names[k] + '_unit'!r})")
-        bad = ~np.isfinite(vectors[names[k]])
+        values = taps.get(names[k], vectors[names[k]][:, None])
+        bad = ~np.isfinite(values)
         if bad.any():
-            j = int(np.argmax(bad))
-            raise FileFormatError(f"{name}: variable {names[k]!r}, sample {j + 1}: {float(vectors[names[k]][j])!r}; "
+            j, tap = np.unravel_index(int(np.argmax(bad)), bad.shape)
+            where = f", tap {tap + 1}" if values.shape[1] > 1 else ""
+            raise FileFormatError(f"{name}: variable {names[k]!r}{where}, sample {j + 1}: {float(values[j, tap])!r}; "
                                   "expected a finite number (a gap in the acquisition?)")
-    force, response = vectors[names[f_col]], vectors[names[r_col]]
+    force, response = (taps.get(names[k], vectors[names[k]][:, None]) for k in (f_col, r_col))
+    if t_col is not None and names[t_col] in taps and taps[names[t_col]].shape[1] > 1:
+        raise FileFormatError(f"{name}: the time {names[t_col]!r} is a matrix; expected a vector")
+    if force.shape != response.shape:
+        raise FileFormatError(f"{name}: the force {names[f_col]!r} holds {force.shape[1]} tap(s) of {force.shape[0]} "
+                              f"samples, the response {names[r_col]!r} {response.shape[1]} of {response.shape[0]}; "
+                              "expected a response for every tap (a tap a column)")
     time = None if t_col is None else (vectors[names[t_col]], parsed[t_col], f"the time vector {names[t_col]!r}")
-    time_s = time_axis(time, stated, force.size, name)
-    return build_record(name, time_s, force, parsed[f_col], labels[f_col], response, parsed[r_col], labels[r_col],
-                        sensitivity, hammer_sensitivity, quantity)
+    time_s = time_axis(time, stated, force.shape[0], name)
+    several = force.shape[1] > 1
+    return [build_record(f"{name} (tap {k + 1})" if several else name, time_s, force[:, k], parsed[f_col],
+                         labels[f_col], response[:, k], parsed[r_col], labels[r_col], sensitivity, hammer_sensitivity,
+                         quantity) for k in range(force.shape[1])]

@@ -33,7 +33,7 @@ from ._tap_build import (RESPONSES, ROUNDED_TIME_TOLERANCE, build_record, check_
                          regular, time_axis, units_of_columns)
 from ._tap_table import finite_rows, parse_rows
 
-__all__ = ["read_tap_csv", "read_tap_lvm", "read_tap_mat", "read_tap_uff", "read_taps_uff",
+__all__ = ["read_tap_csv", "read_tap_lvm", "read_tap_mat", "read_taps_mat", "read_tap_uff", "read_taps_uff",
            "MAX_RECORD_BYTES", "ROUNDED_TIME_TOLERANCE"]
 
 MAX_RECORD_BYTES = 2**29
@@ -333,6 +333,47 @@ def read_tap_mat(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
         force or response without its unit, no or several candidates for a
         channel, no time vector and no sample rate, contradicting rates,
         NaN samples, vectors of different lengths.
+    """
+    records = read_taps_mat(path, sensitivity, hammer_sensitivity, quantity, sample_rate, force_column,
+                            response_column)
+    if len(records) > 1:
+        raise FileFormatError(f"{os.fspath(path)}: the force and the response are matrices of {len(records)} taps; "
+                              "read them with read_taps_mat (the command reads every tap)")
+    return records[0]
+
+
+def read_taps_mat(path: str | os.PathLike, sensitivity: Any = None, hammer_sensitivity: Any = None,
+                  quantity: str | None = None, sample_rate: Any = None, force_column: Any = None,
+                  response_column: Any = None) -> list[TapRecord]:
+    """Read every tap of a MATLAB file: vectors as :func:`read_tap_mat`, or matrices of a tap a column.
+
+    A force and a response that are matrices of one shape hold a tap a
+    column (samples along the longer side, as MATLAB's acquisition
+    functions return them), sharing the time vector or sample rate.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file (see :func:`read_tap_mat`).
+    sensitivity, hammer_sensitivity : str or pint.Quantity, optional
+        As for :func:`read_tap_csv`.
+    quantity : {"acceleration", "velocity", "displacement"}, optional
+        What the response is; it must agree with its unit.
+    sample_rate : str, pint.Quantity or float, optional
+        As for :func:`read_tap_mat`.
+    force_column, response_column : int or str, optional
+        The force and response variables by name or 1-based index.
+
+    Returns
+    -------
+    list of TapRecord
+        One a tap, in the matrices' order (``source`` names the file and the tap).
+
+    Raises
+    ------
+    FileFormatError
+        As :func:`read_tap_mat`; also for a force and a response matrix of
+        different shapes.
     """
     from ._tap_mat import mat_record
 

@@ -14,7 +14,8 @@ The package sits next to :mod:`substructure.frf` in the layers: it needs
   :class:`TapResult`.
 
 Files are read by :mod:`substructure.io.tap_files` (``read_tap_csv``,
-``read_tap_lvm``, ``read_tap_mat``, ``read_tap_uff``, ``read_taps_uff``), the figure to check a result is
+``read_tap_lvm``, ``read_tap_mat``, ``read_taps_mat``, ``read_tap_uff``, ``read_taps_uff``), the figure to check a
+result is
 :func:`substructure.plot.plot_taps`; the command is ``substructure tap``
 (docs/tap.md).
 """
