@@ -221,10 +221,7 @@ def check_outputs(outputs: Iterable[tuple[str, Any]], inputs: Iterable[Any], ove
     """
     from ..io import check_writable
 
-    read = {}
-    for path in inputs:
-        if path is not None:
-            read[_resolved(path)] = os.fspath(path)
+    read = {_resolved(path): os.fspath(path) for path in inputs if path is not None}
     seen: dict[Path, str] = {}
     for option, path in outputs:
         if path is None:
@@ -237,7 +234,6 @@ def check_outputs(outputs: Iterable[tuple[str, Any]], inputs: Iterable[Any], ove
             raise UsageError(f"argument {option}: {os.fspath(path)} is also the file of {seen[where]}")
         seen[where] = option
         check_writable(path, overwrite, option)
-
 
 
 def band_arg(text: str):
@@ -282,7 +278,6 @@ def measurement_inputs(path) -> list:
     A file that cannot be read yields itself only: loading it reports the
     problem properly.
     """
-    from ..errors import SubstructureError
     from .._toml import read_toml
 
     files: list = [path]

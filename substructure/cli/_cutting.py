@@ -152,6 +152,8 @@ def add_cut_options(parser: argparse.ArgumentParser) -> None:
 
 def add_lobes_options(parser: argparse.ArgumentParser) -> None:
     """Add ``--method``, ``--speeds`` and ``--intervals`` to a command's parser."""
+    # '-2000:24000:50' is a (bad) value, not an option: let it reach the option's check
+    parser._negative_number_matcher = re.compile(r"^-[\d.]")
     parser.add_argument("--method", choices=("zoa", "sdm"), default="zoa",
                         help="zoa: zero-order (default, from FRF data); sdm: semi-discretization (modes; fitted "
                              "to FRF data when needed)")
@@ -179,10 +181,7 @@ def tool_of(assembly: Any, at: str):
     from ..points import parse_point
 
     name = parse_point(at).component
-    for comp in assembly.components:
-        if isinstance(comp, Tool) and comp.name == name:
-            return comp
-    return None
+    return next((comp for comp in assembly.components if isinstance(comp, Tool) and comp.name == name), None)
 
 
 def cut_from_args(args: argparse.Namespace, tool: Any, notes: list[str]):

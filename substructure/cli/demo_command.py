@@ -139,8 +139,7 @@ def _demo_diagnose(state: DemoState) -> None:
         what = "model as given" if step.added is None else f"+ {step.added.name} at {step.added.where}"
         state.lines.append(f"  step {step.step}: {what:45s} error {step.error:.4f}")
     for name, make in (("where_it_fails.png", result.plot_where), ("error_fall.png", result.plot_history)):
-        fig = make()
-        save_figure(fig, state.out / name, state.overwrite)
+        save_figure(make(), state.out / name, state.overwrite)
         state.files.append(str(state.out / name))
     path = state.out / "improved_assembly.toml"
     save_assembly(result.refined_assembly, path, overwrite=state.overwrite)

@@ -23,12 +23,6 @@ FIGURES = ("where_it_fails.png", "error_fall.png", "after_refinement.png")
 """The figures ``--plot DIR`` writes."""
 
 
-def _summary(result, assembly, measurements) -> list[str]:
-    from ..diagnose.words import summary
-
-    return summary(result, assembly.name, len(measurements))
-
-
 def run(args: argparse.Namespace) -> int:
     from ..diagnose import diagnose
     from ..io.assembly_toml import load_assembly, save_assembly
@@ -59,14 +53,12 @@ def run(args: argparse.Namespace) -> int:
         figures()
         out = Path(args.plot)
         out.mkdir(parents=True, exist_ok=True)
-        for name, make in ((FIGURES[0], result.plot_where), (FIGURES[1], result.plot_history)):
-            fig = make()
-            save_figure(fig, out / name, args.overwrite)
-            written.append(str(out / name))
+        makers = [result.plot_where, result.plot_history]
         if len(result.refinement) > 1:
-            fig = result.final[0].plot()
-            save_figure(fig, out / FIGURES[2], args.overwrite)
-            written.append(str(out / FIGURES[2]))
+            makers.append(lambda: result.final[0].plot())
+        for name, make in zip(FIGURES, makers):
+            save_figure(make(), out / name, args.overwrite)
+            written.append(str(out / name))
     notes = []
     saved = None
     if args.save_model and (result.explained or args.save_partial):
@@ -84,7 +76,9 @@ def run(args: argparse.Namespace) -> int:
         return print_json(data)
     for note in notes:
         print(f"{PROG}: {note}", file=sys.stderr)
-    print("\n".join(_summary(result, assembly, measurements)))
+    from ..diagnose.words import summary
+
+    print("\n".join(summary(result, assembly.name, len(measurements))))
     for path in written:
         print(f"wrote {path}")
     return 0

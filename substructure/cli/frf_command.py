@@ -31,9 +31,7 @@ def run(args: argparse.Namespace) -> int:
     to = point_arg(args.to) if args.to else at
     frequency = args.grid or assembly.frequency
     if frequency is None:
-        raise UsageError(
-            f"{args.assembly} has no [frequency] table; give the grid with --grid START:STOP:STEP"
-        )
+        raise UsageError(f"{args.assembly} has no [frequency] table; give the grid with --grid START:STOP:STEP")
     frf = assembly.receptance(at, to, frequency)
     peaks = peak_table(frf)
     written = []

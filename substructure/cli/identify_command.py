@@ -18,7 +18,6 @@ from ._common import (
 
 def run(args: argparse.Namespace) -> int:
     from ..io.assembly_toml import load_assembly
-
     from ..identify import identify_joint
     from ..io.measurements import load_measurements
 

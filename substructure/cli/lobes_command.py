@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import re
 import warnings
 
 from ..errors import SubstructureError
-from ._common import UsageError, check_outputs, check_plot, draw_to, grid_text, point_arg, print_json
+from ._common import UsageError, check_outputs, check_plot, draw_to, grid_text, one_line, point_arg, print_json
 from ._cutting import (
     MILLING_DEFAULT_NOTE,
     add_cut_options,
@@ -24,7 +23,7 @@ def _lobes_structure(args: argparse.Namespace):
     """The structure, a line describing it, the band chosen and the tool: FRF (labelled x/y) or ModalModel."""
     from ..frf import FRF
     from ..io.assembly_toml import load_assembly
-    from ..stability import ModalModel, assembly_structure, xy_frf
+    from ..stability import ModalModel, assembly_structure, choose_band, xy_frf
 
     sources = [name for name, value in (("--assembly", args.assembly), ("--frf", args.frf), ("--modes", args.modes))
                if value is not None]
@@ -60,8 +59,6 @@ def _lobes_structure(args: argparse.Namespace):
         y = FRF.from_csv(args.frf_y) if args.frf_y else None
         frf = xy_frf(x, y)
         what = f"FRF from {args.frf}" + (f" (x) and {args.frf_y} (y)" if args.frf_y else ", y = x (a symmetric tool)")
-    from ..stability import choose_band
-
     frf, band = choose_band(frf, band)
     return frf, f"{what}, {grid_text(frf.frequency)}", band, tool
 
@@ -111,7 +108,7 @@ def run(args: argparse.Namespace) -> int:
         try:
             best = recommend(lobes, cut, limits, margin=args.margin, speed_tolerance=args.speed_tolerance)
         except NoRecommendationError as exc:  # the lobes stand; the recommendation is absent, with the reason
-            why = " ".join(str(exc).split())
+            why = one_line(exc)
     else:
         why = "the machinist's recommendation is for milling cuts"
         notes.append(f"no recommendation: {why}")
@@ -204,5 +201,3 @@ def add_parser(commands) -> None:
     lobes.add_argument("--overwrite", action="store_true", help="let --plot replace an existing file")
     lobes.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
     lobes.set_defaults(run=run)
-    # '-2000:24000:50' is a (bad) value, not an option: let it reach the option's check
-    lobes._negative_number_matcher = re.compile(r"^-[\d.]")

@@ -25,7 +25,6 @@ def _features(text: str) -> dict[str, str]:
 
 def run(args: argparse.Namespace) -> int:
     from ..io.assembly_toml import load_assembly
-
     from ..surrogate import JointTable, cross_validate, make_surrogate
 
     check_plot(args.plot)

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import re
 import shlex
 import sys
 import warnings
@@ -59,7 +58,7 @@ def _title(text: str) -> str:
 def run(args: argparse.Namespace) -> int:
     from ..io.assembly_toml import load_assembly
     from ..report import report, tool_point
-    from ..stability import MillingCut
+    from ..stability import CuttingDataWarning, MillingCut
 
     suffix = Path(args.out).suffix.lower()
     if suffix not in REPORT_SUFFIXES:
@@ -101,10 +100,6 @@ def run(args: argparse.Namespace) -> int:
                     margin=args.margin, speed_tolerance=args.speed_tolerance, identify=args.identify,
                     title=args.title, notes=notes, command=command, progress=progress or False,
                     tool_material=args.tool_material, cutting_table=args.cutting_data)
-    import warnings
-
-    from ..stability import CuttingDataWarning
-
     for text in (result.cutting or {}).get("warnings", []):
         warnings.warn(f"{text}: check the recommendation against your tool maker's data", CuttingDataWarning,
                       stacklevel=2)
@@ -168,5 +163,3 @@ def add_parser(commands) -> None:
     rep.add_argument("--json", action="store_true",
                      help="print one JSON object (the report's summary) instead of the lines for people")
     rep.set_defaults(run=run)
-    # '-2000:24000:50' is a (bad) value, not an option: let it reach the option's check
-    rep._negative_number_matcher = re.compile(r"^-[\d.]")

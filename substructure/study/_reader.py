@@ -27,6 +27,8 @@ from typing import Any
 
 from .._toml import TomlDocument, key_path, loads_toml
 from ..errors import FileFormatError, SubstructureError
+from .settings import Compute, Grid
+from .spec import _CUT_KEYS, Combination, Cut, Machine, SurrogateSpec
 
 __all__ = ["read_study", "reads_study", "read_combinations_csv", "TOP_KEYS"]
 
@@ -34,8 +36,6 @@ __all__ = ["read_study", "reads_study", "read_combinations_csv", "TOP_KEYS"]
 TOP_KEYS = ("name", "joint", "plugins", "combinations_csv", "grid", "compute", "surrogate", "machines", "cuts",
             "combinations")
 _MACHINE_KEYS = ("name", "assembly", "supports", "limits")
-_CUT_KEYS = ("name", "workpiece", "workpiece_table", "kt", "kn", "kr", "radial_depth", "immersion", "milling",
-             "feed_per_tooth", "max_depth")
 _COMBINATION_KEYS = ("name", "tool", "holder", "joint", "features", "machines", "cuts")
 _GRID_KEYS = ("frequency", "speeds", "sdm_speeds")
 _COMPUTE_KEYS = ("at", "lobes", "recommend", "band", "samples", "quantiles", "margin", "speed_tolerance", "figures",
@@ -74,9 +74,6 @@ class _Reader:
 
     # -- sections ------------------------------------------------------------------
     def study(self, cls):
-        from .settings import Compute, Grid
-        from .spec import SurrogateSpec
-
         data = self.table(self.data, [], TOP_KEYS, ("name",))
         if not isinstance(data["name"], str) or not data["name"].strip():
             raise self.error(["name"], f"got {data['name']!r}; expected the study's name")
@@ -109,8 +106,6 @@ class _Reader:
                          tuple(plugins), source=self.source, inputs=tuple(self.inputs))
 
     def machine(self, table, parts):
-        from .spec import Machine
-
         table = self.table(table, parts, _MACHINE_KEYS, ("name",))
         kw = dict(table)
         assembly = table.get("assembly", "default")
@@ -118,8 +113,6 @@ class _Reader:
         return self.call(parts, Machine, **kw, where=f"{self.where(parts)}: {key_path(parts)}")
 
     def cut(self, table, parts):
-        from .spec import Cut
-
         table = self.table(table, parts, _CUT_KEYS, ("name",))
         kw = dict(table)
         if "workpiece_table" in table:
@@ -127,8 +120,6 @@ class _Reader:
         return self.call(parts, Cut, **kw, where=f"{self.where(parts)}: {key_path(parts)}")
 
     def combination(self, table, parts):
-        from .spec import Combination
-
         table = self.table(table, parts, _COMBINATION_KEYS, ("name",))
         return self.call(parts, Combination, **table, where=f"{self.where(parts)}: {key_path(parts)}")
 
@@ -151,8 +142,7 @@ def read_study(cls: Any, path: Any) -> Any:
 _HEAD = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_.]*)\s*(?:\[([^\]]*)\])?\s*$")
 _CSV_PREFIXES = ("tool.", "holder.", "joint.k.", "joint.c.", "features.")
 _CSV_PLAIN = ("name", "machines", "cuts")
-_INTEGER = ("tool.teeth",)
-_NUMBER = ("tool.diameter_ratio",)
+_CONVERT = {"tool.teeth": (int, "a whole number"), "tool.diameter_ratio": (float, "a number")}
 _BOOL = ("holder.shank_taper",)
 
 
@@ -165,16 +155,12 @@ def _csv_cell(column: str, unit: str | None, cell: str, where: str):
         if not finite:
             raise FileFormatError(f"{where}: {column}: got {cell!r}; expected a finite number (in {unit})")
         return f"{cell} {unit}"
-    if column in _INTEGER:
+    if column in _CONVERT:
+        kind, expected = _CONVERT[column]
         try:
-            return int(cell)
+            return kind(cell)
         except ValueError:
-            raise FileFormatError(f"{where}: {column}: got {cell!r}; expected a whole number") from None
-    if column in _NUMBER:
-        try:
-            return float(cell)
-        except ValueError:
-            raise FileFormatError(f"{where}: {column}: got {cell!r}; expected a number") from None
+            raise FileFormatError(f"{where}: {column}: got {cell!r}; expected {expected}") from None
     if column in _BOOL:
         if cell.lower() not in ("true", "false"):
             raise FileFormatError(f"{where}: {column}: got {cell!r}; expected true or false")
@@ -202,7 +188,6 @@ def read_combinations_csv(path: Any) -> list:
         In file order, each knowing its file and line.
     """
     from ..io import read_text
-    from .spec import Combination
 
     name = os.fspath(path)
     text = read_text(name, "combinations table")

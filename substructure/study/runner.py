@@ -27,6 +27,7 @@
 from __future__ import annotations
 
 import contextlib
+import importlib.util
 import json
 import os
 import re
@@ -233,6 +234,14 @@ class _Store:
             return None
         return data
 
+    def load_all(self, tasks: list[dict], finished: dict, problems: list[str] | None = None) -> None:
+        """Put the saved results of the tasks not in ``finished`` into it (:meth:`load`)."""
+        for task in tasks:
+            if task["key"] not in finished:
+                record = self.load(task, problems)
+                if record is not None:
+                    finished[task["key"]] = record
+
     def save(self, result: dict) -> dict:
         from ..io import write_bytes, write_text
 
@@ -280,25 +289,18 @@ def _write_frf(data: dict, path: Path) -> None:
 
 
 def _crashed(task: dict, exc: BaseException) -> dict:
-    from .task import _failed_row
-
     what = " ".join(str(exc).split())
     message = (f"{task['where']}: the worker computing it was lost ({type(exc).__name__}"
                + (f": {what}" if what else "") + "); --resume (resume=True) tries it again")
-    rows = [_failed_row(task, spec, message) for spec in (task["cuts"] or [None])]
-    for row in rows:
-        row["status"] = "crashed"
-    return {"key": task["key"], "fingerprint": task["fingerprint"], "status": "crashed", "rows": rows,
-            "figure": None, "frf": None, "elapsed_s": None}
+    return {"key": task["key"], "fingerprint": task["fingerprint"], "status": "crashed",
+            "rows": _status_rows(task, "crashed", message), "figure": None, "frf": None, "elapsed_s": None}
 
 
-def _pending(task: dict) -> list[dict]:
+def _status_rows(task: dict, status: str, message: str = "") -> list[dict]:
+    """The rows of a task not computed (one per cut), with this status and message."""
     from .task import _failed_row
 
-    rows = [_failed_row(task, spec, "") for spec in (task["cuts"] or [None])]
-    for row in rows:
-        row["status"] = "pending"
-    return rows
+    return [{**_failed_row(task, spec, message), "status": status} for spec in (task["cuts"] or [None])]
 
 
 def _serial(tasks: list[dict]):
@@ -333,7 +335,6 @@ def _on_dask(client, tasks: list[dict]):
 
 
 def _local_cluster(kind: str, n: int, progress: Progress):
-    import importlib.util
     import logging
 
     from distributed import Client, LocalCluster
@@ -384,8 +385,6 @@ def _dashboard_address() -> str:
 
 def _dashboard(client, progress: Progress) -> None:
     link = getattr(client, "dashboard_link", None)
-    import importlib.util
-
     if link and importlib.util.find_spec("bokeh") is not None:
         progress.say(f"Dask dashboard: {link}")
     else:
@@ -411,10 +410,7 @@ def run_study(study, client: Any = None, out: Any = None, scheduler: str | None 
         store.check(tasks, resume, overwrite)
         if resume:
             problems: list[str] = []
-            for task in tasks:
-                record = store.load(task, problems)
-                if record is not None:
-                    finished[task["key"]] = record
+            store.load_all(tasks, finished, problems)
             for problem in problems:  # a result file edited or cut short by hand: never a row twice or a crash
                 warnings.warn(f"resume: {problem}", SubstructureWarning, stacklevel=2)
         store.root.mkdir(parents=True, exist_ok=True)
@@ -458,11 +454,7 @@ def run_study(study, client: Any = None, out: Any = None, scheduler: str | None 
             report.say("every combination was finished before; assembling the table")
     except KeyboardInterrupt:
         if store is not None:  # a result saved just as the signal came is on disk, if not yet counted here
-            for task in tasks:
-                if task["key"] not in finished:
-                    record = store.load(task)
-                    if record is not None:
-                        finished[task["key"]] = record
+            store.load_all(tasks, finished)
         message = (f"interrupted: {len(finished)} of {len(tasks)} combinations saved"
                    + (f" in {store.root}; --resume (resume=True) to continue" if store else " (no output directory)"))
         report.say(message)
@@ -483,7 +475,7 @@ def _assemble(study, tasks: list[dict], finished: dict, store: _Store | None):
     rows = []
     for task in tasks:
         record = finished.get(task["key"])
-        rows += record["rows"] if record is not None else _pending(task)
+        rows += record["rows"] if record is not None else _status_rows(task, "pending")
     table = make_table(rows)
     if store is not None:
         write_table(table, store.root / "table.parquet", store.root / "table.csv")

@@ -225,12 +225,8 @@ class Study:
         list of (Combination, Machine)
             Combinations in order, each with its machines in the study's order.
         """
-        out = []
-        for combo in self.combinations:
-            for machine in self.machines:
-                if combo.machines is None or machine.name in combo.machines:
-                    out.append((combo, machine))
-        return out
+        return [(combo, machine) for combo in self.combinations for machine in self.machines
+                if combo.machines is None or machine.name in combo.machines]
 
     def _model(self):
         if "model" not in self._fitted:

@@ -256,12 +256,7 @@ def _lobes(method: str, frf, band, cut, speeds, notes: list[str]):
 
 
 def _caught(record: list) -> list[str]:
-    out = []
-    for w in record:
-        text = " ".join(str(w.message).split())
-        if text not in out:
-            out.append(text)
-    return out
+    return list(dict.fromkeys(" ".join(str(w.message).split()) for w in record))
 
 
 def _entry(joint, kind: str, entry: str) -> float | None:
@@ -352,10 +347,9 @@ def _one_cut(task: dict, spec: dict, tool, nominal: dict, members: list[dict], n
         row[f"{method}_min_limit_m"] = float(np.min(lobes[method].depth_limit_m))
         if method == "zoa" and lobes[method].absolute_limit_m is not None:
             row["zoa_absolute_limit_m"] = float(lobes[method].absolute_limit_m)
-    best = None
+    best = band = None
     method = compute["recommend_method"]
     if compute["recommend"] and method is not None:
-        band = None
         if len(members) > 1:
             n = speeds if method == "zoa" else sdm_speeds
             others = [lobes[method] if m["q"] == 0.5 else
@@ -368,7 +362,7 @@ def _one_cut(task: dict, spec: dict, tool, nominal: dict, members: list[dict], n
                       speed_tolerance=compute["speed_tolerance"], band=band)
         row["method"] = method
         row.update(_recommendation_columns(best))
-    return row, lobes, best, band if compute["recommend"] and method is not None else None
+    return row, lobes, best, band
 
 
 def _figure(task: dict, nominal: dict, members: list, envelope, cuts: list) -> bytes:
@@ -472,14 +466,9 @@ def _failed_row(task: dict, spec: dict | None, message: str) -> dict:
     return row
 
 
-def _structure(assembly, point: str, frequency):
-    from ..stability import assembly_structure
-
-    return assembly_structure(assembly, point, frequency)
-
-
 def _compute(task: dict, out: dict) -> list[dict]:
     from ..frf import Frequency
+    from ..stability import assembly_structure
 
     where, compute, grid = task["where"], task["compute"], task["grid"]
     with warnings.catch_warnings(record=True) as record:
@@ -492,7 +481,8 @@ def _compute(task: dict, out: dict) -> list[dict]:
         else:
             raise _Failed(f"{where}: the machine's assembly has no [frequency] and the study no [grid] frequency")
         point = compute["point"]
-        nominal = {"q": 0.5, "frf_band": _guard(where, f"FRF at {point}", _structure, assembly, point, frequency)}
+        nominal = {"q": 0.5, "frf_band": _guard(where, f"FRF at {point}", assembly_structure, assembly, point,
+                                                   frequency)}
         nominal["tool_mode"] = _tool_mode(*nominal["frf_band"])
         members: list[dict] = []
         envelope = None
@@ -504,8 +494,8 @@ def _compute(task: dict, out: dict) -> list[dict]:
                     members.append(nominal)
                     continue
                 variant = assembly.with_joint(joint_at_quantile(template, prediction, q))
-                member = {"q": q, "frf_band": _guard(where, f"FRF at quantile {q:g}", _structure, variant, point,
-                                                     frequency)}
+                member = {"q": q, "frf_band": _guard(where, f"FRF at quantile {q:g}", assembly_structure, variant,
+                                                     point, frequency)}
                 member["tool_mode"] = _tool_mode(*member["frf_band"], near=nominal["tool_mode"][0])
                 members.append(member)
     if banded and compute["figures"]:  # for the figure only: the rows do not depend on it
@@ -535,9 +525,7 @@ def _compute(task: dict, out: dict) -> list[dict]:
                 drawn.append((spec, lobes, best, lband))
             except _Failed as exc:
                 row = _cut_row(base, spec, None)
-                row.update(status="failed", error=str(exc))
-                for key in ("method",):
-                    row[key] = None
+                row.update(status="failed", error=str(exc), method=None)
                 drawn.append((spec, None, None, None))
         notes += [n for n in _caught(record) if n not in notes]
         row["notes"] = "; ".join(notes)

@@ -282,8 +282,7 @@ class JointSurrogate(BaseEstimator):
             y = table.values(t)
             if np.any(y <= 0):
                 raise InvalidValueError(f"{t}: the surrogates learn log values and need positive values")
-            logy = np.log(y)
-            self.models_[t] = self._fit_one(X, logy)
+            self.models_[t] = self._fit_one(X, np.log(y))
         return self
 
     def _columns(self, features) -> dict[str, list]:

@@ -72,19 +72,15 @@ class JointTable:
         for name, unit in self.features.items():
             if unit is not None:
                 _check_unit(unit, name)
-        n = None
         for name in [*self.parameters, *self.features]:
             if name not in self.columns:
                 raise InvalidValueError(f"joint table: column {name!r} is missing")
+        n = len(next(iter(self.columns.values())))
         for name, col in self.columns.items():
-            if n is None:
-                n = len(col)
-            elif len(col) != n:
+            if len(col) != n:
                 raise InvalidValueError(f"joint table: column {name!r} has {len(col)} rows, expected {n}")
         for name in self.parameters:
-            std = name + "_std"
-            if std not in self.columns:
-                self.columns[std] = np.full(n or 0, np.nan)
+            self.columns.setdefault(name + "_std", np.full(n, np.nan))
         _check_columns(self.parameters, self.features, self.columns, lambda i: f"joint table, row {i + 1}")
 
     # -- construction ---------------------------------------------------------------------
@@ -477,12 +473,7 @@ class JointTable:
                 else:
                     cells.append(repr(float(v)))
             w.writerow(cells)
-        text = buf.getvalue()
-        if path is not None:
-            from ..io import write_text
-
-            write_text(path, text)
-        return text
+        return _written(buf.getvalue(), path)
 
     def to_toml(self, path: str | Path | None = None) -> str:
         """Write the table as TOML: a ``[[joints]]`` table per row, every value with its unit.
@@ -515,12 +506,7 @@ class JointTable:
             rows.append(row)
         header = {"parameters": dict(self.parameters),
                   "features": {f: (u if u is not None else "categorical") for f, u in self.features.items()}}
-        text = tomli_w.dumps({**header, "joints": rows})
-        if path is not None:
-            from ..io import write_text
-
-            write_text(path, text)
-        return text
+        return _written(tomli_w.dumps({**header, "joints": rows}), path)
 
     @classmethod
     def from_toml(cls, path: str | Path) -> "JointTable":
@@ -571,6 +557,15 @@ class JointTable:
         """
         feats = ", ".join(f"{f} [{u}]" if u else f"{f} (categorical)" for f, u in self.features.items())
         return f"{len(self)} joints; parameters {', '.join(self.parameters)}; features {feats}"
+
+
+def _written(text: str, path: str | Path | None) -> str:
+    """``text``, written to ``path`` first unless it is None."""
+    if path is not None:
+        from ..io import write_text
+
+        write_text(path, text)
+    return text
 
 
 def thesis_table_4_2() -> JointTable:
