@@ -21,12 +21,8 @@ MILLING_ALIASES = {"up": "up", "conventional": "up", "down": "down", "climb": "d
 
 
 def _teeth(value: Any) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        if isinstance(value, numbers.Real) and float(value).is_integer() and not isinstance(value, bool):
-            value = int(value)
-        else:
-            raise InvalidValueError(f"teeth: got {show_value(value)}; expected a whole number of teeth >= 1")
-    if value < 1:
+    whole = isinstance(value, numbers.Integral) or (isinstance(value, numbers.Real) and float(value).is_integer())
+    if isinstance(value, bool) or not whole or value < 1:
         raise InvalidValueError(f"teeth: got {show_value(value)}; expected a whole number of teeth >= 1")
     return int(value)
 

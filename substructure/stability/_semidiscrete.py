@@ -76,12 +76,10 @@ class _Grid:
         self.theta = np.array(edges)
         self.cutting = np.array(flags, dtype=bool)
         self.period_angle = cut.period_angle
-        self.teeth = cut.regenerations_per_revolution
-        mean = np.zeros((self.cutting.size, 2, 2))
+        self.mean = np.zeros((self.cutting.size, 2, 2))
         if self.cutting.any():
             idx = np.flatnonzero(self.cutting)
-            mean[idx] = cut.force_matrix_average(self.theta[idx], self.theta[idx + 1])
-        self.mean = mean
+            self.mean[idx] = cut.force_matrix_average(self.theta[idx], self.theta[idx + 1])
 
     @property
     def size(self) -> int:

@@ -228,11 +228,8 @@ def cutting_conditions(cut: Any, speed_rpm: Any, data: CuttingData | None = None
         lo, hi = data.speed_range_m_per_min
         inside = (vc >= lo * (1 - 1e-12)) & (vc <= hi * (1 + 1e-12))
         result["speed_in_range"] = bool(inside) if scalar else inside
-        if fz is None:
-            result["feed_in_range"] = None
-        else:
-            flo, fhi = data.feed_range_m
-            result["feed_in_range"] = bool(flo * (1 - 1e-12) <= fz <= fhi * (1 + 1e-12))
+        flo, fhi = data.feed_range_m
+        result["feed_in_range"] = None if fz is None else bool(flo * (1 - 1e-12) <= fz <= fhi * (1 + 1e-12))
         result["range"] = data.to_json()
     return result
 

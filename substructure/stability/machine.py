@@ -256,8 +256,7 @@ class MachineLimits:
             return float(v.m_as(unit))
 
         return {"max_speed_rpm": self.max_speed, "min_speed_rpm": self.min_speed, "power_w": value(self.power, "W"),
-                "torque_n_m": value(self.torque, "N*m"),
-                "max_depth_m": None if self.max_depth is None else float(self.max_depth.m_as("m"))}
+                "torque_n_m": value(self.torque, "N*m"), "max_depth_m": value(self.max_depth, "m")}
 
 
 def _positive_length(value: Any, field: str) -> pint.Quantity:
@@ -325,8 +324,7 @@ def cut_power(cut: Any, depth_m: Any, speed_rpm: Any) -> np.ndarray:
     phi = 0.5 * (ex - st) * x + 0.5 * (ex + st)
     integral = 0.5 * (ex - st) * float(np.sum(w * _tangential_law(cut)(c * np.sin(phi))))
     radius = 0.5 * float(cut.diameter.m_as("m"))
-    n = np.asarray(speed_rpm, dtype=float)
-    return np.asarray(depth_m, dtype=float) * n * cut.teeth / 60.0 * radius * integral
+    return np.asarray(depth_m, dtype=float) * np.asarray(speed_rpm, dtype=float) * cut.teeth / 60.0 * radius * integral
 
 
 def cut_torque(cut: Any, depth_m: Any, speed_rpm: Any) -> np.ndarray:

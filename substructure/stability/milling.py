@@ -363,12 +363,7 @@ class MillingCut:
             if 1e-12 < r < p - 1e-12:
                 cuts.add(r)
         edges = sorted(cuts)
-        arcs = []
-        for a, b in zip(edges[:-1], edges[1:]):
-            mid = 0.5 * (a + b)
-            cutting = self._teeth_in_cut(mid).size > 0
-            arcs.append((a, b, bool(cutting)))
-        return arcs
+        return [(a, b, self._teeth_in_cut(0.5 * (a + b)).size > 0) for a, b in zip(edges[:-1], edges[1:])]
 
     def _teeth_in_cut(self, theta: float) -> np.ndarray:
         st, ex = self.angles
@@ -398,9 +393,8 @@ class MillingCut:
         out = np.zeros(theta_a.shape + (2, 2))
         for i, (a, b) in enumerate(zip(theta_a, theta_b)):
             for j in self._teeth_in_cut(0.5 * (a + b)):
-                offset = j * self.period_angle
-                phi_mid = np.mod(0.5 * (a + b) + offset, 2.0 * np.pi)
-                shift = phi_mid - 0.5 * (a + b)  # unwrapped angle of tooth j is theta + shift
+                # the unwrapped angle of tooth j is theta + shift
+                shift = np.mod(0.5 * (a + b) + j * self.period_angle, 2.0 * np.pi) - 0.5 * (a + b)
                 upper = _force_antiderivative(np.array(b + shift), self.kr)
                 lower = _force_antiderivative(np.array(a + shift), self.kr)
                 out[i] += (upper - lower) / (b - a)

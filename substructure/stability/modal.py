@@ -63,19 +63,11 @@ def _direction(value: Any) -> str:
     return value
 
 
-def _positive(field: str, dimension: str):
+def _in_range(field: str, dimension: str, unit: str, limits: tuple[float, float], name: str):
     def convert(value: Any) -> pint.Quantity:
         q = quantity(value, field, dimension)
         if q.magnitude <= 0:
             raise InvalidValueError(f"{field}: got {value!r}; expected a positive value")
-        return q
-
-    return convert
-
-
-def _in_range(field: str, dimension: str, unit: str, limits: tuple[float, float], name: str):
-    def convert(value: Any) -> pint.Quantity:
-        q = _positive(field, dimension)(value)
         lo, hi = limits
         v = float(q.m_as(unit))
         if not lo <= v <= hi:
@@ -514,23 +506,20 @@ def fit_modes(structure: FRF, n_modes: int | None = None, band: tuple[float, flo
     -----
     Cross terms are not fitted; a warning says so when they are not zero.
     """
-    fitter = ModalFitter(n_modes=n_modes, band=band, prominence=prominence)
+    def fitted(frf: FRF, direction: str) -> ModalFitter:
+        return ModalFitter(n_modes=n_modes, band=band, prominence=prominence).fit(frf, direction)
+
     if isinstance(structure, FRF) and structure.shape[1:] == (1, 1):
-        fitter.fit(structure, "x")
-        fits = [fitter]
-        modes = list(fitter.modes_) + [attrs.evolve(m, direction="y") for m in fitter.modes_]
+        fits = [fitted(structure, "x")]
+        modes = list(fits[0].modes_) + [attrs.evolve(m, direction="y") for m in fits[0].modes_]
     else:
         hz, g = xy_receptance(structure)
         frequency = Frequency(hz)
         if np.any(g[:, 0, 1] != 0) or np.any(g[:, 1, 0] != 0):
             warnings.warn("fit_modes: the cross receptances xy and yx are not fitted (modes act in x or y only)",
                           ModalFitWarning, stacklevel=2)
-        modes, fits = [], []
-        for i, d in enumerate(XY_LABELS):
-            part = ModalFitter(n_modes=n_modes, band=band, prominence=prominence)
-            part.fit(FRF.single(frequency, g[:, i, i], output=d, input=d), d)
-            modes += list(part.modes_)
-            fits.append(part)
+        fits = [fitted(FRF.single(frequency, g[:, i, i], output=d, input=d), d) for i, d in enumerate(XY_LABELS)]
+        modes = [m for fit in fits for m in fit.modes_]
     worst = max(fit.modal_error_ for fit in fits)
     if worst > max_error:
         warnings.warn(f"fit_modes: the fitted modes miss the data by {worst:.0%} (relative); "

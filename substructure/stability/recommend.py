@@ -206,7 +206,7 @@ def _check(value: Any, field: str, lo: float, hi: float) -> float:
     try:
         v = float(value)
     except (TypeError, ValueError):
-        raise InvalidValueError(f"{field}: got {value!r}; expected a number in [{lo:g}, {hi:g})") from None
+        v = np.nan
     if not lo <= v < hi:
         raise InvalidValueError(f"{field}: got {value!r}; expected a number in [{lo:g}, {hi:g})")
     return v

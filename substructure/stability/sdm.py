@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InvalidValueError
-from ..units import to_si
+from ..units import Q_, to_si
 from ._semidiscrete import _chatter, _critical, _Plan, expm_batch
 from .speeds import as_speed_rpm
 from .modal import ModalModel
@@ -73,8 +73,7 @@ def _check_model(modes: Any) -> ModalModel:
 
 
 def _check_intervals(intervals: Any) -> None:
-    if intervals is not None and isinstance(intervals, (int, np.integer)) and not isinstance(intervals, bool) \
-            and intervals > MAX_INTERVALS:
+    if isinstance(intervals, (int, np.integer)) and not isinstance(intervals, bool) and intervals > MAX_INTERVALS:
         raise InvalidValueError(
             f"intervals: got {intervals}; the limit is MAX_INTERVALS = {MAX_INTERVALS} per delay period (the "
             "monodromy matrix grows with the square of the count, the work with its cube); the default "
@@ -346,7 +345,6 @@ def sdm(modes: ModalModel, cut: Any, speeds: Any, *, intervals: int | None = Non
         ladder = np.geomspace(lo, hi, int(np.ceil(np.log(hi / lo) / np.log(coarse_ratio))) + 1)
     ns = speeds_rpm.size
     lo_d, hi_d, mu_hi, rho_lo, evaluations = _bracket(model, plan, speeds_rpm, ladder)
-    found = np.isfinite(hi_d)
     evaluations += _refine(model, plan, speeds_rpm, lo_d, hi_d, mu_hi, rho_lo, rtol)
     evaluations += _continue(model, plan, speeds_rpm, lo_d, hi_d, mu_hi, rho_lo, rtol, coarse_ratio)
     found = np.isfinite(hi_d)
@@ -384,8 +382,6 @@ class _SdmSource:
         self.model, self.cut, self.settings = model, cut, settings
 
     def limit(self, speeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        from ..units import Q_
-
         order = np.argsort(speeds)
         unique, inverse = np.unique(speeds[order], return_inverse=True)
         result = sdm(self.model, self.cut, Q_(unique, "rpm"), **self.settings)

@@ -75,19 +75,14 @@ def xy_frf(x: FRF, y: FRF | None = None, xy: FRF | None = None, yx: FRF | None =
     parts = {"xx": x, "yy": y}
     if xy is not None:
         parts["xy"], parts["yx"] = _one_entry(xy, "xy"), _one_entry(yx, "yx")
+    data = np.zeros((x.frequency.n, 2, 2), dtype=complex)
     for name, frf in parts.items():
         if frf.frequency != x.frequency:
             raise FrequencyAxisMismatchError(
                 f"{name}: on {frf.frequency!r}, while x is on {x.frequency!r}; "
                 "interpolate them to one grid first (FRF.interpolate)"
             )
-    n = x.frequency.n
-    data = np.zeros((n, 2, 2), dtype=complex)
-    data[:, 0, 0] = parts["xx"].data[:, 0, 0]
-    data[:, 1, 1] = parts["yy"].data[:, 0, 0]
-    if "xy" in parts:
-        data[:, 0, 1] = parts["xy"].data[:, 0, 0]
-        data[:, 1, 0] = parts["yx"].data[:, 0, 0]
+        data[:, XY_LABELS.index(name[0]), XY_LABELS.index(name[1])] = frf.data[:, 0, 0]
     return FRF(x.frequency, data, XY_LABELS, XY_LABELS)
 
 

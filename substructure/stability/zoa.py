@@ -69,16 +69,13 @@ def zoa_eigenvalues(k0: np.ndarray, g: np.ndarray) -> np.ndarray:
 
 def _refine_data(f: np.ndarray, a: np.ndarray, i: int) -> tuple[float, float]:
     """Vertex of the parabola through three lines around the smallest ``a`` (when it is lower)."""
-    if i == 0 or i == a.size - 1 or not np.all(np.isfinite(a[i - 1:i + 2])):
-        return float(a[i]), float(f[i])
-    x, y = f[i - 1:i + 2], a[i - 1:i + 2]
-    c2, c1, c0 = np.polyfit(x - x[1], y, 2)
-    if c2 <= 0:
-        return float(a[i]), float(f[i])
-    dx = -c1 / (2 * c2)
-    if not x[0] - x[1] <= dx <= x[2] - x[1]:
-        return float(a[i]), float(f[i])
-    return float(min(a[i], c0 - c1**2 / (4 * c2))), float(x[1] + dx)
+    if 0 < i < a.size - 1 and np.all(np.isfinite(a[i - 1:i + 2])):
+        x, y = f[i - 1:i + 2], a[i - 1:i + 2]
+        c2, c1, c0 = np.polyfit(x - x[1], y, 2)
+        dx = -c1 / (2 * c2) if c2 > 0 else np.nan
+        if x[0] - x[1] <= dx <= x[2] - x[1]:
+            return float(min(a[i], c0 - c1**2 / (4 * c2))), float(x[1] + dx)
+    return float(a[i]), float(f[i])
 
 
 def _refine_model(structure: Any, k0: np.ndarray, f: np.ndarray, i: int, branch: int) -> tuple[float, float]:
