@@ -16,7 +16,9 @@ package: 25.6 kHz, 1 s each) through ``substructure.tap``:
 (c) a synthetic double hit added to the taps: rejected with its reason,
     never averaged in;
 (d) the result written as a CSV file with a coherence column and a
-    measurement set that ``substructure identify`` and ``diagnose`` read.
+    measurement set that ``substructure identify`` and ``diagnose`` read;
+(e) the same taps as an acquisition system exports them, all in one
+    universal file, read back tap by tap.
 
 Figures are written to $SUBSTRUCTURE_EXAMPLES_OUT (default: out/examples).
 """
@@ -29,10 +31,12 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
+import pyuff
 
 from substructure.datasets import impact_records
 from substructure.io.frf_files import write_csv
 from substructure.io.measurements import load_measurements
+from substructure.io.tap_files import read_taps_uff
 from substructure.plot import plot_taps
 from substructure.tap import TapRecord, process_taps
 
@@ -119,3 +123,29 @@ write_csv(result.frf, out / "12_tool_tip.csv", coherence=result.coherence)
 measurement = load_measurements(out / "12_tests.toml").measurements[0]
 print(f"read back: {measurement.describe()}, {measurement.averages} averages, "
       f"coherence on {measurement.coherence.size} lines")
+
+# %%
+# (e) A file of several taps
+# --------------------------
+# Acquisition systems often export a test's hits into one universal file: a
+# force record (specific data type 13, in N) and a response record (type 12,
+# here in g) per tap.  ``read_taps_uff`` pairs the k-th force with the k-th
+# response (``substructure tap FILE.uff`` does the same) and the FRF is that
+# of the taps read one by one.
+uff_path = out / "12_taps.uff"
+uff_path.unlink(missing_ok=True)
+uff = pyuff.UFF(str(uff_path))
+for k, r in enumerate(records):
+    for node, data, spec, unit in ((1, r.force, 13, "N"), (2, r.response / 9.80665, 12, "g")):
+        uff.write_sets(pyuff.prepare_58(
+            binary=0, func_type=1, rsp_node=node, rsp_dir=3, ref_node=1, ref_dir=3, data=data, x=r.time - r.time[0],
+            num_pts=data.size, abscissa_spacing=1, abscissa_min=0.0, abscissa_inc=1.0 / r.sample_rate,
+            abscissa_spec_data_type=17, abscissa_axis_units_lab="s", ordinate_spec_data_type=spec,
+            ordinate_axis_units_lab=unit, orddenom_spec_data_type=0, orddenom_axis_units_lab="",
+            z_axis_spec_data_type=0, z_axis_axis_units_lab="",
+            id1=f"tap {k + 1} {'force' if node == 1 else 'response'}"), mode="add")
+taps = read_taps_uff(uff_path)
+print(f"{uff_path.name}: {len(taps)} taps, {taps[0].sample_rate:g} Hz, response in {taps[0].quantity}")
+from_file = process_taps(taps)
+close = np.allclose(from_file.frf.data, result.frf.data, rtol=1e-5, atol=1e-6 * np.abs(result.frf.data).max())
+print(f"{from_file.averages} taps averaged; the FRF equals the one from the arrays (to the file's 6 digits): {close}")
