@@ -76,7 +76,6 @@ def _check_hz(instance: Any, attribute: Any, hz: np.ndarray) -> None:
         )
 
 
-
 @attrs.frozen(repr=False)
 class Frequency:
     """A strictly increasing axis of frequencies, stored in Hz.

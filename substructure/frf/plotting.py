@@ -42,10 +42,9 @@ _NOTE_GID = "substructure-note"
 def _axes_for(ax: Any, parts: Sequence[str]) -> list[Axes]:
     if ax is None:
         if parts == ("nyquist",):
-            fig, axis = plt.subplots(figsize=(6.4, 6.4), layout="constrained")
-            return [axis]
-        fig, grid = plt.subplots(len(parts), 1, sharex=True, squeeze=False,
-                                 figsize=(7.0, 2.2 + 1.8 * len(parts)), layout="constrained")
+            return [plt.subplots(figsize=(6.4, 6.4), layout="constrained")[1]]
+        _, grid = plt.subplots(len(parts), 1, sharex=True, squeeze=False,
+                               figsize=(7.0, 2.2 + 1.8 * len(parts)), layout="constrained")
         return list(grid[:, 0])
     if isinstance(ax, Figure):
         ax = ax.axes

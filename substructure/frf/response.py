@@ -398,11 +398,10 @@ class FRF:
                 )
             chosen.append(have[0] if label is None else label)
         magnitude = np.abs(self.entry(*chosen))
-        if prominence is not None:
-            if not isinstance(prominence, numbers.Real) or not 0.0 <= prominence <= 1.0:
-                raise InvalidValueError(
-                    f"prominence: got {prominence!r}; expected a fraction of the largest |FRF| in [0, 1]"
-                )
+        if prominence is not None and (not isinstance(prominence, numbers.Real) or not 0.0 <= prominence <= 1.0):
+            raise InvalidValueError(
+                f"prominence: got {prominence!r}; expected a fraction of the largest |FRF| in [0, 1]"
+            )
         index = local_maxima(magnitude)
         if prominence is not None and index.size:
             from scipy.signal import peak_prominences

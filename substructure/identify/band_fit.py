@@ -44,8 +44,7 @@ DIAGONAL = ("k_yf", "k_tm", "c_yf", "c_tm")
 CROSS = ("k_ym", "c_ym")
 """The cross terms of eq. 2.5 (``k_ym = k_tf``, ``c_ym = c_tf``)."""
 
-_UNITS = {"k_yf": STIFFNESS_UNITS["yf"], "k_ym": STIFFNESS_UNITS["ym"], "k_tm": STIFFNESS_UNITS["tm"],
-          "c_yf": DAMPING_UNITS["yf"], "c_ym": DAMPING_UNITS["ym"], "c_tm": DAMPING_UNITS["tm"]}
+_UNITS = {name: (STIFFNESS_UNITS if name[0] == "k" else DAMPING_UNITS)[name[2:]] for name in PARAMETERS}
 
 
 def _set_parameter(k: dict, c: dict, name: str, value: float) -> None:
@@ -268,13 +267,10 @@ class JointIdentifier:
             )
         start_joint = self._joint(template, {p: nominal[p] for p in PARAMETERS if nominal[p] != 0 or p in CROSS})
         model = assembly.with_joint(start_joint)
-        cases = []
         points = [parse_point(p).component for p in template.between]
-        for m in measurements:
-            removed = set(getattr(m, "removed", ()) or ())
-            if any(any(pt in assembly.component(r).component_names for pt in points) for r in removed):
-                continue
-            cases.append(m)
+        cases = [m for m in measurements
+                 if not any(any(pt in assembly.component(r).component_names for pt in points)
+                            for r in set(getattr(m, "removed", ()) or ()))]
         if not cases:
             have = sorted({f"{getattr(m, 'response', '?')} with {list(getattr(m, 'removed', ()))} removed"
                            for m in measurements})

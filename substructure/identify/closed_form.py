@@ -287,10 +287,7 @@ def joint_sides(assembly: Assembly, joint: str) -> tuple[Assembly, Assembly, str
     """
     j = assembly.joint(joint)
     rest = [x for x in assembly.joints if x.name != joint]
-    owner = {}
-    for comp in assembly.components:
-        for name in comp.component_names:
-            owner[name] = comp.name
+    owner = {name: comp.name for comp in assembly.components for name in comp.component_names}
     adjacency: dict[str, set] = {c.name: set() for c in assembly.components}
     for x in rest:
         a, b = (owner[parse_point(p).component] for p in x.between)

@@ -145,11 +145,8 @@ class IdentificationReport:
         fig, axes = plt.subplots(len(names) + 1, 1, figsize=(7.5, 3.0 + 2.2 * len(names)), layout="constrained")
         axes = np.atleast_1d(axes)
         if names:
-            fitted = {}
-            for name in names:
-                kind, entry = name.split("_")
-                fitted[name] = (self.k if kind == "k" else self.c)[entry]
-                fitted[name + "_std"] = (self.k_std if kind == "k" else self.c_std)[entry]
+            fitted = {name: self._value(name) for name in names}
+            fitted.update({name + "_std": self._std(name) for name in names})
             self.closed_form.plot(names=names, band=self.band, fitted=fitted, ax=list(axes[:-1]))
         ax = axes[-1]
         f = self.measured.frequency.hz
@@ -278,9 +275,7 @@ def _closed_form(assembly: Assembly, measurements, joint: str) -> ClosedFormResu
     removed_b = tuple(sorted(c.name for c in assembly.components if set(c.component_names) <= names_b))
     points_a = _points_on(measurements, assembly, set(side_a.component_names), removed=removed_b)
     f = coupled.frequency
-    if points_a:
-        side_a_frf = _two_by_two(measurements, assembly, points_a, at_a, removed=removed_b)
-    else:
-        side_a_frf = side_a.receptance(at_a, frequency=f)
+    side_a_frf = (_two_by_two(measurements, assembly, points_a, at_a, removed=removed_b) if points_a
+                  else side_a.receptance(at_a, frequency=f))
     side_b_frf = side_b.frf([at, at_b] if at != at_b else [at], frequency=f)
     return closed_form(coupled, side_a_frf, side_b_frf, at=at, at_a=at_a, at_b=at_b, warn=False)

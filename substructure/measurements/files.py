@@ -85,12 +85,12 @@ class _Reader:
             raise self.error(index, "quantity", f"got {value!r}; expected one of {', '.join(QUANTITIES)}")
         return value
 
-    def averages(self, table: dict, index: int) -> int | None:
-        if "averages" not in table:
+    def integer(self, table: dict, index: int, key: str, minimum: int, expected: str) -> int | None:
+        if key not in table:
             return None
-        value = table["averages"]
-        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-            raise self.error(index, "averages", f"got {value!r}; expected the number of averages (an integer >= 1)")
+        value = table[key]
+        if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+            raise self.error(index, key, f"got {value!r}; expected {expected}")
         return value
 
     def window_tau(self, table: dict, index: int) -> float | None:
@@ -102,14 +102,6 @@ class _Reader:
         except InvalidValueError:
             raise self.error(index, "window_tau_s", f"got {value!r}; expected the exponential window's time "
                                                     "constant in s (a number > 0)") from None
-
-    def record(self, table: dict, index: int) -> int | None:
-        if "record" not in table:
-            return None
-        value = table["record"]
-        if isinstance(value, bool) or not isinstance(value, int) or value < 0:
-            raise self.error(index, "record", f"got {value!r}; expected the 0-based index of a type-58 record")
-        return value
 
     # -- data files -----------------------------------------------------------
     def data(self, index: int, file: str, record: int | None, quantity: str | None,
@@ -127,8 +119,7 @@ class _Reader:
                     raise self.error(index, "record", f"a CSV file ({file}) holds one FRF; record is for UFF files")
                 frf, lines_of, coherence = _read_csv(path, output=response, input=excitation, quantity=quantity)
             else:
-                frf, lines_of = self.uff(index, path, record, quantity, response, excitation), None
-                coherence = None
+                frf, lines_of, coherence = self.uff(index, path, record, quantity, response, excitation), None, None
             beyond = _beyond_physical(frf.frequency.hz, frf.data, frf.quantity)  # a measured FRF's range
             if beyond is not None:
                 k, what = beyond
@@ -201,9 +192,11 @@ class _Reader:
                 raise self.error(index, key, "missing; this value is required")
         response, excitation = self.point(table, index, "response"), self.point(table, index, "excitation")
         file = self.string(table, index, "file")
-        quantity, record = self.quantity(table, index), self.record(table, index)
+        quantity = self.quantity(table, index)
+        record = self.integer(table, index, "record", 0, "the 0-based index of a type-58 record")
         sensors, removed = self.names(table, index, "sensors"), self.names(table, index, "removed")
-        averages, tau = self.averages(table, index), self.window_tau(table, index)
+        averages = self.integer(table, index, "averages", 1, "the number of averages (an integer >= 1)")
+        tau = self.window_tau(table, index)
         raw, coherence = self.data(index, file, record, quantity, response, excitation)
         if raw.quantity != "receptance" and raw.frequency.hz[0] == 0.0:
             warnings.warn(

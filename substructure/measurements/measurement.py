@@ -105,12 +105,19 @@ def _names(field: str):
     return convert
 
 
-def _optional_record(value: Any) -> int | None:
-    if value is None:
-        return None
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-        raise InvalidValueError(f"record: got {value!r}; expected a 0-based record index (an integer >= 0)")
-    return int(value)
+def _optional_int(field: str, minimum: int, expected: str):
+    def convert(value: Any) -> int | None:
+        if value is None:
+            return None
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
+            raise InvalidValueError(f"{field}: got {value!r}; expected {expected}")
+        return int(value)
+
+    return convert
+
+
+_optional_record = _optional_int("record", 0, "a 0-based record index (an integer >= 0)")
+_optional_averages = _optional_int("averages", 1, "the number of averages (an integer >= 1)")
 
 
 def _coherence(value: Any) -> np.ndarray | None:
@@ -135,14 +142,6 @@ def _coherence(value: Any) -> np.ndarray | None:
 
 COHERENCE_ROUNDING = 1e-9
 """How far above 1 a coherence may lie and be read as 1 (rounding of its estimate)."""
-
-
-def _optional_averages(value: Any) -> int | None:
-    if value is None:
-        return None
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-        raise InvalidValueError(f"averages: got {value!r}; expected the number of averages (an integer >= 1)")
-    return int(value)
 
 
 def _optional_tau(value: Any) -> float | None:

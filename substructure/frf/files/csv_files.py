@@ -67,19 +67,16 @@ def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coheren
         )
     values = frf.data[:, 0, 0]
     _refuse_all_zero(frf, os.fspath(path))
-    if coherence is None:
-        rows = zip(frf.frequency.hz.tolist(), values.real.tolist(), values.imag.tolist())
-        text = "".join(f"{f!r},{re_!r},{im!r}\n" for f, re_, im in rows)
-        write_text(path, CSV_HEADER + "\n" + text, overwrite=overwrite)
-        return
-    gamma = np.asarray(coherence, dtype=np.float64)
-    if gamma.shape != (frf.frequency.n,) or not np.all((gamma >= 0) & (gamma <= 1)):
-        raise InvalidValueError(
-            f"coherence: cannot write {os.fspath(path)}: expected {frf.frequency.n} values in [0, 1], one per line"
-        )
-    rows4 = zip(frf.frequency.hz.tolist(), values.real.tolist(), values.imag.tolist(), gamma.tolist())
-    text = "".join(f"{f!r},{re_!r},{im!r},{g!r}\n" for f, re_, im, g in rows4)
-    write_text(path, COHERENCE_HEADER + "\n" + text, overwrite=overwrite)
+    header, columns = CSV_HEADER, [frf.frequency.hz, values.real, values.imag]
+    if coherence is not None:
+        gamma = np.asarray(coherence, dtype=np.float64)
+        if gamma.shape != (frf.frequency.n,) or not np.all((gamma >= 0) & (gamma <= 1)):
+            raise InvalidValueError(
+                f"coherence: cannot write {os.fspath(path)}: expected {frf.frequency.n} values in [0, 1], one per line"
+            )
+        header, columns = COHERENCE_HEADER, columns + [gamma]
+    text = "".join(",".join(map(repr, row)) + "\n" for row in zip(*(c.tolist() for c in columns)))
+    write_text(path, header + "\n" + text, overwrite=overwrite)
 
 
 def read_csv(

@@ -21,6 +21,7 @@ import numpy as np
 
 from ...errors import FileFormatError
 from ._common import _shown
+from .uff_units import _TIME_EXPONENT, _a, _exponents, _unit_of_label
 
 __all__ = ["parse_export"]
 
@@ -32,7 +33,6 @@ _NAMES = {
     "phase": {"phase", "angle", "arg"},
 }
 _HEADER = re.compile(r"^\s*(?P<name>[^\[\(]*?)\s*(?:[\[\(](?P<unit>.*)[\]\)])?\s*$")
-_TIME_EXPONENT = {0: "receptance", -1: "mobility", -2: "accelerance"}
 
 
 def _column(cell: str, name: str, line: int) -> tuple[str, str | None]:
@@ -59,8 +59,6 @@ def _column(cell: str, name: str, line: int) -> tuple[str, str | None]:
 
 def _value_unit(unit: str | None, cell: str, name: str, line: int):
     """``(quantity, factor to SI)`` of a value column's unit; ``(None, 1)`` without one."""
-    from .uff_units import _exponents, _unit_of_label
-
     if unit is None:
         return None, 1.0
     if "db" in unit.lower():
@@ -154,7 +152,7 @@ def parse_export(numbered: list[tuple[int, str]], name: str, quantity: str | Non
                                   "(e.g. 'Magnitude [m/N]') or say the quantity")
     if kind is not None and quantity is not None and kind != quantity:
         raise FileFormatError(f"{name}, line {first}: the header's units are those of "
-                              f"{'an' if kind[0] == 'a' else 'a'} {kind}, but the quantity given is {quantity}")
+                              f"{_a(kind)}, but the quantity given is {quantity}")
     data = cells[1:]
     lines = np.array([n for n, _ in rows[1:]])
     for n, row in zip(lines, data):
