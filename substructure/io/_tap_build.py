@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import FileFormatError, SubstructureError
-from ..tap.records import RESPONSE_QUANTITIES, TIME_STEP_TOLERANCE, TapRecord, channel_to_si, unit_of
+from ..tap.records import RESPONSE_QUANTITIES, TIME_STEP_TOLERANCE, TapRecord, channel_to_si, quantity_of, unit_of
 from ._tap_columns import Columns
 
 RESPONSES = ("acceleration", "velocity", "displacement")
@@ -45,9 +45,7 @@ def regular(time_s: np.ndarray) -> np.ndarray:
     k = np.arange(n, dtype=np.float64)
     step = float(np.dot(k - k.mean(), time_s - time_s.mean()) / np.dot(k - k.mean(), k - k.mean()))
     grid = (time_s.mean() - step * k.mean()) + k * step  # the least-squares line: the rounding averages out
-    if not step > 0:
-        return time_s
-    if np.max(np.abs(time_s - grid)) <= ROUNDED_TIME_TOLERANCE * step:
+    if step > 0 and np.max(np.abs(time_s - grid)) <= ROUNDED_TIME_TOLERANCE * step:
         return grid
     return time_s
 
@@ -75,32 +73,17 @@ def units_of_columns(columns: Columns, name: str) -> tuple[list[Any], list[str |
     dims: list[str | None] = []
     errors: list[str | None] = []
     for label, unit in zip(columns.labels, columns.units):
-        if unit is None:
-            parsed.append(None)
-            dims.append(None)
-            errors.append(None)
-            continue
-        try:
-            u = unit_of(unit, label)
-        except SubstructureError as exc:
-            message = str(exc)
-            parsed.append(None)
-            dims.append(None)
-            errors.append(message[message.find("cannot read"):])
-            continue
+        u, error = None, None
+        if unit is not None:
+            try:
+                u = unit_of(unit, label)
+            except SubstructureError as exc:
+                message = str(exc)
+                error = message[message.find("cannot read"):]
         parsed.append(u)
-        dims.append(quantity_of(u))
-        errors.append(None)
+        dims.append(None if u is None else quantity_of(u))
+        errors.append(error)
     return parsed, dims, errors
-
-
-def quantity_of(unit: Any) -> str | None:
-    q = 1.0 * unit
-    for dim, kind in (("[time]", "time"), ("[force]", "force"), ("[electric_potential]", "voltage"),
-                      ("[acceleration]", "acceleration"), ("[velocity]", "velocity"), ("[length]", "displacement")):
-        if q.check(dim):
-            return kind
-    return None
 
 
 def option_rate(sample_rate: Any) -> float:

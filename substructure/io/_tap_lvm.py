@@ -39,7 +39,6 @@ class Segment:
     first_line: int
 
 
-
 def _utf8(raw: bytes) -> bool:
     try:
         raw.decode("utf-8")
@@ -51,6 +50,7 @@ def _utf8(raw: bytes) -> bool:
 def _text(raw: bytes) -> str:
     """Header text: UTF-8, else Windows-1252 (what LabVIEW writes on Windows), said once by the reader."""
     return raw.decode("utf-8") if _utf8(raw) else raw.decode("cp1252", "replace")
+
 
 def _tags(text: str, sep: str) -> dict[str, list[str]]:
     tags: dict[str, list[str]] = {}

@@ -60,6 +60,7 @@ def _fast(chunk: bytes, ncols: int, sep: str | None, decimal_comma: bool) -> np.
     lines = newlines.size
     sep_byte = None if sep is None else ord(sep)
     trailing = False
+    body, blanks = chunk, True  # with blanks (or no separator): count the numbers on each line
     if sep is not None and sep_byte is not None:
         where = np.flatnonzero(b == sep_byte)
         per_line = np.bincount(np.searchsorted(newlines, where), minlength=lines)[:lines]
@@ -70,22 +71,17 @@ def _fast(chunk: bytes, ncols: int, sep: str | None, decimal_comma: bool) -> np.
             if not trailing:
                 return None
         s = sep.encode()
-        if b" " not in chunk and (sep == "\t" or b"\t" not in chunk):
+        blanks = b" " in chunk or (sep != "\t" and b"\t" in chunk)
+        if not blanks:
             # no blanks: a cell is empty only between two separators or at a line's ends
             if s + s in chunk or b"\n" + s in chunk or chunk.startswith(s) or (
                     not trailing and (s + b"\n" in chunk or s + b"\r" in chunk)):
                 return None
-            body = chunk.replace(s, b" ")
-        else:
-            if _blank_inside_a_cell(b, sep_byte):  # '1 2' would hide an empty cell elsewhere on its line
-                return None
-            body = chunk.replace(s, b" ")
-            if not _numbers_per_line(body, newlines, ncols):
-                return None
-    else:
-        body = chunk
-        if not _numbers_per_line(body, newlines, ncols):
+        elif _blank_inside_a_cell(b, sep_byte):  # '1 2' would hide an empty cell elsewhere on its line
             return None
+        body = chunk.replace(s, b" ")
+    if blanks and not _numbers_per_line(body, newlines, ncols):
+        return None
     if decimal_comma:
         body = body.replace(b",", b".")
     with warnings.catch_warnings():

@@ -30,7 +30,7 @@ from . import check_readable_file, read_bytes
 from ._tap_columns import (MAX_PREAMBLE_LINES, NO_UNIT, Columns, choose, header_cells, is_row, is_unit_row,
                            line_separator, name_and_unit, rate_from_lines)
 from ._tap_build import (RESPONSES, ROUNDED_TIME_TOLERANCE, build_record, check_quantity_option, option_rate,
-                         regular, time_axis, units_of_columns)
+                         quantity_of, regular, time_axis, units_of_columns)
 from ._tap_table import finite_rows, parse_rows
 
 __all__ = ["read_tap_csv", "read_tap_lvm", "read_tap_mat", "read_taps_mat", "read_tap_uff", "read_taps_uff",
@@ -87,11 +87,7 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
         samples, a contradiction between the header and the options.
     """
     name = os.fspath(path)
-    data = read_bytes(path, "tap record", MAX_RECORD_BYTES)
-    if data[:2] in (b"\xff\xfe", b"\xfe\xff"):
-        data = decode_text(data, name).encode("utf-8")
-    elif data[:3] == b"\xef\xbb\xbf":
-        data = data[3:]
+    data = _text_bytes(path, name)
     head, start, first_line = _head(data, name)
     row_end = data.find(b"\n", start)
     row = data[start:len(data) if row_end < 0 else row_end].decode("utf-8", "replace").rstrip("\r")
@@ -105,27 +101,23 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
                               "naming each column, e.g. 'time [s],force [N],acceleration [m/s^2]'")
     h_line, h_text = content[-1]
     cells = header_cells(h_text.lstrip("\ufeff"), sep, ncols)
-    preamble_end = h_line
-    if len(content) > 1 and is_unit_row(cells):
-        above = header_cells(content[-2][1].lstrip("\ufeff"), sep, ncols)
-        if len(above) == len(cells) and all(name_and_unit(c)[1] is None for c in above):
-            columns = Columns(above, [None if c.strip("[]() ").lower() in NO_UNIT else c.strip("[]() ")
-                                     for c in cells], content[-2][0])
-            preamble_end = content[-2][0]
-        else:
-            columns = _columns(cells, h_line)
+    above = header_cells(content[-2][1].lstrip("\ufeff"), sep, ncols) if len(content) > 1 and is_unit_row(cells) \
+        else None
+    if above is not None and len(above) == len(cells) and all(name_and_unit(c)[1] is None for c in above):
+        columns = Columns(above, [None if c.strip("[]() ").lower() in NO_UNIT else c.strip("[]() ")
+                                 for c in cells], content[-2][0])
     else:
-        columns = _columns(cells, h_line)
+        pairs = [name_and_unit(c) for c in cells]
+        columns = Columns([n for n, _ in pairs], [u for _, u in pairs], h_line)
     if len(columns.names) != ncols:
         raise FileFormatError(f"{name}, line {columns.line}: the header names {len(columns.names)} columns "
                               f"({', '.join(columns.labels)}), the first row (line {first_line}) has {ncols} values")
-    rate = _stated_rate([(n, t.lstrip("#")) for n, t in head if n < preamble_end], name, decimal_comma, sample_rate)
+    rate = _stated_rate([(n, t.lstrip("#")) for n, t in head if n < columns.line], name, decimal_comma, sample_rate)
     parsed, dims, errors = units_of_columns(columns, name)
     t_col, f_col, r_col = choose(columns, parsed, dims, name, force_column, response_column, rate is not None)
     labels = columns.labels
-    for k in (t_col, f_col, r_col):
-        if k is None:
-            continue
+    used = [k for k in (t_col, f_col, r_col) if k is not None]
+    for k in used:
         if columns.units[k] is None:
             raise FileFormatError(f"{name}, line {columns.line}: column {k + 1} {columns.names[k]!r} has no unit in "
                                   "brackets; expected e.g. 'time [s]', 'force [N]', 'acceleration [m/s^2]' "
@@ -133,12 +125,19 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
         if errors[k]:
             raise FileFormatError(f"{name}, line {columns.line}: {errors[k]} (column {labels[k]!r})")
     table = parse_rows(data, first_line, ncols, sep, decimal_comma, labels, name, start)
-    used = [k for k in (t_col, f_col, r_col) if k is not None]
     finite_rows(table[:, used], first_line, [labels[k] for k in used], name, data, start)
     time = None if t_col is None else (table[:, t_col], parsed[t_col], f"the time column {labels[t_col]!r}")
     time_s = time_axis(time, rate, table.shape[0], name)
     return build_record(name, time_s, table[:, f_col], parsed[f_col], labels[f_col], table[:, r_col],
                         parsed[r_col], labels[r_col], sensitivity, hammer_sensitivity, quantity)
+
+
+def _text_bytes(path: str | os.PathLike, name: str) -> bytes:
+    """The bytes of a text record: UTF-16 re-encoded as UTF-8, a UTF-8 byte-order mark dropped."""
+    data = read_bytes(path, "tap record", MAX_RECORD_BYTES)
+    if data[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        return decode_text(data, name).encode("utf-8")
+    return data[3:] if data[:3] == b"\xef\xbb\xbf" else data
 
 
 def _windows_text(line: bytes, name: str, number: int, pos: int, bad: int) -> str:
@@ -176,8 +175,7 @@ def _head(data: bytes, name: str) -> tuple[list[tuple[int, str]], int, int]:
         if number >= MAX_PREAMBLE_LINES:
             break
         pos = end + 1
-    content = [t for _, t in head if t.strip() and not t.lstrip().startswith("#")]
-    if not content:
+    if not any(t.strip() and not t.lstrip().startswith("#") for _, t in head):
         raise FileFormatError(f"{name}: the file is empty; expected a header such as "
                               "'time [s],force [N],acceleration [m/s^2]' and one row per sample")
     if not_first is not None:
@@ -190,11 +188,6 @@ def _head(data: bytes, name: str) -> tuple[list[tuple[int, str]], int, int]:
         raise FileFormatError(f"{name}: no row of numbers in the first {MAX_PREAMBLE_LINES} lines; expected a "
                               "header and one row per sample")
     raise FileFormatError(f"{name}: a header and no samples; expected one row per sample")
-
-
-def _columns(cells: list[str], line: int) -> Columns:
-    pairs = [name_and_unit(c) for c in cells]
-    return Columns([n for n, _ in pairs], [u for _, u in pairs], line)
 
 
 def _stated_rate(preamble: list[tuple[int, str]], name: str, decimal_comma: bool,
@@ -249,11 +242,7 @@ def read_tap_lvm(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
     from ._tap_lvm import read_segments
 
     name = os.fspath(path)
-    data = read_bytes(path, "tap record", MAX_RECORD_BYTES)
-    if data[:2] in (b"\xff\xfe", b"\xfe\xff"):
-        data = decode_text(data, name).encode("utf-8")
-    elif data[:3] == b"\xef\xbb\xbf":
-        data = data[3:]
+    data = _text_bytes(path, name)
     segments = read_segments(data, name)
     groups: list[list[Any]] = []
     for seg in segments:
@@ -486,8 +475,8 @@ def _uff_records(path) -> tuple[str, list[dict], list[str | None]]:
     kinds = [_uff_kind(name, records, k) for k in range(len(records))]
     if len(records) == 2 and kinds.count(None) == 1 and _uff_unit(name, records, kinds.index(None)) is not None:
         # two records, one of them known by its type or unit, the other in volts or unlabelled: the other channel
-        known = 0 if kinds[0] is not None else 1
-        kinds[1 - known] = ("force" if kinds[known] in RESPONSES else "response") if kinds[known] else None
+        unknown = kinds.index(None)
+        kinds[unknown] = "force" if kinds[1 - unknown] in RESPONSES else "response"
     return name, records, kinds
 
 
@@ -505,12 +494,8 @@ def _uff_kind(name: str, records: list[dict], k: int) -> str | None:
     spec = int(records[k].get("ordinate_spec_data_type", 0))
     u = _uff_unit(name, records, k)
     by_type = "force" if spec in _FORCE_TYPES else _RESPONSE_TYPES.get(spec)
-    by_unit = None
-    if u is not None:
-        for q in ("force", "acceleration", "velocity", "displacement"):
-            if (1.0 * u).check({"force": "[force]", "acceleration": "[acceleration]", "velocity": "[velocity]",
-                                "displacement": "[length]"}[q]):
-                by_unit = q
+    found = None if u is None else quantity_of(u)  # one quantity at most: the dimensions differ
+    by_unit = found if found in ("force", *RESPONSES) else None
     if by_type and by_unit and by_type != by_unit:
         raise FileFormatError(f"{name}, record {k}: the specific data type says {by_type}, the unit label "
                               f"{records[k].get('ordinate_axis_units_lab')!r} says {by_unit}; fix one")

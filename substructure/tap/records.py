@@ -20,7 +20,7 @@ from ..errors import InvalidValueError, UnitError
 from ..units import ureg
 
 __all__ = ["TapRecord", "RESPONSE_QUANTITIES", "MIN_SAMPLES", "TIME_STEP_TOLERANCE", "channel_to_si",
-           "unit_of"]
+           "unit_of", "quantity_of"]
 
 RESPONSE_QUANTITIES = {
     "acceleration": ("m/s^2", "accelerance"),
@@ -69,7 +69,20 @@ def unit_of(text: str, field: str):
     return unit
 
 
-def _dimension(unit) -> str | None:
+def quantity_of(unit) -> str | None:
+    """What a unit measures, among the channels of a tap record.
+
+    Parameters
+    ----------
+    unit : str or pint.Unit
+        The unit.
+
+    Returns
+    -------
+    str or None
+        ``"time"``, ``"force"``, ``"voltage"``, ``"acceleration"``,
+        ``"velocity"`` or ``"displacement"``; None for another dimension.
+    """
     q = ureg.Quantity(1.0, unit)
     for name, dim in (("time", "[time]"), ("force", "[force]"), ("voltage", "[electric_potential]"),
                       ("acceleration", "[acceleration]"), ("velocity", "[velocity]"), ("displacement", "[length]")):
@@ -114,7 +127,7 @@ def channel_to_si(values: np.ndarray, unit: Any, field: str, expected: tuple[str
         channel in physical units.
     """
     unit = unit_of(unit, field) if isinstance(unit, str) else unit
-    kind = _dimension(unit)
+    kind = quantity_of(unit)
     names = " or ".join(expected)
     if kind == "voltage":
         if sensitivity is None:
@@ -123,7 +136,7 @@ def channel_to_si(values: np.ndarray, unit: Any, field: str, expected: tuple[str
                             f"{sensitivity_option}, e.g. {example}")
         sens = _sensitivity(sensitivity, sensitivity_option)
         physical = ureg.Quantity(1.0, unit) / sens
-        quantity = _dimension(physical.units)
+        quantity = quantity_of(physical.units)
         if quantity not in expected:
             raise UnitError(f"{sensitivity_option}: {sensitivity!s} turns volts into {physical.dimensionality}; "
                             f"{field} should hold {names}")

@@ -79,9 +79,10 @@ class _Reader:
         joints = self.unique([self.joint(j, ["joints", i], base) for i, j in enumerate(items["joints"])], "joints")
         supports = [self.support(s, ["supports", i], base) for i, s in enumerate(items["supports"])]
         self.unique([s for s in supports if s.name is not None], "supports")
-        sensors = self.unique([self.sensor(s, ["sensors", i], base) for i, s in enumerate(items["sensors"])],
-                              "sensors")
-        masses = self.unique([self.mass(m, ["masses", i], base) for i, m in enumerate(items["masses"])], "masses")
+        sensors = self.unique([self.point_mass(Sensor, _SENSOR_KEYS, s, ["sensors", i], base)
+                               for i, s in enumerate(items["sensors"])], "sensors")
+        masses = self.unique([self.point_mass(Mass, _MASS_KEYS, m, ["masses", i], base)
+                              for i, m in enumerate(items["masses"])], "masses")
         return self.call([], Assembly, data["name"], components, joints, supports, sensors, frequency, custom,
                          masses)
 
@@ -239,20 +240,12 @@ class _Reader:
         at = self.point(table["at"], parts + ["at"], base)
         return self.call(parts, Support, at, name=table.get("name"), **self.matrices(table, parts))
 
-    def sensor(self, table, parts, base: Assembly) -> Sensor:
-        table = self.table(table, parts, _SENSOR_KEYS, ("name", "at", "mass"))
+    def point_mass(self, cls, keys, table, parts, base: Assembly):
+        """A sensor or a mass (``cls``) of the table of ``keys``; a mass has no ``always_on``."""
+        table = self.table(table, parts, keys, ("name", "at", "mass"))
         at = self.point(table["at"], parts + ["at"], base)
-        extra = {"inertia": table["inertia"]} if "inertia" in table else {}
-        if "always_on" in table:
-            extra["always_on"] = table["always_on"]
-        return self.call(parts, Sensor, table["name"], at, table["mass"], **extra)
-
-    def mass(self, table, parts, base: Assembly) -> Mass:
-        table = self.table(table, parts, _MASS_KEYS, ("name", "at", "mass"))
-        at = self.point(table["at"], parts + ["at"], base)
-        extra = {"inertia": table["inertia"]} if "inertia" in table else {}
-        return self.call(parts, Mass, table["name"], at, table["mass"], **extra)
-
+        extra = {key: table[key] for key in ("inertia", "always_on") if key in table}
+        return self.call(parts, cls, table["name"], at, table["mass"], **extra)
 
 
 def loads_assembly(text: str, source: str = "<string>") -> Assembly:
@@ -295,8 +288,7 @@ def load_assembly(path: str | os.PathLike) -> Assembly:
         The assembly; errors name the file and the key.
     """
     name = os.fspath(path)
-    text = read_text(path, "assembly file")
-    return loads_assembly(text, source=name)
+    return loads_assembly(read_text(path, "assembly file"), source=name)
 
 
 def default_assembly() -> Assembly:
@@ -312,7 +304,4 @@ def default_assembly() -> Assembly:
     """
     resource = importlib.resources.files("substructure") / "data" / "default_assembly.toml"
     return loads_assembly(resource.read_text(encoding="utf-8"), source="default_assembly.toml")
-
-
-# -- writing ---------------------------------------------------------------------------
 

@@ -192,6 +192,12 @@ def _matrices(item) -> dict:
     return {key: m.as_dict() for key, m in (("k", item.k), ("c", item.c)) if m}
 
 
+def _point_mass(item) -> dict:
+    """The table of a sensor or a mass: its name, point, mass and inertia (written when not 0)."""
+    return {"name": item.name, "at": item.at, "mass": format_quantity(item.mass),
+            **({"inertia": format_quantity(item.inertia)} if item.inertia.magnitude != 0 else {})}
+
+
 def _key(key: str) -> str:
     return key if re.fullmatch(r"[A-Za-z0-9_-]+", key) else _inline(key)
 
@@ -282,18 +288,10 @@ def dumps_assembly(assembly: Assembly) -> str:
             for s in assembly.supports
         ]
     if assembly.sensors:
-        doc["sensors"] = [
-            {"name": s.name, "at": s.at, "mass": format_quantity(s.mass),
-             **({"inertia": format_quantity(s.inertia)} if s.inertia.magnitude != 0 else {}),
-             **({"always_on": True} if s.always_on else {})}
-            for s in assembly.sensors
-        ]
+        doc["sensors"] = [{**_point_mass(s), **({"always_on": True} if s.always_on else {})}
+                          for s in assembly.sensors]
     if assembly.masses:
-        doc["masses"] = [
-            {"name": m.name, "at": m.at, "mass": format_quantity(m.mass),
-             **({"inertia": format_quantity(m.inertia)} if m.inertia.magnitude != 0 else {})}
-            for m in assembly.masses
-        ]
+        doc["masses"] = [_point_mass(m) for m in assembly.masses]
     text = _HEADER_COMMENT + _emit(doc)
     _check_round_trip(assembly, text)
     return text
@@ -308,11 +306,7 @@ def _differences(a, b) -> list[str]:
     out = []
     for field in attrs.fields(type(a)):
         x, y = getattr(a, field.name), getattr(b, field.name)
-        try:
-            same = bool(x == y)
-        except Exception:  # e.g. arrays: no single truth value
-            same = False
-        if not same:
+        if not _equal(x, y):  # e.g. arrays: no single truth value, not equal
             out.append(f"{field.name} {x!r} read back as {y!r}")
     return out or ["its value"]
 
@@ -387,5 +381,4 @@ def save_assembly(assembly: Assembly, path: str | os.PathLike, overwrite: bool =
     InvalidValueError
         For what the file cannot hold (:func:`dumps_assembly`).
     """
-    text = dumps_assembly(assembly)
-    write_text(path, text, overwrite=overwrite)
+    write_text(path, dumps_assembly(assembly), overwrite=overwrite)
