@@ -112,7 +112,6 @@ def inv(a: np.ndarray) -> np.ndarray:
     return to_back(np.linalg.inv(to_front(a)))
 
 
-
 def checked_block(owner, kind: str, member: str, compute, rows: int, frequency_hz) -> np.ndarray:
     """The array ``compute()`` gives for ``owner``, checked when the owner's type is one of one's own.
 

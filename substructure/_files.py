@@ -47,18 +47,12 @@ def _a(what: str) -> str:
     return f"{'an' if what[:1].lower() in 'aeiou' else 'a'} {what}"
 
 
+_KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a named pipe (FIFO)"), (stat.S_ISCHR, "a character device"),
+          (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+
+
 def _kind(mode: int) -> str:
-    if stat.S_ISDIR(mode):
-        return "a directory"
-    if stat.S_ISFIFO(mode):
-        return "a named pipe (FIFO)"
-    if stat.S_ISCHR(mode):
-        return "a character device"
-    if stat.S_ISBLK(mode):
-        return "a block device"
-    if stat.S_ISSOCK(mode):
-        return "a socket"
-    return "not a regular file"
+    return next((name for test, name in _KINDS if test(mode)), "not a regular file")
 
 
 def _check_stat(name: str, st: os.stat_result, what: str, limit: int) -> None:
@@ -255,8 +249,7 @@ def read_text(path, what: str = "file", limit: int = MAX_TEXT_BYTES) -> str:
         a file over the cap, an unreadable file or bytes that are not UTF-8
         (nor UTF-16 after a UTF-16 byte-order mark).
     """
-    data = read_bytes(path, what, limit)
-    return decode_text(data, os.fspath(path))
+    return decode_text(read_bytes(path, what, limit), os.fspath(path))
 
 
 def check_writable(path, overwrite: bool, option: str | None = None) -> Path:
@@ -352,10 +345,8 @@ def replacing(path, overwrite: bool = True) -> Iterator[str]:
         else:
             try:
                 os.link(temporary, target)  # atomic and exclusive: fails if the name exists
-            except FileExistsError:
-                raise OutputExistsError(f"{target}: the file exists; pass overwrite=True to replace it") from None
-            except OSError:  # a file system without hard links: check, then rename
-                if target.exists():
+            except OSError as exc:  # the name exists, or a file system without hard links: check, then rename
+                if isinstance(exc, FileExistsError) or target.exists():
                     raise OutputExistsError(f"{target}: the file exists; pass overwrite=True to replace it") from None
                 os.replace(temporary, target)
     finally:

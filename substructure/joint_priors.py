@@ -40,7 +40,8 @@ import numpy as np
 
 from ._toml import loads_toml
 from .errors import InvalidValueError
-from .joints import Joint, JointProvenance
+from .joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint, JointProvenance
+from .points import parse_point
 
 __all__ = ["ROLES", "holder_type", "joint_role", "prior_joint", "prior_for", "joint_provenances",
            "with_joint_priors", "joint_variants", "priors_table"]
@@ -83,15 +84,12 @@ def holder_type(holder: Any) -> dict | None:
     if _CATALOGUE_MARK not in text:
         return None
     head = text.split(":")[0]
-    clamp = next((c for c, word in (("shrink-fit", "shrink-fit"), ("hydraulic", "hydraulic"), ("collet", "collet"))
-                  if word in head.lower()), None)
+    clamp = next((c for c in ("shrink-fit", "hydraulic", "collet") if c in head.lower()), None)
     interface = "hsk" if "HSK" in head else "steep-taper"
     return {"interface": interface, "clamp": clamp, "name": head.strip()}
 
 
 def _type_of(assembly: Any, point: str) -> str:
-    from .points import parse_point
-
     return type(assembly.component(parse_point(point).component)).__name__
 
 
@@ -110,8 +108,6 @@ def joint_role(assembly: Any, joint: Joint) -> tuple[str, Any] | None:
     (str, Holder) or None
         ``("holder-tool", holder)``, ``("spindle-holder", holder)`` or None.
     """
-    from .points import parse_point
-
     types = [_type_of(assembly, p) for p in joint.between]
     holders = [parse_point(p).component for p, t in zip(joint.between, types) if t == "Holder"]
     if not holders:
@@ -242,11 +238,8 @@ def with_joint_priors(assembly: Any, names: Any = None) -> Any:
     """
     out = assembly
     for joint in assembly.joints:
-        if joint.rigid:
-            continue
-        if names is None and joint.provenance is not None and joint.provenance.kind != "borrowed":
-            continue
-        if names is not None and joint.name not in names:
+        if joint.rigid or not (joint.name in names if names is not None
+                               else joint.provenance is None or joint.provenance.kind == "borrowed"):
             continue
         prior = prior_for(assembly, joint)
         if prior is None:
@@ -290,14 +283,9 @@ def joint_variants(assembly: Any, levels: int = 3) -> list:
         out = assembly
         for joint, t in zip(uncertain, combo):
             factor = float(joint.provenance.uncertainty ** t)
-            scaled = {key: f"{float(joint.k.get(key)) * factor!r} {unit}" for key, unit in _UNITS_K.items()
-                      if joint.k.get(key) != 0.0}
-            damp = {key: f"{float(joint.c.get(key)) * factor!r} {unit}" for key, unit in _UNITS_C.items()
-                    if joint.c.get(key) != 0.0}
+            scaled, damp = ({key: f"{float(m.get(key)) * factor!r} {unit}" for key, unit in units.items()
+                             if m.get(key) != 0.0}
+                            for m, units in ((joint.k, STIFFNESS_UNITS), (joint.c, DAMPING_UNITS)))
             out = out.with_joint(attrs.evolve(joint, k=scaled, c=damp))
         variants.append(out)
     return variants
-
-
-_UNITS_K = {"yf": "N/m", "ym": "N", "tf": "N/rad", "tm": "N*m/rad"}
-_UNITS_C = {"yf": "N*s/m", "ym": "N*s", "tf": "N*s/rad", "tm": "N*m*s/rad"}

@@ -103,11 +103,8 @@ class JointMatrix:
                 f"{field}: unknown entries {unknown}; expected some of yf, ym, tf, tm"
             )
         dims = _DIMENSIONS[kind]
-        items = []
-        for key in ENTRIES:
-            if key in mapping:
-                items.append((key, quantity(mapping[key], f"{field}.{key}", dims[key])))
-        return cls(kind, tuple(items))
+        return cls(kind, tuple((key, quantity(mapping[key], f"{field}.{key}", dims[key]))
+                               for key in ENTRIES if key in mapping))
 
     def get(self, key: str) -> float:
         """Entry ``key`` in SI units (0 when not given).
@@ -123,10 +120,8 @@ class JointMatrix:
             The value in the entry's SI unit (:data:`STIFFNESS_UNITS` or :data:`DAMPING_UNITS`).
         """
         units = STIFFNESS_UNITS if self.kind == "stiffness" else DAMPING_UNITS
-        for k, q in self.entries:
-            if k == key:
-                return magnitude_in(q, units[key])
-        return 0.0
+        q = next((q for k, q in self.entries if k == key), None)
+        return 0.0 if q is None else magnitude_in(q, units[key])
 
     @property
     def values(self) -> np.ndarray:
@@ -362,9 +357,7 @@ class Joint:
         Joint
             The new, elastic joint.
         """
-        new_k = {**self.k.as_dict(), **(k or {})}
-        new_c = {**self.c.as_dict(), **(c or {})}
-        return attrs.evolve(self, k=new_k, c=new_c, rigid=False)
+        return attrs.evolve(self, k={**self.k.as_dict(), **(k or {})}, c={**self.c.as_dict(), **(c or {})}, rigid=False)
 
 
 @attrs.frozen
@@ -410,17 +403,10 @@ class Support:
         return self.k.values[:, :, None] + 1j * omega * self.c.values[:, :, None]
 
 
-def _mass(value) -> pint.Quantity:
-    q = quantity(value, "mass", "[mass]")
+def _not_negative(value, field: str, dimension: str, what: str) -> pint.Quantity:
+    q = quantity(value, field, dimension)
     if q.magnitude < 0:
-        raise InvalidValueError(f"mass: got {value!r}; expected a mass >= 0")
-    return q
-
-
-def _inertia(value) -> pint.Quantity:
-    q = quantity(value, "inertia", "[mass] * [length] ** 2")
-    if q.magnitude < 0:
-        raise InvalidValueError(f"inertia: got {value!r}; expected a rotary inertia >= 0")
+        raise InvalidValueError(f"{field}: got {value!r}; expected {what} >= 0")
     return q
 
 
@@ -430,8 +416,9 @@ class _Body:
 
     name: str = attrs.field(converter=check_name)
     at: str = attrs.field(converter=_point)
-    mass: pint.Quantity = attrs.field(converter=_mass)
-    inertia: pint.Quantity = attrs.field(default="0 kg*m^2", converter=_inertia)
+    mass: pint.Quantity = attrs.field(converter=lambda v: _not_negative(v, "mass", "[mass]", "a mass"))
+    inertia: pint.Quantity = attrs.field(default="0 kg*m^2", converter=lambda v: _not_negative(
+        v, "inertia", "[mass] * [length] ** 2", "a rotary inertia"))
 
     @property
     def mass_kg(self) -> float:

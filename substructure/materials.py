@@ -19,17 +19,10 @@ from .units import dimensionless, quantity
 __all__ = ["Material", "CATALOG", "get_material", "steel", "carbide", "aluminium"]
 
 
-def _modulus(value) -> pint.Quantity:
-    q = quantity(value, "E", "[mass] / [length] / [time] ** 2")
+def _positive(value, field: str, dimension: str, what: str) -> pint.Quantity:
+    q = quantity(value, field, dimension)
     if q.magnitude <= 0:
-        raise InvalidValueError(f"E: got {value!r}; expected a positive Young's modulus")
-    return q
-
-
-def _density(value) -> pint.Quantity:
-    q = quantity(value, "rho", "[mass] / [length] ** 3")
-    if q.magnitude <= 0:
-        raise InvalidValueError(f"rho: got {value!r}; expected a positive density")
+        raise InvalidValueError(f"{field}: got {value!r}; expected a positive {what}")
     return q
 
 
@@ -74,9 +67,10 @@ class Material:
     """
 
     name: str = attrs.field(converter=_name)
-    E: pint.Quantity = attrs.field(converter=_modulus)
+    E: pint.Quantity = attrs.field(
+        converter=lambda v: _positive(v, "E", "[mass] / [length] / [time] ** 2", "Young's modulus"))
     nu: float = attrs.field(converter=_poisson)
-    rho: pint.Quantity = attrs.field(converter=_density)
+    rho: pint.Quantity = attrs.field(converter=lambda v: _positive(v, "rho", "[mass] / [length] ** 3", "density"))
     loss_factor: float = attrs.field(default=0.0, converter=_loss)
     # SI values, derived once (every section of every beam variant needs them)
     _si: tuple = attrs.field(init=False, eq=False, repr=False)

@@ -185,10 +185,9 @@ def _point(value: Any, field: str) -> PointRef:
     if not isinstance(value, (str, PointRef)):
         raise InvalidValueError(f"{field}: got {value!r}; expected a point name such as 'tool.tip'")
     try:
-        ref = parse_point(value)
+        return parse_point(value)
     except UnknownPointError as exc:
         raise UnknownPointError(f"{field}: {exc}") from None
-    return ref
 
 
 def _stencil(points: Any, positions: Any, at: Any, at_position: Any, suffix: str = ""):

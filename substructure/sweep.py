@@ -133,10 +133,8 @@ def sweep(
     plans = [a._plan(refs) for a in assemblies]
     _check_structure(plans, assemblies)
     # canonical keys: (group, item) for nodes; outputs mapped through variant 0
-    key_of = []
-    for groups, out_keys, links in plans:
-        mapping = {k: (gi, ii) for gi, (_, items) in enumerate(groups) for ii, (k, _) in enumerate(items)}
-        key_of.append(mapping)
+    key_of = [{k: (gi, ii) for gi, (_, items) in enumerate(groups) for ii, (k, _) in enumerate(items)}
+              for groups, _, _ in plans]
     groups0, out0, links0 = plans[0]
     out_keys = [key_of[0][k] for k in out0]
     rows = [2 * i + d for i, d in out_idx]

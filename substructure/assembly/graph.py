@@ -150,6 +150,13 @@ class Assembly:
                 return comp.component(name)
         raise UnknownPointError(f"no component {name!r} in assembly {self.name!r}")
 
+    def _named(self, items: tuple, kind: str, plural: str, name: str):
+        for item in items:
+            if item.name == name:
+                return item
+        known = ", ".join(i.name for i in items) or "none"
+        raise UnknownPointError(f"no {kind} {name!r} in assembly {self.name!r} ({plural}: {known})")
+
     def joint(self, name: str) -> Joint:
         """The joint called ``name``.
 
@@ -168,11 +175,7 @@ class Assembly:
         UnknownPointError
             When there is no such joint (the message lists the joints).
         """
-        for j in self.joints:
-            if j.name == name:
-                return j
-        known = ", ".join(j.name for j in self.joints) or "none"
-        raise UnknownPointError(f"no joint {name!r} in assembly {self.name!r} (joints: {known})")
+        return self._named(self.joints, "joint", "joints", name)
 
     def mass(self, name: str) -> Mass:
         """The permanent body (:class:`Mass`) called ``name``.
@@ -192,11 +195,7 @@ class Assembly:
         UnknownPointError
             When there is none of that name.
         """
-        for m in self.masses:
-            if m.name == name:
-                return m
-        known = ", ".join(m.name for m in self.masses) or "none"
-        raise UnknownPointError(f"no mass {name!r} in assembly {self.name!r} (masses: {known})")
+        return self._named(self.masses, "mass", "masses", name)
 
     def sensor(self, name: str) -> Sensor:
         """The sensor called ``name``.
@@ -216,11 +215,7 @@ class Assembly:
         UnknownPointError
             When there is no such sensor (the message lists the sensors).
         """
-        for s in self.sensors:
-            if s.name == name:
-                return s
-        known = ", ".join(s.name for s in self.sensors) or "none"
-        raise UnknownPointError(f"no sensor {name!r} in assembly {self.name!r} (sensors: {known})")
+        return self._named(self.sensors, "sensor", "sensors", name)
 
     # -- building (each returns a new assembly) ---------------------------
 

@@ -48,13 +48,11 @@ class PreparedFRF:
         inputs = outputs if inputs is None else ([inputs] if isinstance(inputs, str) else list(inputs))
         self.outputs, out_idx, out_refs = expand_points(outputs)
         self.inputs, in_idx, in_refs = expand_points(inputs)
-        groups, self._out_keys, self._links = assembly._plan(out_refs + in_refs)
-        f = self.frequency.hz
-        self._groups = groups
+        self._groups, self._out_keys, self._links = assembly._plan(out_refs + in_refs)
         self._blocks = [
             ([k for k, _ in items],
-             by_chunks(lambda ff, o=owner, r=[ref for _, ref in items]: receptances(o, r, ff), f))
-            for owner, items in groups
+             by_chunks(lambda ff, o=owner, r=[ref for _, ref in items]: receptances(o, r, ff), self.frequency.hz))
+            for owner, items in self._groups
         ]
         self._rows = [2 * i + d for i, d in out_idx]
         self._cols = [2 * (len(out_refs) + i) + d for i, d in in_idx]
@@ -100,26 +98,22 @@ class PreparedFRF:
             The FRF at the prepared points and lines (m/N, m/(N m), rad/N, rad/(N m)).
         """
         joints, sensors, supports = dict(joints or {}), dict(sensors or {}), dict(supports or {})
-        components = dict(components or {})
-        blocks_all = self._blocks
-        if components:
-            f_all = self.frequency.hz
-            blocks_all = list(self._blocks)
-            names = {owner.name: i for i, (owner, _) in enumerate(self._groups)}
-            for name, comp in components.items():
-                if name not in names:
-                    raise UnknownPointError(
-                        f"prepared FRF: no component {name!r} takes part (components: {sorted(names)})"
-                    )
-                i = names[name]
-                refs = [ref for _, ref in self._groups[i][1]]
-                blocks_all[i] = (blocks_all[i][0], by_chunks(lambda ff: receptances(comp, refs, ff), f_all))
+        f = self.frequency.hz
+        blocks_all = list(self._blocks)
+        names = {owner.name: i for i, (owner, _) in enumerate(self._groups)}
+        for name, comp in dict(components or {}).items():
+            if name not in names:
+                raise UnknownPointError(
+                    f"prepared FRF: no component {name!r} takes part (components: {sorted(names)})"
+                )
+            i = names[name]
+            refs = [ref for _, ref in self._groups[i][1]]
+            blocks_all[i] = (blocks_all[i][0], by_chunks(lambda ff: receptances(comp, refs, ff), f))
         known = {o.name for _, _, o, _ in self._links if not isinstance(o, (Sensor, Support, Mass))}
         unknown = set(joints) - known
         if unknown:
             raise UnknownPointError(f"prepared FRF: no joint {sorted(unknown)} (joints: {sorted(known)})")
         objs = [self._replacement(obj, joints, sensors, supports) for _, _, obj, _ in self._links]
-        f = self.frequency.hz
         n = f.size
         parts = []
         for start in range(0, n, CHUNK_LINES):

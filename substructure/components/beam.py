@@ -104,9 +104,7 @@ class Beam:
     @property
     def length(self) -> pint.Quantity:
         """Total length."""
-        total = self.segments[0].length
-        for s in self.segments[1:]:
-            total = total + s.length
+        total = sum((s.length for s in self.segments[1:]), self.segments[0].length)
         return total.to(self.segments[0].length.units)
 
     @property

@@ -299,8 +299,7 @@ def design(entry: str, **parameters: Any) -> HolderDesign:
             p[key] = quantity(parameters[key], key, "[length]")
         elif key in chuck:
             p[key] = Q_(chuck[key])
-    p["taper_ratio"] = parameters.get("taper_ratio", face["taper_ratio"])
-    ratio = p["taper_ratio"]
+    ratio = p["taper_ratio"] = parameters.get("taper_ratio", face["taper_ratio"])
     if isinstance(ratio, bool) or not isinstance(ratio, (int, float)) or not 0 < ratio < 2:
         raise InvalidValueError(f"taper_ratio: got {ratio!r}; expected the change of diameter per length, e.g. 7/24")
     bore = p["bore"] = quantity(parameters["bore"], "bore", "[length]")
@@ -332,7 +331,7 @@ def design(entry: str, **parameters: Any) -> HolderDesign:
     else:
         p["clamp_length"] = _table_value(data["shank_lengths"], bore, "clamp_length (shank length)", "bore")
     segments, gauge_line = _segments(kind, p)
-    given = tuple(k for k in parameters)
+    given = tuple(parameters)
     return HolderDesign(f"{interface} {clamp}", p, given, segments, gauge_line, _describe(face, chuck, p, given))
 
 

@@ -64,10 +64,7 @@ class MeasuredComponent:
     @property
     def points(self) -> tuple[str, ...]:
         """The point names of the FRF's labels, in order."""
-        seen: dict[str, None] = {}
-        for lbl in self.frf.outputs:
-            seen[str(parse_point(lbl).point)] = None
-        return tuple(seen)
+        return tuple(dict.fromkeys(str(parse_point(lbl).point) for lbl in self.frf.outputs))
 
     def node_key(self, ref: PointRef):
         """A key of the physical point, after checking that both DOFs were measured.

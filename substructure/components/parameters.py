@@ -30,7 +30,7 @@ from typing import Any
 import attrs
 import pint
 
-from ..errors import InvalidValueError
+from ..errors import InvalidValueError, UnknownPointError
 from .beam import Beam
 from .protocol import is_plain_beam
 
@@ -176,8 +176,6 @@ def with_parameter(component: Any, name: str, value: float) -> Any:
     UnknownPointError
         When the component has no such parameter.
     """
-    from ..errors import UnknownPointError
-
     params = {p.name: p for p in own_parameters(component)}
     if name not in params:
         raise UnknownPointError(f"component {component.name!r} has no parameter {name!r}; its own parameters: "

@@ -13,7 +13,8 @@ import numpy as np
 import pint
 
 from ..beams import Flutes, Segment
-from ..errors import InvalidValueError
+from ..errors import InvalidValueError, UnitError
+from ..units import Q_, quantity, ureg
 from .beam import Beam
 from .protocol import register_component
 
@@ -24,9 +25,7 @@ def _tool_teeth(value):
     if value is None:
         return None
     if isinstance(value, bool) or not (isinstance(value, (int, np.integer)) or (
-            isinstance(value, float) and value.is_integer())):
-        raise InvalidValueError(f"teeth: got {value!r}; expected a whole number of teeth (flutes) >= 1")
-    if value < 1:
+            isinstance(value, float) and value.is_integer())) or value < 1:
         raise InvalidValueError(f"teeth: got {value!r}; expected a whole number of teeth (flutes) >= 1")
     return int(value)
 
@@ -34,9 +33,6 @@ def _tool_teeth(value):
 def _tool_helix(value):
     if value is None:
         return None
-    from ..errors import UnitError
-    from ..units import Q_, ureg
-
     try:
         q = Q_(value) if isinstance(value, str) else value
     except Exception:
@@ -53,8 +49,6 @@ def _tool_helix(value):
 def _tool_diameter(value):
     if value is None:
         return None
-    from ..units import quantity
-
     q = quantity(value, "diameter", "[length]")
     if not q.magnitude > 0:
         raise InvalidValueError(f"diameter: got {value!r}; expected a positive cutting diameter")
@@ -148,8 +142,6 @@ class Tool(Beam):
         Tool
             The overhang: a solid shank segment (if any), then the fluted segment.
         """
-        from ..units import quantity
-
         d = quantity(diameter, "diameter", "[length]")
         total = quantity(overhang, "overhang", "[length]")
         flutes = None if flute_length is None else quantity(flute_length, "flute_length", "[length]")
