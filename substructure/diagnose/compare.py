@@ -27,7 +27,7 @@ import numpy as np
 from ..errors import FrequencyAxisMismatchError, InvalidValueError
 from ..frf import FRF
 from ..smoothing import choose_window, smooth
-from .settings import DEFAULT_SETTINGS
+from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
 __all__ = [
     "METRIC",
@@ -255,10 +255,9 @@ def pair_modes(model: FRF, measured: FRF, floor: float = 0.02, window: int | Non
         for j, b in enumerate(fo)
         if abs(np.log(a / b)) < np.log(pairing)
     )
-    used_i, used_j, match = set(), set(), {}
+    used_j, match = set(), {}
     for _, i, j in candidates:
-        if i not in used_i and j not in used_j:
-            used_i.add(i)
+        if i not in match and j not in used_j:
             used_j.add(j)
             match[i] = j
     return [
@@ -266,6 +265,12 @@ def pair_modes(model: FRF, measured: FRF, floor: float = 0.02, window: int | Non
                  float(ho[match[i]]) if i in match else None)
         for i in range(len(fm))
     ]
+
+
+def _pairs(model: FRF, measured: FRF, noise: float, settings: DiagnoseSettings) -> list:
+    """:func:`pair_modes` with the settings' thresholds."""
+    return pair_modes(model, measured, settings.mode_peak_share, noise=noise, prominence=settings.mode_prominence,
+                      noise_prominence=settings.mode_prominence_floors, pairing=settings.mode_pairing)
 
 
 def error_bands(model: FRF, measured: FRF, share: float = 0.5, width_hz: float | None = None,
@@ -310,17 +315,9 @@ def error_bands(model: FRF, measured: FRF, share: float = 0.5, width_hz: float |
     local = np.convolve(r2, np.ones(n) / n, mode="same")
     above = (local > np.median(local)) & (local > (floor_factor * floor) ** 2)
     total = r2.sum()
-    regions = []
-    i = 0
-    while i < f.size:
-        if above[i]:
-            j = i
-            while j + 1 < f.size and above[j + 1]:
-                j += 1
-            regions.append((float(f[i]), float(f[j]), float(r2[i : j + 1].sum() / total)))
-            i = j + 1
-        else:
-            i += 1
+    # the contiguous runs of lines above: [start, stop) between the rises and falls of the padded mask
+    edges = np.flatnonzero(np.diff(np.concatenate(([0], above[: f.size], [0])).astype(int)))
+    regions = [(float(f[i]), float(f[j - 1]), float(r2[i:j].sum() / total)) for i, j in zip(edges[::2], edges[1::2])]
     regions.sort(key=lambda r: -r[2])
     out, covered = [], 0.0
     for reg in regions:

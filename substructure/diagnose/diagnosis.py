@@ -25,10 +25,8 @@ Every threshold, grid and budget is a field of
 :mod:`substructure.diagnose.words`.
 """
 
-
 from __future__ import annotations
 
-import math
 import sys
 from typing import Callable, Sequence
 
@@ -39,13 +37,13 @@ from ..errors import InvalidValueError
 from ..frf import FRF
 from ..updating.likelihood import Likelihood, measured_frfs
 from ..updating.selection import INDIFFERENCE, consistency
-from .compare import METRIC, Comparison, frac, pair_modes, error_bands
+from .compare import METRIC, Comparison, _pairs, frac, error_bands
 from .effects import Effect, registry
 from .refine import refine as refine_model
 from . import words
 from .result import Alternatives, Candidate, Changes, Diagnosis, Found, Measures, Step, Verdict, _finite, strict
 from .search import Budget, candidates
-from .settings import DEFAULT_SETTINGS, FROM_SETTINGS, DiagnoseSettings, _FromSettings
+from .settings import DEFAULT_SETTINGS, FROM_SETTINGS, DiagnoseSettings, _FromSettings, _real
 
 __all__ = ["Found", "Candidate", "Step", "Diagnosis", "diagnose", "strict", "sites"]
 
@@ -57,9 +55,6 @@ def _catalogue(effects) -> dict:
         if effects == "all":
             return known
         effects = [e.strip() for e in effects.split(",") if e.strip()]
-        if not effects:
-            raise InvalidValueError("effects: got an empty list; give 'all' or effect names "
-                                    f"({', '.join(known)})")
     effects = list(effects)
     if not effects:
         raise InvalidValueError("effects: got an empty list; give 'all' or effect names "
@@ -89,12 +84,6 @@ def _comparisons(lik: Likelihood, ratios, floors, settings: DiagnoseSettings = D
                                                 width_share=settings.error_bands_width,
                                                 floor_factor=settings.error_bands_floors)))
     return tuple(out)
-
-
-def _pairs(model: FRF, measured: FRF, noise: float, settings: DiagnoseSettings) -> list:
-    """:func:`~substructure.diagnose.compare.pair_modes` with the settings' thresholds."""
-    return pair_modes(model, measured, settings.mode_peak_share, noise=noise, prominence=settings.mode_prominence,
-                      noise_prominence=settings.mode_prominence_floors, pairing=settings.mode_pairing)
 
 
 def _peak_lines(baseline, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> np.ndarray:
@@ -223,9 +212,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     elif not isinstance(settings, DiagnoseSettings):
         raise InvalidValueError(f"settings: got {settings!r}; expected a DiagnoseSettings (or None: the defaults)")
     for name, value, what in (("budget", budget, "model evaluations"), ("time_limit", time_limit, "seconds")):
-        if value is not None and value is not FROM_SETTINGS and not (
-                isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-                and value > 0):
+        if value is not None and value is not FROM_SETTINGS and not (_real(value) and value > 0):
             raise InvalidValueError(f"{name}: got {value!r}; expected a positive number of {what} (or None: no limit)")
     if max_steps is not FROM_SETTINGS and not (isinstance(max_steps, int) and not isinstance(max_steps, bool)
                                                and max_steps >= 1):
@@ -448,7 +435,6 @@ def _distinct_rivals(assembly, measured, final_effects, outcome, say,
     kept_sites = frozenset().union(*(sites(assembly, f.change, f.values) for f in final_effects))
     out = []
     for _, founds in pool[:settings.rivals_checked]:
-        rival = Explanation(founds)
         same_changes = {f.change.key for f in founds} == keys
         if not same_changes and frozenset().union(*(sites(assembly, f.change, f.values) for f in founds)) == kept_sites:
             continue  # the same parts changed: an equivalent description
@@ -521,7 +507,4 @@ def bound_text(current, hit) -> str:
 
 
 def _std_of(result, change) -> dict:
-    for i, (c, _) in enumerate(result.changes):
-        if c is change:
-            return result.std[i]
-    return {}
+    return next((result.std[i] for i, (c, _) in enumerate(result.changes) if c is change), {})

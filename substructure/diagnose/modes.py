@@ -30,7 +30,7 @@ from ..errors import SubstructureError
 from ..frf import FRF
 from ..updating.elements import SectionChange
 from ..updating.fit import from_u, to_u
-from .compare import pair_modes
+from .compare import _pairs
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
 __all__ = ["mode_starts", "peak_near"]
@@ -112,16 +112,13 @@ def mode_starts(lik0, current, changes, places, settings: DiagnoseSettings = DEF
     except SubstructureError:
         return {}
     model = FRF(measured.frequency, base[:, None, None], measured.outputs, measured.inputs)
-    pairs = [p for p in pair_modes(model, measured, settings.mode_peak_share, noise=lik0.measured[0].noise.floor,
-                                   prominence=settings.mode_prominence,
-                                   noise_prominence=settings.mode_prominence_floors, pairing=settings.mode_pairing)
-             if p.model_hz is not None]
+    pairs = [p for p in _pairs(model, measured, lik0.measured[0].noise.floor, settings) if p.model_hz is not None]
     f0 = np.array([peak_near(f, base, p.model_hz, settings.mode_locate) or p.model_hz for p in pairs])
     if f0.size == 0:
         return {}
     measured_hz = np.array([p.measured_hz for p in pairs])
     step = float(f[1] - f[0]) if f.size > 1 else 1.0
-    if np.all(np.abs(np.array([p.measured_hz for p in pairs]) - f0) < settings.in_place_lines * step):
+    if np.all(np.abs(measured_hz - f0) < settings.in_place_lines * step):
         return {}  # the modes sit where the model has them: nothing to predict from
     out: dict = {}
     for change in changes:
@@ -138,13 +135,11 @@ def mode_starts(lik0, current, changes, places, settings: DiagnoseSettings = DEF
             try:
                 if null is not None:  # an element: linear in its main value, from zero
                     zero = {**values, **{k: v for k, v in null.items() if k not in ("position", "start", "length")}}
-                    ref = lik0.predict(list(current) + [(change, zero)])[0]
-                    f_ref = np.array([peak_near(f, ref, v, settings.mode_follow) or np.nan for v in f0])
+                    f_ref = _modes(lik0, list(current) + [(change, zero)], f, f0, settings.mode_follow)
                     step = settings.element_probe_linear * (main.upper - main.lower) if not main.log \
                         else main.upper * settings.element_probe_log
                     probe = {**zero, main.name: zero[main.name] + step}
-                    moved = lik0.predict(list(current) + [(change, probe)])[0]
-                    f1 = np.array([peak_near(f, moved, v, settings.mode_follow) or np.nan for v in f_ref])
+                    f1 = _modes(lik0, list(current) + [(change, probe)], f, f_ref, settings.mode_follow)
                     s = (np.log(f1) - np.log(f_ref)) / step
                     dd = np.log(measured_hz / f_ref)
                     ok = np.isfinite(s) & np.isfinite(dd)

@@ -73,11 +73,7 @@ def _knobs(assembly) -> list[tuple[str, str, str]]:
     for j in assembly.joints:
         if getattr(j, "rigid", True) is False and getattr(j, "k", None):
             out.append((f"joints.{j.name}.k", "stiffness", f"the stiffness of the joint {j.name}"))
-    comps = {}
-    for s in assembly.supports:
-        comps.setdefault(s.at.split("@")[0].split(".")[0], 0)
-        comps[s.at.split("@")[0].split(".")[0]] += 1
-    for comp, count in comps.items():
+    for comp in dict.fromkeys(s.at.split("@")[0].split(".")[0] for s in assembly.supports):
         out.append((f"components.{comp}.supports.k", "stiffness", f"the stiffness of the supports of the {comp}"))
     return out
 
@@ -115,7 +111,8 @@ def signature(model, measured_frf, pairs, settings: DiagnoseSettings = DEFAULT_S
         return [], {}
     paired = [paired[i] for i in keep]
     f0 = np.array([f0[i] for i in keep])
-    d = np.log(np.array([p.measured_hz for p in paired]) / f0)
+    measured_hz = np.array([p.measured_hz for p in paired])
+    d = np.log(measured_hz / f0)
     sens, names = [], []
     for path, kind, text in _knobs(model):
         try:
@@ -144,10 +141,11 @@ def signature(model, measured_frf, pairs, settings: DiagnoseSettings = DEFAULT_S
         in_place = abs(p.measured_hz - f0[i]) < settings.in_place_lines * step
         lines.append(words.mode_line(f0[i], where_strain, where_motion, None if in_place else float(d[i]),
                                      settings.in_place_lines))
-    moved = np.abs(np.array([p.measured_hz for p in paired]) - f0) >= settings.in_place_lines * step
+    moved = np.abs(measured_hz - f0) >= settings.in_place_lines * step
+    info = {"modes": [{"model_hz": float(v), "measured_hz": float(p.measured_hz), "strain": n}
+                      for v, p, n in zip(f0, paired, mode_names)]}
     if not moved.any():
-        return lines, {"modes": [{"model_hz": float(v), "measured_hz": float(p.measured_hz), "strain": n}
-                                 for v, p, n in zip(f0, paired, mode_names)]}
+        return lines, info
     dd = float(d @ d)
     best = None
     if dd > 0:
@@ -159,13 +157,10 @@ def signature(model, measured_frf, pairs, settings: DiagnoseSettings = DEFAULT_S
             share = 1.0 - float(np.sum((d - a * s[j]) ** 2)) / dd
             if best is None or share > best[0]:
                 best = (share, a, path, kind, text)
-    info = {"modes": [{"model_hz": float(v), "measured_hz": float(p.measured_hz), "strain": n}
-                      for v, p, n in zip(f0, paired, mode_names)]}
     if best is not None and best[0] > settings.signature_share:
         share, a, path, kind, text = best
-        lower = [float(f0[i]) for i in range(len(f0)) if moved[i] and d[i] < 0]
-        higher = [float(f0[i]) for i in range(len(f0)) if moved[i] and d[i] > 0]
-        lines.append(words.signature_line(lower, higher, text, kind, a, share))
+        lines.append(words.signature_line(f0[moved & (d < 0)].tolist(), f0[moved & (d > 0)].tolist(), text, kind, a,
+                                          share))
         info["knob"] = {"path": path, "kind": kind, "factor": float(np.exp(a)), "share": share}
     return lines, info
 
@@ -294,9 +289,8 @@ def unexplained_report(lik, assembly, current, baseline, cons, final_error: floa
 def _measurement_points(assembly) -> list[str]:
     points = []
     for comp in _plain_beams(assembly):
-        L = comp.length_m
-        points += [f"{comp.name}.base", f"{comp.name}@{0.25 * L * 1e3:.4g} mm", f"{comp.name}@{0.5 * L * 1e3:.4g} mm",
-                   f"{comp.name}@{0.75 * L * 1e3:.4g} mm", f"{comp.name}.tip"]
+        inner = [f"{comp.name}@{share * comp.length_m * 1e3:.4g} mm" for share in (0.25, 0.5, 0.75)]
+        points += [f"{comp.name}.base", *inner, f"{comp.name}.tip"]
     return points
 
 
@@ -321,6 +315,16 @@ class Explanation:
         for f in self.founds:
             assembly = f.apply(assembly)
         return assembly
+
+
+def _applied(explanation, config, non_contact: bool):
+    """``config`` with the explanation applied (as it is when that fails, or without a test-only change)."""
+    if non_contact and explanation.change.test_only:
+        return config
+    try:
+        return explanation.apply(config)
+    except SubstructureError:
+        return config
 
 
 def separation(assembly, measured, a, b, say=None, contact_only: bool = False,
@@ -358,21 +362,13 @@ def separation(assembly, measured, a, b, say=None, contact_only: bool = False,
     excitation = str(first.frf.inputs[0]).split(":")[0]
     done = {(str(m.frf.outputs[0]).split(":")[0], str(m.frf.inputs[0]).split(":")[0]) for m in measured}
     points = list(dict.fromkeys(_measurement_points(config) + [p for pair in done for p in pair]))
+    labels = [p + ":y" for p in points]
     variants = [False] + ([True] if (a.change.test_only or b.change.test_only) and not contact_only else [])
     best = None
     for non_contact in variants:
-        models = []
-        for e in (a, b):
-            if non_contact and e.change.test_only:
-                models.append(config)
-            else:
-                try:
-                    models.append(e.apply(config))
-                except SubstructureError:
-                    models.append(config)
+        models = [_applied(e, config, non_contact) for e in (a, b)]
         try:
-            ha = models[0].frf([p + ":y" for p in points], [p + ":y" for p in points], sub).data
-            hb = models[1].frf([p + ":y" for p in points], [p + ":y" for p in points], sub).data
+            ha, hb = (m.frf(labels, labels, sub).data for m in models)
         except (SubstructureError, ValueError) as exc:
             if say:
                 say(f"separating measurement skipped: {exc}")
@@ -384,9 +380,7 @@ def separation(assembly, measured, a, b, say=None, contact_only: bool = False,
             for j, exc in enumerate(points):
                 if j != i and exc != excitation:
                     continue
-                if (resp, exc) in done and not non_contact:
-                    continue
-                if non_contact and (resp, exc) not in done:  # the same test again, without the sensor
+                if ((resp, exc) in done) != non_contact:  # a new test, or the same test again without the sensor
                     continue
                 value = float(score[i, j])
                 if best is None or value > best[0]:

@@ -22,7 +22,6 @@ also read from the diagnosis under its own name (``d.explained``,
 
 from __future__ import annotations
 
-
 import attrs
 
 from .._json import finite as _finite, strict
@@ -86,8 +85,7 @@ class Found:
         """
         out = {}
         for s in self.change.specs:
-            entry = {"value": _finite(self.values.get(s.name)), "unit": s.unit,
-                     "std": _finite(self.std.get(s.name)) if s.name in self.std else None}
+            entry = {"value": _finite(self.values.get(s.name)), "unit": s.unit, "std": _finite(self.std.get(s.name))}
             if s.nominal is not None:
                 entry["nominal"] = _finite(s.nominal)
             out[s.name] = entry
@@ -111,6 +109,10 @@ class Found:
     def __repr__(self) -> str:
         vals = ", ".join(f"{k}={v:.4g}" for k, v in self.values.items())
         return f"{self.name}(where={self.where!r}, {vals})"
+
+
+def _effect_json(found: Found) -> dict:
+    return {"effect": found.name, "where": found.where, "parameters": found.parameters_json()}
 
 
 @attrs.frozen
@@ -155,9 +157,8 @@ class Candidate:
         dict
             ``effect``, ``where``, ``parameters``, ``error``, ``chi2``, ``fitted``, ``explanation``.
         """
-        return {"effect": self.name, "where": self.where, "parameters": self.effect.parameters_json(),
-                "error": _finite(self.error), "chi2": _finite(self.chi2), "fitted": self.fitted,
-                "explanation": self.effect.explanation}
+        return {**_effect_json(self.effect), "error": _finite(self.error), "chi2": _finite(self.chi2),
+                "fitted": self.fitted, "explanation": self.effect.explanation}
 
 
 @attrs.frozen
@@ -418,8 +419,7 @@ class Diagnosis:
             "suggestion": self.suggestion,
             "band_hz": list(self.band),
             "final_error": _finite(self.final_error),
-            "final_effects": [{"effect": e.name, "where": e.where, "parameters": e.parameters_json()}
-                              for e in self.final_effects],
+            "final_effects": [_effect_json(e) for e in self.final_effects],
             "correlation": self.correlation,
             "consistency": None if cons is None else {
                 "chi2_reduced": _finite(cons.chi2_reduced), "threshold": _finite(cons.threshold),
@@ -427,11 +427,9 @@ class Diagnosis:
                                       + self.final[b.item].measured.inputs[0]),
                               "lo": b.lo_hz, "hi": b.hi_hz, "ratio": _finite(b.ratio), "share": _finite(b.share)}
                              for b in cons.bands]},
-            "ambiguous": [{"effect": a.name, "where": a.where, "parameters": a.parameters_json(),
-                           "error": _finite(err)} for a, err in self.ambiguous],
+            "ambiguous": [{**_effect_json(a), "error": _finite(err)} for a, err in self.ambiguous],
             "separation": self.separation,
-            "rivals": [{"effects": [{"effect": f.name, "where": f.where, "parameters": f.parameters_json()}
-                                    for f in r.founds], "separation": sep} for r, sep in self.rivals],
+            "rivals": [{"effects": [_effect_json(f) for f in r.founds], "separation": sep} for r, sep in self.rivals],
             "search": dict(self.search),
             "report": list(self.report),
             "settings": self.settings.to_json(),

@@ -63,9 +63,7 @@ def _number(lo: float = 0.0, hi: float = math.inf, lo_open: bool = True, hi_open
         return _real(x) and (x > lo if lo_open else x >= lo) and (x < hi if hi_open else x <= hi)
 
     def check(_, attribute, value) -> None:
-        if optional and value is None:
-            return
-        if not inside(value):
+        if not (optional and value is None or inside(value)):
             _fail(attribute, value, what)
     check.inside = inside  # type: ignore[attr-defined]
     check.what = what  # type: ignore[attr-defined]

@@ -473,9 +473,7 @@ def summary(result, model_name: str, measured: int) -> list[str]:
         The lines.
     """
     floor = result.noise_floor
-    lines = []
-    if not result.explained:
-        lines += list(result.report)
+    lines = [] if result.explained else list(result.report)
     lines.append(f"model {model_name!r} against {measured} measured FRF(s), "
                  f"{result.band[0]:.0f}-{result.band[1]:.0f} Hz")
     lines.append(f"error ({result.metric}): {result.baseline_error:.4f}; noise floor of the data: {floor:.4f}")
@@ -487,10 +485,8 @@ def summary(result, model_name: str, measured: int) -> list[str]:
         lines.append("  most of the error is in " + ", ".join(f"{lo:.0f}-{hi:.0f} Hz ({share:.0%})"
                                                            for lo, hi, share in base.bands))
     if result.missing_effect is None:
-        if result.explained:
-            lines.append("the model is as good as the data allow: nothing is missing")
-        else:
-            lines.append("no candidate explains the difference significantly")
+        lines.append("the model is as good as the data allow: nothing is missing" if result.explained
+                     else "no candidate explains the difference significantly")
     else:
         label = "missing effect" if result.explained else "best partial explanation (partial)"
         for i, e in enumerate(result.effects):
