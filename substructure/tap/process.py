@@ -439,8 +439,7 @@ def process_taps(
                       record.response_column)
         if tap_length is None:
             first = find_pulse(record.force, trigger_fraction, no_hit_factor)
-            start = 0 if isinstance(first, str) else max(first.start - pre, 0)
-            starts = [start]
+            starts = [0 if isinstance(first, str) else max(first.start - pre, 0)]
         else:
             starts = tap_starts(record.force, length, pre, trigger_fraction, no_hit_factor)
             if not starts:

@@ -28,8 +28,7 @@ from .parameters import Change, ParamSpec
 from .structure import LinkSI
 
 __all__ = ["AddedMass", "GroundSpring", "SectionChange", "split_beam", "split_segments", "unique_name", "body_bounds",
-           "rear_bounds",
-           "STEEL_DENSITY"]
+           "rear_bounds", "STEEL_DENSITY"]
 
 
 def _si(value: float, unit: str) -> str:
@@ -258,20 +257,16 @@ def split_beam(beam, start: float, stop: float, od_factor: float = 1.0, flutes: 
     start, stop = max(0.0, float(start)), min(total, float(stop))
     cuts = np.unique(np.concatenate([ends, [start, stop]]))
     cuts = cuts[np.concatenate([[True], np.diff(cuts) > 1e-12 * total])]
-    idx, lengths, inside = [], [], []
-    for x0, x1 in zip(cuts[:-1], cuts[1:]):
-        k = int(np.clip(np.searchsorted(ends, 0.5 * (x0 + x1)) - 1, 0, beam.length.size - 1))
-        idx.append(k)
-        lengths.append(x1 - x0)
-        inside.append(start - 1e-12 <= 0.5 * (x0 + x1) <= stop + 1e-12)
-    idx, inside = np.array(idx), np.array(inside)
+    mid = 0.5 * (cuts[:-1] + cuts[1:])
+    idx = np.clip(np.searchsorted(ends, mid) - 1, 0, beam.length.size - 1)
+    inside = (start - 1e-12 <= mid) & (mid <= stop + 1e-12)
     od = beam.od[idx] * np.where(inside, od_factor, 1.0)
     ratio = beam.ratio[idx].copy()
     if flutes is not None:
         ratio[inside] = flutes
     bore = beam.id[idx]
     od = np.maximum(od, bore * 1.0001 / ratio)
-    return beam.evolve(length=np.array(lengths), od=od, id=bore, ratio=ratio, material=beam.material[idx],
+    return beam.evolve(length=np.diff(cuts), od=od, id=bore, ratio=ratio, material=beam.material[idx],
                        material_names=[beam.material_names[i] for i in idx], insert=beam.insert[idx],
                        insert_names=[beam.insert_names[i] for i in idx])
 

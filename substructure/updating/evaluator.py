@@ -63,13 +63,8 @@ class Evaluator:
             raise InvalidValueError("frequency: a model evaluation needs lines above 0 Hz (free-free components "
                                     "have no static receptance); crop the data, e.g. from 1 Hz")
         refs = [_parse(p) for p in self.outputs + self.inputs]
-        self._points = []
-        self._dofs = []
-        for r in refs:
-            point = str(r.point)
-            if point not in self._points:
-                self._points.append(point)
-            self._dofs.append((self._points.index(point), DOFS.index(r.dof or "y")))
+        self._points = list(dict.fromkeys(str(r.point) for r in refs))
+        self._dofs = [(self._points.index(str(r.point)), DOFS.index(r.dof or "y")) for r in refs]
         self._n_out = len(self.outputs)
         self._pinned: dict = {}
         self._lru: OrderedDict = OrderedDict()

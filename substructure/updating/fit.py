@@ -168,9 +168,7 @@ def fit(likelihood, changes: Sequence[tuple], free: Sequence[bool] | None = None
     slots = []  # (change index, spec)
     for i, ((change, values), is_free) in enumerate(zip(changes, free)):
         for spec in change.specs:
-            if spec.name not in values:
-                values[spec.name] = spec.start
-            values[spec.name] = float(np.clip(values[spec.name], spec.lower, spec.upper))
+            values[spec.name] = float(np.clip(values.get(spec.name, spec.start), spec.lower, spec.upper))
             if is_free:
                 slots.append((i, spec))
 
@@ -205,9 +203,7 @@ def fit(likelihood, changes: Sequence[tuple], free: Sequence[bool] | None = None
     u0 = np.clip(u0, lo + 1e-9 * span, hi - 1e-9 * span)
     result = least_squares(residual, u0, bounds=(lo, hi), method="trf", x_scale=1.0, diff_step=1e-6,
                            ftol=FTOL, xtol=XTOL, max_nfev=max_nfev or 30 * (len(slots) + 1))
-    u = result.x
-    f0 = result.fun
-    jac = result.jac
+    u, f0, jac = result.x, result.fun, result.jac
     chi2 = float(f0 @ f0)
     n, p = f0.size, len(slots)
     s2 = max(1.0, chi2 / max(n - p, 1))
@@ -218,12 +214,11 @@ def fit(likelihood, changes: Sequence[tuple], free: Sequence[bool] | None = None
     corr = np.where(np.isfinite(corr), corr, 0.0)
     final = model_of(u)
     std = [dict() for _ in changes]
-    at_bound = []
-    for (i, spec), ui, sd in zip(slots, u, sd_u):
+    for (i, spec), sd in zip(slots, sd_u):
         v = final[i][1][spec.name]
         std[i][spec.name] = float(abs(v) * sd) if spec.log else float(_scale(spec) * sd)
-        width = 1e-6 * (hi - lo)[len(at_bound)]
-        at_bound.append(bool(ui <= lo[len(at_bound)] + width or ui >= hi[len(at_bound)] - width))
+    width = 1e-6 * (hi - lo)
+    at_bound = ((u <= lo + width) | (u >= hi - width)).tolist()
     if progress:
         progress(f"fitted {', '.join(f'{c.effect} at {c.where}' for c, _ in final)}: chi^2/n = {chi2 / n:.4g}")
     return Fit(tuple(final), tuple(std), corr, tuple((i, s.name) for i, s in slots), chi2, n,

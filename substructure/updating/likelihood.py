@@ -268,9 +268,13 @@ class Likelihood:
             Complex receptances, one array per measured FRF.
         """
         self.evaluations += 1
+        return self._gather([g.predict(changes) for g in self.groups])
+
+    def _gather(self, per_group: list) -> list:
+        """Per measured FRF, its array among the groups' (each group's in the order of its indices)."""
         out: list = [None] * len(self.measured)
-        for g in self.groups:
-            for i, y in zip(g.indices, g.predict(changes)):
+        for g, ys in zip(self.groups, per_group):
+            for i, y in zip(g.indices, ys):
                 out[i] = y
         return out
 
@@ -364,14 +368,7 @@ class Likelihood:
         except Exception:  # noqa: BLE001 - one by one, so that the error is the first model's, as with residual
             return [self.residual(changes) for changes in lists]
         self.evaluations += len(lists)
-        out = []
-        for k in range(len(lists)):
-            predicted: list = [None] * len(self.measured)
-            for g, ys in zip(self.groups, per_group):
-                for i, y in zip(g.indices, ys[k]):
-                    predicted[i] = y
-            out.append(self.whiten(self._ratios(predicted)))
-        return out
+        return [self.whiten(self._ratios(self._gather([ys[k] for ys in per_group]))) for k in range(len(lists))]
 
     def chi2(self, changes: Sequence[tuple] = ()) -> float:
         """``chi^2`` of the model (``-2 ln L`` up to a constant).

@@ -414,8 +414,7 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     with np.errstate(invalid="ignore"):
         spike = usable & np.isfinite(z) & (z / local > _TRIM / 2)
     own = np.abs(q_local) ** 2 / (1.0 - h0) ** 2
-    v_re = np.where(spike, np.maximum(v_re, own), v_re)
-    v_im = np.where(spike, np.maximum(v_im, own), v_im)
+    v_re, v_im = (np.where(spike, np.maximum(v, own), v) for v in (v_re, v_im))
     # lines where the additive noise (the floor's, and the response's noise that the coherence term
     # carries) is as large as the signal: the log of the data is biased and heavy-tailed there, and
     # the tests read the residual in the linear domain
@@ -437,12 +436,9 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     with np.errstate(divide="ignore", invalid="ignore"):
         v_lin = 0.5 * local_d2 / np.abs(s) ** 2
     linear = linear & np.isfinite(v_lin) & (v_lin > 0)
-    lin_re = np.where(linear, np.maximum(v_lin, coef[0]), np.nan)
-    lin_im = np.where(linear, np.maximum(v_lin, coef[1]), np.nan)
-    var_re = np.minimum(np.where(np.isfinite(v_re), v_re, VARIANCE_CAP), VARIANCE_CAP)
-    var_im = np.minimum(np.where(np.isfinite(v_im), v_im, VARIANCE_CAP), VARIANCE_CAP)
-    var_re[~usable] = VARIANCE_CAP
-    var_im[~usable] = VARIANCE_CAP
+    lin_re, lin_im = (np.where(linear, np.maximum(v_lin, c), np.nan) for c in coef[:2])
+    var_re, var_im = (np.where(usable, np.minimum(np.where(np.isfinite(v), v, VARIANCE_CAP), VARIANCE_CAP),
+                               VARIANCE_CAP) for v in (v_re, v_im))
     # the scale's standard error from the spread over blocks of lines
     zf = 0.5 * (q_re2 / ((1 - h0) * var_re) + q_im2 / ((1 - h0) * var_im))
     keep = keep & ~spike

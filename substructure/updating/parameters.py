@@ -240,14 +240,15 @@ def model_parameters(assembly) -> list[ModelParameter]:
         for i, seg in enumerate(comp.segments):
             p = f"{base}.segments.{i}"
             L, od, id_ = seg.length_m, seg.od.m_as("m"), seg.id.m_as("m")
+            fluted = seg.flutes.diameter_ratio if seg.flutes else 1.0
             out.append(_log(f"{p}.length", "m", L, L / LENGTH_FACTOR, LENGTH_FACTOR * L,
                             f"length of segment {i} of {comp.name}"))
-            low = max(od / LENGTH_FACTOR, 1.02 * id_ / (seg.flutes.diameter_ratio if seg.flutes else 1.0))
+            low = max(od / LENGTH_FACTOR, 1.02 * id_ / fluted)
             out.append(_log(f"{p}.od", "m", od, low, LENGTH_FACTOR * od,
                             f"outer diameter of segment {i} of {comp.name}"))
             if seg.is_tapered:
                 od1, id1 = seg._od_tip.m_as("m"), seg._id_tip.m_as("m")
-                low = max(od1 / LENGTH_FACTOR, 1.02 * id1 / (seg.flutes.diameter_ratio if seg.flutes else 1.0))
+                low = max(od1 / LENGTH_FACTOR, 1.02 * id1 / fluted)
                 out.append(_log(f"{p}.od_tip", "m", od1, low, LENGTH_FACTOR * od1,
                                 f"outer diameter at the tip end of tapered segment {i} of {comp.name}"))
                 if id1 > 0:
@@ -255,9 +256,7 @@ def model_parameters(assembly) -> list[ModelParameter]:
                                                                             f"{i} of {comp.name}"))
             if seg.insert is None:
                 narrow = min(od, seg._od_tip.m_as("m")) if seg.is_tapered else od
-                out.append(_lin(f"{p}.id", "m", id_, 0.0,
-                                0.9 * narrow * (seg.flutes.diameter_ratio if seg.flutes else 1.0),
-                                f"bore of segment {i} of {comp.name}"))
+                out.append(_lin(f"{p}.id", "m", id_, 0.0, 0.9 * narrow * fluted, f"bore of segment {i} of {comp.name}"))
             else:
                 iod = seg.insert.od.m_as("m")
                 out.append(_log(f"{p}.insert.od", "m", iod, max(0.5 * iod, 1.02 * seg.insert.id.m_as("m")), id_,
@@ -329,7 +328,7 @@ def model_parameters(assembly) -> list[ModelParameter]:
     per_component: dict[str, list] = {}
     for i, s in enumerate(assembly.supports):
         p = f"supports.{i}"
-        out += [m for m in _matrix_parameters(p, s, f"support {s.name or i} at {s.at}")]
+        out += _matrix_parameters(p, s, f"support {s.name or i} at {s.at}")
         comp, x, length = _on_beam(assembly, s.at)
         if comp is not None:
             out.append(_lin(f"{p}.at", "m", x, *_position_bounds(x, length),
@@ -359,7 +358,6 @@ def model_parameters(assembly) -> list[ModelParameter]:
                     out.append(_lin(f"{p}.at", "m", x, *_position_bounds(x, length),
                                     f"position of {s.name} along {comp}"))
     return out
-
 
 
 def material_changes(assembly, known=None) -> list["ParameterSet"]:
@@ -448,7 +446,6 @@ def get_parameter(assembly, path: str) -> float:
             return p.nominal
     check_path(assembly, path)  # a key that names nothing: refused with the keys that exist
     raise _unknown(path, "not a parameter of this assembly (see model_parameters)")
-
 
 
 # ---------------------------------------------------------------------------

@@ -217,8 +217,7 @@ def consistency(likelihood, ratios: Sequence[np.ndarray], p: int) -> Consistency
         starts = list(range(0, z.size, size))
         if len(starts) > 1 and z.size - starts[-1] < size // 2:  # a short last block joins the one before
             starts.pop()
-        for k, start in enumerate(starts):
-            stop = starts[k + 1] if k + 1 < len(starts) else z.size
+        for start, stop in zip(starts, starts[1:] + [z.size]):
             blocks.append((item, slice(start, stop), f))
     m_blocks = max(len(blocks), 1)
     # each block's chi^2 above its degrees of freedom; a share is of the sum of these (so the shares of all
@@ -229,8 +228,7 @@ def consistency(likelihood, ratios: Sequence[np.ndarray], p: int) -> Consistency
     for (item, sl, f), over in zip(blocks, excess):
         z = z2[item][sl]
         # widened, as the global test is, by how well the noise itself is known
-        dof = likelihood.measured[item].noise.dof
-        dof = None if dof is None else dof[likelihood.lines][sl]
+        dof = None if dofs[item] is None else dofs[item][sl]
         bound = _block_bound(z.size, CONSISTENCY_ALPHA / m_blocks, dof) * (1.0 + _Z * float(errs[item]))
         ratio = float(np.minimum(z, LINE_CAP).mean())
         if ratio > bound:

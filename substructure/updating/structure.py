@@ -364,10 +364,8 @@ class Structure:
             else:
                 opaque[comp.name] = comp
         links = []
-        for s in assembly.sensors:
-            links.append(LinkSI(("sensors", s.name), s.at, M=np.diag([s.mass_kg, s.inertia_si])))
-        for m in assembly.masses:
-            links.append(LinkSI(("masses", m.name), m.at, M=np.diag([m.mass_kg, m.inertia_si])))
+        for kind, bodies in (("sensors", assembly.sensors), ("masses", assembly.masses)):
+            links += [LinkSI((kind, b.name), b.at, M=np.diag([b.mass_kg, b.inertia_si])) for b in bodies]
         for i, s in enumerate(assembly.supports):
             links.append(LinkSI(("supports", i), s.at, K=s.k.values, C=s.c.values))
         for j in assembly.joints:
