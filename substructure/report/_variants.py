@@ -22,11 +22,21 @@ def _lobes(structure: Any, band: Any, cut: Any, speeds: Any, method: str, interv
     return attrs.evolve(sdm(fit_modes(xy), cut, speeds, intervals=intervals), band=band)
 
 
-def _joint_band(assembly, at, band, chosen, lobes, cut, limits, speeds, method, intervals, margin, tolerance, say):
+def _structure(assembly: Any, at: str, band: Any, frf: Any = None) -> tuple[Any, Any]:
+    """The receptance stability uses and its band: ``"auto"`` as :func:`~substructure.stability.assembly_structure`,
+    else the band chosen of the tool point receptance ``frf`` (computed when not given)."""
+    from ..stability import assembly_structure, choose_band
+
+    if isinstance(band, str) and band == "auto":
+        return assembly_structure(assembly, at)
+    return choose_band(assembly.receptance(at, frequency=assembly.frequency) if frf is None else frf, band)
+
+
+def _joint_band(assembly, at, band, lobes, cut, limits, speeds, method, intervals, margin, tolerance, say):
     """The lobes over the joints' stated uncertainty, the recommendation stable across them (or why none is) and
     each variant's own recommended depth (None, None, None, () when no joint states an uncertainty)."""
     from ..joint_priors import joint_variants
-    from ..stability import (NoRecommendationError, assembly_structure, choose_band, lobes_band, recommend)
+    from ..stability import NoRecommendationError, lobes_band, recommend
 
     variants = joint_variants(assembly)
     if len(variants) < 2:
@@ -34,11 +44,7 @@ def _joint_band(assembly, at, band, chosen, lobes, cut, limits, speeds, method, 
     say(f"stability band: lobes of {len(variants)} variants of the joints within their uncertainty")
     members = []
     for variant in variants:
-        if isinstance(band, str) and band == "auto":
-            structure, used = assembly_structure(variant, at)
-        else:
-            structure, used = choose_band(variant.receptance(at, frequency=variant.frequency), band)
-        members.append(_lobes(structure, used, cut, speeds, method, intervals, lambda text: None))
+        members.append(_lobes(*_structure(variant, at, band), cut, speeds, method, intervals, lambda text: None))
     spread = lobes_band(members, nominal=lobes, label="joints within their uncertainty")
     own = []  # each variant's own recommended depth, as if its joints were known: their range is the uncertainty
     for member in members:

@@ -25,7 +25,8 @@ import attrs
 import numpy as np
 
 from ..errors import InvalidValueError, SubstructureError
-from ._variants import _cutting, _joint_band, _lobes
+from ._variants import _cutting, _joint_band, _lobes, _structure
+from .text import _number
 
 __all__ = ["Report", "ToolMode", "report", "tool_point", "SUMMARY_KEYS", "DEFAULT_SPEEDS"]
 
@@ -282,11 +283,8 @@ class Report:
 
 
 def _fraction(value: Any, field: str, hi: float) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InvalidValueError(f"{field}: got {value!r}; expected a number in [0, {hi:g})") from None
-    if not 0.0 <= v < hi:
+    v = _number(value)
+    if v is None or not 0.0 <= v < hi:
         raise InvalidValueError(f"{field}: got {value!r}; expected a number in [0, {hi:g})")
     return v
 
@@ -456,8 +454,7 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
 
     from ..assembly import Assembly
     from ..measurements import MeasurementSet
-    from ..stability import (MachineLimits, MillingCut, TurningCut, assembly_structure, choose_band, recommend,
-                             spindle_speeds)
+    from ..stability import MachineLimits, MillingCut, TurningCut, recommend, spindle_speeds
 
     if progress is True:
         import sys
@@ -500,15 +497,11 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
     notes = list(notes)
     say(f"tool point receptance at {at}")
     frf = assembly.receptance(at, frequency=assembly.frequency)
-    if isinstance(band, str) and band == "auto":
-        structure, chosen = assembly_structure(assembly, at)
-    else:
-        structure, chosen = choose_band(frf, band)
+    structure, chosen = _structure(assembly, at, band, frf)
     modes, fit_error = _modes(structure, notes)
     tool = _tool_of(assembly, at)
-    lobes = best = why = spread = robust = robust_why = shop = None
+    lobes = best = why = spread = robust = robust_why = shop = band_shop = None
     own = ()
-    band_shop = None
     if cut is not None:
         milling = hasattr(cut, "radial_depth")
         if milling:
@@ -533,8 +526,8 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
                 best = recommend(lobes, cut, limits, margin=margin, speed_tolerance=speed_tolerance)
             except InvalidValueError as exc:  # the lobes leave nothing to recommend: the report says why
                 why = str(exc)
-            spread, robust, robust_why, own = _joint_band(assembly, at, band, chosen, lobes, cut, limits, speeds,
-                                                          method, intervals, margin, speed_tolerance, say)
+            spread, robust, robust_why, own = _joint_band(assembly, at, band, lobes, cut, limits, speeds, method,
+                                                          intervals, margin, speed_tolerance, say)
             shop = _cutting(cut, best, tool, cutting_table, tool_material)
             band_shop = _cutting(cut, robust, tool, cutting_table, tool_material)
         else:

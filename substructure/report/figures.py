@@ -92,8 +92,7 @@ def lobes_figure(report: Any) -> str:
     ax = fig.axes[0]
     band = getattr(report, "band", None)
     if band is not None:  # the joints within their stated uncertainty
-        lo = np.where(np.isfinite(band.lower_m), band.lower_m, np.nan) * 1e3
-        hi = np.where(np.isfinite(band.upper_m), band.upper_m, np.nan) * 1e3
+        lo, hi = (np.where(np.isfinite(m), m, np.nan) * 1e3 for m in (band.lower_m, band.upper_m))
         ax.fill_between(band.spindle_speed_rpm, lo, hi, color="tab:purple", alpha=0.12, lw=0,
                         label=f"stability band ({len(band.members)} variants of the joints)")
         ax.plot(band.spindle_speed_rpm, lo, color="tab:purple", lw=1.0, label="lowest limit of the variants")

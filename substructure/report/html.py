@@ -16,17 +16,17 @@ from typing import Any
 import numpy as np
 
 from . import figures
-from .shop import (band_lines, band_table, cutting_lines, every_speed_line, lobes_caption, provenance_note,
-                   provenance_table, provenance_warnings, readable)
+from .shop import (_choice, _num, band_lines, band_table, cutting_lines, every_speed_line, lobes_caption,
+                   provenance_note, provenance_table, provenance_warnings, readable)
 from .style import STYLE
-from .text import ENTRY_NAMES, EFFECT_NAMES, assumptions, diagnosis_verdict, joint_findings
+from .text import ENTRY_NAMES, EFFECT_NAMES, _number, assumptions, diagnosis_verdict, joint_findings
 
 __all__ = ["render"]
 
 _UNIT = {"N*m/rad": "N·m/rad", "N*s/m": "N·s/m", "N*s": "N·s", "N*s/rad": "N·s/rad", "N*m*s/rad": "N·m·s/rad",
          "kg*m^2": "kg·m²", "kg*m**2": "kg·m²", "N*m": "N·m"}
-_K_UNITS = {"yf": "N/m", "ym": "N", "tf": "N/rad", "tm": "N·m/rad"}
-_C_UNITS = {"yf": "N·s/m", "ym": "N·s", "tf": "N·s/rad", "tm": "N·m·s/rad"}
+_UNITS = {"k": {"yf": "N/m", "ym": "N", "tf": "N/rad", "tm": "N·m/rad"},
+          "c": {"yf": "N·s/m", "ym": "N·s", "tf": "N·s/rad", "tm": "N·m·s/rad"}}
 
 
 # -- small pieces -------------------------------------------------------------------------------------
@@ -55,11 +55,8 @@ def unit(text: Any) -> str:
 
 def sci(value: Any, digits: int = 3) -> str:
     """A number with ``digits`` significant digits: plain from 0.001 to 99,999, else ``1.43 × 10<sup>7</sup>``."""
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        return "–"
-    if not np.isfinite(v):
+    v = _number(value)
+    if v is None:
         return "–"
     if v == 0:
         return "0"
@@ -73,9 +70,8 @@ def sci(value: Any, digits: int = 3) -> str:
 
 def quantity(value: Any, unit_text: str, digits: int = 3) -> str:
     """A value in an SI unit shown in the unit a machinist reads: kg below 1 kg in g, m below 1 m in mm."""
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
+    v = _number(value)  # None, infinite or not a number: a dash
+    if v is None:
         return f"– {unit(unit_text)}"
     if unit_text == "kg" and abs(v) < 1:
         return f"{sci(v * 1e3, digits)} g"
@@ -86,11 +82,7 @@ def quantity(value: Any, unit_text: str, digits: int = 3) -> str:
 
 def fixed(value: Any, fmt: str, scale: float = 1.0) -> str:
     """``value * scale`` with a format (``",.0f"``), or a dash for none."""
-    try:
-        v = float(value) * scale
-    except (TypeError, ValueError):
-        return "–"
-    return esc(format(v, fmt)) if np.isfinite(v) else "–"
+    return _num(value, fmt, scale)  # a formatted number holds nothing to escape
 
 
 def tech(text: str) -> str:
@@ -124,6 +116,12 @@ def section(ident: str, title: str, body: str) -> str:
 def mm(q: Any) -> str:
     """A length quantity in mm."""
     return fixed(q.m_as("mm"), ".4g")
+
+
+def _matrix(owner: Any, kind: str, digits: int, sep: str) -> str:
+    """The entries a joint or support gives of its stiffness (``kind`` "k") or damping ("c"), with units."""
+    matrix = getattr(owner, kind)
+    return sep.join(f"{tech(f'{kind}_{e}')} {sci(matrix.get(e), digits)} {_UNITS[kind][e]}" for e, _ in matrix.entries)
 
 
 # -- the summary -------------------------------------------------------------------------------------
@@ -247,20 +245,14 @@ def _model(report: Any) -> str:
                                               "Density (kg/m³)", "Loss factor"], rows))
     rows = []
     for j in a.joints:
-        if getattr(j, "rigid", False) or not hasattr(j, "k"):
-            rows.append([esc(j.name), esc(f"{j.between[0]} – {j.between[1]}"), "rigid", "–"])
-            continue
-        rows.append([esc(j.name), esc(f"{j.between[0]} – {j.between[1]}"),
-                     "<br />".join(f"{tech('k_' + e)} {sci(j.k.get(e), 4)} {_K_UNITS[e]}" for e, _ in j.k.entries),
-                     "<br />".join(f"{tech('c_' + e)} {sci(j.c.get(e), 4)} {_C_UNITS[e]}" for e, _ in j.c.entries)
-                     or "none"])
+        values = (["rigid", "–"] if getattr(j, "rigid", False) or not hasattr(j, "k")
+                  else [_matrix(j, "k", 4, "<br />"), _matrix(j, "c", 4, "<br />") or "none"])
+        rows.append([esc(j.name), esc(f"{j.between[0]} – {j.between[1]}")] + values)
     out.append("<h3>Joints</h3>" + (table(["Joint", "Connects", "Stiffness", "Damping"], rows)
                                     + note('Their uncertainty: <a href="#joints">the joints</a>.')
                                     if rows else "<p>None.</p>"))
     if a.supports:
-        rows = [[esc(s.name or "–"), esc(s.at),
-                 ", ".join(f"{tech('k_' + e)} {sci(s.k.get(e))} {_K_UNITS[e]}" for e, _ in s.k.entries) or "–",
-                 ", ".join(f"{tech('c_' + e)} {sci(s.c.get(e))} {_C_UNITS[e]}" for e, _ in s.c.entries) or "–"]
+        rows = [[esc(s.name or "–"), esc(s.at), _matrix(s, "k", 3, ", ") or "–", _matrix(s, "c", 3, ", ") or "–"]
                 for s in a.supports]
         out.append("<h3>Supports (springs to the ground)</h3>" + table(["Name", "At", "Stiffness", "Damping"], rows))
     if a.sensors:
@@ -284,9 +276,8 @@ def _tool_point(report: Any) -> str:
         worst = max(report.modes, key=lambda m: m.peak_m_per_n)
         rows = [[("<strong>" if m is worst else "") + fixed(m.frequency_hz, ",.0f")
                  + ("</strong>" if m is worst else ""),
-                 fixed(m.peak_m_per_n, ".3g", 1e6),
-                 fixed(m.damping_ratio, ".2g", 100.0) if m.damping_ratio is not None else "–",
-                 fixed(m.stiffness_n_per_m, ".3g", 1e-6) if m.stiffness_n_per_m is not None else "–"]
+                 fixed(m.peak_m_per_n, ".3g", 1e6), fixed(m.damping_ratio, ".2g", 100.0),
+                 fixed(m.stiffness_n_per_m, ".3g", 1e-6)]
                 for m in report.modes]
         out.append("<h3>Modes</h3>" + table(["Frequency (Hz)", "Peak (µm/N)", "Damping (% of critical)",
                                              "Modal stiffness (N/µm)"], rows))
@@ -394,13 +385,8 @@ def _diagnosis(report: Any) -> str:
 
 
 def _row(label: str, r: Any) -> list[str]:
-    lo, hi = r.window_rpm
-    return [label, fixed(r.spindle_speed_rpm, ",.0f"), fixed(r.depth_m, ".3g", 1e3), fixed(r.limit_depth_m, ".3g", 1e3),
-            f"{fixed(lo, ',.0f')}–{fixed(hi, ',.0f')}", esc(r.limited_by),
-            fixed(r.mrr_m3_per_s, ".3g", 6e7) if r.mrr_m3_per_s is not None else "–",
-            fixed(r.power_w, ".2g", 1e-3) if r.power_w is not None else "–",
-            fixed(r.torque_n_m, ".3g") if r.torque_n_m is not None else "–",
-            fixed(r.chatter_frequency_hz, ",.0f")]
+    return _choice(label, r) + [esc(r.limited_by), fixed(r.mrr_m3_per_s, ".3g", 6e7), fixed(r.power_w, ".2g", 1e-3),
+                                fixed(r.torque_n_m, ".3g"), fixed(r.chatter_frequency_hz, ",.0f")]
 
 
 def _stability(report: Any) -> str:
@@ -510,13 +496,14 @@ def _joints(report: Any) -> str:
             continue
         ident = identified.get(j.name)
         found = {f["parameter"]: f for f in joint_findings(data, j.name)}
+        tapped = ident is not None or j.name in failed
         headers = ["Entry", "In the model"]
-        if ident is not None or j.name in failed:
+        if tapped:
             headers.append("Identified from the tap test")
         if found:
             headers.append("Found by the diagnosis")
         rows = []
-        for kind, units in (("k", _K_UNITS), ("c", _C_UNITS)):
+        for kind, units in _UNITS.items():
             for e, plain in ENTRY_NAMES.items():
                 model = getattr(j, kind).get(e)
                 fitted = ident is not None and (f"{kind}_{e}" in ident.fitted
@@ -525,12 +512,11 @@ def _joints(report: Any) -> str:
                     continue
                 what = "stiffness" if kind == "k" else "damping"
                 row = [f"{what}, {plain} {tech(f'{kind}_{e}')}", f"{sci(model, 4)} {units[e]}"]
-                if len(headers) > 2 and headers[2].startswith("Identified"):
+                if tapped:
                     if ident is None:
                         row.append("–")
                     elif fitted:
-                        std = (ident.k_std if kind == "k" else ident.c_std)[e]
-                        row.append(_entry((ident.k if kind == "k" else ident.c)[e], std, units[e]))
+                        row.append(_entry(getattr(ident, kind)[e], getattr(ident, f"{kind}_std")[e], units[e]))
                     else:
                         row.append("kept from the model")
                 if found:

@@ -30,6 +30,13 @@ def _num(value: Any, fmt: str, scale: float = 1.0) -> str:
     return format(v, fmt) if math.isfinite(v) else "–"
 
 
+def _choice(label: str, r: Any) -> list[str]:
+    """A recommendation's first cells: the label, speed (rpm), depth and chatter limit (mm), speed window (rpm)."""
+    lo, hi = r.window_rpm
+    return [label, _num(r.spindle_speed_rpm, ",.0f"), _num(r.depth_m, ".3g", 1e3), _num(r.limit_depth_m, ".3g", 1e3),
+            f"{_num(lo, ',.0f')}–{_num(hi, ',.0f')}"]
+
+
 def cutting_lines(report: Any) -> list[str]:
     """Paragraphs for the answer: cutting speed (m/min, SFM), feed per tooth and feed rate, checked against the
     usual range; the milling direction in the shop's words.
@@ -222,11 +229,8 @@ def band_table(report: Any) -> str:
     for label, r in rows:
         if r is None:
             body += f"<tr><td>{label}</td><td colspan=\"4\">{_esc(report.band_no_recommendation or 'none')}</td></tr>"
-            continue
-        lo, hi = r.window_rpm
-        body += (f"<tr><td>{label}</td><td>{_num(r.spindle_speed_rpm, ',.0f')}</td><td>{_num(r.depth_m, '.3g', 1e3)}"
-                 f"</td><td>{_num(r.limit_depth_m, '.3g', 1e3)}</td>"
-                 f"<td>{_num(lo, ',.0f')}–{_num(hi, ',.0f')}</td></tr>")
+        else:
+            body += "<tr>" + "".join(f"<td>{cell}</td>" for cell in _choice(label, r)) + "</tr>"
     head = ("<tr><th>Joints</th><th>Speed (rpm)</th><th>Axial depth (mm)</th><th>Chatter limit in the window (mm)"
             "</th><th>Speed window (rpm)</th></tr>")
     lower = report.band.lower_m
