@@ -20,7 +20,6 @@ from typing import ClassVar
 import attrs
 import numpy as np
 
-from ..assembly import Assembly
 from ..beams import Flutes
 from ..components import Beam, Tool
 from ..errors import InvalidValueError, UnknownPointError
@@ -38,10 +37,6 @@ PASSIVE_SHARE = 0.999
 """A joint's cross terms are searched up to this share of their passivity bound (``k_ym^2 < k_yf k_tm``), so that
 every value of the search is a passive joint.  A bound of the effect's parameters, as the ranges of the catalogue
 are, not a setting of the diagnosis."""
-
-
-def _elastic_joints(assembly: Assembly) -> list[str]:
-    return [j.name for j in assembly.joints if not getattr(j, "rigid", False) and isinstance(j, Joint)]
 
 
 def _si(value: float, unit: str) -> str:
@@ -107,7 +102,7 @@ class _JointEffect(Effect):
 
     @classmethod
     def places(cls, assembly, measured_points):
-        return _elastic_joints(assembly)
+        return [j.name for j in assembly.joints if not getattr(j, "rigid", False) and isinstance(j, Joint)]
 
     @classmethod
     def starting_values(cls, assembly, where, shift):
@@ -230,10 +225,6 @@ class RigidJointFlexibility(_JointEffect):
                                                   C=np.zeros((2, 2))))
 
 
-def _tools(assembly: Assembly) -> list[Beam]:
-    return [c for c in assembly.components if isinstance(c, Tool)]
-
-
 @register_effect
 class FlutedSection(Effect):
     """A tool's last ``length`` fluted, at ``diameter_ratio`` (equivalent diameter)."""
@@ -250,7 +241,7 @@ class FlutedSection(Effect):
 
     @classmethod
     def places(cls, assembly, measured_points):
-        return [t.name for t in _tools(assembly) if not any(s.flutes for s in t.segments)]
+        return [t.name for t in assembly.components if isinstance(t, Tool) and not any(s.flutes for s in t.segments)]
 
     @classmethod
     def starting_values(cls, assembly, where, shift):

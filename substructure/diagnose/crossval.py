@@ -40,6 +40,7 @@ import numpy as np
 
 from ..errors import SubstructureError
 from ..updating.fit import fit, from_u, to_u
+from ..updating.likelihood import Likelihood
 
 __all__ = ["CV_FOLDS", "CV_BLOCKS", "fold_masks", "held_back_chi2", "cross_validate"]
 
@@ -93,8 +94,6 @@ def _model(changes, slots, u) -> list:
 
 def _refitted(likelihood, changes: list, masks: Sequence[np.ndarray]) -> np.ndarray:
     """Held-back ``chi^2`` per fold with full refits on the lines kept (from the values fitted on all lines)."""
-    from ..updating.likelihood import Likelihood
-
     n_lines = likelihood.lines.size
     out = []
     for held in masks:
@@ -209,11 +208,10 @@ def cross_validate(lik, current: list, final, refits: dict, say=None):
         full = None  # the explanation's held-back chi^2 with full refits, once one change needs it
         for i, (change, values) in enumerate(current):
             rest = current[:i] + current[i + 1:]
-            refit = None
-            if rest:
-                refit = refits.get(frozenset(c.key for c, _ in rest))
-                if refit is None:
-                    refit = refits[frozenset(c.key for c, _ in rest)] = fit(lik, rest)
+            key = frozenset(c.key for c, _ in rest)
+            if rest and key not in refits:
+                refits[key] = fit(lik, rest)
+            refit = refits[key] if rest else None
             others = refit.changes if refit is not None else []
             without = float(held_back_chi2(lik, others, masks).sum())
             record = {"effect": change.effect, "where": change.place(values), "chi2_with": with_it,

@@ -361,15 +361,11 @@ class EffectChange(Change):
         return self.instance(values).apply_si(structure)
 
 
-def _has_si(cls) -> bool:
-    return getattr(cls, "apply_si", None) is not None and cls.apply_si is not Effect.apply_si
-
-
 def effect_change(cls: type, where: str, assembly: Assembly, shift: float = 0.0) -> Change:
     """An :class:`EffectChange` (arguments as there), or one fitted through ``apply`` when the effect has no SI
     form."""
     change = EffectChange(cls, where, assembly, shift)
-    if not _has_si(cls):
+    if getattr(cls, "apply_si", None) is None or cls.apply_si is Effect.apply_si:
         change.__class__ = _AssemblyOnlyEffect
     return change
 

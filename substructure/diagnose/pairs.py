@@ -30,7 +30,7 @@ from typing import Callable
 from ..errors import SubstructureError
 from .modes import mode_starts
 from .scan import places
-from .search import choose, full_fits, physical, rank, screen, shortlist
+from .search import _p, choose, full_fits, physical, rank, screen, shortlist
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
 __all__ = ["OTHER_FIRSTS", "SECONDS", "other_paths"]
@@ -40,10 +40,6 @@ OTHER_FIRSTS = 3
 screened when the forward path did not reach the noise with at most two changes."""
 SECONDS = 3
 """Shortlisted second changes fitted on all lines with each of those singles."""
-
-
-def _p(changes) -> int:
-    return sum(len(c.specs) for c, _ in changes)
 
 
 def other_paths(lik, screen_lik, lik0, firsts: list, cands: list, passive: Callable, say=None,

@@ -94,8 +94,7 @@ def plot_history(diagnosis, ax=None):
         fig = ax.figure
     steps = diagnosis.refinement
     x = [s.step for s in steps]
-    y = [s.error for s in steps]
-    ax.semilogy(x, y, "o-", color="tab:blue")
+    ax.semilogy(x, [s.error for s in steps], "o-", color="tab:blue")
     for s in steps:
         label = "model as given" if s.added is None else f"+ {s.added.name}\n({s.added.where})"
         ax.annotate(plain_text(label), (s.step, s.error), textcoords="offset points", xytext=(6, 6), fontsize="x-small")

@@ -43,7 +43,7 @@ of :class:`~substructure.diagnose.settings.DiagnoseSettings`.
 
 from __future__ import annotations
 
-import math
+import itertools
 from types import SimpleNamespace
 from typing import Callable
 
@@ -51,15 +51,14 @@ import attrs
 import numpy as np
 
 from ..errors import SubstructureError
-from ..updating.fit import Fit, fit
-from ..updating.selection import INDIFFERENCE, consistency, significance
+from ..updating.fit import Fit, fit, to_u
+from ..updating.selection import INDIFFERENCE, bic, consistency, significance
 from ..updating.likelihood import Likelihood
 from .crossval import cross_validate
 from .modes import mode_starts
 from .pairs import OTHER_FIRSTS, other_paths
-from ..updating.fit import to_u
 from .scan import places, trials
-from .search import Budget, Scored, choose, full_fits, physical, preference, rank, screen, shortlist
+from .search import Budget, Scored, _p, choose, full_fits, physical, preference, rank, screen, shortlist
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
 __all__ = ["Outcome", "refine"]
@@ -99,10 +98,6 @@ class Outcome:
     alternatives: dict
     rivals: list = attrs.field(factory=list)
     search: dict = attrs.field(factory=dict)
-
-
-def _p(changes) -> int:
-    return sum(len(c.specs) for c, _ in changes)
 
 
 def _prune(lik, current, chi2_now, say, refits: dict | None = None):
@@ -154,10 +149,7 @@ def _review(lik, current, chi2_now, steps_fitted, steps_inside, dropped, passive
             s2 = max(1.0, min(result.chi2, chi2_now) / max(n - _p(current), 1))
             if abs(result.chi2 - chi2_now) / s2 <= INDIFFERENCE:
                 found.append((result, s))
-        best = None
-        for result, s in found:
-            if preference(s.change) < preference(change) and (best is None or result.chi2 < best[0].chi2):
-                best = (result, s)
+        best = min(found, key=lambda t: t[0].chi2, default=None)  # every one of the pool is preferred
         if best is not None:
             result, s = best
             if say:
@@ -170,10 +162,10 @@ def _review(lik, current, chi2_now, steps_fitted, steps_inside, dropped, passive
         else:
             alternatives[change.key] = [(t.change, r.changes[i][1], r.chi2) for r, t in found]
         # and those that were inside the indifference region when it was added
+        alts = alternatives[current[i][0].key]
         for s in steps_inside.get(current[i][0].key, []):
-            if s.change.key not in {c.key for c, _ in current} and \
-                    s.change.key not in {a[0].key for a in alternatives[current[i][0].key]}:
-                alternatives[current[i][0].key].append((s.change, s.fit.changes[-1][1], s.fit.chi2))
+            if s.change.key not in {c.key for c, _ in current} and s.change.key not in {a[0].key for a in alts}:
+                alts.append((s.change, s.fit.changes[-1][1], s.fit.chi2))
     return current, chi2_now, alternatives
 
 
@@ -184,15 +176,11 @@ def _history(lik, current, final: Fit, tried: int):
     chi2_prev = lik.chi2([])
     while rest:
         if len(rest) == 1:
-            result = final
-            pick = rest[0]
+            result, pick = final, rest[0]
         else:
-            trials = []
             chosen = {id(x) for x in order}
-            for c in rest:
-                subset = [x for x in current if id(x) in chosen or x is c]
-                trials.append((fit(lik, subset), c))
-            result, pick = min(trials, key=lambda t: t[0].chi2)
+            result, pick = min([(fit(lik, [x for x in current if id(x) in chosen or x is c]), c) for c in rest],
+                               key=lambda t: t[0].chi2)
         order.append(pick)
         rest = [c for c in rest if c is not pick]
         sig = significance(chi2_prev, result.chi2, len(pick[0].specs), n, _p(order), tried)
@@ -237,10 +225,6 @@ def _distinct(screen_lik, singles, count: int, settings: DiagnoseSettings = DEFA
     return pool
 
 
-def _bic(chi2: float, p: int, n: int, s2: float) -> float:
-    return chi2 / s2 + p * math.log(n)
-
-
 def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
                settings: DiagnoseSettings = DEFAULT_SETTINGS, more=()):
     """The kept explanation against the best single and best pair ones fitted from fair starts.
@@ -269,9 +253,7 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
     options = [([(c, dict(v)) for c, v in current], chi2_now)]
     keys_now = sorted(c.key for c, _ in current)
     singles = [s for s in first_fitted if s.fit is not None]
-    for s in singles:
-        if [s.change.key] != keys_now:
-            options.append(([(c, dict(v)) for c, v in s.fit.changes], s.fit.chi2))
+    options += [([(c, dict(v)) for c, v in s.fit.changes], s.fit.chi2) for s in singles if [s.change.key] != keys_now]
     if len(current) >= 2:
         # the pool: the best singles of the first step, and the changes the path kept (a change the
         # first step ranked too low to fit, found later once another had taken its share, pairs too)
@@ -281,16 +263,14 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
         keys = {s.change.key for s in pool}
         pool += [k for k in _distinct(screen_lik, kept_path, len(kept_path), settings) if k.change.key not in keys]
         trials = []
-        for i in range(len(pool)):
-            for j in range(i + 1, len(pool)):
-                a, b = pool[i], pool[j]
-                if sorted([a.change.key, b.change.key]) == keys_now:
-                    continue
-                pair = [(a.change, dict(a.values)), (b.change, dict(b.values))]
-                try:
-                    trials.append((fit(screen_lik, pair, max_nfev=settings.pair_screen_evaluations).chi2, pair))
-                except (ValueError, ArithmeticError, SubstructureError):
-                    continue
+        for a, b in itertools.combinations(pool, 2):
+            if sorted([a.change.key, b.change.key]) == keys_now:
+                continue
+            pair = [(a.change, dict(a.values)), (b.change, dict(b.values))]
+            try:
+                trials.append((fit(screen_lik, pair, max_nfev=settings.pair_screen_evaluations).chi2, pair))
+            except (ValueError, ArithmeticError, SubstructureError):
+                continue
         trials.sort(key=lambda t: t[0])
         for _, pair in trials[:settings.pairs_fitted]:
             try:
@@ -303,7 +283,7 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
     best_chi2 = min(chi2 for _, chi2 in options)
     p_best = next(_p(ch) for ch, chi2 in options if chi2 == best_chi2)
     s2 = max(1.0, best_chi2 / max(n - p_best, 1))
-    scored = sorted(((ch, chi2, _bic(chi2, _p(ch), n, s2)) for ch, chi2 in options), key=lambda t: (t[2], _p(t[0])))
+    scored = sorted(((ch, chi2, bic(chi2, _p(ch), n, s2)) for ch, chi2 in options), key=lambda t: (t[2], _p(t[0])))
     inside = [t for t in scored if t[2] - scored[0][2] <= INDIFFERENCE]
     # the data do not decide between these: the one with the fewest changes is kept, then the preferred names
     # (flutes over the same equivalent diameter written as a segment's od), then the fewest parameters and
@@ -383,15 +363,14 @@ def _other_values(lik, screen_lik, current, final: Fit, passive, say,
             except (ValueError, ArithmeticError, SubstructureError):
                 continue
             got = result.changes[i][1]
-            if result.chi2 - chi2_now > INDIFFERENCE * s2 or not apart(got):
-                continue
-            if not (all(physical(c, v) for c, v in result.changes) and passive(result.changes)):
+            if (result.chi2 - chi2_now > INDIFFERENCE * s2 or not apart(got)
+                    or not (all(physical(c, v) for c, v in result.changes) and passive(result.changes))):
                 continue
             if say:
                 say(f"{change.effect} at {change.where} fits as well at other values: "
                     + ", ".join(f"{k} = {v:.4g}" for k, v in got.items()))
             out.append(([(c, dict(v)) for c, v in result.changes], result.chi2,
-                        _bic(result.chi2, _p(current), n, s2)))
+                        bic(result.chi2, _p(current), n, s2)))
             break
     return out
 
@@ -514,20 +493,15 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
         steps_fitted[best.change.key] = [s for s in ranked if s is not best] + near
         steps_inside[best.change.key] = inside
         path.append((best.fit, best.change, sig.statistic, sig.threshold))
-        current = [(c, dict(v)) for c, v in best.fit.changes]
-        chi2_now = best.chi2
+        current, chi2_now = [(c, dict(v)) for c, v in best.fit.changes], best.chi2
         if say:
             say(f"step {len(current)}: added {best.change.effect} at {best.change.place(best.values)}, "
                 f"chi^2/nu = {chi2_now / max(n - _p(current), 1):.4g}")
-    dropped: list = []
     refits = {frozenset(c.key for c, _ in f.changes): f for f, _, _, _ in path}  # fits of subsets, all lines
-    if len(current) > 1:
-        current, chi2_now, dropped = _prune(lik, current, chi2_now, say, refits)
+    current, chi2_now, dropped = _prune(lik, current, chi2_now, say, refits)  # nothing to drop from one change
     pruned = sorted(c.key for c, _ in current)
-    alternatives: dict = {}
-    if current:
-        current, chi2_now, alternatives = _review(lik, current, chi2_now, steps_fitted, steps_inside, dropped,
-                                                  passive, say, settings)
+    current, chi2_now, alternatives = _review(lik, current, chi2_now, steps_fitted, steps_inside, dropped,
+                                              passive, say, settings)
     rivals: list = []
     if len(current) >= 2:
         before = [c.key for c, _ in current]

@@ -86,9 +86,6 @@ def trials(change: Change, first: bool = True, settings: DiagnoseSettings = DEFA
     out += [{**where[0], **trial} for trial in getattr(change, "trials", ())]  # e.g. known materials
     logs = [s for s in change.specs if s.log]
     if len(logs) >= 2 and len(where) == 1:  # all log parameters scaled together too
-        for factor in np.geomspace(1.0 / settings.scale_span, settings.scale_span, settings.scale_values):
-            trial = dict(where[0])
-            for spec in logs:
-                trial[spec.name] = float(np.clip(spec.start * factor, spec.lower, spec.upper))
-            out.append(trial)
+        out += [{**where[0], **{s.name: float(np.clip(s.start * factor, s.lower, s.upper)) for s in logs}}
+                for factor in np.geomspace(1.0 / settings.scale_span, settings.scale_span, settings.scale_values)]
     return out

@@ -118,8 +118,9 @@ class Budget:
                     or (self.seconds is not None and self.elapsed() > self.seconds))
 
 
-def _plain(component) -> bool:
-    return si_beam(component)
+def _p(changes) -> int:
+    """Parameters of ``(Change, values)`` pairs."""
+    return sum(len(c.specs) for c, _ in changes)
 
 
 def candidates(assembly, measured_points: Sequence[str], effects: dict, open_world: bool = True,
@@ -165,7 +166,7 @@ def candidates(assembly, measured_points: Sequence[str], effects: dict, open_wor
             if rear is not None:  # a spindle's rear end: a pulley, a rotary union
                 out.append(AddedMass(comp.name, comp.length_m, mass_max, rear, inertia_max, f"{comp.name} rear end"))
             out.append(GroundSpring(comp.name, comp.length_m))
-            if _plain(comp):  # a section changed in the arrays of a plain beam
+            if si_beam(comp):  # a section changed in the arrays of a plain beam
                 out.append(SectionChange(comp.name, comp.length_m))
     for name, cls in effects.items():
         try:
@@ -281,7 +282,7 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
     scanned.sort(key=lambda s: s.chi2)
     scanned = [s for s in _polish(scanned, chi2_of, current, settings) if s.chi2 < chi2_now]
     local = []
-    p_now = sum(len(c.specs) for c, _ in current)
+    p_now = _p(current)
     for s in shortlist(scanned, chi2_now, likelihood.n, n_full, p_now, settings):
         try:
             result = fit(likelihood, list(current) + [(s.change, s.values)],
@@ -449,9 +450,7 @@ def _ties_by_preference(scored: Sequence[Scored], tie: float) -> list[Scored]:
 
 
 def _builtin(change: Change) -> bool:
-    if isinstance(change, EffectChange):
-        return change.cls.__module__ == __name__.rsplit(".", 1)[0] + ".effects"
-    return True
+    return not isinstance(change, EffectChange) or change.cls.__module__ == __name__.rsplit(".", 1)[0] + ".effects"
 
 
 def full_fits(likelihood, current: Sequence[tuple], chosen: Sequence[Scored],
