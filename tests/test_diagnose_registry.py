@@ -67,3 +67,21 @@ def test_effects_given_per_call_need_no_registration():
     assert "tool-overhang" not in EFFECTS
     assert d.explained and d.missing_effect == "tool-overhang"
     assert d.effects[0].values["extra_length"] == pytest.approx(0.006, abs=2e-4)
+
+
+def test_users_effects_have_slots_of_their_own_in_the_shortlist():
+    """Eight user candidates that screen best leave the catalogue's and the model's candidates their slots."""
+    from substructure.diagnose.effects import EffectChange
+    from substructure.diagnose.search import Scored, shortlist
+    from substructure.diagnose.settings import DEFAULT_SETTINGS
+    from substructure.updating.parameters import model_parameters, parameter_change
+
+    model = hd.nominal_model()
+    user = [EffectChange(ToolOverhang, "tool", model) for _ in range(8)]
+    catalogue = [EffectChange(EFFECTS["joint-stiffness"], where, model) for where in ("holder-tool", "spindle-holder")]
+    params = [parameter_change(p) for p in model_parameters(model)[:3]]
+    # screened chi^2 from 1000 (the current model) down: the users' first, all well above the share and significant
+    scored = [Scored(c, {}, 100.0 + i) for i, c in enumerate(user + catalogue + params)]
+    kept = shortlist(scored, 1000.0, 2000, 2000, 10, DEFAULT_SETTINGS)
+    assert sum(s.change in user for s in kept) == DEFAULT_SETTINGS.shortlist_max
+    assert all(any(s.change is c for s in kept) for c in catalogue + params)

@@ -393,8 +393,9 @@ def shortlist(scored: Sequence[Scored], chi2_now: float, n_lines: int, n_full: i
     ``settings.shortlist_share`` of the best one and, less the ``k`` that
     fitting its ``k`` parameters to noise gains and scaled to all lines, could
     pass the significance test; of those, at most ``settings.shortlist_max``
-    of the built-in candidates and as many of users' registered effects (so
-    that registering effects never pushes a built-in candidate out).
+    of each kind: the model's parameters and elements, the catalogue's
+    effects, and users' registered effects (so that registering effects
+    never pushes a built-in candidate out).
 
     Parameters
     ----------
@@ -420,7 +421,7 @@ def shortlist(scored: Sequence[Scored], chi2_now: float, n_lines: int, n_full: i
         return []
     scale = n_full / max(n_lines, 1)
     gain = chi2_now - scored[0].chi2
-    out, counts = [], {True: 0, False: 0}
+    out, counts = [], {"model": 0, "catalogue": 0, "user": 0}
     for s in _ties_by_preference(scored, settings.tie_chi2):
         own = chi2_now - s.chi2
         if own < settings.shortlist_share * gain:
@@ -428,10 +429,10 @@ def shortlist(scored: Sequence[Scored], chi2_now: float, n_lines: int, n_full: i
         # scaled to all lines, less what fitting k parameters to noise gains on the subsample
         if not significance((chi2_now - s.k) * scale, s.chi2 * scale, s.k, n_full, p_now + s.k).significant:
             continue
-        user = not _builtin(s.change)
-        if counts[user] >= settings.shortlist_max:
+        kind = _kind(s.change)
+        if counts[kind] >= settings.shortlist_max:
             continue
-        counts[user] += 1
+        counts[kind] += 1
         out.append(s)
     return out
 
@@ -449,8 +450,12 @@ def _ties_by_preference(scored: Sequence[Scored], tie: float) -> list[Scored]:
     return out
 
 
-def _builtin(change: Change) -> bool:
-    return not isinstance(change, EffectChange) or change.cls.__module__ == __name__.rsplit(".", 1)[0] + ".effects"
+def _kind(change: Change) -> str:
+    """A candidate's kind in the shortlist: ``model`` (a parameter or an element), ``catalogue`` (an effect of
+    this package) or ``user`` (an effect registered from elsewhere)."""
+    if not isinstance(change, EffectChange):
+        return "model"
+    return "catalogue" if change.cls.__module__.startswith(__name__.split(".")[0] + ".") else "user"
 
 
 def full_fits(likelihood, current: Sequence[tuple], chosen: Sequence[Scored],

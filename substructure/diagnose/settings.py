@@ -156,9 +156,10 @@ class DiagnoseSettings:
         is at least this share of the best one's (default 0.25): decided by
         each candidate's own improvement, never by a count.
     shortlist_max : int
-        Most candidates of one kind (built-in, or registered by users) fitted
-        further in one step (default 6), so that registered effects never push
-        a built-in candidate out.
+        Most candidates of one kind (the model's parameters and elements, the
+        catalogue's effects, or effects registered by users) fitted further in
+        one step (default 6), so that registered effects never push a built-in
+        candidate out.
     tie_chi2 : float
         Candidates whose screened ``chi^2`` differ by at most this are taken in
         order of preference (default 1.0, a unit of ``chi^2``: below what the
