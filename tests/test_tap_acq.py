@@ -529,6 +529,15 @@ def test_matlab_matrices_of_a_tap_a_column(tmp_path, capsys):
     with pytest.raises(FileFormatError, match=r"taps.mat: the force and the response are matrices of 3 taps; read "
                                               r"them with read_taps_mat"):
         read_tap_mat(path)
+    # a time per tap, as some exports write it: the same clock for every tap, or refused
+    timed = tmp_path / "timed.mat"
+    clock = np.column_stack([taps[0].time - taps[0].time[0]] * 3)
+    savemat(timed, {"t": clock, "force": forces, "force_unit": "N", "acc": accs, "acc_unit": "m/s^2"})
+    assert [r.sample_rate for r in read_taps_mat(timed)] == [fs] * 3
+    clock[:, 2] += 1.0
+    savemat(timed, {"t": clock, "force": forces, "force_unit": "N", "acc": accs, "acc_unit": "m/s^2"})
+    with pytest.raises(FileFormatError, match=r"timed.mat: the time 't' is a matrix whose columns differ"):
+        read_taps_mat(timed)
     # the command averages them as the same taps in files of their own
     one_each = []
     for k, r in enumerate(taps):

@@ -125,8 +125,10 @@ def mat_record(path: str | os.PathLike, data: bytes, sensitivity: Any, hammer_se
             raise FileFormatError(f"{name}: variable {names[k]!r}{where}, sample {j + 1}: {float(values[j, tap])!r}; "
                                   "expected a finite number (a gap in the acquisition?)")
     force, response = (taps.get(names[k], vectors[names[k]][:, None]) for k in (f_col, r_col))
-    if t_col is not None and names[t_col] in taps and taps[names[t_col]].shape[1] > 1:
-        raise FileFormatError(f"{name}: the time {names[t_col]!r} is a matrix; expected a vector")
+    clock = None if t_col is None else taps.get(names[t_col])
+    if clock is not None and np.any(clock != clock[:, :1]):  # a time per tap: one clock for all, or refused
+        raise FileFormatError(f"{name}: the time {names[t_col]!r} is a matrix whose columns differ; expected one "
+                              "time vector for every tap")
     if force.shape != response.shape:
         raise FileFormatError(f"{name}: the force {names[f_col]!r} holds {force.shape[1]} tap(s) of {force.shape[0]} "
                               f"samples, the response {names[r_col]!r} {response.shape[1]} of {response.shape[0]}; "
