@@ -151,3 +151,25 @@ def test_a_windowed_measurement_is_said_so_in_the_report(model):
     assert line.startswith("tool.tip:y / tool.tip:y was measured through an exponential window (tau = 0.2 s)")
     assert f"{1 / (0.2 * 2 * np.pi * middle):.2g} at {middle:.4g} Hz" in line
     assert not [r for r in diagnose(model, [measured], progress=False).report if "window" in r]
+
+
+@pytest.mark.parametrize("exponential", [False, True])
+def test_the_hammer_noise_in_h1_is_what_the_tap_processing_says(model, exponential):
+    """The variance of H1's relative error from the hammer channel's noise (TapResult.force_noise) against
+    the error itself: the same taps with and without noise on the force, over 30 seeds (Monte Carlo)."""
+    errors, predicted = [], []
+    for seed in range(30):
+        noisy = process_taps(_taps(model, seed, force_noise=1e-3, response_noise=0.0), exponential=exponential)
+        clean = process_taps(_taps(model, seed, force_noise=0.0, response_noise=0.0), exponential=exponential)
+        errors.append(np.abs(noisy.frf.data[:, 0, 0] / clean.frf.data[:, 0, 0] - 1.0) ** 2)
+        predicted.append(noisy.force_noise)
+    f = noisy.frf.frequency.hz
+    band = (f > 100.0) & (f < noisy.hammer_band_hz)
+    ratio = np.mean(errors, axis=0)[band] / np.mean(predicted, axis=0)[band]
+    assert 0.8 < np.median(ratio) < 1.2 and np.percentile(ratio, 90) < 1.5
+    # the noise measured outside the pulse, and the force window's length (a pulse of 0.25 ms, opened one
+    # pulse width before it and closed one after)
+    assert noisy.force_noise_rms == pytest.approx(1e-3 * 75.0, rel=0.1)  # the taps' peaks: 60 to 90 N
+    assert 0.5e-3 < noisy.force_window_s < 1.2e-3
+    assert noisy.force_scatter() == pytest.approx(np.sqrt(np.max(noisy.force_noise[f <= noisy.hammer_band_hz])))
+    assert process_taps(_taps(model, 1), estimator="H2").force_noise is None

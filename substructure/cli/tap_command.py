@@ -134,6 +134,13 @@ def run(args: argparse.Namespace) -> int:
     usable = result.frf.frequency.hz <= result.hammer_band_hz
     gamma = result.coherence[usable] if usable.any() else result.coherence
     print(f"coherence within the band: median {np.median(gamma):.4f}, minimum {np.min(gamma):.4f}")
+    peak = np.mean([t.peak_force for t in result.taps if t.kept])
+    scatter = result.force_scatter()
+    print(f"hammer's noise: {result.force_noise_rms:.3g} N RMS outside the pulse ({result.force_noise_rms / peak:.2g} "
+          "of the peak)" + ("" if scatter is None else
+                            f"; H1 scatters by up to {scatter:.2%} from it within the band, a smooth error over "
+                            f"about {1.0 / result.force_window_s:.0f} Hz (the force window's "
+                            f"{result.force_window_s * 1e3:.2g} ms)"))
     if result.tau is None:
         print(f"exponential window: {result.window}")
     else:

@@ -149,6 +149,19 @@ class TapResult:
         Samples per tap.
     window : str
         Why the exponential window was (or was not) applied, in words.
+    force_noise : numpy.ndarray or None
+        Per line of ``frf``, the variance of the relative error of H1 that
+        the hammer channel's noise gives (``E|dH / H|^2``; half of it in the
+        log magnitude, half in the phase): each kept tap's noise, measured
+        outside its force window, through the force window and the
+        exponential one. It is smooth in frequency, over about
+        ``1 / force_window_s`` hertz. None for H2 and Hv.
+    force_noise_rms : float
+        The hammer channel's noise outside the pulse, RMS over the kept taps
+        (N).
+    force_window_s : float
+        The force window's effective length (s): the width of the window that
+        holds the same noise, ``(sum w)^2 / sum w^2`` samples.
     """
 
     frf: FRF
@@ -163,6 +176,9 @@ class TapResult:
     sample_rate: float
     tap_samples: int
     window: str = ""
+    force_noise: np.ndarray | None = None
+    force_noise_rms: float = 0.0
+    force_window_s: float = 0.0
 
     @property
     def averages(self) -> int:
@@ -267,6 +283,22 @@ class TapResult:
                         "damping_ratio_corrected": None if zeta is None else zeta - added})
         return out
 
+    def force_scatter(self) -> float | None:
+        """The largest relative scatter of H1 that the hammer's noise gives within the usable band.
+
+        Returns
+        -------
+        float or None
+            ``sqrt(force_noise)`` at its largest over the lines up to
+            ``hammer_band_hz`` (0.01: 1 %); None for H2 and Hv.
+        """
+        if self.force_noise is None:
+            return None
+        usable = self.frf.frequency.hz <= self.hammer_band_hz
+        values = self.force_noise[usable] if usable.any() else self.force_noise
+        values = values[np.isfinite(values)]  # a line without force has no finite variance
+        return float(np.sqrt(np.max(values))) if values.size else None
+
     def summary(self) -> dict:
         """The result as plain data (the JSON of ``substructure tap``).
 
@@ -275,7 +307,8 @@ class TapResult:
         dict
             Keys ``taps``, ``rejected``, ``estimator``, ``averages``, ``frequency_hz``,
             ``real``, ``imag``, ``coherence``, ``tau_s``, ``window`` (why the window was or was
-            not applied), ``hammer_band_hz``, ``per_tap``.
+            not applied), ``hammer_band_hz``, ``force_noise_rms_n``, ``force_window_s``,
+            ``force_scatter`` (:meth:`force_scatter`), ``per_tap``.
         """
         values = self.frf.data[:, 0, 0]
         return {
@@ -291,6 +324,9 @@ class TapResult:
             "window": self.window,
             "hammer_band_hz": self.hammer_band_hz,
             "hammer_band_db": self.hammer_band_db,
+            "force_noise_rms_n": self.force_noise_rms,
+            "force_window_s": self.force_window_s,
+            "force_scatter": self.force_scatter(),
             "per_tap": [{"tap": t.number, "file": t.source, "start_s": t.start_s, "peak_force_n": t.peak_force,
                          "pulse_width_s": t.pulse_width_s, "band_hz": t.band_hz, "kept": t.kept}
                         for t in self.taps],
@@ -518,6 +554,7 @@ def process_taps(
         if p >= 8:
             x[i] -= x[i, :p].mean()
     f = f * force_window[rows]
+    noise_sd = np.array([_noise_outside(force[r] - baseline[r], force_window[r]) for r in rows.tolist()])
     decayed, why = _decay(x, pre_rows, [taps[cuts[r][2]].number for r in rows])
     if exponential is None and tau is None:
         exponential = not decayed
@@ -537,7 +574,8 @@ def process_taps(
         w = np.exp(-(t[None, :] - trigger[rows][:, None]) / tau)
         f, x = f * w, x * w
     else:
-        tau = None
+        tau, w = None, np.ones((1, length))
+    w_f = force_window[rows] * w  # the windows the force's noise passes through
     F = scipy.fft.rfft(f, axis=1) * dt
     X = scipy.fft.rfft(x, axis=1) * dt
     gff = np.mean(np.abs(F) ** 2, axis=0)
@@ -565,8 +603,26 @@ def process_taps(
     measured = FRF.single(Frequency.from_hz(hz[keep]), h[keep], quantity=kind)
     spectra = 10.0 * np.log10(np.maximum(np.abs(F[:, keep]) ** 2, 1e-300))
     hammer_band = float(_band_end(gff[None, :], hz, hammer_band_db)[0])
+    # the noise of the force channel in F: per tap sigma^2 sum(w^2) dt^2, the same on every line; in H1 =
+    # sum X F* / sum |F|^2 a relative error whose variance is sum_j n_j |F_j|^2 / (sum_j |F_j|^2)^2
+    n_f = noise_sd**2 * np.sum(w_f**2, axis=1) * dt**2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v_f = np.sum(n_f[:, None] * np.abs(F) ** 2, axis=0) / np.sum(np.abs(F) ** 2, axis=0) ** 2
+    v_f = np.where(np.isfinite(v_f), v_f, np.inf)[keep] if estimator == "H1" else None
+    width = float(np.mean(np.sum(w_f, axis=1) ** 2 / np.sum(w_f**2, axis=1))) * dt
     return TapResult(measured.to_receptance(), measured, coherence[keep], estimator, tuple(taps), tau,
-                     hammer_band, float(hammer_band_db), spectra, rate, length, why)
+                     hammer_band, float(hammer_band_db), spectra, rate, length, why, v_f,
+                     float(np.sqrt(np.mean(noise_sd**2))), width)
+
+
+def _noise_outside(force: np.ndarray, window: np.ndarray) -> float:
+    """The force channel's noise (standard deviation, robust: from the median absolute deviation) over the
+    samples outside the force window, after it where there are enough, else before it."""
+    after = force[np.flatnonzero(window)[-1] + 1:]
+    rest = after if after.size >= 64 else force[window == 0]
+    if rest.size < 8:
+        return 0.0
+    return float(1.4826 * np.median(np.abs(rest - np.median(rest))))
 
 
 def _decay(x: np.ndarray, pre: np.ndarray, numbers: list[int]) -> tuple[bool, str]:
