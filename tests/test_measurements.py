@@ -201,6 +201,41 @@ def test_a_window_s_time_constant_reads_into_the_measurement(tmp_path, tip_file)
         Measurement.from_frf(m.frf, "tool.tip", "tool.tip", window_tau=0)
 
 
+def test_the_hammer_noise_column_and_its_window_read_into_the_measurement(tmp_path, model):
+    from substructure.io.frf_files import write_csv
+
+    frf = model.select(["tool.tip:y"], ["tool.tip:y"]).crop(100, 400)
+    n = frf.frequency.n
+    noise = np.linspace(1e-8, 4e-8, n)
+    noise[-1] = np.inf  # a line without force
+    write_csv(frf, tmp_path / "tip.csv", coherence=np.full(n, 0.99), force_noise=noise)
+    assert (tmp_path / "tip.csv").read_text().splitlines()[0] == "frequency_hz,real,imag,coherence,force_noise"
+    path = tmp_path / "set.toml"
+    path.write_text(GOOD + "force_window_s = 0.001\n")
+    (m,) = load_measurements(path).measurements
+    assert np.array_equal(m.force_noise, noise) and m.force_window_s == 0.001
+    cropped = m.crop(150, 200)
+    assert np.array_equal(cropped.force_noise, noise[5:11]) and cropped.force_window_s == 0.001
+    # the column needs its window; a negative variance is refused naming its line
+    path.write_text(GOOD)
+    with pytest.raises(FileFormatError, match=r"frf\[0\]\.force_window_s: missing; tip.csv has a force_noise column"):
+        load_measurements(path)
+    lines = (tmp_path / "tip.csv").read_text().splitlines()
+    lines[3] = lines[3].rsplit(",", 1)[0] + ",-1e-8"
+    (tmp_path / "tip.csv").write_text("\n".join(lines) + "\n")
+    path.write_text(GOOD + "force_window_s = 0.001\n")
+    with pytest.raises(FileFormatError, match=r"tip.csv, line 4: force_noise is -1e-08; expected a variance >= 0"):
+        load_measurements(path)
+    path.write_text(GOOD + "force_window_s = 0\n")
+    with pytest.raises(FileFormatError, match=r"frf\[0\]\.force_window_s: got 0; expected the force window's length"):
+        load_measurements(path)
+    with pytest.raises(InvalidValueError, match="force_window_s: needed with force_noise"):
+        Measurement.from_frf(frf, "tool.tip", "tool.tip", force_noise=noise)
+    with pytest.raises(InvalidValueError, match="force_noise: got 3 values for 31 frequency lines"):
+        Measurement.from_frf(frf, "tool.tip", "tool.tip", force_noise=[0.0] * 3, force_window_s=0.001)
+    with pytest.raises(InvalidValueError, match="force_noise: line 0 is nan; expected a variance >= 0"):
+        Measurement.from_frf(frf, "tool.tip", "tool.tip", force_noise=[np.nan] * n, force_window_s=0.001)
+
 def test_missing_data_file(tmp_path):
     message = error_of(tmp_path, GOOD.replace("tip.csv", "nowhere.csv"))
     assert "frf[0].file" in message and str(tmp_path / "nowhere.csv") in message and "no such file" in message

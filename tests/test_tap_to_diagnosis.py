@@ -50,7 +50,8 @@ def _taps(truth, seed: int, peaks=(60.0, 75.0, 90.0, 70.0, 80.0), length: float 
 def _measured(records) -> tuple[Measurement, object]:
     result = process_taps(records)
     m = Measurement.from_frf(result.frf, "tool.tip", "tool.tip", coherence=result.coherence,
-                             averages=result.averages)
+                             averages=result.averages, force_noise=result.force_noise,
+                             force_window_s=result.force_window_s)  # as substructure tap writes the set
     return m.crop(150.0, 5000.0), result
 
 
@@ -173,3 +174,36 @@ def test_the_hammer_noise_in_h1_is_what_the_tap_processing_says(model, exponenti
     assert 0.5e-3 < noisy.force_window_s < 1.2e-3
     assert noisy.force_scatter() == pytest.approx(np.sqrt(np.max(noisy.force_noise[f <= noisy.hammer_band_hz])))
     assert process_taps(_taps(model, 1), estimator="H2").force_noise is None
+
+
+def test_the_hammer_noise_enters_the_noise_model_over_its_width(model):
+    from substructure.updating.noise import VARIANCE_CAP, estimate_noise
+
+    result = process_taps(_taps(model, 1, force_noise=1e-3))
+    plain = estimate_noise(result.frf, coherence=result.coherence, averages=result.averages)
+    with_force = estimate_noise(result.frf, coherence=result.coherence, averages=result.averages,
+                                force_noise=result.force_noise, force_window_s=result.force_window_s)
+    lines = 1.0 / (result.force_window_s * (result.frf.frequency.hz[1] - result.frf.frequency.hz[0]))
+    expected = np.minimum(plain.var_re + 0.5 * result.force_noise * lines, VARIANCE_CAP)
+    np.testing.assert_allclose(with_force.var_re, expected, rtol=1e-12)
+    assert lines > 100  # a window of under 1 ms on 2 Hz lines: the error spans hundreds of lines
+    with pytest.raises(Exception, match="the force window's length is needed"):
+        estimate_noise(result.frf, force_noise=result.force_noise)
+
+
+@pytest.mark.parametrize("seed", [5, 6, 8, 9])
+def test_an_exact_model_is_consistent_with_a_noisy_hammer(model, seed):
+    # ten times the hammer's noise (1e-3 of the peak, as on the shipped real records' pre-trigger) and a clean
+    # accelerometer: the force window's smooth error dominated the resonances' lines; these seeds were called
+    # unexplained, or had corrections invented, before the noise model counted it
+    measured, _ = _measured(_taps(model, seed, force_noise=1e-3))
+    d = diagnose(model, [measured], progress=False)
+    assert d.explained and d.effects == [], d.report
+
+
+def test_a_light_body_is_still_found_with_a_noisy_hammer(model):
+    truth = model.attach(Mass("sensor", "tool.tip", "1 g"))
+    measured, _ = _measured(_taps(truth, 2, force_noise=1e-3))
+    d = diagnose(model, [measured], progress=False)
+    assert d.explained and [e.name for e in d.effects] == ["sensor-mass"], d.report
+    assert d.effects[0].values["mass"] == pytest.approx(1e-3, rel=0.1)

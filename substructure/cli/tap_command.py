@@ -40,13 +40,16 @@ def _read(path: str, args: argparse.Namespace) -> list:
     return [read_tap_csv(path, args.sensitivity, args.hammer_sensitivity, args.quantity, **columns)]
 
 
-def _set_text(name: str, response: str, excitation: str, file: str, averages: int, tau: float | None) -> str:
+def _set_text(name: str, response: str, excitation: str, file: str, averages: int, tau: float | None,
+              force_window: float | None = None) -> str:
     import tomli_w
 
     frf = {"response": response, "excitation": excitation, "file": file, "quantity": "receptance",
            "averages": averages}
     if tau is not None:
         frf["window_tau_s"] = float(tau)
+    if force_window:  # the file's force_noise column is correlated over 1 / force_window_s hertz
+        frf["force_window_s"] = float(force_window)
     text = tomli_w.dumps({"name": name, "frf": [frf]})
     if tau is None:
         return text
@@ -95,13 +98,15 @@ def run(args: argparse.Namespace) -> int:
     peaks = result.peaks()
     written = []
     if args.out:
-        write_csv(result.frf, args.out, args.overwrite, coherence=result.coherence)
+        write_csv(result.frf, args.out, args.overwrite, coherence=result.coherence, force_noise=result.force_noise)
         written.append(args.out)
     if args.measurements:
         relative = os.path.relpath(os.path.abspath(args.out), os.path.dirname(os.path.abspath(args.measurements)))
         name = args.name or f"tap test: {response} / {excitation}"
         write_text(args.measurements, _set_text(name, response, excitation, Path(relative).as_posix(),
-                                                result.averages, result.tau), overwrite=args.overwrite)
+                                                result.averages, result.tau,
+                                                result.force_window_s if result.force_noise is not None else None),
+                   overwrite=args.overwrite)
         written.append(args.measurements)
     if args.plot:
         figures()

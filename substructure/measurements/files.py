@@ -21,12 +21,13 @@ from ..frf.files._common import _beyond_physical
 from ..frf.files.csv_files import _read_csv
 from ..frf.files.uff_reader import read_uff
 from ..points import check_name
-from .measurement import Measurement, _optional_tau, dof_label
+from .measurement import Measurement, _optional_force_window, _optional_tau, dof_label
 
 __all__ = ["read_measurements", "reads_measurements"]
 
 _TOP_KEYS = ("name", "frf")
-_FRF_KEYS = ("response", "excitation", "file", "record", "quantity", "sensors", "removed", "averages", "window_tau_s")
+_FRF_KEYS = ("response", "excitation", "file", "record", "quantity", "sensors", "removed", "averages", "window_tau_s",
+             "force_window_s")
 _REQUIRED = ("response", "excitation", "file")
 _CSV = (".csv",)
 _UFF = (".uff", ".unv")
@@ -93,19 +94,18 @@ class _Reader:
             raise self.error(index, key, f"got {value!r}; expected {expected}")
         return value
 
-    def window_tau(self, table: dict, index: int) -> float | None:
-        if "window_tau_s" not in table:
+    def seconds(self, table: dict, index: int, key: str, convert, expected: str) -> float | None:
+        if key not in table:
             return None
-        value = table["window_tau_s"]
+        value = table[key]
         try:
-            return _optional_tau(value)  # what a measurement takes, said with the file's key
+            return convert(value)  # what a measurement takes, said with the file's key
         except InvalidValueError:
-            raise self.error(index, "window_tau_s", f"got {value!r}; expected the exponential window's time "
-                                                    "constant in s (a number > 0)") from None
+            raise self.error(index, key, f"got {value!r}; expected {expected} (a number > 0)") from None
 
     # -- data files -----------------------------------------------------------
     def data(self, index: int, file: str, record: int | None, quantity: str | None,
-             response: str, excitation: str) -> tuple[FRF, Any]:
+             response: str, excitation: str) -> tuple[FRF, Any, Any]:
         path = self.base_dir / file
         suffix = path.suffix.lower()
         if suffix not in _CSV + _UFF:
@@ -117,16 +117,18 @@ class _Reader:
             if suffix in _CSV:
                 if record is not None:
                     raise self.error(index, "record", f"a CSV file ({file}) holds one FRF; record is for UFF files")
-                frf, lines_of, coherence = _read_csv(path, output=response, input=excitation, quantity=quantity)
+                frf, lines_of, coherence, force_noise = _read_csv(path, output=response, input=excitation,
+                                                                  quantity=quantity)
             else:
-                frf, lines_of, coherence = self.uff(index, path, record, quantity, response, excitation), None, None
+                frf = self.uff(index, path, record, quantity, response, excitation)
+                lines_of = coherence = force_noise = None
             beyond = _beyond_physical(frf.frequency.hz, frf.data, frf.quantity)  # a measured FRF's range
             if beyond is not None:
                 k, what = beyond
                 where = (f"line {lines_of[k]}" if lines_of is not None else
                          f"type-58 record {record or 0}, value {k + 1} of {frf.frequency.n}")
                 raise FileFormatError(f"{path}, {where}: at {frf.frequency.hz[k]:g} Hz: {what}")
-            return frf, coherence
+            return frf, coherence, force_noise
         except _LocatedError:
             raise
         except FileFormatError as exc:  # names the data file (and its line)
@@ -196,8 +198,13 @@ class _Reader:
         record = self.integer(table, index, "record", 0, "the 0-based index of a type-58 record")
         sensors, removed = self.names(table, index, "sensors"), self.names(table, index, "removed")
         averages = self.integer(table, index, "averages", 1, "the number of averages (an integer >= 1)")
-        tau = self.window_tau(table, index)
-        raw, coherence = self.data(index, file, record, quantity, response, excitation)
+        tau = self.seconds(table, index, "window_tau_s", _optional_tau, "the exponential window's time constant in s")
+        force_window = self.seconds(table, index, "force_window_s", _optional_force_window,
+                                    "the force window's length in s")
+        raw, coherence, force_noise = self.data(index, file, record, quantity, response, excitation)
+        if force_noise is not None and force_window is None:
+            raise self.error(index, "force_window_s", f"missing; {file} has a force_noise column, correlated over "
+                                                      "1 / force_window_s hertz (the force window's length in s)")
         if raw.quantity != "receptance" and raw.frequency.hz[0] == 0.0:
             warnings.warn(
                 f"{self.doc.where(self.parts(index, 'file'))}: frf[{index}].file: {file}: dropped the 0 Hz "
@@ -206,13 +213,14 @@ class _Reader:
             )
             raw = raw.crop(lo=raw.frequency.hz[1])
             coherence = None if coherence is None else coherence[1:]
+            force_noise = None if force_noise is None else force_noise[1:]
         try:
             receptance = raw.to_receptance()
         except SubstructureError as exc:
             raise self.error(index, "file", f"{self.base_dir / file}: {exc}") from None
         try:
             return Measurement(response, excitation, receptance, raw.quantity, sensors, removed, file, record,
-                               coherence, averages, tau)
+                               coherence, averages, tau, force_noise, force_window)
         except SubstructureError as exc:  # pragma: no cover - every field was checked above
             raise self.error(index, None, str(exc)) from None
 

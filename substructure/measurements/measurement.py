@@ -144,14 +144,40 @@ COHERENCE_ROUNDING = 1e-9
 """How far above 1 a coherence may lie and be read as 1 (rounding of its estimate)."""
 
 
-def _optional_tau(value: Any) -> float | None:
+def _optional_seconds(field: str, expected: str):
+    def convert(value: Any) -> float | None:
+        if value is None:
+            return None
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+                or not np.isfinite(value) or value <= 0:
+            raise InvalidValueError(f"{field}: got {value!r}; expected {expected}")
+        return float(value)
+
+    return convert
+
+
+_optional_tau = _optional_seconds("window_tau", "the exponential window's time constant in s (a finite number > 0), "
+                                                "or None for no window")
+_optional_force_window = _optional_seconds("force_window_s", "the force window's length in s (a finite number > 0), "
+                                                             "or None")
+
+
+def _force_noise(value: Any) -> np.ndarray | None:
     if value is None:
         return None
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
-            or not np.isfinite(value) or value <= 0:
-        raise InvalidValueError(f"window_tau: got {value!r}; expected the exponential window's time constant in s "
-                                "(a finite number > 0), or None for no window")
-    return float(value)
+    try:
+        array = np.array(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InvalidValueError(f"force_noise: got {type(value).__name__}; expected an array of variances >= 0") \
+            from None
+    if array.ndim != 1:
+        raise InvalidValueError(f"force_noise: got shape {array.shape}; expected one value per frequency line")
+    bad = ~(array >= 0.0)  # NaN or negative; inf is a line without force
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise InvalidValueError(f"force_noise: line {k} is {float(array[k])!r}; expected a variance >= 0")
+    array.setflags(write=False)
+    return array
 
 
 def _same_array(a: Any, b: Any) -> bool:
@@ -160,10 +186,10 @@ def _same_array(a: Any, b: Any) -> bool:
     return bool(np.array_equal(a, b))
 
 
-def _check_coherence(instance: "Measurement", attribute: Any, value: np.ndarray | None) -> None:
+def _check_lines(instance: "Measurement", attribute: Any, value: np.ndarray | None) -> None:
     if value is not None and value.shape[0] != instance.frf.frequency.n:
         raise InvalidValueError(
-            f"coherence: got {value.shape[0]} values for {instance.frf.frequency.n} frequency lines; expected "
+            f"{attribute.name}: got {value.shape[0]} values for {instance.frf.frequency.n} frequency lines; expected "
             "one per line of the FRF"
         )
 
@@ -222,6 +248,14 @@ class Measurement:
         measured through (None: no window).  The window adds the damping
         ratio ``1 / (tau omega)`` to every measured mode, which no model
         has: the diagnosis says so in its report.
+    force_noise : array of float, optional
+        Per line, the variance of H1's relative error from the hammer's
+        noise (:attr:`substructure.tap.TapResult.force_noise`; >= 0, ``inf``
+        where there was no force); read-only.  With ``force_window_s`` the
+        noise model counts it as the smooth error it is.
+    force_window_s : float, optional
+        The force window's effective length [s]: the hammer's noise in H1 is
+        correlated over about ``1 / force_window_s`` hertz.
     """
 
     response: str = attrs.field(converter=lambda value: dof_label(value, "response"))
@@ -233,16 +267,27 @@ class Measurement:
     file: str | None = attrs.field(default=None)
     record: int | None = attrs.field(default=None, converter=_optional_record)
     coherence: np.ndarray | None = attrs.field(
-        default=None, converter=_coherence, validator=_check_coherence, eq=attrs.cmp_using(eq=_same_array)
+        default=None, converter=_coherence, validator=_check_lines, eq=attrs.cmp_using(eq=_same_array)
     )
     averages: int | None = attrs.field(default=None, converter=_optional_averages)
     window_tau: float | None = attrs.field(default=None, converter=_optional_tau)
+    force_noise: np.ndarray | None = attrs.field(
+        default=None, converter=_force_noise, validator=_check_lines, eq=attrs.cmp_using(eq=_same_array)
+    )
+    force_window_s: float | None = attrs.field(default=None, converter=_optional_force_window)
+
+    @force_window_s.validator
+    def _check_force_window(self, attribute: Any, value: float | None) -> None:
+        if self.force_noise is not None and value is None:
+            raise InvalidValueError("force_window_s: needed with force_noise (the force window's length in s, over "
+                                    "whose inverse the hammer's noise is correlated)")
 
     @classmethod
     def from_frf(
         cls, frf: FRF, response: str, excitation: str, *, sensors: Sequence[str] = (),
         removed: Sequence[str] = (), file: str | None = None, record: int | None = None,
         coherence: Any = None, averages: int | None = None, window_tau: float | None = None,
+        force_noise: Any = None, force_window_s: float | None = None,
     ) -> "Measurement":
         """A measurement from a one-entry FRF of any quantity.
 
@@ -272,6 +317,10 @@ class Measurement:
             The number of averages (>= 1).
         window_tau : float, optional
             The exponential window's time constant [s], when there was one.
+        force_noise : array of float, optional
+            The hammer's noise in H1 per line (a variance, >= 0).
+        force_window_s : float, optional
+            The force window's effective length [s].
 
         Returns
         -------
@@ -287,10 +336,10 @@ class Measurement:
             )
         receptance = frf.with_labels((out,), (inp,)).to_receptance()
         return cls(out, inp, receptance, frf.quantity, sensors, removed, file, record, coherence, averages,
-                   window_tau)
+                   window_tau, force_noise, force_window_s)
 
     def crop(self, lo: Any = None, hi: Any = None) -> "Measurement":
-        """The measurement restricted to ``lo <= f <= hi``, its coherence on the same lines.
+        """The measurement restricted to ``lo <= f <= hi``, its coherence and force noise on the same lines.
 
         Parameters
         ----------
@@ -304,7 +353,8 @@ class Measurement:
         """
         mask = self.frf.frequency.band_mask(lo, hi)
         coherence = None if self.coherence is None else self.coherence[mask]
-        return attrs.evolve(self, frf=self.frf.crop(lo, hi), coherence=coherence)
+        force_noise = None if self.force_noise is None else self.force_noise[mask]
+        return attrs.evolve(self, frf=self.frf.crop(lo, hi), coherence=coherence, force_noise=force_noise)
 
     @property
     def configuration(self) -> Configuration:

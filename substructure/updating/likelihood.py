@@ -131,7 +131,9 @@ def measured_frfs(measurements, band=None) -> tuple[list[Measured], tuple[float,
             where = getattr(m, "describe", lambda: label)()
             raise InvalidValueError(f"measured FRF {where}: zero (or not finite) on every line: a dead channel? "
                                     "Leave it out of the measurement set")
-        noise = estimate_noise(frf, coherence=getattr(m, "coherence", None), averages=getattr(m, "averages", None))
+        noise = estimate_noise(frf, coherence=getattr(m, "coherence", None), averages=getattr(m, "averages", None),
+                               force_noise=getattr(m, "force_noise", None),
+                               force_window_s=getattr(m, "force_window_s", None))
         mask = frf.frequency.band_mask(lo, hi)
         if mask.sum() < 10:
             raise InvalidValueError(f"band: {lo:g}-{hi:g} Hz holds {int(mask.sum())} lines of {label}; "

@@ -290,8 +290,21 @@ def _coherence_regressor(coherence, averages, n: int, label: str) -> np.ndarray 
     return (1.0 - gamma) / (2.0 * int(averages) * gamma)
 
 
+def _force_term(force_noise, window_s, hz: np.ndarray, label: str) -> np.ndarray | None:
+    """Half the hammer's noise variance per line times the lines its error spans (None without it)."""
+    if force_noise is None:
+        return None
+    v = np.asarray(force_noise, dtype=float).reshape(-1)
+    if v.size != hz.size or not np.all(v >= 0):
+        raise InvalidValueError(f"force noise of {label}: expected {hz.size} variances >= 0, one per line")
+    if window_s is None or not np.isfinite(window_s) or window_s <= 0:
+        raise InvalidValueError(f"force noise of {label}: the force window's length is needed (force_window_s > 0)")
+    spacing = float(np.median(np.diff(hz))) if hz.size > 1 else 1.0
+    return 0.5 * v * max(1.0, 1.0 / (float(window_s) * spacing))
+
+
 def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3, *, coherence=None,
-                   averages: int | None = None) -> NoiseModel:
+                   averages: int | None = None, force_noise=None, force_window_s: float | None = None) -> NoiseModel:
     """The per-line noise of a measured FRF (one entry), estimated from the data.
 
     Parameters
@@ -311,6 +324,16 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
         fitted to the data.
     averages : int, optional
         The number of taps averaged.
+    force_noise : array_like, optional
+        Per line, the variance of H1's relative error that the hammer's noise
+        gives (:attr:`substructure.tap.TapResult.force_noise`).  The error
+        passes through the force window only, so it is smooth over about
+        ``1 / force_window_s`` hertz, which the smoothing residual cannot
+        see and the tests would read as independent lines: with
+        ``force_window_s`` it is added to each line's variance (half to each
+        part) times the lines it spans, ``1 / (force_window_s df)``.
+    force_window_s : float, optional
+        The force window's effective length [s] (needed with ``force_noise``).
 
     Returns
     -------
@@ -322,7 +345,8 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     InvalidValueError
         For an FRF that is zero (or not finite) on every line, too short,
         with magnitudes whose square overflows (beyond 1e140 in SI units) or
-        underflows (below 1e-140), or a coherence of the wrong length.
+        underflows (below 1e-140), a coherence or force noise of the wrong
+        length, or a force noise without the window's length.
     """
     if measured.shape[1:] != (1, 1):
         raise InvalidValueError(f"measured: got {measured.shape[1]}x{measured.shape[2]} entries; expected one")
@@ -447,6 +471,7 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     spread = float(np.std(blocks, ddof=1) / np.sqrt(len(blocks))) if len(blocks) > 1 else 1.0
     scatter = np.where(keep, zf, np.nan)
     coherence_factor = float(0.5 * coef[3] / coh_scale) if coh is not None else None
+    extra = _force_term(force_noise, force_window_s, measured.frequency.hz, label)
     dof = None
     if coh is not None:
         # the share of each line's variance that the coherence of a few taps gives, and the variance's degrees
@@ -455,6 +480,8 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
             share = np.clip(0.5 * coef[3] * g[1] * local / (0.5 * (var_re + var_im)), 0.0, 1.0)
             dof = np.where(usable & (share > 0), 2.0 * (int(averages) - 1) / np.maximum(share, 1e-12) ** 2, np.inf)
         dof = np.where(np.isfinite(dof), dof, np.inf)
+    if extra is not None:  # the hammer's noise: a smooth error the smoothing residual does not see (docstring)
+        var_re, var_im = (np.minimum(v + extra, VARIANCE_CAP) for v in (var_re, var_im))
     return NoiseModel(var_re, var_im, (float(coef[0]), float(coef[1])), float(coef[2]) / scale,
                       max(spread, float(np.sqrt(1.0 / max(idx.size, 1)))), w, scatter,
                       local_scale=local, outliers=int(spike.sum()), coherence_factor=coherence_factor,

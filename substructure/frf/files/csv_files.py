@@ -4,8 +4,11 @@ One FRF per file, header ``frequency_hz,real,imag``, one line per frequency,
 receptance in m/N unless told otherwise; values are written with every
 digit (``repr``) so that a written file reads back to the same floats.  A
 fourth column ``coherence`` (the ordinary coherence of a tap test, in
-[0, 1]) may follow: :func:`read_csv_with_coherence` returns it,
-:func:`read_csv` reads such files too and returns the FRF alone.
+[0, 1]) may follow, and after it a fifth, ``force_noise`` (the variance of
+H1's relative error that the hammer's noise gives, per line, a tap test's;
+``inf`` where there was no force): :func:`read_csv_with_coherence` returns
+the coherence, :func:`read_csv` reads such files too and returns the FRF
+alone.
 """
 
 from __future__ import annotations
@@ -26,9 +29,10 @@ __all__ = ["write_csv", "read_csv", "read_csv_with_coherence"]
 
 CSV_HEADER = "frequency_hz,real,imag"
 COHERENCE_HEADER = CSV_HEADER + ",coherence"
+FORCE_NOISE_HEADER = COHERENCE_HEADER + ",force_noise"
 
 
-def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coherence=None) -> None:
+def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coherence=None, force_noise=None) -> None:
     """Write a one-entry FRF to a CSV file ``frequency_hz,real,imag`` (``,coherence`` when given).
 
     Parameters
@@ -45,12 +49,18 @@ def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coheren
     coherence : array of float, optional
         The coherence (dimensionless, in [0, 1]) on the FRF's lines, written
         as a fourth column ``coherence``.
+    force_noise : array of float, optional
+        With a coherence: per line, the variance of H1's relative error from
+        the hammer's noise (:attr:`substructure.tap.TapResult.force_noise`;
+        >= 0, ``inf`` allowed), written as a fifth column ``force_noise``.
 
     Raises
     ------
     InvalidValueError
         For an FRF of more than one entry or of fewer than 2 lines (which
-        no reader takes), or a coherence of another length or outside [0, 1].
+        no reader takes), a coherence of another length or outside [0, 1],
+        or a force noise without a coherence, of another length, negative or
+        NaN.
     """
     from ..._files import write_text
 
@@ -75,6 +85,12 @@ def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coheren
                 f"coherence: cannot write {os.fspath(path)}: expected {frf.frequency.n} values in [0, 1], one per line"
             )
         header, columns = COHERENCE_HEADER, columns + [gamma]
+    if force_noise is not None:
+        v = np.asarray(force_noise, dtype=np.float64)
+        if coherence is None or v.shape != (frf.frequency.n,) or not np.all(v >= 0):
+            raise InvalidValueError(f"force_noise: cannot write {os.fspath(path)}: expected {frf.frequency.n} values "
+                                    ">= 0 (inf allowed), one per line, and a coherence")
+        header, columns = FORCE_NOISE_HEADER, columns + [v]
     text = "".join(",".join(map(repr, row)) + "\n" for row in zip(*(c.tolist() for c in columns)))
     write_text(path, header + "\n" + text, overwrite=overwrite)
 
@@ -150,12 +166,14 @@ def read_csv_with_coherence(
         As :func:`read_csv`, and for a coherence that is not a number in
         [0, 1], naming the file and the line.
     """
-    frf, _, coherence = _read_csv(path, output, input, quantity)
+    frf, _, coherence, _ = _read_csv(path, output, input, quantity)
     return frf, coherence
 
 
-def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF, np.ndarray, np.ndarray | None]:
-    """:func:`read_csv_with_coherence`, with the line of the file each frequency line comes from."""
+def _read_csv(path, output: str, input: str,
+              quantity: str | None) -> tuple[FRF, np.ndarray, np.ndarray | None, np.ndarray | None]:
+    """:func:`read_csv_with_coherence`, with the line of the file each frequency line comes from and the force
+    noise column."""
     from ..._files import MAX_DATA_BYTES, read_text
 
     name = os.fspath(path)
@@ -169,11 +187,12 @@ def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF,
         raise FileFormatError(f"{name}: the file is empty; expected the header {CSV_HEADER!r}")
     first, header = numbered[0]
     columns = header.replace(" ", "").lstrip("\ufeff")
-    if columns not in (CSV_HEADER, COHERENCE_HEADER):  # another program's export: read what is unambiguous
+    if columns not in (CSV_HEADER, COHERENCE_HEADER, FORCE_NOISE_HEADER):  # another program's export
         from .exports import parse_export
 
         table, lines_of, said = parse_export(numbered, name, quantity)
-        return _checked_csv(table, lines_of, name, output, input, quantity or said or "receptance"), lines_of, None
+        frf = _checked_csv(table, lines_of, name, output, input, quantity or said or "receptance")
+        return frf, lines_of, None, None
     names = columns.split(",")
     numbered = numbered[1:]
     if len(numbered) < 2:
@@ -200,8 +219,8 @@ def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF,
                     ) from None
         raise  # pragma: no cover - numpy and float() disagree on a cell
     lines_of = np.array([number for number, _ in numbered])
-    coherence = None
-    if len(names) == 4:
+    coherence = force_noise = None
+    if len(names) >= 4:
         coherence = table[:, 3]
         bad = ~(np.isfinite(coherence) & (coherence >= 0.0) & (coherence <= 1.0))
         if bad.any():
@@ -209,8 +228,15 @@ def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF,
             raise FileFormatError(
                 f"{name}, line {lines_of[k]}: coherence is {float(coherence[k])!r}; expected a number in [0, 1]"
             )
-        table = table[:, :3]
-    return _checked_csv(table, lines_of, name, output, input, quantity or "receptance"), lines_of, coherence
+    if len(names) == 5:
+        force_noise = table[:, 4]
+        bad = ~(force_noise >= 0.0)  # NaN and negative values; inf is a line without force
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise FileFormatError(f"{name}, line {lines_of[k]}: force_noise is {float(force_noise[k])!r}; expected "
+                                  "a variance >= 0 (inf where there was no force)")
+    frf = _checked_csv(table[:, :3], lines_of, name, output, input, quantity or "receptance")
+    return frf, lines_of, coherence, force_noise
 
 
 def _checked_csv(table: np.ndarray, lines_of: np.ndarray, name: str, output: str, input: str,
