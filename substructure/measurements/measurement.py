@@ -250,7 +250,7 @@ class Measurement:
         has: the diagnosis says so in its report.
     force_noise : array of float, optional
         Per line, the variance of H1's relative error from the hammer's
-        noise (:attr:`substructure.tap.TapResult.force_noise`; >= 0, ``inf``
+        noise (``substructure.tap.TapResult.force_noise``; >= 0, ``inf``
         where there was no force); read-only.  With ``force_window_s`` the
         noise model counts it as the smooth error it is.
     force_window_s : float, optional

@@ -326,7 +326,7 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
         The number of taps averaged.
     force_noise : array_like, optional
         Per line, the variance of H1's relative error that the hammer's noise
-        gives (:attr:`substructure.tap.TapResult.force_noise`).  The error
+        gives (``substructure.tap.TapResult.force_noise``).  The error
         passes through the force window only, so it is smooth over about
         ``1 / force_window_s`` hertz, which the smoothing residual cannot
         see and the tests would read as independent lines: with

@@ -51,7 +51,7 @@ def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coheren
         as a fourth column ``coherence``.
     force_noise : array of float, optional
         With a coherence: per line, the variance of H1's relative error from
-        the hammer's noise (:attr:`substructure.tap.TapResult.force_noise`;
+        the hammer's noise (``substructure.tap.TapResult.force_noise``;
         >= 0, ``inf`` allowed), written as a fifth column ``force_noise``.
 
     Raises
