@@ -328,8 +328,8 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     for m in lik.measured:  # a fact of the data, whatever the verdict
         tau = getattr(m.measurement, "window_tau", None)
         if tau is not None:
-            middle = float(np.median(m.frf.frequency.hz))
-            report = list(report) + [words.windowed(m.measurement.describe(), tau, middle)]
+            hz = m.frf.frequency.hz
+            report = list(report) + [words.windowed(m.measurement.describe(), tau, float(hz[0]), float(hz[-1]))]
     return Diagnosis(
         verdict=Verdict(explained=explained, report=tuple(report),
                         missing_effect=None if missing is None else missing.name,

@@ -219,7 +219,7 @@ def budget_cut(where: str) -> str:
     return f"the search was cut by its budget ({where}); a larger budget (--budget, --time-limit) may find more"
 
 
-def windowed(which: str, tau: float, f_hz: float) -> str:
+def windowed(which: str, tau: float, lo_hz: float, hi_hz: float) -> str:
     """The note that a measurement was taken through an exponential window (its modes carry damping no model has).
 
     Parameters
@@ -228,16 +228,19 @@ def windowed(which: str, tau: float, f_hz: float) -> str:
         The measurement (``response / excitation``).
     tau : float
         The window's time constant [s].
-    f_hz : float
-        A frequency at which to quote the added damping ratio [Hz].
+    lo_hz, hi_hz : float
+        The band's ends, at which the added damping ratio is quoted [Hz] (it is largest at the lowest line).
 
     Returns
     -------
     str
         One line.
     """
+    def zeta(f_hz: float) -> str:
+        return f"{1.0 / (tau * 2.0 * math.pi * f_hz):.2g} at {f_hz:.4g} Hz"
+
     return (f"{which} was measured through an exponential window (tau = {tau:.4g} s): it adds the damping ratio "
-            f"1/(tau omega) to every mode ({1.0 / (tau * 2.0 * math.pi * f_hz):.2g} at {f_hz:.4g} Hz), "
+            f"1/(tau omega) to every mode ({zeta(lo_hz)} to {zeta(hi_hz)}), "
             "which the model lacks; damping found here may be the window's (taps long enough for the response to "
             "die out need no window)")
 
