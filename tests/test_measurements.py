@@ -181,6 +181,8 @@ def tip_file(tmp_path, model):
                                         r"window's time constant in s"),
         (GOOD + 'window_tau_s = "0.2 s"\n', r"line 5: frf\[0\]\.window_tau_s: got '0\.2 s'"),
         (GOOD + "window_tau_s = nan\n", r"line 5: frf\[0\]\.window_tau_s: got nan"),
+        (GOOD + 'estimator = "H3"\n', r"line 5: frf\[0\]\.estimator: got 'H3'; expected one of H1, H2, Hv"),
+        (GOOD + "estimator = 2\n", r"line 5: frf\[0\]\.estimator: got 2; expected one of H1, H2, Hv"),
         (GOOD.replace("tip.csv", "tip.txt"), r"frf\[0\]\.file: 'tip\.txt': unknown kind of file"),
         (GOOD + GOOD, r"line 5: frf\[1\]: measures tool\.tip:y / tool\.tip:y in the same configuration as frf\[0\]"),
         ("name = [", r"invalid TOML"),
@@ -199,6 +201,16 @@ def test_a_window_s_time_constant_reads_into_the_measurement(tmp_path, tip_file)
     assert load_measurements(path).measurements[0].window_tau is None
     with pytest.raises(InvalidValueError, match="window_tau: got 0; expected the exponential window's time constant"):
         Measurement.from_frf(m.frf, "tool.tip", "tool.tip", window_tau=0)
+
+
+def test_the_estimator_reads_into_the_measurement(tmp_path, tip_file):
+    path = tmp_path / "set.toml"
+    path.write_text(GOOD + 'estimator = "H2"\n')
+    (m,) = load_measurements(path).measurements
+    assert m.estimator == "H2" and m.crop(100, 200).estimator == "H2"
+    assert m.h1_frf is m.frf  # no coherence column: nothing to make it the H1 of its taps with
+    path.write_text(GOOD)
+    assert load_measurements(path).measurements[0].estimator is None
 
 
 def test_the_hammer_noise_column_and_its_window_read_into_the_measurement(tmp_path, model):

@@ -50,7 +50,7 @@ def test_tap_writes_frf_with_coherence_and_a_set_that_reads_back(records, tmp_pa
     assert read_csv(out).frequency == frf.frequency  # the three-column reader reads it too
     measurements = load_measurements(toml)
     (m,) = measurements.measurements
-    assert m.averages == 5 and m.response == "tool.tip:y"
+    assert m.averages == 5 and m.response == "tool.tip:y" and m.estimator == "H1"
     assert np.array_equal(m.coherence, coherence)
     hz = m.frf.frequency.hz
     assert np.median(m.coherence[(hz >= 20) & (hz <= 5000)]) > 0.99
@@ -75,6 +75,13 @@ def test_tap_writes_frf_with_coherence_and_a_set_that_reads_back(records, tmp_pa
     assert load_measurements(toml).measurements[0].averages == 5
     # and in a key the diagnosis reads (its report says what the window adds)
     assert abs(load_measurements(toml).measurements[0].window_tau - 0.2171) < 1e-3
+    # an H2 set says so, with its coherence and the hammer's noise of the H1 it is compared as
+    code, _, err = run(capsys, "tap", *paths, "--out", out, "--measurements", toml, "--response", "tool.tip",
+                       "--excitation", "tool.tip", "--overwrite", "--estimator", "H2")
+    assert code == 0, err
+    (m,) = load_measurements(toml).measurements
+    assert m.estimator == "H2" and m.force_noise is not None and m.force_window_s > 0
+    np.testing.assert_allclose(m.h1_frf.data, m.frf.data * m.coherence[:, None, None])
 
 
 def test_tap_json(records, capsys):

@@ -41,11 +41,11 @@ def _read(path: str, args: argparse.Namespace) -> list:
 
 
 def _set_text(name: str, response: str, excitation: str, file: str, averages: int, tau: float | None,
-              force_window: float | None = None) -> str:
+              force_window: float | None, estimator: str) -> str:
     import tomli_w
 
     frf = {"response": response, "excitation": excitation, "file": file, "quantity": "receptance",
-           "averages": averages}
+           "averages": averages, "estimator": estimator}
     if tau is not None:
         frf["window_tau_s"] = float(tau)
     if force_window:  # the file's force_noise column is correlated over 1 / force_window_s hertz
@@ -105,7 +105,8 @@ def run(args: argparse.Namespace) -> int:
         name = args.name or f"tap test: {response} / {excitation}"
         write_text(args.measurements, _set_text(name, response, excitation, Path(relative).as_posix(),
                                                 result.averages, result.tau,
-                                                result.force_window_s if result.force_noise is not None else None),
+                                                result.force_window_s if result.force_noise is not None else None,
+                                                result.estimator),
                    overwrite=args.overwrite)
         written.append(args.measurements)
     if args.plot:
@@ -143,7 +144,8 @@ def run(args: argparse.Namespace) -> int:
     scatter = result.force_scatter()
     print(f"hammer's noise: {result.force_noise_rms:.3g} N RMS outside the pulse ({result.force_noise_rms / peak:.2g} "
           "of the peak)" + ("" if scatter is None else
-                            f"; H1 scatters by up to {scatter:.2%} from it within the band, a smooth error over "
+                            f"; H1{'' if result.estimator == 'H1' else ' (gamma^2 H2, which the diagnosis compares)'}"
+                            f" scatters by up to {scatter:.2%} from it within the band, a smooth error over "
                             f"about {1.0 / result.force_window_s:.0f} Hz (the force window's "
                             f"{result.force_window_s * 1e3:.2g} ms)"))
     if result.tau is None:

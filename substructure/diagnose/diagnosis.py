@@ -330,6 +330,9 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         if tau is not None:
             hz = m.frf.frequency.hz
             report = list(report) + [words.windowed(m.measurement.describe(), tau, float(hz[0]), float(hz[-1]))]
+        if getattr(m.measurement, "estimator", None) == "H2":
+            report = list(report) + [words.estimated_as_h2(m.measurement.describe(),
+                                                           getattr(m.measurement, "coherence", None) is not None)]
     return Diagnosis(
         verdict=Verdict(explained=explained, report=tuple(report),
                         missing_effect=None if missing is None else missing.name,

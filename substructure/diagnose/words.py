@@ -245,6 +245,28 @@ def windowed(which: str, tau: float, lo_hz: float, hi_hz: float) -> str:
             "die out need no window)")
 
 
+def estimated_as_h2(which: str, compared_as_h1: bool) -> str:
+    """The note that a measurement is an H2 estimate, and how the diagnosis took it.
+
+    Parameters
+    ----------
+    which : str
+        The measurement (``response / excitation``).
+    compared_as_h1 : bool
+        Whether its coherence let it be compared as the H1 of the same taps, ``gamma^2 H2``.
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    if compared_as_h1:
+        return (f"{which} is an H2 estimate: compared as the H1 of the same taps, gamma^2 H2 (H2 exceeds the FRF "
+                "by 1/gamma^2 where the response's noise is large)")
+    return (f"{which} is an H2 estimate without its coherence: it exceeds the FRF by 1/gamma^2 where the response's "
+            "noise is large, which the comparison cannot take out (give the coherence column, or an H1)")
+
+
 def unexplained(final_error: float, floor: float, chi2_reduced: float, threshold: float) -> str:
     """The first line of the verdict when no candidate reaches the noise.
 

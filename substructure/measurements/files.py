@@ -21,13 +21,14 @@ from ..frf.files._common import _beyond_physical
 from ..frf.files.csv_files import _read_csv
 from ..frf.files.uff_reader import read_uff
 from ..points import check_name
+from ..tap import ESTIMATORS
 from .measurement import Measurement, _optional_force_window, _optional_tau, dof_label
 
 __all__ = ["read_measurements", "reads_measurements"]
 
 _TOP_KEYS = ("name", "frf")
 _FRF_KEYS = ("response", "excitation", "file", "record", "quantity", "sensors", "removed", "averages", "window_tau_s",
-             "force_window_s")
+             "force_window_s", "estimator")
 _REQUIRED = ("response", "excitation", "file")
 _CSV = (".csv",)
 _UFF = (".uff", ".unv")
@@ -78,12 +79,12 @@ class _Reader:
             raise self.error(index, key, f"{', '.join(map(repr, twice))} given more than once")
         return tuple(value)
 
-    def quantity(self, table: dict, index: int) -> str | None:
-        if "quantity" not in table:
+    def choice(self, table: dict, index: int, key: str, options: tuple[str, ...]) -> str | None:
+        if key not in table:
             return None
-        value = table["quantity"]
-        if value not in QUANTITIES:
-            raise self.error(index, "quantity", f"got {value!r}; expected one of {', '.join(QUANTITIES)}")
+        value = table[key]
+        if value not in options:
+            raise self.error(index, key, f"got {value!r}; expected one of {', '.join(options)}")
         return value
 
     def integer(self, table: dict, index: int, key: str, minimum: int, expected: str) -> int | None:
@@ -194,13 +195,14 @@ class _Reader:
                 raise self.error(index, key, "missing; this value is required")
         response, excitation = self.point(table, index, "response"), self.point(table, index, "excitation")
         file = self.string(table, index, "file")
-        quantity = self.quantity(table, index)
+        quantity = self.choice(table, index, "quantity", QUANTITIES)
         record = self.integer(table, index, "record", 0, "the 0-based index of a type-58 record")
         sensors, removed = self.names(table, index, "sensors"), self.names(table, index, "removed")
         averages = self.integer(table, index, "averages", 1, "the number of averages (an integer >= 1)")
         tau = self.seconds(table, index, "window_tau_s", _optional_tau, "the exponential window's time constant in s")
         force_window = self.seconds(table, index, "force_window_s", _optional_force_window,
                                     "the force window's length in s")
+        estimator = self.choice(table, index, "estimator", ESTIMATORS)
         raw, coherence, force_noise = self.data(index, file, record, quantity, response, excitation)
         if force_noise is not None and force_window is None:
             raise self.error(index, "force_window_s", f"missing; {file} has a force_noise column, correlated over "
@@ -220,7 +222,7 @@ class _Reader:
             raise self.error(index, "file", f"{self.base_dir / file}: {exc}") from None
         try:
             return Measurement(response, excitation, receptance, raw.quantity, sensors, removed, file, record,
-                               coherence, averages, tau, force_noise, force_window)
+                               coherence, averages, tau, force_noise, force_window, estimator)
         except SubstructureError as exc:  # pragma: no cover - every field was checked above
             raise self.error(index, None, str(exc)) from None
 

@@ -15,6 +15,7 @@ from ..errors import InvalidValueError, SubstructureError, UnknownPointError
 from ..frf import FRF
 from ..frf._fields import _check_quantity
 from ..points import check_name, parse_point
+from ..tap import ESTIMATORS
 
 __all__ = ["Measurement", "MeasurementSetError", "MissingMeasurementError", "dof_label", "Configuration"]
 
@@ -180,6 +181,13 @@ def _force_noise(value: Any) -> np.ndarray | None:
     return array
 
 
+def _estimator(value: Any) -> str | None:
+    if value is not None and value not in ESTIMATORS:
+        raise InvalidValueError(f"estimator: got {value!r}; expected one of {', '.join(ESTIMATORS)}, or None when "
+                                "not known")
+    return value
+
+
 def _same_array(a: Any, b: Any) -> bool:
     if a is None or b is None:
         return a is b
@@ -256,6 +264,11 @@ class Measurement:
     force_window_s : float, optional
         The force window's effective length [s]: the hammer's noise in H1 is
         correlated over about ``1 / force_window_s`` hertz.
+    estimator : {"H1", "H2", "Hv"}, optional
+        How the FRF was estimated from the taps (None: not known).  An H2
+        estimate exceeds the FRF by the factor ``1 / gamma^2`` where the
+        response's noise is large; with its coherence it is compared as H1
+        (:attr:`h1_frf`).
     """
 
     response: str = attrs.field(converter=lambda value: dof_label(value, "response"))
@@ -275,6 +288,7 @@ class Measurement:
         default=None, converter=_force_noise, validator=_check_lines, eq=attrs.cmp_using(eq=_same_array)
     )
     force_window_s: float | None = attrs.field(default=None, converter=_optional_force_window)
+    estimator: str | None = attrs.field(default=None, converter=_estimator)
 
     @force_window_s.validator
     def _check_force_window(self, attribute: Any, value: float | None) -> None:
@@ -287,7 +301,7 @@ class Measurement:
         cls, frf: FRF, response: str, excitation: str, *, sensors: Sequence[str] = (),
         removed: Sequence[str] = (), file: str | None = None, record: int | None = None,
         coherence: Any = None, averages: int | None = None, window_tau: float | None = None,
-        force_noise: Any = None, force_window_s: float | None = None,
+        force_noise: Any = None, force_window_s: float | None = None, estimator: str | None = None,
     ) -> "Measurement":
         """A measurement from a one-entry FRF of any quantity.
 
@@ -321,6 +335,8 @@ class Measurement:
             The hammer's noise in H1 per line (a variance, >= 0).
         force_window_s : float, optional
             The force window's effective length [s].
+        estimator : {"H1", "H2", "Hv"}, optional
+            How the FRF was estimated from the taps.
 
         Returns
         -------
@@ -336,7 +352,7 @@ class Measurement:
             )
         receptance = frf.with_labels((out,), (inp,)).to_receptance()
         return cls(out, inp, receptance, frf.quantity, sensors, removed, file, record, coherence, averages,
-                   window_tau, force_noise, force_window_s)
+                   window_tau, force_noise, force_window_s, estimator)
 
     def crop(self, lo: Any = None, hi: Any = None) -> "Measurement":
         """The measurement restricted to ``lo <= f <= hi``, its coherence and force noise on the same lines.
@@ -360,6 +376,22 @@ class Measurement:
     def configuration(self) -> Configuration:
         """``(sensors, removed)``, each sorted: what identifies the tested configuration."""
         return tuple(sorted(self.sensors)), tuple(sorted(self.removed))
+
+    @property
+    def h1_frf(self) -> FRF:
+        """The FRF as H1 where it can be had: for an H2 estimate with its coherence, ``gamma^2 H2``.
+
+        H1 = Gfx / Gff and H2 = Gxx / Gxf of one set of spectra differ by their
+        coherence, ``H1 = gamma^2 H2`` exactly, so this is the H1 of the same
+        taps: free of H2's bias ``1 / gamma^2`` from the response's noise
+        (large where the coherence is low), with H1's own error from the
+        hammer's noise (``force_noise``).  Any other FRF (H1, Hv, an estimator
+        not stated, an H2 without its coherence) is returned as it is.  The
+        fits and the diagnosis compare this FRF with the model.
+        """
+        if self.estimator != "H2" or self.coherence is None:
+            return self.frf
+        return attrs.evolve(self.frf, data=self.frf.data * self.coherence[:, None, None])
 
     @property
     def values(self) -> np.ndarray:

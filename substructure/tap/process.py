@@ -155,7 +155,10 @@ class TapResult:
         log magnitude, half in the phase): each kept tap's noise, measured
         outside its force window, through the force window and the
         exponential one. It is smooth in frequency, over about
-        ``1 / force_window_s`` hertz. None for H2 and Hv.
+        ``1 / force_window_s`` hertz.  For H2 too, which is compared as the
+        H1 of the same taps, ``gamma^2 H2``
+        (:attr:`Measurement.h1_frf <substructure.measurements.Measurement.h1_frf>`);
+        None for Hv.
     force_noise_rms : float
         The hammer channel's noise outside the pulse, RMS over the kept taps
         (N).
@@ -290,7 +293,7 @@ class TapResult:
         -------
         float or None
             ``sqrt(force_noise)`` at its largest over the lines up to
-            ``hammer_band_hz`` (0.01: 1 %); None for H2 and Hv.
+            ``hammer_band_hz`` (0.01: 1 %); None for Hv.
         """
         if self.force_noise is None:
             return None
@@ -608,7 +611,8 @@ def process_taps(
     n_f = noise_sd**2 * np.sum(w_f**2, axis=1) * dt**2
     with np.errstate(divide="ignore", invalid="ignore"):
         v_f = np.sum(n_f[:, None] * np.abs(F) ** 2, axis=0) / np.sum(np.abs(F) ** 2, axis=0) ** 2
-    v_f = np.where(np.isfinite(v_f), v_f, np.inf)[keep] if estimator == "H1" else None
+    # an H2 is compared as gamma^2 H2, which is this H1 (Measurement.h1_frf): its hammer noise is the same
+    v_f = np.where(np.isfinite(v_f), v_f, np.inf)[keep] if estimator != "Hv" else None
     width = float(np.mean(np.sum(w_f, axis=1) ** 2 / np.sum(w_f**2, axis=1))) * dt
     return TapResult(measured.to_receptance(), measured, coherence[keep], estimator, tuple(taps), tau,
                      hammer_band, float(hammer_band_db), spectra, rate, length, why, v_f,

@@ -97,7 +97,8 @@ def measured_frfs(measurements, band=None) -> tuple[list[Measured], tuple[float,
     """
     items = []
     for m in measurements:
-        frf = m if isinstance(m, FRF) else getattr(m, "frf", None)
+        # an H2 with its coherence is compared as the H1 of the same taps (Measurement.h1_frf)
+        frf = m if isinstance(m, FRF) else getattr(m, "h1_frf", getattr(m, "frf", None))
         if not isinstance(frf, FRF):
             raise InvalidValueError(f"measurements: got {m!r}; expected FRFs or measurements")
         frf = frf.to_receptance()
@@ -133,7 +134,8 @@ def measured_frfs(measurements, band=None) -> tuple[list[Measured], tuple[float,
                                     "Leave it out of the measurement set")
         noise = estimate_noise(frf, coherence=getattr(m, "coherence", None), averages=getattr(m, "averages", None),
                                force_noise=getattr(m, "force_noise", None),
-                               force_window_s=getattr(m, "force_window_s", None))
+                               force_window_s=getattr(m, "force_window_s", None),
+                               estimator=getattr(m, "estimator", None))
         mask = frf.frequency.band_mask(lo, hi)
         if mask.sum() < 10:
             raise InvalidValueError(f"band: {lo:g}-{hi:g} Hz holds {int(mask.sum())} lines of {label}; "

@@ -290,6 +290,14 @@ def _coherence_regressor(coherence, averages, n: int, label: str) -> np.ndarray 
     return (1.0 - gamma) / (2.0 * int(averages) * gamma)
 
 
+def _hv_bias(coherence, averages, estimator) -> np.ndarray | None:
+    """``-ln gamma^2`` per line for an Hv estimate over two taps or more: how far it may lie above H1 (else None)."""
+    if estimator != "Hv" or coherence is None or averages is None or int(averages) < 2:
+        return None
+    gamma = np.asarray(coherence, dtype=float).reshape(-1)
+    return -np.log(np.clip(np.where(np.isfinite(gamma), gamma, 0.0), COHERENCE_MIN, 1.0))
+
+
 def _force_term(force_noise, window_s, hz: np.ndarray, label: str) -> np.ndarray | None:
     """Half the hammer's noise variance per line times the lines its error spans (None without it)."""
     if force_noise is None:
@@ -304,7 +312,8 @@ def _force_term(force_noise, window_s, hz: np.ndarray, label: str) -> np.ndarray
 
 
 def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3, *, coherence=None,
-                   averages: int | None = None, force_noise=None, force_window_s: float | None = None) -> NoiseModel:
+                   averages: int | None = None, force_noise=None, force_window_s: float | None = None,
+                   estimator: str | None = None) -> NoiseModel:
     """The per-line noise of a measured FRF (one entry), estimated from the data.
 
     Parameters
@@ -334,6 +343,15 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
         part) times the lines it spans, ``1 / (force_window_s df)``.
     force_window_s : float, optional
         The force window's effective length [s] (needed with ``force_noise``).
+    estimator : {"H1", "H2", "Hv"}, optional
+        How the FRF was estimated.  An Hv estimate lies between H1 and
+        ``H2 = H1 / gamma^2`` (nearer H2 where the response channel's power
+        is the larger), by an amount its coherence alone does not give: with
+        a coherence of two taps or more, the bias it may carry, ``-ln gamma^2``
+        in the log magnitude (``1 / gamma^2 - 1`` relative, in the linear
+        domain), is added to each line's variance.  An H2 is compared as
+        ``gamma^2 H2``, which is H1 (``Measurement.h1_frf``): give that FRF
+        and ``"H1"``.
 
     Returns
     -------
@@ -482,6 +500,10 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
         dof = np.where(np.isfinite(dof), dof, np.inf)
     if extra is not None:  # the hammer's noise: a smooth error the smoothing residual does not see (docstring)
         var_re, var_im = (np.minimum(v + extra, VARIANCE_CAP) for v in (var_re, var_im))
+    bias = _hv_bias(coherence, averages, estimator)
+    if bias is not None:  # Hv's bias towards H2, in the magnitude only (H1, H2 and Hv share their phase)
+        var_re = np.minimum(var_re + bias**2, VARIANCE_CAP)
+        lin_re = lin_re + np.expm1(bias) ** 2
     return NoiseModel(var_re, var_im, (float(coef[0]), float(coef[1])), float(coef[2]) / scale,
                       max(spread, float(np.sqrt(1.0 / max(idx.size, 1)))), w, scatter,
                       local_scale=local, outliers=int(spike.sum()), coherence_factor=coherence_factor,
