@@ -87,6 +87,21 @@ def test_an_exact_model_is_consistent_with_real_noise(exact, real_residual, offs
     assert _consistent(hd.nominal_model(), _with(exact, exact.data[:, 0, 0] * rho))
 
 
+def test_real_noise_that_turns_a_driving_points_sign_is_not_a_reversed_sign(exact, real_residual):
+    """Ten times the real residual's log turns the imaginary part of the driving point positive on lines
+    holding most of |Im H| (its phase errors are not centred), the mark of a reversed sign by passivity
+    alone; the data are not nearer the model negated or conjugated, so they are not refused as such."""
+    from substructure.frf import REVERSED_SHARE, reversed_share
+
+    n = exact.frequency.n
+    noisy = exact.data[:, 0, 0] * np.exp(10.0 * np.log(real_residual[2400: 2400 + n]))
+    assert reversed_share(noisy) > REVERSED_SHARE
+    measured, _ = measured_frfs([_with(exact, noisy)])
+    Likelihood(hd.nominal_model(), measured)  # no error
+    with pytest.raises(Exception, match="when it is negated: one channel's sign is reversed"):
+        Likelihood(hd.nominal_model(), measured_frfs([_with(exact, -exact.data[:, 0, 0])])[0])
+
+
 @pytest.mark.parametrize("floor", [1e-9, 5e-9, 2e-8, 1e-7])
 def test_an_exact_model_is_consistent_with_an_additive_floor(exact, floor):
     """Up to a floor far above the antiresonances (where the data are then noise alone)."""

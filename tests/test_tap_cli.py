@@ -233,3 +233,36 @@ def test_tap_reads_a_universal_file_and_a_long_record(tmp_path, capsys):
     assert code == 0, err
     data = json.loads(text)
     assert data["taps"] == 5 and [round(p["start_s"]) for p in data["per_tap"]] == [0, 1, 2, 3, 4]
+
+
+def test_a_reversed_polarity_is_said_and_undone(tmp_path, capsys):
+    """Taps simulated on the tool tip of the default assembly, the hammer's channel negated: the driving
+    point's imaginary part is then positive, which no passive structure gives; the command says so, and
+    --reverse-polarity gives the FRF of the records as they were (the diagnosis refuses such a driving
+    point by name, tests/test_passivity.py)."""
+    from substructure import default_assembly
+    from test_tap_to_diagnosis import _taps
+
+    paths, flipped = [], []
+    for i, r in enumerate(_taps(default_assembly(), seed=1)):
+        for sign, names in ((1, paths), (-1, flipped)):
+            names.append(tmp_path / f"tap{i + 1}{'-' if sign < 0 else ''}.csv")
+            np.savetxt(names[-1], np.column_stack([r.time, sign * r.force, r.response]), delimiter=",",
+                       header="time [s],force [N],acceleration [m/s^2]", comments="")
+    point = ("--response", "tool.tip", "--excitation", "tool.tip")
+    code, _, err = run(capsys, "tap", *paths, "--out", tmp_path / "a.csv", "--measurements", tmp_path / "a.toml",
+                       *point)
+    assert code == 0 and "warning" not in err, err
+    code, _, err = run(capsys, "tap", *flipped, "--out", tmp_path / "b.csv", "--measurements", tmp_path / "b.toml",
+                       *point)
+    assert code == 0 and "warning: the FRF of the driving point tool.tip:y has a positive imaginary part" in err
+    assert "--reverse-polarity negates it" in err
+    code, _, err = run(capsys, "tap", *flipped, "--out", tmp_path / "c.csv", "--measurements", tmp_path / "c.toml",
+                       *point, "--reverse-polarity")
+    assert code == 0 and "warning" not in err, err
+    a, c = read_csv(tmp_path / "a.csv"), read_csv(tmp_path / "c.csv")
+    np.testing.assert_allclose(c.data, a.data, rtol=1e-12, atol=0)
+    # no warning where the points differ: a cross point has no sign of its own
+    code, _, err = run(capsys, "tap", *flipped, "--out", tmp_path / "d.csv", "--measurements", tmp_path / "d.toml",
+                       "--response", "holder.tip", "--excitation", "tool.tip")
+    assert code == 0 and "warning" not in err, err

@@ -5,8 +5,10 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import warnings
 from pathlib import Path
 
+from ..errors import SubstructureWarning
 from ._common import UsageError, band_range_arg, check_outputs, check_plot, figures, print_json, save_figure
 
 _TEXT_SUFFIXES = (".csv", ".txt", ".dat", ".asc")
@@ -61,6 +63,7 @@ def run(args: argparse.Namespace) -> int:
     from ..io import write_text
     from ..io.frf_files import write_csv
     from ..measurements import dof_label
+    from ..frf import REVERSED_SHARE, reversed_share
     from ..tap import HAMMER_BAND_DB, PRE_TRIGGER_S, process_taps
 
     for path in args.records:
@@ -95,6 +98,16 @@ def run(args: argparse.Namespace) -> int:
                           exponential=True if args.exponential_window else False if args.no_exponential_window
                           else None, tau=args.tau, band=args.band,
                           hammer_band_db=HAMMER_BAND_DB if args.hammer_band_db is None else args.hammer_band_db)
+    if args.reverse_polarity:  # one channel's sign reversed: the FRF negated, its coherence and noise as they are
+        import attrs
+
+        result = attrs.evolve(result, frf=-result.frf, measured=-result.measured)
+    share = reversed_share(result.frf.data[:, 0, 0]) if response is not None and response == excitation else 0.0
+    if share > REVERSED_SHARE:
+        warnings.warn(f"the FRF of the driving point {response} has a positive imaginary part on lines holding "
+                      f"{share:.0%} of |Im H| (a passive structure's is <= 0): one channel's sign is reversed (the "
+                      "hammer's or the sensor's polarity, or a sensor facing the other way); --reverse-polarity "
+                      "negates it", SubstructureWarning, stacklevel=2)
     peaks = result.peaks()
     written = []
     if args.out:
@@ -219,6 +232,8 @@ def add_parser(commands) -> None:
     tap.add_argument("--hammer-band-db", type=float, metavar="DB",
                      help="force spectrum drop that ends the hammer's usable band (default 20 dB, tap.HAMMER_BAND_DB)")
     tap.add_argument("--band", type=band_range_arg, metavar="LO:HI", help="keep only these lines (Hz)")
+    tap.add_argument("--reverse-polarity", action="store_true",
+                     help="negate the FRF: one channel's sign is reversed (a driving point's Im(H) must be <= 0)")
     tap.add_argument("--overwrite", action="store_true", help="let the outputs replace existing files")
     tap.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
     tap.set_defaults(run=run)

@@ -10,14 +10,16 @@ and :mod:`substructure.io.frf_files`, imported on use.
 
 The package holds one concept per module: ``axis`` (:class:`Frequency`),
 ``response`` (:class:`FRF`), ``_fields`` (the checks of an FRF's fields) and
-``peaks`` (:func:`local_maxima`); every name is imported from here.
+``peaks`` (:func:`local_maxima`) and ``passivity`` (:func:`reversed_share`, the
+sign of a driving point); every name is imported from here.
 """
 
 from __future__ import annotations
 
 from ._fields import QUANTITIES
 from .axis import MAX_GRID_LINES, Frequency
+from .passivity import REVERSED_SHARE, reversed_share
 from .peaks import local_maxima
 from .response import FRF
 
-__all__ = ["Frequency", "FRF", "QUANTITIES", "MAX_GRID_LINES", "local_maxima"]
+__all__ = ["Frequency", "FRF", "QUANTITIES", "MAX_GRID_LINES", "local_maxima", "reversed_share", "REVERSED_SHARE"]

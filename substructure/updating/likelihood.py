@@ -28,7 +28,7 @@ import numpy as np
 
 from ..errors import InvalidValueError, UnknownPointError
 from .._memo import Same
-from ..frf import FRF
+from ..frf import FRF, REVERSED_SHARE, reversed_share
 from ..measurements import model_of_measurement
 from .noise import NoiseModel, estimate_noise
 from .parameters import Change
@@ -37,6 +37,8 @@ from .structure import Structure
 
 __all__ = ["Measured", "Likelihood", "measured_frfs", "LOG_RATIO_PENALTY"]
 
+SIGN_ERROR_FACTOR = 4.0
+"""How many times smaller a driving point's phase error must be negated or conjugated to call it so."""
 LOG_RATIO_PENALTY = 10.0
 """The log ratio used where a model value is zero or not finite [-]."""
 
@@ -128,8 +130,8 @@ def measured_frfs(measurements, band=None) -> tuple[list[Measured], tuple[float,
     for m, frf in items:
         label = f"{frf.outputs[0]} / {frf.inputs[0]}"
         h = frf.data[:, 0, 0]
+        where = getattr(m, "describe", lambda: label)()
         if not np.any(np.isfinite(h) & (np.abs(h) > 0)):
-            where = getattr(m, "describe", lambda: label)()
             raise InvalidValueError(f"measured FRF {where}: zero (or not finite) on every line: a dead channel? "
                                     "Leave it out of the measurement set")
         noise = estimate_noise(frf, coherence=getattr(m, "coherence", None), averages=getattr(m, "averages", None),
@@ -234,6 +236,49 @@ class Likelihood:
         self.w_im = [1.0 / np.sqrt(m.noise.var_im[self.lines]) for m in self.measured]
         self.n = 2 * sum(d.size for d in self.data)
         self.evaluations = 0
+        self._check_signs()
+        self.evaluations = 0  # the check's evaluation is not the caller's
+
+    def _check_signs(self) -> None:
+        """Refuse a driving point whose sign is reversed or conjugated: by passivity, and against the model.
+
+        A passive structure's driving-point receptance has ``Im H <= 0``
+        (:func:`~substructure.frf.reversed_share`).  One whose imaginary part
+        is mostly positive, and whose phase error against the model (its mean
+        square, weighted by the noise) falls :data:`SIGN_ERROR_FACTOR` times or
+        more when the data are negated or conjugated, is refused, saying
+        which: large phase noise can turn the first test, a wrong model the
+        second, not both.
+        """
+        suspects = [i for i, m in enumerate(self.measured)
+                    if m.frf.outputs[0] == m.frf.inputs[0] and reversed_share(self.data[i]) > REVERSED_SHARE]
+        if not suspects:
+            return
+        predicted = self.predict()
+        for i in suspects:
+            h, w = self.data[i], self.w_im[i] ** 2
+
+            def error(x):
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    phase = np.angle(predicted[i] / x)
+                ok = np.isfinite(phase) & np.isfinite(w)
+                return float(np.sum(w[ok] * phase[ok] ** 2) / max(np.sum(w[ok]), 1e-300))
+
+            as_is, negated, conjugated = error(h), error(-h), error(np.conj(h))
+            if min(negated, conjugated) * SIGN_ERROR_FACTOR > as_is:
+                continue
+            m = self.measured[i]
+            where = getattr(m.measurement, "describe", lambda: m.label)()
+            fix = ("one channel's sign is reversed (the hammer's or the sensor's polarity, or a sensor facing the "
+                   "other way): negate the FRF (substructure tap --reverse-polarity)" if negated <= conjugated else
+                   "the data follow the convention exp(-i omega t), not exp(+i omega t): take their complex "
+                   "conjugate")
+            raise InvalidValueError(
+                f"measured FRF {where}: a driving point, whose receptance has Im(H) <= 0 on a passive structure, "
+                f"has a positive imaginary part on lines holding {reversed_share(h):.0%} of |Im H|, and its phase "
+                f"error against the model falls from {np.sqrt(as_is):.2f} rad RMS to "
+                f"{np.sqrt(min(negated, conjugated)):.2f} when it is "
+                f"{'negated' if negated <= conjugated else 'conjugated'}: {fix}")
 
     def subsample(self, step: int, keep=None) -> "Likelihood":
         """The same likelihood on every ``step``-th line, and on the lines ``keep`` (for cheap screening).
