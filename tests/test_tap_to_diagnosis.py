@@ -269,3 +269,40 @@ def test_a_body_is_found_through_h2_and_hv_estimates(model, estimator, grams, re
     (effect,) = d.effects
     assert effect.where == "tool.tip" and effect.name == "sensor-mass"
     assert abs(effect.values["mass"] - grams * 1e-3) < max(3 * effect.std["mass"], 1e-4)
+
+
+@pytest.mark.parametrize("lines", [slice(100, 103), slice(700, 1450), slice(0, None, 7)],
+                         ids=["three lines", "a block of 30 %", "every 7th line"])
+def test_lines_without_a_value_are_left_out(model, lines):
+    """Lines an FRF holds no value on (zero: an FRF holds no NaN; a dropout, lines an analyser left empty) say
+    nothing of the structure.  Compared as values, three zero lines had the exact model called unexplained
+    (its error 3.1 times the noise floor); they are left out of every comparison, and the report says so."""
+    measured, _ = _measured(_taps(model, seed=2))
+    data = measured.frf.data.copy()
+    data[lines] = 0.0
+    holed = attrs.evolve(measured, frf=attrs.evolve(measured.frf, data=data))
+    d = diagnose(model, [holed], progress=False)
+    assert d.explained and d.effects == [], d.report
+    count = int(np.sum(data[:, 0, 0] == 0))
+    (line,) = [r for r in d.report if "holds no value" in r]
+    assert line.startswith(f"tool.tip:y / tool.tip:y holds no value on {count} lines of the band")
+    assert d.measures.final_error <= 1.5 * d.measures.noise_floor
+    if lines.start == 700:  # a body is still found at its mass through the hole
+        truth = model.attach(Mass("sensor", "tool.tip", "4 g"))
+        found, _ = _measured(_taps(truth, seed=2))
+        data = found.frf.data.copy()
+        data[lines] = 0.0
+        d = diagnose(model, [attrs.evolve(found, frf=attrs.evolve(found.frf, data=data))], progress=False)
+        assert d.explained and [e.name for e in d.effects] == ["sensor-mass"], d.report
+        assert abs(d.effects[0].values["mass"] - 0.004) < max(3 * d.effects[0].std["mass"], 1e-4)
+
+
+def test_a_band_with_too_few_values_is_refused(model):
+    measured, _ = _measured(_taps(model, seed=2))
+    data = measured.frf.data.copy()
+    hz = measured.frf.frequency.hz
+    data[(hz > 1000.0) & (hz < 1100.0)] = 0.0
+    holed = attrs.evolve(measured, frf=attrs.evolve(measured.frf, data=data))
+    with pytest.raises(InvalidValueError, match=r"measured FRF tool.tip:y / tool.tip:y: 0 of its \d+ lines in the band "
+                                                r"1010-1090 Hz hold a value"):
+        diagnose(model, [holed], band=(1010.0, 1090.0), progress=False)

@@ -73,11 +73,11 @@ def _catalogue(effects) -> dict:
 def _comparisons(lik: Likelihood, ratios, floors, settings: DiagnoseSettings = DEFAULT_SETTINGS
                  ) -> tuple[Comparison, ...]:
     out = []
-    for m, r, floor in zip(lik.measured, ratios, floors):
+    for m, r, floor, alive in zip(lik.measured, ratios, floors, lik.alive):
         measured = m.frf
         model = FRF(measured.frequency, (measured.data[:, 0, 0] * np.exp(r))[:, None, None], measured.outputs,
                     measured.inputs)
-        out.append(Comparison(model=model, measured=measured, error=float(np.sqrt(np.mean(np.abs(r) ** 2))),
+        out.append(Comparison(model=model, measured=measured, error=float(np.sqrt(np.mean(np.abs(r[alive]) ** 2))),
                               noise_floor=floor, frac=frac(model, measured),
                               modes=_pairs(model, measured, floor, settings),
                               bands=error_bands(model, measured, settings.error_bands_share, floor=floor,
@@ -101,10 +101,6 @@ def _peak_lines(baseline, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> np.n
             i = int(np.argmin(np.abs(hz - p.measured_hz)))
             keep += range(max(0, i - settings.peak_lines), min(hz.size, i + settings.peak_lines + 1))
     return np.unique(np.array(keep, dtype=int))
-
-
-def _rms(ratios) -> float:
-    return float(np.sqrt(np.mean(np.concatenate([np.abs(r) ** 2 for r in ratios]))))
 
 
 def _passive(lik: Likelihood, changes) -> bool:
@@ -231,10 +227,11 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     _refuse_rotations(measurements)
     measured, band = measured_frfs(measurements, band)
     lik = Likelihood(assembly, measured)
-    floors = [m.noise.floor for m in measured]
-    floor = float(np.sqrt(np.mean(np.concatenate([m.noise.var_re + m.noise.var_im for m in measured]))))
+    floors = lik.floors()
+    floor = float(np.sqrt(np.mean(np.concatenate([(m.noise.var_re + m.noise.var_im)[a]
+                                                  for m, a in zip(measured, lik.alive)]))))
     base_ratios = lik.log_ratios([])
-    e0 = _rms(base_ratios)
+    e0 = lik.rms(base_ratios)
     chi2_now = float(lik.whiten(base_ratios) @ lik.whiten(base_ratios))
     n = lik.n
     cons = consistency(lik, base_ratios, 0)
@@ -255,20 +252,20 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     steps = [Step(0, None, e0, chi2_now / n)]
     for k, (result, added, stat, threshold) in enumerate(outcome.history, start=1):
         values = next(v for c, v in result.changes if c is added)
-        steps.append(Step(k, Found(added, values, _std_of(result, added)), _rms(lik.log_ratios(result.changes)),
+        steps.append(Step(k, Found(added, values, _std_of(result, added)), lik.rms(lik.log_ratios(result.changes)),
                           result.chi2_reduced, stat, threshold))
-    first = [Candidate(Found(s.change, s.values, s.fit.std[-1]), _rms(lik.log_ratios(s.fit.changes)), s.chi2, True,
+    first = [Candidate(Found(s.change, s.values, s.fit.std[-1]), lik.rms(lik.log_ratios(s.fit.changes)), s.chi2, True,
                        s.fit.nfev) for s in outcome.first_fitted]
     done = {s.change.key for s in outcome.first_fitted}
     for s in outcome.first_scored:
         if s.change.key not in done:
             r = lik.log_ratios([(s.change, s.values)])
             w = lik.whiten(r)
-            first.append(Candidate(Found(s.change, s.values), _rms(r), float(w @ w), False))
+            first.append(Candidate(Found(s.change, s.values), lik.rms(r), float(w @ w), False))
     final_fit = outcome.fit
     final_ratios = lik.log_ratios(current)
     cons = consistency(lik, final_ratios, p_now)
-    final_error = _rms(final_ratios)
+    final_error = lik.rms(final_ratios)
     explained = bool(cons.consistent and final_error <= settings.explained_error_factor * floor)
     hits = bound_hits(current, final_fit)
     final_effects = tuple(Found(c, v, {k: x for k, x in (final_fit.std[i] if final_fit else {}).items()
@@ -282,7 +279,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     if missing is not None:
         for c, v, chi2 in outcome.alternatives.get(missing.change.key, []):
             alt = [(c, v) if x is missing.change else (x, y) for x, y in current]
-            ambiguous.append((Found(c, v), _rms(lik.log_ratios(alt))))
+            ambiguous.append((Found(c, v), lik.rms(lik.log_ratios(alt))))
     names = tuple(dict.fromkeys(a.name for a, _ in ambiguous))
     sep = None
     if missing is not None and ambiguous:
@@ -325,14 +322,16 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
                                  for r in search.get("held_back", []) if not r["predicts"]]
     if search["cut"] and not explained:
         report = list(report) + [words.budget_cut(search["cut_at"])]
-    for m in lik.measured:  # a fact of the data, whatever the verdict
+    for m, alive in zip(lik.measured, lik.alive):  # facts of the data, whatever the verdict
+        which, hz = getattr(m.measurement, "describe", lambda: m.label)(), m.frf.frequency.hz
         tau = getattr(m.measurement, "window_tau", None)
         if tau is not None:
-            hz = m.frf.frequency.hz
-            report = list(report) + [words.windowed(m.measurement.describe(), tau, float(hz[0]), float(hz[-1]))]
+            report = list(report) + [words.windowed(which, tau, float(hz[0]), float(hz[-1]))]
+        if not alive.all():
+            report = list(report) + [words.empty_lines(which, hz[~alive])]
         if getattr(m.measurement, "estimator", None) == "H2":
-            report = list(report) + [words.estimated_as_h2(m.measurement.describe(),
-                                                           getattr(m.measurement, "coherence", None) is not None)]
+            corrected = getattr(m.measurement, "coherence", None) is not None
+            report = list(report) + [words.estimated_as_h2(which, corrected)]
     return Diagnosis(
         verdict=Verdict(explained=explained, report=tuple(report),
                         missing_effect=None if missing is None else missing.name,

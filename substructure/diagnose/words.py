@@ -245,6 +245,26 @@ def windowed(which: str, tau: float, lo_hz: float, hi_hz: float) -> str:
             "die out need no window)")
 
 
+def empty_lines(which: str, hz) -> str:
+    """The note that a measurement holds nothing on some lines of the band (zero or not finite), left out.
+
+    Parameters
+    ----------
+    which : str
+        The measurement (``response / excitation``).
+    hz : array of float
+        The frequencies of those lines [Hz].
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    shown = ", ".join(f"{f:.6g}" for f in hz[:3]) + (", ..." if len(hz) > 3 else "")
+    return (f"{which} holds no value on {len(hz)} line{'s' if len(hz) != 1 else ''} of the band ({shown} Hz: zero "
+            "or not finite, a dropout or lines an analyser left empty): left out of every comparison")
+
+
 def estimated_as_h2(which: str, compared_as_h1: bool) -> str:
     """The note that a measurement is an H2 estimate, and how the diagnosis took it.
 

@@ -142,6 +142,11 @@ def measured_frfs(measurements, band=None) -> tuple[list[Measured], tuple[float,
         if mask.sum() < 10:
             raise InvalidValueError(f"band: {lo:g}-{hi:g} Hz holds {int(mask.sum())} lines of {label}; "
                                     "at least 10 are needed")
+        held = int(np.sum(mask & np.isfinite(h) & (h != 0)))
+        if held < 10:
+            raise InvalidValueError(f"measured FRF {where}: {held} of its {int(mask.sum())} lines in the band "
+                                    f"{lo:g}-{hi:g} Hz hold a value (the others are zero or not finite); at least "
+                                    "10 are needed")
         out.append(Measured(label, frf.crop(lo, hi), noise.select(mask), m))
     return out, (lo, hi)
 
@@ -232,9 +237,14 @@ class Likelihood:
             groups.setdefault(m.configuration, []).append((i, m))
         self.groups = [_Group(assembly, items, self.lines) for items in groups.values()]
         self.data = [m.frf.data[self.lines, 0, 0] for m in self.measured]
-        self.w_re = [1.0 / np.sqrt(m.noise.var_re[self.lines]) for m in self.measured]
-        self.w_im = [1.0 / np.sqrt(m.noise.var_im[self.lines]) for m in self.measured]
-        self.n = 2 * sum(d.size for d in self.data)
+        # the lines each FRF holds: a line of zero or not finite (a dropout, a line an analyser left empty) says
+        # nothing of the structure, and is left out (no weight, no degree of freedom, no share of an error)
+        self.alive = [np.isfinite(d) & (d != 0) for d in self.data]
+        self.w_re = [np.where(a, 1.0 / np.sqrt(m.noise.var_re[self.lines]), 0.0)
+                     for m, a in zip(self.measured, self.alive)]
+        self.w_im = [np.where(a, 1.0 / np.sqrt(m.noise.var_im[self.lines]), 0.0)
+                     for m, a in zip(self.measured, self.alive)]
+        self.n = 2 * sum(int(a.sum()) for a in self.alive)
         self.evaluations = 0
         self._check_signs()
         self.evaluations = 0  # the check's evaluation is not the caller's
@@ -342,9 +352,35 @@ class Likelihood:
         """
         return self._ratios(self.predict(changes))
 
+    def rms(self, ratios: Sequence[np.ndarray]) -> float:
+        """The RMS of log ratios over the lines the data hold (:attr:`alive`).
+
+        Parameters
+        ----------
+        ratios : sequence of ndarray
+            Log ratios per measured FRF (:meth:`log_ratios`).
+
+        Returns
+        -------
+        float
+            ``sqrt(mean |r|^2)``.
+        """
+        return float(np.sqrt(np.mean(np.concatenate([np.abs(r[a]) ** 2 for r, a in zip(ratios, self.alive)]))))
+
+    def floors(self) -> list[float]:
+        """Per measured FRF, the RMS log ratio a perfect model would show on the lines it holds.
+
+        Returns
+        -------
+        list of float
+            ``sqrt(mean(v_re + v_im))`` over its :attr:`alive` lines.
+        """
+        return [float(np.sqrt(np.mean((m.noise.var_re + m.noise.var_im)[self.lines][a])))
+                for m, a in zip(self.measured, self.alive)]
+
     def _ratios(self, predicted: list) -> list[np.ndarray]:
         out = []
-        for model, data in zip(predicted, self.data):
+        for model, data, alive in zip(predicted, self.data, self.alive):
             with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
                 q = model / data
                 # ln|q| + i arg q: the complex logarithm's value (to rounding), several times faster than np.log
@@ -354,6 +390,8 @@ class Likelihood:
             bad = ~np.isfinite(r)
             if bad.any():
                 r = np.where(bad, LOG_RATIO_PENALTY * (1 + 1j), r)
+            if not alive.all():  # a line without data: no residual
+                r = np.where(alive, r, 0.0)
             out.append(r)
         return out
 

@@ -187,16 +187,18 @@ def consistency(likelihood, ratios: Sequence[np.ndarray], p: int) -> Consistency
     Consistency
         The verdict and where the residual is too large.
     """
-    z2 = [m.noise.line_scores(r, likelihood.lines) for r, m in zip(ratios, likelihood.measured)]
+    alive = likelihood.alive  # the lines each FRF holds (no score where it holds nothing)
+    z2 = [m.noise.line_scores(r, likelihood.lines)[a] for r, m, a in zip(ratios, likelihood.measured, alive)]
     n = 2 * sum(z.size for z in z2)
     nu = max(n - p, 1)
     chi2 = 2.0 * sum(float(z.sum()) for z in z2)
     sizes = np.array([z.size for z in z2], dtype=float)
     errs = np.array([m.noise.scale_error for m in likelihood.measured])
-    e = float(np.sqrt(np.sum((sizes * errs) ** 2)) / sizes.sum())
+    e = float(np.sqrt(np.sum((sizes * errs) ** 2)) / max(sizes.sum(), 1.0))
     threshold = 1.0 + _Z * math.sqrt(2.0 / nu + e * e)
     reduced = chi2 / nu
-    dofs = [None if m.noise.dof is None else m.noise.dof[likelihood.lines] for m in likelihood.measured]
+    dofs = [None if m.noise.dof is None else m.noise.dof[likelihood.lines][a] for m, a in zip(likelihood.measured,
+                                                                                             alive)]
     if any(d is not None and np.isfinite(d).any() for d in dofs):
         # lines whose variance is estimated (F(2, nu) scores, heavy-tailed: infinite variance for nu <= 4)
         # enter capped, against the capped scores' mean and variance; the others as they are
@@ -213,7 +215,7 @@ def consistency(likelihood, ratios: Sequence[np.ndarray], p: int) -> Consistency
     blocks = []
     for item, (z, m) in enumerate(zip(z2, likelihood.measured)):
         size = max(20, int(round(0.02 * z.size)))
-        f = m.frf.frequency.hz[likelihood.lines]
+        f = m.frf.frequency.hz[likelihood.lines][alive[item]]
         starts = list(range(0, z.size, size))
         if len(starts) > 1 and z.size - starts[-1] < size // 2:  # a short last block joins the one before
             starts.pop()
