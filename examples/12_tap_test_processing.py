@@ -18,7 +18,9 @@ package: 25.6 kHz, 1 s each) through ``substructure.tap``:
 (d) the result written as a CSV file with a coherence column and a
     measurement set that ``substructure identify`` and ``diagnose`` read;
 (e) the same taps as an acquisition system exports them, all in one
-    universal file, read back tap by tap.
+    universal file, read back tap by tap;
+(f) the three estimators of the same taps, and why a diagnosis compares
+    an H2 as the H1 of its taps.
 
 Figures are written to $SUBSTRUCTURE_EXAMPLES_OUT (default: out/examples).
 """
@@ -37,6 +39,7 @@ from substructure.datasets import impact_records
 from substructure.io.frf_files import write_csv
 from substructure.io.measurements import load_measurements
 from substructure.io.tap_files import read_taps_uff
+from substructure.measurements import Measurement
 from substructure.plot import plot_taps
 from substructure.tap import TapRecord, process_taps
 
@@ -149,3 +152,38 @@ print(f"{uff_path.name}: {len(taps)} taps, {taps[0].sample_rate:g} Hz, response 
 from_file = process_taps(taps)
 close = np.allclose(from_file.frf.data, result.frf.data, rtol=1e-5, atol=1e-6 * np.abs(result.frf.data).max())
 print(f"{from_file.averages} taps averaged; the FRF equals the one from the arrays (to the file's 6 digits): {close}")
+
+# %%
+# (f) H1, H2 and Hv
+# -----------------
+# H1 = Gfx/Gff is unbiased by the response's noise, H2 = Gxx/Gxf by the
+# force's, and Hv (total least squares) lies between them.  Of one set of
+# spectra, H1 = gamma^2 H2 exactly: where the coherence is low, H2 lies
+# above the FRF by 1/gamma^2, a bias more taps do not remove.  A
+# measurement set written by ``substructure tap`` says which estimator it
+# holds (``estimator``), and the diagnosis and the fits compare an H2 that
+# carries its coherence as ``gamma^2 H2`` (``Measurement.h1_frf``): the
+# H1 of the same taps.
+h1, h2, hv = (process_taps(records, e) for e in ("H1", "H2", "Hv"))
+low = band & (result.coherence < 0.99)
+print(f"{low.sum()} lines of 20 Hz - 5 kHz with a coherence below 0.99; there |H2/H1| reaches "
+      f"{np.abs(h2.frf.data[low, 0, 0] / h1.frf.data[low, 0, 0]).max():.3g}")
+between = np.all(np.abs(h1.frf.data) <= np.abs(hv.frf.data) * (1 + 1e-9)) and \
+    np.all(np.abs(hv.frf.data) <= np.abs(h2.frf.data) * (1 + 1e-9))
+print(f"|H1| <= |Hv| <= |H2| on every line: {between}")
+as_h2 = Measurement.from_frf(h2.frf, "tool.tip", "tool.tip", coherence=h2.coherence, averages=h2.averages,
+                             estimator="H2")
+same = np.allclose(as_h2.h1_frf.data, h1.frf.data, rtol=1e-9, atol=0.0)
+print(f"the H2 measurement compared as gamma^2 H2 equals H1: {same}")
+fig, (ax, ax_c) = plt.subplots(2, 1, figsize=(7, 5), sharex=True)
+for name, r in (("H2", h2), ("Hv", hv), ("H1", h1)):
+    ax.semilogy(hz[band], np.abs(r.frf.data[band, 0, 0]), lw=0.8, label=name)
+ax_c.plot(hz[band], result.coherence[band], lw=0.8, color="k")
+ax.set_xlim(2500, 3800)  # a band of low coherence between two modes
+ax.set_ylabel("|receptance| [m/N]")
+ax_c.set_ylabel("coherence")
+ax_c.set_xlabel("frequency [Hz]")
+ax.legend()
+ax.set_title("three estimators of the same taps: apart where the coherence is low")
+save(fig, "12_estimators.png")
+

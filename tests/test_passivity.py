@@ -29,6 +29,8 @@ def test_the_share_of_a_closed_form_driving_point():
     h_nan = h.copy()
     h_nan[3] = np.nan
     assert reversed_share(h_nan) == 0.0  # a line that is not finite is left out
+    with pytest.raises(InvalidValueError, match="receptance: got str; expected an array of complex values"):
+        reversed_share("tool.tip")
 
 
 def test_noise_alone_stays_far_from_the_threshold():

@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InvalidValueError
+
 __all__ = ["reversed_share", "REVERSED_SHARE"]
 
 REVERSED_SHARE = 0.8
@@ -38,8 +40,18 @@ def reversed_share(receptance) -> float:
         0 for a passive structure's FRF (noise adds a little near its
         antiresonances), 1 for one whose sign is reversed; NaN when no line
         has an imaginary part.
+
+    Raises
+    ------
+    InvalidValueError
+        For values that are not numbers.
     """
-    imag = np.imag(np.asarray(receptance, dtype=complex).reshape(-1))
+    try:
+        values = np.asarray(receptance, dtype=complex).reshape(-1)
+    except (TypeError, ValueError):
+        raise InvalidValueError(f"receptance: got {type(receptance).__name__}; expected an array of complex values "
+                                "(one driving point's receptance per line)") from None
+    imag = np.imag(values)
     imag = imag[np.isfinite(imag)]
     total = float(np.sum(np.abs(imag)))
     return float(np.sum(imag[imag > 0.0]) / total) if total > 0.0 else float("nan")

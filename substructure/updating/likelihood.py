@@ -225,6 +225,12 @@ class Likelihood:
         The data (:func:`measured_frfs`).
     lines : ndarray of int, optional
         Indices of the lines to use (default all): a subsample for screening.
+
+    Attributes
+    ----------
+    alive : list of ndarray of bool
+        Per measured FRF, on ``lines``: the lines it holds a value on (not
+        zero, finite).  The others are left out of every comparison.
     """
 
     def __init__(self, assembly, measured: Sequence[Measured], lines: np.ndarray | None = None):
@@ -353,7 +359,7 @@ class Likelihood:
         return self._ratios(self.predict(changes))
 
     def rms(self, ratios: Sequence[np.ndarray]) -> float:
-        """The RMS of log ratios over the lines the data hold (:attr:`alive`).
+        """The RMS of log ratios over the lines the data hold (``alive``).
 
         Parameters
         ----------
@@ -373,7 +379,7 @@ class Likelihood:
         Returns
         -------
         list of float
-            ``sqrt(mean(v_re + v_im))`` over its :attr:`alive` lines.
+            ``sqrt(mean(v_re + v_im))`` over its ``alive`` lines.
         """
         return [float(np.sqrt(np.mean((m.noise.var_re + m.noise.var_im)[self.lines][a])))
                 for m, a in zip(self.measured, self.alive)]
