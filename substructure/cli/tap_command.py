@@ -13,11 +13,11 @@ from ._common import UsageError, band_range_arg, check_outputs, check_plot, figu
 
 _TEXT_SUFFIXES = (".csv", ".txt", ".dat", ".asc")
 _UFF_SUFFIXES = (".uff", ".unv", ".uf")
-_RECORD_SUFFIXES = _TEXT_SUFFIXES + (".lvm", ".mat") + _UFF_SUFFIXES
+_RECORD_SUFFIXES = _TEXT_SUFFIXES + (".lvm", ".mat", ".tdms") + _UFF_SUFFIXES
 
 
 def _read(path: str, args: argparse.Namespace) -> list:
-    from ..io.tap_files import read_tap_csv, read_tap_lvm, read_taps_mat, read_tap_uff, read_taps_uff
+    from ..io.tap_files import read_tap_csv, read_tap_lvm, read_tap_tdms, read_taps_mat, read_tap_uff, read_taps_uff
 
     suffix = Path(path).suffix.lower()
     columns = dict(sample_rate=args.sample_rate, force_column=args.force_column,
@@ -37,6 +37,8 @@ def _read(path: str, args: argparse.Namespace) -> list:
                          f"not columns of {path} (use --force-column and --response-column)")
     if suffix == ".mat":
         return read_taps_mat(path, args.sensitivity, args.hammer_sensitivity, args.quantity, **columns)
+    if suffix == ".tdms":
+        return read_tap_tdms(path, args.sensitivity, args.hammer_sensitivity, args.quantity, **columns)
     if suffix == ".lvm":
         return read_tap_lvm(path, args.sensitivity, args.hammer_sensitivity, args.quantity, **columns)
     return [read_tap_csv(path, args.sensitivity, args.hammer_sensitivity, args.quantity, **columns)]
@@ -69,7 +71,8 @@ def run(args: argparse.Namespace) -> int:
     for path in args.records:
         if Path(path).suffix.lower() not in _RECORD_SUFFIXES:
             raise UsageError(f"{path}: expected a tap record in a .csv, .uff or .unv file (or text in .txt, "
-                             ".dat or .asc, a LabVIEW .lvm file, a MATLAB .mat file, a .uf universal file)")
+                             ".dat or .asc, a LabVIEW .lvm file, an NI .tdms file, a MATLAB .mat file, a .uf "
+                             "universal file)")
     if args.out and Path(args.out).suffix.lower() != ".csv":
         raise UsageError(f"argument --out: {args.out!r}: expected a .csv file (frequency_hz,real,imag,coherence)")
     if args.measurements:
@@ -188,7 +191,8 @@ def add_parser(commands) -> None:
     tap = commands.add_parser("tap", help="time records of hammer taps to an FRF with coherence")
     tap.add_argument("records", nargs="+", metavar="RECORD",
                      help="tap records: CSV or text (time [s],force [N],acceleration [m/s^2], a preamble "
-                     "allowed), LabVIEW .lvm, MATLAB .mat (vectors, or matrices of a tap a column, with "
+                     "allowed), LabVIEW .lvm, NI .tdms (a group of channels per tap, units in unit_string), "
+                     "MATLAB .mat (vectors, or matrices of a tap a column, with "
                      "<name>_unit texts), or UFF type-58 time records (a force and a response record per tap)")
     tap.add_argument("--out", metavar="FRF.csv", help="write the receptance with its coherence column")
     tap.add_argument("--measurements", metavar="SET.toml", help="write a measurement set naming --out")
@@ -205,13 +209,15 @@ def add_parser(commands) -> None:
     tap.add_argument("--hammer-sensitivity", metavar="VALUE",
                      help="hammer sensitivity for a force channel in volts, e.g. '2.25 mV/N'")
     tap.add_argument("--sample-rate", metavar="VALUE",
-                     help="text and .mat records without a time column: samples per second, e.g. '51.2 kHz' "
+                     help="text, .tdms and .mat records without a time column: samples per second, e.g. '51.2 kHz' "
                      "(refused when the file states another rate)")
     tap.add_argument("--force-column", metavar="NAME|INDEX",
-                     help="text, .lvm and .mat records: the force column (or vector) by name or 1-based index, "
+                     help="text, .lvm, .tdms and .mat records: the force column (channel, vector) by name or "
+                     "1-based index, "
                      "when the file has more than one candidate")
     tap.add_argument("--response-column", metavar="NAME|INDEX",
-                     help="text, .lvm and .mat records: the response column (or vector) by name or 1-based index "
+                     help="text, .lvm, .tdms and .mat records: the response column (channel, vector) by name or "
+                     "1-based index "
                      "(a second accelerometer, a trigger channel)")
     tap.add_argument("--force-record", type=int, metavar="N",
                      help="UFF: 0-based index of the force record (one tap; default: every tap of the file)")

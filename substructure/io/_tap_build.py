@@ -15,6 +15,11 @@ from ._tap_columns import Columns
 
 RESPONSES = ("acceleration", "velocity", "displacement")
 
+MAX_RECORD_BYTES = 2**29
+"""The largest tap record file read (512 MiB: minutes of three channels at 51.2 kHz written as text; the
+reading needs about four times the file's size in memory, so a larger file is refused rather than let run
+the machine out of memory)."""
+
 
 def check_quantity_option(quantity: str | None, found: str, where: str) -> None:
     if quantity is None:

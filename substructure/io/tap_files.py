@@ -13,6 +13,10 @@ type 13) or whose unit label is a force, the response the record of
 displacement, velocity or acceleration (types 8, 11, 12) or whose unit
 label says so; ``force_record`` and ``response_record`` choose them by index
 when a file holds more.
+
+TDMS (NI's acquisition): channels found by their ``unit_string`` as columns
+are, the time step from ``wf_increment``; :func:`read_tap_tdms`, in
+``_tap_tdms``.
 """
 
 from __future__ import annotations
@@ -29,17 +33,16 @@ from ..tap.records import RESPONSE_QUANTITIES, TIME_STEP_TOLERANCE, TapRecord, c
 from . import check_readable_file, read_bytes
 from ._tap_columns import (MAX_PREAMBLE_LINES, NO_UNIT, Columns, choose, header_cells, is_row, is_unit_row,
                            line_separator, name_and_unit, rate_from_lines)
-from ._tap_build import (RESPONSES, ROUNDED_TIME_TOLERANCE, build_record, check_quantity_option, option_rate,
-                         quantity_of, regular, time_axis, units_of_columns)
+from ._tap_build import (MAX_RECORD_BYTES, RESPONSES, ROUNDED_TIME_TOLERANCE, build_record, check_quantity_option,
+                         option_rate, quantity_of, regular, time_axis, units_of_columns)
 from ._tap_table import finite_rows, parse_rows
+from ._tap_tdms import read_tap_tdms
 
-__all__ = ["read_tap_csv", "read_tap_lvm", "read_tap_mat", "read_taps_mat", "read_tap_uff", "read_taps_uff",
+__all__ = ["read_tap_csv", "read_tap_lvm", "read_tap_mat", "read_taps_mat", "read_tap_tdms", "read_tap_uff",
+           "read_taps_uff",
            "MAX_RECORD_BYTES", "ROUNDED_TIME_TOLERANCE"]
 
-MAX_RECORD_BYTES = 2**29
-"""The largest tap record file read (512 MiB: minutes of three channels at 51.2 kHz written as text; the
-reading needs about four times the file's size in memory, so a larger file is refused rather than let run
-the machine out of memory)."""
+
 def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensitivity: Any = None,
                  quantity: str | None = None, sample_rate: Any = None, force_column: Any = None,
                  response_column: Any = None) -> TapRecord:
