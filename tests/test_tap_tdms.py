@@ -147,3 +147,29 @@ def test_the_command_reads_a_tdms_file(records, tmp_path, capsys):
     b = process_taps(records).frf
     written = read_csv(tmp_path / "frf.csv").data
     np.testing.assert_allclose(written, b.data, rtol=1e-9, atol=1e-12 * np.abs(b.data).max())
+
+
+def test_time_stamps_text_and_integer_channels(records, tmp_path):
+    """A logger's clock as time stamps (read as seconds from the first), a channel of text beside the samples
+    (not a candidate), the force as int16 counts already scaled to N by the writer; a group of text alone is
+    refused by name."""
+    r = records[0]
+    n = 4096
+    clock = (np.arange(n) * 1e9 / r.sample_rate).astype("timedelta64[ns]")
+    stamps = np.datetime64("2026-11-26T10:00:00", "ns") + clock
+    force = np.round(r.force[:n]).astype(np.int16)
+    path = _write(tmp_path / "log.tdms", {"g": [
+        ChannelObject("g", "Timestamp", stamps), ChannelObject("g", "Comment", np.array(["hit"] * n)),
+        ChannelObject("g", "Hammer", force, properties={"unit_string": "N"}),
+        ChannelObject("g", "Acc", r.response[:n].astype(np.float32), properties={"unit_string": "m/s^2"})]})
+    (tap,) = read_tap_tdms(path)
+    assert tap.sample_rate == pytest.approx(r.sample_rate, rel=1e-6)
+    assert tap.time[0] == pytest.approx(0.0, abs=1e-6)  # stamps come to the microsecond: the clock fitted to them
+    np.testing.assert_array_equal(tap.force, force.astype(float))
+    np.testing.assert_allclose(tap.response, r.response[:n], rtol=1e-6)
+    path = _write(tmp_path / "text.tdms", {"notes": [ChannelObject("notes", "Comment", np.array(["a", "b"])),
+                                                     ChannelObject("notes", "Force", np.array([1.0, 2.0]),
+                                                                   properties={"unit_string": "N"})]})
+    with pytest.raises(FileFormatError, match=r"group 'notes': 1 channel of numbers \(Comment, Force\); expected a "
+                                              r"force and a response channel"):
+        read_tap_tdms(path)

@@ -100,9 +100,27 @@ def _unit(channel) -> str | None:
     return None
 
 
+def _numeric(channel) -> tuple[np.ndarray, str | None] | None:
+    """A channel's samples as floats with its unit; a time stamp channel in s from its first sample; None for
+    a channel of text or other data (not a candidate)."""
+    values = np.asarray(channel[:])
+    if values.dtype.kind == "M":  # time stamps (a logger's clock): seconds from the first
+        return (values - values[0]) / np.timedelta64(1, "s"), "s"
+    if values.dtype.kind in "biuf":
+        return values.astype(np.float64, copy=False), _unit(channel)
+    return None
+
+
 def _group_record(name: str, where: str, source: str, channels: list, sensitivity: Any, hammer_sensitivity: Any,
                   quantity: str | None, sample_rate: Any, force_column: Any, response_column: Any) -> TapRecord:
-    columns = Columns([c.name for c in channels], [_unit(c) for c in channels], None)
+    read = [(c, _numeric(c)) for c in channels]
+    kept = [(c, got) for c, got in read if got is not None]
+    if len(kept) < 2:
+        raise FileFormatError(f"{where}: {len(kept)} channel{'s' if len(kept) != 1 else ''} of numbers "
+                              f"({', '.join(c.name for c in channels)}); expected a force and a response channel")
+    channels = [c for c, _ in kept]
+    samples = [got[0] for _, got in kept]
+    columns = Columns([c.name for c in channels], [got[1] for _, got in kept], None)
     steps = {float(c.properties["wf_increment"]) for c in channels if "wf_increment" in c.properties}
     if len(steps) > 1:
         raise FileFormatError(f"{where}: the channels' time steps (wf_increment) differ: "
@@ -134,7 +152,7 @@ def _group_record(name: str, where: str, source: str, channels: list, sensitivit
     if len(lengths) > 1:
         raise FileFormatError(f"{where}: channels of {', '.join(str(len(channels[k])) for k in used)} samples "
                               f"({', '.join(labels[k] for k in used)}); expected one length")
-    data = {k: np.asarray(channels[k][:], dtype=np.float64) for k in used}
+    data = {k: samples[k] for k in used}
     for k in used:
         bad = np.flatnonzero(~np.isfinite(data[k]))
         if bad.size:
