@@ -103,6 +103,8 @@ def test_the_sample_rate_comes_from_wf_increment_or_the_option(records, tmp_path
     ("nan", r"group 'g': channel 'acc \[m/s\^2\]', sample 11 is nan; expected a finite number"),
     ("quantity", r"holds an acceleration, and the quantity option says velocity"),
     ("empty", r"no channel with data"),
+    ("text step", r"group 'g': channel 'acc': wf_increment 'fast'; expected a time step in s"),
+    ("zero step", r"group 'g': channel 'acc': wf_increment 0.0 s; expected a time step > 0"),
 ])
 def test_errors_name_the_file_the_group_and_the_channel(records, tmp_path, case, message):
     r = records[0]
@@ -118,6 +120,8 @@ def test_errors_name_the_file_the_group_and_the_channel(records, tmp_path, case,
     elif case == "nan":
         acc[10] = np.nan
         channels[1] = _channel("g", "acc", acc, "m/s^2", dt)
+    elif case in ("text step", "zero step"):
+        channels[1] = _channel("g", "acc", acc, "m/s^2", wf_increment="fast" if case == "text step" else 0.0)
     elif case == "empty":
         channels = [_channel("g", "force", [], "N")]
     path = _write(tmp_path / "bad.tdms", {"g": channels})
@@ -173,3 +177,20 @@ def test_time_stamps_text_and_integer_channels(records, tmp_path):
     with pytest.raises(FileFormatError, match=r"group 'notes': 1 channel of numbers \(Comment, Force\); expected a "
                                               r"force and a response channel"):
         read_tap_tdms(path)
+
+
+@pytest.mark.parametrize("force_unit, response_unit, scale_f, scale_r, options", [
+    ("Newtons", "MetersPerSecondSquared", 1.0, 1.0, {}),
+    ("Pounds", "g", 1.0 / 4.4482216152605, 1.0 / G, {}),
+    ("Volts", "Volts", 2.25e-3, 10.2e-3 / G, {"hammer_sensitivity": "2.25 mV/N", "sensitivity": "10.2 mV/g"}),
+])
+def test_units_as_ni_writes_them(records, tmp_path, force_unit, response_unit, scale_f, scale_r, options):
+    """DAQmx and LabVIEW name units in words (Newtons, Volts, MetersPerSecondSquared); read as N, V, m/s^2."""
+    r = records[1]
+    dt = 1.0 / r.sample_rate
+    path = _write(tmp_path / "ni.tdms", {"Hammer test": [
+        _channel("Hammer test", "Dev1/ai0", r.force * scale_f, force_unit, dt),
+        _channel("Hammer test", "Dev1/ai1", r.response * scale_r, response_unit, dt)]})
+    (tap,) = read_tap_tdms(path, force_column=1, response_column=2, **options)
+    np.testing.assert_allclose(tap.force, r.force, rtol=1e-12)
+    np.testing.assert_allclose(tap.response, r.response, rtol=1e-12)

@@ -36,6 +36,21 @@ _SAMPLES_PER_SECOND = re.compile(r"^(s/s|sa/s|samples?/s|samples? per second|sps
 _TIME_NAME = re.compile(r"^(time|t|zeit|temps|tiempo|x_value)$", re.I)
 NO_UNIT = ("", "-", "--", "n/a", "none")
 """Cells of a row of units that say a column has none (a trigger, a status)."""
+_UNIT_WORDS = {"volts": "V", "volt": "V", "millivolts": "mV", "newtons": "N", "newton": "N", "kilonewtons": "kN",
+               "pounds": "lbf", "kilogramforce": "kgf", "seconds": "s", "second": "s", "sec": "s",
+               "meterspersecondsquared": "m/s^2", "metrespersecondsquared": "m/s^2", "inchespersecondsquared": "in/s^2",
+               "meterspersecond": "m/s", "metrespersecond": "m/s", "inchespersecond": "in/s"}
+
+
+def unit_label(label: str) -> str | None:
+    """A unit as NI's software writes it (``Volts``, ``Newtons``, ``MetersPerSecondSquared``) in the form pint
+    reads; None for no unit (empty, ``None``, ``EU``: engineering units not named, ``-``)."""
+    label = label.strip()
+    if not label or label.lower() in ("none", "eu", "-"):
+        return None
+    return _UNIT_WORDS.get(label.lower().replace(" ", ""), label)
+
+
 _FORCE_NAME = re.compile(r"\b(force|hammer|kraft|impact)", re.I)
 
 

@@ -19,13 +19,11 @@ import attrs
 import numpy as np
 
 from ..errors import FileFormatError, SubstructureWarning
-from ._tap_columns import Columns, is_number, name_and_unit
+from ._tap_columns import Columns, is_number, name_and_unit, unit_label
 from ._tap_table import parse_rows
 
 _MARK = b"***End_of_Header***"
 _TAG_LINE = re.compile(rb"^[ \t]*(?![-+]?(?:nan|inf)(?:inity)?\b)[A-Za-z_*]", re.M | re.I)  # not NaN, Inf
-_UNIT_WORDS = {"volts": "V", "volt": "V", "millivolts": "mV", "newtons": "N", "newton": "N", "seconds": "s",
-               "second": "s", "sec": "s"}
 
 
 @attrs.frozen
@@ -66,13 +64,6 @@ def _number(text: str, decimal_comma: bool, where: str) -> float:
         return float(text.replace(",", ".") if decimal_comma else text)
     except ValueError:
         raise FileFormatError(f"{where} is {text!r}; expected a number") from None
-
-
-def _unit(label: str) -> str | None:
-    label = label.strip()
-    if not label or label.lower() in ("none", "eu", "-"):
-        return None
-    return _UNIT_WORDS.get(label.lower(), label)
 
 
 def read_segments(data: bytes, name: str) -> list[Segment]:
@@ -153,7 +144,7 @@ def read_segments(data: bytes, name: str) -> list[Segment]:
                     raise FileFormatError(f"{where}: X_Value {float(table[worst, j])!r} on row {worst + 1} where "
                                           f"X0 + n Delta_X is {float(expected[worst])!r}; expected the x column of a "
                                           "uniform time axis")
-        units = [_unit(u) for u in tags.get("Y_Unit_Label", [])]
+        units = [unit_label(u) for u in tags.get("Y_Unit_Label", [])]
         channel_names, channel_units = [], []
         for pos, j in enumerate(keep):
             plain, unit = name_and_unit(names[j])

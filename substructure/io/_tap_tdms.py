@@ -20,7 +20,7 @@ from ..errors import FileFormatError
 from ..tap.records import TapRecord
 from . import check_readable_file
 from ._tap_build import MAX_RECORD_BYTES, build_record, option_rate, time_axis, units_of_columns
-from ._tap_columns import Columns, choose
+from ._tap_columns import Columns, choose, unit_label
 
 __all__ = ["read_tap_tdms"]
 
@@ -95,9 +95,22 @@ def read_tap_tdms(path: str | os.PathLike, sensitivity: Any = None, hammer_sensi
 def _unit(channel) -> str | None:
     for key in UNIT_PROPERTIES:
         value = channel.properties.get(key)
-        if isinstance(value, str) and value.strip():
-            return value.strip()
+        if isinstance(value, str) and unit_label(value):
+            return unit_label(value)
     return None
+
+
+def _step(channel, where: str) -> float:
+    value = channel.properties["wf_increment"]
+    try:
+        step = float(value)
+    except (TypeError, ValueError):
+        raise FileFormatError(f"{where}: channel {channel.name!r}: wf_increment {value!r}; expected a time step in "
+                              "s") from None
+    if not (np.isfinite(step) and step > 0):
+        raise FileFormatError(f"{where}: channel {channel.name!r}: wf_increment {value!r} s; expected a time step "
+                              "> 0")
+    return step
 
 
 def _numeric(channel) -> tuple[np.ndarray, str | None] | None:
@@ -121,17 +134,14 @@ def _group_record(name: str, where: str, source: str, channels: list, sensitivit
     channels = [c for c, _ in kept]
     samples = [got[0] for _, got in kept]
     columns = Columns([c.name for c in channels], [got[1] for _, got in kept], None)
-    steps = {float(c.properties["wf_increment"]) for c in channels if "wf_increment" in c.properties}
+    steps = {_step(c, where) for c in channels if "wf_increment" in c.properties}
     if len(steps) > 1:
         raise FileFormatError(f"{where}: the channels' time steps (wf_increment) differ: "
                               f"{', '.join(f'{s:.10g}' for s in sorted(steps))} s; expected one sample rate")
     parsed, dims, errors = units_of_columns(columns, where)
     stated = None
     if steps:
-        step = steps.pop()
-        if not (np.isfinite(step) and step > 0):
-            raise FileFormatError(f"{where}: wf_increment {step!r} s; expected a time step > 0")
-        stated = (1.0 / step, "the channels' wf_increment")
+        stated = (1.0 / steps.pop(), "the channels' wf_increment")
     if sample_rate is not None:
         hz = option_rate(sample_rate)
         if stated is not None and abs(hz - stated[0]) > 1e-6 * stated[0]:
