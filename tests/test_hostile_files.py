@@ -186,13 +186,52 @@ def test_exports_with_units_in_the_header_are_read_and_converted(tmp_path, heade
     ("Frequency [mm],Real [m/N],Imag [m/N]", "not a frequency unit"),
     ("Frequency [Hz],Real [m/N],Imag [mm/N]", "different units"),
     ("Frequency [Hz],Real [N/m],Imag [N/m]", "not that of a receptance"),
-    ("Frequency [Hz],Coherence,Imag", "column 'Coherence'"),
+    ("Frequency [Hz],Coherence,Imag", "in this order"),  # a coherence goes after the FRF's columns
     ("Frequency [Hz],Imag [m/N],Real [m/N]", "in this order"),
 ])
 def test_ambiguous_exports_are_refused_with_what_to_give(tmp_path, header, pattern):
     from substructure.io.frf_files import read_csv
 
     path = _export(tmp_path, header, (HZ, H.real, H.imag))
+    with pytest.raises(FileFormatError, match=pattern):
+        read_csv(path)
+
+
+@pytest.mark.parametrize("header, scale, kw", [
+    ("Frequency [Hz];Real [m/N];Imag [m/N];Coherence", 1.0, {"sep": ";", "decimal": ","}),
+    ("Frequency (Hz)\tMagnitude (m/N)\tPhase (deg)\tCoh (%)", 100.0, {"sep": "\t"}),
+    ("frequency_hz,real [m/N],imag [m/N],gamma^2 [-]", 1.0, {}),
+])
+def test_exports_with_a_coherence_column_carry_it_into_the_measurement(tmp_path, header, scale, kw):
+    """Analysers export the coherence beside the FRF; it is read (in [0, 1], or in % with its unit) and the
+    measurement set gives it to the measurement, as for the package's own files."""
+    from substructure.io.frf_files import read_csv_with_coherence
+
+    gamma = np.linspace(0.5, 1.0, HZ.size)
+    values = (np.abs(H), np.degrees(np.angle(H))) if "Magnitude" in header else (H.real, H.imag)
+    path = _export(tmp_path, header, (HZ, *values, gamma * scale), **kw)
+    frf, coherence = read_csv_with_coherence(path)
+    np.testing.assert_allclose(coherence, gamma, rtol=1e-12)
+    np.testing.assert_allclose(frf.data[:, 0, 0], H, rtol=1e-9, atol=1e-9 * np.abs(H).max())
+    (tmp_path / "m.toml").write_text('[[frf]]\nresponse = "tool.tip"\nexcitation = "tool.tip"\n'
+                                     'file = "export.csv"\naverages = 5\n', encoding="utf-8")
+    measurement = next(iter(load_measurements(tmp_path / "m.toml")))
+    np.testing.assert_allclose(measurement.coherence, gamma, rtol=1e-12)
+
+
+@pytest.mark.parametrize("header, gamma, pattern", [
+    ("Frequency [Hz],Real [m/N],Imag [m/N],Coherence", 1.5, r"line 2: Coherence is '1.5'; expected a coherence "
+                                                             r"in \[0, 1\]$"),
+    ("Frequency [Hz],Real [m/N],Imag [m/N],Coherence [%]", 150.0, r"expected a coherence in \[0, 1\] \(0 to 100 %\)"),
+    ("Frequency [Hz],Real [m/N],Imag [m/N],Coherence [dB]", 0.5, r"a coherence has no unit \(or %\); got 'dB'"),
+    ("Frequency [Hz],Real [m/N],Imag [m/N],Coherence,Coherence", 0.5, "in this order"),
+])
+def test_a_coherence_column_out_of_range_is_refused_naming_the_line(tmp_path, header, gamma, pattern):
+    from substructure.io.frf_files import read_csv
+
+    columns = (HZ, H.real, H.imag, np.full(HZ.size, gamma)) + ((np.full(HZ.size, gamma),) if header.count("Coh") > 1
+                                                             else ())
+    path = _export(tmp_path, header, columns)
     with pytest.raises(FileFormatError, match=pattern):
         read_csv(path)
 

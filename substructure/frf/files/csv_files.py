@@ -188,11 +188,11 @@ def _read_csv(path, output: str, input: str,
     first, header = numbered[0]
     columns = header.replace(" ", "").lstrip("\ufeff")
     if columns not in (CSV_HEADER, COHERENCE_HEADER, FORCE_NOISE_HEADER):  # another program's export
-        from .exports import parse_export
+        from .exports import read_export
 
-        table, lines_of, said = parse_export(numbered, name, quantity)
+        table, lines_of, said, coherence = read_export(numbered, name, quantity)
         frf = _checked_csv(table, lines_of, name, output, input, quantity or said or "receptance")
-        return frf, lines_of, None, None
+        return frf, lines_of, coherence, None
     names = columns.split(",")
     numbered = numbered[1:]
     if len(numbered) < 2:

@@ -7,8 +7,9 @@ the rest with what to give instead: comment lines (``#``) before the header,
 ``;`` or tab separators (with decimal commas), quoted cells, empty trailing
 columns, units in the header (``Frequency [Hz]``, ``Real [mm/N]``,
 ``Magnitude [g/N]``, ``Phase [deg]``), real and imaginary parts or magnitude
-and phase.  A magnitude in dB is refused (its reference is not in the file),
-and so is a column that is neither of these.
+and phase, and a fourth column of the coherence (``Coherence``, ``Coh``,
+``gamma^2``; no unit, or ``%``).  A magnitude in dB is refused (its
+reference is not in the file), and so is a column that is neither of these.
 """
 
 from __future__ import annotations
@@ -31,7 +32,9 @@ _NAMES = {
     "imag": {"imag", "im", "imaginary", "imagpart", "imaginarypart"},
     "magnitude": {"magnitude", "mag", "amplitude", "abs", "modulus"},
     "phase": {"phase", "angle", "arg"},
+    "coherence": {"coherence", "coh", "gamma2", "gamma^2", "γ2", "γ²", "ordinarycoherence"},
 }
+_COHERENCE_UNITS = {None: 1.0, "-": 1.0, "1": 1.0, "": 1.0, "%": 0.01}
 _HEADER = re.compile(r"^\s*(?P<name>[^\[\(]*?)\s*(?:[\[\(](?P<unit>.*)[\]\)])?\s*$")
 
 
@@ -54,7 +57,8 @@ def _column(cell: str, name: str, line: int) -> tuple[str, str | None]:
                               "such as m/N or g/N with the phase")
     raise FileFormatError(
         f"{name}, line {line}: column {_shown(cell)}; expected frequency, then real and imaginary parts or magnitude "
-        "and phase (e.g. 'frequency_hz,real,imag' or 'Frequency [Hz];Magnitude [m/N];Phase [deg]')")
+        "and phase, and optionally the coherence (e.g. 'frequency_hz,real,imag' or "
+        "'Frequency [Hz];Magnitude [m/N];Phase [deg];Coherence')")
 
 
 def _value_unit(unit: str | None, cell: str, name: str, line: int):
@@ -101,8 +105,15 @@ def parse_export(numbered: list[tuple[int, str]], name: str, quantity: str | Non
     Raises
     ------
     FileFormatError
-        Naming the file and the line, for what cannot be read unambiguously.
+        Naming the file and the line, for what cannot be read unambiguously
+        (a coherence column is checked, and read by
+        :func:`~substructure.io.frf_files.read_csv_with_coherence`).
     """
+    return read_export(numbered, name, quantity)[:3]
+
+
+def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None):
+    """:func:`parse_export`, and the coherence column's values in [0, 1] (None without one) as a fourth item."""
     from ...units import cycles_per_second, ureg
 
     rows = [(n, line) for n, line in numbered if not line.lstrip().startswith("#")]
@@ -117,10 +128,16 @@ def parse_export(numbered: list[tuple[int, str]], name: str, quantity: str | Non
             row.pop()
     columns = [_column(c, name, first) for c in cells[0]]
     kinds = [k for k, _ in columns]
-    if kinds not in (["frequency", "real", "imag"], ["frequency", "magnitude", "phase"]):
+    if kinds[:3] not in (["frequency", "real", "imag"], ["frequency", "magnitude", "phase"]) \
+            or kinds[3:] not in ([], ["coherence"]):
         raise FileFormatError(
             f"{name}, line {first}: columns {_shown(delimiter.join(cells[0]))}; expected frequency, then real and "
-            "imaginary parts, or frequency, magnitude and phase, in this order")
+            "imaginary parts, or frequency, magnitude and phase, in this order (then the coherence, if any)")
+    width = len(kinds)
+    gamma_factor = _COHERENCE_UNITS.get(columns[3][1]) if width == 4 else 1.0
+    if gamma_factor is None:
+        raise FileFormatError(f"{name}, line {first}: column {_shown(cells[0][3])}: a coherence has no unit (or %); "
+                              f"got {_shown(columns[3][1])}")
     fcell, vcells = cells[0][0], cells[0][1:]
     if columns[0][1] is None:
         raise FileFormatError(f"{name}, line {first}: column {_shown(fcell)} has no unit; name it frequency_hz or give "
@@ -134,7 +151,7 @@ def parse_export(numbered: list[tuple[int, str]], name: str, quantity: str | Non
         raise FileFormatError(f"{name}, line {first}: column {_shown(fcell)}: {_shown(columns[0][1])} is not a "
                               "frequency unit (Hz, kHz, rad/s, rpm)")
     if kinds[1] == "real":
-        said = [_value_unit(u, c, name, first) for (_, u), c in zip(columns[1:], vcells)]
+        said = [_value_unit(u, c, name, first) for (_, u), c in zip(columns[1:3], vcells[:2])]
         if said[0] != said[1]:
             raise FileFormatError(f"{name}, line {first}: the real and imaginary parts have different units "
                                   f"({columns[1][1]!r}, {columns[2][1]!r})")
@@ -156,12 +173,12 @@ def parse_export(numbered: list[tuple[int, str]], name: str, quantity: str | Non
     data = cells[1:]
     lines = np.array([n for n, _ in rows[1:]])
     for n, row in zip(lines, data):
-        if len(row) != 3:
+        if len(row) != width:
             raise FileFormatError(f"{name}, line {n}: {_shown(delimiter.join(row))} has {len(row)} value(s); "
-                                  "expected 3")
+                                  f"expected {width}")
     text = [[c.replace(",", ".") if delimiter != "," else c for c in row] for row in data]
     try:
-        table = np.array(text, dtype=np.float64).reshape(-1, 3)
+        table = np.array(text, dtype=np.float64).reshape(-1, width)
     except ValueError:
         for n, row in zip(lines, text):
             for column, cell in zip(cells[0], row):
@@ -175,6 +192,16 @@ def parse_export(numbered: list[tuple[int, str]], name: str, quantity: str | Non
         k = int(np.argmax(table[:, 1] < 0))
         raise FileFormatError(f"{name}, line {lines[k]}: {cells[0][1]} is {_shown(data[k][1])}; a magnitude is >= 0 (a "
                               "negative one would turn the phase by 180 degrees): check the export")
+    coherence = None
+    if width == 4:
+        coherence = table[:, 3] * gamma_factor
+        bad = ~(np.isfinite(coherence) & (coherence >= 0.0) & (coherence <= 1.0 + 1e-9))
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise FileFormatError(f"{name}, line {lines[k]}: {cells[0][3]} is {_shown(data[k][3])}; expected a "
+                                  f"coherence in [0, 1]{' (0 to 100 %)' if gamma_factor != 1.0 else ''}")
+        coherence = np.minimum(coherence, 1.0)
+        table = table[:, :3].copy()
     with np.errstate(over="ignore", invalid="ignore"):
         hz: Any = table[:, 0] * funit  # a quantity: the column times its unit
         table[:, 0] = np.asarray(cycles_per_second(hz, fcell), dtype=np.float64)
@@ -182,4 +209,4 @@ def parse_export(numbered: list[tuple[int, str]], name: str, quantity: str | Non
             value = table[:, 1] * np.exp(1j * table[:, 2] * angle)
             table[:, 1], table[:, 2] = value.real, value.imag
         table[:, 1:] *= factor
-    return table, lines, kind
+    return table, lines, kind, coherence
