@@ -137,7 +137,7 @@ def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None
     gamma_factor = _COHERENCE_UNITS.get(columns[3][1]) if width == 4 else 1.0
     if gamma_factor is None:
         raise FileFormatError(f"{name}, line {first}: column {_shown(cells[0][3])}: a coherence has no unit (or %); "
-                              f"got {_shown(columns[3][1])}")
+                              f"got {_shown(columns[3][1] or '')}")
     fcell, vcells = cells[0][0], cells[0][1:]
     if columns[0][1] is None:
         raise FileFormatError(f"{name}, line {first}: column {_shown(fcell)} has no unit; name it frequency_hz or give "
