@@ -12,6 +12,8 @@ import warnings
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from .._files import MAX_DATA_BYTES, read_text
 from .._files import check_file as check_readable_file
 from .._toml import TomlDocument, loads_toml
@@ -19,7 +21,7 @@ from ..errors import FileFormatError, InvalidValueError, SubstructureError, Subs
 from ..frf import FRF, QUANTITIES
 from ..frf.files._common import _beyond_physical
 from ..frf.files.csv_files import _read_csv
-from ..frf.files.uff_reader import read_uff
+from ..frf.files.uff_reader import read_uff, read_uff_coherence
 from ..points import check_name
 from ..tap import ESTIMATORS
 from .measurement import Measurement, _optional_force_window, _optional_tau, dof_label
@@ -28,7 +30,7 @@ __all__ = ["read_measurements", "reads_measurements"]
 
 _TOP_KEYS = ("name", "frf")
 _FRF_KEYS = ("response", "excitation", "file", "record", "quantity", "sensors", "removed", "averages", "window_tau_s",
-             "force_window_s", "estimator")
+             "force_window_s", "estimator", "coherence_record")
 _REQUIRED = ("response", "excitation", "file")
 _CSV = (".csv",)
 _UFF = (".uff", ".unv")
@@ -137,6 +139,21 @@ class _Reader:
         except SubstructureError as exc:
             raise self.error(index, "file", f"{path}: {exc}") from None
 
+    def uff_coherence(self, index: int, file: str, record: int, frf: FRF) -> Any:
+        path = self.base_dir / file
+        if path.suffix.lower() not in _UFF:
+            raise self.error(index, "coherence_record", f"a CSV file ({file}) has no records; its coherence is its "
+                                                        "fourth column")
+        try:
+            hz, values = read_uff_coherence(path, record)
+        except FileFormatError as exc:
+            raise self.error(index, "coherence_record", str(exc)) from None
+        if hz.size != frf.frequency.n or not np.allclose(hz, frf.frequency.hz, rtol=1e-6, atol=0.0):
+            raise self.error(index, "coherence_record",
+                             f"{path}, type-58 record {record}: the coherence's {hz.size} lines from {hz[0]:g} to "
+                             f"{hz[-1]:g} Hz are not the FRF's {frf.frequency!r}")
+        return values
+
     def uff(self, index: int, path: Path, record: int | None, quantity: str | None,
             response: str, excitation: str) -> FRF:
         try:
@@ -203,7 +220,11 @@ class _Reader:
         force_window = self.seconds(table, index, "force_window_s", _optional_force_window,
                                     "the force window's length in s")
         estimator = self.choice(table, index, "estimator", ESTIMATORS)
+        coherence_record = self.integer(table, index, "coherence_record", 0,
+                                        "the 0-based index of the type-58 coherence record")
         raw, coherence, force_noise = self.data(index, file, record, quantity, response, excitation)
+        if coherence_record is not None:
+            coherence = self.uff_coherence(index, file, coherence_record, raw)
         if force_noise is not None and force_window is None:
             raise self.error(index, "force_window_s", f"missing; {file} has a force_noise column, correlated over "
                                                       "1 / force_window_s hertz (the force window's length in s)")

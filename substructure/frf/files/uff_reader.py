@@ -23,7 +23,7 @@ if TYPE_CHECKING:  # the annotations only (frf.response imports this module)
     from ..response import FRF
 from .uff_units import _FUNCTION_TYPES, _a, _abscissa_hz, _label, _record_quantity, _unit_system
 
-__all__ = ["read_uff"]
+__all__ = ["read_uff", "read_uff_coherence"]
 
 
 def _parse_record(dset: dict, name: str, number: int, quantity: str | None,
@@ -32,9 +32,11 @@ def _parse_record(dset: dict, name: str, number: int, quantity: str | None,
     function = int(dset.get("func_type", -1))
     if function not in (0, 4) or (function == 0 and int(dset.get("orddenom_spec_data_type", 0) or 0) != 13):
         kind = _FUNCTION_TYPES.get(function, f"function type {function}")
+        hint = ("; a coherence beside its FRF is read with it: give the FRF's index as record = N and this one "
+                "as coherence_record = M in the measurement set" if function == 6 else
+                "; export the FRFs (H1 or H2) from the acquisition software")
         raise FileFormatError(
-            f"{where}: {_a(kind)} (function type {function}), not a frequency response function (type 4); "
-            "export the FRFs (H1 or H2) from the acquisition software"
+            f"{where}: {_a(kind)} (function type {function}), not a frequency response function (type 4){hint}"
         )
     data = np.asarray(dset["data"])
     if not np.iscomplexobj(data):
@@ -290,3 +292,58 @@ def _assemble(parsed: list[tuple], name: str) -> FRF:
             f"{' ...' if len(missing) > 4 else ''}; read them one at a time with record=N"
         )
     return frf_class()(frequency, data, outputs, inputs, kind)
+
+
+def read_uff_coherence(path: str | os.PathLike, record: int) -> tuple[np.ndarray, np.ndarray]:
+    """Read a coherence record of a universal file (type 58, function type 6), as analysers export it beside
+    the FRF.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The universal file (ASCII or binary type 58).
+    record : int
+        0-based index of the coherence among the file's type-58 records.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        Its frequencies [Hz] and its values in [0, 1].
+
+    Raises
+    ------
+    FileFormatError
+        Naming the file and the record: no such record, a record that is
+        not a coherence, values outside [0, 1] or not finite.
+    """
+    import pyuff
+
+    from ..._files import MAX_DATA_BYTES, check_file
+
+    name = check_file(path, "universal file", MAX_DATA_BYTES)
+    _check_complete(name)
+    try:
+        uff = pyuff.UFF(name)
+        positions = [k for k, t in enumerate(uff.get_set_types()) if int(t) == 58]
+    except Exception as exc:  # pyuff raises bare Exception
+        raise FileFormatError(f"{name}: not a readable universal file ({exc})") from None
+    if isinstance(record, bool) or not isinstance(record, (int, np.integer)) or not 0 <= record < len(positions):
+        raise FileFormatError(f"{name}: coherence record {record!r}; the file has {len(positions)} type-58 "
+                              f"record(s), indices 0..{len(positions) - 1}")
+    where = f"{name}, type-58 record {record}"
+    try:
+        dset = uff.read_sets(positions[int(record)])
+    except Exception as exc:  # pyuff raises bare Exception
+        raise FileFormatError(f"{where}: cannot read it ({exc})") from None
+    function = int(dset.get("func_type", -1))
+    if function != 6:
+        kind = _FUNCTION_TYPES.get(function, f"function type {function}")
+        raise FileFormatError(f"{where}: {_a(kind)} (function type {function}), not a coherence (type 6)")
+    data = np.asarray(dset["data"])
+    values = np.real(data).astype(np.float64)
+    bad = ~(np.isfinite(values) & (values >= 0.0) & (values <= 1.0 + 1e-6)) | (np.abs(np.imag(data)) > 1e-9)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise FileFormatError(f"{where}: value {k + 1} is {data[k]!r}; expected a coherence in [0, 1]")
+    return _abscissa_hz(dset, where), np.minimum(values, 1.0)
+
