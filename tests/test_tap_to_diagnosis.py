@@ -250,6 +250,29 @@ def test_an_exact_model_is_consistent_with_an_h2_estimate(model, seed):
     assert any("an H2 estimate without its coherence" in r for r in bare.report)
 
 
+def test_the_bias_an_hv_estimate_may_carry_enters_the_noise_model(model):
+    """Closed form of the term: ``(ln gamma^2)^2`` added to the log magnitude's variance (capped), nothing to
+    the phase's, ``(1/gamma^2 - 1)^2`` to the linear domain's; none for H1, H2 or one average."""
+    from substructure.updating.noise import VARIANCE_CAP, estimate_noise
+
+    result = process_taps(_taps(model, 1, response_noise=1e-3), "Hv")
+    frf, gamma = result.frf.crop(150.0, 5000.0), result.coherence[(result.frf.frequency.hz >= 150.0)
+                                                                   & (result.frf.frequency.hz <= 5000.0)]
+    plain = estimate_noise(frf, coherence=gamma, averages=5)
+    hv = estimate_noise(frf, coherence=gamma, averages=5, estimator="Hv")
+    b = -np.log(np.clip(gamma, 1e-3, 1.0))
+    np.testing.assert_allclose(hv.var_re, np.minimum(plain.var_re + b**2, VARIANCE_CAP), rtol=1e-12)
+    np.testing.assert_array_equal(hv.var_im, plain.var_im)
+    lin = np.isfinite(plain.linear[1])
+    assert lin.any()
+    np.testing.assert_allclose(hv.linear[1][lin], plain.linear[1][lin] + (1 / np.clip(gamma, 1e-3, 1) - 1)[lin] ** 2,
+                               rtol=1e-12)
+    for estimator, averages in (("H1", 5), ("H2", 5), ("Hv", 1)):
+        other = estimate_noise(frf, coherence=gamma, averages=averages, estimator=estimator)
+        same = estimate_noise(frf, coherence=gamma, averages=averages)
+        np.testing.assert_array_equal(other.var_re, same.var_re)
+
+
 @pytest.mark.parametrize("seed", range(4))
 def test_an_exact_model_is_consistent_with_an_hv_estimate_of_noisy_taps(model, seed):
     """Ten times the accelerometer's noise: Hv sits near H2 where the response channel's power is the larger

@@ -227,9 +227,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     _refuse_rotations(measurements)
     measured, band = measured_frfs(measurements, band)
     lik = Likelihood(assembly, measured)
-    floors = lik.floors()
-    floor = float(np.sqrt(np.mean(np.concatenate([(m.noise.var_re + m.noise.var_im)[a]
-                                                  for m, a in zip(measured, lik.alive)]))))
+    floor, floors = lik.floors()
     base_ratios = lik.log_ratios([])
     e0 = lik.rms(base_ratios)
     chi2_now = float(lik.whiten(base_ratios) @ lik.whiten(base_ratios))

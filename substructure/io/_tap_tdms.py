@@ -158,22 +158,21 @@ def _group_record(name: str, where: str, source: str, channels: list, sensitivit
         if errors[k]:
             raise FileFormatError(f"{where}: {errors[k]} (channel {labels[k]!r})")
     used = [k for k in (t_col, f_col, r_col) if k is not None]
-    lengths = {len(channels[k]) for k in used}
+    lengths = {samples[k].size for k in used}
     if len(lengths) > 1:
-        raise FileFormatError(f"{where}: channels of {', '.join(str(len(channels[k])) for k in used)} samples "
+        raise FileFormatError(f"{where}: channels of {', '.join(str(samples[k].size) for k in used)} samples "
                               f"({', '.join(labels[k] for k in used)}); expected one length")
-    data = {k: samples[k] for k in used}
     for k in used:
-        bad = np.flatnonzero(~np.isfinite(data[k]))
+        bad = np.flatnonzero(~np.isfinite(samples[k]))
         if bad.size:
-            raise FileFormatError(f"{where}: channel {labels[k]!r}, sample {bad[0] + 1} is {data[k][bad[0]]}; "
+            raise FileFormatError(f"{where}: channel {labels[k]!r}, sample {bad[0] + 1} is {samples[k][bad[0]]}; "
                                   "expected a finite number (a gap in the acquisition?)")
     n = lengths.pop()
-    time = None if t_col is None else (data[t_col], parsed[t_col], f"channel {labels[t_col]!r}")
+    time = None if t_col is None else (samples[t_col], parsed[t_col], f"channel {labels[t_col]!r}")
     time_s = time_axis(time, stated, n, where)
     if time is None:
         offset = channels[f_col].properties.get("wf_start_offset", 0.0)
         time_s = time_s + (float(offset) if isinstance(offset, (int, float)) and abs(offset) < 1e6 else 0.0)
-    record = build_record(where, time_s, data[f_col], parsed[f_col], labels[f_col], data[r_col], parsed[r_col],
+    record = build_record(where, time_s, samples[f_col], parsed[f_col], labels[f_col], samples[r_col], parsed[r_col],
                           labels[r_col], sensitivity, hammer_sensitivity, quantity)
     return attrs.evolve(record, source=source)

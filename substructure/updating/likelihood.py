@@ -373,16 +373,18 @@ class Likelihood:
         """
         return float(np.sqrt(np.mean(np.concatenate([np.abs(r[a]) ** 2 for r, a in zip(ratios, self.alive)]))))
 
-    def floors(self) -> list[float]:
-        """Per measured FRF, the RMS log ratio a perfect model would show on the lines it holds.
+    def floors(self) -> tuple[float, list[float]]:
+        """The RMS log ratio a perfect model would show on the lines the data hold: in all, and per FRF.
 
         Returns
         -------
-        list of float
-            ``sqrt(mean(v_re + v_im))`` over its ``alive`` lines.
+        (float, list of float)
+            ``sqrt(mean(v_re + v_im))`` over every measured FRF's ``alive``
+            lines, and over each one's.
         """
-        return [float(np.sqrt(np.mean((m.noise.var_re + m.noise.var_im)[self.lines][a])))
-                for m, a in zip(self.measured, self.alive)]
+        variances = [(m.noise.var_re + m.noise.var_im)[self.lines][a] for m, a in zip(self.measured, self.alive)]
+        return (float(np.sqrt(np.mean(np.concatenate(variances)))),
+                [float(np.sqrt(np.mean(v))) for v in variances])
 
     def _ratios(self, predicted: list) -> list[np.ndarray]:
         out = []
