@@ -53,6 +53,26 @@ def test_a_preamble_and_a_row_of_units_under_the_names(tmp_path):
     assert record.force_column == "Force [N]" and record.response_column == "Accel [g]"
 
 
+@pytest.mark.parametrize("names, units, scale", [
+    ('"Time";"Hammer";"Acc"', '"s";"N";"m/s2"', 1.0),  # quoted names and units, as exports with ';' write them
+    ("Time;Force;Accel", "s;N;m s-2", 1.0),
+    ("Time;Force;Accel", "s;N;m.s-2", 1.0),
+    ("Time;Force;Accel", "s;N;m\u00b7s\u207b\u00b2", 1.0),
+    ("Time;Force;Accel", "s;lbf;G", 1.0 / G),  # G: gravity (not the gauss), the force in pounds
+    ("Time;Force;Accel", "s;lb;mm/s2", 1000.0),
+])
+def test_units_as_acquisition_programs_write_them_in_a_row_of_their_own(tmp_path, names, units, scale):
+    t, f, a = samples()
+    lbf = 4.4482216152605  # N, the pound-force by definition (0.45359237 kg times 9.80665 m/s^2)
+    force_scale = 1.0 / lbf if "lb" in units else 1.0
+    path = tmp_path / "export.csv"
+    path.write_text(names + "\n" + units + "\n" + rows([t, f * force_scale, a * scale], sep=";", decimal_comma=True),
+                    encoding="utf-8")
+    record = read_tap_csv(path)
+    assert np.allclose(record.force, f, rtol=1e-12, atol=1e-12)
+    assert np.allclose(record.response, a, rtol=1e-12, atol=1e-12) and record.quantity == "acceleration"
+
+
 @pytest.mark.parametrize("header", [
     "Time (s)\tForce (N)\tAcceleration (m/s^2)",
     "Time [s]\tForce [N]\tAcceleration [m/s²]",

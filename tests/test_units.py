@@ -7,7 +7,8 @@ import pint
 import pytest
 
 from substructure import InvalidValueError, Material, Segment, UnitError
-from substructure.units import Q_, dimensionless, format_quantity, hz_to_rpm, quantity, rpm_to_hz, to_si, ureg
+from substructure.units import (Q_, dimensionless, format_quantity, hz_to_rpm, instrument_unit, quantity, rpm_to_hz,
+                                to_si, ureg)
 
 
 def test_strings_and_quantities_are_accepted():
@@ -98,3 +99,21 @@ def test_catalogue():
     assert Material.from_catalog("steel") is CATALOG["steel"]
     with pytest.raises(InvalidValueError, match="unknown material 'unobtainium'; known: aluminium, carbide, steel"):
         get_material("unobtainium")
+
+
+@pytest.mark.parametrize("text, si, factor", [
+    ("m/s2", "m/s^2", 1.0), ("m s-2", "m/s^2", 1.0), ("m.s-2", "m/s^2", 1.0), ("m\u00b7s\u207b\u00b2", "m/s^2", 1.0),
+    ("mm/s\u00b2", "m/s^2", 1e-3), ("m/s**2", "m/s^2", 1.0), ("g", "m/s^2", 9.80665), ("G", "m/s^2", 9.80665),
+    ("\u00b5m", "m", 1e-6), ("\u03bcm", "m", 1e-6), ("um", "m", 1e-6), ("lb", "N", 0.45359237 * 9.80665),
+    ("mV/lb", "V/N", 1e-3 / (0.45359237 * 9.80665)), ("mV/g", "V/(m/s^2)", 1e-3 / 9.80665), ("(m/s2)/N", "1/kg", 1.0),
+    ("g/N", "1/kg", 9.80665), ("m^2", "m^2", 1.0),
+])
+def test_instrument_units_read_as_acquisition_programs_write_them(text, si, factor):
+    # factors by the definitions: g_n = 9.80665 m/s^2, 1 lb = 0.45359237 kg, so 1 lbf = 0.45359237 g_n newtons
+    assert ureg.Quantity(1.0, instrument_unit(text)).m_as(si) == pytest.approx(factor, rel=1e-12)
+
+
+@pytest.mark.parametrize("text", ["m/s^", "Volts per g", "m/(s"])
+def test_an_instrument_unit_pint_cannot_read_is_a_value_error(text):
+    with pytest.raises(ValueError):
+        instrument_unit(text)

@@ -17,7 +17,7 @@ import attrs
 import numpy as np
 
 from ..errors import InvalidValueError, UnitError
-from ..units import ureg
+from ..units import instrument_unit, ureg
 
 __all__ = ["TapRecord", "RESPONSE_QUANTITIES", "MIN_SAMPLES", "TIME_STEP_TOLERANCE", "channel_to_si",
            "unit_of", "quantity_of"]
@@ -35,13 +35,12 @@ MIN_SAMPLES = 16
 TIME_STEP_TOLERANCE = 1e-3
 """Largest deviation of one time step from the mean step, relative to the mean step (uniform sampling)."""
 
-_G = re.compile(r"(?<![A-Za-z_0-9])g(?![A-Za-z_0-9])")
-
-
 def unit_of(text: str, field: str):
     """The pint unit of a unit text of a record (``"m/s^2"``, ``"g"``, ``"mV"``, ``"um"``).
 
-    ``g`` is the standard acceleration of gravity (9.80665 m/s^2), not the gram.
+    Read by :func:`substructure.units.instrument_unit`: ``g`` is the
+    standard acceleration of gravity (9.80665 m/s^2), ``lb`` the
+    pound-force, and exponents may be written ``m/s2``, ``m s-2``.
 
     Parameters
     ----------
@@ -60,10 +59,9 @@ def unit_of(text: str, field: str):
     UnitError
         When pint cannot read it.
     """
-    cleaned = _G.sub("g0", text.strip().replace("²", "^2").replace("µ", "u"))
     try:
-        unit = ureg.Unit(cleaned)
-    except Exception:
+        unit = instrument_unit(text)
+    except ValueError:
         raise UnitError(f"{field}: cannot read the unit {text!r}; expected e.g. N, m/s^2, g, m/s, mm/s, m, um, "
                         "mV or V") from None
     return unit

@@ -69,7 +69,7 @@ def _value_unit(unit: str | None, cell: str, name: str, line: int):
         raise FileFormatError(f"{name}, line {line}: column {_shown(cell)}: a magnitude in dB has no unit of its own "
                               "(dB of what?); give the magnitude in a unit such as m/N or g/N")
     try:
-        q = _unit_of_label(unit.replace("µ", "u").replace("μ", "u"))
+        q = _unit_of_label(unit)
     except ValueError:
         q = None
     exps = _exponents(q) if q is not None else None

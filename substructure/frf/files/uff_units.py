@@ -58,27 +58,21 @@ _UNREADABLE = re.compile(r"[\ufffd\x00-\x1f\x7f-\x9f]")
 def _unit_of_label(label: Any):
     """A pint Quantity of 1 of the unit an axis units label names; None for no label; ValueError if unreadable.
 
-    Labels of acquisition systems are made readable first: ``g`` is the
-    standard acceleration of gravity (not the gram), ``s2`` and ``s²`` are
-    ``s^2`` (``²`` and ``³`` as UTF-8 or, in a label pyuff could not
-    decode, as Latin-1 bytes: ``_latin1_labels``).  A label with a byte
-    that is no character (U+FFFD) or a control character is unreadable.
+    Labels of acquisition systems are read by
+    :func:`substructure.units.instrument_unit` (``g`` is the standard
+    acceleration of gravity, ``s2`` and ``s\u00b2`` are ``s^2``; ``\u00b2`` and
+    ``\u00b3`` may come as Latin-1 bytes in a label pyuff could not decode:
+    ``_latin1_labels``).  A label with a byte that is no character (U+FFFD)
+    or a control character is unreadable.
     """
-    from ...units import ureg
+    from ...units import instrument_unit, ureg
 
     text = str(label if label is not None else "").strip()
     if text.upper() in _NO_LABEL:
         return None
     if _UNREADABLE.search(text):  # a byte that is no character (U+FFFD), a control character
         raise ValueError(text)
-    cleaned = text.replace("²", "^2").replace("³", "^3").replace("·", "*").replace("**", "^")
-    cleaned = re.sub(r"(?<![A-Za-z_])g(?![A-Za-z_0-9])", "g_n", cleaned)  # g: gravity, in an FRF label
-    cleaned = re.sub(r"([A-Za-z])(\d)", r"\1^\2", cleaned)  # m/s2 -> m/s^2
-    try:
-        q = ureg.Quantity(1.0, cleaned)
-    except Exception:
-        raise ValueError(text) from None
-    return q
+    return ureg.Quantity(1.0, instrument_unit(text))
 
 
 def _exponents(q) -> tuple[int, int, int] | None:
