@@ -20,7 +20,10 @@ package: 25.6 kHz, 1 s each) through ``substructure.tap``:
 (e) the same taps as an acquisition system exports them, all in one
     universal file, read back tap by tap;
 (f) the three estimators of the same taps, and why a diagnosis compares
-    an H2 as the H1 of its taps.
+    an H2 as the H1 of its taps;
+(g) the same taps cut short while their modes still ring: the error the
+    end of a tap leaves, which the coherence does not see, estimated from
+    the taps and counted.
 
 Figures are written to $SUBSTRUCTURE_EXAMPLES_OUT (default: out/examples).
 """
@@ -187,3 +190,42 @@ ax.legend()
 ax.set_title("three estimators of the same taps: apart where the coherence is low")
 save(fig, "12_estimators.png")
 
+
+# %%
+# (g) A tap cut short
+# -------------------
+# This structure's lightest modes still ring after a second.  Cut to
+# 0.25 s, the taps leave out the rest of the response: every tap repeats
+# that error, so the coherence does not see it.  The processing estimates
+# it from the taps' last samples (``TapResult.truncation``; the exponential
+# window is kept for responses ringing above 10 % of their peak, since its
+# damping is an error no model shares) and the diagnosis's noise model
+# counts it.  Against the FRF of the whole second, the difference is that
+# error.  The estimate is conservative (for lightly damped modes several
+# times the error between them): it says where a short record cannot be
+# trusted, not what the rest of the response was.
+n = int(0.25 * records[0].sample_rate)
+short = process_taps([TapRecord(r.time[:n], r.force[:n], r.response[:n], r.quantity, r.source) for r in records])
+print(f"0.25 s taps: {short.window}")
+lines = np.searchsorted(hz, short.frf.frequency.hz)
+difference = np.abs(short.frf.data[:, 0, 0] / result.frf.data[lines, 0, 0] - 1.0)
+gamma = np.clip(short.coherence, 1e-3, 1.0)
+scatter = np.sqrt((1.0 - gamma) / (2 * short.averages * gamma))  # H1's noise, from the coherence
+estimate = np.sqrt(short.truncation)
+cut_band = (short.frf.frequency.hz > 20) & (short.frf.frequency.hz < 5000)
+print(f"difference from the 1 s FRF: median {np.median(difference[cut_band]):.1%}; within the coherence's noise on "
+      f"{np.mean(difference[cut_band] <= scatter[cut_band]):.0%} of the lines, within the truncation's estimate "
+      f"(and the noise) on {np.mean(difference[cut_band] <= np.hypot(estimate, scatter)[cut_band]):.0%}")
+error_at, where = short.truncation_error()
+print(f"largest estimated error {error_at:.2g} (relative) near {where:.0f} Hz")
+fig, ax = plt.subplots(figsize=(7, 3.5))
+f_short = short.frf.frequency.hz
+ax.semilogy(f_short[cut_band], difference[cut_band], lw=0.8, color="k", label="difference from the 1 s FRF")
+ax.semilogy(f_short[cut_band], estimate[cut_band], lw=0.8, label="truncation's estimate")
+ax.semilogy(f_short[cut_band], scatter[cut_band], lw=0.8, label="noise from the coherence")
+ax.set_xlabel("frequency [Hz]")
+ax.set_ylabel("relative error")
+ax.legend(fontsize=8)
+ax.set_title("taps cut at 0.25 s: an error the coherence does not see")
+fig.tight_layout()
+save(fig, "12_truncation.png")

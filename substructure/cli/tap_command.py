@@ -114,7 +114,8 @@ def run(args: argparse.Namespace) -> int:
     peaks = result.peaks()
     written = []
     if args.out:
-        write_csv(result.frf, args.out, args.overwrite, coherence=result.coherence, force_noise=result.force_noise)
+        write_csv(result.frf, args.out, args.overwrite, coherence=result.coherence, force_noise=result.force_noise,
+                  truncation=result.truncation)
         written.append(args.out)
     if args.measurements:
         relative = os.path.relpath(os.path.abspath(args.out), os.path.dirname(os.path.abspath(args.measurements)))
@@ -169,6 +170,11 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(f"exponential window: tau = {result.tau:.4g} s, {result.window}; it adds a damping ratio "
               "1/(tau omega) to every mode")
+    cut = result.truncation_error()
+    if cut is not None:
+        print(f"truncation: the response still rang at the taps' end; the error it leaves in the FRF is at most "
+              f"{cut[0]:.2g} (relative) near {cut[1]:.0f} Hz, and counted as noise by the fits (the file's truncation "
+              "column; a longer record removes it)")
     shown = list(zip(peaks, added))
     print(f"peaks within the band ({result.measured.quantity}):" if shown else "peaks: none within the band")
     for k, (f, z) in enumerate(shown):

@@ -108,7 +108,7 @@ class _Reader:
 
     # -- data files -----------------------------------------------------------
     def data(self, index: int, file: str, record: int | None, quantity: str | None,
-             response: str, excitation: str) -> tuple[FRF, Any, Any]:
+             response: str, excitation: str) -> tuple[FRF, dict[str, Any]]:
         path = self.base_dir / file
         suffix = path.suffix.lower()
         if suffix not in _CSV + _UFF:
@@ -120,18 +120,17 @@ class _Reader:
             if suffix in _CSV:
                 if record is not None:
                     raise self.error(index, "record", f"a CSV file ({file}) holds one FRF; record is for UFF files")
-                frf, lines_of, coherence, force_noise = _read_csv(path, output=response, input=excitation,
-                                                                  quantity=quantity)
+                frf, lines_of, columns = _read_csv(path, output=response, input=excitation, quantity=quantity)
             else:
                 frf = self.uff(index, path, record, quantity, response, excitation)
-                lines_of = coherence = force_noise = None
+                lines_of, columns = None, {}
             beyond = _beyond_physical(frf.frequency.hz, frf.data, frf.quantity)  # a measured FRF's range
             if beyond is not None:
                 k, what = beyond
                 where = (f"line {lines_of[k]}" if lines_of is not None else
                          f"type-58 record {record or 0}, value {k + 1} of {frf.frequency.n}")
                 raise FileFormatError(f"{path}, {where}: at {frf.frequency.hz[k]:g} Hz: {what}")
-            return frf, coherence, force_noise
+            return frf, columns
         except _LocatedError:
             raise
         except FileFormatError as exc:  # names the data file (and its line)
@@ -222,10 +221,10 @@ class _Reader:
         estimator = self.choice(table, index, "estimator", ESTIMATORS)
         coherence_record = self.integer(table, index, "coherence_record", 0,
                                         "the 0-based index of the type-58 coherence record")
-        raw, coherence, force_noise = self.data(index, file, record, quantity, response, excitation)
+        raw, columns = self.data(index, file, record, quantity, response, excitation)
         if coherence_record is not None:
-            coherence = self.uff_coherence(index, file, coherence_record, raw)
-        if force_noise is not None and force_window is None:
+            columns["coherence"] = self.uff_coherence(index, file, coherence_record, raw)
+        if "force_noise" in columns and force_window is None:
             raise self.error(index, "force_window_s", f"missing; {file} has a force_noise column, correlated over "
                                                       "1 / force_window_s hertz (the force window's length in s)")
         if raw.quantity != "receptance" and raw.frequency.hz[0] == 0.0:
@@ -235,15 +234,15 @@ class _Reader:
                 SubstructureWarning, stacklevel=2,
             )
             raw = raw.crop(lo=raw.frequency.hz[1])
-            coherence = None if coherence is None else coherence[1:]
-            force_noise = None if force_noise is None else force_noise[1:]
+            columns = {key: value[1:] for key, value in columns.items()}
         try:
             receptance = raw.to_receptance()
         except SubstructureError as exc:
             raise self.error(index, "file", f"{self.base_dir / file}: {exc}") from None
         try:
             return Measurement(response, excitation, receptance, raw.quantity, sensors, removed, file, record,
-                               coherence, averages, tau, force_noise, force_window, estimator)
+                               columns.get("coherence"), averages, tau, columns.get("force_noise"), force_window,
+                               estimator, columns.get("truncation"))
         except SubstructureError as exc:  # pragma: no cover - every field was checked above
             raise self.error(index, None, str(exc)) from None
 

@@ -163,22 +163,32 @@ _optional_force_window = _optional_seconds("force_window_s", "the force window's
                                                              "or None")
 
 
-def _force_noise(value: Any) -> np.ndarray | None:
-    if value is None:
-        return None
-    try:
-        array = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise InvalidValueError(f"force_noise: got {type(value).__name__}; expected an array of variances >= 0") \
-            from None
-    if array.ndim != 1:
-        raise InvalidValueError(f"force_noise: got shape {array.shape}; expected one value per frequency line")
-    bad = ~(array >= 0.0)  # NaN or negative; inf is a line without force
-    if bad.any():
-        k = int(np.argmax(bad))
-        raise InvalidValueError(f"force_noise: line {k} is {float(array[k])!r}; expected a variance >= 0")
-    array.setflags(write=False)
-    return array
+def _per_line_variances(name: str, infinite: str):
+    """A converter of an optional array of per-line variances (>= 0; ``inf`` for ``infinite``), read-only."""
+
+    def convert(value: Any) -> np.ndarray | None:
+        if value is None:
+            return None
+        try:
+            array = np.array(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise InvalidValueError(f"{name}: got {type(value).__name__}; expected an array of variances >= 0") \
+                from None
+        if array.ndim != 1:
+            raise InvalidValueError(f"{name}: got shape {array.shape}; expected one value per frequency line")
+        bad = ~(array >= 0.0)  # NaN or negative; inf is allowed
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise InvalidValueError(f"{name}: line {k} is {float(array[k])!r}; expected a variance >= 0 (inf "
+                                    f"{infinite})")
+        array.setflags(write=False)
+        return array
+
+    return convert
+
+
+_force_noise = _per_line_variances("force_noise", "where there was no force")
+_truncation = _per_line_variances("truncation", "where the FRF is zero")
 
 
 def _estimator(value: Any) -> str | None:
@@ -269,6 +279,11 @@ class Measurement:
         estimate exceeds the FRF by the factor ``1 / gamma^2`` where the
         response's noise is large; with its coherence it is compared as H1
         (:attr:`h1_frf`).
+    truncation : array of float, optional
+        Per line, the variance of the FRF's relative error that the end of
+        the taps leaves where the response still rang there, counted over
+        the lines it spans (``substructure.tap.TapResult.truncation``; >= 0,
+        ``inf`` allowed); read-only.  The noise model adds it.
     """
 
     response: str = attrs.field(converter=lambda value: dof_label(value, "response"))
@@ -289,6 +304,9 @@ class Measurement:
     )
     force_window_s: float | None = attrs.field(default=None, converter=_optional_force_window)
     estimator: str | None = attrs.field(default=None, converter=_estimator)
+    truncation: np.ndarray | None = attrs.field(
+        default=None, converter=_truncation, validator=_check_lines, eq=attrs.cmp_using(eq=_same_array)
+    )
 
     @force_window_s.validator
     def _check_force_window(self, attribute: Any, value: float | None) -> None:
@@ -302,6 +320,7 @@ class Measurement:
         removed: Sequence[str] = (), file: str | None = None, record: int | None = None,
         coherence: Any = None, averages: int | None = None, window_tau: float | None = None,
         force_noise: Any = None, force_window_s: float | None = None, estimator: str | None = None,
+        truncation: Any = None,
     ) -> "Measurement":
         """A measurement from a one-entry FRF of any quantity.
 
@@ -337,6 +356,8 @@ class Measurement:
             The force window's effective length [s].
         estimator : {"H1", "H2", "Hv"}, optional
             How the FRF was estimated from the taps.
+        truncation : array of float, optional
+            The error the taps' end leaves, per line (a variance, >= 0).
 
         Returns
         -------
@@ -352,10 +373,10 @@ class Measurement:
             )
         receptance = frf.with_labels((out,), (inp,)).to_receptance()
         return cls(out, inp, receptance, frf.quantity, sensors, removed, file, record, coherence, averages,
-                   window_tau, force_noise, force_window_s, estimator)
+                   window_tau, force_noise, force_window_s, estimator, truncation)
 
     def crop(self, lo: Any = None, hi: Any = None) -> "Measurement":
-        """The measurement restricted to ``lo <= f <= hi``, its coherence and force noise on the same lines.
+        """The measurement restricted to ``lo <= f <= hi``, its per-line arrays (coherence, noise) on the same lines.
 
         Parameters
         ----------
@@ -368,9 +389,9 @@ class Measurement:
             The lines of the band (an empty band is an error).
         """
         mask = self.frf.frequency.band_mask(lo, hi)
-        coherence = None if self.coherence is None else self.coherence[mask]
-        force_noise = None if self.force_noise is None else self.force_noise[mask]
-        return attrs.evolve(self, frf=self.frf.crop(lo, hi), coherence=coherence, force_noise=force_noise)
+        lines = {name: None if getattr(self, name) is None else getattr(self, name)[mask]
+                 for name in ("coherence", "force_noise", "truncation")}
+        return attrs.evolve(self, frf=self.frf.crop(lo, hi), **lines)
 
     @property
     def configuration(self) -> Configuration:

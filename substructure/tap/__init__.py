@@ -12,6 +12,9 @@ The package sits next to :mod:`substructure.frf` in the layers: it needs
 - :mod:`~substructure.tap.process`: :func:`process_taps` (windows, H1/H2/Hv,
   coherence, the hammer's usable band, the window's added damping) and
   :class:`TapResult`.
+- :mod:`~substructure.tap.record_end`: the end of a tap: whether the
+  exponential window is needed, and the error the truncation of a response
+  that still rings leaves in the FRF (counted by the noise model).
 
 Files are read by :mod:`substructure.io.tap_files` (``read_tap_csv``,
 ``read_tap_lvm``, ``read_tap_mat``, ``read_taps_mat``, ``read_tap_uff``, ``read_taps_uff``), the figure to check a
@@ -22,8 +25,9 @@ result is
 
 from .detect import (CLIP_REACH, CLIP_RUN, CLIP_TOLERANCE, CREST_FACTOR_PULSE, DOUBLE_HIT_FRACTION, NO_HIT_FACTOR,
                      PRE_TRIGGER_S, TRIGGER_FRACTION, SwappedChannelsError)
-from .process import (DECAYED_SHARE, ESTIMATORS, EXP_WINDOW_END, FORCE_WINDOW_BEFORE, FORCE_WINDOW_EXTRA,
-                      HALF_POWER_LINES, HAMMER_BAND_DB, PEAK_PROMINENCE, Tap, TapResult, added_damping, process_taps)
+from .process import (ESTIMATORS, EXP_WINDOW_END, FORCE_WINDOW_BEFORE, FORCE_WINDOW_EXTRA, HALF_POWER_LINES,
+                      HAMMER_BAND_DB, PEAK_PROMINENCE, Tap, TapResult, added_damping, process_taps)
+from .record_end import DECAYED_SHARE, TRUNCATION_RATIO_MAX, TRUNCATION_SEGMENT, WINDOW_SHARE
 from .records import RESPONSE_QUANTITIES, TapRecord, channel_to_si, unit_of
 
 __all__ = [
@@ -31,6 +35,6 @@ __all__ = [
     "SwappedChannelsError", "ESTIMATORS", "RESPONSE_QUANTITIES", "TRIGGER_FRACTION", "NO_HIT_FACTOR",
     "DOUBLE_HIT_FRACTION", "CLIP_RUN", "CLIP_TOLERANCE", "CLIP_REACH", "PRE_TRIGGER_S", "CREST_FACTOR_PULSE",
     "EXP_WINDOW_END", "FORCE_WINDOW_EXTRA", "FORCE_WINDOW_BEFORE", "HAMMER_BAND_DB", "PEAK_PROMINENCE",
-    "HALF_POWER_LINES", "DECAYED_SHARE",
+    "HALF_POWER_LINES", "DECAYED_SHARE", "WINDOW_SHARE", "TRUNCATION_SEGMENT", "TRUNCATION_RATIO_MAX",
 ]
 

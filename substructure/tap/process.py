@@ -21,10 +21,11 @@ from ..errors import InvalidValueError
 from ..frf import FRF, Frequency
 from .detect import (CLIP_RUN, DOUBLE_HIT_FRACTION, NO_HIT_FACTOR, PRE_TRIGGER_S, TRIGGER_FRACTION,
                      check_swapped, double_hit, find_pulse, longest_flat_run, tap_starts)
+from .record_end import TRUNCATION_SEGMENT, noise_variance, truncation_variance, window_needed
 from .records import RESPONSE_QUANTITIES, TapRecord
 
 __all__ = ["process_taps", "TapResult", "Tap", "ESTIMATORS", "EXP_WINDOW_END", "FORCE_WINDOW_EXTRA",
-           "FORCE_WINDOW_BEFORE", "HAMMER_BAND_DB", "PEAK_PROMINENCE", "HALF_POWER_LINES", "DECAYED_SHARE",
+           "FORCE_WINDOW_BEFORE", "HAMMER_BAND_DB", "PEAK_PROMINENCE", "HALF_POWER_LINES",
            "added_damping"]
 
 ESTIMATORS = ("H1", "H2", "Hv")
@@ -32,11 +33,6 @@ ESTIMATORS = ("H1", "H2", "Hv")
 
 EXP_WINDOW_END = 0.01
 """The exponential window's value at the end of the tap when its time constant is not given."""
-
-DECAYED_SHARE = 3e-3
-"""A response has died out by the end of a tap when its RMS over the tap's last 5 % is at most this share of its
-peak, or at most three times its RMS before the hit (its noise): the exponential window is then not needed, and
-not applied unless asked for (it would add the damping ratio ``1 / (tau omega)`` to every mode for nothing)."""
 
 FORCE_WINDOW_EXTRA = 1.0
 """The force window stays open this many pulse widths after the pulse ends."""
@@ -165,6 +161,13 @@ class TapResult:
     force_window_s : float
         The force window's effective length (s): the width of the window that
         holds the same noise, ``(sum w)^2 / sum w^2`` samples.
+    truncation : numpy.ndarray or None
+        Per line of ``frf``, the variance of the FRF's relative error that
+        the end of the taps leaves where the response still rings there,
+        counted over the lines it spans
+        (:func:`~substructure.tap.record_end.truncation_variance`); None
+        when the response died out.  The diagnosis's noise model adds it as
+        it adds ``force_noise``.
     """
 
     frf: FRF
@@ -182,6 +185,7 @@ class TapResult:
     force_noise: np.ndarray | None = None
     force_noise_rms: float = 0.0
     force_window_s: float = 0.0
+    truncation: np.ndarray | None = None
 
     @property
     def averages(self) -> int:
@@ -302,6 +306,27 @@ class TapResult:
         values = values[np.isfinite(values)]  # a line without force has no finite variance
         return float(np.sqrt(np.max(values))) if values.size else None
 
+    def truncation_error(self) -> tuple[float, float] | None:
+        """The largest relative error the end of the taps leaves within the usable band, and where.
+
+        Returns
+        -------
+        (float, float) or None
+            ``(error, frequency_hz)``: the bound of
+            :func:`~substructure.tap.record_end.truncation_variance` at its
+            largest over the finite lines up to ``hammer_band_hz`` (0.01: 1 %),
+            without the count of lines it spans; None when the response
+            died out.
+        """
+        if self.truncation is None:
+            return None
+        hz = self.frf.frequency.hz
+        usable = (hz <= self.hammer_band_hz) & np.isfinite(self.truncation)
+        if not usable.any():
+            return None
+        k = int(np.argmax(np.where(usable, self.truncation, -1.0)))
+        return float(np.sqrt(self.truncation[k] * TRUNCATION_SEGMENT)), float(hz[k])
+
     def summary(self) -> dict:
         """The result as plain data (the JSON of ``substructure tap``).
 
@@ -311,7 +336,9 @@ class TapResult:
             Keys ``taps``, ``rejected``, ``estimator``, ``averages``, ``frequency_hz``,
             ``real``, ``imag``, ``coherence``, ``tau_s``, ``window`` (why the window was or was
             not applied), ``hammer_band_hz``, ``force_noise_rms_n``, ``force_window_s``,
-            ``force_scatter`` (:meth:`force_scatter`), ``per_tap``.
+            ``force_scatter`` (:meth:`force_scatter`), ``truncation_error``
+            (:meth:`truncation_error` as ``{"error", "frequency_hz"}``, or
+            None), ``per_tap``.
         """
         values = self.frf.data[:, 0, 0]
         return {
@@ -330,6 +357,8 @@ class TapResult:
             "force_noise_rms_n": self.force_noise_rms,
             "force_window_s": self.force_window_s,
             "force_scatter": self.force_scatter(),
+            "truncation_error": None if (cut := self.truncation_error()) is None else
+            {"error": cut[0], "frequency_hz": cut[1]},
             "per_tap": [{"tap": t.number, "file": t.source, "start_s": t.start_s, "peak_force_n": t.peak_force,
                          "pulse_width_s": t.pulse_width_s, "band_hz": t.band_hz, "kept": t.kept}
                         for t in self.taps],
@@ -419,10 +448,11 @@ def process_taps(
         Time kept before the trigger crossing, in s.
     exponential : bool or None
         Whether to apply the exponential window to both channels; None
-        (default): only when the response has not died out by the end of
-        every tap (see :data:`DECAYED_SHARE`): a window adds the damping
+        (default): only when the response still rings at the end of a tap
+        above :data:`WINDOW_SHARE` of its peak: a window adds the damping
         ratio ``1 / (tau omega)`` to every mode, which a comparison with a
-        model sees.
+        model sees; below it, the truncation's error is counted
+        (``TapResult.truncation``).
     tau : float, optional
         Its time constant in s (given: the window is applied unless
         ``exponential`` is False); default such that it falls to
@@ -558,9 +588,11 @@ def process_taps(
             x[i] -= x[i, :p].mean()
     f = f * force_window[rows]
     noise_sd = np.array([_noise_outside(force[r] - baseline[r], force_window[r]) for r in rows.tolist()])
-    decayed, why = _decay(x, pre_rows, [taps[cuts[r][2]].number for r in rows])
+    quiet = np.argmax(force_window[rows] > 0, axis=1)  # the samples before the force window: no pulse yet
+    needed, why = window_needed(x, quiet, [taps[cuts[r][2]].number for r in rows])
+    response_noise = noise_variance(x, quiet)
     if exponential is None and tau is None:
-        exponential = not decayed
+        exponential = needed
     elif exponential is False:
         why = "none: not asked for"
     else:  # asked for: exponential=True, or a time constant given
@@ -614,9 +646,12 @@ def process_taps(
     # an H2 is compared as gamma^2 H2, which is this H1 (Measurement.h1_frf): its hammer noise is the same
     v_f = np.where(np.isfinite(v_f), v_f, np.inf)[keep] if estimator != "Hv" else None
     width = float(np.mean(np.sum(w_f, axis=1) ** 2 / np.sum(w_f**2, axis=1))) * dt
+    truncation = truncation_variance(x, F, w, response_noise, h, dt)
+    why = why.format("" if truncation is None else
+                     "; cutting what still rang leaves an error, counted as noise (the truncation)")
     return TapResult(measured.to_receptance(), measured, coherence[keep], estimator, tuple(taps), tau,
                      hammer_band, float(hammer_band_db), spectra, rate, length, why, v_f,
-                     float(np.sqrt(np.mean(noise_sd**2))), width)
+                     float(np.sqrt(np.mean(noise_sd**2))), width, None if truncation is None else truncation[keep])
 
 
 def _noise_outside(force: np.ndarray, window: np.ndarray) -> float:
@@ -627,23 +662,3 @@ def _noise_outside(force: np.ndarray, window: np.ndarray) -> float:
     if rest.size < 8:
         return 0.0
     return float(1.4826 * np.median(np.abs(rest - np.median(rest))))
-
-
-def _decay(x: np.ndarray, pre: np.ndarray, numbers: list[int]) -> tuple[bool, str]:
-    """Whether the responses ``x`` (one kept tap a row) died out by the end of their taps, and why, in words.
-
-    They did when every tap's RMS over its last 5 % (at least 16 samples) is at most :data:`DECAYED_SHARE` of
-    its peak or three times its RMS before the hit; else the words say which tap needs the window.
-    """
-    tail = max(16, x.shape[1] // 20)
-    end = np.sqrt(np.mean(x[:, -tail:] ** 2, axis=1))
-    peak = np.max(np.abs(x), axis=1)
-    noise = np.array([np.sqrt(np.mean(row[:p] ** 2)) if p >= 8 else 0.0 for row, p in zip(x, pre.tolist())])
-    share = end / np.maximum(peak, 1e-300)
-    alive = end > np.maximum(DECAYED_SHARE * peak, 3.0 * noise)
-    if not alive.any():
-        return True, (f"none: the response died out within every tap (its RMS over the last {tail} samples at "
-                      f"most {share.max():.2g} of its peak)")
-    k = int(np.argmax(np.where(alive, share, -1.0)))
-    return False, (f"the response had not died out by the end of tap {numbers[k]} ({share[k]:.2g} of its peak over "
-                   f"its last {tail} samples): a longer record would need none")

@@ -137,7 +137,8 @@ def measured_frfs(measurements, band=None) -> tuple[list[Measured], tuple[float,
         noise = estimate_noise(frf, coherence=getattr(m, "coherence", None), averages=getattr(m, "averages", None),
                                force_noise=getattr(m, "force_noise", None),
                                force_window_s=getattr(m, "force_window_s", None),
-                               estimator=getattr(m, "estimator", None))
+                               estimator=getattr(m, "estimator", None),
+                               truncation=getattr(m, "truncation", None))
         mask = frf.frequency.band_mask(lo, hi)
         if mask.sum() < 10:
             raise InvalidValueError(f"band: {lo:g}-{hi:g} Hz holds {int(mask.sum())} lines of {label}; "

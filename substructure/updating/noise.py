@@ -42,8 +42,11 @@ standard errors above the model); a line beyond the tail of even the local
 model gets its own squared residual as variance; and the lines where the
 additive terms of the log variance (the floor's and the coherence's: the
 response's noise is additive) exceed :data:`NOISE_DOMINATED` are read in
-the linear domain by :meth:`NoiseModel.line_scores`.  See
-docs/diagnose.md, "The noise model".
+the linear domain by :meth:`NoiseModel.line_scores`.  Errors the
+smoothing residual cannot see are added when the measurement carries
+them: the hammer's noise (smooth over the force window's inverse) and the
+truncation of a response that still rang at the end of the taps (which
+every tap repeats, so that the coherence does not see it either).  See docs/diagnose.md, "The noise model".
 """
 
 from __future__ import annotations
@@ -313,7 +316,7 @@ def _force_term(force_noise, window_s, hz: np.ndarray, label: str) -> np.ndarray
 
 def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3, *, coherence=None,
                    averages: int | None = None, force_noise=None, force_window_s: float | None = None,
-                   estimator: str | None = None) -> NoiseModel:
+                   estimator: str | None = None, truncation=None) -> NoiseModel:
     """The per-line noise of a measured FRF (one entry), estimated from the data.
 
     Parameters
@@ -352,6 +355,13 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
         domain), is added to each line's variance.  An H2 is compared as
         ``gamma^2 H2``, which is H1 (``Measurement.h1_frf``): give that FRF
         and ``"H1"``.
+    truncation : array_like, optional
+        Per line, the variance of the FRF's relative error that the end of
+        the taps leaves where the response still rang
+        (``substructure.tap.TapResult.truncation``, already counted over the
+        lines it spans): an error the taps repeat, which neither the
+        coherence nor the smoothing residual sees; added to each line's
+        variance, half to each part.
 
     Returns
     -------
@@ -364,7 +374,8 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
         For an FRF that is zero (or not finite) on every line, too short,
         with magnitudes whose square overflows (beyond 1e140 in SI units) or
         underflows (below 1e-140), a coherence or force noise of the wrong
-        length, or a force noise without the window's length.
+        length, or a force noise without the window's length, a truncation
+        of the wrong length or negative.
     """
     if measured.shape[1:] != (1, 1):
         raise InvalidValueError(f"measured: got {measured.shape[1]}x{measured.shape[2]} entries; expected one")
@@ -490,6 +501,11 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     scatter = np.where(keep, zf, np.nan)
     coherence_factor = float(0.5 * coef[3] / coh_scale) if coh is not None else None
     extra = _force_term(force_noise, force_window_s, measured.frequency.hz, label)
+    if truncation is not None:  # the taps' end: an error repeated by every tap, counted like the hammer's
+        cut = np.asarray(truncation, dtype=float).reshape(-1)
+        if cut.size != n or not np.all(cut >= 0):
+            raise InvalidValueError(f"truncation of {label}: expected {n} variances >= 0, one per line")
+        extra = 0.5 * cut if extra is None else extra + 0.5 * cut
     dof = None
     if coh is not None:
         # the share of each line's variance that the coherence of a few taps gives, and the variance's degrees

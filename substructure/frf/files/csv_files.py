@@ -4,11 +4,12 @@ One FRF per file, header ``frequency_hz,real,imag``, one line per frequency,
 receptance in m/N unless told otherwise; values are written with every
 digit (``repr``) so that a written file reads back to the same floats.  A
 fourth column ``coherence`` (the ordinary coherence of a tap test, in
-[0, 1]) may follow, and after it a fifth, ``force_noise`` (the variance of
-H1's relative error that the hammer's noise gives, per line, a tap test's;
-``inf`` where there was no force): :func:`read_csv_with_coherence` returns
-the coherence, :func:`read_csv` reads such files too and returns the FRF
-alone.
+[0, 1]) may follow, and after it ``force_noise`` (the variance of H1's
+relative error that the hammer's noise gives, per line, a tap test's;
+``inf`` where there was no force) and ``truncation`` (the variance of the
+relative error the end of the taps leaves), each optional:
+:func:`read_csv_with_coherence` returns the coherence, :func:`read_csv`
+reads such files too and returns the FRF alone.
 """
 
 from __future__ import annotations
@@ -30,9 +31,13 @@ __all__ = ["write_csv", "read_csv", "read_csv_with_coherence"]
 CSV_HEADER = "frequency_hz,real,imag"
 COHERENCE_HEADER = CSV_HEADER + ",coherence"
 FORCE_NOISE_HEADER = COHERENCE_HEADER + ",force_noise"
+_VARIANCE_COLUMNS = ("force_noise", "truncation")  # after the coherence, in this order, each optional
+_HEADERS = (CSV_HEADER, COHERENCE_HEADER, FORCE_NOISE_HEADER, COHERENCE_HEADER + ",truncation",
+            FORCE_NOISE_HEADER + ",truncation")
 
 
-def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coherence=None, force_noise=None) -> None:
+def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coherence=None, force_noise=None,
+              truncation=None) -> None:
     """Write a one-entry FRF to a CSV file ``frequency_hz,real,imag`` (``,coherence`` when given).
 
     Parameters
@@ -53,14 +58,18 @@ def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coheren
         With a coherence: per line, the variance of H1's relative error from
         the hammer's noise (``substructure.tap.TapResult.force_noise``;
         >= 0, ``inf`` allowed), written as a fifth column ``force_noise``.
+    truncation : array of float, optional
+        With a coherence: per line, the variance of the relative error the
+        end of the taps leaves (``substructure.tap.TapResult.truncation``;
+        >= 0, ``inf`` allowed), written as the last column ``truncation``.
 
     Raises
     ------
     InvalidValueError
         For an FRF of more than one entry or of fewer than 2 lines (which
         no reader takes), a coherence of another length or outside [0, 1],
-        or a force noise without a coherence, of another length, negative or
-        NaN.
+        or a force noise or truncation without a coherence, of another
+        length, negative or NaN.
     """
     from ..._files import write_text
 
@@ -85,12 +94,14 @@ def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coheren
                 f"coherence: cannot write {os.fspath(path)}: expected {frf.frequency.n} values in [0, 1], one per line"
             )
         header, columns = COHERENCE_HEADER, columns + [gamma]
-    if force_noise is not None:
-        v = np.asarray(force_noise, dtype=np.float64)
+    for column, given in zip(_VARIANCE_COLUMNS, (force_noise, truncation)):
+        if given is None:
+            continue
+        v = np.asarray(given, dtype=np.float64)
         if coherence is None or v.shape != (frf.frequency.n,) or not np.all(v >= 0):
-            raise InvalidValueError(f"force_noise: cannot write {os.fspath(path)}: expected {frf.frequency.n} values "
+            raise InvalidValueError(f"{column}: cannot write {os.fspath(path)}: expected {frf.frequency.n} values "
                                     ">= 0 (inf allowed), one per line, and a coherence")
-        header, columns = FORCE_NOISE_HEADER, columns + [v]
+        header, columns = header + "," + column, columns + [v]
     text = "".join(",".join(map(repr, row)) + "\n" for row in zip(*(c.tolist() for c in columns)))
     write_text(path, header + "\n" + text, overwrite=overwrite)
 
@@ -166,14 +177,13 @@ def read_csv_with_coherence(
         As :func:`read_csv`, and for a coherence that is not a number in
         [0, 1], naming the file and the line.
     """
-    frf, _, coherence, _ = _read_csv(path, output, input, quantity)
-    return frf, coherence
+    frf, _, columns = _read_csv(path, output, input, quantity)
+    return frf, columns.get("coherence")
 
 
-def _read_csv(path, output: str, input: str,
-              quantity: str | None) -> tuple[FRF, np.ndarray, np.ndarray | None, np.ndarray | None]:
-    """:func:`read_csv_with_coherence`, with the line of the file each frequency line comes from and the force
-    noise column."""
+def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF, np.ndarray, dict[str, np.ndarray]]:
+    """:func:`read_csv_with_coherence`, with the line of the file each frequency line comes from and the per-line
+    columns the file has (``coherence``, ``force_noise``, ``truncation``) by name."""
     from ..._files import MAX_DATA_BYTES, read_text
 
     name = os.fspath(path)
@@ -187,12 +197,12 @@ def _read_csv(path, output: str, input: str,
         raise FileFormatError(f"{name}: the file is empty; expected the header {CSV_HEADER!r}")
     first, header = numbered[0]
     columns = header.replace(" ", "").lstrip("\ufeff")
-    if columns not in (CSV_HEADER, COHERENCE_HEADER, FORCE_NOISE_HEADER):  # another program's export
+    if columns not in _HEADERS:  # another program's export
         from .exports import read_export
 
         table, lines_of, said, coherence = read_export(numbered, name, quantity)
         frf = _checked_csv(table, lines_of, name, output, input, quantity or said or "receptance")
-        return frf, lines_of, coherence, None
+        return frf, lines_of, {} if coherence is None else {"coherence": coherence}
     names = columns.split(",")
     numbered = numbered[1:]
     if len(numbered) < 2:
@@ -219,24 +229,23 @@ def _read_csv(path, output: str, input: str,
                     ) from None
         raise  # pragma: no cover - numpy and float() disagree on a cell
     lines_of = np.array([number for number, _ in numbered])
-    coherence = force_noise = None
-    if len(names) >= 4:
-        coherence = table[:, 3]
+    found = dict(zip(names[3:], table[:, 3:].T))
+    if "coherence" in found:
+        coherence = found["coherence"]
         bad = ~(np.isfinite(coherence) & (coherence >= 0.0) & (coherence <= 1.0))
         if bad.any():
             k = int(np.argmax(bad))
             raise FileFormatError(
                 f"{name}, line {lines_of[k]}: coherence is {float(coherence[k])!r}; expected a number in [0, 1]"
             )
-    if len(names) == 5:
-        force_noise = table[:, 4]
-        bad = ~(force_noise >= 0.0)  # NaN and negative values; inf is a line without force
-        if bad.any():
+    for column in _VARIANCE_COLUMNS:
+        bad = ~(found[column] >= 0.0) if column in found else None  # NaN and negative values; inf is allowed
+        if bad is not None and bad.any():
             k = int(np.argmax(bad))
-            raise FileFormatError(f"{name}, line {lines_of[k]}: force_noise is {float(force_noise[k])!r}; expected "
-                                  "a variance >= 0 (inf where there was no force)")
+            raise FileFormatError(f"{name}, line {lines_of[k]}: {column} is {float(found[column][k])!r}; expected "
+                                  "a variance >= 0 (inf where the FRF carries nothing)")
     frf = _checked_csv(table[:, :3], lines_of, name, output, input, quantity or "receptance")
-    return frf, lines_of, coherence, force_noise
+    return frf, lines_of, found
 
 
 def _checked_csv(table: np.ndarray, lines_of: np.ndarray, name: str, output: str, input: str,
