@@ -21,7 +21,7 @@ from ..errors import InvalidValueError
 from ..frf import FRF, Frequency
 from .detect import (CLIP_RUN, DOUBLE_HIT_FRACTION, NO_HIT_FACTOR, PRE_TRIGGER_S, TRIGGER_FRACTION,
                      check_swapped, double_hit, find_pulse, longest_flat_run, tap_starts)
-from .record_end import TRUNCATION_SEGMENT, noise_variance, truncation_variance, window_needed
+from .record_end import TRUNCATION_SEGMENT, end_words, noise_variance, truncation_variance, window_needed
 from .records import RESPONSE_QUANTITIES, TapRecord
 
 __all__ = ["process_taps", "TapResult", "Tap", "ESTIMATORS", "EXP_WINDOW_END", "FORCE_WINDOW_EXTRA",
@@ -647,8 +647,7 @@ def process_taps(
     v_f = np.where(np.isfinite(v_f), v_f, np.inf)[keep] if estimator != "Hv" else None
     width = float(np.mean(np.sum(w_f, axis=1) ** 2 / np.sum(w_f**2, axis=1))) * dt
     truncation = truncation_variance(x, F, w, response_noise, h, dt)
-    why = why.format("" if truncation is None else
-                     "; cutting what still rang leaves an error, counted as noise (the truncation)")
+    why = end_words(why, truncation)
     return TapResult(measured.to_receptance(), measured, coherence[keep], estimator, tuple(taps), tau,
                      hammer_band, float(hammer_band_db), spectra, rate, length, why, v_f,
                      float(np.sqrt(np.mean(noise_sd**2))), width, None if truncation is None else truncation[keep])

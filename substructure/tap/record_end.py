@@ -27,7 +27,7 @@ from scipy.stats import chi2
 from scipy.stats import f as f_dist
 
 __all__ = ["DECAYED_SHARE", "WINDOW_SHARE", "TRUNCATION_SEGMENT", "TRUNCATION_RATIO_MAX", "TRUNCATION_SIGNIFICANCE",
-           "window_needed",
+           "TRUNCATION_NEGLIGIBLE", "window_needed", "end_words",
            "noise_variance", "truncation_variance"]
 
 DECAYED_SHARE = 3e-3
@@ -45,6 +45,9 @@ TRUNCATION_SIGNIFICANCE = 1e-3
 noise does with this probability, over all the independent lines of the band (the lines of a segment's
 spectrum are correlated over ``1 / TRUNCATION_SEGMENT`` lines)."""
 
+TRUNCATION_NEGLIGIBLE = 1e-6
+"""A truncation whose relative error is below this on every line is none (a response rung down to rounding)."""
+
 TRUNCATION_SEGMENT = 0.1
 """The share of a tap whose response estimates the truncation's error, and the segment before it its decay."""
 
@@ -58,8 +61,8 @@ def window_needed(x: np.ndarray, pre: np.ndarray, numbers: list[int]) -> tuple[b
 
     They do when a tap's RMS over its last 5 % (at least 16 samples) exceeds :data:`WINDOW_SHARE` of its peak
     and three times its RMS before the hit; the words also say whether they died out (:data:`DECAYED_SHARE`)
-    or still rang, their truncation counted.  Words that say the response died out hold a ``{}`` for what
-    :func:`truncation_variance` then finds (``str.format`` it with ``""`` or a clause).
+    or still rang, their truncation counted.  Words that say the response died out hold two ``{}`` for what
+    :func:`truncation_variance` then finds: :func:`end_words` fills them.
     """
     tail = max(16, x.shape[1] // 20)
     end = np.sqrt(np.mean(x[:, -tail:] ** 2, axis=1))
@@ -68,14 +71,22 @@ def window_needed(x: np.ndarray, pre: np.ndarray, numbers: list[int]) -> tuple[b
     share = end / np.maximum(peak, 1e-300)
     alive = end > np.maximum(DECAYED_SHARE * peak, 3.0 * noise)
     if not alive.any():
-        return False, (f"none: the response died out within every tap (its RMS over the last {tail} samples at "
-                       f"most {share.max():.2g} of its peak{{}})")
+        return False, (f"none: the response {{}} every tap (its RMS over the last {tail} samples at most "
+                       f"{share.max():.2g} of its peak){{}}")
     k = int(np.argmax(np.where(alive, share, -1.0)))
     where = f"by the end of tap {numbers[k]} ({share[k]:.2g} of its peak over its last {tail} samples)"
     if share[k] <= WINDOW_SHARE:
         return False, (f"none: the response still rang {where}; its truncation is counted as noise rather than "
                        "traded for the window's damping (a longer record would be better)")
     return True, f"the response had not died out {where}: a longer record would need none"
+
+
+def end_words(why: str, truncation: np.ndarray | None) -> str:
+    """The words of :func:`window_needed` completed with what the end of the taps leaves (``truncation``)."""
+    if truncation is None:
+        return why.format("died out within", "")
+    return why.format("nearly died out within",
+                      "; what still rang leaves an error, counted as noise (the truncation)")
 
 
 def noise_variance(x: np.ndarray, pre: np.ndarray) -> np.ndarray:
@@ -108,7 +119,8 @@ def truncation_variance(x: np.ndarray, F: np.ndarray, w: np.ndarray, noise: np.n
         ``|E / H|^2`` per line, ``E`` the bound of the module docstring,
         counted as ``TapResult.force_noise`` is (half in the log magnitude,
         half in the phase); None when the response's end holds nothing
-        above its noise (it died out).
+        above its noise (it died out), or nothing above
+        :data:`TRUNCATION_NEGLIGIBLE` on any line.
     """
     n = x.shape[1]
     seg = max(16, int(TRUNCATION_SEGMENT * n))
@@ -126,7 +138,9 @@ def truncation_variance(x: np.ndarray, F: np.ndarray, w: np.ndarray, noise: np.n
         """
         piece = np.zeros_like(x)
         where = slice(n - stop - seg, n - stop)
-        piece[:, where] = x[:, where]
+        # less its mean: an offset left by the one removed before the hit (a mean of a few noisy samples)
+        # is no ringing, and it would stand out of the noise, the same on the segment's lowest lines
+        piece[:, where] = x[:, where] - np.mean(x[:, where], axis=1, keepdims=True)
         spectrum = scipy.fft.rfft(piece, axis=1) * dt
         with np.errstate(divide="ignore", invalid="ignore"):
             mean = np.sum(np.conj(F) * spectrum, axis=0) / power
@@ -166,5 +180,5 @@ def truncation_variance(x: np.ndarray, F: np.ndarray, w: np.ndarray, noise: np.n
     r = np.minimum(np.where(np.isfinite(r), r, overall), TRUNCATION_RATIO_MAX)
     size = excess_last * (r / (1.0 - r)) ** 2
     with np.errstate(divide="ignore", invalid="ignore"):
-        v = size / np.abs(h) ** 2
-    return np.where(np.abs(h) > 0, v, np.inf)
+        v = np.where(np.abs(h) > 0, size / np.abs(h) ** 2, np.inf)
+    return v if np.max(v) > TRUNCATION_NEGLIGIBLE**2 else None
