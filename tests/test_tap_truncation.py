@@ -154,3 +154,15 @@ def test_the_command_says_what_the_end_of_the_taps_leaves_and_writes_it(tmp_path
     assert main(["tap", *files, "--json"]) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["truncation_error"]["error"] > 0 and "still rang" in summary["window"]
+
+
+@pytest.mark.parametrize("header", ["frequency_hz,real,imag,truncation",
+                                    "frequency_hz,real,imag,coherence,truncation,force_noise",
+                                    "frequency_hz,real,imag,force_noise,coherence"])
+def test_the_package_columns_in_another_order_or_without_the_coherence_are_refused_so(tmp_path, header):
+    path = tmp_path / "frf.csv"
+    cells = ",".join(["0.5"] * (header.count(",") - 2))
+    path.write_text(f"{header}\n10,1e-6,-1e-7,{cells}\n20,1e-6,-2e-7,{cells}\n")
+    with pytest.raises(FileFormatError, match=r"line 1: the columns .* are the package's in another order or without "
+                                              "the coherence; expected 'frequency_hz,real,imag', then 'coherence'"):
+        read_csv_with_coherence(path)

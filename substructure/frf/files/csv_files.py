@@ -197,6 +197,12 @@ def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF,
         raise FileFormatError(f"{name}: the file is empty; expected the header {CSV_HEADER!r}")
     first, header = numbered[0]
     columns = header.replace(" ", "").lstrip("\ufeff")
+    if columns not in _HEADERS and columns.startswith(CSV_HEADER + ",") and \
+            set(columns.split(",")[3:]) <= {"coherence", *_VARIANCE_COLUMNS}:
+        raise FileFormatError(f"{name}, line {first}: the columns {_shown(columns)} are the package's in another "
+                              f"order or without the coherence; expected {CSV_HEADER!r}, then 'coherence', then "
+                              "'force_noise' and 'truncation', each optional, in this order (the last two need the "
+                              "coherence)")
     if columns not in _HEADERS:  # another program's export
         from .exports import read_export
 
