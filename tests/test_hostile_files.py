@@ -159,6 +159,12 @@ def _export(tmp_path, header, columns, sep=",", decimal=".", prefix="", encoding
     ("freq [rad/s],magnitude [(m/s^2)/N],phase [rad]", (W, np.abs(W**2 * H), np.angle(-(W**2) * H)), {},
      "accelerance"),
     ("frequency_hz,real [m/s/N],imag [m/s/N]", (HZ, (1j * W * H).real, (1j * W * H).imag), {}, "mobility"),
+    # units in a row of their own under the names, names of several words (as analysers export an FRF)
+    ('"Frequency","FRF Real","FRF Imag"\n"Hz","(m/s2)/N","(m/s2)/N"', (HZ, (-(W**2) * H).real, (-(W**2) * H).imag),
+     {}, "accelerance"),
+    ("Frequency\tH1 Real\tH1 Imag\nHz\tmm/N\tmm/N", (HZ, 1e3 * H.real, 1e3 * H.imag), {"sep": "\t"}, "receptance"),
+    ("Freq;Re;Im\n[Hz];[g/N];[g/N]", (HZ, (-(W**2) * H).real / G, (-(W**2) * H).imag / G),
+     {"sep": ";", "decimal": ","}, "accelerance"),
 ])
 def test_exports_with_units_in_the_header_are_read_and_converted(tmp_path, header, columns, kw, quantity):
     from substructure.io.frf_files import read_csv
@@ -188,6 +194,8 @@ def test_exports_with_units_in_the_header_are_read_and_converted(tmp_path, heade
     ("Frequency [Hz],Real [N/m],Imag [N/m]", "not that of a receptance"),
     ("Frequency [Hz],Coherence,Imag", "in this order"),  # a coherence goes after the FRF's columns
     ("Frequency [Hz],Imag [m/N],Real [m/N]", "in this order"),
+    ("Frequency [Hz],Real Imag [m/N],Imag [m/N]", "column 'Real Imag \\[m/N\\]'; expected frequency"),  # two kinds
+    ("Frequency,Real,Imag\nHz,,m/N", "has no unit|different units"),  # a unit row with a unit missing
 ])
 def test_ambiguous_exports_are_refused_with_what_to_give(tmp_path, header, pattern):
     from substructure.io.frf_files import read_csv

@@ -6,7 +6,9 @@ header to :func:`parse_export`, which reads what is unambiguous and refuses
 the rest with what to give instead: comment lines (``#``) before the header,
 ``;`` or tab separators (with decimal commas), quoted cells, empty trailing
 columns, units in the header (``Frequency [Hz]``, ``Real [mm/N]``,
-``Magnitude [g/N]``, ``Phase [deg]``), real and imaginary parts or magnitude
+``Magnitude [g/N]``, ``Phase [deg]``) or in a row of their own under the
+names, names of several words one of which says the column (``FRF Real``,
+``H1 Imag``), real and imaginary parts or magnitude
 and phase, and a fourth column of the coherence (``Coherence``, ``Coh``,
 ``gamma^2``; no unit, or ``%``).  A magnitude in dB is refused (its
 reference is not in the file), and so is a column that is neither of these.
@@ -51,6 +53,12 @@ def _column(cell: str, name: str, line: int) -> tuple[str, str | None]:
     for kind, names in _NAMES.items():
         if key in names:
             return kind, unit
+    # a name of several words, one of them the column's kind: 'FRF Real', 'H1 Imag', 'Coherence H1'
+    tokens = set(re.split(r"[^0-9a-zγ²^]+", raw.lower())) - {""}
+    if "db" not in tokens:
+        found = {kind for kind, names in _NAMES.items() if tokens & names}
+        if len(found) == 1:
+            return found.pop(), unit
     if "db" in key:
         raise FileFormatError(f"{name}, line {line}: column {_shown(cell)}: a magnitude in dB has no unit of its own "
                               "(dB of what?); export the real and imaginary parts, or the magnitude in a unit "
@@ -59,6 +67,27 @@ def _column(cell: str, name: str, line: int) -> tuple[str, str | None]:
         f"{name}, line {line}: column {_shown(cell)}; expected frequency, then real and imaginary parts or magnitude "
         "and phase, and optionally the coherence (e.g. 'frequency_hz,real,imag' or "
         "'Frequency [Hz];Magnitude [m/N];Phase [deg];Coherence')")
+
+
+def _bare_unit(cell: str) -> str | None:
+    """A unit cell without the brackets around it (``[Hz]``, ``(m/N)``; not those of ``(m/s2)/N``); None if empty."""
+    text = cell.strip()
+    if len(text) > 1 and text[0] + text[-1] in ("[]", "()"):
+        inner, depth = text[1:-1], 0
+        for c in inner:
+            depth += {"(": 1, ")": -1, "[": 1, "]": -1}.get(c, 0)
+            if depth < 0:  # the first bracket closes inside: it is not around the whole
+                return text
+        return inner.strip() or None
+    return text or None
+
+
+def _is_number(cell: str) -> bool:
+    try:
+        float(cell.replace(",", "."))
+    except ValueError:
+        return False
+    return True
 
 
 def _value_unit(unit: str | None, cell: str, name: str, line: int):
@@ -127,6 +156,11 @@ def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None
         while row and row[-1] == "":  # an empty trailing column (a spreadsheet's last separator)
             row.pop()
     columns = [_column(c, name, first) for c in cells[0]]
+    if len(cells) > 1 and cells[1] and not any(_is_number(c) for c in cells[1]):
+        # a row of units under the names (an empty cell: no unit), as acquisition programs export them
+        units = cells[1] + [""] * (len(columns) - len(cells[1]))
+        columns = [(kind, unit if unit is not None else _bare_unit(u)) for (kind, unit), u in zip(columns, units)]
+        cells, rows = [cells[0]] + cells[2:], [rows[0]] + rows[2:]
     kinds = [k for k, _ in columns]
     if kinds[:3] not in (["frequency", "real", "imag"], ["frequency", "magnitude", "phase"]) \
             or kinds[3:] not in ([], ["coherence"]):
