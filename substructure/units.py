@@ -42,6 +42,7 @@ __all__ = [
     "CACHE_VARIABLE",
     "magnitude_in",
     "show_value",
+    "instrument_unit",
 ]
 
 CACHE_VARIABLE = "SUBSTRUCTURE_UNITS_CACHE"
@@ -351,6 +352,16 @@ def instrument_unit(text: str) -> pint.Unit:
     Exponents may be written without ``^`` (``m/s2``, ``m s-2``), as
     superscripts (``m/s\u00b2``, ``m\u00b7s\u207b\u00b2``) or after ``**``; a product with
     ``.`` or ``\u00b7``; micro as ``u``, ``\u00b5`` or ``\u03bc``.
+
+    Parameters
+    ----------
+    text : str
+        The label, e.g. ``"m/s2"``, ``"mV/g"``, ``"(m/s²)/N"``.
+
+    Returns
+    -------
+    pint.Unit
+        The unit, of the package's registry.
 
     Raises
     ------

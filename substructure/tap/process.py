@@ -165,7 +165,7 @@ class TapResult:
         Per line of ``frf``, the variance of the FRF's relative error that
         the end of the taps leaves where the response still rings there,
         counted over the lines it spans
-        (:func:`~substructure.tap.record_end.truncation_variance`); None
+        (``substructure.tap.record_end.truncation_variance``); None
         when the response died out.  The diagnosis's noise model adds it as
         it adds ``force_noise``.
     """
@@ -313,7 +313,7 @@ class TapResult:
         -------
         (float, float) or None
             ``(error, frequency_hz)``: the bound of
-            :func:`~substructure.tap.record_end.truncation_variance` at its
+            ``substructure.tap.record_end.truncation_variance`` at its
             largest over the finite lines up to ``hammer_band_hz`` (0.01: 1 %),
             without the count of lines it spans; None when the response
             died out.

@@ -37,7 +37,7 @@ peak, or at most three times its RMS before the hit (its noise)."""
 WINDOW_SHARE = 0.1
 """The exponential window is applied by default only when the response's RMS over a tap's last 5 % exceeds this
 share of its peak (and three times its noise).  Below it the truncation's error is estimated and counted
-(:func:`truncation_variance`) rather than traded for the damping ``1 / (tau omega)`` the window adds to every mode,
+(``TapResult.truncation``) rather than traded for the damping ``1 / (tau omega)`` the window adds to every mode,
 which no model compared with the FRF has."""
 
 TRUNCATION_SIGNIFICANCE = 1e-3

@@ -488,6 +488,12 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
         local_d2 = np.nanmedian(windows, axis=1) / np.log(2.0) / (1.0 - h0)
     with np.errstate(divide="ignore", invalid="ignore"):
         v_lin = 0.5 * local_d2 / np.abs(s) ** 2
+    if coh is not None:
+        # a line's own coherence says how noisy it is, wherever its neighbours stand: its H1 variance (with the
+        # fitted weight, as in the log domain) relative to |S|^2, at least (a single line at an antiresonance
+        # the grid does not resolve: the smoother does not dip with it, and its neighbours are far less noisy)
+        with np.errstate(invalid="ignore", over="ignore"):
+            v_lin = np.maximum(v_lin, 0.5 * coef[3] * g[1] * local * np.abs(hs) ** 2)
     linear = linear & np.isfinite(v_lin) & (v_lin > 0)
     lin_re, lin_im = (np.where(linear, np.maximum(v_lin, c), np.nan) for c in coef[:2])
     var_re, var_im = (np.where(usable, np.minimum(np.where(np.isfinite(v), v, VARIANCE_CAP), VARIANCE_CAP),
