@@ -10,8 +10,9 @@ The package sits next to :mod:`substructure.frf` in the layers: it needs
   clipping, records without a hit, swapped channels, the taps of a long
   record; the thresholds as named constants.
 - :mod:`~substructure.tap.process`: :func:`process_taps` (windows, H1/H2/Hv,
-  coherence, the hammer's usable band, the window's added damping) and
-  :class:`TapResult`.
+  coherence, the hammer's usable band).
+- :mod:`~substructure.tap.result`: :class:`TapResult` (and :class:`Tap`):
+  the FRF, its coherence, peaks and damping, the window's added damping.
 - :mod:`~substructure.tap.record_end`: the end of a tap: whether the
   exponential window is needed, and the error the truncation of a response
   that still rings leaves in the FRF (counted by the noise model).
@@ -25,11 +26,11 @@ result is
 
 from .detect import (CLIP_REACH, CLIP_RUN, CLIP_TOLERANCE, CREST_FACTOR_PULSE, DOUBLE_HIT_FRACTION, NO_HIT_FACTOR,
                      PRE_TRIGGER_S, TRIGGER_FRACTION, SwappedChannelsError)
-from .process import (ESTIMATORS, EXP_WINDOW_END, FORCE_WINDOW_BEFORE, FORCE_WINDOW_EXTRA, HALF_POWER_LINES,
-                      HAMMER_BAND_DB, PEAK_PROMINENCE, Tap, TapResult, added_damping, process_taps)
+from .process import ESTIMATORS, EXP_WINDOW_END, FORCE_WINDOW_BEFORE, FORCE_WINDOW_EXTRA, HAMMER_BAND_DB, process_taps
 from .record_end import (DECAYED_SHARE, TRUNCATION_NEGLIGIBLE, TRUNCATION_RATIO_MAX, TRUNCATION_SEGMENT,
                          TRUNCATION_SIGNIFICANCE, WINDOW_SHARE)
 from .records import RESPONSE_QUANTITIES, TapRecord, channel_to_si, unit_of
+from .result import HALF_POWER_LINES, PEAK_PROMINENCE, Tap, TapResult, added_damping
 
 __all__ = [
     "TapRecord", "process_taps", "TapResult", "Tap", "added_damping", "channel_to_si", "unit_of",
