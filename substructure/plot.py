@@ -114,7 +114,9 @@ def plot_taps(result, title: str | None = None, unit: str = "um/N") -> Figure:
     Top to bottom, on one frequency axis: each kept tap's force spectrum in
     dB with the hammer's usable band marked, the coherence, and the
     receptance's magnitude and phase drawn by :func:`plot_frf` (its units,
-    labels and rigid-body line left out of the scale).
+    labels and rigid-body line left out of the scale), with the error the
+    end of the taps may leave where the response still rang there
+    (``TapResult.truncation``).
 
     Parameters
     ----------
@@ -147,6 +149,13 @@ def plot_taps(result, title: str | None = None, unit: str = "um/N") -> Figure:
     for ax in (ax_f, ax_c):
         ax.grid(True, alpha=0.3)
     plot_frf(result.frf, ax=[ax_m, ax_p], unit=unit, note=False)
+    if result.truncation is not None:  # the end of the taps: the error it leaves, on the magnitude's scale
+        import numpy as np
+
+        size = np.abs(result.frf.data[:, 0, 0]) * np.sqrt(result.truncation) * FRF_UNITS[unit]
+        ax_m.plot(hz, np.where(np.isfinite(size), size, np.nan), color="C3", lw=0.7, ls=":",
+                  label="error the taps' end may leave")
+        ax_m.legend(fontsize=7, loc="lower left")
     rejected = len(result.rejected)
     about = (f"{result.estimator}, {result.averages} taps averaged" + (f", {rejected} rejected" if rejected else "")
              + (f"; exponential window tau = {result.tau:.4g} s" if result.tau else "; no exponential window"))

@@ -166,3 +166,21 @@ def test_the_package_columns_in_another_order_or_without_the_coherence_are_refus
     with pytest.raises(FileFormatError, match=r"line 1: the columns .* are the package's in another order or without "
                                               "the coherence; expected 'frequency_hz,real,imag', then 'coherence'"):
         read_csv_with_coherence(path)
+
+
+def test_the_figure_shows_the_error_the_end_of_the_taps_may_leave():
+    import matplotlib.pyplot as plt  # the backend is the Makefile's (Agg)
+
+    from substructure.plot import plot_taps
+
+    result = process_taps(_short_taps(1229, noise=1e-5))
+    fig = plot_taps(result)
+    magnitude = fig.axes[2]
+    (line,) = [ln for ln in magnitude.get_lines() if ln.get_label() == "error the taps' end may leave"]
+    drawn = np.asarray(line.get_ydata(), dtype=float)
+    expected = np.abs(result.frf.data[:, 0, 0]) * np.sqrt(result.truncation) * 1e6  # um/N, the default unit
+    assert np.allclose(drawn, expected, rtol=1e-12, equal_nan=True)
+    plt.close(fig)
+    died = plot_taps(process_taps(_short_taps(N_LONG, noise=1e-4)))
+    assert not [ln for ln in died.axes[2].get_lines() if ln.get_label() == "error the taps' end may leave"]
+    plt.close(died)
