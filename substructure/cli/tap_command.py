@@ -236,8 +236,9 @@ def add_parser(commands) -> None:
                      help="time constant of the exponential window (default: 1%% left at the end of the tap)")
     window = tap.add_mutually_exclusive_group()
     window.add_argument("--exponential-window", action="store_true",
-                        help="an exponential window on both channels even when the response dies out within the tap "
-                             "(default: only when it does not)")
+                        help="an exponential window on both channels whatever the response does at the end of "
+                             "the tap (default: only when it still rings above 10%% of its peak there; below, "
+                             "the error of its end is counted instead)")
     window.add_argument("--no-exponential-window", action="store_true", help="no exponential window")
     tap.add_argument("--correct-window-damping", action="store_true",
                      help="also each peak's half-power damping ratio, and the same less the window's 1/(tau omega)")
