@@ -184,3 +184,22 @@ def test_the_figure_shows_the_error_the_end_of_the_taps_may_leave():
     died = plot_taps(process_taps(_short_taps(N_LONG, noise=1e-4)))
     assert not [ln for ln in died.axes[2].get_lines() if ln.get_label() == "error the taps' end may leave"]
     plt.close(died)
+
+
+def test_one_tap_without_samples_before_the_hit_cannot_tell_its_end_from_its_noise():
+    # its noise is measured nowhere: whatever its last samples hold would be taken for a tail (it was: an error
+    # of 7.5 times the FRF claimed at 32 Hz on a tap that died out)
+    (record,) = _short_taps(N_LONG, noise=1e-4, peaks=(50.0,))
+    start = int(np.argmax(record.force > 0)) - 1  # the record starts at the hit
+    cut = TapRecord(record.time[start:] - record.time[start], record.force[start:], record.response[start:],
+                    record.quantity, "at the hit")
+    result = process_taps([cut], pre_trigger=0.0)
+    assert result.truncation is None
+    assert "with one tap and no samples before the hit, an error of its end cannot be told from its noise" \
+        in result.window
+    # with its noise measured before the hit, one tap cut while it rings has its end's error estimated
+    one = process_taps(_short_taps(1229, noise=1e-5, peaks=(50.0,)))
+    assert one.truncation is not None and "its truncation is counted" in one.window
+    hz, error = _relative_error(one)
+    band = (hz > 50) & (hz < 2000)
+    assert np.quantile(error[band] / np.sqrt(one.truncation[band]), 0.95) < 1.0

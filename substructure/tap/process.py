@@ -21,7 +21,7 @@ from ..errors import InvalidValueError
 from ..frf import FRF, Frequency
 from .detect import (CLIP_RUN, DOUBLE_HIT_FRACTION, NO_HIT_FACTOR, PRE_TRIGGER_S, TRIGGER_FRACTION,
                      check_swapped, double_hit, find_pulse, longest_flat_run, tap_starts)
-from .record_end import end_words, noise_variance, truncation_variance, window_needed
+from .record_end import end_words, noise_variance, told_apart, truncation_variance, window_needed
 from .records import RESPONSE_QUANTITIES, TapRecord
 from .result import Tap, TapResult
 
@@ -328,7 +328,7 @@ def process_taps(
     v_f = np.where(np.isfinite(v_f), v_f, np.inf)[keep] if estimator != "Hv" else None
     width = float(np.mean(np.sum(w_f, axis=1) ** 2 / np.sum(w_f**2, axis=1))) * dt
     truncation = truncation_variance(x, F, w, response_noise, h, dt)
-    why = end_words(why, truncation)
+    why = end_words(why, truncation, told_apart(x, response_noise))
     return TapResult(measured.to_receptance(), measured, coherence[keep], estimator, tuple(taps), tau,
                      hammer_band, float(hammer_band_db), spectra, rate, length, why, v_f,
                      float(np.sqrt(np.mean(noise_sd**2))), width, None if truncation is None else truncation[keep])

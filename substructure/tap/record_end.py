@@ -27,7 +27,7 @@ from scipy.stats import chi2
 from scipy.stats import f as f_dist
 
 __all__ = ["DECAYED_SHARE", "WINDOW_SHARE", "TRUNCATION_SEGMENT", "TRUNCATION_RATIO_MAX", "TRUNCATION_SIGNIFICANCE",
-           "TRUNCATION_NEGLIGIBLE", "window_needed", "end_words",
+           "TRUNCATION_NEGLIGIBLE", "window_needed", "end_words", "told_apart",
            "noise_variance", "truncation_variance"]
 
 DECAYED_SHARE = 3e-3
@@ -61,7 +61,7 @@ def window_needed(x: np.ndarray, pre: np.ndarray, numbers: list[int]) -> tuple[b
 
     They do when a tap's RMS over its last 5 % (at least 16 samples) exceeds :data:`WINDOW_SHARE` of its peak
     and three times its RMS before the hit; the words also say whether they died out (:data:`DECAYED_SHARE`)
-    or still rang, their truncation counted.  Words that say the response died out hold two ``{}`` for what
+    or still rang.  Unless the window is needed, they hold ``{verb}`` and ``{clause}`` for what
     :func:`truncation_variance` then finds: :func:`end_words` fills them.
     """
     tail = max(16, x.shape[1] // 20)
@@ -71,22 +71,38 @@ def window_needed(x: np.ndarray, pre: np.ndarray, numbers: list[int]) -> tuple[b
     share = end / np.maximum(peak, 1e-300)
     alive = end > np.maximum(DECAYED_SHARE * peak, 3.0 * noise)
     if not alive.any():
-        return False, (f"none: the response {{}} every tap (its RMS over the last {tail} samples at most "
-                       f"{share.max():.2g} of its peak){{}}")
+        return False, (f"none: the response {{verb}} every tap (its RMS over the last {tail} samples at most "
+                       f"{share.max():.2g} of its peak){{clause}}")
     k = int(np.argmax(np.where(alive, share, -1.0)))
     where = f"by the end of tap {numbers[k]} ({share[k]:.2g} of its peak over its last {tail} samples)"
     if share[k] <= WINDOW_SHARE:
-        return False, (f"none: the response still rang {where}; its truncation is counted as noise rather than "
-                       "traded for the window's damping (a longer record would be better)")
+        return False, f"none: the response still rang {where}{{clause}}"
     return True, f"the response had not died out {where}: a longer record would need none"
 
 
-def end_words(why: str, truncation: np.ndarray | None) -> str:
-    """The words of :func:`window_needed` completed with what the end of the taps leaves (``truncation``)."""
-    if truncation is None:
-        return why.format("died out within", "")
-    return why.format("nearly died out within",
-                      "; what still rang leaves an error, counted as noise (the truncation)")
+def end_words(why: str, truncation: np.ndarray | None, told: bool = True) -> str:
+    """The words of :func:`window_needed` completed with what the end of the taps leaves.
+
+    ``truncation`` is what :func:`truncation_variance` found; ``told`` is False when it could not tell an
+    error of the end from the noise (one tap, no samples before the hit to measure the noise on).
+    """
+    rang = why.startswith("none: the response still rang")
+    if truncation is not None:
+        clause = ("; its truncation is counted as noise rather than traded for the window's damping (a longer "
+                  "record would be better)" if rang else
+                  "; what still rang leaves an error, counted as noise (the truncation)")
+    elif not told:
+        clause = ("; with one tap and no samples before the hit, an error of its end cannot be told from its noise "
+                  "and is not counted (record a pre-trigger, or more taps)")
+    else:
+        clause = "; no error of its end stands out of the noise" if rang else ""
+    return why.format(verb="died out within" if truncation is None else "nearly died out within", clause=clause)
+
+
+def told_apart(x: np.ndarray, noise: np.ndarray) -> bool:
+    """Whether an error of the taps' end can be told from their noise: two taps or more (their scatter), or
+    one with its noise measured before the hit."""
+    return x.shape[0] > 1 or bool(noise[0] > 0)
 
 
 def noise_variance(x: np.ndarray, pre: np.ndarray) -> np.ndarray:
@@ -119,12 +135,13 @@ def truncation_variance(x: np.ndarray, F: np.ndarray, w: np.ndarray, noise: np.n
         ``|E / H|^2`` per line, ``E`` the bound of the module docstring,
         counted as ``TapResult.force_noise`` is (half in the log magnitude,
         half in the phase); None when the response's end holds nothing
-        above its noise (it died out), or nothing above
+        above its noise (it died out), when the two cannot be told apart
+        (:func:`told_apart`), or nothing above
         :data:`TRUNCATION_NEGLIGIBLE` on any line.
     """
     n = x.shape[1]
     seg = max(16, int(TRUNCATION_SEGMENT * n))
-    if 2 * seg > n:
+    if 2 * seg > n or not told_apart(x, noise):
         return None
     w2 = np.broadcast_to(w, x.shape) ** 2
     power = np.sum(np.abs(F) ** 2, axis=0)
