@@ -379,3 +379,29 @@ def test_an_antiresonance_line_the_grid_does_not_resolve_is_scored_by_its_own_co
         assert np.isfinite(noise.linear[1][k])  # read in the linear domain
         scores.append(noise.line_scores(np.log(exact / measured.values))[k])
     assert np.median(scores) < 1.5 and max(scores) < LINE_CAP, scores
+
+
+def test_the_report_says_when_the_taps_ended_while_the_response_rang(model):
+    measured, result = _measured(_taps(model, seed=1, length=0.03))
+    d = diagnose(model, [measured], progress=False)
+    (line,) = [r for r in d.report if "the taps ended while the response still rang" in r]
+    hz = measured.frf.frequency.hz
+    k = int(np.argmax(measured.truncation))
+    assert line.startswith("tool.tip:y / tool.tip:y: the taps ended") and f"near {hz[k]:.4g} Hz" in line
+    assert f"up to {np.sqrt(measured.truncation[k]):.2g} relative" in line
+    long, _ = _measured(_taps(model, seed=1))
+    assert not [r for r in diagnose(model, [long], progress=False).report if "still rang" in r]
+
+
+def test_an_explained_summary_shows_the_facts_of_the_data_as_notes(model):
+    """The facts a report holds whatever the verdict (a window, an H2, lines without a value, the taps' end) were
+    printed by the command only for an unexplained diagnosis."""
+    from substructure.diagnose import words
+
+    measured, _ = _measured(_taps(model, seed=1, length=0.03))
+    d = diagnose(model, [attrs.evolve(measured, window_tau=0.2)], progress=False)
+    assert d.explained
+    lines = words.summary(d, "built-in", 1)
+    notes = [line for line in lines if line.startswith("note: ")]
+    assert len(notes) == 2 and any("exponential window" in n for n in notes) and any("still rang" in n for n in notes)
+    assert lines[-1].startswith("verdict: explained")

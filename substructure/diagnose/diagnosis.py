@@ -325,6 +325,13 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         tau = getattr(m.measurement, "window_tau", None)
         if tau is not None:
             report = list(report) + [words.windowed(which, tau, float(hz[0]), float(hz[-1]))]
+        cut = getattr(m.measurement, "truncation", None)
+        if cut is not None:  # on the measurement's own lines: those of the band
+            full = m.measurement.frf.frequency.hz
+            inside = (full >= hz[0]) & (full <= hz[-1]) & np.isfinite(cut)
+            if inside.any() and cut[inside].max() > 0:
+                k = int(np.argmax(np.where(inside, cut, -1.0)))
+                report = list(report) + [words.truncated(which, float(np.sqrt(cut[k])), float(full[k]))]
         if not alive.all():
             report = list(report) + [words.empty_lines(which, hz[~alive])]
         if getattr(m.measurement, "estimator", None) == "H2":

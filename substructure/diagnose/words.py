@@ -245,6 +245,28 @@ def windowed(which: str, tau: float, lo_hz: float, hi_hz: float) -> str:
             "die out need no window)")
 
 
+def truncated(which: str, error: float, at_hz: float) -> str:
+    """The note that a measurement's taps ended while the response still rang (an error counted as noise).
+
+    Parameters
+    ----------
+    which : str
+        The measurement (``response / excitation``).
+    error : float
+        The largest relative error the end of the taps leaves within the band (``Measurement.truncation``).
+    at_hz : float
+        Where [Hz].
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    return (f"{which}: the taps ended while the response still rang; the error that leaves (up to {error:.2g} "
+            f"relative, near {at_hz:.4g} Hz) is counted as noise, so that less can be told there (a longer record "
+            "would not need it)")
+
+
 def empty_lines(which: str, hz) -> str:
     """The note that a measurement holds nothing on some lines of the band (zero or not finite), left out.
 
@@ -548,6 +570,8 @@ def summary(result, model_name: str, measured: int) -> list[str]:
         for step in result.refinement:
             what = "model as given" if step.added is None else f"+ {step.added.name} at {step.added.where}"
             lines.append(f"  step {step.step}: {what:50s} error {step.error:.4f}  chi^2/nu {step.chi2_reduced:.4g}")
+    if result.explained:  # an explained verdict's report holds the facts of the data only (a window, an H2, ...)
+        lines.extend(f"note: {line}" for line in result.report)
     cons = result.consistency
     verdict = "explained" if result.explained else "not explained"
     lines.append(f"verdict: {verdict}: final error {result.final_error:.4f} ({result.final_error / floor:.2f} x the "
