@@ -43,6 +43,7 @@ __all__ = [
     "magnitude_in",
     "show_value",
     "instrument_unit",
+    "bare_unit",
 ]
 
 CACHE_VARIABLE = "SUBSTRUCTURE_UNITS_CACHE"
@@ -341,6 +342,31 @@ _POUND = re.compile(r"(?<![A-Za-z_0-9])lbs?(?![A-Za-z_0-9])")
 _POWER = re.compile(r"(?<=[A-Za-z])(-?[0-9]+)(?![0-9.])")  # s2, s-2: an exponent written without ^
 _TIMES = re.compile(r"(?<=[A-Za-z0-9])\s*[.\u00b7\u22c5]\s*(?=[A-Za-z])")  # m.s-2, m\u00b7s-2
 _SUPERSCRIPTS = str.maketrans("\u207b\u00b9\u00b2\u00b3\u00b5\u03bc", "-123uu")
+
+
+def bare_unit(cell: str) -> str | None:
+    """A unit as a table's cell writes it, without brackets around the whole: ``[Hz]``, ``(m/N)`` (not the
+    parentheses of ``(m/s2)/N``); None for an empty cell.
+
+    Parameters
+    ----------
+    cell : str
+        The cell.
+
+    Returns
+    -------
+    str or None
+        The unit's text.
+    """
+    text = cell.strip()
+    if len(text) > 1 and text[0] + text[-1] in ("[]", "()"):
+        depth = 0
+        for c in text[1:-1]:
+            depth += {"(": 1, ")": -1, "[": 1, "]": -1}.get(c, 0)
+            if depth < 0:  # the first bracket closes inside: it is not around the whole
+                return text
+        return text[1:-1].strip() or None
+    return text or None
 
 
 def instrument_unit(text: str) -> pint.Unit:

@@ -7,8 +7,8 @@ import pint
 import pytest
 
 from substructure import InvalidValueError, Material, Segment, UnitError
-from substructure.units import (Q_, dimensionless, format_quantity, hz_to_rpm, instrument_unit, quantity, rpm_to_hz,
-                                to_si, ureg)
+from substructure.units import (Q_, bare_unit, dimensionless, format_quantity, hz_to_rpm, instrument_unit, quantity,
+                                rpm_to_hz, to_si, ureg)
 
 
 def test_strings_and_quantities_are_accepted():
@@ -117,3 +117,10 @@ def test_instrument_units_read_as_acquisition_programs_write_them(text, si, fact
 def test_an_instrument_unit_pint_cannot_read_is_a_value_error(text):
     with pytest.raises(ValueError):
         instrument_unit(text)
+
+
+@pytest.mark.parametrize("cell, unit", [("[Hz]", "Hz"), ("(m/N)", "m/N"), (" [ mm/N ] ", "mm/N"),
+                                        ("(m/s2)/N", "(m/s2)/N"), ("(m/s^2)/(N)", "(m/s^2)/(N)"), ("g/N", "g/N"),
+                                        ("", None), ("[]", None)])
+def test_a_unit_cell_loses_only_the_brackets_around_the_whole(cell, unit):
+    assert bare_unit(cell) == unit

@@ -18,6 +18,7 @@ import attrs
 
 from ..errors import FileFormatError, SubstructureError
 from ..tap.records import unit_of
+from ..units import bare_unit
 
 MAX_PREAMBLE_LINES = 2000
 """Lines read before the first row of numbers; a file with none by then is refused."""
@@ -115,7 +116,7 @@ def is_unit_row(cells: list[str]) -> bool:
         if is_number(cell, False):
             return False
         try:
-            unit_of(cell.strip("[]() "), "")
+            unit_of(bare_unit(cell) or "", "")
         except SubstructureError:
             return False
     return True

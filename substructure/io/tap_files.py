@@ -30,6 +30,7 @@ import numpy as np
 from .._files import decode_text
 from ..errors import FileFormatError, SubstructureError, SubstructureWarning
 from ..tap.records import RESPONSE_QUANTITIES, TIME_STEP_TOLERANCE, TapRecord, channel_to_si, unit_of
+from ..units import bare_unit
 from . import check_readable_file, read_bytes
 from ._tap_columns import (MAX_PREAMBLE_LINES, NO_UNIT, Columns, choose, header_cells, is_row, is_unit_row,
                            line_separator, name_and_unit, rate_from_lines)
@@ -107,7 +108,7 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
     above = header_cells(content[-2][1].lstrip("\ufeff"), sep, ncols) if len(content) > 1 and is_unit_row(cells) \
         else None
     if above is not None and len(above) == len(cells) and all(name_and_unit(c)[1] is None for c in above):
-        columns = Columns(above, [None if c.strip("[]() ").lower() in NO_UNIT else c.strip("[]() ")
+        columns = Columns(above, [None if (bare_unit(c) or "").lower() in NO_UNIT else bare_unit(c)
                                  for c in cells], content[-2][0])
     else:
         pairs = [name_and_unit(c) for c in cells]

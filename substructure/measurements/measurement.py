@@ -121,26 +121,6 @@ _optional_record = _optional_int("record", 0, "a 0-based record index (an intege
 _optional_averages = _optional_int("averages", 1, "the number of averages (an integer >= 1)")
 
 
-def _coherence(value: Any) -> np.ndarray | None:
-    if value is None:
-        return None
-    try:
-        array = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise InvalidValueError(
-            f"coherence: got {type(value).__name__}; expected an array of floats in [0, 1]"
-        ) from None
-    if array.ndim != 1:
-        raise InvalidValueError(f"coherence: got shape {array.shape}; expected one value per frequency line")
-    bad = ~np.isfinite(array) | (array < 0.0) | (array > 1.0 + COHERENCE_ROUNDING)
-    if bad.any():
-        k = int(np.argmax(bad))
-        raise InvalidValueError(f"coherence: line {k} is {float(array[k])!r}; expected a number in [0, 1]")
-    array = np.minimum(array, 1.0)
-    array.setflags(write=False)
-    return array
-
-
 COHERENCE_ROUNDING = 1e-9
 """How far above 1 a coherence may lie and be read as 1 (rounding of its estimate)."""
 
@@ -163,8 +143,12 @@ _optional_force_window = _optional_seconds("force_window_s", "the force window's
                                                              "or None")
 
 
-def _per_line_variances(name: str, infinite: str):
-    """A converter of an optional array of per-line variances (>= 0; ``inf`` for ``infinite``), read-only."""
+def _per_line(name: str, values: str, each: str, bad, top: float | None = None):
+    """A converter of an optional array of one value per frequency line, read-only.
+
+    ``bad`` marks the values refused (``values`` and ``each`` say what is wanted of the array and of a value);
+    ``top`` clips the rest from above.
+    """
 
     def convert(value: Any) -> np.ndarray | None:
         if value is None:
@@ -172,23 +156,27 @@ def _per_line_variances(name: str, infinite: str):
         try:
             array = np.array(value, dtype=np.float64)
         except (TypeError, ValueError):
-            raise InvalidValueError(f"{name}: got {type(value).__name__}; expected an array of variances >= 0") \
-                from None
+            raise InvalidValueError(f"{name}: got {type(value).__name__}; expected an array of {values}") from None
         if array.ndim != 1:
             raise InvalidValueError(f"{name}: got shape {array.shape}; expected one value per frequency line")
-        bad = ~(array >= 0.0)  # NaN or negative; inf is allowed
-        if bad.any():
-            k = int(np.argmax(bad))
-            raise InvalidValueError(f"{name}: line {k} is {float(array[k])!r}; expected a variance >= 0 (inf "
-                                    f"{infinite})")
+        refused = bad(array)
+        if refused.any():
+            k = int(np.argmax(refused))
+            raise InvalidValueError(f"{name}: line {k} is {float(array[k])!r}; expected {each}")
+        if top is not None:
+            array = np.minimum(array, top)
         array.setflags(write=False)
         return array
 
     return convert
 
 
-_force_noise = _per_line_variances("force_noise", "where there was no force")
-_truncation = _per_line_variances("truncation", "where the FRF is zero")
+_coherence = _per_line("coherence", "floats in [0, 1]", "a number in [0, 1]",
+                       lambda a: ~np.isfinite(a) | (a < 0.0) | (a > 1.0 + COHERENCE_ROUNDING), top=1.0)
+_force_noise = _per_line("force_noise", "variances >= 0", "a variance >= 0 (inf where there was no force)",
+                         lambda a: ~(a >= 0.0))
+_truncation = _per_line("truncation", "variances >= 0", "a variance >= 0 (inf where the FRF is zero)",
+                        lambda a: ~(a >= 0.0))
 
 
 def _estimator(value: Any) -> str | None:

@@ -21,7 +21,7 @@ from ..errors import InvalidValueError
 from ..frf import FRF, Frequency
 from .detect import (CLIP_RUN, DOUBLE_HIT_FRACTION, NO_HIT_FACTOR, PRE_TRIGGER_S, TRIGGER_FRACTION,
                      check_swapped, double_hit, find_pulse, longest_flat_run, tap_starts)
-from .record_end import end_words, noise_variance, told_apart, truncation_variance, window_needed
+from .record_end import noise_variance, the_end, told_apart, truncation_variance, window_words
 from .records import RESPONSE_QUANTITIES, TapRecord
 from .result import Tap, TapResult
 
@@ -270,10 +270,11 @@ def process_taps(
     f = f * force_window[rows]
     noise_sd = np.array([_noise_outside(force[r] - baseline[r], force_window[r]) for r in rows.tolist()])
     quiet = np.argmax(force_window[rows] > 0, axis=1)  # the samples before the force window: no pulse yet
-    needed, why = window_needed(x, quiet, [taps[cuts[r][2]].number for r in rows])
+    end = the_end(x, quiet, [taps[cuts[r][2]].number for r in rows])
+    why: str | None = None  # said by the end of the taps, when the default decides
     response_noise = noise_variance(x, quiet)
     if exponential is None and tau is None:
-        exponential = needed
+        exponential = end.needs_window
     elif exponential is False:
         why = "none: not asked for"
     else:  # asked for: exponential=True, or a time constant given
@@ -328,7 +329,8 @@ def process_taps(
     v_f = np.where(np.isfinite(v_f), v_f, np.inf)[keep] if estimator != "Hv" else None
     width = float(np.mean(np.sum(w_f, axis=1) ** 2 / np.sum(w_f**2, axis=1))) * dt
     truncation = truncation_variance(x, F, w, response_noise, h, dt)
-    why = end_words(why, truncation, told_apart(x, response_noise))
+    if why is None:
+        why = window_words(end, truncation, told_apart(x, response_noise))
     return TapResult(measured.to_receptance(), measured, coherence[keep], estimator, tuple(taps), tau,
                      hammer_band, float(hammer_band_db), spectra, rate, length, why, v_f,
                      float(np.sqrt(np.mean(noise_sd**2))), width, None if truncation is None else truncation[keep])

@@ -21,13 +21,14 @@ See docs/tap.md, "The end of a tap".
 
 from __future__ import annotations
 
+import attrs
 import numpy as np
 import scipy.fft
 from scipy.stats import chi2
 from scipy.stats import f as f_dist
 
 __all__ = ["DECAYED_SHARE", "WINDOW_SHARE", "TRUNCATION_SEGMENT", "TRUNCATION_RATIO_MAX", "TRUNCATION_SIGNIFICANCE",
-           "TRUNCATION_NEGLIGIBLE", "window_needed", "end_words", "told_apart",
+           "TRUNCATION_NEGLIGIBLE", "End", "the_end", "window_words", "told_apart",
            "noise_variance", "truncation_variance"]
 
 DECAYED_SHARE = 3e-3
@@ -56,14 +57,26 @@ TRUNCATION_RATIO_MAX = 0.9
 tap's last fifth is bounded as if it did by this much (the rest is then at most nine times the last segment's)."""
 
 
-def window_needed(x: np.ndarray, pre: np.ndarray, numbers: list[int]) -> tuple[bool, str]:
-    """Whether the responses ``x`` (one kept tap a row) need the exponential window by default, and why, in words.
+@attrs.frozen
+class End:
+    """How the responses of the kept taps end: ``state`` is ``"died"`` (every tap's RMS over its last
+    ``tail`` samples at most :data:`DECAYED_SHARE` of its peak, or three times its noise), ``"rang"`` (above
+    that, at most :data:`WINDOW_SHARE`) or ``"ringing"`` (above it: the exponential window is needed);
+    ``share`` is that RMS over the peak (the largest, or that of tap ``tap``, the one that rang most)."""
 
-    They do when a tap's RMS over its last 5 % (at least 16 samples) exceeds :data:`WINDOW_SHARE` of its peak
-    and three times its RMS before the hit; the words also say whether they died out (:data:`DECAYED_SHARE`)
-    or still rang.  Unless the window is needed, they hold ``{verb}`` and ``{clause}`` for what
-    :func:`truncation_variance` then finds: :func:`end_words` fills them.
-    """
+    state: str
+    share: float
+    tail: int
+    tap: int | None = None
+
+    @property
+    def needs_window(self) -> bool:
+        """Whether the exponential window is needed (by default)."""
+        return self.state == "ringing"
+
+
+def the_end(x: np.ndarray, pre: np.ndarray, numbers: list[int]) -> End:
+    """How the responses ``x`` (one kept tap a row, numbered ``numbers``) end; ``pre``: the samples before each hit."""
     tail = max(16, x.shape[1] // 20)
     end = np.sqrt(np.mean(x[:, -tail:] ** 2, axis=1))
     peak = np.max(np.abs(x), axis=1)
@@ -71,32 +84,33 @@ def window_needed(x: np.ndarray, pre: np.ndarray, numbers: list[int]) -> tuple[b
     share = end / np.maximum(peak, 1e-300)
     alive = end > np.maximum(DECAYED_SHARE * peak, 3.0 * noise)
     if not alive.any():
-        return False, (f"none: the response {{verb}} every tap (its RMS over the last {tail} samples at most "
-                       f"{share.max():.2g} of its peak){{clause}}")
+        return End("died", float(share.max()), tail)
     k = int(np.argmax(np.where(alive, share, -1.0)))
-    where = f"by the end of tap {numbers[k]} ({share[k]:.2g} of its peak over its last {tail} samples)"
-    if share[k] <= WINDOW_SHARE:
-        return False, f"none: the response still rang {where}{{clause}}"
-    return True, f"the response had not died out {where}: a longer record would need none"
+    return End("rang" if share[k] <= WINDOW_SHARE else "ringing", float(share[k]), tail, numbers[k])
 
 
-def end_words(why: str, truncation: np.ndarray | None, told: bool = True) -> str:
-    """The words of :func:`window_needed` completed with what the end of the taps leaves.
+def window_words(end: End, truncation: np.ndarray | None, told: bool = True) -> str:
+    """Why the exponential window was (or was not) applied by default, with what the end of the taps leaves.
 
     ``truncation`` is what :func:`truncation_variance` found; ``told`` is False when it could not tell an
     error of the end from the noise (one tap, no samples before the hit to measure the noise on).
     """
-    rang = why.startswith("none: the response still rang")
-    if truncation is not None:
-        clause = ("; its truncation is counted as noise rather than traded for the window's damping (a longer "
-                  "record would be better)" if rang else
-                  "; what still rang leaves an error, counted as noise (the truncation)")
-    elif not told:
-        clause = ("; with one tap and no samples before the hit, an error of its end cannot be told from its noise "
-                  "and is not counted (record a pre-trigger, or more taps)")
+    if end.state == "died":
+        words = (f"none: the response {'died' if truncation is None else 'nearly died'} out within every tap (its "
+                 f"RMS over the last {end.tail} samples at most {end.share:.2g} of its peak)")
     else:
-        clause = "; no error of its end stands out of the noise" if rang else ""
-    return why.format(verb="died out within" if truncation is None else "nearly died out within", clause=clause)
+        where = f"by the end of tap {end.tap} ({end.share:.2g} of its peak over its last {end.tail} samples)"
+        if end.needs_window:
+            return f"the response had not died out {where}: a longer record would need none"
+        words = f"none: the response still rang {where}"
+    if truncation is not None:
+        return words + ("; what still rang leaves an error, counted as noise (the truncation)" if end.state == "died"
+                        else "; its truncation is counted as noise rather than traded for the window's damping (a "
+                             "longer record would be better)")
+    if not told:
+        return words + ("; with one tap and no samples before the hit, an error of its end cannot be told from its "
+                        "noise and is not counted (record a pre-trigger, or more taps)")
+    return words + ("" if end.state == "died" else "; no error of its end stands out of the noise")
 
 
 def told_apart(x: np.ndarray, noise: np.ndarray) -> bool:

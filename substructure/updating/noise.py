@@ -301,13 +301,19 @@ def _hv_bias(coherence, averages, estimator) -> np.ndarray | None:
     return -np.log(np.clip(np.where(np.isfinite(gamma), gamma, 0.0), COHERENCE_MIN, 1.0))
 
 
+def _carried(value, n: int, what: str) -> np.ndarray:
+    """A per-line variance the measurement carries, checked: ``n`` values >= 0 (``inf`` allowed)."""
+    v = np.asarray(value, dtype=float).reshape(-1)
+    if v.size != n or not np.all(v >= 0):
+        raise InvalidValueError(f"{what}: expected {n} variances >= 0, one per line")
+    return v
+
+
 def _force_term(force_noise, window_s, hz: np.ndarray, label: str) -> np.ndarray | None:
     """Half the hammer's noise variance per line times the lines its error spans (None without it)."""
     if force_noise is None:
         return None
-    v = np.asarray(force_noise, dtype=float).reshape(-1)
-    if v.size != hz.size or not np.all(v >= 0):
-        raise InvalidValueError(f"force noise of {label}: expected {hz.size} variances >= 0, one per line")
+    v = _carried(force_noise, hz.size, f"force noise of {label}")
     if window_s is None or not np.isfinite(window_s) or window_s <= 0:
         raise InvalidValueError(f"force noise of {label}: the force window's length is needed (force_window_s > 0)")
     spacing = float(np.median(np.diff(hz))) if hz.size > 1 else 1.0
@@ -508,10 +514,8 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     coherence_factor = float(0.5 * coef[3] / coh_scale) if coh is not None else None
     extra = _force_term(force_noise, force_window_s, measured.frequency.hz, label)
     if truncation is not None:  # the taps' end: an error repeated by every tap, counted like the hammer's
-        cut = np.asarray(truncation, dtype=float).reshape(-1)
-        if cut.size != n or not np.all(cut >= 0):
-            raise InvalidValueError(f"truncation of {label}: expected {n} variances >= 0, one per line")
-        extra = 0.5 * cut if extra is None else extra + 0.5 * cut
+        cut = 0.5 * _carried(truncation, n, f"truncation of {label}")
+        extra = cut if extra is None else extra + cut
     dof = None
     if coh is not None:
         # the share of each line's variance that the coherence of a few taps gives, and the variance's degrees

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import FileFormatError
+from ...units import bare_unit
 from ._common import _shown
 from .uff_units import _TIME_EXPONENT, _a, _exponents, _unit_of_label
 
@@ -67,19 +68,6 @@ def _column(cell: str, name: str, line: int) -> tuple[str, str | None]:
         f"{name}, line {line}: column {_shown(cell)}; expected frequency, then real and imaginary parts or magnitude "
         "and phase, and optionally the coherence (e.g. 'frequency_hz,real,imag' or "
         "'Frequency [Hz];Magnitude [m/N];Phase [deg];Coherence')")
-
-
-def _bare_unit(cell: str) -> str | None:
-    """A unit cell without the brackets around it (``[Hz]``, ``(m/N)``; not those of ``(m/s2)/N``); None if empty."""
-    text = cell.strip()
-    if len(text) > 1 and text[0] + text[-1] in ("[]", "()"):
-        inner, depth = text[1:-1], 0
-        for c in inner:
-            depth += {"(": 1, ")": -1, "[": 1, "]": -1}.get(c, 0)
-            if depth < 0:  # the first bracket closes inside: it is not around the whole
-                return text
-        return inner.strip() or None
-    return text or None
 
 
 def _is_number(cell: str) -> bool:
@@ -159,7 +147,7 @@ def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None
     if len(cells) > 1 and cells[1] and not any(_is_number(c) for c in cells[1]):
         # a row of units under the names (an empty cell: no unit), as acquisition programs export them
         units = cells[1] + [""] * (len(columns) - len(cells[1]))
-        columns = [(kind, unit if unit is not None else _bare_unit(u)) for (kind, unit), u in zip(columns, units)]
+        columns = [(kind, unit if unit is not None else bare_unit(u)) for (kind, unit), u in zip(columns, units)]
         cells, rows = [cells[0]] + cells[2:], [rows[0]] + rows[2:]
     kinds = [k for k, _ in columns]
     if kinds[:3] not in (["frequency", "real", "imag"], ["frequency", "magnitude", "phase"]) \
