@@ -24,7 +24,7 @@ from substructure.diagnose import DEFAULT_SETTINGS, DiagnoseSettings, diagnose
 from substructure.diagnose.compare import compare
 from substructure.diagnose.report import level_signature
 from substructure.diagnose.result import Alternatives, Changes, Diagnosis, Measures, Verdict
-from substructure.diagnose.scan import places, trials
+from substructure.diagnose.scan import finer, places, trials
 from substructure.errors import InvalidValueError
 from substructure.updating.changes import ParamSpec
 
@@ -40,7 +40,8 @@ OUT_OF_RANGE = {
     "short_fit_evaluations": 0, "inertia_floor": 0.0, "scan_values": 1, "scan_values_placed": 1,
     "signed_decades": 0.0, "signed_values_min": 1, "body_positions": 1, "section_lengths": (0.5, 1.2),
     "section_starts": 1, "section_ratios": (0.7, -1.0), "named_grid": 1, "named_second": 1, "named_third": 1,
-    "scale_span": 1.0, "scale_values": 1, "polish_points": 0, "brent_candidates": -1, "brent_evaluations": 0,
+    "scale_span": 1.0, "scale_values": 1, "place_search": -1, "polish_points": 0, "brent_candidates": -1,
+    "brent_evaluations": 0,
     "brent_tolerance": 0.0, "slope_divisions": 1, "jacobian_step": 1.0, "mode_window": 1.0, "mode_follow": 0.0,
     "mode_locate": -0.1, "in_place_lines": -1, "secant_iterations": -1, "secant_first_step": 0.0,
     "secant_max_step": -1.5, "secant_tolerance": 0.0, "element_probe_linear": 2.0, "element_probe_log": 0.0,
@@ -115,6 +116,53 @@ def test_the_scan_grids_follow_the_settings():
     fewer = len({round(t[spring.specs[0].name], 12) for t in trials(spring, settings=DiagnoseSettings(
         scan_values_placed=3))})
     assert fewer == count - 2  # two values fewer on the grid; the start is the same
+
+
+def test_an_elements_size_is_searched_at_each_of_its_places():
+    """The minimum of a body's size at every place: a cost whose minimum at each place is a known mass between the
+    scan's grid values, lowest at the holder's tip, where the grid's values are far off: the scan's best trial is
+    elsewhere."""
+    from substructure.updating.elements import AddedMass
+
+    body = AddedMass("holder", 0.066, 0.9, (0.0, 0.066), 1e-3)
+    best_mass = {p["position"]: 0.013 * (1.0 + 3.0 * p["position"] / 0.066) for p in places(body)}  # 13 g to 52 g
+
+    def cost(trial):  # steep in the log of the mass, lowest at the tip
+        miss = np.log(trial["mass"] / best_mass[trial["position"]])
+        return 1e4 * miss**2 + 100.0 * (1.0 - trial["position"] / 0.066)
+
+    tried = trials(body)
+    costs = [cost(t) for t in tried]
+    assert min(zip(costs, tried), key=lambda ct: ct[0])[1]["position"] < 0.066  # the grid's best is not the tip
+    batches = []
+
+    def evaluate(batch):
+        batches.append(len(batch))
+        return [cost(t) for t in batch]
+
+    more, more_costs = finer(body, tried, costs, evaluate)
+    assert set(batches) == {len(places(body))}  # the places together at each step
+    assert len(batches) == DiagnoseSettings().place_search + 1
+    assert more_costs == [cost(t) for t in more]
+    # every place's minimum, within the golden section's last interval (two grid steps shrunk at each step)
+    step = np.log(0.9 / body.specs[0].lower) / (DiagnoseSettings().scan_values_placed - 1)
+    last = 2.0 * step * ((np.sqrt(5.0) - 1.0) / 2.0) ** (DiagnoseSettings().place_search - 1)
+    for x, mass in best_mass.items():
+        found = min((c, t["mass"]) for c, t in zip(more_costs, more) if t["position"] == x)[1]
+        assert abs(np.log(found / mass)) < last, x
+        assert abs(np.log(found / mass)) > 0.0  # the grid holds no minimum: the search moved
+    assert min(zip(more_costs, more), key=lambda ct: ct[0])[1]["position"] == pytest.approx(0.066)
+    assert finer(body, tried, costs, evaluate, DiagnoseSettings(place_search=0)) == ([], [])
+    # below: only the places where some trial costs less are searched
+    least = {x: min(c for c, t in zip(costs, tried) if t["position"] == x) for x in best_mass}
+    below = float(np.median(list(least.values())))
+    searched = {t["position"] for t in finer(body, tried, costs, evaluate, below=below)[0]}
+    assert searched == {x for x, c in least.items() if c < below} and 0 < len(searched) < len(least)
+    from substructure import default_assembly
+    from substructure.updating.parameters import model_parameters, parameter_change
+
+    one_place = parameter_change(model_parameters(default_assembly())[0])  # a parameter of the model: no places
+    assert finer(one_place, trials(one_place), [0.0] * len(trials(one_place)), evaluate) == ([], [])
 
 
 def _scaled_baseline(factor: float):

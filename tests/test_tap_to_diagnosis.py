@@ -358,6 +358,23 @@ def test_a_body_is_found_at_its_mass_through_taps_cut_while_the_response_rings(m
     assert abs(mass - grams / 1000) < max(3 * std, 0.05 * grams / 1000), (mass, std)
 
 
+@pytest.mark.parametrize("grams, length, seed", [(20.0, 0.03, 2), (35.0, 0.03, 4), (60.0, 0.1, 5)])
+def test_a_nut_on_the_holder_is_found_where_and_as_heavy_as_it_is(model, grams, length, seed):
+    """A body on the holder's tip, not the tool's: the scan tried its size on a coarse grid and searched only the
+    best place between the grid's values; 20 g at the tip lies between 10 g and 94 g, both far off there, while
+    10 g near the base fitted fairly: the body was fitted at the base (13 g) and a section of the holder changed
+    instead (20 g and 35 g, 30 ms).  Searching the size at every place must not favour a section change (60 g,
+    0.1 s: a first version of the search had one with a 0.92 kg spindle body stacked on it)."""
+    truth = model.attach(Mass("nut", "holder.tip", f"{grams} g"))
+    measured, _ = _measured(_taps(truth, seed=seed, length=length))
+    d = diagnose(model, [measured], progress=False)
+    assert d.explained, d.report
+    (effect,) = d.effects
+    assert effect.name == "added-mass" and effect.where.startswith("holder@"), (effect.name, effect.where)
+    assert effect.values["position"] == pytest.approx(0.066, abs=0.002)
+    assert effect.values["mass"] == pytest.approx(grams / 1000, rel=0.02)
+
+
 def test_an_antiresonance_line_the_grid_does_not_resolve_is_scored_by_its_own_coherence(model):
     """45 ms taps (22 Hz lines): the receptance's zero near 180 Hz falls on one line, ten times below its
     neighbours, with a coherence of 0.04 to 0.5.  Read in the linear domain with the variance of its neighbours'

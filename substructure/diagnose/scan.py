@@ -6,6 +6,8 @@ whose range holds zero, linearly otherwise), at each place an element may
 sit (:func:`places`); an effect of several log-scale parameters is also
 tried with all of them scaled together, and an effect of the catalogue
 whose size comes with positions (springs) with both crossed on finer grids.
+An element's main parameter is then tried between the grid's values at
+every place, around the best value there (:func:`finer`).
 The numbers of values, places and decades are fields of
 :class:`~substructure.diagnose.settings.DiagnoseSettings` (``scan_values``,
 ``body_positions``, ``signed_decades``, ``named_grid``, ...).  :mod:`substructure.diagnose.search` evaluates the
@@ -15,15 +17,17 @@ trials on the screening lines and refines the best.
 from __future__ import annotations
 
 import itertools
+from typing import Callable
 
 import numpy as np
 
 from ..updating.elements import SectionChange
+from ..updating.fit import from_u, to_u
 from ..updating.parameters import Change
 from .effects import EffectChange
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
-__all__ = ["trials", "places", "grid"]
+__all__ = ["trials", "places", "grid", "finer"]
 
 
 def grid(spec, count: int, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> np.ndarray:
@@ -89,3 +93,86 @@ def trials(change: Change, first: bool = True, settings: DiagnoseSettings = DEFA
         out += [{**where[0], **{s.name: float(np.clip(s.start * factor, s.lower, s.upper)) for s in logs}}
                 for factor in np.geomspace(1.0 / settings.scale_span, settings.scale_span, settings.scale_values)]
     return out
+
+
+
+GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
+"""The golden ratio's inverse: the share of its interval a golden-section step keeps."""
+
+
+def finer(change: Change, tried: list[dict], costs: list[float], evaluate: Callable[[list[dict]], list[float]],
+          settings: DiagnoseSettings = DEFAULT_SETTINGS, below: float = np.inf) -> tuple[list[dict], list[float]]:
+    """An element that sits at several places: its main parameter searched at each of them.
+
+    At every place of :func:`places`, from the value whose trial cost least
+    there, a golden-section search of ``settings.place_search`` steps
+    between the grid's neighbours of that value (on the parameter's fitted
+    scale), the places' trials evaluated together at each step.  The grid
+    of an element's size is coarse (``settings.scan_values_placed`` values
+    over decades) and a body's minimum is narrow: a 20 g nut at a holder's
+    tip sits between the grid's 10 g and 94 g, both far off there, while
+    10 g near the holder's base fits fairly; the polish that follows the
+    scan refines only the best place, and the fit that starts there stays.
+
+    Parameters
+    ----------
+    change : Change
+        The candidate.
+    tried : list of dict
+        The trials evaluated (:func:`trials`, and any others).
+    costs : list of float
+        Their ``chi^2``.
+    evaluate : callable
+        ``evaluate(trials) -> costs``, for several trials together.
+    settings : DiagnoseSettings
+        ``scan_values_placed`` (the grid's step) and ``place_search``.
+    below : float
+        Only the places where a trial cost less than this are searched (the
+        model as it is: where every size tried makes it worse, no size does).
+
+    Returns
+    -------
+    (list of dict, list of float)
+        The trials evaluated besides, and their costs (none for a change at one place).
+    """
+    where = places(change, settings)
+    if len(where) < 2 or settings.place_search == 0:
+        return [], []
+    main = change.specs[0]
+    lo, hi = sorted((to_u(main, main.lower), to_u(main, main.upper)))
+    step = (hi - lo) / (settings.scan_values_placed - 1)
+
+    def key(values: dict) -> tuple:
+        return tuple(sorted((k, v) for k, v in values.items() if k != main.name))
+
+    at_places = {key(place) for place in where}
+    best: dict[tuple, tuple[float, dict]] = {}
+    for trial, cost in zip(tried, costs):
+        k = key(trial)
+        if k in at_places and np.isfinite(cost) and cost < below and (k not in best or cost < best[k][0]):
+            best[k] = (float(cost), trial)
+    if not best:
+        return [], []
+    starts = [trial for _, trial in best.values()]
+    u0 = np.array([to_u(main, t[main.name]) for t in starts])
+    a, b = np.maximum(u0 - step, lo), np.minimum(u0 + step, hi)
+    out: list[dict] = []
+    got: list[float] = []
+
+    def at(u) -> np.ndarray:
+        batch = [{**t, main.name: from_u(main, float(x))} for t, x in zip(starts, u)]
+        cost = [float(c) if np.isfinite(c) else np.inf for c in evaluate(batch)]
+        out.extend(batch)
+        got.extend(cost)
+        return np.array(cost)
+
+    c, d = b - GOLDEN * (b - a), a + GOLDEN * (b - a)
+    fc, fd = at(c), at(d)
+    for _ in range(settings.place_search - 1):
+        left = fc <= fd  # the minimum lies in [a, d]: d becomes b, c becomes d
+        a, b = np.where(left, a, c), np.where(left, d, b)
+        c, d, fc_old, fd_old = (np.where(left, b - GOLDEN * (b - a), d), np.where(left, c, a + GOLDEN * (b - a)),
+                                fc, fd)
+        new = at(np.where(left, c, d))
+        fc, fd = np.where(left, new, fd_old), np.where(left, fc_old, new)
+    return out, got

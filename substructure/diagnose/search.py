@@ -44,6 +44,7 @@ from ..updating.parameters import Change, ParameterChange, material_changes, mod
 from ..updating.structure import si_beam
 from ..updating.selection import INDIFFERENCE, bic, significance
 from .effects import EffectChange, effect_change
+from .scan import finer
 from .scan import trials as _trials
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
@@ -268,9 +269,15 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
         best_chi2, best = math.inf, None
         try:
             tried = _trials(change, first=cross, settings=settings) + list((extra or {}).get(change.key, ()))
-            # evaluated together (the same numbers as one by one)
-            for trial, w in zip(tried, likelihood.residuals([list(current) + [(change, t)] for t in tried])):
-                chi2 = projected(w)
+            # evaluated together (the same numbers as one by one), then an element's size searched at each of
+            # its places
+            def evaluate(batch, change=change) -> list[float]:
+                return [projected(w) for w in likelihood.residuals([list(current) + [(change, t)] for t in batch])]
+
+            costs = evaluate(tried)
+            more, more_costs = finer(change, tried, costs, evaluate, settings, below=chi2_now)
+            tried, costs = tried + more, costs + more_costs
+            for trial, chi2 in zip(tried, costs):
                 if chi2 < best_chi2:
                     best_chi2, best = chi2, trial
         except (SubstructureError, ValueError, FloatingPointError) as exc:

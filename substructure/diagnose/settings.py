@@ -208,6 +208,11 @@ class DiagnoseSettings:
         ``scale_span`` (default 100.0: two decades either way).
     scale_values : int
         Factors of that scan (default 9).
+    place_search : int
+        Steps of the golden-section search of an element's main parameter at
+        each of its places, between the grid's neighbours of the best value
+        there (all places evaluated together; default 10, about a hundredth
+        of the grid's step).
     polish_points : int
         The best scanned candidates are refined at points ``1 / polish_points``
         of a grid step apart either side of the scan's best (default 3) before
@@ -350,6 +355,7 @@ class DiagnoseSettings:
     named_third: int = attrs.field(default=4, validator=_count(2))
     scale_span: float = attrs.field(default=100.0, validator=_number(1.0, lo_open=True))
     scale_values: int = attrs.field(default=9, validator=_count(2))
+    place_search: int = attrs.field(default=10, validator=_count(0))
     polish_points: int = attrs.field(default=3, validator=_count())
     brent_candidates: int = attrs.field(default=24, validator=_count(0))
     brent_evaluations: int = attrs.field(default=8, validator=_count())
