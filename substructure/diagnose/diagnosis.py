@@ -10,7 +10,9 @@ catalogue of effects) by forward selection with the significance test of
 step, drops at the end what no longer earns its parameters, and says
 ``explained`` only when the final residual is consistent with the noise
 (and, as a plain check, its RMS error within ``explained_error_factor``,
-1.5, times the noise floor).
+1.5, times the noise floor, each line as the noise model scores it, or
+within what the noise allows when the floor lives on a few lines:
+:func:`~substructure.updating.selection.error_check`).
 When it is not, the report says so first, with where the remaining error
 lives and what kind of effect has that signature
 (:mod:`substructure.diagnose.report`).  Explanations the data cannot tell
@@ -36,7 +38,7 @@ from ..assembly import Assembly
 from ..errors import InvalidValueError
 from ..frf import FRF
 from ..updating.likelihood import Likelihood, measured_frfs
-from ..updating.selection import INDIFFERENCE, consistency
+from ..updating.selection import INDIFFERENCE, consistency, error_check
 from .compare import METRIC, Comparison, _pairs, frac, error_bands
 from .effects import Effect, registry
 from .refine import refine as refine_model
@@ -264,7 +266,8 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     final_ratios = lik.log_ratios(current)
     cons = consistency(lik, final_ratios, p_now)
     final_error = lik.rms(final_ratios)
-    explained = bool(cons.consistent and final_error <= settings.explained_error_factor * floor)
+    check = error_check(lik, final_ratios, settings.explained_error_factor)
+    explained = bool(cons.consistent and check.passed)
     hits = bound_hits(current, final_fit)
     final_effects = tuple(Found(c, v, {k: x for k, x in (final_fit.std[i] if final_fit else {}).items()
                                        if (i, k) not in {(h[0], h[1]) for h in hits}})
@@ -289,7 +292,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     rivals = _distinct_rivals(assembly, measured, final_effects, outcome, say, settings) if explained else []
     final = _comparisons(lik, final_ratios, floors, settings)
     report = unexplained_report(lik, assembly, current, baseline, cons, final_error, floor, explained, say,
-                                settings) if not explained else ()
+                                settings, check) if not explained else ()
     if explained and len(current) > settings.most_changes:  # a composite that only just reaches the noise
         explained = False
         report = [words.too_many_changes(settings.most_changes, [f"{c.effect} at {c.place(v)}" for c, v in current]),
@@ -342,7 +345,8 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
                         missing_effect=None if missing is None else missing.name,
                         missing_where=None if missing is None else missing.where),
         measures=Measures(metric=METRIC, band=band, noise_floor=floor, baseline_error=e0, final_error=final_error,
-                          consistency=cons, correlation=correlation, baseline=baseline, final=final),
+                          consistency=cons, correlation=correlation, baseline=baseline, final=final,
+                          error_check=check),
         changes=Changes(final_effects=final_effects, refined_assembly=refined, candidates=tuple(first),
                         refinement=tuple(steps)),
         alternatives=Alternatives(ambiguous=tuple(ambiguous), ambiguous_with=names,

@@ -223,7 +223,8 @@ def level_signature(baseline, floor: float, settings: DiagnoseSettings = DEFAULT
 
 
 def unexplained_report(lik, assembly, current, baseline, cons, final_error: float, floor: float,
-                       explained: bool, say=None, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> list[str]:
+                       explained: bool, say=None, settings: DiagnoseSettings = DEFAULT_SETTINGS,
+                       check=None) -> list[str]:
     """The lines of the verdict when the data are not explained (see the module docstring).
 
     Parameters
@@ -248,13 +249,16 @@ def unexplained_report(lik, assembly, current, baseline, cons, final_error: floa
         Progress.
     settings : DiagnoseSettings
         The numbers of the signatures and of the bands named.
+    check : ErrorCheck, optional
+        The plain check of the error (said when it failed).
 
     Returns
     -------
     list of str
         The report, the verdict first.
     """
-    lines = [words.unexplained(final_error, floor, cons.chi2_reduced, cons.threshold)]
+    lines = [words.unexplained(final_error, floor, cons.chi2_reduced, cons.threshold,
+                               None if check is None or check.passed else (check.ratio, check.allowed))]
     near = settings.band_merge
     merged = []
     for b in cons.bands:

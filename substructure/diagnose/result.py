@@ -26,6 +26,7 @@ import attrs
 
 from .._json import finite as _finite, strict
 from ..assembly import Assembly
+from ..updating.selection import ErrorCheck
 from .compare import Comparison
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
@@ -254,6 +255,10 @@ class Measures:
         Every measurement against the model as given.
     final : tuple of Comparison
         Every measurement against the final model.
+    error_check : ErrorCheck or None
+        The plain check of the verdict: the final error in noise floors with
+        each line as the noise model scores it, and what the noise allows
+        (:func:`~substructure.updating.selection.error_check`).
     """
 
     metric: str
@@ -265,6 +270,7 @@ class Measures:
     correlation: dict = attrs.field(factory=dict, eq=False)
     baseline: tuple[Comparison, ...] = attrs.field(default=(), eq=False)
     final: tuple[Comparison, ...] = attrs.field(default=(), eq=False)
+    error_check: ErrorCheck | None = attrs.field(default=None, eq=False)
 
 
 @attrs.frozen
@@ -335,7 +341,7 @@ class Diagnosis:
     (read-only): ``explained``, ``report``, ``missing_effect``,
     ``missing_where`` (of ``verdict``); ``metric``, ``band``,
     ``noise_floor``, ``baseline_error``, ``final_error``, ``consistency``,
-    ``correlation``, ``baseline``, ``final`` (of ``measures``);
+    ``correlation``, ``baseline``, ``final``, ``error_check`` (of ``measures``);
     ``final_effects``, ``refined_assembly``, ``candidates``, ``refinement``
     (of ``changes``); ``ambiguous``, ``ambiguous_with``, ``suggestion``,
     ``separation``, ``rivals`` (of ``alternatives``).
@@ -379,6 +385,7 @@ class Diagnosis:
     correlation = _read("measures", "correlation")
     baseline = _read("measures", "baseline")
     final = _read("measures", "final")
+    error_check = _read("measures", "error_check")
     final_effects = _read("changes", "final_effects")
     refined_assembly = _read("changes", "refined_assembly")
     candidates = _read("changes", "candidates")
@@ -419,6 +426,8 @@ class Diagnosis:
             "suggestion": self.suggestion,
             "band_hz": list(self.band),
             "final_error": _finite(self.final_error),
+            "error_check": None if self.error_check is None else {
+                "ratio": _finite(self.error_check.ratio), "allowed": _finite(self.error_check.allowed)},
             "final_effects": [_effect_json(e) for e in self.final_effects],
             "correlation": self.correlation,
             "consistency": None if cons is None else {

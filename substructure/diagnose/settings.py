@@ -291,7 +291,10 @@ class DiagnoseSettings:
         (default 3).
     explained_error_factor : float
         ``explained`` also needs the final RMS error within this many noise
-        floors (default 1.5), a plain check beside the statistical test.
+        floors (default 1.5), a plain check beside the statistical test:
+        each line as the noise model scores it (capped as in the band test),
+        and within what the noise allows when that is more (the floor living
+        on a few lines).
     signature_step : float
         The factor of the finite differences of the signature (default 1.05: 5 %).
     signature_window : float

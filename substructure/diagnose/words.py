@@ -309,7 +309,8 @@ def estimated_as_h2(which: str, compared_as_h1: bool) -> str:
             "noise is large, which the comparison cannot take out (give the coherence column, or an H1)")
 
 
-def unexplained(final_error: float, floor: float, chi2_reduced: float, threshold: float) -> str:
+def unexplained(final_error: float, floor: float, chi2_reduced: float, threshold: float,
+                scored: tuple[float, float] | None = None) -> str:
     """The first line of the verdict when no candidate reaches the noise.
 
     Parameters
@@ -322,6 +323,9 @@ def unexplained(final_error: float, floor: float, chi2_reduced: float, threshold
         Its ``chi^2 / nu``.
     threshold : float
         What the noise allows.
+    scored : (float, float), optional
+        The plain check when it failed: the error in noise floors with each
+        line as the noise model scores it, and what the noise allows.
 
     Returns
     -------
@@ -330,7 +334,9 @@ def unexplained(final_error: float, floor: float, chi2_reduced: float, threshold
     """
     return (f"{UNEXPLAINED}; the best model found leaves an error of {final_error:.4g}, {final_error / floor:.2g} "
             f"times the noise floor ({floor:.4g}); chi^2/nu = {chi2_reduced:.4g} where the noise allows "
-            f"{threshold:.4g}")
+            f"{threshold:.4g}"
+            + ("" if scored is None else f"; with each line as the noise model scores it, {scored[0]:.3g} noise "
+               f"floors where the noise allows {scored[1]:.3g}"))
 
 
 def error_lives(bands: Sequence[tuple[str, float, float, float]]) -> str:
@@ -574,7 +580,10 @@ def summary(result, model_name: str, measured: int) -> list[str]:
         lines.extend(f"note: {line}" for line in result.report)
     cons = result.consistency
     verdict = "explained" if result.explained else "not explained"
+    check = result.error_check
+    scored = "" if check is None else (f"; {check.ratio:.2f} with each line as the noise model scores it, up to "
+                                       f"{check.allowed:.2f}")
     lines.append(f"verdict: {verdict}: final error {result.final_error:.4f} ({result.final_error / floor:.2f} x the "
-                 f"noise floor), chi^2/nu = {cons.chi2_reduced:.4g} (consistent with the noise up to "
+                 f"noise floor{scored}), chi^2/nu = {cons.chi2_reduced:.4g} (consistent with the noise up to "
                  f"{cons.threshold:.4g})")
     return lines
