@@ -337,7 +337,7 @@ def dimensionless(value: Any, field: str) -> float:
     return value
 
 
-_GRAVITY = re.compile(r"(?<![A-Za-z_0-9])[gG](?![A-Za-z_0-9])")
+_GRAVITY = re.compile(r"(?<![A-Za-z_0-9])(?:[gG]|gn|g_n)(?![A-Za-z_0-9])")
 _POUND = re.compile(r"(?<![A-Za-z_0-9])lbs?(?![A-Za-z_0-9])")
 _POWER = re.compile(r"(?<=[A-Za-z])(-?[0-9]+)(?![0-9.])")  # s2, s-2: an exponent written without ^
 _TIMES = re.compile(r"(?<=[A-Za-z0-9])\s*[.\u00b7\u22c5]\s*(?=[A-Za-z])")  # m.s-2, m\u00b7s-2
@@ -372,8 +372,8 @@ def bare_unit(cell: str) -> str | None:
 def instrument_unit(text: str) -> pint.Unit:
     """The unit of a channel or axis label as measuring instruments and their programs write it.
 
-    ``g`` and ``G`` are the standard acceleration of gravity (not the gram
-    or the gauss) and ``lb`` is the pound-force (not the pound of mass):
+    ``g``, ``G`` and ``gn`` (``g_n``) are the standard acceleration of
+    gravity (not the gram or the gauss) and ``lb`` is the pound-force (not the pound of mass):
     the only meanings they have for a sensor, a hammer or an FRF.
     Exponents may be written without ``^`` (``m/s2``, ``m s-2``), as
     superscripts (``m/s\u00b2``, ``m\u00b7s\u207b\u00b2``) or after ``**``; a product with
