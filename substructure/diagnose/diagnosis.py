@@ -12,7 +12,7 @@ step, drops at the end what no longer earns its parameters, and says
 (and, as a plain check, its RMS error within ``explained_error_factor``,
 1.5, times the noise floor, each line as the noise model scores it, or
 within what the noise allows when the floor lives on a few lines:
-:func:`~substructure.updating.selection.error_check`).
+:func:`~substructure.updating.error_check`).
 When it is not, the report says so first, with where the remaining error
 lives and what kind of effect has that signature
 (:mod:`substructure.diagnose.report`).  Explanations the data cannot tell

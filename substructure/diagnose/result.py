@@ -258,7 +258,7 @@ class Measures:
     error_check : ErrorCheck or None
         The plain check of the verdict: the final error in noise floors with
         each line as the noise model scores it, and what the noise allows
-        (:func:`~substructure.updating.selection.error_check`).
+        (:func:`~substructure.updating.error_check`).
     """
 
     metric: str

@@ -34,13 +34,13 @@ from .noise import NoiseModel, estimate_noise
 from .parameters import (ModelParameter, ParameterChange, ParameterSet, get_parameter, model_parameters,
                          set_parameters)
 from .paths import apply_path_si
-from .selection import Consistency, Significance, consistency, indifferent, significance
+from .selection import Consistency, ErrorCheck, Significance, consistency, error_check, indifferent, significance
 from .evaluator import Evaluator
 from .structure import Structure
 
 __all__ = [
     "Change", "ParamSpec", "AddedMass", "GroundSpring", "SectionChange", "Fit", "fit", "Likelihood", "Measured",
     "measured_frfs", "NoiseModel", "estimate_noise", "ModelParameter", "ParameterChange", "ParameterSet",
-    "get_parameter", "model_parameters", "set_parameters", "apply_path_si", "Consistency", "Significance",
-    "consistency", "indifferent", "significance", "Evaluator", "Structure",
+    "get_parameter", "model_parameters", "set_parameters", "apply_path_si", "Consistency", "ErrorCheck",
+    "Significance", "consistency", "error_check", "indifferent", "significance", "Evaluator", "Structure",
 ]
