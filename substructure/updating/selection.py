@@ -258,11 +258,11 @@ class ErrorCheck:
         ``sqrt(sum v_k min(z_k, c) / sum v_k)``: the RMS error over the
         noise floor with each line's squared error ``v_k z_k`` (``z_k`` its
         score, read linearly where the noise drowns it) capped at
-        :data:`LINE_CAP` times its variance ``v_k``; the plain ratio, where
+        ``LINE_CAP`` times its variance ``v_k``; the plain ratio, where
         no line is capped or read linearly.
     allowed : float
         What the noise allows: ``factor``, or the upper
-        :data:`CONSISTENCY_ALPHA` quantile of ``ratio`` for noise when the
+        ``CONSISTENCY_ALPHA`` (0.1 %) quantile of ``ratio`` for noise when the
         floor lives on a few lines and that is larger.
     """
 
@@ -287,11 +287,11 @@ def error_check(likelihood, ratios: Sequence[np.ndarray], factor: float) -> Erro
     line drowned in noise read as a log ratio (``ln(M / H)`` of a data value
     near zero) put it at 1.8.  So each line enters with its score as the
     noise model gives it (read linearly where drowned) and capped at
-    :data:`LINE_CAP`, as in the band test, and the bound is the larger of
-    ``factor`` and the upper :data:`CONSISTENCY_ALPHA` quantile of the
+    ``LINE_CAP``, as in the band test, and the bound is the larger of
+    ``factor`` and the upper ``CONSISTENCY_ALPHA`` (0.1 %) quantile of the
     weighted mean for noise: a shifted gamma distribution of its mean,
     variance and third moment, from each line's capped score's
-    (:func:`_each_line_moments`; the gamma of the mean and variance alone has
+    (``_each_line_moments``; the gamma of the mean and variance alone has
     too light a tail when a few weights dominate: 0.3 % of noise above its
     0.1 % quantile).
 
