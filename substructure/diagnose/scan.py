@@ -6,8 +6,8 @@ whose range holds zero, linearly otherwise), at each place an element may
 sit (:func:`places`); an effect of several log-scale parameters is also
 tried with all of them scaled together, and an effect of the catalogue
 whose size comes with positions (springs) with both crossed on finer grids.
-An element's main parameter is then tried between the grid's values at
-every place, around the best value there (:func:`finer`).
+An element's main parameter is then searched between the grid's values at
+every place where some value made the model better (:func:`finer`).
 The numbers of values, places and decades are fields of
 :class:`~substructure.diagnose.settings.DiagnoseSettings` (``scan_values``,
 ``body_positions``, ``signed_decades``, ``named_grid``, ...).  :mod:`substructure.diagnose.search` evaluates the
@@ -93,7 +93,6 @@ def trials(change: Change, first: bool = True, settings: DiagnoseSettings = DEFA
         out += [{**where[0], **{s.name: float(np.clip(s.start * factor, s.lower, s.upper)) for s in logs}}
                 for factor in np.geomspace(1.0 / settings.scale_span, settings.scale_span, settings.scale_values)]
     return out
-
 
 
 GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0

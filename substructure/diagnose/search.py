@@ -275,7 +275,10 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
                 return [projected(w) for w in likelihood.residuals([list(current) + [(change, t)] for t in batch])]
 
             costs = evaluate(tried)
-            more, more_costs = finer(change, tried, costs, evaluate, settings, below=chi2_now)
+            try:
+                more, more_costs = finer(change, tried, costs, evaluate, settings, below=chi2_now)
+            except (SubstructureError, ValueError, FloatingPointError):
+                more, more_costs = [], []  # a size between the grid's that cannot be evaluated: the grid's stand
             tried, costs = tried + more, costs + more_costs
             for trial, chi2 in zip(tried, costs):
                 if chi2 < best_chi2:
