@@ -157,6 +157,25 @@ def test_a_windowed_measurement_is_said_so_in_the_report(model):
     assert not [r for r in diagnose(model, [measured], progress=False).report if "window" in r]
 
 
+def test_the_report_of_a_windowed_measurement_names_the_remedy_and_the_remedy_works(model):
+    """Taps of the exact model processed through an exponential window (tau = 50 ms on 0.1 s taps) are not
+    explained (the window's damping, which no model has); the report says so and names the remedy, and the same
+    time records processed without the window are explained with nothing added."""
+    records = _taps(model, seed=1, length=0.1)
+    result = process_taps(records, "H1", exponential=True, tau=0.05)
+    windowed = Measurement.from_frf(result.frf, "tool.tip", "tool.tip", coherence=result.coherence,
+                                    averages=result.averages, force_noise=result.force_noise,
+                                    force_window_s=result.force_window_s, estimator="H1",
+                                    window_tau=result.tau).crop(150.0, 5000.0)
+    d = diagnose(model, [windowed], progress=False)
+    assert not d.explained
+    (line,) = [r for r in d.report if "exponential window" in r]
+    assert "substructure tap --no-exponential-window" in line
+    plain, _ = _measured(records)  # the default: no window below 10 % of the peak at the end
+    d = diagnose(model, [plain], progress=False)
+    assert d.explained and d.effects == [], d.report
+
+
 @pytest.mark.parametrize("exponential", [False, True])
 def test_the_hammer_noise_in_h1_is_what_the_tap_processing_says(model, exponential):
     """The variance of H1's relative error from the hammer channel's noise (TapResult.force_noise) against

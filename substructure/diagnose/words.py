@@ -241,8 +241,9 @@ def windowed(which: str, tau: float, lo_hz: float, hi_hz: float) -> str:
 
     return (f"{which} was measured through an exponential window (tau = {tau:.4g} s): it adds the damping ratio "
             f"1/(tau omega) to every mode ({zeta(lo_hz)} to {zeta(hi_hz)}), "
-            "which the model lacks; damping found here may be the window's (taps long enough for the response to "
-            "die out need no window)")
+            "which the model lacks; damping found here may be the window's (the time records processed without "
+            "it, substructure tap --no-exponential-window, leave the error of the taps' end counted as noise "
+            "instead; taps long enough for the response to die out need no window)")
 
 
 def truncated(which: str, error: float, at_hz: float) -> str:
