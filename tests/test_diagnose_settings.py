@@ -33,7 +33,8 @@ FIELDS = [f.name for f in attrs.fields(DiagnoseSettings)]
 
 # one value out of range for every field (a new field must be added here, or the first test fails)
 OUT_OF_RANGE = {
-    "budget": 0.0, "time_limit": -1.0, "max_steps": 0, "most_changes": 0, "screen_lines": 0, "peak_lines": -1,
+    "budget": 0.0, "budget_lines": 0, "time_limit": -1.0, "max_steps": 0, "most_changes": 0, "screen_lines": 0,
+    "peak_lines": -1,
     "mode_peak_share": 1.0, "mode_prominence": 0.0, "mode_prominence_floors": -1.0, "mode_pairing": 1.0,
     "error_bands_share": 0.0, "error_bands_width": 1.5, "error_bands_floors": -2.0, "main_mode_share": 1.5,
     "shortlist_share": 0.0, "shortlist_max": 0, "tie_chi2": -1.0,

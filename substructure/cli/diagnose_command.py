@@ -96,7 +96,8 @@ def add_parser(commands) -> None:
     diag.add_argument("--max-steps", type=int, default=4, metavar="N",
                       help="most changes the refinement adds (default 4)")
     diag.add_argument("--budget", type=float, default=None, metavar="N",
-                      help="budget of the search in model evaluations of all lines (default 3000); once spent the "
+                      help="budget of the search in model evaluations of all lines, of at least 2,500 lines "
+                           "(default 3000); once spent the "
                            "search stops adding changes and says so")
     diag.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
                       help="a limit in wall-clock seconds as well (default none)")

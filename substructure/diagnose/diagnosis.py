@@ -218,7 +218,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     budget = settings.budget if isinstance(budget, _FromSettings) else budget
     time_limit = settings.time_limit if isinstance(time_limit, _FromSettings) else time_limit
     max_steps = settings.max_steps if isinstance(max_steps, _FromSettings) else max_steps
-    meter = Budget(budget, time_limit)
+    meter = Budget(budget, time_limit, settings.budget_lines)
     catalogue = _catalogue(effects)
     if progress is True:
         def progress(text):  # noqa: F811 - a printer when asked for

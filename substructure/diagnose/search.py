@@ -56,9 +56,10 @@ class Budget:
 
     Evaluations are counted in evaluations of all lines of all measured
     FRFs (one on the screening subsample of a tenth of the lines counts a
-    tenth), so that the same data and model give the same search on any
-    machine; a limit in seconds is there for users who want one (it makes
-    the result depend on the machine's speed).
+    tenth), and of at least ``lines`` lines (data of fewer lines count
+    each evaluation as its share of that), so that the same data and model
+    give the same search on any machine; a limit in seconds is there for
+    users who want one (it makes the result depend on the machine's speed).
 
     Parameters
     ----------
@@ -66,14 +67,18 @@ class Budget:
         Most evaluations (None: no limit).
     seconds : float or None
         Most wall-clock seconds (None: no limit).
+    lines : int
+        The fewest lines an evaluation of all lines counts as
+        (``DiagnoseSettings.budget_lines``).
     """
 
-    def __init__(self, evaluations: float | None = None, seconds: float | None = None):
+    def __init__(self, evaluations: float | None = None, seconds: float | None = None, lines: int = 1):
         self.evaluations = evaluations
         self.seconds = seconds
         self.started = time.monotonic()
         self.likelihoods: list = []
-        self.full = 1
+        self.lines = max(int(lines), 1)
+        self.full = self.lines
 
     def watch(self, *likelihoods) -> None:
         """Count the evaluations of these likelihoods (the first one's lines are "all lines").
@@ -84,7 +89,7 @@ class Budget:
             The likelihoods the search evaluates.
         """
         if not self.likelihoods and likelihoods:
-            self.full = max(likelihoods[0].n, 1)
+            self.full = max(likelihoods[0].n, self.lines)
         self.likelihoods += [x for x in likelihoods if all(x is not y for y in self.likelihoods)]
 
     def used(self) -> float:

@@ -107,6 +107,12 @@ class DiagnoseSettings:
         on all lines (the checks after the forward search always run).
         Counted in evaluations, not seconds, so that the same data give the
         same answer on any machine.
+    budget_lines : int
+        The fewest lines an evaluation of all lines counts as (default 2500):
+        data of fewer lines (a short record's coarse grid) count each
+        evaluation as its share of this, so that their search may do as
+        much work as one FRF of 2,500 lines (counted in full evaluations,
+        the 142 lines of 30 ms taps spent the budget in the first step).
     time_limit : float or None
         A limit in wall-clock seconds as well (default None; with one, the
         answer may depend on the machine's speed).
@@ -325,6 +331,7 @@ class DiagnoseSettings:
     """
 
     budget: float | None = attrs.field(default=3000, validator=_number(optional=True))
+    budget_lines: int = attrs.field(default=2500, validator=_count())
     time_limit: float | None = attrs.field(default=None, validator=_number(optional=True))
     max_steps: int = attrs.field(default=4, validator=_count())
     most_changes: int = attrs.field(default=2, validator=_count())
