@@ -80,3 +80,20 @@ def test_a_misfit_of_many_lines_fails():
     off = _draws(variances, 1, seed=5)[0] + 0.12  # every line off by 12 %, about three of its deviations
     check = error_check(lik, [off], 1.5)
     assert not check.passed and check.ratio > 1.5 * check.allowed
+
+
+@pytest.mark.parametrize("nu", [3.0, 8.0, 40.0, None])
+def test_the_capped_scores_moments_are_those_of_the_distribution(nu):
+    """Mean, variance and third central moment of a capped line score, against scipy's F(2, nu) (exponential
+    without degrees of freedom) integrated here: the moments the bound of the check is built from."""
+    from scipy import integrate, stats
+
+    from substructure.updating.selection import _each_line_moments
+
+    dist = stats.expon() if nu is None else stats.f(2, nu)
+    raw = [integrate.quad(lambda x, k=k: x**k * dist.pdf(x), 0.0, LINE_CAP, limit=200)[0]
+           + LINE_CAP**k * dist.sf(LINE_CAP) for k in (1, 2, 3)]
+    mean, var = raw[0], raw[1] - raw[0] ** 2
+    third = raw[2] - 3.0 * raw[0] * raw[1] + 2.0 * raw[0] ** 3
+    got = _each_line_moments(None if nu is None else np.array([nu]), 1)
+    assert [float(g[0]) for g in got] == pytest.approx([mean, var, third], rel=2e-3)

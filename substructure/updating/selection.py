@@ -179,6 +179,14 @@ class Consistency:
     bands: tuple
 
 
+def _scores(likelihood, ratios: Sequence[np.ndarray]) -> list[tuple[np.ndarray, np.ndarray | None]]:
+    """Per measured FRF, on the lines it holds (``alive``: no score where it holds nothing), its lines' scores
+    (:meth:`NoiseModel.line_scores`) and the degrees of freedom of their variances (None: known)."""
+    return [(m.noise.line_scores(r, likelihood.lines)[a],
+             None if m.noise.dof is None else m.noise.dof[likelihood.lines][a])
+            for r, m, a in zip(ratios, likelihood.measured, likelihood.alive)]
+
+
 def consistency(likelihood, ratios: Sequence[np.ndarray], p: int) -> Consistency:
     """Test a model's residual against the noise, globally and band by band.
 
@@ -196,8 +204,9 @@ def consistency(likelihood, ratios: Sequence[np.ndarray], p: int) -> Consistency
     Consistency
         The verdict and where the residual is too large.
     """
-    alive = likelihood.alive  # the lines each FRF holds (no score where it holds nothing)
-    z2 = [m.noise.line_scores(r, likelihood.lines)[a] for r, m, a in zip(ratios, likelihood.measured, alive)]
+    alive = likelihood.alive
+    scored = _scores(likelihood, ratios)
+    z2, dofs = [z for z, _ in scored], [d for _, d in scored]
     n = 2 * sum(z.size for z in z2)
     nu = max(n - p, 1)
     chi2 = 2.0 * sum(float(z.sum()) for z in z2)
@@ -206,8 +215,6 @@ def consistency(likelihood, ratios: Sequence[np.ndarray], p: int) -> Consistency
     e = float(np.sqrt(np.sum((sizes * errs) ** 2)) / max(sizes.sum(), 1.0))
     threshold = 1.0 + _Z * math.sqrt(2.0 / nu + e * e)
     reduced = chi2 / nu
-    dofs = [None if m.noise.dof is None else m.noise.dof[likelihood.lines][a] for m, a in zip(likelihood.measured,
-                                                                                             alive)]
     if any(d is not None and np.isfinite(d).any() for d in dofs):
         # lines whose variance is estimated (F(2, nu) scores, heavy-tailed: infinite variance for nu <= 4)
         # enter capped, against the capped scores' mean and variance; the others as they are
@@ -310,10 +317,9 @@ def error_check(likelihood, ratios: Sequence[np.ndarray], factor: float) -> Erro
         The ratio and what is allowed.
     """
     weighted = mean = var = third = total = 0.0
-    for r, m, a in zip(ratios, likelihood.measured, likelihood.alive):
+    for (z, dof), m, a in zip(_scores(likelihood, ratios), likelihood.measured, likelihood.alive):
         v = (m.noise.var_re + m.noise.var_im)[likelihood.lines][a]
-        z = np.minimum(m.noise.line_scores(r, likelihood.lines)[a], LINE_CAP)
-        dof = None if m.noise.dof is None else m.noise.dof[likelihood.lines][a]
+        z = np.minimum(z, LINE_CAP)
         means, variances, thirds = _each_line_moments(dof, v.size)
         weighted += float(v @ z)
         mean += float(v @ means)
