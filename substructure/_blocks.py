@@ -16,7 +16,10 @@ closed-form identification and the segment dynamic stiffness.
 
 :func:`checked_block` is the check of the arrays a component or joint type
 of one's own gives, where they enter a computation (their shape
-``(r, r, n_freq)`` is the one this module works on).
+``(r, r, n_freq)`` is the one this module works on).  :func:`angular_lines`,
+:func:`takes_decay` and :func:`at_decay` are the model at a complex frequency
+``omega - i sigma`` (a tap test seen through an exponential window), for the
+components and joints that can be evaluated there.
 """
 
 from __future__ import annotations
@@ -25,7 +28,8 @@ import numpy as np
 
 from .errors import InvalidValueError, SubstructureError
 
-__all__ = ["mul2", "inv2", "inv", "to_front", "to_back", "CHUNK_LINES", "by_chunks", "checked_block"]
+__all__ = ["mul2", "inv2", "inv", "to_front", "to_back", "CHUNK_LINES", "by_chunks", "checked_block", "angular_lines",
+           "takes_decay", "at_decay"]
 
 CHUNK_LINES = 16384
 """Frequency lines evaluated at once by an assembly (bounds the memory of intermediates).
@@ -166,3 +170,92 @@ def checked_block(owner, kind: str, member: str, compute, rows: int, frequency_h
         raise InvalidValueError(f"{who}: {member} gave values that are not finite on {int(bad.sum())} of "
                                 f"{f.size} lines (the first at {f[bad][0]:g} Hz)")
     return out
+
+
+def angular_lines(frequency_hz, decay: float = 0.0) -> np.ndarray:
+    """The angular frequency of each line, ``2 pi f - i decay`` [rad/s].
+
+    With ``decay = 0`` (the default) the real lines; with ``decay = 1/tau``
+    the complex frequency at which a model is seen through an exponential
+    window ``exp(-t/tau)`` applied to both channels of a tap test: the
+    windowed FRF is ``H(omega - i/tau)`` exactly, whatever the force's shape
+    (``x(t) = X exp(i omega t)``: a window multiplies the impulse response
+    by ``exp(-t/tau)``).
+
+    Parameters
+    ----------
+    frequency_hz : array_like
+        Frequency lines [Hz].
+    decay : float, optional
+        ``sigma = 1/tau`` [1/s], finite and >= 0.
+
+    Returns
+    -------
+    ndarray
+        float64 when ``decay`` is 0, else complex128, one value per line.
+    """
+    omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float).reshape(-1)
+    decay = float(decay)
+    if not np.isfinite(decay) or decay < 0:
+        raise InvalidValueError(f"decay: got {decay!r}; expected a finite rate >= 0 in 1/s (1/tau of the window)")
+    return omega - 1j * decay if decay else omega
+
+
+def takes_decay(method) -> bool:
+    """Whether a component's ``receptance_matrix`` or a joint model's ``dynamic_stiffness`` takes ``decay``.
+
+    The protocol's optional keyword: a type that can be evaluated at the
+    complex frequency ``omega - i decay`` (:func:`angular_lines`) says so by
+    taking it; the package's beams, joints, supports and bodies do.
+
+    Parameters
+    ----------
+    method : callable
+        The bound method.
+
+    Returns
+    -------
+    bool
+    """
+    import inspect
+
+    try:
+        return "decay" in inspect.signature(method).parameters
+    except (TypeError, ValueError):  # a builtin without a signature
+        return False
+
+
+def at_decay(owner, member: str, frequency_hz, decay: float):
+    """``owner.member(frequency_hz)``'s arguments at ``decay``: a callable giving the array.
+
+    Parameters
+    ----------
+    owner : object
+        A component or joint model.
+    member : str
+        ``"receptance_matrix"`` or ``"dynamic_stiffness"``.
+    frequency_hz : ndarray
+        Frequencies [Hz].
+    decay : float
+        ``1/tau`` [1/s]; 0 calls the method as the protocol always has.
+
+    Returns
+    -------
+    callable
+        ``f(*args)`` calling the method with ``args``, the frequencies and, when
+        ``decay`` is not 0, ``decay``.
+
+    Raises
+    ------
+    InvalidValueError
+        When ``decay`` is not 0 and the method does not take it: the type
+        cannot be evaluated at a complex frequency.
+    """
+    method = getattr(owner, member)
+    if not decay:
+        return lambda *args: method(*args, frequency_hz)
+    if not takes_decay(method):
+        raise InvalidValueError(
+            f"{type(owner).__name__} {getattr(owner, 'name', '')!r}: its {member} takes no decay, so it cannot be "
+            "evaluated at a complex frequency (the model seen through an exponential window)")
+    return lambda *args: method(*args, frequency_hz, decay=decay)

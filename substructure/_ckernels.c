@@ -325,12 +325,13 @@ typedef struct {
     double p[2][VL], c[2][VL], s[2][VL]; /* exp(x), cos(y), sin(y) */
 } wave_t;
 
-/* Phase 1: wavenumbers, the choice series/exponential per lane, and r L where needed. */
-AI void waves(const cx co[5], double length, vd w2, wave_t *wv)
+/* Phase 1: wavenumbers, the choice series/exponential per lane, and r L where needed (w2 = omega^2 per lane,
+ * complex where omega is: the model at a complex frequency, as seen through an exponential window). */
+AI void waves(const cx co[5], double length, cv w2, wave_t *wv)
 {
-    cv a = vscale(w2, vc(co[0])), e = vscale(w2, vc(co[1]));
+    cv a = vmulc(w2, co[0]), e = vmulc(w2, co[1]);
     cv half = vscale(splat(0.5), vsub(a, e));
-    cv root = vcsqrt(vadd(vmul(half, half), vscale(w2, vc(co[2]))));
+    cv root = vcsqrt(vadd(vmul(half, half), vmulc(w2, co[2])));
     cv mean = vscale(splat(0.5), vadd(a, e));
     cv s1 = vadd(mean, root), s2 = vsub(mean, root);
     double l2 = length * length;
@@ -388,7 +389,7 @@ AI vd vload(const double *x)
 }
 
 /* Phase 3: the 16 entries (row-major) of T on the lanes, w2 = omega^2 per lane. */
-AI void transfer(const cx co[5], double rhoa, double rhoi, double length, vd w2, const wave_t *wv, cv *t)
+AI void transfer(const cx co[5], double rhoa, double rhoi, double length, cv w2, const wave_t *wv, cv *t)
 {
     cv a = wv->a, e = wv->e, s1 = wv->s1, s2 = wv->s2;
     vm series = wv->series;
@@ -465,7 +466,7 @@ AI void transfer(const cx co[5], double rhoa, double rhoi, double length, vd w2,
     cv alpha = vsub(c0, vmul(c1, s2)), beta = vsub(g0, vmul(g1, s2));
     cv gamma = c1, delta = g1;
     cx iei = co[3], ikga = co[4];
-    vd ma = w2 * rhoa, mi = w2 * rhoi;
+    cv ma = vscale(splat(rhoa), w2), mi = vscale(splat(rhoi), w2);
     cv d00 = vadd(alpha, vmul(gamma, a)), d11 = vadd(alpha, vmul(gamma, e));
     t[0] = d00;
     t[10] = d00;
@@ -477,15 +478,15 @@ AI void transfer(const cx co[5], double rhoa, double rhoi, double length, vd w2,
     t[2] = vadd(vmulc(beta, ikga), vmul(delta, u));
     t[3] = vmulc(gamma, iei);
     t[6] = vneg(t[3]);
-    t[4] = vmulc(vscale(ma, delta), iei);
+    t[4] = vmulc(vmul(ma, delta), iei);
     t[11] = vneg(t[4]);
     t[7] = vmulc(vadd(beta, vmul(delta, e)), iei);
-    t[8] = vneg(vscale(ma, vadd(beta, vmul(delta, a))));
-    t[12] = vscale(ma, gamma);
+    t[8] = vneg(vmul(ma, vadd(beta, vmul(delta, a))));
+    t[12] = vmul(ma, gamma);
     t[9] = vneg(t[12]);
     /* t31 = -mi beta + delta (ma - mi e), t32 = -beta + delta (mi / EI - a) */
-    t[13] = vadd(vscale(-mi, beta), vmul(delta, V(ma - mi * e.re, splat(0.0) - mi * e.im)));
-    t[14] = vadd(vneg(beta), vmul(delta, V(mi * iei.re - a.re, mi * iei.im - a.im)));
+    t[13] = vadd(vmul(vneg(mi), beta), vmul(delta, vsub(ma, vmul(mi, e))));
+    t[14] = vadd(vneg(beta), vmul(delta, vsub(vmulc(mi, iei), a)));
 }
 
 /* ------------------------------------------------------------------------ */
@@ -667,7 +668,7 @@ AI void chain_block(const cv *tmat, const int64_t *seg_of, Py_ssize_t n_int, con
 #endif
 
 /* Lines lo .. hi - 1 (see py_chain_lines). */
-KERNEL_CLONES static void chain_range(const double *omega, Py_ssize_t n_f, const cx *coef, const double *rhoa,
+KERNEL_CLONES static void chain_range(const cx *omega, Py_ssize_t n_f, const cx *coef, const double *rhoa,
                                       const double *rhoi, const double *length, Py_ssize_t n_u, Py_ssize_t n_c,
                                       const int64_t *slot, cx *table, const int64_t *seg_of, Py_ssize_t n_int,
                                       const int64_t *nodes, const int64_t *place, Py_ssize_t m, cx *out,
@@ -680,10 +681,11 @@ KERNEL_CLONES static void chain_range(const double *omega, Py_ssize_t n_f, const
         Py_ssize_t i = q - c * n_f;
         Py_ssize_t left = hi - q < n_f - i ? hi - q : n_f - i;
         int nb = left < VL ? (int)left : VL; /* lines of this block, all of configuration c */
-        vd w2;
+        cv w2;
         for (int l = 0; l < VL; l++) {
-            double w = omega[i + (l < nb ? l : nb - 1)];
-            w2[l] = w * w;
+            cx w = omega[i + (l < nb ? l : nb - 1)];
+            w2.re[l] = w.re * w.re - w.im * w.im;
+            w2.im[l] = 2.0 * w.re * w.im;
         }
         /* the segments computed here (not read from the table): phases 1 to 3 of the closed form */
         for (Py_ssize_t u = 0; u < n_u; u++) {
@@ -846,7 +848,7 @@ static PyObject *py_chain_lines(PyObject *self, PyObject *args)
                           &o[9], &o[10], &table_only, &lo, &hi))
         return NULL;
     buf_t b[11] = {{0}};
-    if (get(o[0], &b[0], 'd', 1, 0, "omega") || get(o[1], &b[1], 'Z', 3, 0, "coef") ||
+    if (get(o[0], &b[0], 'Z', 1, 0, "omega") || get(o[1], &b[1], 'Z', 3, 0, "coef") ||
         get(o[2], &b[2], 'd', 2, 0, "rhoa") || get(o[3], &b[3], 'd', 2, 0, "rhoi") ||
         get(o[4], &b[4], 'd', 2, 0, "length") || get(o[5], &b[5], 'q', 1, 0, "slot") ||
         get(o[6], &b[6], 'Z', 3, 1, "table") || get(o[7], &b[7], 'q', 1, 0, "seg_of") ||
@@ -889,8 +891,8 @@ static PyObject *py_chain_lines(PyObject *self, PyObject *args)
         PyErr_Format(PyExc_ValueError, "chain_lines: inconsistent %s", bad);
         return NULL;
     }
-    const double *omega = b[0].view.buf, *rhoa = b[2].view.buf, *rhoi = b[3].view.buf, *length = b[4].view.buf;
-    const cx *coef = b[1].view.buf;
+    const double *rhoa = b[2].view.buf, *rhoi = b[3].view.buf, *length = b[4].view.buf;
+    const cx *omega = b[0].view.buf, *coef = b[1].view.buf;
     cx *table = b[6].view.buf, *out = b[10].view.buf;
     Py_ssize_t nu1 = n_u > 0 ? n_u : 1, m1 = m > 0 ? m : 1;
     /* the transfer matrices and the end products of a block (cv), then the segments' wave_t */

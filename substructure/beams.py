@@ -42,6 +42,7 @@ import numpy as np
 import pint
 
 from . import _blocks as bk
+from ._blocks import angular_lines
 from ._chains import _CHUNK_KL, _chain_receptance, _chain_single, _is_shared, _phase, _stack_sections  # noqa: F401
 from .errors import InvalidValueError
 from .materials import Material
@@ -359,7 +360,7 @@ def segment_transfer_matrix(sec: Section, length: float, omega: np.ndarray) -> n
     """
     from . import _kernels
 
-    omega = _kernels.c_array(np.reshape(omega, -1), float)
+    omega = _kernels.c_array(np.reshape(omega, -1), complex)
     t = _kernels.transfer_matrices(
         omega, np.array([[sec.EI]], dtype=complex), np.array([[sec.kGA]], dtype=complex),
         np.array([[sec.rhoA]], dtype=float), np.array([[sec.rhoI]], dtype=float), np.array([[length]], dtype=float),
@@ -399,7 +400,7 @@ def segment_dynamic_stiffness(sec: Section, length: float, omega: np.ndarray):
 
 
 def stepped_beam_receptance(
-    segments: Sequence[Segment], positions: Sequence[float], frequency_hz: np.ndarray
+    segments: Sequence[Segment], positions: Sequence[float], frequency_hz: np.ndarray, decay: float = 0.0
 ) -> np.ndarray:
     """Free-free receptance matrix of a stepped beam between points.
 
@@ -411,6 +412,10 @@ def stepped_beam_receptance(
         Distinct positions from the base, in metres, within ``[0, length]``.
     frequency_hz : ndarray
         Frequency lines in Hz, all > 0 (a free-free beam has no static receptance).
+    decay : float, optional
+        ``1/tau`` [1/s]: the receptances at the complex frequency
+        ``omega - i decay``, as a tap test sees the beam through an
+        exponential window ``exp(-t/tau)``; default 0.
 
     Returns
     -------
@@ -423,10 +428,10 @@ def stepped_beam_receptance(
     sorted_pos = pos[order]
     if np.any(np.diff(sorted_pos) <= 0):
         raise InvalidValueError("positions: expected distinct positions")
-    omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float).reshape(-1)
+    omega = angular_lines(frequency_hz, decay)
     from .tapers import piecewise_sections
 
-    sections, ends = piecewise_sections(segments, float(omega.max()) if omega.size else 0.0, sorted_pos)
+    sections, ends = piecewise_sections(segments, float(np.abs(omega).max()) if omega.size else 0.0, sorted_pos)
     cuts = np.unique(np.concatenate([ends, sorted_pos]))
     intervals = []
     for x0, x1 in zip(cuts[:-1], cuts[1:]):
@@ -438,7 +443,7 @@ def stepped_beam_receptance(
 
 def stepped_beam_receptance_si(
     ei: np.ndarray, kga: np.ndarray, rhoa: np.ndarray, rhoi: np.ndarray, lengths: np.ndarray,
-    positions: Sequence[float], frequency_hz: np.ndarray,
+    positions: Sequence[float], frequency_hz: np.ndarray, decay: float = 0.0,
 ) -> np.ndarray:
     """Free-free receptances of a stepped beam given by SI arrays (no Segment objects).
 
@@ -459,6 +464,8 @@ def stepped_beam_receptance_si(
         Distinct positions from the base [m], within ``[0, sum(lengths)]``.
     frequency_hz : ndarray
         Frequency lines [Hz], all > 0.
+    decay : float, optional
+        ``1/tau`` [1/s]: at the complex frequency ``omega - i decay``.
 
     Returns
     -------
@@ -474,14 +481,14 @@ def stepped_beam_receptance_si(
     lengths = np.asarray(lengths, dtype=float)
     ends = np.concatenate([[0.0], np.cumsum(lengths)])
     cuts = np.unique(np.concatenate([ends, sorted_pos]))
-    omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float).reshape(-1)
+    omega = angular_lines(frequency_hz, decay)
     from . import _kernels
 
     ei, kga = (_kernels.c_array(np.asarray(v, complex).reshape(-1, 1), complex) for v in (ei, kga))
     rhoa, rhoi = (_kernels.c_array(np.asarray(v, float).reshape(-1, 1), float) for v in (rhoa, rhoi))
     _, k_max = _kernels.segment_coefficients(  # every segment's largest wavenumber, in one call
         ei.reshape(1, -1), kga.reshape(1, -1), rhoa.reshape(1, -1), rhoi.reshape(1, -1),
-        float(np.max(omega)) if omega.size else 0.0)
+        float(np.max(np.abs(omega))) if omega.size else 0.0)
     widths = np.diff(cuts)
     seg = np.clip(np.searchsorted(ends, 0.5 * (cuts[:-1] + cuts[1:])) - 1, 0, lengths.size - 1)
     phases = k_max[0, seg] * widths
@@ -489,7 +496,7 @@ def stepped_beam_receptance_si(
     if phases.max() <= _CHUNK_KL and np.cumsum(phases)[-1] <= _CHUNK_KL:
         # one transfer-matrix chain (the usual case): the kernel takes the arrays as they are
         return _kernels.chain_receptance(
-            _kernels.c_array(omega, float), ei[seg], kga[seg], rhoa[seg], rhoi[seg], widths.reshape(-1, 1),
+            _kernels.c_array(omega, complex), ei[seg], kga[seg], rhoa[seg], rhoi[seg], widths.reshape(-1, 1),
             np.zeros(seg.size, dtype=bool), np.arange(seg.size, dtype=np.int64), nodes.astype(np.int64),
             order.astype(np.int64))
     sections = [Section(complex(a), complex(b), float(c), float(d))

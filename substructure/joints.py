@@ -25,7 +25,7 @@ import attrs
 import numpy as np
 import pint
 
-from ._blocks import checked_block
+from ._blocks import angular_lines, at_decay, checked_block
 from .errors import InvalidValueError, NonPassiveJointWarning, NonReciprocalWarning
 from .points import check_name, parse_point
 from .units import format_quantity, magnitude_in, quantity
@@ -324,13 +324,16 @@ class Joint:
         """
         return cls(name, (a, b), rigid=True)
 
-    def dynamic_stiffness(self, frequency_hz: np.ndarray) -> np.ndarray:
+    def dynamic_stiffness(self, frequency_hz: np.ndarray, decay: float = 0.0) -> np.ndarray:
         """``K + i omega C`` (thesis eq. 2.5) as an array ``(2, 2, n_freq)``; rigid joints have none.
 
         Parameters
         ----------
         frequency_hz : array_like
             Frequencies in Hz.
+        decay : float, optional
+            ``1/tau`` [1/s]: at the complex frequency ``omega - i decay`` (a tap
+            test seen through an exponential window); default 0.
 
         Returns
         -------
@@ -339,7 +342,7 @@ class Joint:
         """
         if self.rigid:
             raise InvalidValueError(f"joint {self.name!r} is rigid: it has no finite stiffness")
-        omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
+        omega = angular_lines(frequency_hz, decay)
         return self.k.values[:, :, None] + 1j * omega * self.c.values[:, :, None]
 
     def with_parameters(self, k=None, c=None) -> "Joint":
@@ -386,20 +389,23 @@ class Support:
             raise InvalidValueError(f"support at {self.at}: needs stiffness k or damping c entries")
         _check_matrices(self.k.values, self.c.values, f"support at {self.at}")
 
-    def dynamic_stiffness(self, frequency_hz: np.ndarray) -> np.ndarray:
+    def dynamic_stiffness(self, frequency_hz: np.ndarray, decay: float = 0.0) -> np.ndarray:
         """``K + i omega C`` of the support, as for a joint.
 
         Parameters
         ----------
         frequency_hz : array_like
             Frequencies in Hz.
+        decay : float, optional
+            ``1/tau`` [1/s]: at the complex frequency ``omega - i decay`` (a tap
+            test seen through an exponential window); default 0.
 
         Returns
         -------
         ndarray
             Complex, shape ``(2, 2, n_freq)``, entries in N/m, N, N/rad and N m/rad.
         """
-        omega = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
+        omega = angular_lines(frequency_hz, decay)
         return self.k.values[:, :, None] + 1j * omega * self.c.values[:, :, None]
 
 
@@ -430,20 +436,23 @@ class _Body:
         """The rotary inertia in kg m^2 (a float)."""
         return magnitude_in(self.inertia, "kg*m^2")
 
-    def dynamic_stiffness(self, frequency_hz: np.ndarray) -> np.ndarray:
+    def dynamic_stiffness(self, frequency_hz: np.ndarray, decay: float = 0.0) -> np.ndarray:
         """``-omega^2 diag(m, J)`` (thesis eq. 5.2, with the rotary inertia J).
 
         Parameters
         ----------
         frequency_hz : array_like
             Frequencies in Hz.
+        decay : float, optional
+            ``1/tau`` [1/s]: at the complex frequency ``omega - i decay`` (a tap
+            test seen through an exponential window); default 0.
 
         Returns
         -------
         ndarray
             Complex, shape ``(2, 2, n_freq)``: N/m on y, N m/rad on theta.
         """
-        w2 = (2.0 * np.pi * np.asarray(frequency_hz, dtype=float)) ** 2
+        w2 = angular_lines(frequency_hz, decay) ** 2
         out = np.zeros((2, 2, w2.size), dtype=complex)
         out[0, 0] = -w2 * self.mass_kg
         out[1, 1] = -w2 * self.inertia_si
@@ -517,7 +526,7 @@ class Mass(_Body):
     """
 
 
-def dynamic_stiffness(link, frequency_hz) -> np.ndarray:
+def dynamic_stiffness(link, frequency_hz, decay: float = 0.0) -> np.ndarray:
     """``link.dynamic_stiffness(frequency_hz)``, checked when the joint model is one of one's own.
 
     Every computation takes a joint's (support's, body's) dynamic stiffness
@@ -531,6 +540,10 @@ def dynamic_stiffness(link, frequency_hz) -> np.ndarray:
         What connects or hangs on points.
     frequency_hz : ndarray
         Frequencies [Hz].
+    decay : float, optional
+        ``1/tau`` [1/s]: at the complex frequency ``omega - i decay`` (a tap
+        test seen through an exponential window), from a
+        ``dynamic_stiffness`` that takes ``decay``; default 0.
 
     Returns
     -------
@@ -540,7 +553,8 @@ def dynamic_stiffness(link, frequency_hz) -> np.ndarray:
     Raises
     ------
     InvalidValueError
-        When a joint model of one's own breaks the protocol.
+        When a joint model of one's own breaks the protocol, or ``decay`` is
+        not 0 and its ``dynamic_stiffness`` does not take it.
     """
-    return checked_block(link, "joint", "dynamic_stiffness", lambda: link.dynamic_stiffness(frequency_hz), 2,
-                         frequency_hz)
+    return checked_block(link, "joint", "dynamic_stiffness", at_decay(link, "dynamic_stiffness", frequency_hz, decay),
+                         2, frequency_hz)

@@ -422,13 +422,14 @@ class Model:
             f = f[int(skip_rigid):]
         return f if n is None else f[:n]
 
-    def receptance(self, f_hz, outputs, inputs=None) -> np.ndarray:
+    def receptance(self, f_hz, outputs, inputs=None, decay: float = 0.0) -> np.ndarray:
         """Receptances ``(n_freq, n_out, n_in)`` between points (outputs: y or theta;
         inputs: force on y, moment on theta).  Clamped DOFs give 0.  ``f_hz = 0``
         is the static compliance of a constrained structure.  One sparse LU per
-        frequency (fast for the banded beam matrices)."""
+        frequency (fast for the banded beam matrices).  ``decay``: at the complex
+        angular frequency ``2 pi f - i decay`` (the same matrices, ``w`` complex)."""
         inputs = outputs if inputs is None else inputs
-        w = 2 * math.pi * np.atleast_1d(np.asarray(f_hz, float))
+        w = 2 * math.pi * np.atleast_1d(np.asarray(f_hz, float)) - 1j * decay
         K0, C, M, red = self.matrices()
         oi = np.array([red[self.dof(p)] for p in outputs])
         ii = np.array([red[self.dof(p)] for p in inputs])

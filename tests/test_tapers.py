@@ -112,8 +112,11 @@ def test_free_free_natural_frequencies_match_fe(name):
     np.testing.assert_allclose(found, expected, rtol=TAPER_ERROR_BOUND)
 
 
-def test_tapered_holder_in_an_assembly_matches_fe_receptances():
-    """A spindle, a holder with a tapered nose around the tool shank and a tapered tool, with joints."""
+@pytest.mark.parametrize("decay", [0.0, 50.0])
+def test_tapered_holder_in_an_assembly_matches_fe_receptances(decay):
+    """A spindle, a holder with a tapered nose around the tool shank and a tapered tool, with joints; with
+    ``decay``, at the complex frequency omega - i decay (as seen through an exponential window of 20 ms), the
+    tapered components through their receptance_matrix (not plain SI beams)."""
     spindle = Spindle("spindle", [Segment("200 mm", "80 mm", "40 mm", STEEL_D),
                                   Segment("60 mm", "100 mm", "40 mm", STEEL_D, od_tip="70 mm")])
     holder = Holder("holder", [Segment("20 mm", "63 mm", material=STEEL_D),
@@ -139,8 +142,18 @@ def test_tapered_holder_in_an_assembly_matches_fe_receptances():
     m.add_joint((s, 0.26), (h, 0.0), k=[[4e7, 0], [0, 3e6]], c=[[400, 0], [0, 7]])
     m.add_joint((h, 0.07), (t, 0.0), k=[[1.4e7, 0], [0, 8e4]], c=[[12, 0], [0, 4]])
     grid = Frequency.from_range("50 Hz", "6000 Hz", "50 Hz")
-    ours = asm.frf(["tool.tip", "holder.tip"], frequency=grid).data
-    theirs = m.receptance(grid.hz, [(t, 0.07, "y"), (t, 0.07, "theta"), (h, 0.07, "y"), (h, 0.07, "theta")])
+    if decay:
+        from substructure.updating.evaluator import Evaluator
+        from substructure.updating.structure import Structure
+
+        structure = Structure.from_assembly(asm)
+        assert set(structure.opaque) == {"spindle", "holder", "tool"} and structure.not_at_complex_frequency() == []
+        labels = ["tool.tip:y", "tool.tip:theta", "holder.tip:y", "holder.tip:theta"]
+        ours = Evaluator(labels, labels, grid.hz, decay=decay)(structure)
+    else:
+        ours = asm.frf(["tool.tip", "holder.tip"], frequency=grid).data
+    theirs = m.receptance(grid.hz, [(t, 0.07, "y"), (t, 0.07, "theta"), (h, 0.07, "y"), (h, 0.07, "theta")],
+                          decay=decay)
     err = np.abs(ours - theirs).max(axis=0) / np.abs(theirs).max(axis=0)
     assert err.max() < RECEPTANCE_TOL  # measured 7e-5 (the FE mesh error included)
     assert asm.frf(["tool.tip"], frequency=grid).reciprocity_error() < 1e-10

@@ -179,7 +179,7 @@ class Beam:
         """
         return (self.name, round(self.position(ref), 12))
 
-    def receptance_matrix(self, refs: Sequence[PointRef], frequency_hz: np.ndarray) -> np.ndarray:
+    def receptance_matrix(self, refs: Sequence[PointRef], frequency_hz: np.ndarray, decay: float = 0.0) -> np.ndarray:
         """The free-free receptances between points, frequency last (the component protocol).
 
         Parameters
@@ -188,6 +188,9 @@ class Beam:
             The p points.
         frequency_hz : ndarray
             Frequencies in Hz, all > 0 (a free-free beam has no static receptance).
+        decay : float, optional
+            ``1/tau`` [1/s]: at the complex frequency ``omega - i decay`` (a tap
+            test seen through an exponential window); default 0.
 
         Returns
         -------
@@ -197,7 +200,7 @@ class Beam:
         """
         f = np.asarray(frequency_hz, dtype=float)
         _positive_frequencies(f, f"component {self.name!r}")
-        return stepped_beam_receptance(self.segments, [self.position(r) for r in refs], f)
+        return stepped_beam_receptance(self.segments, [self.position(r) for r in refs], f, decay)
 
     def _ref(self, point: str) -> PointRef:
         text = point if point.startswith(self.name + ".") or point.startswith(self.name + "@") else (

@@ -16,7 +16,7 @@ import numpy as np
 import pint
 
 from ..beams import Segment
-from .._blocks import checked_block
+from .._blocks import at_decay, checked_block
 from ..errors import InvalidValueError
 from ..frf import FRF, Frequency
 from ..points import DOFS
@@ -150,7 +150,7 @@ def is_plain_beam(component: Any) -> bool:
     return isinstance(segments, tuple) and bool(segments) and all(isinstance(s, Segment) for s in segments)
 
 
-def receptances(component: Any, refs: list, frequency_hz: np.ndarray) -> np.ndarray:
+def receptances(component: Any, refs: list, frequency_hz: np.ndarray, decay: float = 0.0) -> np.ndarray:
     """``component.receptance_matrix(refs, frequency_hz)``, checked when the component's type is one of one's own.
 
     A type defined outside the package is held to the protocol where its
@@ -167,6 +167,10 @@ def receptances(component: Any, refs: list, frequency_hz: np.ndarray) -> np.ndar
         Its points.
     frequency_hz : ndarray
         Frequencies [Hz].
+    decay : float, optional
+        ``1/tau`` [1/s]: the receptances at the complex frequency
+        ``omega - i decay`` (a tap test seen through an exponential window),
+        from a ``receptance_matrix`` that takes ``decay``; default 0.
 
     Returns
     -------
@@ -176,7 +180,9 @@ def receptances(component: Any, refs: list, frequency_hz: np.ndarray) -> np.ndar
     Raises
     ------
     InvalidValueError
-        When a component type of one's own breaks the protocol.
+        When a component type of one's own breaks the protocol, or ``decay``
+        is not 0 and its ``receptance_matrix`` does not take it.
     """
-    return checked_block(component, "component", "receptance_matrix",
-                         lambda: component.receptance_matrix(refs, frequency_hz), 2 * len(refs), frequency_hz)
+    call = at_decay(component, "receptance_matrix", frequency_hz, decay)
+    return checked_block(component, "component", "receptance_matrix", lambda: call(refs), 2 * len(refs),
+                         frequency_hz)

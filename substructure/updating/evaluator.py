@@ -52,13 +52,21 @@ class Evaluator:
         from earlier evaluations: a coupling step whose inputs are those of
         an earlier one (the components and links a change did not touch) is
         not computed again.
+    decay : float
+        ``1/tau`` [1/s]: the receptances at the complex frequency
+        ``omega - i decay``, as a tap test processed through an exponential
+        window ``exp(-t/tau)`` sees the structure (default 0: the real
+        lines).  Every component and joint model of the structures must
+        then take ``decay`` (:meth:`Structure.not_at_complex_frequency
+        <substructure.updating.structure.Structure.not_at_complex_frequency>` names those that do not).
     """
 
     def __init__(self, outputs: Sequence[str], inputs: Sequence[str], frequency_hz: np.ndarray, cache: int = 12,
-                 memo_bytes: int = 32 * 2**20):
+                 memo_bytes: int = 32 * 2**20, decay: float = 0.0):
         self.outputs = tuple(outputs)
         self.inputs = tuple(inputs)
         self.f = np.asarray(frequency_hz, dtype=float)
+        self.decay = float(decay)
         if self.f.size == 0 or np.any(self.f <= 0):
             raise InvalidValueError("frequency: a model evaluation needs lines above 0 Hz (free-free components "
                                     "have no static receptance); crop the data, e.g. from 1 Hz")
@@ -93,21 +101,21 @@ class Evaluator:
             beam = structure.beams[name]
             xs = [x for x, _ in nodes]
             key = (beam.token, tuple(xs))  # a token is never reused
-            return self._store(key, lambda: beam.receptance(xs, self.f), pin), key
+            return self._store(key, lambda: beam.receptance(xs, self.f, self.decay), pin), key
         comp = structure.opaque[name]
         refs = [r if r is not None else _at(name, x, comp.length_m) for x, r in nodes]
         # keyed by the object's id, stored with the object itself so that the id cannot be reused while cached;
         # pinned only for the first structure (a component changed by a fit is rebuilt at every evaluation)
         key = (id(comp), tuple(str(r) for r in refs))
-        kept = self._store(key, lambda: (comp, receptances(comp, refs, self.f)), pin)
+        kept = self._store(key, lambda: (comp, receptances(comp, refs, self.f, self.decay)), pin)
         return kept[1], (Same(comp), key[1])
 
     def _dynamic_stiffness(self, link: "LinkSI", token) -> np.ndarray | None:
         if token is None or link.rigid:
-            return link.dynamic_stiffness(self.f)
+            return link.dynamic_stiffness(self.f, self.decay)
         found = self._stiffness.get(token)
         if found is None:
-            found = link.dynamic_stiffness(self.f)
+            found = link.dynamic_stiffness(self.f, self.decay)
             self._stiffness[token] = found
         return found
 

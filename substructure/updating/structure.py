@@ -21,6 +21,7 @@ from typing import Sequence
 
 import numpy as np
 
+from .._blocks import angular_lines, takes_decay
 from ..beams import Segment, shear_coefficient, stepped_beam_receptance_si
 from ..components import Beam, is_plain_beam
 from ..errors import UnknownPointError
@@ -193,7 +194,7 @@ class BeamArrays:
         """
         return float(np.sum(self.sections()[2] * self.length))
 
-    def receptance(self, positions: Sequence[float], frequency_hz: np.ndarray) -> np.ndarray:
+    def receptance(self, positions: Sequence[float], frequency_hz: np.ndarray, decay: float = 0.0) -> np.ndarray:
         """Free-free receptances between positions.
 
         Parameters
@@ -202,6 +203,8 @@ class BeamArrays:
             Distinct positions [m from the base].
         frequency_hz : ndarray
             Frequency lines [Hz], > 0.
+        decay : float, optional
+            ``1/tau`` [1/s]: at the complex frequency ``omega - i decay``.
 
         Returns
         -------
@@ -209,7 +212,7 @@ class BeamArrays:
             Frequency-last receptances, DOFs ``(y, theta)`` per position.
         """
         ei, kga, rhoa, rhoi = self.sections()
-        return stepped_beam_receptance_si(ei, kga, rhoa, rhoi, self.length, positions, frequency_hz)
+        return stepped_beam_receptance_si(ei, kga, rhoa, rhoi, self.length, positions, frequency_hz, decay)
 
 
 class LinkSI:
@@ -258,13 +261,15 @@ class LinkSI:
         fields.update(changes)
         return LinkSI(**fields)
 
-    def dynamic_stiffness(self, frequency_hz: np.ndarray) -> np.ndarray | None:
+    def dynamic_stiffness(self, frequency_hz: np.ndarray, decay: float = 0.0) -> np.ndarray | None:
         """``K + i omega C - omega^2 M``, frequency last.
 
         Parameters
         ----------
         frequency_hz : ndarray
             Frequency lines [Hz].
+        decay : float, optional
+            ``1/tau`` [1/s]: at the complex frequency ``omega - i decay``.
 
         Returns
         -------
@@ -274,8 +279,8 @@ class LinkSI:
         if self.rigid:
             return None
         if self.custom is not None:
-            return dynamic_stiffness(self.custom, frequency_hz)
-        w = 2.0 * np.pi * np.asarray(frequency_hz, dtype=float)
+            return dynamic_stiffness(self.custom, frequency_hz, decay)
+        w = angular_lines(frequency_hz, decay)
         return self.K[:, :, None] + 1j * w * self.C[:, :, None] - (w * w) * self.M[:, :, None]
 
 
@@ -377,6 +382,26 @@ class Structure:
                               custom=j)
             links.append(link)
         return cls(assembly, beams, opaque, tuple(links), tuple(order), sources)
+
+    def not_at_complex_frequency(self) -> list[str]:
+        """What cannot be evaluated at a complex frequency (a tap test seen through an exponential window).
+
+        The package's beams, joints, supports and bodies can; a component or
+        joint model of one's own can when its ``receptance_matrix`` or
+        ``dynamic_stiffness`` takes ``decay``; a measured component cannot
+        (its FRF is known on the real lines only).
+
+        Returns
+        -------
+        list of str
+            ``"component 'name' (Type)"`` or ``"joint 'name' (Type)"`` for each
+            one that cannot; empty when the whole structure can.
+        """
+        out = [f"component {name!r} ({type(c).__name__})" for name, c in self.opaque.items()
+               if not takes_decay(c.receptance_matrix)]
+        out += [f"{link.key[0][:-1]} {link.key[1]!r} ({type(link.custom).__name__})" for link in self.links
+                if link.custom is not None and not takes_decay(link.custom.dynamic_stiffness)]
+        return out
 
     # -- lookup and changes --------------------------------------------------------
 
