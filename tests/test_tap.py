@@ -90,14 +90,16 @@ def test_the_window_is_applied_only_when_the_response_has_not_died_out():
 
 
 def test_acceleration_is_converted_to_receptance():
+    """Through the window the taps measure the system at s = i omega + 1/tau: the accelerance s^2 H(s), and the
+    receptance it converts to is H(s) (divided by s^2, not by (i omega)^2, which left a phase error of
+    2 / (tau omega))."""
     result = process_taps([tap(quantity="acceleration")], exponential=True)
     hz = result.frf.frequency.hz
     s = 2j * np.pi * hz + 1.0 / result.tau
-    expected = s**2 * receptance(s) / (2j * np.pi * hz) ** 2  # accelerance of the windowed system / (i omega)^2
+    expected = receptance(s)  # the windowed system's receptance
     band = (hz > 20) & (hz < 1000)
-    # the force's direct part of the acceleration is sampled, not held: the sinc^2 applies only roughly
-    assert np.abs(result.frf.data[band, 0, 0] / expected[band] - 1.0).max() < 0.05
-    assert np.abs(result.frf.data[band, 0, 0] / expected[band] - 1.0)[hz[band] < 600].max() < 0.01
+    # the force's direct part of the acceleration is sampled, not held: 0.5 % here (7 % with (i omega)^2)
+    assert np.abs(result.frf.data[band, 0, 0] / expected[band] - 1.0).max() < 0.01
     assert result.measured.quantity == "accelerance" and result.frf.quantity == "receptance"
     assert hz[0] > 0.0  # the 0 Hz line dropped
 

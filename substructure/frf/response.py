@@ -450,8 +450,18 @@ class FRF:
             warnings.warn(message, NonReciprocalWarning, stacklevel=2)
         return error
 
-    def to_receptance(self) -> FRF:
+    def to_receptance(self, decay: float = 0.0) -> FRF:
         """Receptance from mobility (``/ (i omega)``) or accelerance (``/ -omega**2``).
+
+        Parameters
+        ----------
+        decay : float, optional
+            ``1/tau`` [1/s] of the exponential window ``exp(-t/tau)`` the FRF
+            was measured through (default 0: none).  Such an FRF is the
+            structure's at the complex frequency ``omega - i/tau``, and so is
+            the quotient: ``/ (i (omega - i/tau))`` and ``/ -(omega - i/tau)**2``
+            (with the real ``omega``, a windowed accelerance's receptance would
+            carry a phase error of ``2/(tau omega)``).
 
         Returns
         -------
@@ -460,7 +470,9 @@ class FRF:
         """
         if self.quantity == "receptance":
             return self
-        omega = self.frequency.omega
+        if not (np.isfinite(decay) and decay >= 0):
+            raise InvalidValueError(f"decay: got {decay!r}; expected a finite rate >= 0 in 1/s (1/tau of the window)")
+        omega = self.frequency.omega - 1j * decay if decay else self.frequency.omega
         if omega[0] == 0.0:
             raise InvalidValueError(
                 f"frequency: the grid starts at 0 Hz, where a {self.quantity} has no "

@@ -236,7 +236,7 @@ class _Reader:
             raw = raw.crop(lo=raw.frequency.hz[1])
             columns = {key: value[1:] for key, value in columns.items()}
         try:
-            receptance = raw.to_receptance()
+            receptance = raw.to_receptance(1.0 / tau if tau else 0.0)
         except SubstructureError as exc:
             raise self.error(index, "file", f"{self.base_dir / file}: {exc}") from None
         try:

@@ -359,7 +359,8 @@ class Measurement:
             raise InvalidValueError(
                 f"frf: got {frf.shape[1]}x{frf.shape[2]} entries; expected one FRF (select one entry first)"
             )
-        receptance = frf.with_labels((out,), (inp,)).to_receptance()
+        tau = _optional_tau(window_tau)  # a windowed FRF's receptance: at omega - i/tau, as the window saw it
+        receptance = frf.with_labels((out,), (inp,)).to_receptance(1.0 / tau if tau else 0.0)
         return cls(out, inp, receptance, frf.quantity, sensors, removed, file, record, coherence, averages,
                    window_tau, force_noise, force_window_s, estimator, truncation)
 

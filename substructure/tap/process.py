@@ -263,13 +263,15 @@ def process_taps(
     rows = np.array(kept)
     f = force[rows] - baseline[rows, None]
     x = response[rows].copy()
-    pre_rows = (trigger[rows] / dt).astype(int)
-    for i, p in enumerate(pre_rows.tolist()):  # per tap, not per line: the response's offset before the hit
+    quiet = np.argmax(force_window[rows] > 0, axis=1)  # the samples before the force window: no pulse yet
+    for i, p in enumerate(quiet.tolist()):  # per tap, not per line: the response's offset before the hit
+        # from the quiet samples only: what a filter of the acquisition spreads ahead of the pulse (a linear-phase
+        # decimation filter rings before it) is no offset; through the exponential window an error c of the
+        # offset is c / (1/tau + i omega) on every line, not on the 0 Hz line alone
         if p >= 8:
             x[i] -= x[i, :p].mean()
     f = f * force_window[rows]
     noise_sd = np.array([_noise_outside(force[r] - baseline[r], force_window[r]) for r in rows.tolist()])
-    quiet = np.argmax(force_window[rows] > 0, axis=1)  # the samples before the force window: no pulse yet
     end = the_end(x, quiet, [taps[cuts[r][2]].number for r in rows])
     why: str | None = None  # said by the end of the taps, when the default decides
     response_noise = noise_variance(x, quiet)
@@ -331,7 +333,9 @@ def process_taps(
     truncation = truncation_variance(x, F, w, response_noise, h, dt)
     if why is None:
         why = window_words(end, truncation, told_apart(x, response_noise))
-    return TapResult(measured.to_receptance(), measured, coherence[keep], estimator, tuple(taps), tau,
+    # through the window the taps measured the structure at omega - i/tau: so is its receptance
+    receptance = measured.to_receptance(1.0 / tau if tau else 0.0)
+    return TapResult(receptance, measured, coherence[keep], estimator, tuple(taps), tau,
                      hammer_band, float(hammer_band_db), spectra, rate, length, why, v_f,
                      float(np.sqrt(np.mean(noise_sd**2))), width, None if truncation is None else truncation[keep])
 
