@@ -58,7 +58,8 @@ def _set_text(name: str, response: str, excitation: str, file: str, averages: in
     if tau is None:
         return text
     return (f"# measured through an exponential window, tau = {tau:.4g} s: it adds the damping ratio 1/(tau omega) to "
-            "every mode,\n# which a model compared with this FRF lacks (a longer record needs no window)\n" + text)
+            "every mode;\n# diagnose and identify compare the model through the same window (window_tau_s); other "
+            "uses of the FRF see the added damping (a longer record needs no window)\n" + text)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -169,7 +170,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"exponential window: {result.window}")
     else:
         print(f"exponential window: tau = {result.tau:.4g} s, {result.window}; it adds a damping ratio "
-              "1/(tau omega) to every mode")
+              "1/(tau omega) to every mode (diagnose and identify compare the model through the same window; "
+              "lobes and a modal fit of this FRF see the added damping)")
     cut = result.truncation_error()
     if cut is not None:
         print(f"truncation: the response still rang at the taps' end; the error it leaves in the FRF is at most "

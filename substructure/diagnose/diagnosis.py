@@ -323,11 +323,13 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
                                  for r in search.get("held_back", []) if not r["predicts"]]
     if search["cut"] and not explained:
         report = list(report) + [words.budget_cut(search["cut_at"])]
-    for m, alive in zip(lik.measured, lik.alive):  # facts of the data, whatever the verdict
+    # facts of the data, whatever the verdict
+    for m, alive, (_, lacking) in zip(lik.measured, lik.alive, lik.windows()):
         which, hz = getattr(m.measurement, "describe", lambda: m.label)(), m.frf.frequency.hz
         tau = getattr(m.measurement, "window_tau", None)
         if tau is not None:
-            report = list(report) + [words.windowed(which, tau, float(hz[0]), float(hz[-1]))]
+            report = list(report) + [words.windowed(which, tau, float(hz[0]), float(hz[-1]), m.noise.correlation,
+                                                    lacking)]
         cut = getattr(m.measurement, "truncation", None)
         if cut is not None:  # on the measurement's own lines: those of the band
             full = m.measurement.frf.frequency.hz

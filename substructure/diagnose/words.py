@@ -219,8 +219,8 @@ def budget_cut(where: str) -> str:
     return f"the search was cut by its budget ({where}); a larger budget (--budget, --time-limit) may find more"
 
 
-def windowed(which: str, tau: float, lo_hz: float, hi_hz: float) -> str:
-    """The note that a measurement was taken through an exponential window (its modes carry damping no model has).
+def windowed(which: str, tau: float, lo_hz: float, hi_hz: float, lines: float, lacking: Sequence[str] = ()) -> str:
+    """The note that a measurement was taken through an exponential window, and how the model was compared with it.
 
     Parameters
     ----------
@@ -230,6 +230,12 @@ def windowed(which: str, tau: float, lo_hz: float, hi_hz: float) -> str:
         The window's time constant [s].
     lo_hz, hi_hz : float
         The band's ends, at which the added damping ratio is quoted [Hz] (it is largest at the lowest line).
+    lines : float
+        The noise's correlation between neighbouring lines: a sum of lines varies this many times as much as
+        one of independent lines (``NoiseModel.correlation``).
+    lacking : sequence of str
+        The components and joint models that kept the model from being evaluated through the window (their
+        methods take no ``decay``); empty when it was.
 
     Returns
     -------
@@ -239,11 +245,16 @@ def windowed(which: str, tau: float, lo_hz: float, hi_hz: float) -> str:
     def zeta(f_hz: float) -> str:
         return f"{1.0 / (tau * 2.0 * math.pi * f_hz):.2g} at {f_hz:.4g} Hz"
 
-    return (f"{which} was measured through an exponential window (tau = {tau:.4g} s): it adds the damping ratio "
-            f"1/(tau omega) to every mode ({zeta(lo_hz)} to {zeta(hi_hz)}), "
-            "which the model lacks; damping found here may be the window's (the time records processed without "
-            "it, substructure tap --no-exponential-window, leave the error of the taps' end counted as noise "
-            "instead; taps long enough for the response to die out need no window)")
+    head = (f"{which} was measured through an exponential window (tau = {tau:.4g} s): it adds the damping ratio "
+            f"1/(tau omega) to every mode ({zeta(lo_hz)} to {zeta(hi_hz)})")
+    if not lacking:
+        return (head + ", and the model was compared through the same window (evaluated at the complex frequency "
+                f"omega - i/tau); its noise is correlated over neighbouring lines, counted as {lines:.3g} times "
+                "fewer lines")
+    return (head + f", which the model lacks: {', '.join(lacking)} cannot be evaluated through it (a "
+            "receptance_matrix or dynamic_stiffness that takes decay can); damping found here may be the window's "
+            "(the time records processed without it, substructure tap --no-exponential-window, leave the error of "
+            "the taps' end counted as noise instead; taps long enough for the response to die out need no window)")
 
 
 def truncated(which: str, error: float, at_hz: float) -> str:

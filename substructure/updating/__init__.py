@@ -30,7 +30,7 @@ from .changes import Change, ParamSpec
 from .elements import AddedMass, GroundSpring, SectionChange
 from .fit import Fit, fit
 from .likelihood import Likelihood, Measured, measured_frfs
-from .noise import NoiseModel, estimate_noise
+from .noise import NoiseModel, estimate_noise, window_correlation
 from .parameters import (ModelParameter, ParameterChange, ParameterSet, get_parameter, model_parameters,
                          set_parameters)
 from .paths import apply_path_si
@@ -40,7 +40,8 @@ from .structure import Structure
 
 __all__ = [
     "Change", "ParamSpec", "AddedMass", "GroundSpring", "SectionChange", "Fit", "fit", "Likelihood", "Measured",
-    "measured_frfs", "NoiseModel", "estimate_noise", "ModelParameter", "ParameterChange", "ParameterSet",
+    "measured_frfs", "NoiseModel", "estimate_noise", "window_correlation", "ModelParameter", "ParameterChange",
+    "ParameterSet",
     "get_parameter", "model_parameters", "set_parameters", "apply_path_si", "Consistency", "ErrorCheck",
     "Significance", "consistency", "error_check", "indifferent", "significance", "Evaluator", "Structure",
 ]

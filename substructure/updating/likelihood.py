@@ -138,7 +138,8 @@ def measured_frfs(measurements, band=None) -> tuple[list[Measured], tuple[float,
                                force_noise=getattr(m, "force_noise", None),
                                force_window_s=getattr(m, "force_window_s", None),
                                estimator=getattr(m, "estimator", None),
-                               truncation=getattr(m, "truncation", None))
+                               truncation=getattr(m, "truncation", None),
+                               window_tau=getattr(m, "window_tau", None))
         mask = frf.frequency.band_mask(lo, hi)
         if mask.sum() < 10:
             raise InvalidValueError(f"band: {lo:g}-{hi:g} Hz holds {int(mask.sum())} lines of {label}; "
@@ -157,7 +158,15 @@ def _has_si(change) -> bool:
 
 
 class _Group:
-    """The measured FRFs of one configuration: one evaluation gives all of them."""
+    """The measured FRFs of one configuration (and one exponential window): one evaluation gives all of them.
+
+    FRFs measured through an exponential window ``exp(-t/tau)`` are compared
+    with the model at the complex frequency ``omega - i/tau`` (the windowed
+    FRF is exactly that, whatever the force's shape): the window's damping is
+    in the model as in the data.  Where a component or joint model cannot be
+    evaluated there (``not_windowed`` names it), the model is evaluated on
+    the real lines and the window's damping is left in the data alone.
+    """
 
     def __init__(self, assembly, items: list[tuple[int, Measured]], lines: np.ndarray):
         first = items[0][1]
@@ -167,7 +176,11 @@ class _Group:
         outputs = list(dict.fromkeys(m.frf.outputs[0] for _, m in items))
         inputs = list(dict.fromkeys(m.frf.inputs[0] for _, m in items))
         self.entries = [(outputs.index(m.frf.outputs[0]), inputs.index(m.frf.inputs[0])) for _, m in items]
-        self.evaluator = Evaluator(outputs, inputs, first.frf.frequency.hz[lines])
+        tau = getattr(first.measurement, "window_tau", None)
+        self.not_windowed = self.structure.not_at_complex_frequency() if tau else []
+        self.window_tau = None if self.not_windowed else tau
+        self.evaluator = Evaluator(outputs, inputs, first.frf.frequency.hz[lines],
+                                   decay=1.0 / self.window_tau if self.window_tau else 0.0)
         self._applied: OrderedDict = OrderedDict()
 
     def structure_with(self, changes: Sequence[tuple]) -> Structure:
@@ -241,15 +254,17 @@ class Likelihood:
         self.lines = np.arange(n) if lines is None else np.asarray(lines)
         groups: dict[tuple, list] = {}
         for i, m in enumerate(self.measured):
-            groups.setdefault(m.configuration, []).append((i, m))
+            groups.setdefault((m.configuration, getattr(m.measurement, "window_tau", None)), []).append((i, m))
         self.groups = [_Group(assembly, items, self.lines) for items in groups.values()]
         self.data = [m.frf.data[self.lines, 0, 0] for m in self.measured]
         # the lines each FRF holds: a line of zero or not finite (a dropout, a line an analyser left empty) says
         # nothing of the structure, and is left out (no weight, no degree of freedom, no share of an error)
         self.alive = [np.isfinite(d) & (d != 0) for d in self.data]
-        self.w_re = [np.where(a, 1.0 / np.sqrt(m.noise.var_re[self.lines]), 0.0)
+        # lines whose noise is correlated (through an exponential window, NoiseModel.correlation) weigh as that
+        # many times fewer lines: a fit's uncertainty and a comparison of chi^2 count what the data hold
+        self.w_re = [np.where(a, 1.0 / np.sqrt(m.noise.correlation * m.noise.var_re[self.lines]), 0.0)
                      for m, a in zip(self.measured, self.alive)]
-        self.w_im = [np.where(a, 1.0 / np.sqrt(m.noise.var_im[self.lines]), 0.0)
+        self.w_im = [np.where(a, 1.0 / np.sqrt(m.noise.correlation * m.noise.var_im[self.lines]), 0.0)
                      for m, a in zip(self.measured, self.alive)]
         self.n = 2 * sum(int(a.sum()) for a in self.alive)
         self.evaluations = 0
@@ -296,6 +311,23 @@ class Likelihood:
                 f"error against the model falls from {np.sqrt(as_is):.2f} rad RMS to "
                 f"{np.sqrt(min(negated, conjugated)):.2f} when it is "
                 f"{'negated' if negated <= conjugated else 'conjugated'}: {fix}")
+
+    def windows(self) -> list[tuple[float | None, list[str]]]:
+        """How each measured FRF's model is seen: through its exponential window or on the real lines.
+
+        Returns
+        -------
+        list of (float or None, list of str)
+            Per measured FRF: the window's ``tau`` [s] when the model is
+            evaluated at ``omega - i/tau`` as the data were measured (else
+            None), and the components and joint models that kept a windowed
+            measurement's model on the real lines (empty otherwise).
+        """
+        out: list = [(None, [])] * len(self.measured)
+        for g in self.groups:
+            for i in g.indices:
+                out[i] = (g.window_tau, list(g.not_windowed))
+        return out
 
     def subsample(self, step: int, keep=None) -> "Likelihood":
         """The same likelihood on every ``step``-th line, and on the lines ``keep`` (for cheap screening).

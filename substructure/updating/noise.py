@@ -62,7 +62,7 @@ from ..errors import InvalidValueError
 from ..frf import FRF
 from ..smoothing import choose_window, smooth
 
-__all__ = ["NoiseModel", "estimate_noise", "VARIANCE_CAP"]
+__all__ = ["NoiseModel", "estimate_noise", "window_correlation", "VARIANCE_CAP"]
 
 VARIANCE_CAP = float(np.pi**2 / 3.0)
 """Largest per-line variance of a part of ``ln H``: that of a uniform phase [rad^2]."""
@@ -122,6 +122,14 @@ class NoiseModel:
         ``chi^2`` with ``2 (n - 1)`` degrees of freedom; infinite where no
         part does.  A line's score then follows ``F(2, dof)`` rather than
         the exponential (:func:`substructure.updating.selection.consistency`).
+    correlation : float
+        The variance of a sum of neighbouring lines' scores over that of as
+        many independent ones (1: independent lines).  An exponential window
+        ``exp(-t/tau)`` on records of ``T = 1/df`` seconds makes the noise of
+        lines ``k`` apart correlated, ``|rho_k|^2 = 1 / (1 + (pi k tau / T)^2)``,
+        and the sum of all lags gives ``(T/tau) coth(T/tau)``
+        (:func:`window_correlation`): a fit, a test or a comparison of
+        ``chi^2`` counts the data as that many times fewer lines.
     """
 
     var_re: np.ndarray = attrs.field(eq=False, repr=False)
@@ -136,6 +144,7 @@ class NoiseModel:
     coherence_factor: float | None = None
     linear: tuple | None = attrs.field(default=None, eq=False, repr=False)
     dof: np.ndarray | None = attrs.field(default=None, eq=False, repr=False)
+    correlation: float = 1.0
 
     @property
     def floor(self) -> float:
@@ -320,9 +329,57 @@ def _force_term(force_noise, window_s, hz: np.ndarray, label: str) -> np.ndarray
     return 0.5 * v * max(1.0, 1.0 / (float(window_s) * spacing))
 
 
+def window_correlation(tau: float | None, spacing_hz: float) -> float:
+    """How many times a sum of line scores varies more than for independent lines, under an exponential window.
+
+    The noise of a record of ``T`` seconds through the window ``exp(-t/tau)``
+    is correlated between lines ``k`` apart (``k / T`` hertz) as the
+    transform of the squared window at that distance,
+    ``rho_k = 1 / (1 + i pi k tau / T)``; a line's score (the squared
+    modulus of a complex Gaussian) correlates with ``|rho_k|^2``, and
+    ``1 + 2 sum_k |rho_k|^2 = x coth x`` with ``x = T / tau``.
+
+    Parameters
+    ----------
+    tau : float or None
+        The window's time constant [s]; None for no window (1).
+    spacing_hz : float
+        The line spacing ``1 / T`` [Hz].
+
+    Returns
+    -------
+    float
+        ``x coth x`` (>= 1; about ``x`` for a window much shorter than the
+        record, 1 for none).
+    """
+    if tau is None or not np.isfinite(spacing_hz) or spacing_hz <= 0:
+        return 1.0
+    x = 1.0 / (float(tau) * float(spacing_hz))
+    return float(x / np.tanh(x)) if x < 350.0 else x
+
+
+def _kept_share(w: int, polyorder: int, tau: float | None, spacing_hz: float) -> float:
+    """``h0``: the share of a line's noise variance the smoother keeps, ``1 - E[q^2] / v``.
+
+    For white noise the filter's central coefficient.  Through an exponential window the noise of
+    lines ``k`` apart is correlated, the real and the imaginary parts each by
+    ``c_k = 1 / (1 + (pi k tau df)^2)`` (:func:`window_correlation`), and the smoother follows more of
+    it: ``E[q^2] / v = 1 - 2 s . c + s^T C s`` (``s`` the filter's coefficients, ``C`` the lines'
+    correlations); read as white noise, a windowed FRF's scatter put the coherence's fitted weight at
+    0.12 of its theory (records five time constants long).
+    """
+    s = savgol_coeffs(w, polyorder)
+    if tau is None or not spacing_hz > 0:
+        return float(s[w // 2])
+    lag = np.arange(w) - w // 2
+    c = 1.0 / (1.0 + (np.pi * float(tau) * spacing_hz * np.subtract.outer(lag, lag)) ** 2)
+    residual = 1.0 - 2.0 * float(s @ c[w // 2]) + float(s @ c @ s)
+    return 1.0 - max(residual, 1e-9)
+
+
 def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3, *, coherence=None,
                    averages: int | None = None, force_noise=None, force_window_s: float | None = None,
-                   estimator: str | None = None, truncation=None) -> NoiseModel:
+                   estimator: str | None = None, truncation=None, window_tau: float | None = None) -> NoiseModel:
     """The per-line noise of a measured FRF (one entry), estimated from the data.
 
     Parameters
@@ -368,6 +425,10 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
         lines it spans): an error the taps repeat, which neither the
         coherence nor the smoothing residual sees; added to each line's
         variance, half to each part.
+    window_tau : float, optional
+        The time constant [s] of the exponential window the FRF was measured
+        through: its noise is correlated over neighbouring lines
+        (:attr:`NoiseModel.correlation`, :func:`window_correlation`).
 
     Returns
     -------
@@ -404,7 +465,8 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
                                              measured.outputs, measured.inputs)
     w = window or _window(clean, polyorder)
     s = smooth(clean, window=w, polyorder=polyorder).data[:, 0, 0]
-    h0 = float(savgol_coeffs(w, polyorder)[w // 2])
+    spacing = float(np.median(np.diff(measured.frequency.hz)))
+    h0 = _kept_share(w, polyorder, window_tau, spacing)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         q = np.log(h / s)
         g_all = 1.0 / np.abs(s) ** 2
@@ -533,4 +595,5 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     return NoiseModel(var_re, var_im, (float(coef[0]), float(coef[1])), float(coef[2]) / scale,
                       max(spread, float(np.sqrt(1.0 / max(idx.size, 1)))), w, scatter,
                       local_scale=local, outliers=int(spike.sum()), coherence_factor=coherence_factor,
-                      linear=(hs, lin_re, lin_im), dof=dof)
+                      linear=(hs, lin_re, lin_im), dof=dof,
+                      correlation=window_correlation(window_tau, spacing))

@@ -69,7 +69,7 @@ while a missing effect, which moves many lines, still does."""
 _Z = 3.090232306167813  # one-sided 0.1 %
 
 
-def _block_bound(size: int, alpha: float, dof: np.ndarray | None = None) -> float:
+def _block_bound(size: int, alpha: float, dof: np.ndarray | None = None, correlation: float = 1.0) -> float:
     """Upper ``alpha`` quantile of the mean of ``size`` line scores capped at :data:`LINE_CAP`.
 
     A line score of noise is exponential with mean 1 where its variance is known; capped at
@@ -78,9 +78,12 @@ def _block_bound(size: int, alpha: float, dof: np.ndarray | None = None) -> floa
     :attr:`~substructure.updating.noise.NoiseModel.dof`), the score follows ``F(2, dof)``,
     heavier-tailed (a mean of 2 for 3 taps).  The sum of the ``size`` capped scores is taken as
     the gamma distribution of the same mean and variance (it is bounded and skewed to the
-    right, as the gamma is).
+    right, as the gamma is).  Lines whose noise is correlated (an exponential window,
+    :attr:`~substructure.updating.noise.NoiseModel.correlation`) keep the mean and vary
+    ``correlation`` times as much.
     """
     mean, var = _line_moments(dof, size)
+    var *= correlation
     shape = mean * mean / var
     scale = var / mean
     return float(gamma_dist.isf(alpha, shape, scale=scale)) / size
@@ -179,6 +182,11 @@ class Consistency:
     bands: tuple
 
 
+def _correlation(noise) -> float:
+    """A noise model's correlation of neighbouring lines (1 for one that does not say: independent lines)."""
+    return float(getattr(noise, "correlation", 1.0))
+
+
 def _scores(likelihood, ratios: Sequence[np.ndarray]) -> list[tuple[np.ndarray, np.ndarray | None]]:
     """Per measured FRF, on the lines it holds (``alive``: no score where it holds nothing), its lines' scores
     (:meth:`NoiseModel.line_scores`) and the degrees of freedom of their variances (None: known)."""
@@ -212,19 +220,21 @@ def consistency(likelihood, ratios: Sequence[np.ndarray], p: int) -> Consistency
     chi2 = 2.0 * sum(float(z.sum()) for z in z2)
     sizes = np.array([z.size for z in z2], dtype=float)
     errs = np.array([m.noise.scale_error for m in likelihood.measured])
+    kappa = [_correlation(m.noise) for m in likelihood.measured]  # 1 for independent lines
     e = float(np.sqrt(np.sum((sizes * errs) ** 2)) / max(sizes.sum(), 1.0))
-    threshold = 1.0 + _Z * math.sqrt(2.0 / nu + e * e)
+    inflation = float(np.dot(sizes, kappa) / max(sizes.sum(), 1.0))
+    threshold = 1.0 + _Z * math.sqrt(2.0 * inflation / nu + e * e)
     reduced = chi2 / nu
     if any(d is not None and np.isfinite(d).any() for d in dofs):
         # lines whose variance is estimated (F(2, nu) scores, heavy-tailed: infinite variance for nu <= 4)
         # enter capped, against the capped scores' mean and variance; the others as they are
         total, mean, var = 0.0, 0.0, 0.0
-        for z, d in zip(z2, dofs):
+        for z, d, k in zip(z2, dofs, kappa):
             est = np.zeros(z.size, dtype=bool) if d is None else np.isfinite(d)
             total += float(z[~est].sum()) + float(np.minimum(z[est], LINE_CAP).sum())
             m_est, v_est = _line_moments(d[est], int(est.sum())) if est.any() else (0.0, 0.0)
             mean += int((~est).sum()) + m_est
-            var += int((~est).sum()) + v_est
+            var += k * (int((~est).sum()) + v_est)
         expected = max(2.0 * mean - p, 1.0)
         reduced = 2.0 * total / expected
         threshold = 1.0 + _Z * math.sqrt(4.0 * var / expected**2 + e * e)
@@ -247,7 +257,7 @@ def consistency(likelihood, ratios: Sequence[np.ndarray], p: int) -> Consistency
         z = z2[item][sl]
         # widened, as the global test is, by how well the noise itself is known
         dof = None if dofs[item] is None else dofs[item][sl]
-        bound = _block_bound(z.size, CONSISTENCY_ALPHA / m_blocks, dof) * (1.0 + _Z * float(errs[item]))
+        bound = _block_bound(z.size, CONSISTENCY_ALPHA / m_blocks, dof, kappa[item]) * (1.0 + _Z * float(errs[item]))
         ratio = float(np.minimum(z, LINE_CAP).mean())
         if ratio > bound:
             failing.append(Band(item, float(f[sl][0]), float(f[sl][-1]), ratio, bound, over / excess_total))
@@ -321,10 +331,11 @@ def error_check(likelihood, ratios: Sequence[np.ndarray], factor: float) -> Erro
         v = (m.noise.var_re + m.noise.var_im)[likelihood.lines][a]
         z = np.minimum(z, LINE_CAP)
         means, variances, thirds = _each_line_moments(dof, v.size)
+        k = _correlation(m.noise)  # correlated lines: a sum of k times fewer independent ones, each k lines' worth
         weighted += float(v @ z)
         mean += float(v @ means)
-        var += float((v * v) @ variances)
-        third += float((v * v * v) @ thirds)
+        var += k * float((v * v) @ variances)
+        third += k * k * float((v * v * v) @ thirds)
         total += float(v.sum())
     if not total > 0.0:
         return ErrorCheck(0.0, factor)
