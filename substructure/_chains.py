@@ -77,7 +77,7 @@ def _chain_single(intervals: list[tuple[Section, object]], nodes: list[int], ome
         ei[u], kga[u], rhoa[u], rhoi[u], lengths[u] = sec.EI, sec.kGA, sec.rhoA, sec.rhoI, length
         shared[u] = n_config > 1 and _is_shared(sec, length)
     return _kernels.chain_receptance(
-        _kernels.c_array(omega, complex), ei, kga, rhoa, rhoi, lengths, shared,
+        omega, ei, kga, rhoa, rhoi, lengths, shared,
         np.array(seg_of, dtype=np.int64), np.array(nodes, dtype=np.int64),
         np.arange(len(nodes), dtype=np.int64) if place is None else np.array(place, dtype=np.int64),
     )

@@ -327,11 +327,12 @@ typedef struct {
 
 /* Phase 1: wavenumbers, the choice series/exponential per lane, and r L where needed (w2 = omega^2 per lane,
  * complex where omega is: the model at a complex frequency, as seen through an exponential window). */
-AI void waves(const cx co[5], double length, cv w2, wave_t *wv)
+AI void waves(const cx co[5], double length, cv w2, const int cplx, wave_t *wv)
 {
-    cv a = vmulc(w2, co[0]), e = vmulc(w2, co[1]);
+    /* cplx: a constant where inlined (chain_range's two versions): real lines keep the real products */
+    cv a = cplx ? vmulc(w2, co[0]) : vscale(w2.re, vc(co[0])), e = cplx ? vmulc(w2, co[1]) : vscale(w2.re, vc(co[1]));
     cv half = vscale(splat(0.5), vsub(a, e));
-    cv root = vcsqrt(vadd(vmul(half, half), vmulc(w2, co[2])));
+    cv root = vcsqrt(vadd(vmul(half, half), cplx ? vmulc(w2, co[2]) : vscale(w2.re, vc(co[2]))));
     cv mean = vscale(splat(0.5), vadd(a, e));
     cv s1 = vadd(mean, root), s2 = vsub(mean, root);
     double l2 = length * length;
@@ -389,7 +390,8 @@ AI vd vload(const double *x)
 }
 
 /* Phase 3: the 16 entries (row-major) of T on the lanes, w2 = omega^2 per lane. */
-AI void transfer(const cx co[5], double rhoa, double rhoi, double length, cv w2, const wave_t *wv, cv *t)
+AI void transfer(const cx co[5], double rhoa, double rhoi, double length, cv w2, const int cplx, const wave_t *wv,
+                 cv *t)
 {
     cv a = wv->a, e = wv->e, s1 = wv->s1, s2 = wv->s2;
     vm series = wv->series;
@@ -466,7 +468,9 @@ AI void transfer(const cx co[5], double rhoa, double rhoi, double length, cv w2,
     cv alpha = vsub(c0, vmul(c1, s2)), beta = vsub(g0, vmul(g1, s2));
     cv gamma = c1, delta = g1;
     cx iei = co[3], ikga = co[4];
+    /* omega^2 rho A and omega^2 rho I: real on real lines (their products with a complex number real-scaled) */
     cv ma = vscale(splat(rhoa), w2), mi = vscale(splat(rhoi), w2);
+#define MSCALE(m, z) (cplx ? vmul((m), (z)) : vscale((m).re, (z)))
     cv d00 = vadd(alpha, vmul(gamma, a)), d11 = vadd(alpha, vmul(gamma, e));
     t[0] = d00;
     t[10] = d00;
@@ -478,15 +482,16 @@ AI void transfer(const cx co[5], double rhoa, double rhoi, double length, cv w2,
     t[2] = vadd(vmulc(beta, ikga), vmul(delta, u));
     t[3] = vmulc(gamma, iei);
     t[6] = vneg(t[3]);
-    t[4] = vmulc(vmul(ma, delta), iei);
+    t[4] = vmulc(MSCALE(ma, delta), iei);
     t[11] = vneg(t[4]);
     t[7] = vmulc(vadd(beta, vmul(delta, e)), iei);
-    t[8] = vneg(vmul(ma, vadd(beta, vmul(delta, a))));
-    t[12] = vmul(ma, gamma);
+    t[8] = vneg(MSCALE(ma, vadd(beta, vmul(delta, a))));
+    t[12] = MSCALE(ma, gamma);
     t[9] = vneg(t[12]);
     /* t31 = -mi beta + delta (ma - mi e), t32 = -beta + delta (mi / EI - a) */
-    t[13] = vadd(vmul(vneg(mi), beta), vmul(delta, vsub(ma, vmul(mi, e))));
-    t[14] = vadd(vneg(beta), vmul(delta, vsub(vmulc(mi, iei), a)));
+    t[13] = vadd(MSCALE(vneg(mi), beta), vmul(delta, vsub(ma, MSCALE(mi, e))));
+    t[14] = vadd(vneg(beta), vmul(delta, vsub(MSCALE(mi, vc(iei)), a)));
+#undef MSCALE
 }
 
 /* ------------------------------------------------------------------------ */
@@ -667,13 +672,12 @@ AI void chain_block(const cv *tmat, const int64_t *seg_of, Py_ssize_t n_int, con
 #define KERNEL_CLONES
 #endif
 
-/* Lines lo .. hi - 1 (see py_chain_lines). */
-KERNEL_CLONES static void chain_range(const cx *omega, Py_ssize_t n_f, const cx *coef, const double *rhoa,
-                                      const double *rhoi, const double *length, Py_ssize_t n_u, Py_ssize_t n_c,
-                                      const int64_t *slot, cx *table, const int64_t *seg_of, Py_ssize_t n_int,
-                                      const int64_t *nodes, const int64_t *place, Py_ssize_t m, cx *out,
-                                      int table_only, Py_ssize_t lo, Py_ssize_t hi, cv *tmat, cv *pre, cv *post,
-                                      wave_t *wv)
+/* The line loop of chain_real and chain_complex, cplx a constant where inlined. */
+AI void chain_body(const void *omega, Py_ssize_t n_f, const cx *coef, const double *rhoa, const double *rhoi,
+                   const double *length, Py_ssize_t n_u, Py_ssize_t n_c, const int64_t *slot, cx *table,
+                   const int64_t *seg_of, Py_ssize_t n_int, const int64_t *nodes, const int64_t *place, Py_ssize_t m,
+                   cx *out, int table_only, Py_ssize_t lo, Py_ssize_t hi, cv *tmat, cv *pre, cv *post, wave_t *wv,
+                   const int cplx)
 {
     Py_ssize_t n_lines = table_only ? n_f : n_c * n_f;
     for (Py_ssize_t q = lo; q < hi;) {
@@ -683,16 +687,23 @@ KERNEL_CLONES static void chain_range(const cx *omega, Py_ssize_t n_f, const cx 
         int nb = left < VL ? (int)left : VL; /* lines of this block, all of configuration c */
         cv w2;
         for (int l = 0; l < VL; l++) {
-            cx w = omega[i + (l < nb ? l : nb - 1)];
-            w2.re[l] = w.re * w.re - w.im * w.im;
-            w2.im[l] = 2.0 * w.re * w.im;
+            Py_ssize_t at = i + (l < nb ? l : nb - 1);
+            if (cplx) {
+                cx w = ((const cx *)omega)[at];
+                w2.re[l] = w.re * w.re - w.im * w.im;
+                w2.im[l] = 2.0 * w.re * w.im;
+            } else {
+                double w = ((const double *)omega)[at];
+                w2.re[l] = w * w;
+                w2.im[l] = 0.0;
+            }
         }
         /* the segments computed here (not read from the table): phases 1 to 3 of the closed form */
         for (Py_ssize_t u = 0; u < n_u; u++) {
             int shared = slot[u] >= 0;
             if (shared ? table_only : !table_only) {
                 Py_ssize_t k = u * n_c + c;
-                waves(coef + 5 * k, length[k], w2, wv + u);
+                waves(coef + 5 * k, length[k], w2, cplx, wv + u);
             } else
                 wv[u].some_exp = 0;
         }
@@ -711,7 +722,7 @@ KERNEL_CLONES static void chain_range(const cx *omega, Py_ssize_t n_f, const cx 
                 }
             } else if (shared || !table_only) {
                 Py_ssize_t k = u * n_c + c;
-                transfer(coef + 5 * k, rhoa[k], rhoi[k], length[k], w2, wv + u, t);
+                transfer(coef + 5 * k, rhoa[k], rhoi[k], length[k], w2, cplx, wv + u, t);
                 if (table_only)
                     for (int e = 0; e < 16; e++) {
                         cx *dst = table + (slot[u] * 16 + e) * n_f + i;
@@ -726,6 +737,31 @@ KERNEL_CLONES static void chain_range(const cx *omega, Py_ssize_t n_f, const cx 
             chain_block(tmat, seg_of, n_int, nodes, place, m, out, n_lines, q, nb, pre, post);
         q += nb;
     }
+}
+
+/* Lines lo .. hi - 1 (see py_chain_lines) on real lines: the products of omega^2 real, as they always were. */
+KERNEL_CLONES static void chain_real(const void *omega, Py_ssize_t n_f, const cx *coef, const double *rhoa,
+                                     const double *rhoi, const double *length, Py_ssize_t n_u, Py_ssize_t n_c,
+                                     const int64_t *slot, cx *table, const int64_t *seg_of, Py_ssize_t n_int,
+                                     const int64_t *nodes, const int64_t *place, Py_ssize_t m, cx *out,
+                                     int table_only, Py_ssize_t lo, Py_ssize_t hi, cv *tmat, cv *pre, cv *post,
+                                     wave_t *wv)
+{
+    chain_body(omega, n_f, coef, rhoa, rhoi, length, n_u, n_c, slot, table, seg_of, n_int, nodes, place, m, out,
+               table_only, lo, hi, tmat, pre, post, wv, 0);
+}
+
+/* The same on complex lines (the model seen through an exponential window). */
+__attribute__((noinline)) static void chain_complex(const void *omega, Py_ssize_t n_f, const cx *coef,
+                                                    const double *rhoa, const double *rhoi, const double *length,
+                                                    Py_ssize_t n_u, Py_ssize_t n_c, const int64_t *slot, cx *table,
+                                                    const int64_t *seg_of, Py_ssize_t n_int, const int64_t *nodes,
+                                                    const int64_t *place, Py_ssize_t m, cx *out, int table_only,
+                                                    Py_ssize_t lo, Py_ssize_t hi, cv *tmat, cv *pre, cv *post,
+                                                    wave_t *wv)
+{
+    chain_body(omega, n_f, coef, rhoa, rhoi, length, n_u, n_c, slot, table, seg_of, n_int, nodes, place, m, out,
+               table_only, lo, hi, tmat, pre, post, wv, 1);
 }
 
 /* ------------------------------------------------------------------------ */
@@ -834,6 +870,7 @@ shape:
 /* ------------------------------------------------------------------------ */
 /* chain_lines(omega, coef, rhoa, rhoi, length, slot, table, seg_of, nodes, place, out, table_only, lo, hi)
  *
+ * omega float64 (real lines) or complex128 (the complex frequency omega - i sigma of an exponential window).
  * Lines lo .. hi - 1 of the chains' receptances into out, line q = c * n_f + i for configuration c;
  * with table_only, instead, the transfer matrices of the shared segments (slot[u] >= 0) at the
  * frequency lines lo .. hi - 1 into table[slot[u], entry, i] (one function for both, so that the
@@ -848,7 +885,19 @@ static PyObject *py_chain_lines(PyObject *self, PyObject *args)
                           &o[9], &o[10], &table_only, &lo, &hi))
         return NULL;
     buf_t b[11] = {{0}};
-    if (get(o[0], &b[0], 'Z', 1, 0, "omega") || get(o[1], &b[1], 'Z', 3, 0, "coef") ||
+    int cplx = 0; /* omega: float64 (real lines) or complex128 (omega - i sigma: seen through a window) */
+    if (get(o[0], &b[0], 'd', 1, 0, "omega")) {
+        release(b, 1);
+        PyErr_Clear();
+        cplx = 1;
+        if (get(o[0], &b[0], 'Z', 1, 0, "omega")) {
+            release(b, 1);
+            PyErr_Clear();
+            PyErr_SetString(PyExc_TypeError, "omega: expected a 1-dimensional float64 or complex128 array");
+            return NULL;
+        }
+    }
+    if (get(o[1], &b[1], 'Z', 3, 0, "coef") ||
         get(o[2], &b[2], 'd', 2, 0, "rhoa") || get(o[3], &b[3], 'd', 2, 0, "rhoi") ||
         get(o[4], &b[4], 'd', 2, 0, "length") || get(o[5], &b[5], 'q', 1, 0, "slot") ||
         get(o[6], &b[6], 'Z', 3, 1, "table") || get(o[7], &b[7], 'q', 1, 0, "seg_of") ||
@@ -892,7 +941,8 @@ static PyObject *py_chain_lines(PyObject *self, PyObject *args)
         return NULL;
     }
     const double *rhoa = b[2].view.buf, *rhoi = b[3].view.buf, *length = b[4].view.buf;
-    const cx *omega = b[0].view.buf, *coef = b[1].view.buf;
+    const void *omega = b[0].view.buf;
+    const cx *coef = b[1].view.buf;
     cx *table = b[6].view.buf, *out = b[10].view.buf;
     Py_ssize_t nu1 = n_u > 0 ? n_u : 1, m1 = m > 0 ? m : 1;
     /* the transfer matrices and the end products of a block (cv), then the segments' wave_t */
@@ -902,9 +952,9 @@ static PyObject *py_chain_lines(PyObject *self, PyObject *args)
         return PyErr_NoMemory();
     }
     Py_BEGIN_ALLOW_THREADS
-    chain_range(omega, n_f, coef, rhoa, rhoi, length, n_u, n_c, slot, table, seg_of, n_int, nodes, place, m, out,
-                table_only, lo, hi, work, work + 16 * nu1, work + 16 * nu1 + 4 * m1,
-                (wave_t *)(work + 16 * nu1 + 8 * m1));
+    (cplx ? chain_complex : chain_real)(omega, n_f, coef, rhoa, rhoi, length, n_u, n_c, slot, table, seg_of, n_int,
+                                        nodes, place, m, out, table_only, lo, hi, work, work + 16 * nu1,
+                                        work + 16 * nu1 + 4 * m1, (wave_t *)(work + 16 * nu1 + 8 * m1));
     Py_END_ALLOW_THREADS
     aligned_free_(work);
     release(b, 11);

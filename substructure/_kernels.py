@@ -225,7 +225,7 @@ def segment_coefficients(ei, kga, rhoa, rhoi, omega_max):
 chain_lines = _c.chain_lines
 """The chain kernel:
 ``chain_lines(omega, coef, rhoa, rhoi, length, slot, table, seg_of, nodes, place, out, table_only, lo, hi)``,
-``omega`` complex128 (real lines, or ``omega - i sigma`` for the model seen through an exponential window)."""
+``omega`` float64 (real lines) or complex128 (``omega - i sigma``: the model seen through an exponential window)."""
 
 couple_lines = _c.couple_lines
 """The coupling kernel:
@@ -268,7 +268,7 @@ def transfer_matrices(omega, ei, kga, rhoa, rhoi, length):
     complex128 ndarray (n_u, n_f, 4, 4)
         State ``[w, psi, V, M]``.
     """
-    omega = c_array(omega, complex)
+    omega = c_array(omega, complex if np.iscomplexobj(omega) else float)
     rhoa, rhoi, length = (c_array(v, float) for v in (rhoa, rhoi, length))
     coef, _ = segment_coefficients(ei, kga, rhoa, rhoi, 0.0)
     _, table = _shared_table(omega, coef, rhoa, rhoi, length, np.ones(coef.shape[0], dtype=bool))
@@ -307,7 +307,7 @@ def chain_receptance(omega, ei, kga, rhoa, rhoi, length, shared, seg_of, nodes, 
         DOFs ``(y, theta)`` per node [m/N, 1/N, 1/(N m)]; the last axis runs
         over configurations first (``index = c * n_f + line``).
     """
-    omega = c_array(omega, complex)
+    omega = c_array(omega, complex if np.iscomplexobj(omega) else float)
     rhoa, rhoi, length = (c_array(v, float) for v in (rhoa, rhoi, length))
     seg_of, nodes, place = (c_array(v, np.int64) for v in (seg_of, nodes, place))
     n_c = np.shape(ei)[1]

@@ -360,7 +360,7 @@ def segment_transfer_matrix(sec: Section, length: float, omega: np.ndarray) -> n
     """
     from . import _kernels
 
-    omega = _kernels.c_array(np.reshape(omega, -1), complex)
+    omega = np.reshape(omega, -1)
     t = _kernels.transfer_matrices(
         omega, np.array([[sec.EI]], dtype=complex), np.array([[sec.kGA]], dtype=complex),
         np.array([[sec.rhoA]], dtype=float), np.array([[sec.rhoI]], dtype=float), np.array([[length]], dtype=float),
@@ -496,7 +496,7 @@ def stepped_beam_receptance_si(
     if phases.max() <= _CHUNK_KL and np.cumsum(phases)[-1] <= _CHUNK_KL:
         # one transfer-matrix chain (the usual case): the kernel takes the arrays as they are
         return _kernels.chain_receptance(
-            _kernels.c_array(omega, complex), ei[seg], kga[seg], rhoa[seg], rhoi[seg], widths.reshape(-1, 1),
+            omega, ei[seg], kga[seg], rhoa[seg], rhoi[seg], widths.reshape(-1, 1),
             np.zeros(seg.size, dtype=bool), np.arange(seg.size, dtype=np.int64), nodes.astype(np.int64),
             order.astype(np.int64))
     sections = [Section(complex(a), complex(b), float(c), float(d))

@@ -50,15 +50,16 @@ def test_read_only_inputs_are_taken_and_bad_arrays_refused():
     with pytest.raises(ValueError, match="inconsistent"):
         kernels._c.segment_coefficients(*args[:5], np.empty((1, 1, 4), dtype=complex), k_max)
     out = np.empty((2, 2, 10), dtype=complex)
-    good = [omega.astype(complex), coef, args[2], args[3], np.array([[0.046]]), np.full(1, -1, dtype=np.int64),
+    good = [omega.copy(), coef, args[2], args[3], np.array([[0.046]]), np.full(1, -1, dtype=np.int64),
             np.zeros((0, 16, 10), dtype=complex), np.zeros(1, dtype=np.int64), np.array([1], dtype=np.int64),
             np.zeros(1, dtype=np.int64), out, False, 0, 10]
     with pytest.raises(ValueError, match="inconsistent"):
         kernels._c.chain_lines(*good)  # omega has 50 lines, out 10
-    good[0] = omega[:10].astype(complex)
+    good[0] = omega[:10].copy()
     kernels._c.chain_lines(*good)
-    with pytest.raises(TypeError, match="omega: expected a 1-dimensional complex128 array"):
-        kernels._c.chain_lines(omega[:10].copy(), *good[1:])  # real lines reach the kernel as complex
+    kernels._c.chain_lines(omega[:10] - 1j, *good[1:])  # complex lines: the model seen through a window
+    with pytest.raises(TypeError, match="omega: expected a 1-dimensional float64 or complex128 array"):
+        kernels._c.chain_lines(omega[:10].astype(np.float32), *good[1:])
     for bad_nodes in ([2], [-1]):  # beyond the chain's one interval
         with pytest.raises(ValueError, match="nodes"):
             kernels._c.chain_lines(*good[:8], np.array(bad_nodes, dtype=np.int64), *good[9:])
