@@ -23,6 +23,7 @@ from ..errors import SubstructureError
 from ..frf import FRF
 from ..points import parse_point
 from ..rdof import estimate_rotational, positions_from
+from ..updating import Evaluator, Structure
 from .band_fit import _UNITS, JointIdentifier, model_of_measurement
 from .closed_form import ClosedFormResult, closed_form, joint_sides
 
@@ -230,8 +231,13 @@ def identify_joint(assembly: Assembly, measurements, joint: str, band="auto",
     notes = list(ident.warnings_)
     first = next(m for m in measurements if not set(m.removed) & _sides_components(assembly, joint))
     model = model_of_measurement(assembly, first)
-    initial = model.frf(list(first.frf.outputs), list(first.frf.inputs), first.frf.frequency)
-    predicted = model.with_joint(ident.joint_).frf(list(first.frf.outputs), list(first.frf.inputs), first.frf.frequency)
+    tau = getattr(first, "window_tau", None)
+    initial, predicted = (_seen(m, first.frf, tau) for m in (model, model.with_joint(ident.joint_)))
+    if tau is not None:
+        notes.append(f"measured through an exponential window (tau = {tau:.4g} s): the joint was fitted with the "
+                     "model at omega - i/tau, the window's damping 1/(tau omega) in the model as in the data (its "
+                     "damping is the joint's); the closed form is computed on the real lines and carries the "
+                     "window's damping")
     result = None
     try:
         result = _closed_form(assembly, measurements, joint)
@@ -256,6 +262,15 @@ def identify_joint(assembly: Assembly, measurements, joint: str, band="auto",
         residual_rms=ident.residual_rms_, closed_form=result, model=ident.model_, consistent=ident.consistent_,
         chi2_reduced=ident.chi2_reduced_, correlation=tuple(tuple(float(x) for x in row) for row in ident.correlation_),
     )
+
+
+def _seen(model: Assembly, frf: FRF, tau: float | None) -> FRF:
+    """The model at a measured entry's lines, through the measurement's exponential window when it has one."""
+    structure = None if tau is None else Structure.from_assembly(model)
+    if structure is None or structure.not_at_complex_frequency():
+        return model.frf(list(frf.outputs), list(frf.inputs), frf.frequency)
+    y = Evaluator(list(frf.outputs), list(frf.inputs), frf.frequency.hz, decay=1.0 / tau)(structure)
+    return FRF(frf.frequency, y, frf.outputs, frf.inputs)
 
 
 def _sides_components(assembly: Assembly, joint: str) -> set:

@@ -46,7 +46,12 @@ the linear domain by :meth:`NoiseModel.line_scores`.  Errors the
 smoothing residual cannot see are added when the measurement carries
 them: the hammer's noise (smooth over the force window's inverse) and the
 truncation of a response that still rang at the end of the taps (which
-every tap repeats, so that the coherence does not see it either).  See docs/diagnose.md, "The noise model".
+every tap repeats, so that the coherence does not see it either).  An FRF
+measured through an exponential window has its noise correlated over
+neighbouring lines (:func:`window_correlation`): the smoother then keeps
+more of it, the share ``h0`` is computed for that correlation, and
+:attr:`NoiseModel.correlation` tells the fits and tests how many times
+fewer lines the data count as.  See docs/diagnose.md, "The noise model".
 """
 
 from __future__ import annotations

@@ -20,7 +20,11 @@ in every band:
   below the upper ``0.001 / M`` quantile of its distribution (Bonferroni
   over the ``M`` blocks), widened by ``1 + z e`` as the global test is; a
   line whose variance is estimated with ``nu`` degrees of freedom (the
-  coherence of a few taps, :attr:`NoiseModel.dof`) scores ``F(2, nu)``.
+  coherence of a few taps, :attr:`NoiseModel.dof`) scores ``F(2, nu)``;
+* lines whose noise is correlated (an FRF measured through an exponential
+  window, :attr:`NoiseModel.correlation` ``kappa``) keep the mean of their
+  scores and their sums vary ``kappa`` times as much: both tests, and the
+  plain check beside them (:func:`error_check`), widen by it.
 
 **Significance of a change** (:func:`significance`).  A change with ``k``
 parameters that lowers ``chi^2`` from ``chi2_0`` to ``chi2_1`` enters only
