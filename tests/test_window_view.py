@@ -146,3 +146,15 @@ def test_accelerance_through_a_window_converts_to_the_receptance_at_the_complex_
     assert np.allclose(mobility.to_receptance(5.0).data[:, 0, 0], receptance(s), rtol=1e-12)
     with pytest.raises(InvalidValueError, match="decay: got -1.0"):
         accelerance.to_receptance(-1.0)
+
+
+def test_frfs_on_different_lines_are_refused_where_they_enter():
+    """Taps of different lengths give different lines; the fits compare every FRF line by line: refused naming
+    both grids (before: a broadcasting error deep in the diagnosis)."""
+    from substructure.errors import FrequencyAxisMismatchError
+
+    model = default_assembly()
+    a, b = (Measurement.from_frf(model.frf("tool.tip:y", "tool.tip:y", Frequency.from_hz(np.arange(150.0, 5000.0, s))),
+                                 "tool.tip", "tool.tip") for s in (10.0, 5.0))
+    with pytest.raises(FrequencyAxisMismatchError, match=r"485 lines every 10 Hz against 969 every 5 Hz"):
+        measured_frfs([a, b])

@@ -26,7 +26,7 @@ from typing import Sequence
 import attrs
 import numpy as np
 
-from ..errors import InvalidValueError, UnknownPointError
+from ..errors import FrequencyAxisMismatchError, InvalidValueError, UnknownPointError
 from .._memo import Same
 from ..frf import FRF, REVERSED_SHARE, reversed_share
 from ..measurements import model_of_measurement
@@ -96,6 +96,9 @@ def measured_frfs(measurements, band=None) -> tuple[list[Measured], tuple[float,
         For no data, a band not within the data (saying which part is
         outside), fewer than 10 lines in the band, or an FRF that is zero on
         every line (named).
+    FrequencyAxisMismatchError
+        For FRFs on different frequency lines in the band (taps of different
+        lengths or sample rates), naming two of them.
     """
     items = []
     for m in measurements:
@@ -150,7 +153,21 @@ def measured_frfs(measurements, band=None) -> tuple[list[Measured], tuple[float,
                                     f"{lo:g}-{hi:g} Hz hold a value (the others are zero or not finite); at least "
                                     "10 are needed")
         out.append(Measured(label, frf.crop(lo, hi), noise.select(mask), m))
+    first = out[0].frf.frequency.hz
+    for item in out[1:]:  # one set of lines for all: the fits compare every FRF line by line
+        hz = item.frf.frequency.hz
+        if hz.size != first.size or not np.allclose(hz, first, rtol=1e-9, atol=0.0):
+            where = [getattr(x.measurement, "describe", lambda x=x: x.label)() for x in (out[0], item)]
+            raise FrequencyAxisMismatchError(
+                f"measured FRFs {where[0]} and {where[1]} are on different frequency lines in the band "
+                f"{lo:g}-{hi:g} Hz ({first.size} lines every {_step(first)} Hz against {hz.size} every "
+                f"{_step(hz)} Hz): taps of different lengths or sample rates give different lines; compare each "
+                "such set on its own, or take the taps with one length and rate")
     return out, (lo, hi)
+
+
+def _step(hz: np.ndarray) -> str:
+    return f"{float(np.median(np.diff(hz))):.4g}" if hz.size > 1 else "-"
 
 
 def _has_si(change) -> bool:
