@@ -50,7 +50,7 @@ every tap repeats, so that the coherence does not see it either).  An FRF
 measured through an exponential window has its noise correlated over
 neighbouring lines (:func:`window_correlation`): the smoother then keeps
 more of it, the share ``h0`` is computed for that correlation, and
-:attr:`NoiseModel.correlation` tells the fits and tests how many times
+``NoiseModel.correlation`` tells the fits and tests how many times
 fewer lines the data count as.  See docs/diagnose.md, "The noise model".
 """
 
@@ -433,7 +433,7 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     window_tau : float, optional
         The time constant [s] of the exponential window the FRF was measured
         through: its noise is correlated over neighbouring lines
-        (:attr:`NoiseModel.correlation`, :func:`window_correlation`).
+        (``NoiseModel.correlation``, :func:`window_correlation`).
 
     Returns
     -------

@@ -22,7 +22,7 @@ in every band:
   line whose variance is estimated with ``nu`` degrees of freedom (the
   coherence of a few taps, :attr:`NoiseModel.dof`) scores ``F(2, nu)``;
 * lines whose noise is correlated (an FRF measured through an exponential
-  window, :attr:`NoiseModel.correlation` ``kappa``) keep the mean of their
+  window, ``NoiseModel.correlation`` ``kappa``) keep the mean of their
   scores and their sums vary ``kappa`` times as much: both tests, and the
   plain check beside them (:func:`error_check`), widen by it.
 
@@ -83,7 +83,7 @@ def _block_bound(size: int, alpha: float, dof: np.ndarray | None = None, correla
     heavier-tailed (a mean of 2 for 3 taps).  The sum of the ``size`` capped scores is taken as
     the gamma distribution of the same mean and variance (it is bounded and skewed to the
     right, as the gamma is).  Lines whose noise is correlated (an exponential window,
-    :attr:`~substructure.updating.noise.NoiseModel.correlation`) keep the mean and vary
+    ``NoiseModel.correlation``) keep the mean and vary
     ``correlation`` times as much.
     """
     mean, var = _line_moments(dof, size)
