@@ -24,6 +24,8 @@ components and joints that can be evaluated there.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from .errors import InvalidValueError, SubstructureError
@@ -217,10 +219,19 @@ def takes_decay(method) -> bool:
     -------
     bool
     """
+    function = getattr(method, "__func__", method)  # the class's function: one reading per type
+    try:
+        return _signature_has_decay(function)
+    except TypeError:  # an object that cannot be a cache key
+        return _signature_has_decay.__wrapped__(function)
+
+
+@functools.lru_cache(maxsize=512)
+def _signature_has_decay(function) -> bool:
     import inspect
 
     try:
-        return "decay" in inspect.signature(method).parameters
+        return "decay" in inspect.signature(function).parameters
     except (TypeError, ValueError):  # a builtin without a signature
         return False
 

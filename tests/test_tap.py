@@ -468,3 +468,30 @@ def test_csv_of_another_acquisition_system_semicolons_decimal_commas_and_parenth
                                                          for row in zip(t, f, x)]
     (tmp_path / "tab.csv").write_text("\n".join(tabbed) + "\n")
     assert np.array_equal(read_tap_csv(tmp_path / "tab.csv").response, a.response)
+
+
+def test_the_offset_is_read_before_the_force_window_not_from_what_rings_ahead_of_the_pulse():
+    """A response with a constant offset (a sensor's bias) and, in the last 0.3 ms before the pulse, what an
+    acquisition's linear-phase filter spreads ahead of it.  The offset is read from the samples before the force
+    window opens: through the exponential window an error c of the offset is c / (1/tau + i omega) on every line,
+    not on the 0 Hz line alone (read up to the pulse, it took the ringing for offset)."""
+    t, f = half_sine(55.0)
+    clean = simulate(f)
+    ahead = (t >= 0.01 - 0.3e-3) & (t < 0.01)
+    ring = np.where(ahead, 0.3 * clean.max(), 0.0)  # one-signed: its mean is no offset
+    result = process_taps([TapRecord(t, f, clean + 2e-7 + ring, "displacement", "tap")], exponential=True, tau=0.05)
+    hz = result.frf.frequency.hz
+    # the closed form, and what the ringing itself adds to H = X / F on the same cut of the record, same window
+    first = int(round(result.taps[0].start_s * FS))
+    cut = slice(first, first + int(round(FS / hz[1])))
+    w = np.exp(-(t[cut] - 0.01) / result.tau)
+    ring_h = np.fft.rfft(ring[cut] * w) / np.fft.rfft(f[cut] * w)
+    expected = receptance(2j * np.pi * hz + 1.0 / result.tau) * held(hz) + ring_h[np.searchsorted(
+        np.fft.rfftfreq(w.size, 1.0 / FS), hz)]
+    band = (hz > 20) & (hz < 1500)
+    assert np.abs(result.frf.data[band, 0, 0] / expected[band] - 1.0).max() < 5e-3
+    # read up to the pulse, the offset would have been the bias plus the ringing's mean: that error, as it shows
+    p = int(round((0.01 - result.taps[0].start_s) * FS))
+    leak = np.mean(ring[cut][:p]) * np.fft.rfft(w)[np.searchsorted(np.fft.rfftfreq(w.size, 1.0 / FS), hz)] / \
+        np.fft.rfft(f[cut] * w)[np.searchsorted(np.fft.rfftfreq(w.size, 1.0 / FS), hz)]
+    assert np.abs(leak[band] / expected[band]).max() > 0.02

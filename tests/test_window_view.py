@@ -158,3 +158,12 @@ def test_frfs_on_different_lines_are_refused_where_they_enter():
                                  "tool.tip", "tool.tip") for s in (10.0, 5.0))
     with pytest.raises(FrequencyAxisMismatchError, match=r"485 lines every 10 Hz against 969 every 5 Hz"):
         measured_frfs([a, b])
+
+
+def test_a_window_time_constant_that_is_not_one_is_refused_by_the_noise_model():
+    from substructure.updating import estimate_noise
+
+    frf = default_assembly().frf("tool.tip:y", "tool.tip:y", Frequency.from_hz(np.arange(150.0, 5000.0, 10.0)))
+    for bad in (0.0, -0.1, float("nan")):
+        with pytest.raises(InvalidValueError, match="window_tau: got"):
+            estimate_noise(frf, window_tau=bad)
