@@ -23,6 +23,7 @@ __all__ = [
     "NonPassiveJointWarning",
     "NonReciprocalWarning",
     "IllConditionedWarning",
+    "WindowedFRFWarning",
 ]
 
 
@@ -78,3 +79,7 @@ class NonReciprocalWarning(SubstructureWarning):
 
 class IllConditionedWarning(SubstructureWarning):
     """A matrix inversion is so ill-conditioned that its result is unreliable."""
+
+
+class WindowedFRFWarning(SubstructureWarning):
+    """An FRF read as it is was measured through an exponential window: every mode carries the window's damping."""

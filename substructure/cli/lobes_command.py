@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import warnings
 
-from ..errors import SubstructureError
+from ..errors import SubstructureError, WindowedFRFWarning
 from ._common import UsageError, check_outputs, check_plot, draw_to, grid_text, one_line, point_arg, print_json
 from ._cutting import (
     MILLING_DEFAULT_NOTE,
@@ -19,11 +19,33 @@ from ._cutting import (
 )
 
 
+def _window(args: argparse.Namespace) -> dict | None:
+    """The exponential window of each direction's FRF file (``# window_tau_s``, or ``--window-tau``), None without."""
+    from ..io.frf_files import read_csv_window
+
+    if args.window_tau is not None and not (args.window_tau > 0 and args.window_tau < float("inf")):
+        raise UsageError(f"argument --window-tau: got {args.window_tau!r}; expected the exponential window's time "
+                         "constant in s, a number > 0")
+    if args.frf is None:
+        if args.window_tau is not None:
+            raise UsageError("--window-tau is for measured FRFs (--frf X.csv): a model or modes have no window")
+        return None
+    files = {"x": args.frf, "y": args.frf_y or args.frf}
+    taus = {}
+    for d, path in files.items():
+        said = read_csv_window(path) if str(path).lower().endswith(".csv") else None
+        if said is not None and args.window_tau is not None and abs(said / args.window_tau - 1) > 1e-9:
+            raise UsageError(f"--window-tau {args.window_tau:g}: {path} says it was measured through a window of "
+                             f"{said!r} s (its '# window_tau_s' line); give the file's value or leave the option out")
+        taus[d] = said if said is not None else args.window_tau
+    return taus if any(t is not None for t in taus.values()) else None
+
+
 def _lobes_structure(args: argparse.Namespace):
-    """The structure, a line describing it, the band chosen and the tool: FRF (labelled x/y) or ModalModel."""
+    """The structure, a line describing it, the band chosen, the tool and the window removed (or None)."""
     from ..frf import FRF
     from ..io.assembly_toml import load_assembly
-    from ..stability import ModalModel, assembly_structure, choose_band, xy_frf
+    from ..stability import ModalModel, assembly_structure, choose_band, window_removed, xy_frf
 
     sources = [name for name, value in (("--assembly", args.assembly), ("--frf", args.frf), ("--modes", args.modes))
                if value is not None]
@@ -34,11 +56,12 @@ def _lobes_structure(args: argparse.Namespace):
         raise UsageError("--at POINT goes with --assembly A.toml (and --assembly needs --at)")
     if args.frf_y is not None and args.frf is None:
         raise UsageError("--frf-y goes with --frf")
+    taus = _window(args)
     if args.modes is not None:
         if args.band is not None:
             raise UsageError("--band crops FRF data; --modes are used as they are")
         model = ModalModel.from_csv(args.modes)
-        return model, f"modes from {args.modes}: {model.describe()}", None, None
+        return model, f"modes from {args.modes}: {model.describe()}", None, None, None
     band = "auto" if args.band is None else args.band
     tool = None
     if args.assembly is not None:
@@ -52,15 +75,20 @@ def _lobes_structure(args: argparse.Namespace):
         what = f"tool point FRF of {assembly.name} at {at}, y = x (a symmetric tool)"
         if band == "auto":  # the model says what its supports do
             one, band = assembly_structure(assembly, at)
-            return xy_frf(one), f"{what}, {grid_text(one.frequency)}", band, tool
+            return xy_frf(one), f"{what}, {grid_text(one.frequency)}", band, tool, None
         frf = xy_frf(assembly.receptance(at, frequency=assembly.frequency))
     else:
-        x = FRF.from_csv(args.frf)
-        y = FRF.from_csv(args.frf_y) if args.frf_y else None
+        with warnings.catch_warnings():  # the window a file declares is taken out below
+            warnings.simplefilter("ignore", WindowedFRFWarning)
+            x = FRF.from_csv(args.frf)
+            y = FRF.from_csv(args.frf_y) if args.frf_y else None
         frf = xy_frf(x, y)
         what = f"FRF from {args.frf}" + (f" (x) and {args.frf_y} (y)" if args.frf_y else ", y = x (a symmetric tool)")
     frf, band = choose_band(frf, band)
-    return frf, f"{what}, {grid_text(frf.frequency)}", band, tool
+    # through an exponential window every mode carries 1/(tau omega) of the window's damping: taken out of the
+    # fitted modes, or the lobes would promise depths the tool cannot take
+    window = None if taus is None else window_removed(frf, taus)
+    return (frf if window is None else window.frf), f"{what}, {grid_text(frf.frequency)}", band, tool, window
 
 
 def run(args: argparse.Namespace) -> int:
@@ -76,17 +104,30 @@ def run(args: argparse.Namespace) -> int:
                                             args.cutting_data], args.overwrite)
     if args.intervals is not None and args.method != "sdm":
         raise UsageError("--intervals sets the semi-discretization: use it with --method sdm")
-    structure, what, band, tool = _lobes_structure(args)
+    structure, what, band, tool, window = _lobes_structure(args)
     notes: list[str] = []
     if band is not None:
         notes.append(f"structure band: {band.lo_hz:g} to {band.hi_hz:g} Hz ({band.kind}); {band.reason}")
+    if window is not None:
+        said = ", ".join(f"{d} {t:.4g} s" for d, t in window.tau.items() if t is not None)
+        notes.append(f"exponential window: tau {said}; its damping 1/(tau omega) taken out of the "
+                     f"{len(window.modes.modes)} fitted modes (the FRF less each mode as fitted, plus the mode without "
+                     "the window)")
+        notes.extend(f"  {line}" for line in window.describe())
     cut = cut_from_args(args, tool, notes)
     limits = limits_from_args(args, tool, notes) if isinstance(cut, MillingCut) else None
     if args.method == "zoa":
         lobes = zoa(structure, cut, args.speeds, band=band if band is not None else "auto")
         method = "zero-order approximation (Altintas & Budak 1995)"
     else:
-        if isinstance(structure, FRF):  # semi-discretization needs modes: fit them to x and y
+        if window is not None:  # the modes fitted to take the window out, without its damping
+            structure = window.modes
+            errors = ", ".join(f"{d} {e:.1%}" for d, e in window.modal_error.items())
+            notes.append(f"modal fit: {len(structure.modes)} modes ({structure.describe()}); relative error {errors}")
+            if window.modal_error and max(window.modal_error.values()) > 0.2:
+                warnings.warn(f"the fitted modes miss the FRF by {errors}; choose the band with --band LO:HI",
+                              ModalFitWarning, stacklevel=2)
+        elif isinstance(structure, FRF):  # semi-discretization needs modes: fit them to x and y
             fits = [ModalFitter().fit(FRF.single(structure.frequency, structure.data[:, i, i], output=d, input=d), d)
                     for i, d in enumerate("xy")]
             structure = ModalModel([m for fit in fits for m in fit.modes_])
@@ -129,6 +170,11 @@ def run(args: argparse.Namespace) -> int:
             out["cut"] = cut.to_json()
             out["milling_default"] = MILLING_DEFAULT_NOTE in notes
         out["cutting_data"] = shop
+        out["window"] = None if window is None else {
+            "tau_s": window.tau, "modal_error": window.modal_error,
+            "modes": [{"direction": m.direction, "frequency_hz": m.frequency_hz,
+                       "damping_ratio_measured": m.damping_ratio, "damping_ratio": c.damping_ratio}
+                      for m, c in zip(window.measured.modes, window.modes.modes)]}
         out["notes"] = notes
         return print_json(out)
     speeds = lobes.spindle_speed_rpm
@@ -192,6 +238,10 @@ def add_parser(commands) -> None:
     where.add_argument("--frf-y", metavar="Y.csv", help="receptance in y (default: equal to x, a symmetric tool)")
     where.add_argument("--modes", metavar="MODES.csv",
                        help="modal parameters, header direction,frequency_hz,damping_ratio,stiffness_n_per_m")
+    where.add_argument("--window-tau", type=float, metavar="SECONDS",
+                       help="the FRF was measured through an exponential window of this time constant: its damping "
+                            "is taken out of the fitted modes (default: what the file's '# window_tau_s' line says, "
+                            "as substructure tap writes it)")
     where.add_argument("--band", type=structure_band_arg, metavar="auto|all|LO:HI",
                        help="FRF lines to use: auto (default: leave out rigid-body and suspension lines, "
                             "reported), all, or LO:HI in Hz")

@@ -58,8 +58,9 @@ def _set_text(name: str, response: str, excitation: str, file: str, averages: in
     if tau is None:
         return text
     return (f"# measured through an exponential window, tau = {tau:.4g} s: it adds the damping ratio 1/(tau omega) to "
-            "every mode;\n# diagnose and identify compare the model through the same window (window_tau_s); other "
-            "uses of the FRF see the added damping (a longer record needs no window)\n" + text)
+            "every mode;\n# diagnose and identify compare the model through the same window (window_tau_s), lobes "
+            "removes it from the fitted modes; other uses of the FRF see the added damping (a longer record needs "
+            "no window)\n" + text)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -116,7 +117,7 @@ def run(args: argparse.Namespace) -> int:
     written = []
     if args.out:
         write_csv(result.frf, args.out, args.overwrite, coherence=result.coherence, force_noise=result.force_noise,
-                  truncation=result.truncation)
+                  truncation=result.truncation, window_tau=result.tau)
         written.append(args.out)
     if args.measurements:
         relative = os.path.relpath(os.path.abspath(args.out), os.path.dirname(os.path.abspath(args.measurements)))
@@ -170,8 +171,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"exponential window: {result.window}")
     else:
         print(f"exponential window: tau = {result.tau:.4g} s, {result.window}; it adds a damping ratio "
-              "1/(tau omega) to every mode (diagnose and identify compare the model through the same window; "
-              "lobes and a modal fit of this FRF see the added damping)")
+              "1/(tau omega) to every mode (the --out file says so; diagnose and identify compare the model through "
+              "the same window, lobes takes it out of the fitted modes; other uses of the FRF see it)")
     cut = result.truncation_error()
     if cut is not None:
         print(f"truncation: the response still rang at the taps' end; the error it leaves in the FRF is at most "

@@ -7,6 +7,7 @@ the ``measurements`` layer, so that ``MeasurementSet.from_file`` reads without i
 
 from __future__ import annotations
 
+import math
 import os
 import warnings
 from pathlib import Path
@@ -108,7 +109,7 @@ class _Reader:
 
     # -- data files -----------------------------------------------------------
     def data(self, index: int, file: str, record: int | None, quantity: str | None,
-             response: str, excitation: str) -> tuple[FRF, dict[str, Any]]:
+             response: str, excitation: str) -> tuple[FRF, dict[str, Any], float | None]:
         path = self.base_dir / file
         suffix = path.suffix.lower()
         if suffix not in _CSV + _UFF:
@@ -120,17 +121,18 @@ class _Reader:
             if suffix in _CSV:
                 if record is not None:
                     raise self.error(index, "record", f"a CSV file ({file}) holds one FRF; record is for UFF files")
-                frf, lines_of, columns = _read_csv(path, output=response, input=excitation, quantity=quantity)
+                frf, lines_of, columns, window = _read_csv(path, output=response, input=excitation,
+                                                           quantity=quantity)
             else:
                 frf = self.uff(index, path, record, quantity, response, excitation)
-                lines_of, columns = None, {}
+                lines_of, columns, window = None, {}, None
             beyond = _beyond_physical(frf.frequency.hz, frf.data, frf.quantity)  # a measured FRF's range
             if beyond is not None:
                 k, what = beyond
                 where = (f"line {lines_of[k]}" if lines_of is not None else
                          f"type-58 record {record or 0}, value {k + 1} of {frf.frequency.n}")
                 raise FileFormatError(f"{path}, {where}: at {frf.frequency.hz[k]:g} Hz: {what}")
-            return frf, columns
+            return frf, columns, window
         except _LocatedError:
             raise
         except FileFormatError as exc:  # names the data file (and its line)
@@ -221,7 +223,14 @@ class _Reader:
         estimator = self.choice(table, index, "estimator", ESTIMATORS)
         coherence_record = self.integer(table, index, "coherence_record", 0,
                                         "the 0-based index of the type-58 coherence record")
-        raw, columns = self.data(index, file, record, quantity, response, excitation)
+        raw, columns, window = self.data(index, file, record, quantity, response, excitation)
+        if window is not None:  # the data file says it was measured through the window: it travels with the data
+            if tau is None:
+                tau = window
+            elif not math.isclose(tau, window, rel_tol=1e-9):
+                raise self.error(index, "window_tau_s", f"got {tau!r} s, but {file} says it was measured through "
+                                                        f"a window of {window!r} s (its '# window_tau_s' line); "
+                                                        "give the file's value or leave the key out")
         if coherence_record is not None:
             columns["coherence"] = self.uff_coherence(index, file, coherence_record, raw)
         if "force_noise" in columns and force_window is None:

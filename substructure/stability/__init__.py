@@ -16,6 +16,9 @@ best speeds, and how much the lobes move when the FRF changes.
   low radial immersion where the zero order is not.
 * :class:`Lobes`, :func:`lobes_band`: results, several on one plot, and a
   band from an FRF uncertainty band.
+* :func:`window_removed`, :func:`mode_without_window`: the damping of an
+  exponential window taken out of a tapped FRF (``substructure tap``
+  applies one when the response still rings at the end of the taps).
 * :func:`flexible_band`, :func:`assembly_structure`: the part of a tool point
   FRF stability may use (no rigid-body or suspension lines).
 * :func:`recommend`, :class:`MachineLimits`, :class:`Recommendation`: the
@@ -51,6 +54,7 @@ from .sdm import sdm, spectral_radius
 from .structure import XY_LABELS, xy_frf
 from .recommend import RECOMMENDATION_KEYS, NoRecommendationError, Recommendation, recommend
 from .workpieces import Workpiece, load_workpieces, workpiece, workpieces
+from .window import WindowRemoved, mode_without_window, window_removed
 from .zoa import zoa
 
 __all__ = [
@@ -63,4 +67,5 @@ __all__ = [
     "Recommendation", "recommend", "RECOMMENDATION_KEYS", "NoRecommendationError",
     "Workpiece", "workpiece", "workpieces", "load_workpieces",
     "CuttingData", "CuttingDataWarning", "cutting_data", "load_cutting_data", "cutting_conditions", "check_cutting",
+    "window_removed", "mode_without_window", "WindowRemoved",
 ]

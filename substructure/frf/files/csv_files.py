@@ -10,23 +10,33 @@ relative error that the hammer's noise gives, per line, a tap test's;
 relative error the end of the taps leaves), each optional:
 :func:`read_csv_with_coherence` returns the coherence, :func:`read_csv`
 reads such files too and returns the FRF alone.
+
+An FRF measured through an exponential window (``substructure tap``, where
+the response still rang at the end of the taps) has the window's damping in
+it; the file says so in a comment line before the header,
+``# window_tau_s = 0.0217``, which :func:`read_csv_window` returns (the
+``lobes`` command removes that damping, a measurement set compares the
+model through the same window).
 """
 
 from __future__ import annotations
 
+import math
 import os
+import re
+import warnings
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ...errors import FileFormatError, InvalidValueError
+from ...errors import FileFormatError, InvalidValueError, WindowedFRFWarning
 from ..axis import MAX_GRID_LINES, Frequency
 from ._common import _refuse_all_zero, _require_frf, _shown, frf_class
 
 if TYPE_CHECKING:  # the annotations only (frf.response imports this module)
     from ..response import FRF
 
-__all__ = ["write_csv", "read_csv", "read_csv_with_coherence"]
+__all__ = ["write_csv", "read_csv", "read_csv_with_coherence", "read_csv_window"]
 
 CSV_HEADER = "frequency_hz,real,imag"
 COHERENCE_HEADER = CSV_HEADER + ",coherence"
@@ -34,10 +44,13 @@ FORCE_NOISE_HEADER = COHERENCE_HEADER + ",force_noise"
 _VARIANCE_COLUMNS = ("force_noise", "truncation")  # after the coherence, in this order, each optional
 _HEADERS = (CSV_HEADER, COHERENCE_HEADER, FORCE_NOISE_HEADER, COHERENCE_HEADER + ",truncation",
             FORCE_NOISE_HEADER + ",truncation")
+WINDOW_KEY = "window_tau_s"
+"""The comment line before the header that gives the exponential window's time constant [s]."""
+_WINDOW_LINE = re.compile(r"#\s*window_tau_s\s*(?:=\s*(.*?))?\s*$")
 
 
 def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coherence=None, force_noise=None,
-              truncation=None) -> None:
+              truncation=None, window_tau: float | None = None) -> None:
     """Write a one-entry FRF to a CSV file ``frequency_hz,real,imag`` (``,coherence`` when given).
 
     Parameters
@@ -62,6 +75,10 @@ def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coheren
         With a coherence: per line, the variance of the relative error the
         end of the taps leaves (``substructure.tap.TapResult.truncation``;
         >= 0, ``inf`` allowed), written as the last column ``truncation``.
+    window_tau : float, optional
+        The time constant [s] of the exponential window the FRF was measured
+        through, written as a comment line ``# window_tau_s = ...`` before
+        the header (:func:`read_csv_window`).
 
     Raises
     ------
@@ -69,7 +86,8 @@ def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coheren
         For an FRF of more than one entry or of fewer than 2 lines (which
         no reader takes), a coherence of another length or outside [0, 1],
         or a force noise or truncation without a coherence, of another
-        length, negative or NaN.
+        length, negative or NaN, or a window time constant that is not a
+        number > 0.
     """
     from ..._files import write_text
 
@@ -102,8 +120,71 @@ def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coheren
             raise InvalidValueError(f"{column}: cannot write {os.fspath(path)}: expected {frf.frequency.n} values "
                                     ">= 0 (inf allowed), one per line, and a coherence")
         header, columns = header + "," + column, columns + [v]
+    comment = ""
+    if window_tau is not None:
+        tau = _window_tau(window_tau)
+        if tau is None:
+            raise InvalidValueError(f"window_tau: cannot write {os.fspath(path)}: got {window_tau!r}; expected the "
+                                    "exponential window's time constant in s, a number > 0")
+        comment = (f"# {WINDOW_KEY} = {tau!r}\n# measured through an exponential window exp(-t/tau): every mode "
+                   "carries the added damping ratio 1/(tau omega)\n")
     text = "".join(",".join(map(repr, row)) + "\n" for row in zip(*(c.tolist() for c in columns)))
-    write_text(path, header + "\n" + text, overwrite=overwrite)
+    write_text(path, comment + header + "\n" + text, overwrite=overwrite)
+
+
+def _window_tau(value) -> float | None:
+    """A window time constant as a float > 0, or None for anything else."""
+    try:
+        tau = float(value)
+    except (TypeError, ValueError):
+        return None
+    return tau if math.isfinite(tau) and tau > 0 else None
+
+
+def read_csv_window(path: str | os.PathLike) -> float | None:
+    """The exponential window's time constant a CSV file of an FRF declares, or None.
+
+    ``substructure tap`` writes the line ``# window_tau_s = 0.0217`` before
+    the header when it applied the window: the FRF is the structure's at
+    the complex frequency ``omega - i/tau``, every mode with the added
+    damping ratio ``1/(tau omega)``.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file (see :func:`read_csv`).
+
+    Returns
+    -------
+    float or None
+        ``tau`` [s], or None when the file declares no window.
+
+    Raises
+    ------
+    FileFormatError
+        As :func:`read_csv`, and for a ``window_tau_s`` line whose value is
+        not a number > 0 or that is given twice, naming the file and the line.
+    """
+    return _read_csv(path, "response", "excitation", None)[3]
+
+
+def _window_line(numbered: list, name: str) -> float | None:
+    """The ``# window_tau_s = ...`` line among the comment lines before the header (None without one)."""
+    tau, seen = None, None
+    for number, line in numbered:
+        text = line.strip().lstrip("\ufeff")
+        if not text.startswith("#"):
+            break
+        match = _WINDOW_LINE.match(text)
+        if match is None:
+            continue
+        if seen is not None:
+            raise FileFormatError(f"{name}, line {number}: {WINDOW_KEY} is given again (first on line {seen})")
+        tau, seen = _window_tau(match.group(1)), number
+        if tau is None:
+            raise FileFormatError(f"{name}, line {number}: {_shown(text)}: expected '# {WINDOW_KEY} = SECONDS', the "
+                                  "exponential window's time constant, a number > 0")
+    return tau
 
 
 def read_csv(
@@ -142,8 +223,21 @@ def read_csv(
     -------
     FRF
         Shape ``(n_freq, 1, 1)``: frequencies in Hz, values as in the file (SI).
+
+    Warns
+    -----
+    WindowedFRFWarning
+        For a file measured through an exponential window (its
+        ``# window_tau_s`` line, :func:`read_csv_window`): the FRF is read as
+        it is, every mode with the window's damping.
     """
-    return _read_csv(path, output, input, quantity)[0]
+    frf, _, _, window = _read_csv(path, output, input, quantity)
+    if window is not None:
+        warnings.warn(f"{os.fspath(path)}: measured through an exponential window (tau = {window:.4g} s): every mode "
+                      "carries the window's damping 1/(tau omega), which raises stability limits; "
+                      "substructure.stability.window_removed takes it out (the lobes command does), a measurement set "
+                      "compares the model through the window", WindowedFRFWarning, stacklevel=3)
+    return frf
 
 
 def read_csv_with_coherence(
@@ -177,13 +271,15 @@ def read_csv_with_coherence(
         As :func:`read_csv`, and for a coherence that is not a number in
         [0, 1], naming the file and the line.
     """
-    frf, _, columns = _read_csv(path, output, input, quantity)
+    frf, _, columns, _ = _read_csv(path, output, input, quantity)
     return frf, columns.get("coherence")
 
 
-def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF, np.ndarray, dict[str, np.ndarray]]:
-    """:func:`read_csv_with_coherence`, with the line of the file each frequency line comes from and the per-line
-    columns the file has (``coherence``, ``force_noise``, ``truncation``) by name."""
+def _read_csv(path, output: str, input: str,
+              quantity: str | None) -> tuple[FRF, np.ndarray, dict[str, np.ndarray], float | None]:
+    """:func:`read_csv_with_coherence`, with the line of the file each frequency line comes from, the per-line
+    columns the file has (``coherence``, ``force_noise``, ``truncation``) by name and the window it declares
+    (:func:`read_csv_window`)."""
     from ..._files import MAX_DATA_BYTES, read_text
 
     name = os.fspath(path)
@@ -195,7 +291,11 @@ def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF,
     numbered = [(k + 1, line) for k, line in enumerate(lines) if line.strip()]
     if not numbered:
         raise FileFormatError(f"{name}: the file is empty; expected the header {CSV_HEADER!r}")
-    first, header = numbered[0]
+    window = _window_line(numbered, name)
+    comments = 0
+    while comments < len(numbered) and numbered[comments][1].strip().lstrip("\ufeff").startswith("#"):
+        comments += 1
+    first, header = numbered[min(comments, len(numbered) - 1)]
     columns = header.replace(" ", "").lstrip("\ufeff")
     if columns not in _HEADERS and columns.startswith(CSV_HEADER + ",") and \
             set(columns.split(",")[3:]) <= {"coherence", *_VARIANCE_COLUMNS}:
@@ -208,9 +308,9 @@ def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF,
 
         table, lines_of, said, coherence = read_export(numbered, name, quantity)
         frf = _checked_csv(table, lines_of, name, output, input, quantity or said or "receptance")
-        return frf, lines_of, {} if coherence is None else {"coherence": coherence}
+        return frf, lines_of, {} if coherence is None else {"coherence": coherence}, window
     names = columns.split(",")
-    numbered = numbered[1:]
+    numbered = numbered[comments + 1:]
     if len(numbered) < 2:
         raise FileFormatError(
             f"{name}: {len(numbered)} data row(s); an FRF needs at least 2 frequency lines"
@@ -251,7 +351,7 @@ def _read_csv(path, output: str, input: str, quantity: str | None) -> tuple[FRF,
             raise FileFormatError(f"{name}, line {lines_of[k]}: {column} is {float(found[column][k])!r}; expected "
                                   "a variance >= 0 (inf where the FRF carries nothing)")
     frf = _checked_csv(table[:, :3], lines_of, name, output, input, quantity or "receptance")
-    return frf, lines_of, found
+    return frf, lines_of, found, window
 
 
 def _checked_csv(table: np.ndarray, lines_of: np.ndarray, name: str, output: str, input: str,

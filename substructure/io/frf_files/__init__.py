@@ -22,7 +22,8 @@ significant digits, and any other grid is refused with an error that says
 what to do.
 
 The code is in ``substructure.frf.files``, one format per module: ``csv_files`` (:func:`read_csv`,
-:func:`read_csv_with_coherence`, :func:`write_csv`; ``exports`` for other programs' CSV exports),
+:func:`read_csv_with_coherence`, :func:`read_csv_window`, :func:`write_csv`; ``exports`` for other
+programs' CSV exports),
 ``uff_writer`` (:func:`write_uff`), ``uff_reader`` (:func:`read_uff`,
 :func:`read_uff_coherence`) and ``uff_units`` (what a
 type-58 record holds: its labels, quantity, units and abscissa), with ``_common`` for the checks
@@ -36,10 +37,12 @@ from __future__ import annotations
 from ...frf.files.csv_files import (  # noqa: F401 (CSV_HEADER: its old place)
     CSV_HEADER,
     read_csv,
+    read_csv_window,
     read_csv_with_coherence,
     write_csv,
 )
 from ...frf.files.uff_reader import read_uff, read_uff_coherence
 from ...frf.files.uff_writer import write_uff
 
-__all__ = ["write_csv", "read_csv", "read_csv_with_coherence", "write_uff", "read_uff", "read_uff_coherence"]
+__all__ = ["write_csv", "read_csv", "read_csv_with_coherence", "read_csv_window", "write_uff", "read_uff",
+           "read_uff_coherence"]
