@@ -259,10 +259,10 @@ def test_taps_through_the_window_give_the_structures_lobes_through_the_commands(
     assert x[0]["damping_ratio_measured"] == pytest.approx(ZETA + 1 / (tau * 2 * np.pi * FN), rel=0.03)
     assert got["absolute_limit_m"] == pytest.approx(truth["absolute_limit_m"], rel=0.02)
     np.testing.assert_allclose(got["depth_limit_m"], truth["depth_limit_m"], rtol=0.02)
-    # read as it is, the same file promises about twice the depth (0.97 % of the window on a 1 % mode)
+    # read as it is, the same file promises 2.3 times the depth (0.99 % of the window on a 1 % mode)
     with pytest.warns(WindowedFRFWarning):
         raw = zoa(xy_frf(FRF.from_csv(tmp_path / "frf.csv")), CUT, SPEEDS)
-    assert raw.absolute_limit_m > 1.6 * truth["absolute_limit_m"]
+    assert raw.absolute_limit_m > 2 * truth["absolute_limit_m"]
     code, out, err = run(capsys, "lobes", "--frf", tmp_path / "frf.csv", *LOBES)
     assert code == 0 and "exponential window: tau x" in out and "without the window's" in out
     code, out, err = run(capsys, "lobes", "--frf", tmp_path / "frf.csv", *LOBES, "--method", "sdm", "--speeds",
