@@ -34,7 +34,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from substructure import FRF, Frequency
+from substructure import FRF
 from substructure.errors import WindowedFRFWarning
 from substructure.io.frf_files import read_csv_window, write_csv
 from substructure.stability import MillingCut, ModalModel, Mode, spindle_speeds, window_removed, xy_frf, zoa
