@@ -290,3 +290,13 @@ def test_the_window_option_for_files_that_do_not_say_and_its_errors(capsys, tmp_
     ]:
         code, out, err = run(capsys, "lobes", *argv, *LOBES)
         assert code == 2 and message in err, err
+
+
+def test_a_window_that_explains_all_of_a_modes_damping_is_refused_by_the_command(capsys, tmp_path):
+    """A 0.3 % mode at 650 Hz in a file that says tau = 0.02 s (the window alone adds 1.2 %): no lobes."""
+    hz = np.linspace(100.0, 2000.0, 381)
+    path = tmp_path / "frf.csv"
+    write_csv(_frf(hz, closed_form(2j * np.pi * hz, [("650 Hz", 0.003, 3e6)])), path, window_tau=0.02)
+    code, out, err = run(capsys, "lobes", "--frf", path, *LOBES)
+    assert code != 0 and out == ""
+    assert "the mode at 650" in err and "the record shows the window's damping, not the structure's" in err
