@@ -65,12 +65,16 @@ def pool(tmp_path_factory):
     (d / "dead.csv").write_text("frequency_hz,real,imag\n"
                                 + "".join(f"{float(f)!r},0.0,0.0\n" for f in frf.frequency.hz))
     (d / "one.csv").write_text("frequency_hz,real,imag\n" + rows.splitlines()[0] + "\n")
+    (d / "windowed.csv").write_text("# window_tau_s = 0.5\nfrequency_hz,real,imag\n" + rows)
+    (d / "window_bad.csv").write_text("# window_tau_s = -1\nfrequency_hz,real,imag\n" + rows)
+    (d / "window_short.csv").write_text("# window_tau_s = 1e-6\nfrequency_hz,real,imag\n" + rows)
     write_uff(frf.with_labels(("tool.tip:y",), ("tool.tip:y",)), d / "tap.uff")
     lines = (d / "tap.uff").read_text().splitlines()
     (d / "trunc.uff").write_text("\n".join(lines[: len(lines) // 2]) + "\n")
     for name, data in (("meas", "tap.csv"), ("meas_bom", "tap_bom.csv"), ("meas_dead", "dead.csv"),
                        ("meas_nan", "nan.csv"), ("meas_uff", "tap.uff"), ("meas_trunc", "trunc.uff"),
-                       ("meas_missing", "absent.csv"), ("meas_dir", "folder")):
+                       ("meas_missing", "absent.csv"), ("meas_dir", "folder"), ("meas_windowed", "windowed.csv"),
+                       ("meas_window_bad", "window_bad.csv")):
         (d / f"{name}.toml").write_text(f'name = "tap"\n[[frf]]\nresponse = "tool.tip"\nexcitation = "tool.tip"\n'
                                         f'file = "{data}"\n')
     header = "tool_diameter [mm],gauge_length [mm],k_yf [N/m]\n"
@@ -96,9 +100,10 @@ def digest(directory: Path) -> dict:
 ASSEMBLIES = ["model.toml", "model_bom.toml", "model_rpm.toml", "model_nan.toml", "model_badkey.toml", "empty.toml",
               "binary.toml", "folder", "absent.toml", "tap.csv"]
 MEASUREMENTS = ["meas.toml", "meas_bom.toml", "meas_dead.toml", "meas_nan.toml", "meas_uff.toml", "meas_trunc.toml",
-                "meas_missing.toml", "meas_dir.toml", "empty.toml", "model.toml", "folder"]
+                "meas_missing.toml", "meas_dir.toml", "empty.toml", "model.toml", "folder", "meas_windowed.toml",
+                "meas_window_bad.toml"]
 FRF_FILES = ["tap.csv", "tap_bom.csv", "nan.csv", "dead.csv", "one.csv", "empty.csv", "folder", "absent.csv",
-             "tap.uff"]
+             "tap.uff", "windowed.csv", "window_bad.csv", "window_short.csv"]
 TABLES = ["table.csv", "table1.csv", "table_n.csv", "table_nan.csv", "table_const.csv", "table_neg.csv", "empty.csv",
           "folder", "absent.csv", "tap.csv"]
 POINTS = ["tool.tip", "tool.tip:theta", "holder.tip", "tool.nose", "tool@500 mm", "tool.tip:z", "", "-1", "x" * 300]
@@ -180,6 +185,8 @@ def invocation(draw):
             argv += ["--speeds=" + draw(pick(SPEEDS))]
         if draw(flag):
             argv += ["--band=" + draw(pick(BANDS))]
+        if draw(flag):
+            argv += ["--window-tau=" + draw(pick(["0.5", "0", "-1", "x", "nan", "1e-6", ""]))]
         if draw(flag):
             argv += output("--plot")
     elif command == "predict":
