@@ -174,7 +174,9 @@ def run(args: argparse.Namespace) -> int:
             "tau_s": window.tau, "modal_error": window.modal_error,
             "modes": [{"direction": m.direction, "frequency_hz": m.frequency_hz,
                        "damping_ratio_measured": m.damping_ratio, "damping_ratio": c.damping_ratio}
-                      for m, c in zip(window.measured.modes, window.modes.modes)]}
+                      for m, c in zip(window.measured.modes, window.modes.modes)],
+            "uncorrected": [{"direction": m.direction, "frequency_hz": m.frequency_hz,
+                             "damping_ratio_measured": m.damping_ratio, "why": why} for m, why in window.uncorrected]}
         out["notes"] = notes
         return print_json(out)
     speeds = lobes.spindle_speed_rpm

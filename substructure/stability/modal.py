@@ -34,7 +34,7 @@ from ..units import Q_, dimensionless, quantity
 from .structure import XY_LABELS, _one_entry, xy_receptance
 
 __all__ = ["Mode", "ModalModel", "ModalFitter", "fit_modes", "MODES_CSV_HEADER", "MODE_FREQUENCY_RANGE_HZ",
-           "MODE_STIFFNESS_RANGE_N_PER_M", "ModalFitWarning"]
+           "MODE_STIFFNESS_RANGE_N_PER_M", "ModalFitWarning", "FIT_DAMPING_RANGE"]
 
 #: Most lines of a modal model's default grid (about 64 MB of 2x2 complex receptances).
 MAX_DEFAULT_LINES = 2_000_000
@@ -51,6 +51,11 @@ MODE_FREQUENCY_RANGE_HZ = (0.1, 1e6)
 #: The modal stiffnesses a mode may have, in N/m: a tool point has 1e5 to 1e9 N/m; outside 1 N/m to
 #: 1e12 N/m a number is a wrong unit (and the lobes divide by zero or overflow).
 MODE_STIFFNESS_RANGE_N_PER_M = (1.0, 1e12)
+
+
+#: The damping ratios :class:`ModalFitter` may give a mode: a fitted mode at the lower end is one the fit
+#: did not resolve (noise, or a feature of the data that is not a mode), not a mode of that damping.
+FIT_DAMPING_RANGE = (1e-5, 0.5)
 
 
 class ModalFitWarning(SubstructureWarning):
@@ -411,7 +416,8 @@ class ModalFitter:
             peaks = np.sort(peaks[np.argsort(props["prominences"])[::-1][: self.n_modes]])
         if peaks.size == 0:
             raise InvalidValueError(
-                f"frf: no peak of |H| in {f[0]:g}..{f[-1]:g} Hz; a modal fit needs resonances in the band"
+                f"frf: no peak of |H| in {f[0]:g}..{f[-1]:g} Hz; a modal fit needs resonances in the band (choose "
+                "it around the tool's modes)"
             )
         fn0 = f[peaks]
         zeta0 = np.array([_half_power_zeta(f, mag, i) for i in peaks])
@@ -422,9 +428,10 @@ class ModalFitter:
         w_mid = 2.0 * np.pi * np.sqrt(f[0] * f[-1])
         n = peaks.size
         x0 = np.concatenate([np.log(fn0), np.log(zeta0), np.log(k0), [0.0, 0.0] if self.residuals else []])
-        lower = np.concatenate([np.full(n, np.log(f[0])), np.full(n, np.log(1e-5)), np.log(k0) - 7.0,
+        zeta_lo, zeta_hi = FIT_DAMPING_RANGE
+        lower = np.concatenate([np.full(n, np.log(f[0])), np.full(n, np.log(zeta_lo)), np.log(k0) - 7.0,
                                 [-np.inf, -np.inf] if self.residuals else []])
-        upper = np.concatenate([np.full(n, np.log(f[-1])), np.full(n, np.log(0.5)), np.log(k0) + 7.0,
+        upper = np.concatenate([np.full(n, np.log(f[-1])), np.full(n, np.log(zeta_hi)), np.log(k0) + 7.0,
                                 [np.inf, np.inf] if self.residuals else []])
         x0 = np.clip(x0, lower + 1e-9, upper - 1e-9)
 
@@ -444,6 +451,14 @@ class ModalFitter:
                             max_nfev=200 * (3 * n + 2))
         p = sol.x
         order = np.argsort(p[:n])
+        lo_k, hi_k = MODE_STIFFNESS_RANGE_N_PER_M
+        for i in order:
+            k = float(np.exp(p[2 * n + i]))
+            if not lo_k <= k <= hi_k:  # the fit, not a unit: say so, with what to do
+                raise InvalidValueError(
+                    f"frf: the modal fit gave the mode near {float(np.exp(p[i])):.5g} Hz a stiffness of {k:.3g} N/m, "
+                    f"outside {lo_k:g} to {hi_k:g} N/m (MODE_STIFFNESS_RANGE_N_PER_M): the band holds more than its "
+                    f"{n} peaks' modes resolve; choose the band (e.g. around the tool's modes) or the number of modes")
         self.modes_ = tuple(
             Mode(direction, Q_(float(np.exp(p[i])), "Hz"), float(np.exp(p[n + i])),
                  Q_(float(np.exp(p[2 * n + i])), "N/m"))

@@ -28,7 +28,12 @@ measured FRF plus, per fitted mode, the corrected mode less the mode as
 fitted; what the modes do not fit (noise, small modes under the
 prominence) stays as measured.  A mode whose fitted decay rate is not above
 ``1/tau`` cannot be corrected (the record says nothing of its own damping)
-and is refused with what to do.
+and is refused with what to do, unless its peak is small: a mode whose
+peak in the data is under ``MINOR_PEAK_SHARE`` (10 %) of the direction's
+largest, and whose fitted decay rate is not above ``1/tau`` or whose fitted
+damping sits at the fit's lower bound (a feature of the data the fit did not
+resolve), is left as measured and named (``WindowRemoved.uncorrected``, a
+:class:`~substructure.stability.ModalFitWarning`).
 """
 
 from __future__ import annotations
@@ -43,10 +48,14 @@ import numpy as np
 from ..errors import InvalidValueError
 from ..frf import FRF, Frequency
 from ..units import Q_
-from .modal import ModalFitter, ModalFitWarning, ModalModel, Mode
+from .modal import FIT_DAMPING_RANGE, ModalFitter, ModalFitWarning, ModalModel, Mode
 from .structure import XY_LABELS, xy_receptance
 
-__all__ = ["mode_without_window", "window_removed", "WindowRemoved"]
+__all__ = ["mode_without_window", "window_removed", "WindowRemoved", "MINOR_PEAK_SHARE"]
+
+MINOR_PEAK_SHARE = 0.1
+"""The data's peak at a mode, relative to the direction's largest, under which a mode the window cannot be
+taken out of is left as measured (named) rather than refused."""
 
 
 def _tau(value: Any) -> float:
@@ -118,6 +127,8 @@ class WindowRemoved:
     modal_error : dict
         Per direction, how far the fitted modes alone miss the windowed data
         (relative, as ``ModalFitter.modal_error_``).
+    uncorrected : tuple
+        ``(mode as fitted, why)`` of the minor modes left as measured.
     """
 
     frf: FRF
@@ -125,6 +136,7 @@ class WindowRemoved:
     measured: ModalModel
     tau: dict
     modal_error: dict
+    uncorrected: tuple = ()
 
     def describe(self) -> list[str]:
         """One line per mode: its frequency and damping ratio as measured and without the window.
@@ -137,7 +149,8 @@ class WindowRemoved:
         return [f"{m.direction} {m.frequency_hz:.5g} Hz: damping ratio {m.damping_ratio:.3%} measured, "
                 f"{c.damping_ratio:.3%} without the window's "
                 f"{1.0 / (self.tau[m.direction] * 2 * math.pi * m.frequency_hz):.3%}"
-                for m, c in zip(self.measured.modes, self.modes.modes)]
+                for m, c in zip(self.measured.modes, self.modes.modes)] + [
+            f"{m.direction} {m.frequency_hz:.5g} Hz: left as measured, {why}" for m, why in self.uncorrected]
 
 
 def window_removed(structure: FRF, tau: float | dict, n_modes: int | None = None, prominence: float = 0.05,
@@ -192,24 +205,43 @@ def window_removed(structure: FRF, tau: float | dict, n_modes: int | None = None
     hz, g = xy_receptance(structure)
     frequency = Frequency(hz)
     out = np.array(g, dtype=complex)
-    fitted, corrected, errors = [], [], {}
+    fitted, corrected, errors, skipped = [], [], {}, []
     for i, d in enumerate(XY_LABELS):
         if taus[d] is None or not np.any(g[:, i, i]):
             continue  # measured without the window, or a rigid direction
         fit = ModalFitter(n_modes=n_modes, prominence=prominence).fit(
             FRF.single(frequency, g[:, i, i], output=d, input=d), d)
         errors[d] = fit.modal_error_
+        mag = np.abs(g[:, i, i])
         for mode in fit.modes_:
-            fixed = mode_without_window(mode, taus[d])
+            share = float(mag[np.argmin(np.abs(hz - mode.frequency_hz))] / mag.max())
+            try:
+                if mode.damping_ratio <= FIT_DAMPING_RANGE[0] * (1 + 1e-6):
+                    raise InvalidValueError(
+                        f"the mode at {mode.frequency_hz:.5g} Hz ({d}): its fitted damping ratio sits at the fit's "
+                        f"lower bound {FIT_DAMPING_RANGE[0]:g}: the fit did not resolve it; choose the band (around "
+                        "the tool's modes) or the number of modes")
+                fixed = mode_without_window(mode, taus[d])
+            except InvalidValueError as exc:
+                if share >= MINOR_PEAK_SHARE:
+                    raise InvalidValueError(f"{exc} (its peak is {share:.0%} of the largest)") from None
+                skipped.append((mode, f"its peak {share:.1%} of the largest: {str(exc).split(': ', 1)[1]}"))
+                continue
             out[:, i, i] += fixed.receptance(hz) - mode.receptance(hz)
             fitted.append(mode)
             corrected.append(fixed)
+    if skipped:
+        warnings.warn("window_removed: " + "; ".join(f"the mode at {m.frequency_hz:.5g} Hz ({m.direction}) is left "
+                                                     f"as measured, {why}" for m, why in skipped),
+                      ModalFitWarning, stacklevel=2)
     if not fitted:
-        raise InvalidValueError("structure: every receptance is 0; there are no modes to take the window out of")
+        raise InvalidValueError("structure: no mode the window can be taken out of" +
+                                (f" ({len(skipped)} left as measured)" if skipped else
+                                 "; every receptance is 0"))
     worst = max(errors.values())
     if worst > max_error:
         warnings.warn(f"window_removed: the fitted modes miss the data by {worst:.0%} (relative); a mode they do not "
                       "fit keeps the window's damping: choose the band or the number of modes", ModalFitWarning,
                       stacklevel=2)
     frf = FRF(frequency, out, XY_LABELS, XY_LABELS)
-    return WindowRemoved(frf, ModalModel(corrected), ModalModel(fitted), taus, errors)
+    return WindowRemoved(frf, ModalModel(corrected), ModalModel(fitted), taus, errors, tuple(skipped))
