@@ -985,32 +985,52 @@ static inline void block(const pair_t *y, int64_t sp, int64_t p, int64_t sq, int
     v[3] = base[((r + 1) * w + c + 1) * n + line];
 }
 
-/* couple_lines(ya, yb, a_src, a_idx, b_src, b_idx, src, idx, stiffness, rigid, out, lo, hi) -> bool */
+/* Entry (dof a of point p, dof b of point pq) of diag(ya, yb) at one line. */
+static inline cx entry(const pair_t *y, int64_t sp, int64_t p, int64_t a, int64_t sq, int64_t pq, int64_t b,
+                       Py_ssize_t line)
+{
+    if (sp != sq)
+        return mk(0.0, 0.0);
+    const cx *base = sp == 0 ? y->ya : y->yb;
+    Py_ssize_t w = sp == 0 ? y->wa : y->wb;
+    return base[((2 * p + a) * w + 2 * pq + b) * y->n + line];
+}
+
+/* couple_lines(ya, yb, a_src, a_idx, b_src, b_idx, src, idx, stiffness, rigid, rows, cols, out, lo, hi) -> bool
+ * rows and cols: the entries wanted, as DOF indices 2 k + d over the kept points (k indexes src/idx); out is
+ * (len(rows), len(cols), n). */
 static PyObject *py_couple_lines(PyObject *self, PyObject *args)
 {
-    PyObject *o[7];
+    PyObject *o[9];
     long long a_src, a_idx, b_src, b_idx;
     int rigid;
     Py_ssize_t lo, hi;
-    if (!PyArg_ParseTuple(args, "OOLLLLOOOpOnn", &o[0], &o[1], &a_src, &a_idx, &b_src, &b_idx, &o[2], &o[3], &o[4],
-                          &rigid, &o[5], &lo, &hi))
+    if (!PyArg_ParseTuple(args, "OOLLLLOOOpOOOnn", &o[0], &o[1], &a_src, &a_idx, &b_src, &b_idx, &o[2], &o[3], &o[4],
+                          &rigid, &o[6], &o[7], &o[5], &lo, &hi))
         return NULL;
-    buf_t b[6] = {{0}};
+    buf_t b[8] = {{0}};
     if (get(o[0], &b[0], 'Z', 3, 0, "ya") || get(o[1], &b[1], 'Z', 3, 0, "yb") ||
         get(o[2], &b[2], 'q', 1, 0, "src") || get(o[3], &b[3], 'q', 1, 0, "idx") ||
-        get(o[4], &b[4], 'Z', 3, 0, "stiffness") || get(o[5], &b[5], 'Z', 3, 1, "out")) {
-        release(b, 6);
+        get(o[4], &b[4], 'Z', 3, 0, "stiffness") || get(o[5], &b[5], 'Z', 3, 1, "out") ||
+        get(o[6], &b[6], 'q', 1, 0, "rows") || get(o[7], &b[7], 'q', 1, 0, "cols")) {
+        release(b, 8);
         return NULL;
     }
     pair_t y = {b[0].view.buf, b[1].view.buf, SHAPE(b[0], 0), SHAPE(b[1], 0), SHAPE(b[0], 2)};
-    Py_ssize_t m = SHAPE(b[2], 0), n = y.n, n_k = SHAPE(b[4], 2);
-    const int64_t *src = b[2].view.buf, *idx = b[3].view.buf;
+    Py_ssize_t m = SHAPE(b[2], 0), n = y.n, n_k = SHAPE(b[4], 2), nr = SHAPE(b[6], 0), nc = SHAPE(b[7], 0);
+    const int64_t *src = b[2].view.buf, *idx = b[3].view.buf, *rows = b[6].view.buf, *cols = b[7].view.buf;
     int ground = b_src < 0;
     const char *bad = NULL;
     if (SHAPE(b[0], 1) != y.wa || SHAPE(b[1], 1) != y.wb || SHAPE(b[1], 2) != n)
         bad = "ya or yb";
-    if (SHAPE(b[3], 0) != m || SHAPE(b[5], 0) != 2 * m || SHAPE(b[5], 1) != 2 * m || SHAPE(b[5], 2) != n)
+    if (SHAPE(b[3], 0) != m || SHAPE(b[5], 0) != nr || SHAPE(b[5], 1) != nc || SHAPE(b[5], 2) != n)
         bad = "src, idx or out";
+    for (Py_ssize_t i = 0; i < nr && !bad; i++)
+        if (rows[i] < 0 || rows[i] >= 2 * m)
+            bad = "rows";
+    for (Py_ssize_t j = 0; j < nc && !bad; j++)
+        if (cols[j] < 0 || cols[j] >= 2 * m)
+            bad = "cols";
     if (SHAPE(b[4], 0) != 2 || SHAPE(b[4], 1) != 2 || (n_k != n && n_k != 1))
         bad = "stiffness";
     if (lo < 0 || hi > n || lo > hi)
@@ -1027,17 +1047,28 @@ static PyObject *py_couple_lines(PyObject *self, PyObject *args)
     }
 #undef CHECK_POINT
     if (bad) {
-        release(b, 6);
+        release(b, 8);
         PyErr_Format(PyExc_ValueError, "couple_lines: inconsistent %s", bad);
         return NULL;
     }
     const cx *stiffness = b[4].view.buf;
     cx *out = b[5].view.buf;
-    cx *uw = malloc(sizeof(cx) * 4 * (m > 0 ? m : 1));
-    if (!uw) {
-        release(b, 6);
+    /* per kept point: its row of U W (4 entries) and its column of B Y (4 entries), and whether a wanted entry
+     * needs them */
+    size_t mm = (size_t)(m > 0 ? m : 1);
+    cx *uw = malloc(sizeof(cx) * 8 * mm);
+    char *need = calloc(2 * mm, 1);
+    if (!uw || !need) {
+        free(uw);
+        free(need);
+        release(b, 8);
         return PyErr_NoMemory();
     }
+    cx *vv = uw + 4 * mm;
+    for (Py_ssize_t i = 0; i < nr; i++)
+        need[rows[i] >> 1] = 1;
+    for (Py_ssize_t j = 0; j < nc; j++)
+        need[mm + (cols[j] >> 1)] = 1;
     double bad_re = 0.0, bad_im = 0.0; /* stays 0 while every entry is finite */
     Py_BEGIN_ALLOW_THREADS
     for (Py_ssize_t q = lo; q < hi; q++) {
@@ -1074,50 +1105,48 @@ static PyObject *py_couple_lines(PyObject *self, PyObject *args)
             w11 = cadd(cmul(k10, f01), cmul(k11, f11));
         }
         for (Py_ssize_t i = 0; i < m; i++) {
-            cx u[4];
-            block(&y, src[i], idx[i], a_src, a_idx, q, u);
-            if (!ground) {
-                block(&y, src[i], idx[i], b_src, b_idx, q, x);
-                for (int k = 0; k < 4; k++)
-                    u[k] = csub(u[k], x[k]);
-            }
-            cx *row = uw + 4 * i;
-            row[0] = cadd(cmul(u[0], w00), cmul(u[1], w10));
-            row[1] = cadd(cmul(u[0], w01), cmul(u[1], w11));
-            row[2] = cadd(cmul(u[2], w00), cmul(u[3], w10));
-            row[3] = cadd(cmul(u[2], w01), cmul(u[3], w11));
-        }
-        Py_ssize_t w = 2 * m;
-        for (Py_ssize_t j = 0; j < m; j++) {
-            cx v[4];
-            block(&y, a_src, a_idx, src[j], idx[j], q, v);
-            if (!ground) {
-                block(&y, b_src, b_idx, src[j], idx[j], q, x);
-                for (int k = 0; k < 4; k++)
-                    v[k] = csub(v[k], x[k]);
-            }
-            for (Py_ssize_t i = 0; i < m; i++) {
-                cx yy[4];
-                const cx *row = uw + 4 * i;
-                block(&y, src[i], idx[i], src[j], idx[j], q, yy);
-                yy[0] = csub(yy[0], cadd(cmul(row[0], v[0]), cmul(row[1], v[2])));
-                yy[1] = csub(yy[1], cadd(cmul(row[0], v[1]), cmul(row[1], v[3])));
-                yy[2] = csub(yy[2], cadd(cmul(row[2], v[0]), cmul(row[3], v[2])));
-                yy[3] = csub(yy[3], cadd(cmul(row[2], v[1]), cmul(row[3], v[3])));
-                out[((2 * i) * w + 2 * j) * n + q] = yy[0];
-                out[((2 * i) * w + 2 * j + 1) * n + q] = yy[1];
-                out[((2 * i + 1) * w + 2 * j) * n + q] = yy[2];
-                out[((2 * i + 1) * w + 2 * j + 1) * n + q] = yy[3];
-                for (int k = 0; k < 4; k++) {
-                    bad_re += yy[k].re - yy[k].re;
-                    bad_im += yy[k].im - yy[k].im;
+            if (need[i]) {
+                cx u[4];
+                block(&y, src[i], idx[i], a_src, a_idx, q, u);
+                if (!ground) {
+                    block(&y, src[i], idx[i], b_src, b_idx, q, x);
+                    for (int k = 0; k < 4; k++)
+                        u[k] = csub(u[k], x[k]);
                 }
+                cx *row = uw + 4 * i;
+                row[0] = cadd(cmul(u[0], w00), cmul(u[1], w10));
+                row[1] = cadd(cmul(u[0], w01), cmul(u[1], w11));
+                row[2] = cadd(cmul(u[2], w00), cmul(u[3], w10));
+                row[3] = cadd(cmul(u[2], w01), cmul(u[3], w11));
+            }
+            if (need[mm + i]) {
+                cx *v = vv + 4 * i;
+                block(&y, a_src, a_idx, src[i], idx[i], q, v);
+                if (!ground) {
+                    block(&y, b_src, b_idx, src[i], idx[i], q, x);
+                    for (int k = 0; k < 4; k++)
+                        v[k] = csub(v[k], x[k]);
+                }
+            }
+        }
+        for (Py_ssize_t i = 0; i < nr; i++) {
+            int64_t pi = rows[i] >> 1, da = rows[i] & 1;
+            const cx *row = uw + 4 * pi + 2 * da;
+            for (Py_ssize_t j = 0; j < nc; j++) {
+                int64_t pj = cols[j] >> 1, db = cols[j] & 1;
+                const cx *v = vv + 4 * pj + db;
+                cx yy = entry(&y, src[pi], idx[pi], da, src[pj], idx[pj], db, q);
+                yy = csub(yy, cadd(cmul(row[0], v[0]), cmul(row[1], v[2])));
+                out[(i * nc + j) * n + q] = yy;
+                bad_re += yy.re - yy.re;
+                bad_im += yy.im - yy.im;
             }
         }
     }
     Py_END_ALLOW_THREADS
     free(uw);
-    release(b, 6);
+    free(need);
+    release(b, 8);
     return PyBool_FromLong(bad_re == 0.0 && bad_im == 0.0);
 }
 
@@ -1160,7 +1189,8 @@ static PyMethodDef methods[] = {
     {"chain_lines", py_chain_lines, METH_VARARGS,
      "chain_lines(omega, coef, rhoa, rhoi, length, slot, table, seg_of, nodes, place, out, table_only, lo, hi)."},
     {"couple_lines", py_couple_lines, METH_VARARGS,
-     "couple_lines(ya, yb, a_src, a_idx, b_src, b_idx, src, idx, stiffness, rigid, out, lo, hi) -> all finite."},
+     "couple_lines(ya, yb, a_src, a_idx, b_src, b_idx, src, idx, stiffness, rigid, rows, cols, out, lo, hi) -> all "
+     "finite."},
     {"transcendental_floor", py_transcendental_floor, METH_VARARGS,
      "transcendental_floor(x, y): sum of exp(x) + cos(y) + sin(y) (the beam kernel's floor, for benchmarks)."},
     {NULL, NULL, 0, NULL},

@@ -167,7 +167,8 @@ def _blk(y: np.ndarray, i: int, j: int) -> np.ndarray:
 
 
 def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object], memo=None,
-                         tokens: tuple | None = None, copies: int = 1, lines: int | None = None) -> np.ndarray:
+                         tokens: tuple | None = None, copies: int = 1, lines: int | None = None,
+                         pick: tuple | None = None) -> np.ndarray:
     """Couple substructures through links and return the receptances at ``outputs``.
 
     Parameters
@@ -196,10 +197,14 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
         one that differs (each line computed as alone).
     lines : int, optional
         The lines of one model (needed with ``copies`` above 1).
+    pick : (sequence of int, sequence of int), optional
+        Only these rows and columns of the result (DOF indices ``2 i + d``
+        over ``outputs``): the last step, when it joins every output,
+        computes just those entries (the same numbers).
 
     Returns
     -------
-    ndarray ``(2p, 2p, n)``
+    ndarray ``(2p, 2p, n)``, or ``(len(rows), len(cols), n)`` with ``pick``
         Zero between points of substructures that end up unconnected
         (``n = copies * lines`` with copies).
 
@@ -243,6 +248,7 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
             later.add(link.b)
         needed_after.append(later)
     needed_after.reverse()
+    picked = None  # the result, when the last step computed only the entries of pick
     for step, link in enumerate(links):
         needed = needed_after[step]
         ca = where[link.a]
@@ -261,12 +267,22 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
             kept = [(0, i) for i, k in enumerate(ka) if k in needed]
             kept += [(1, i) for i, k in enumerate(kb) if k in needed]
             new_keys = [(ka, kb)[src][i] for src, i in kept]
-        key = None
+        key: tuple | None = None
+        # the last step, joining every output: only the entries wanted
+        rows = cols = None
+        wanted: tuple = ()
+        if pick is not None and step == len(links) - 1 and set(outputs) <= set(new_keys):
+            at = [new_keys.index(k) for k in outputs]
+            wanted = (tuple(2 * at[r // 2] + r % 2 for r in pick[0]), tuple(2 * at[c // 2] + c % 2 for c in pick[1]))
+            rows, cols = (np.array(w, dtype=np.int64) for w in wanted)
         link_token = link_tokens[step] if step < len(link_tokens) else None
         parts = (made[ca], None if cb is None else made[cb], link_token)
         if parts[0] is not None and (cb is None or parts[1] is not None) and link_token is not None:
-            key = (parts, link.a, link.b, tuple(new_keys))
+            key = (parts, link.a, link.b, tuple(new_keys)) + wanted
             found = memo.get(key)
+            if found is not None and rows is not None:
+                picked = found
+                continue
             if found is not None:
                 cid = min(ca, cb if cb is not None else ca)
                 clusters[cid], made[cid] = (new_keys, found), key
@@ -286,19 +302,24 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
             yb = ya if same else spread(yb)
         src = np.array([p for p, _ in kept], dtype=np.int64)
         idx = np.array([i for _, i in kept], dtype=np.int64)
-        out, finite = _kernels.couple_link(ya, yb, a[0], a[1], b[0], b[1], src, idx, stiffness, rigid)
+        out, finite = _kernels.couple_link(ya, yb, a[0], a[1], b[0], b[1], src, idx, stiffness, rigid, rows, cols)
         if not finite:
             raise AssemblyError(
                 f"coupling through {link.label or 'a connection'} is singular: a rigid joint that "
                 "closes a loop of rigid joints (redundant), or a connection to a point with no "
                 "flexibility"
             )
-        cid = min(ca, cb if cb is not None else ca)
-        clusters[cid], made[cid] = (new_keys, out), key
         if key is not None:
             memo[key] = out
+        if rows is not None:
+            picked = out
+            continue
+        cid = min(ca, cb if cb is not None else ca)
+        clusters[cid], made[cid] = (new_keys, out), key
         for k in new_keys:
             where[k] = cid
+    if picked is not None:
+        return spread(picked)
     result = np.zeros((2 * len(outputs), 2 * len(outputs), full), dtype=complex)
     for i, ki in enumerate(outputs):
         ci = where[ki]
@@ -306,4 +327,6 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
         for j, kj in enumerate(outputs):
             if where[kj] == ci:
                 result[2 * i : 2 * i + 2, 2 * j : 2 * j + 2] = spread(_blk(y_i, keys_i.index(ki), keys_i.index(kj)))
+    if pick is not None:
+        return result[np.ix_(list(pick[0]), list(pick[1]))]
     return result

@@ -229,7 +229,7 @@ chain_lines = _c.chain_lines
 
 couple_lines = _c.couple_lines
 """The coupling kernel:
-``couple_lines(ya, yb, a_src, a_idx, b_src, b_idx, src, idx, stiffness, rigid, out, lo, hi)``."""
+``couple_lines(ya, yb, a_src, a_idx, b_src, b_idx, src, idx, stiffness, rigid, rows, cols, out, lo, hi)``."""
 
 transcendental_floor = _c.transcendental_floor
 """``exp(x) + cos(y) + sin(y)`` summed over arrays: the floor of the beam kernel (benchmarks only)."""
@@ -327,7 +327,7 @@ def chain_receptance(omega, ei, kga, rhoa, rhoi, length, shared, seg_of, nodes, 
 _NO_STIFFNESS = np.zeros((2, 2, 1), dtype=np.complex128)
 
 
-def couple_link(ya, yb, a_src, a_idx, b_src, b_idx, src, idx, stiffness, rigid):
+def couple_link(ya, yb, a_src, a_idx, b_src, b_idx, src, idx, stiffness, rigid, rows=None, cols=None):
     """One link of the coupling engine on all lines: ``Y_c = Y - (Y B^T) W (B Y)``.
 
     ``Y`` is block diagonal, ``diag(ya, yb)``, with 2x2 blocks per point; a
@@ -348,20 +348,27 @@ def couple_link(ya, yb, a_src, a_idx, b_src, b_idx, src, idx, stiffness, rigid):
         The link's dynamic stiffness (ignored when ``rigid``).
     rigid : bool
         A rigid connection.
+    rows, cols : int64 ndarray, optional
+        Only these entries of the result: DOF indices ``2 j + d`` over the
+        kept points (default every one); the entries are the same numbers as
+        those of the whole result.
 
     Returns
     -------
-    out : complex128 ndarray (2k, 2k, n)
+    out : complex128 ndarray (2k, 2k, n), or (len(rows), len(cols), n)
         The coupled receptances between the kept points.
     finite : bool
-        Whether every entry is finite.
+        Whether every entry computed is finite.
     """
     ya = c_array(ya, complex)
     yb = ya if yb is ya else c_array(yb, complex)
     src, idx = c_array(src, np.int64), c_array(idx, np.int64)
     stiffness = _NO_STIFFNESS if rigid else c_array(stiffness, complex)
+    every = np.arange(2 * src.size, dtype=np.int64)
+    rows = every if rows is None else c_array(rows, np.int64)
+    cols = every if cols is None else c_array(cols, np.int64)
     n = ya.shape[2]
-    out = np.empty((2 * src.size, 2 * src.size, n), dtype=np.complex128)
+    out = np.empty((rows.size, cols.size, n), dtype=np.complex128)
     finite = over_lines(couple_lines, n, ya, yb, int(a_src), int(a_idx), int(b_src), int(b_idx), src, idx,
-                        stiffness, bool(rigid), out)
+                        stiffness, bool(rigid), rows, cols, out)
     return out, finite

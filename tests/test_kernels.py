@@ -109,3 +109,60 @@ def test_a_line_does_not_depend_on_the_lines_computed_with_it():
     for start, n in ((1, 37), (2, 1), (3, 6), (50, 53)):
         part = stepped_beam_receptance(segs, [0.0, 0.05, length], f[start : start + n])
         assert np.array_equal(part, full[..., start : start + n])
+
+
+def _beams(n=400):
+    omega = 2 * np.pi * np.linspace(50.0, 6000.0, n)
+    a = stepped_beam_receptance([Segment("60 mm", "40 mm"), Segment("40 mm", "30 mm")], [0.0, 0.05, 0.1], omega)
+    b = stepped_beam_receptance([Segment("50 mm", "12 mm", material="carbide")], [0.0, 0.03, 0.05], omega)
+    return omega, a, b
+
+
+@pytest.mark.parametrize("rigid, ground", [(False, False), (True, False), (False, True)])
+def test_a_coupling_step_picked_entries_are_the_whole_steps_to_the_bit(rigid, ground):
+    """couple_link(rows=, cols=): any rows and columns (repeated, out of order, one) are those entries of the whole
+    result, the same floats, also for a rigid link and a link to the ground."""
+    omega, a, b = _beams()
+    k = np.broadcast_to(np.array([[4e7, 1e6], [1e6, 6.5e4]])[:, :, None] * (1 + 0.01j), (2, 2, omega.size)).copy()
+    src, idx = np.array([0, 0, 1, 1], dtype=np.int64), np.array([0, 2, 1, 2], dtype=np.int64)
+    args = (a, b, 0, 2, -1 if ground else 1, 0, src, idx, k, rigid)
+    if ground:
+        args = (a, a, 0, 2, -1, 0, np.array([0, 1], dtype=np.int64), np.array([0, 2], dtype=np.int64), k, rigid)
+    whole, finite = kernels.couple_link(*args)
+    assert finite and whole.shape[0] == whole.shape[1]
+    size = whole.shape[0]
+    for rows, cols in ([[0], [0]], [[size - 1, 0, 2], [1, 1]], [list(range(size)), [size - 2]]):
+        part, ok = kernels.couple_link(*args, rows=np.array(rows), cols=np.array(cols))
+        assert ok and np.array_equal(part, whole[np.ix_(rows, cols)])
+    with pytest.raises(ValueError, match="rows"):
+        kernels.couple_link(*args, rows=np.array([size]), cols=np.array([0]))
+    with pytest.raises(ValueError, match="cols"):
+        kernels.couple_link(*args, rows=np.array([0]), cols=np.array([-1]))
+
+
+def test_the_engine_picks_the_same_numbers_with_its_memo_with_copies_and_with_unconnected_outputs():
+    from substructure._engine import Link, couple_substructures
+
+    omega, a, b = _beams()
+    k = np.array([[4e7, 1e6], [1e6, 6.5e4]], dtype=complex)[:, :, None]
+    blocks = [(["s0", "s1", "s2"], a), (["t0", "t1", "t2"], b)]
+    links = [Link("s0", None, k * 10), Link("s2", "t0", k)]
+    outputs = ["t2", "t1", "s1"]
+    whole = couple_substructures(blocks, links, outputs)
+    pick = ([0, 2, 5], [0])
+    memo = {}
+    tokens = (["a", "b"], ["g", "j"])
+    for _ in range(2):  # the second call takes the last step from the memo
+        got = couple_substructures(blocks, links, outputs, memo, tokens, pick=pick)
+        assert np.array_equal(got, whole[np.ix_(*pick)])
+    assert any(len(key) == 6 for key in memo)  # the picked step is kept under its own key
+    # two copies side by side, the tool's block differing between them
+    b2 = b * 1.01
+    both = couple_substructures([blocks[0], (blocks[1][0], np.concatenate([b, b2], axis=-1))], links, outputs,
+                                copies=2, lines=omega.size, pick=pick)
+    other = couple_substructures([blocks[0], (blocks[1][0], b2)], links, outputs)
+    assert np.array_equal(both, np.concatenate([whole[np.ix_(*pick)], other[np.ix_(*pick)]], axis=-1))
+    # an output on a block nothing connects: picked from the whole result, zero between the two
+    apart = couple_substructures(blocks + [(["u0"], a[:2, :2])], links, outputs + ["u0"], pick=([0, 6], [6, 0]))
+    full = couple_substructures(blocks + [(["u0"], a[:2, :2])], links, outputs + ["u0"])
+    assert np.array_equal(apart, full[np.ix_([0, 6], [6, 0])]) and not apart[0, 0].any()

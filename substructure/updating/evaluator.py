@@ -74,6 +74,9 @@ class Evaluator:
         self._points = list(dict.fromkeys(str(r.point) for r in refs))
         self._dofs = [(self._points.index(str(r.point)), DOFS.index(r.dof or "y")) for r in refs]
         self._n_out = len(self.outputs)
+        # the engine's rows and columns of the outputs and inputs (DOF indices over the points)
+        self._wanted = ([2 * p + d for p, d in self._dofs[: self._n_out]],
+                        [2 * p + d for p, d in self._dofs[self._n_out:]])
         self._pinned: dict = {}
         self._lru: OrderedDict = OrderedDict()
         self._size = cache
@@ -122,7 +125,7 @@ class Evaluator:
     def __call__(self, structure: Structure) -> np.ndarray:
         """The receptances ``(n_freq, n_out, n_in)`` of ``structure``."""
         blocks, coupling, out_keys, tokens = self._prepare(structure)
-        return self._pick(couple_substructures(blocks, coupling, out_keys, self._memo, tokens))
+        return self._pick(couple_substructures(blocks, coupling, out_keys, self._memo, tokens, pick=self._wanted))
 
     def many(self, structures: Sequence[Structure]) -> list[np.ndarray]:
         """The receptances of several structures, each as calling the evaluator with it gives them (the same numbers).
@@ -153,7 +156,8 @@ class Evaluator:
         for members in groups.values():
             if len(members) == 1:
                 blocks, coupling, out_keys, tokens = prepared[members[0]]
-                out[members[0]] = self._pick(couple_substructures(blocks, coupling, out_keys, self._memo, tokens))
+                out[members[0]] = self._pick(couple_substructures(blocks, coupling, out_keys, self._memo, tokens,
+                                                                  pick=self._wanted))
                 continue
             first = prepared[members[0]]
             # a block or link the same in every structure (by its token) is given once: the steps of only such
@@ -178,7 +182,7 @@ class Evaluator:
                         [np.broadcast_to(prepared[i][1][k].stiffness, (2, 2, n)) for i in members], axis=-1), c.label))
                     link_tokens.append(None)
             y = couple_substructures(blocks, coupling, first[2], self._memo, (block_tokens, link_tokens),
-                                     copies=len(members), lines=n)
+                                     copies=len(members), lines=n, pick=self._wanted)
             for j, i in enumerate(members):
                 out[i] = self._pick(y[..., j * n:(j + 1) * n])
         return out
@@ -226,8 +230,7 @@ class Evaluator:
                     for (ka, kb, link), token in zip(links, link_tokens)]
         return blocks, coupling, out_keys, (block_tokens, link_tokens)
 
-    def _pick(self, y: np.ndarray) -> np.ndarray:
-        """The outputs' and inputs' entries of the engine's result, frequency first."""
-        rows = [2 * p + d for p, d in self._dofs[: self._n_out]]
-        cols = [2 * p + d for p, d in self._dofs[self._n_out:]]
-        return np.moveaxis(y[np.ix_(rows, cols)], -1, 0)
+    @staticmethod
+    def _pick(y: np.ndarray) -> np.ndarray:
+        """The engine's result (the outputs' and inputs' entries, ``pick``), frequency first."""
+        return np.moveaxis(y, -1, 0)
