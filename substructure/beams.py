@@ -441,6 +441,36 @@ def stepped_beam_receptance(
     return _chain_receptance(intervals, nodes, omega, place=[int(i) for i in order])
 
 
+_INTERVALS: dict = {}
+_INTERVALS_KEPT = 256
+
+
+def _intervals(lengths: np.ndarray, positions) -> tuple:
+    """The intervals of a stepped beam between its steps and the positions: ``(order, widths (k, 1), segment of
+    each, node of each sorted position)``, kept for the layouts seen last (a fit changes sizes, not places)."""
+    key = (lengths.tobytes(), tuple(float(x) for x in positions))
+    found = _INTERVALS.get(key)
+    if found is not None:
+        return found
+    pos = np.asarray(positions, dtype=float)
+    order = np.argsort(pos)
+    sorted_pos = pos[order]
+    if np.any(np.diff(sorted_pos) <= 0):
+        raise InvalidValueError("positions: expected distinct positions")
+    ends = np.concatenate([[0.0], np.cumsum(lengths)])
+    cuts = np.unique(np.concatenate([ends, sorted_pos]))
+    widths = np.diff(cuts)
+    seg = np.clip(np.searchsorted(ends, 0.5 * (cuts[:-1] + cuts[1:])) - 1, 0, lengths.size - 1)
+    nodes = np.searchsorted(cuts, sorted_pos).astype(np.int64)
+    found = (order.astype(np.int64), widths.reshape(-1, 1), seg, nodes)
+    for a in found:
+        a.flags.writeable = False  # shared between calls
+    if len(_INTERVALS) >= _INTERVALS_KEPT:
+        _INTERVALS.pop(next(iter(_INTERVALS)))
+    _INTERVALS[key] = found
+    return found
+
+
 def stepped_beam_receptance_si(
     ei: np.ndarray, kga: np.ndarray, rhoa: np.ndarray, rhoi: np.ndarray, lengths: np.ndarray,
     positions: Sequence[float], frequency_hz: np.ndarray, decay: float = 0.0,
@@ -473,14 +503,8 @@ def stepped_beam_receptance_si(
         Frequency-last receptances; DOFs ``(y, theta)`` per position in the
         order given.
     """
-    pos = np.asarray(positions, dtype=float)
-    order = np.argsort(pos)
-    sorted_pos = pos[order]
-    if np.any(np.diff(sorted_pos) <= 0):
-        raise InvalidValueError("positions: expected distinct positions")
     lengths = np.asarray(lengths, dtype=float)
-    ends = np.concatenate([[0.0], np.cumsum(lengths)])
-    cuts = np.unique(np.concatenate([ends, sorted_pos]))
+    order, widths, seg, nodes = _intervals(lengths, positions)
     omega = angular_lines(frequency_hz, decay)
     from . import _kernels
 
@@ -489,16 +513,13 @@ def stepped_beam_receptance_si(
     _, k_max = _kernels.segment_coefficients(  # every segment's largest wavenumber, in one call
         ei.reshape(1, -1), kga.reshape(1, -1), rhoa.reshape(1, -1), rhoi.reshape(1, -1),
         float(np.max(np.abs(omega))) if omega.size else 0.0)
-    widths = np.diff(cuts)
-    seg = np.clip(np.searchsorted(ends, 0.5 * (cuts[:-1] + cuts[1:])) - 1, 0, lengths.size - 1)
-    phases = k_max[0, seg] * widths
-    nodes = np.searchsorted(cuts, sorted_pos)
+    phases = k_max[0, seg] * widths[:, 0]
     if phases.max() <= _CHUNK_KL and np.cumsum(phases)[-1] <= _CHUNK_KL:
         # one transfer-matrix chain (the usual case): the kernel takes the arrays as they are
         return _kernels.chain_receptance(
-            omega, ei[seg], kga[seg], rhoa[seg], rhoi[seg], widths.reshape(-1, 1),
-            np.zeros(seg.size, dtype=bool), np.arange(seg.size, dtype=np.int64), nodes.astype(np.int64),
-            order.astype(np.int64))
+            omega, ei[seg], kga[seg], rhoa[seg], rhoi[seg], widths,
+            np.zeros(seg.size, dtype=bool), np.arange(seg.size, dtype=np.int64), nodes, order)
+    widths = widths[:, 0]
     sections = [Section(complex(a), complex(b), float(c), float(d))
                 for a, b, c, d in zip(ei[:, 0], kga[:, 0], rhoa[:, 0], rhoi[:, 0])]
     intervals = [(sections[k], float(w)) for k, w in zip(seg, widths)]

@@ -284,6 +284,11 @@ class Likelihood:
         self.w_im = [np.where(a, 1.0 / np.sqrt(m.noise.correlation * m.noise.var_im[self.lines]), 0.0)
                      for m, a in zip(self.measured, self.alive)]
         self.n = 2 * sum(int(a.sum()) for a in self.alive)
+        # the same, one row per FRF: every evaluation's ratios and weights in one pass
+        self._data = np.array(self.data)
+        self._alive = np.array(self.alive)
+        self._all_alive = bool(self._alive.all())
+        self._w = np.stack([np.array(self.w_re), np.array(self.w_im)], axis=1)  # (FRF, part, line)
         self.evaluations = 0
         self._check_signs()
         self.evaluations = 0  # the check's evaluation is not the caller's
@@ -437,21 +442,18 @@ class Likelihood:
                 [float(np.sqrt(np.mean(v))) for v in variances])
 
     def _ratios(self, predicted: list) -> list[np.ndarray]:
-        out = []
-        for model, data, alive in zip(predicted, self.data, self.alive):
-            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-                q = model / data
-                # ln|q| + i arg q: the complex logarithm's value (to rounding), several times faster than np.log
-                r = np.empty_like(q)
-                r.real = np.log(np.abs(q))
-                r.imag = np.arctan2(q.imag, q.real)
-            bad = ~np.isfinite(r)
-            if bad.any():
-                r = np.where(bad, LOG_RATIO_PENALTY * (1 + 1j), r)
-            if not alive.all():  # a line without data: no residual
-                r = np.where(alive, r, 0.0)
-            out.append(r)
-        return out
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            q = np.array(predicted) / self._data
+            # ln|q| + i arg q: the complex logarithm's value (to rounding), several times faster than np.log
+            r = np.empty_like(q)
+            r.real = np.log(np.abs(q))
+            r.imag = np.arctan2(q.imag, q.real)
+        bad = ~np.isfinite(r)
+        if bad.any():
+            r = np.where(bad, LOG_RATIO_PENALTY * (1 + 1j), r)
+        if not self._all_alive:  # a line without data: no residual
+            r = np.where(self._alive, r, 0.0)
+        return list(r)
 
     def whiten(self, ratios: Sequence[np.ndarray]) -> np.ndarray:
         """The whitened residual vector of log ratios (real parts, then imaginary parts, per FRF).
@@ -466,11 +468,8 @@ class Likelihood:
         ndarray
             Each part divided by its standard deviation.
         """
-        parts = []
-        for r, wr, wi in zip(ratios, self.w_re, self.w_im):
-            parts.append(r.real * wr)
-            parts.append(r.imag * wi)
-        return np.concatenate(parts)
+        r = np.array(ratios)
+        return (np.stack([r.real, r.imag], axis=1) * self._w).ravel()
 
     def residual(self, changes: Sequence[tuple] = ()) -> np.ndarray:
         """The whitened residual vector; its sum of squares is ``chi^2``.
