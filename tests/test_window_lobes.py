@@ -359,3 +359,18 @@ def test_real_taps_cut_short_give_the_whole_records_damping_once_the_window_is_o
         assert m.frequency_hz == pytest.approx(ref.frequency_hz, rel=1e-3)
         assert m.damping_ratio == pytest.approx(ref.damping_ratio, rel=0.35)
         assert w.damping_ratio > 2 * ref.damping_ratio
+
+
+def test_semi_discretization_with_one_direction_windowed_keeps_the_other_directions_modes(capsys, tmp_path):
+    """x tapped through the window, y without: both directions' modes reach the semi-discretization."""
+    hz = np.linspace(100.0, 3000.0, 581)
+    s = 2j * np.pi * hz
+    write_csv(_frf(hz, closed_form(s + 1 / 0.03, MODES[:1])), tmp_path / "x.csv", window_tau=0.03)
+    write_csv(_frf(hz, closed_form(s, [("1200 Hz", 0.03, 3e7)])), tmp_path / "y.csv")
+    code, out, err = run(capsys, "lobes", "--frf", tmp_path / "x.csv", "--frf-y", tmp_path / "y.csv", *LOBES[:-2],
+                         "--speeds", "3000:30000:1000", "--method", "sdm", "--json")
+    assert code == 0, err
+    got = json.loads(out)
+    assert got["window"]["tau_s"] == {"x": 0.03, "y": None}
+    fit = next(n for n in got["notes"] if n.startswith("modal fit"))
+    assert "x: 900" in fit and "y: 1200" in fit and "zeta 0.02," in fit, fit

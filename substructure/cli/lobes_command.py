@@ -120,14 +120,7 @@ def run(args: argparse.Namespace) -> int:
         lobes = zoa(structure, cut, args.speeds, band=band if band is not None else "auto")
         method = "zero-order approximation (Altintas & Budak 1995)"
     else:
-        if window is not None:  # the modes fitted to take the window out, without its damping
-            structure = window.modes
-            errors = ", ".join(f"{d} {e:.1%}" for d, e in window.modal_error.items())
-            notes.append(f"modal fit: {len(structure.modes)} modes ({structure.describe()}); relative error {errors}")
-            if window.modal_error and max(window.modal_error.values()) > 0.2:
-                warnings.warn(f"the fitted modes miss the FRF by {errors}; choose the band with --band LO:HI",
-                              ModalFitWarning, stacklevel=2)
-        elif isinstance(structure, FRF):  # semi-discretization needs modes: fit them to x and y
+        if isinstance(structure, FRF):  # semi-discretization needs modes: fit them to x and y (without the window)
             fits = [ModalFitter().fit(FRF.single(structure.frequency, structure.data[:, i, i], output=d, input=d), d)
                     for i, d in enumerate("xy")]
             structure = ModalModel([m for fit in fits for m in fit.modes_])
