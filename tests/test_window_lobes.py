@@ -284,8 +284,9 @@ def test_the_window_option_for_files_that_do_not_say_and_its_errors(capsys, tmp_
     assert json.loads(out)["window"] is None
     for argv, message in [
         (["--frf", tmp_path / "frf.csv", "--window-tau", "0.5"], "says it was measured through a window of"),
-        (["--frf", tmp_path / "bare.csv", "--window-tau", "0"], "expected the exponential window's time constant"),
-        (["--frf", tmp_path / "bare.csv", "--window-tau", "nan"], "a number > 0"),
+        (["--frf", tmp_path / "bare.csv", "--window-tau", "0"],
+         "argument --window-tau: got 0.0; expected a finite number > 0"),
+        (["--frf", tmp_path / "bare.csv", "--window-tau", "nan"], "got nan; expected a finite number > 0"),
         (["--modes", tmp_path / "none.csv", "--window-tau", "0.1"], "--window-tau is for measured FRFs"),
     ]:
         code, out, err = run(capsys, "lobes", *argv, *LOBES)

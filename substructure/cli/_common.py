@@ -64,6 +64,13 @@ class Parser(argparse.ArgumentParser):
         raise UsageError(message)
 
 
+def positive_arg(option: str, value: float | None, zero: bool = False) -> float | None:
+    """A number option's value when it is finite and > 0 (>= 0 with ``zero``), None when not given; else an error."""
+    if value is not None and not (math.isfinite(value) and (value > 0 or (zero and value == 0))):
+        raise UsageError(f"argument {option}: got {value!r}; expected a finite number {'>= 0' if zero else '> 0'}")
+    return value
+
+
 def one_line(text: str) -> str:
     """The text on one line, runs of white space made one space."""
     return " ".join(str(text).split())

@@ -6,7 +6,8 @@ import argparse
 import warnings
 
 from ..errors import SubstructureError, WindowedFRFWarning
-from ._common import UsageError, check_outputs, check_plot, draw_to, grid_text, one_line, point_arg, print_json
+from ._common import (UsageError, check_outputs, positive_arg, check_plot, draw_to, grid_text,
+                      one_line, point_arg, print_json)
 from ._cutting import (
     MILLING_DEFAULT_NOTE,
     add_cut_options,
@@ -23,9 +24,7 @@ def _window(args: argparse.Namespace) -> dict | None:
     """The exponential window of each direction's FRF file (``# window_tau_s``, or ``--window-tau``), None without."""
     from ..io.frf_files import read_csv_window
 
-    if args.window_tau is not None and not (args.window_tau > 0 and args.window_tau < float("inf")):
-        raise UsageError(f"argument --window-tau: got {args.window_tau!r}; expected the exponential window's time "
-                         "constant in s, a number > 0")
+    positive_arg("--window-tau", args.window_tau)
     if args.frf is None:
         if args.window_tau is not None:
             raise UsageError("--window-tau is for measured FRFs (--frf X.csv): a model or modes have no window")

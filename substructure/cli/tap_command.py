@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import warnings
 from pathlib import Path
 
 from ..errors import SubstructureWarning
-from ._common import UsageError, band_range_arg, check_outputs, check_plot, figures, print_json, save_figure
+from ._common import (UsageError, band_range_arg, check_outputs, check_plot, figures, positive_arg, print_json,
+                      save_figure)
 
 _TEXT_SUFFIXES = (".csv", ".txt", ".dat", ".asc")
 _UFF_SUFFIXES = (".uff", ".unv", ".uf")
@@ -93,8 +93,7 @@ def run(args: argparse.Namespace) -> int:
                   args.records, args.overwrite)
     for option, value, zero in (("--tap-length", args.tap_length, False), ("--pre-trigger", args.pre_trigger, True),
                                 ("--tau", args.tau, False), ("--hammer-band-db", args.hammer_band_db, False)):
-        if value is not None and not (math.isfinite(value) and (value > 0 or (zero and value == 0))):
-            raise UsageError(f"argument {option}: got {value!r}; expected a finite number {'>= 0' if zero else '> 0'}")
+        positive_arg(option, value, zero)
     if args.no_exponential_window and args.tau is not None:
         raise UsageError("--tau sets the exponential window's time constant; it cannot go with --no-exponential-window")
     records = [record for path in args.records for record in _read(path, args)]

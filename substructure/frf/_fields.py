@@ -6,6 +6,7 @@ each names the field and what was expected when it refuses a value.
 
 from __future__ import annotations
 
+import math
 import numbers
 from typing import Any, cast
 
@@ -78,3 +79,14 @@ def _scalar(value: Any) -> complex | None:
         return value
     return None
 
+
+def window_tau(value: Any, field: str = "window_tau") -> float:
+    """An exponential window's time constant [s] as a float: a finite number > 0, else an error naming ``field``.
+
+    The one check of ``tau`` for every place that takes it (measurements, FRF files, the noise model, the
+    window's removal from fitted modes).
+    """
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value) or value <= 0:
+        raise InvalidValueError(f"{field}: got {value!r}; expected the exponential window's time constant in s "
+                                "(a finite number > 0)")
+    return float(value)

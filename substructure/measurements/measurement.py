@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import InvalidValueError, SubstructureError, UnknownPointError
 from ..frf import FRF
-from ..frf._fields import _check_quantity
+from ..frf._fields import _check_quantity, window_tau
 from ..points import check_name, parse_point
 from ..tap import ESTIMATORS
 
@@ -137,8 +137,10 @@ def _optional_seconds(field: str, expected: str):
     return convert
 
 
-_optional_tau = _optional_seconds("window_tau", "the exponential window's time constant in s (a finite number > 0), "
-                                                "or None for no window")
+def _optional_tau(value: Any) -> float | None:
+    return None if value is None else window_tau(value)
+
+
 _optional_force_window = _optional_seconds("force_window_s", "the force window's length in s (a finite number > 0), "
                                                              "or None")
 

@@ -40,13 +40,13 @@ from __future__ import annotations
 
 import math
 import warnings
-from typing import Any
 
 import attrs
 import numpy as np
 
 from ..errors import InvalidValueError
 from ..frf import FRF, Frequency
+from ..frf._fields import window_tau
 from ..units import Q_
 from .modal import FIT_DAMPING_RANGE, ModalFitter, ModalFitWarning, ModalModel, Mode
 from .structure import XY_LABELS, xy_receptance
@@ -56,17 +56,6 @@ __all__ = ["mode_without_window", "window_removed", "WindowRemoved", "MINOR_PEAK
 MINOR_PEAK_SHARE = 0.1
 """The data's peak at a mode, relative to the direction's largest, under which a mode the window cannot be
 taken out of is left as measured (named) rather than refused."""
-
-
-def _tau(value: Any) -> float:
-    try:
-        tau = float(value)
-    except (TypeError, ValueError):
-        tau = math.nan
-    if not (math.isfinite(tau) and tau > 0):
-        raise InvalidValueError(f"tau: got {value!r}; expected the exponential window's time constant in s, "
-                                "a number > 0")
-    return tau
 
 
 def mode_without_window(mode: Mode, tau: float) -> Mode:
@@ -91,7 +80,7 @@ def mode_without_window(mode: Mode, tau: float) -> Mode:
         rate ``zeta omega_n`` is not above ``1/tau``: the window's damping is
         all the record shows of it.
     """
-    tau = _tau(tau)
+    tau = window_tau(tau, "tau")
     w1 = 2.0 * math.pi * mode.frequency_hz
     sigma1 = mode.damping_ratio * w1
     sigma = sigma1 - 1.0 / tau
@@ -194,11 +183,11 @@ def window_removed(structure: FRF, tau: float | dict, n_modes: int | None = None
         unknown = set(tau) - set(XY_LABELS)
         if unknown:
             raise InvalidValueError(f"tau: got the directions {sorted(unknown)}; expected 'x' and 'y'")
-        taus = {d: None if tau.get(d) is None else _tau(tau[d]) for d in XY_LABELS}
+        taus = {d: None if tau.get(d) is None else window_tau(tau[d], "tau") for d in XY_LABELS}
         if all(t is None for t in taus.values()):
             raise InvalidValueError("tau: no direction has a window; there is nothing to take out")
     else:
-        taus = dict.fromkeys(XY_LABELS, _tau(tau))
+        taus = dict.fromkeys(XY_LABELS, window_tau(tau, "tau"))
     if not isinstance(structure, FRF):
         raise InvalidValueError(f"structure: got {type(structure).__name__}; expected the measured FRF (modes given "
                                 "as such have no window to take out)")

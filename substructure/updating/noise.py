@@ -65,6 +65,7 @@ from scipy.signal import savgol_coeffs
 
 from ..errors import InvalidValueError
 from ..frf import FRF
+from ..frf._fields import window_tau as window_tau_s
 from ..smoothing import choose_window, smooth
 
 __all__ = ["NoiseModel", "estimate_noise", "window_correlation", "VARIANCE_CAP"]
@@ -470,9 +471,8 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
                                              measured.outputs, measured.inputs)
     w = window or _window(clean, polyorder)
     s = smooth(clean, window=w, polyorder=polyorder).data[:, 0, 0]
-    if window_tau is not None and not (np.isfinite(window_tau) and window_tau > 0):
-        raise InvalidValueError(f"window_tau: got {window_tau!r}; expected the exponential window's time constant "
-                                "in s (a finite number > 0), or None for no window")
+    if window_tau is not None:
+        window_tau = window_tau_s(window_tau)
     spacing = float(np.median(np.diff(measured.frequency.hz)))
     h0 = _kept_share(w, polyorder, window_tau, spacing)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):

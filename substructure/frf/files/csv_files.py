@@ -21,7 +21,6 @@ model through the same window).
 
 from __future__ import annotations
 
-import math
 import os
 import re
 import warnings
@@ -30,6 +29,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...errors import FileFormatError, InvalidValueError, WindowedFRFWarning
+from .._fields import window_tau as _window_tau
 from ..axis import MAX_GRID_LINES, Frequency
 from ._common import _refuse_all_zero, _require_frf, _shown, frf_class
 
@@ -123,22 +123,10 @@ def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coheren
     comment = ""
     if window_tau is not None:
         tau = _window_tau(window_tau)
-        if tau is None:
-            raise InvalidValueError(f"window_tau: cannot write {os.fspath(path)}: got {window_tau!r}; expected the "
-                                    "exponential window's time constant in s, a number > 0")
         comment = (f"# {WINDOW_KEY} = {tau!r}\n# measured through an exponential window exp(-t/tau): every mode "
                    "carries the added damping ratio 1/(tau omega)\n")
     text = "".join(",".join(map(repr, row)) + "\n" for row in zip(*(c.tolist() for c in columns)))
     write_text(path, comment + header + "\n" + text, overwrite=overwrite)
-
-
-def _window_tau(value) -> float | None:
-    """A window time constant as a float > 0, or None for anything else."""
-    try:
-        tau = float(value)
-    except (TypeError, ValueError):
-        return None
-    return tau if math.isfinite(tau) and tau > 0 else None
 
 
 def read_csv_window(path: str | os.PathLike) -> float | None:
@@ -180,10 +168,11 @@ def _window_line(numbered: list, name: str) -> float | None:
             continue
         if seen is not None:
             raise FileFormatError(f"{name}, line {number}: {WINDOW_KEY} is given again (first on line {seen})")
-        tau, seen = _window_tau(match.group(1)), number
-        if tau is None:
+        try:
+            tau, seen = _window_tau(float(match.group(1) or "nan")), number
+        except ValueError:
             raise FileFormatError(f"{name}, line {number}: {_shown(text)}: expected '# {WINDOW_KEY} = SECONDS', the "
-                                  "exponential window's time constant, a number > 0")
+                                  "exponential window's time constant, a number > 0") from None
     return tau
 
 
