@@ -3,8 +3,11 @@
 The data come from the independent FE rig of hidden_data.py; a miscalibrated hammer or sensor scales every
 line of an FRF by one factor and leaves the modes where they are.  No candidate of the diagnosis does that
 (it would have to scale every mass and stiffness alike), so the data are not explained, and the report says
-which kind of error has this signature.
+which kind of error has this signature.  Beside it, the verdict's first line for an error that is local
+(within the noise over the whole band, not band by band).
 """
+
+import re
 
 import numpy as np
 import pytest
@@ -50,3 +53,28 @@ def test_a_miscalibrated_test_is_unexplained_and_the_report_says_why():
     (line,) = [x for x in d.report if "calibration" in x]
     assert "1.1 times" in line
     assert np.isfinite(d.final_error)
+
+
+def _bumped(frf, height):
+    """The data with a bump of ``height`` (relative) in magnitude around 150 Hz: a local error no change makes."""
+    hz = frf.frequency.hz
+    bump = 1 + height * np.exp(-((hz - 150.0) / 25.0) ** 2)
+    return FRF(frf.frequency, frf.data * bump[:, None, None], frf.outputs, frf.inputs)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_an_error_within_the_noise_overall_but_not_band_by_band_is_said_to_be_local(seed):
+    """The first line gives the whole band's numbers; when those pass and only a band fails, it says so (else
+    an error of 1 noise floor, chi^2/nu under what the noise allows, would read as a pass)."""
+    d = diagnose(hd.nominal_model(), [_bumped(hd.measure(seed=seed)[0], 0.06)])
+    assert not d.explained
+    first = d.report[0]
+    assert first.startswith("unexplained: no candidate explains the data")
+    chi2, allowed = (float(x) for x in re.search(r"chi\^2/nu = (\S+) where the noise allows (\S+?)[;,]", first).groups())
+    assert chi2 <= allowed
+    assert "not band by band: the error is local" in first
+    assert "110-208 Hz" in d.report[1]
+    # scaled by 1.1, the data fail over the whole band: not called local (one candidate, to be quick)
+    worse = diagnose(hd.nominal_model(), _scaled(hd.measure(seed=seed), 1.1), effects=["sensor-mass"],
+                     open_world=False)
+    assert not worse.explained and "the error is local" not in worse.report[0]

@@ -257,8 +257,9 @@ def unexplained_report(lik, assembly, current, baseline, cons, final_error: floa
     list of str
         The report, the verdict first.
     """
-    lines = [words.unexplained(final_error, floor, cons.chi2_reduced, cons.threshold,
-                               None if check is None or check.passed else (check.ratio, check.allowed))]
+    scored = None if check is None or check.passed else (check.ratio, check.allowed)
+    local = bool(cons.bands) and cons.chi2_reduced <= cons.threshold and scored is None
+    lines = [words.unexplained(final_error, floor, cons.chi2_reduced, cons.threshold, scored, local)]
     near = settings.band_merge
     merged = []
     for b in cons.bands:

@@ -322,7 +322,7 @@ def estimated_as_h2(which: str, compared_as_h1: bool) -> str:
 
 
 def unexplained(final_error: float, floor: float, chi2_reduced: float, threshold: float,
-                scored: tuple[float, float] | None = None) -> str:
+                scored: tuple[float, float] | None = None, local: bool = False) -> str:
     """The first line of the verdict when no candidate reaches the noise.
 
     Parameters
@@ -338,6 +338,9 @@ def unexplained(final_error: float, floor: float, chi2_reduced: float, threshold
     scored : (float, float), optional
         The plain check when it failed: the error in noise floors with each
         line as the noise model scores it, and what the noise allows.
+    local : bool
+        The residual fails band by band only (the whole band's tests pass):
+        said, so that numbers within the noise do not read as a pass.
 
     Returns
     -------
@@ -348,7 +351,9 @@ def unexplained(final_error: float, floor: float, chi2_reduced: float, threshold
             f"times the noise floor ({floor:.4g}); chi^2/nu = {chi2_reduced:.4g} where the noise allows "
             f"{threshold:.4g}"
             + ("" if scored is None else f"; with each line as the noise model scores it, {scored[0]:.3g} noise "
-               f"floors where the noise allows {scored[1]:.3g}"))
+               f"floors where the noise allows {scored[1]:.3g}")
+            + ("; within the noise over the whole band, not band by band: the error is local (where, below)"
+               if local else ""))
 
 
 def error_lives(bands: Sequence[tuple[str, float, float, float]]) -> str:
