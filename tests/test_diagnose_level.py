@@ -70,7 +70,8 @@ def test_an_error_within_the_noise_overall_but_not_band_by_band_is_said_to_be_lo
     assert not d.explained
     first = d.report[0]
     assert first.startswith("unexplained: no candidate explains the data")
-    chi2, allowed = (float(x) for x in re.search(r"chi\^2/nu = (\S+) where the noise allows (\S+?)[;,]", first).groups())
+    found = re.search(r"chi\^2/nu = (\S+) where the noise allows (\S+?)[;,]", first)
+    chi2, allowed = (float(x) for x in found.groups())
     assert chi2 <= allowed
     assert "not band by band: the error is local" in first
     assert "110-208 Hz" in d.report[1]
