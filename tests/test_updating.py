@@ -342,6 +342,42 @@ def test_a_tapered_tool_takes_part_as_it_is():
         np.testing.assert_allclose(got, change.apply(tapered, {"value": value}).frf(OUT, IN, F).data, rtol=1e-10)
 
 
+@pytest.mark.parametrize("before", [{}, {"components.tool.segments.0.od": 0.0115},
+                                    {"materials.carbide.E": 5.5e11, "components.holder.segments.2.insert.od": 0.0119},
+                                    {"components.tool.segments.1.flutes.diameter_ratio": 0.75}],
+                         ids=["alone", "after-its-od", "after-material-and-insert", "after-flutes"])
+def test_a_taper_set_on_a_uniform_segment_is_the_assemblys_taper_in_the_si_form(before):
+    """``od_tip`` and ``id_tip`` of a uniform segment make it tapered on the assembly; the SI form's arrays of
+    uniform segments cannot hold that: the component, with the changes its arrays carry, is evaluated by its
+    own methods (they once set the flutes' ratio instead, 350 times off)."""
+    model = _rich_model()
+    evaluate = Evaluator(OUT, IN, F)
+    for path, value in (("components.tool.segments.0.od_tip", 0.0105), ("components.tool.segments.1.od_tip", 0.011),
+                        ("components.holder.segments.2.od_tip", 0.036), ("components.spindle.segments.0.id_tip", 0.03),
+                        ("components.holder.segments.0.id_tip", 0.004)):
+        values = {**before, path: value}
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            changed = set_parameters(model, values)
+        name = path.split(".")[1]
+        segment = changed.component(name).segments[int(path.split(".")[3])]
+        assert segment.is_tapered, path
+        ref = changed.frf(OUT, IN, F).data
+        structure = Structure.from_assembly(model)
+        for p, v in values.items():
+            structure = apply_path_si(structure, p, v)
+        assert name in structure.opaque and name not in structure.beams
+        got = evaluate(structure)
+        assert np.abs(got - ref).max() <= 1e-10 * np.abs(ref).max(), path
+        assert np.abs(ref - evaluate(Structure.from_assembly(set_parameters(model, before)))).max() \
+            > 1e-4 * np.abs(ref).max(), path  # the taper moved the FRF
+        # and a number set after the taper is set on the (now tapered) component, as on the assembly
+        length = {f"components.{name}.segments.0.length": 1.05 * changed.component(name).segments[0].length_m}
+        after = apply_path_si(structure, *next(iter(length.items())))
+        np.testing.assert_allclose(evaluate(after), set_parameters(changed, length).frf(OUT, IN, F).data, rtol=1e-9,
+                                   err_msg=path)
+
+
 def test_the_coupling_steps_an_evaluator_reuses_give_what_a_fresh_evaluator_gives(monkeypatch):
     """Coupling steps whose components and links are unchanged are taken from earlier evaluations: the same
     numbers, bit for bit, as an evaluator that computes everything, in any order of structures, and fewer

@@ -6,7 +6,7 @@ A model parameter is named by where it sits in the assembly file:
 path                                           value (SI)
 =============================================  ==========================================
 ``components.C.segments.I.length|od|id``       a segment's length or diameter [m]
-``components.C.segments.I.od_tip|id_tip``      a tapered segment's diameters at its tip end [m]
+``components.C.segments.I.od_tip|id_tip``      a segment's diameters at its tip end [m] (a uniform one set so tapers)
 ``components.C.segments.I.insert.od|id``       the insert's diameters [m]
 ``components.C.segments.I.flutes.diameter_ratio``  the flutes' equivalent diameter ratio
 ``components.C.segments.I.end``                where segment ``I`` ends and ``I+1`` begins, from the

@@ -489,16 +489,22 @@ class Structure:
         Parameters
         ----------
         component : object
-            The new component (a changed copy of one in ``opaque``).
+            The new component (a changed copy of one in ``opaque``, or of a
+            beam in ``beams``, which it then replaces: a taper).
 
         Returns
         -------
         Structure
             A new structure sharing everything else.
         """
-        if component.name not in self.opaque:
-            raise UnknownPointError(f"no component {component.name!r} evaluated by its own methods here")
-        return Structure(self.assembly, self.beams, {**self.opaque, component.name: component}, self.links,
+        name = component.name
+        if name in self.beams:  # a beam that takes a change its arrays cannot hold (a taper)
+            beams = {k: v for k, v in self.beams.items() if k != name}
+            sources = {k: v for k, v in self.sources.items() if k != name}
+            return Structure(self.assembly, beams, {**self.opaque, name: component}, self.links, self.order, sources)
+        if name not in self.opaque:
+            raise UnknownPointError(f"no component {name!r} evaluated by its own methods here")
+        return Structure(self.assembly, self.beams, {**self.opaque, name: component}, self.links,
                          self.order, self.sources)
 
     def with_link(self, index: int, link: LinkSI) -> "Structure":
