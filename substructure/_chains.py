@@ -101,6 +101,20 @@ def _phase(sec: Section, length, omega_max: float) -> float:
     return float(np.max(k_max[0] * length))
 
 
+def _phases(intervals: list[tuple], omega_max: float) -> list[float]:
+    """:func:`_phase` of every interval: one kernel call for intervals of plain numbers (the same numbers)."""
+    from . import _kernels
+
+    if not all(_is_shared(sec, length) for sec, length in intervals):
+        return [_phase(sec, length, omega_max) for sec, length in intervals]
+    ei, kga, rhoa, rhoi, length = (np.array([[v for v in column]]) for column in zip(
+        *((sec.EI, sec.kGA, sec.rhoA, sec.rhoI, length) for sec, length in intervals)))
+    _, k_max = _kernels.segment_coefficients(
+        _kernels.c_array(ei, complex), _kernels.c_array(kga, complex), _kernels.c_array(rhoa, float),
+        _kernels.c_array(rhoi, float), float(omega_max))
+    return [float(x) for x in k_max[0] * length[0]]
+
+
 def _chain_receptance(
     intervals: list[tuple], nodes: list[int], omega: np.ndarray, phases: list[float] | None = None,
     n_config: int = 1, place: list[int] | None = None,
@@ -119,7 +133,7 @@ def _chain_receptance(
     """
     omega_max = float(np.max(np.abs(omega))) if omega.size else 0.0
     if phases is None:
-        phases = [_phase(sec, length, omega_max) for sec, length in intervals]
+        phases = _phases(intervals, omega_max)
     refined, node_map, piece_phases = [], [0], []
     for item, kl in zip(intervals, phases):
         n_sub = max(1, math.ceil(kl / _CHUNK_KL))
