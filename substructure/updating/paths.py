@@ -489,32 +489,12 @@ def _component_obj(assembly, path: str, name: str, rest: tuple, value: float):
     return out
 
 
-def _arrays_as_component(structure, beam):
-    """The component whose segments the arrays ``beam`` hold (their changes kept: sizes, materials, inserts,
-    flutes, segments split by an added element), the type and the other numbers of the assembly's."""
-    from ..beams import Flutes, Insert, Segment
-
-    def material(name, values):
-        E, nu, rho, eta = (float(v) for v in values)
-        return Material(name, Q_(E, "Pa"), nu, Q_(rho, "kg/m^3"), eta)
-
-    segs = []
-    for i in range(beam.length.size):
-        od_in, id_in = (float(v) for v in beam.insert[i, :2])
-        insert = None if not od_in > 0 else Insert(Q_(od_in, "m"), material(beam.insert_names[i], beam.insert[i, 2:]),
-                                                    Q_(id_in, "m"))
-        ratio = float(beam.ratio[i])
-        segs.append(Segment(Q_(float(beam.length[i]), "m"), Q_(float(beam.od[i]), "m"), Q_(float(beam.id[i]), "m"),
-                            material(beam.material_names[i], beam.material[i]), insert,
-                            None if ratio == 1.0 else Flutes(ratio)))
-    return attrs.evolve(structure.assembly.component(beam.name), segments=segs)
-
-
 def _component_si(structure, path: str, name: str, rest: tuple, value: float):
     if rest[0] == "segments" and rest[-1] in ("od_tip", "id_tip") and name in structure.beams:
         # a taper, which the arrays of uniform segments cannot hold: the component, with every change the arrays
         # carry, is evaluated by its own methods from here on (as the assembly's tapered one is)
-        comp = _set_component(_arrays_as_component(structure, structure.beam(name)), path, list(rest), value)
+        arrays = structure.beam(name).as_component(structure.assembly.component(name))
+        comp = _set_component(arrays, path, list(rest), value)
         return structure.with_opaque(comp)
     if name in structure.opaque:  # a component evaluated by its own methods: changed as an object
         comp = _set_component(structure.opaque[name], path, list(rest), value)

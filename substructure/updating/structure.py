@@ -19,14 +19,17 @@ import itertools
 import math
 from typing import Sequence
 
+import attrs
 import numpy as np
 
 from .._blocks import angular_lines, takes_decay
-from ..beams import Segment, shear_coefficient, stepped_beam_receptance_si
+from ..beams import Flutes, Insert, Segment, shear_coefficient, stepped_beam_receptance_si
 from ..components import Beam, is_plain_beam
 from ..errors import UnknownPointError
 from ..joints import Joint, dynamic_stiffness
+from ..materials import Material
 from ..points import parse_point
+from ..units import Q_
 
 __all__ = ["BeamArrays", "LinkSI", "Structure", "si_beam"]
 
@@ -137,6 +140,38 @@ class BeamArrays:
                    [s.id.m_as("m") for s in segs],
                    [1.0 if s.flutes is None else s.flutes.diameter_ratio for s in segs],
                    mat, [s.material.name for s in segs], ins, ins_names)
+
+    def as_component(self, template: Beam) -> Beam:
+        """The component whose segments these arrays hold, with every change they carry (sizes, materials,
+        inserts, flutes, segments split by an added element); its type and other numbers are ``template``'s.
+
+        For a change the arrays of uniform segments cannot hold (a taper): the component is then evaluated by
+        its own methods (:meth:`Structure.with_opaque`).
+
+        Parameters
+        ----------
+        template : Beam
+            The component the arrays were made from (the assembly's).
+
+        Returns
+        -------
+        Beam
+            A copy of ``template`` with the arrays' segments.
+        """
+        def material(name, values):
+            E, nu, rho, eta = (float(v) for v in values)
+            return Material(name, Q_(E, "Pa"), nu, Q_(rho, "kg/m^3"), eta)
+
+        segs = []
+        for i in range(self.length.size):
+            od_in, id_in = (float(v) for v in self.insert[i, :2])
+            insert = None if not od_in > 0 else Insert(Q_(od_in, "m"), material(self.insert_names[i],
+                                                                                 self.insert[i, 2:]), Q_(id_in, "m"))
+            ratio = float(self.ratio[i])
+            segs.append(Segment(Q_(float(self.length[i]), "m"), Q_(float(self.od[i]), "m"),
+                                Q_(float(self.id[i]), "m"), material(self.material_names[i], self.material[i]), insert,
+                                None if ratio == 1.0 else Flutes(ratio)))
+        return attrs.evolve(template, segments=segs)
 
     def evolve(self, **changes) -> "BeamArrays":
         """A copy with some arrays replaced (a new token).
