@@ -1,8 +1,8 @@
 """The built-in effects of the diagnosis: the physical effects the catalogue names.
 
 A sensor's mass on a measured point, a joint's stiffness, damping and
-cross-coupling, a rigid joint made elastic, a fluted section of a tool and
-springs of a free-free test's suspension.  Each is an
+cross-coupling, a rigid joint made elastic, a fluted section of a tool,
+springs of a free-free test's suspension and a tool that tapers.  Each is an
 :class:`~substructure.diagnose.effects.Effect` registered by name when the
 package is imported, in this order (the built-in answer does not depend on
 the order, but ties between candidates are broken by it); each also gives
@@ -25,7 +25,7 @@ from ..components import Beam, Tool
 from ..errors import InvalidValueError, UnknownPointError
 from ..joints import Joint, Sensor, Support
 from ..points import parse_point
-from ..units import format_quantity, ureg
+from ..units import Q_, format_quantity, ureg
 from ..updating.elements import split_beam, split_segments
 from ..updating.paths import apply_path_si, set_parameters
 from ..updating.structure import LinkSI
@@ -362,3 +362,74 @@ class SupportSprings(Effect):
         near = LinkSI(("added", f"springs-{name}-1"), (name, first), K=k)
         far = LinkSI(("added", f"springs-{name}-2"), (name, second), K=k)
         return structure.add_link(near).add_link(far)
+
+
+def _taperable(tool) -> bool:
+    """A tool the ``tapered-tool`` effect can act on: a plain beam of uniform segments, one without flutes."""
+    return (isinstance(tool, Tool) and not any(s.is_tapered for s in tool.segments)
+            and any(s.flutes is None and s.insert is None for s in tool.segments))
+
+
+@register_effect
+class TaperedTool(Effect):
+    """A tool whose diameter falls linearly along it, to ``tip_ratio`` times at its tip (a tapered end mill)."""
+
+    name = "tapered-tool"
+    parameters = (Parameter("tip_ratio", "dimensionless", 0.5, 1.0, 0.9, log=False),)
+    explanation = (
+        "a tool that tapers towards its tip (a tapered end mill, one reground or necked along its length) "
+        "is softer and lighter than the cylinder of the model, more so near the tip: the tool modes drop, "
+        "the spindle and holder modes hardly move"
+    )
+
+    @classmethod
+    def places(cls, assembly, measured_points):
+        return [t.name for t in assembly.components if _taperable(t)]
+
+    def apply(self, assembly):
+        return assembly.with_component(taper_tool(assembly.component(self.where), self.values["tip_ratio"]))
+
+    def apply_si(self, structure):
+        if self.where in structure.opaque:  # evaluated by its own methods (as it is now)
+            tool = structure.opaque[self.where]
+        else:  # arrays: the assembly's own object while nothing changed them, else the arrays' component
+            tool = structure.sources.get(self.where) or structure.beam(self.where).as_component(
+                structure.assembly.component(self.where))
+        return structure.with_opaque(taper_tool(tool, self.values["tip_ratio"]))
+
+
+def taper_tool(tool: Beam, tip_ratio: float) -> Beam:
+    """The tool with its diameters falling linearly along it, from as they are at its base to ``tip_ratio``
+    times at its tip.
+
+    Each segment without flutes or insert becomes tapered: its outer diameter at a distance ``x`` from the
+    tool's base is ``od (1 - (1 - tip_ratio) x / L)`` (``L`` the tool's length); its bore stays.  Fluted
+    segments (their equivalent diameter is the flutes' ratio of ``od``) and segments with an insert stay as
+    they are.
+
+    Parameters
+    ----------
+    tool : Beam
+        A tool of uniform segments.
+    tip_ratio : float
+        The outer diameter at the tip over the one the tool has there (0 to 1).
+
+    Returns
+    -------
+    Beam
+        A new tool.
+    """
+    total = tool.length_m
+    segs, start = [], 0.0
+    for seg in tool.segments:
+        stop = start + seg.length_m
+        if seg.flutes is None and seg.insert is None and not seg.is_tapered:
+            od = seg.od.m_as("m")
+            base, tip = (od * (1.0 - (1.0 - tip_ratio) * x / total) for x in (start, stop))
+            bore = seg.id.m_as("m")
+            if bore > 0:  # the bore stays inside the section as it narrows
+                base, tip = max(base, 1.0001 * bore), max(tip, 1.0001 * bore)
+            seg = attrs.evolve(seg, od=Q_(base, "m"), od_tip=Q_(tip, "m"))
+        segs.append(seg)
+        start = stop
+    return attrs.evolve(tool, segments=segs)

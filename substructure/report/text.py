@@ -32,6 +32,7 @@ EFFECT_NAMES = {
     "joint-cross-coupling": "a joint whose deflection and rotation are coupled",
     "rigid-joint-flexibility": "a connection modelled as rigid that gives",
     "fluted-section": "flutes the tool model lacks",
+    "tapered-tool": "a taper the tool model lacks",
     "support-springs": "springs to the ground (suspension bands, a fixture)",
     "model-parameter": "a value of the model file that is off",
     "added-mass": "a mass the model lacks (a nut, a ring, a sensor)",
