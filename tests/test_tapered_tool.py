@@ -88,3 +88,17 @@ def test_a_taper_is_not_what_flutes_or_a_longer_overhang_are():
     for hidden, name in ((dict(flutes=(0.03, 0.8)), "fluted-section"), (dict(tool_length=0.080), "model-parameter")):
         d = diagnose(hd.nominal_model(), hd.measure(seed=44, **hidden))
         assert d.explained and [e.name for e in d.effects] == [name], [repr(e) for e in d.effects]
+
+
+def test_the_tapered_model_saves_reads_back_and_explains_new_taps_with_nothing():
+    from substructure import dumps_assembly, loads_assembly
+
+    d = diagnose(hd.nominal_model(), hd.measure(seed=41, taper=0.010, taper_pieces=32))
+    text = dumps_assembly(d.refined_assembly)
+    assert 'od = "12 mm", od_tip = "0.0107' in text  # the base as written, the taper's diameters in metres
+    again = loads_assembly(text)
+    points = ["tool.tip:y"]
+    np.testing.assert_array_equal(again.frf(points, points, hd.GRID).data,
+                                  d.refined_assembly.frf(points, points, hd.GRID).data)
+    later = diagnose(again, hd.measure(seed=45, taper=0.010, taper_pieces=32))
+    assert later.explained and not later.effects

@@ -429,7 +429,7 @@ def taper_tool(tool: Beam, tip_ratio: float) -> Beam:
             bore = seg.id.m_as("m")
             if bore > 0:  # the bore stays inside the section as it narrows
                 base, tip = max(base, 1.0001 * bore), max(tip, 1.0001 * bore)
-            seg = attrs.evolve(seg, od=Q_(base, "m"), od_tip=Q_(tip, "m"))
+            seg = attrs.evolve(seg, od=seg.od if base == od else Q_(base, "m"), od_tip=Q_(tip, "m"))
         segs.append(seg)
         start = stop
     return attrs.evolve(tool, segments=segs)
