@@ -179,6 +179,19 @@ def test_a_hidden_sensor_under_real_noise_is_found_and_nothing_else(real_residua
     assert mass == pytest.approx(0.002, rel=0.15)
 
 
+@pytest.mark.parametrize("level, offset", [(1.0, 700), (3.0, 2100)])
+def test_a_tapered_tool_under_real_noise_is_the_taper_and_nothing_else(real_residual, level, offset):
+    """The FE rig's tool tapering from 12 to 10 mm, the model's a cylinder: under the real residual the taper
+    alone (not flutes and a section change that together reach the noise)."""
+    clean = hd.measure(noise=0.0, phase_deg=0.0, floor=0.0, taper=0.010, taper_pieces=32)[0]
+    n = clean.frequency.n
+    rho = np.exp(level * np.log(real_residual[offset: offset + n]))
+    d = diagnose(hd.nominal_model(), [_with(clean, clean.data[:, 0, 0] * rho)])
+    assert d.explained, d.report
+    assert [(e.name, e.where) for e in d.effects] == [("tapered-tool", "tool")], [repr(e) for e in d.effects]
+    assert d.effects[0].values["tip_ratio"] == pytest.approx(10 / 12, abs=0.01)
+
+
 @pytest.mark.parametrize("tau", [0.05])
 def test_real_noise_through_an_exponential_window_keeps_an_exact_model_consistent(tau):
     """The real records processed through an exponential window of 50 ms (4.3 times shorter than their default): their
