@@ -18,7 +18,12 @@ model in different ways: every candidate is screened with that single held
 (and refitted to first order, as the forward step does), the
 :data:`SECONDS` best of the shortlist are fitted on all lines with it, and
 the one :func:`~substructure.diagnose.search.choose` takes (the preferred
-name among those the data cannot tell apart) makes a pair.  The pairs join
+name among those the data cannot tell apart) makes a pair.  Where the path
+did reach the noise with two changes, its first choice may still have stood
+in for another effect, the second change inventing the rest (a tapered tool
+with a sensor came back as flutes and a bore): the second step is repeated
+from the :data:`CONFIRM_FIRSTS` best other single, its best second change
+fitted on all lines.  The pairs join
 the parsimony check's explanations, where the fewest changes, then the
 preferred names, are kept among those the data do not decide between.
 """
@@ -33,17 +38,22 @@ from .scan import places
 from .search import _p, choose, full_fits, physical, rank, screen, shortlist
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
-__all__ = ["OTHER_FIRSTS", "SECONDS", "other_paths"]
+__all__ = ["OTHER_FIRSTS", "SECONDS", "CONFIRM_FIRSTS", "other_paths"]
 
 OTHER_FIRSTS = 3
 """Singles of the first step (best first, changing the model in different ways) from which a second step is
 screened when the forward path did not reach the noise with at most two changes."""
 SECONDS = 3
 """Shortlisted second changes fitted on all lines with each of those singles."""
+CONFIRM_FIRSTS = 1
+"""Where the forward path reached the noise with two changes: singles of the first step (the best other one)
+from which a second step is screened too, its best second change fitted on all lines, so that a first choice
+that only stood in for another effect (flutes for a taper, a section change for a tool's material), completed
+to the noise by an invented second change, meets the pair that describes the data better."""
 
 
 def other_paths(lik, screen_lik, lik0, firsts: list, cands: list, passive: Callable, say=None,
-                settings: DiagnoseSettings = DEFAULT_SETTINGS) -> list:
+                settings: DiagnoseSettings = DEFAULT_SETTINGS, seconds: int = SECONDS) -> list:
     """Pairs of changes from other first changes (see the module docstring).
 
     Parameters
@@ -64,6 +74,8 @@ def other_paths(lik, screen_lik, lik0, firsts: list, cands: list, passive: Calla
         Progress.
     settings : DiagnoseSettings
         The diagnosis's settings.
+    seconds : int, default SECONDS
+        Shortlisted second changes fitted on all lines with each single.
 
     Returns
     -------
@@ -84,7 +96,7 @@ def other_paths(lik, screen_lik, lik0, firsts: list, cands: list, passive: Calla
             scored = screen(screen_lik, held, remaining, chi2_s, n, None, starts, settings=settings)
         except (ValueError, ArithmeticError, SubstructureError):
             continue
-        chosen = shortlist(scored, chi2_s, screen_lik.n, n, _p(held), settings)[:SECONDS]
+        chosen = shortlist(scored, chi2_s, screen_lik.n, n, _p(held), settings)[:seconds]
         done = [s for s in full_fits(lik, held, chosen) if physical(s.change, s.values) and passive(s.fit.changes)]
         if not done:
             continue

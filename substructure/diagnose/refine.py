@@ -56,7 +56,7 @@ from ..updating.selection import INDIFFERENCE, bic, consistency, significance
 from ..updating.likelihood import Likelihood
 from .crossval import cross_validate
 from .modes import mode_starts
-from .pairs import OTHER_FIRSTS, other_paths
+from .pairs import CONFIRM_FIRSTS, OTHER_FIRSTS, SECONDS, other_paths
 from .scan import places, trials
 from .search import Budget, Scored, _p, choose, full_fits, physical, preference, rank, screen, shortlist
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
@@ -506,14 +506,17 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     if len(current) >= 2:
         before = [c.key for c, _ in current]
         more = []
-        if len(current) > settings.most_changes or not consistency(lik, lik.log_ratios(current),
-                                                                   _p(current)).consistent:
-            # the path did not reach the noise with two changes: its first choice may be the wrong one
-            # the path's own first change (or the same change under another name) is not started from again
+        failed = len(current) > settings.most_changes or not consistency(lik, lik.log_ratios(current),
+                                                                          _p(current)).consistent
+        # its first choice may be the wrong one: where the path did not reach the noise with two changes, and where
+        # it did (a stand-in completed by an invented second change), from fewer other firsts
+        # the path's own first change (or the same change under another name) is not started from again
+        starts, seconds = (OTHER_FIRSTS, SECONDS) if failed else (CONFIRM_FIRSTS, 1)
+        if starts:
             singles = [s for s in first_fitted if s.fit is not None]
-            firsts = [s for s in _distinct(screen_lik, singles, OTHER_FIRSTS + 1, settings)
+            firsts = [s for s in _distinct(screen_lik, singles, starts + 1, settings)
                       if s.change.key != path[0][1].key]
-            more = other_paths(lik, screen_lik, lik0, firsts[:OTHER_FIRSTS], cands, passive, say, settings)
+            more = other_paths(lik, screen_lik, lik0, firsts[:starts], cands, passive, say, settings, seconds)
         current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
                                                settings, more)
         if len(current) > 1 and sorted(c.key for c, _ in current) != pruned:
