@@ -22,8 +22,9 @@ name among those the data cannot tell apart) makes a pair.  Where the path
 did reach the noise with two changes, its first choice may still have stood
 in for another effect, the second change inventing the rest (a tapered tool
 with a sensor came back as flutes and a bore): the second step is repeated
-from the :data:`CONFIRM_FIRSTS` best other single, its best second change
-fitted on all lines.  The pairs join
+from the :data:`CONFIRM_FIRSTS` best other single (screened on every other
+line of the screening subsample, from the scan's own starts), its best
+second change fitted on all lines.  The pairs join
 the parsimony check's explanations, where the fewest changes, then the
 preferred names, are kept among those the data do not decide between.
 """
@@ -53,7 +54,8 @@ to the noise by an invented second change, meets the pair that describes the dat
 
 
 def other_paths(lik, screen_lik, lik0, firsts: list, cands: list, passive: Callable, say=None,
-                settings: DiagnoseSettings = DEFAULT_SETTINGS, seconds: int = SECONDS) -> list:
+                settings: DiagnoseSettings = DEFAULT_SETTINGS, seconds: int = SECONDS,
+                with_mode_starts: bool = True) -> list:
     """Pairs of changes from other first changes (see the module docstring).
 
     Parameters
@@ -92,7 +94,8 @@ def other_paths(lik, screen_lik, lik0, firsts: list, cands: list, passive: Calla
             say(f"pairs: a second change screened with {first.change.effect} at {first.change.place(first.values)}")
         try:
             chi2_s = screen_lik.chi2(held)
-            starts = mode_starts(lik0, held, remaining, lambda change: places(change, settings), settings)
+            starts = mode_starts(lik0, held, remaining, lambda change: places(change, settings), settings) \
+                if with_mode_starts else {}
             scored = screen(screen_lik, held, remaining, chi2_s, n, None, starts, settings=settings)
         except (ValueError, ArithmeticError, SubstructureError):
             continue

@@ -516,7 +516,8 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
             singles = [s for s in first_fitted if s.fit is not None]
             firsts = [s for s in _distinct(screen_lik, singles, starts + 1, settings)
                       if s.change.key != path[0][1].key]
-            more = other_paths(lik, screen_lik, lik0, firsts[:starts], cands, passive, say, settings, seconds)
+            more = other_paths(lik, screen_lik if failed else screen_lik.subsample(2), lik0, firsts[:starts], cands,
+                               passive, say, settings, seconds, with_mode_starts=failed)
         current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
                                                settings, more)
         if len(current) > 1 and sorted(c.key for c, _ in current) != pruned:
