@@ -107,7 +107,7 @@ def _phases(intervals: list[tuple], omega_max: float) -> list[float]:
 
     if not all(_is_shared(sec, length) for sec, length in intervals):
         return [_phase(sec, length, omega_max) for sec, length in intervals]
-    ei, kga, rhoa, rhoi, length = (np.array([[v for v in column]]) for column in zip(
+    ei, kga, rhoa, rhoi, length = (np.array([column]) for column in zip(
         *((sec.EI, sec.kGA, sec.rhoA, sec.rhoI, length) for sec, length in intervals)))
     _, k_max = _kernels.segment_coefficients(
         _kernels.c_array(ei, complex), _kernels.c_array(kga, complex), _kernels.c_array(rhoa, float),

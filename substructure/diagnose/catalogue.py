@@ -390,12 +390,7 @@ class TaperedTool(Effect):
         return assembly.with_component(taper_tool(assembly.component(self.where), self.values["tip_ratio"]))
 
     def apply_si(self, structure):
-        if self.where in structure.opaque:  # evaluated by its own methods (as it is now)
-            tool = structure.opaque[self.where]
-        else:  # arrays: the assembly's own object while nothing changed them, else the arrays' component
-            tool = structure.sources.get(self.where) or structure.beam(self.where).as_component(
-                structure.assembly.component(self.where))
-        return structure.with_opaque(taper_tool(tool, self.values["tip_ratio"]))
+        return structure.with_opaque(taper_tool(structure.component(self.where), self.values["tip_ratio"]))
 
 
 def taper_tool(tool: Beam, tip_ratio: float) -> Beam:

@@ -493,9 +493,7 @@ def _component_si(structure, path: str, name: str, rest: tuple, value: float):
     if rest[0] == "segments" and rest[-1] in ("od_tip", "id_tip") and name in structure.beams:
         # a taper, which the arrays of uniform segments cannot hold: the component, with every change the arrays
         # carry, is evaluated by its own methods from here on (as the assembly's tapered one is)
-        arrays = structure.beam(name).as_component(structure.assembly.component(name))
-        comp = _set_component(arrays, path, list(rest), value)
-        return structure.with_opaque(comp)
+        return structure.with_opaque(_set_component(structure.component(name), path, list(rest), value))
     if name in structure.opaque:  # a component evaluated by its own methods: changed as an object
         comp = _set_component(structure.opaque[name], path, list(rest), value)
         out = structure.with_opaque(comp)

@@ -455,6 +455,31 @@ class Structure:
         """
         return name in self.beams or any(name in getattr(c, "component_names", ()) for c in self.opaque.values())
 
+    def component(self, name: str):
+        """A component as it stands in this structure, as an object: the one evaluated by its own methods, the
+        assembly's own while its arrays are unchanged, else the component its arrays hold
+        (:meth:`BeamArrays.as_component`).
+
+        Parameters
+        ----------
+        name : str
+            The component's name.
+
+        Returns
+        -------
+        object
+            The component, with every change made to it.
+
+        Raises
+        ------
+        UnknownPointError
+            When no component has that name here.
+        """
+        if name in self.opaque:
+            return self.opaque[name]
+        source = self.sources.get(name)  # dropped when the arrays change
+        return source if source is not None else self.beam(name).as_component(self.assembly.component(name))
+
     def beam(self, name: str) -> BeamArrays:
         """The arrays of a plain beam.
 
