@@ -5,7 +5,7 @@ first was only standing in for another effect, the second is invented to make up
 tapering to 10 mm with a forgotten 2 g sensor came back as flutes over 56 mm and a 1.5 mm bore, an HSS tool
 (modelled as carbide) with a 2 g sensor as a section change over the whole tool and a material of E 480 GPa,
 rho 12,300 kg/m^3 and nu 0.4, both called explained.  The second step repeated from the best other single
-(``pairs.CONFIRM_FIRSTS``) meets the true pair, which describes the data far better (chi^2 lower by about 370
+(``DiagnoseSettings.confirm_firsts``) meets the true pair, which describes the data far better (chi^2 lower by about 370
 at the same number of parameters).  The data come from the independent FE rig of hidden_data.py.
 """
 
@@ -13,8 +13,7 @@ import numpy as np
 import pytest
 
 import hidden_data as hd
-import substructure.diagnose.refine as refine_module
-from substructure.diagnose import diagnose
+from substructure.diagnose import DiagnoseSettings, diagnose
 
 
 def _names(d):
@@ -49,11 +48,11 @@ def test_an_hss_tool_with_a_sensor_is_the_material_and_the_sensor(seed):
     assert _hss_and_sensor(d), [repr(e) for e in d.effects]
 
 
-def test_without_the_confirming_step_the_stand_in_and_an_invented_change_are_claimed(monkeypatch):
+def test_without_the_confirming_step_the_stand_in_and_an_invented_change_are_claimed():
     """What the step is for: switched off, the same data are called explained by flutes and a bore that do not
     exist (so the tests above cannot pass by chance)."""
-    monkeypatch.setattr(refine_module, "CONFIRM_FIRSTS", 0)
-    d = diagnose(hd.nominal_model(), hd.measure(seed=5, taper=0.010, taper_pieces=32, sensor_kg=0.002))
+    d = diagnose(hd.nominal_model(), hd.measure(seed=5, taper=0.010, taper_pieces=32, sensor_kg=0.002),
+                 settings=DiagnoseSettings(confirm_firsts=0))
     assert d.explained and "tapered-tool" not in _names(d) and "sensor-mass" not in _names(d)
 
 
@@ -64,3 +63,4 @@ def test_pairs_the_forward_path_found_right_stay_as_they_are():
         d = diagnose(hd.nominal_model(), hd.measure(seed=2, **hidden))
         assert d.explained and _names(d) == names, [repr(e) for e in d.effects]
         assert np.isfinite(d.final_error) and d.final_error <= 1.5 * d.noise_floor
+

@@ -22,9 +22,9 @@ name among those the data cannot tell apart) makes a pair.  Where the path
 did reach the noise with two changes, its first choice may still have stood
 in for another effect, the second change inventing the rest (a tapered tool
 with a sensor came back as flutes and a bore): the second step is repeated
-from the :data:`CONFIRM_FIRSTS` best other single (screened on every other
-line of the screening subsample, from the scan's own starts), its best
-second change fitted on all lines.  The pairs join
+from the ``DiagnoseSettings.confirm_firsts`` best other singles (screened on
+every ``confirm_screen_step``-th line of the screening subsample, from the
+scan's own starts), the best second change of each fitted on all lines.  The pairs join
 the parsimony check's explanations, where the fewest changes, then the
 preferred names, are kept among those the data do not decide between.
 """
@@ -39,18 +39,13 @@ from .scan import places
 from .search import _p, choose, full_fits, physical, rank, screen, shortlist
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
-__all__ = ["OTHER_FIRSTS", "SECONDS", "CONFIRM_FIRSTS", "other_paths"]
+__all__ = ["OTHER_FIRSTS", "SECONDS", "other_paths"]
 
 OTHER_FIRSTS = 3
 """Singles of the first step (best first, changing the model in different ways) from which a second step is
 screened when the forward path did not reach the noise with at most two changes."""
 SECONDS = 3
 """Shortlisted second changes fitted on all lines with each of those singles."""
-CONFIRM_FIRSTS = 1
-"""Where the forward path reached the noise with two changes: singles of the first step (the best other one)
-from which a second step is screened too, its best second change fitted on all lines, so that a first choice
-that only stood in for another effect (flutes for a taper, a section change for a tool's material), completed
-to the noise by an invented second change, meets the pair that describes the data better."""
 
 
 def other_paths(lik, screen_lik, lik0, firsts: list, cands: list, passive: Callable, say=None,
@@ -78,6 +73,9 @@ def other_paths(lik, screen_lik, lik0, firsts: list, cands: list, passive: Calla
         The diagnosis's settings.
     seconds : int, default SECONDS
         Shortlisted second changes fitted on all lines with each single.
+    with_mode_starts : bool, default True
+        Screen from the starts the mode shifts predict as well as from the
+        scan's own.
 
     Returns
     -------

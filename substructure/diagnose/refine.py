@@ -56,7 +56,7 @@ from ..updating.selection import INDIFFERENCE, bic, consistency, significance
 from ..updating.likelihood import Likelihood
 from .crossval import cross_validate
 from .modes import mode_starts
-from .pairs import CONFIRM_FIRSTS, OTHER_FIRSTS, SECONDS, other_paths
+from .pairs import OTHER_FIRSTS, other_paths
 from .scan import places, trials
 from .search import Budget, Scored, _p, choose, full_fits, physical, preference, rank, screen, shortlist
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
@@ -511,13 +511,16 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
         # its first choice may be the wrong one: where the path did not reach the noise with two changes, and where
         # it did (a stand-in completed by an invented second change), from fewer other firsts
         # the path's own first change (or the same change under another name) is not started from again
-        starts, seconds = (OTHER_FIRSTS, SECONDS) if failed else (CONFIRM_FIRSTS, 1)
+        starts = OTHER_FIRSTS if failed else settings.confirm_firsts
         if starts:
             singles = [s for s in first_fitted if s.fit is not None]
             firsts = [s for s in _distinct(screen_lik, singles, starts + 1, settings)
                       if s.change.key != path[0][1].key]
-            more = other_paths(lik, screen_lik if failed else screen_lik.subsample(2), lik0, firsts[:starts], cands,
-                               passive, say, settings, seconds, with_mode_starts=failed)
+            if failed:
+                more = other_paths(lik, screen_lik, lik0, firsts[:starts], cands, passive, say, settings)
+            else:  # a cheaper screening: one second change per first, fitted on all lines
+                more = other_paths(lik, screen_lik.subsample(settings.confirm_screen_step), lik0, firsts[:starts],
+                                   cands, passive, say, settings, seconds=1, with_mode_starts=False)
         current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
                                                settings, more)
         if len(current) > 1 and sorted(c.key for c, _ in current) != pruned:

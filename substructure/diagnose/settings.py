@@ -284,6 +284,16 @@ class DiagnoseSettings:
         Most evaluations of a pair's fit on the screening lines (default 40).
     pairs_fitted : int
         Pairs (best on the screening lines) fitted on all lines (default 2).
+    confirm_firsts : int
+        Where the forward path reached the noise with two changes, the other
+        singles of the first step (best first) from which a second step is
+        screened too, its best second change fitted on all lines: a first
+        choice that stood in for another effect, completed by an invented
+        second change, meets the pair that describes the data better
+        (default 1; 0: not checked).
+    confirm_screen_step : int
+        That second step screens every this-many-th line of the screening
+        subsample, from the scan's own starts (default 2).
     other_starts : int
         Starts per placed change from which other values of the same change are
         fitted (default 2).
@@ -391,6 +401,8 @@ class DiagnoseSettings:
     same_direction: float = attrs.field(default=0.995, validator=_number(0.0, 1.0))
     pair_screen_evaluations: int = attrs.field(default=40, validator=_count())
     pairs_fitted: int = attrs.field(default=2, validator=_count(0))
+    confirm_firsts: int = attrs.field(default=1, validator=_count(0))
+    confirm_screen_step: int = attrs.field(default=2, validator=_count())
     other_starts: int = attrs.field(default=2, validator=_count(0))
     other_apart: float = attrs.field(default=0.05, validator=_number(0.0, 1.0))
     other_apart_std: float = attrs.field(default=3.0, validator=_number(0.0, lo_open=False))
