@@ -146,7 +146,7 @@ class BeamArrays:
         inserts, flutes, segments split by an added element); its type and other numbers are ``template``'s.
 
         For a change the arrays of uniform segments cannot hold (a taper): the component is then evaluated by
-        its own methods (:meth:`Structure.with_opaque`).
+        its own methods (:meth:`~substructure.updating.structure.Structure.with_opaque`).
 
         Parameters
         ----------
@@ -458,7 +458,7 @@ class Structure:
     def component(self, name: str):
         """A component as it stands in this structure, as an object: the one evaluated by its own methods, the
         assembly's own while its arrays are unchanged, else the component its arrays hold
-        (:meth:`BeamArrays.as_component`).
+        (``BeamArrays.as_component``).
 
         Parameters
         ----------
