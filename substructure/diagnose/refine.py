@@ -196,7 +196,9 @@ def _distinct(screen_lik, singles, count: int, settings: DiagnoseSettings = DEFA
     a cosine above ``settings.same_direction`` are one explanation under
     two names (a joint's stiffness and its ``k.yf`` entry; an overhang and
     its free segment's length): only one enters the pool, under the name
-    :func:`~substructure.diagnose.search.preference` puts first.
+    :func:`~substructure.diagnose.search.preference` puts first, also when
+    that name ranks after the pool is full (a flutes' ratio behind the
+    fluted segment's ``od``, equal to the last digit).
     """
     try:
         r0 = screen_lik.residual([])
@@ -204,8 +206,8 @@ def _distinct(screen_lik, singles, count: int, settings: DiagnoseSettings = DEFA
         return list(singles[:count])
     pool, directions = [], []
     for s in singles:
-        if len(pool) == count:
-            break
+        if len(pool) == count and all(preference(s.change) >= preference(p.change) for p in pool):
+            continue  # full, and this one cannot stand for one of the pool under a preferred name
         try:
             d = screen_lik.residual(s.fit.changes) - r0
         except (ValueError, ArithmeticError, SubstructureError):
@@ -220,8 +222,9 @@ def _distinct(screen_lik, singles, count: int, settings: DiagnoseSettings = DEFA
             if preference(s.change) < preference(pool[k].change):
                 pool[k] = s
             continue
-        pool.append(s)
-        directions.append(d)
+        if len(pool) < count:
+            pool.append(s)
+            directions.append(d)
     return pool
 
 
