@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 import hidden_data as hd
+import real_noise
 from substructure import FRF, Frequency
 from substructure import datasets
 from substructure.diagnose import diagnose
@@ -30,23 +31,7 @@ from substructure.updating.selection import consistency
 @pytest.fixture(scope="module")
 def real_residual() -> np.ndarray:
     """``H / S(H)`` of the real H1 estimate (20 Hz - 5 kHz at 1 Hz): the multiplicative noise of a real test."""
-    records = datasets.impact_records()
-    spectra = [(np.fft.rfft(r.force), np.fft.rfft(r.response)) for r in records]
-    gff = sum(np.abs(f) ** 2 for f, _ in spectra)
-    gfx = sum(np.conj(f) * x for f, x in spectra)
-    rate = 1.0 / float(records[0].time[1] - records[0].time[0])
-    freq = np.fft.rfftfreq(records[0].force.size, 1.0 / rate)
-    keep = (freq >= 20) & (freq <= 5000)
-    h1 = (gfx / gff)[keep]
-    real = FRF(Frequency(freq[keep]), h1[:, None, None], ("a:y",), ("b:y",))
-    import warnings
-
-    from substructure.smoothing import CoarseDataWarning
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", CoarseDataWarning)  # the real peaks are sharper than a line
-        window = choose_window(real)
-    return h1 / smooth(real, window=window).data[:, 0, 0]
+    return real_noise.real_residual()
 
 
 @pytest.fixture(scope="module")

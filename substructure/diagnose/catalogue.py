@@ -227,7 +227,12 @@ class RigidJointFlexibility(_JointEffect):
 
 @register_effect
 class FlutedSection(Effect):
-    """A tool's last ``length`` fluted, at ``diameter_ratio`` (equivalent diameter)."""
+    """A tool's flutes: its last ``length`` fluted at ``diameter_ratio`` (equivalent diameter), none before.
+
+    On a tool the model gives flutes, the effect says where they really
+    begin and how deep they are (it starts from the model's); on a tool
+    without, that it has them.
+    """
 
     name = "fluted-section"
     parameters = (
@@ -241,12 +246,22 @@ class FlutedSection(Effect):
 
     @classmethod
     def places(cls, assembly, measured_points):
-        return [t.name for t in assembly.components if isinstance(t, Tool) and not any(s.flutes for s in t.segments)]
+        return [t.name for t in assembly.components if isinstance(t, Tool)]
 
     @classmethod
     def starting_values(cls, assembly, where, shift):
         tool = assembly.component(where)
+        length, ratio = fluted_tip(tool)
+        if length:
+            return {"diameter_ratio": ratio, "length": length}
         return {"diameter_ratio": 0.8, "length": min(0.03, 0.5 * tool.length_m)}
+
+    @classmethod
+    def scan_starts(cls, assembly, where):
+        # length and depth act together (deeper and shorter flutes lower the tool modes alike): crossed
+        length = cls.starting_values(assembly, where, 0.0)["length"]
+        return [{"diameter_ratio": ratio, "length": factor * length}
+                for ratio in (0.7, 0.8, 0.9) for factor in (0.5, 0.75, 1.25, 1.5, 2.0)]
 
     @classmethod
     def bounds(cls, assembly, where):
@@ -255,13 +270,40 @@ class FlutedSection(Effect):
 
     def apply(self, assembly):
         tool = assembly.component(self.where)
+        if any(seg.flutes for seg in tool.segments):
+            tool = attrs.evolve(tool, segments=tuple(attrs.evolve(seg, flutes=None) for seg in tool.segments))
         return assembly.with_component(flute_tip(tool, self.values["length"], self.values["diameter_ratio"]))
 
     def apply_si(self, structure):
         beam = structure.beam(self.where)
+        if np.any(beam.ratio != 1.0):
+            beam = beam.evolve(ratio=np.ones_like(beam.ratio))
         total = beam.total_length
         return structure.with_beam(split_beam(beam, total - min(self.values["length"], total), total,
                                               flutes=self.values["diameter_ratio"]))
+
+
+def fluted_tip(tool: Beam) -> tuple[float, float]:
+    """The length [m] of a tool's fluted tip (the fluted segments next to its tip) and their ratio.
+
+    Parameters
+    ----------
+    tool : Beam
+        The tool.
+
+    Returns
+    -------
+    (float, float)
+        ``(0.0, 1.0)`` for a tool whose last segment has no flutes; else the
+        fluted tip's length and its last segment's ``diameter_ratio``.
+    """
+    length, ratio = 0.0, 1.0
+    for seg in reversed(tool.segments):
+        if not seg.flutes:
+            break
+        length += seg.length_m
+        ratio = ratio if length > seg.length_m else seg.flutes.diameter_ratio
+    return length, ratio
 
 
 def flute_tip(tool: Beam, length_m: float, ratio: float) -> Beam:

@@ -258,6 +258,28 @@ class Effect:
         return {p.name: p.start for p in cls.parameters}
 
     @classmethod
+    def scan_starts(cls, assembly: Assembly, where: str) -> list[dict[str, float]]:
+        """More starting points of the screening scan at a place (optional; default none).
+
+        The scan tries the first parameter over its range with the others at
+        their starting values; an effect whose parameters act together (a
+        flutes' length and depth) gives combinations here.
+
+        Parameters
+        ----------
+        assembly : Assembly
+            The model.
+        where : str
+            The place.
+
+        Returns
+        -------
+        list of dict of str to float
+            Values (SI) of some parameters each; the others stay at their start.
+        """
+        return []
+
+    @classmethod
     def bounds(cls, assembly: Assembly, where: str) -> dict[str, tuple[float, float]]:
         """Bounds of each parameter at this place.
 
@@ -347,6 +369,9 @@ class EffectChange(Change):
             specs.append(ParamSpec(p.name, p.unit, lo, hi, float(np.clip(start.get(p.name, p.start), lo, hi)),
                                    p.log and lo > 0))
         self.specs = tuple(specs)
+        limits = {spec.name: (spec.lower, spec.upper) for spec in specs}
+        self.trials = tuple({k: float(np.clip(v, *limits[k])) for k, v in trial.items() if k in limits}
+                            for trial in cls.scan_starts(assembly, where))
 
     def instance(self, values) -> Effect:
         """The effect at this change's place with these values (SI)."""

@@ -1,0 +1,157 @@
+"""The ``fluted-section`` effect on a tool the model already gives flutes: where they begin and how deep they are.
+
+Before, the effect was offered only for tools without flutes.  On a second, larger FE rig
+(hidden_data_large.py: a 20 mm end mill whose model has flutes over 40 mm at 0.8), real flutes of 60 mm at 0.75
+came back as the fluted segment's start and its ``od`` (the flutes' ratio, preferred, stood behind the ``od`` in
+the pool of pairs), under the real residual at three times its level as a section change from 90 to 147 mm, and
+with a 3 g sensor besides as the flutes' start and a section change ending 10 mm short of the tip that stood in
+for the sensor: "explained" without it.  The data are the independent FE rigs' exact FRFs times the residual of
+a real tap test (real_noise.py).
+"""
+
+import numpy as np
+import pytest
+
+import hidden_data as hd
+import hidden_data_large as hl
+import real_noise
+from substructure import Flutes, Mass, Segment, Tool
+from substructure.diagnose import diagnose
+from substructure.diagnose.catalogue import fluted_tip
+from substructure.diagnose.effects import EFFECTS, effect_change
+from substructure.updating.elements import SectionChange
+from substructure.updating.evaluator import Evaluator
+from substructure.updating.structure import Structure
+
+F = np.linspace(20.0, 4000.0, 300)
+OUT, IN = ["tool.tip:y", "tool@40 mm:y", "holder.tip:y"], ["tool.tip:y"]
+
+
+def _flutes(ratio, length, where="tool"):
+    return EFFECTS["fluted-section"](where, diameter_ratio=ratio, length=length)
+
+
+def _summary(d):
+    return [(e.name, e.where, {k: float(f"{v:.4g}") for k, v in e.values.items()}) for e in d.effects]
+
+
+def test_the_flutes_replace_the_models_and_start_from_them():
+    tool = hl.model().component("tool")
+    assert fluted_tip(tool) == pytest.approx((0.040, 0.8))
+    assert fluted_tip(Tool("t", [Segment("50 mm", "12 mm")])) == (0.0, 1.0)
+    longer = _flutes(0.75, 0.060).apply(hl.model()).component("tool")
+    assert [(round(s.length_m, 9), s.flutes) for s in longer.segments] == [
+        (0.1, None), (0.02, Flutes(0.75)), (0.04, Flutes(0.75))]
+    shorter = _flutes(0.85, 0.025).apply(hl.model()).component("tool")
+    assert [(round(s.length_m, 9), s.flutes) for s in shorter.segments] == [
+        (0.12, None), (0.015, None), (0.025, Flutes(0.85))]  # no flutes before the new ones
+    change = effect_change(EFFECTS["fluted-section"], "tool", hl.model())
+    assert {s.name: s.start for s in change.specs} == pytest.approx({"diameter_ratio": 0.8, "length": 0.040})
+    assert len(change.trials) == 15 and all(0.5 <= t["diameter_ratio"] <= 1 and 1e-3 <= t["length"] <= 0.16
+                                            for t in change.trials)
+
+
+@pytest.mark.parametrize("model, before", [
+    (hl.model, None),
+    (lambda: hd.nominal_model(flutes=(0.03, 0.8)), None),
+    (hd.nominal_model, None),
+    (hl.model, (SectionChange("tool", 0.16), {"diameter_ratio": 0.9, "start": 0.05, "length": 0.03})),
+], ids=["large-fluted", "fluted", "plain", "after-a-section-change"])
+@pytest.mark.parametrize("ratio, length", [(0.75, 0.060), (0.85, 0.025), (0.8, 0.04)])
+def test_the_si_form_flutes_the_tool_as_the_assembly_does(model, before, ratio, length):
+    model = model()
+    structure = Structure.from_assembly(model)
+    if before is not None:
+        element, values = before
+        model, structure = element.apply(model, values), element.apply_si(structure, values)
+    effect = _flutes(ratio, length)
+    ref = effect.apply(model).frf(OUT, IN, F).data
+    got = Evaluator(OUT, IN, F)(effect.apply_si(structure))
+    np.testing.assert_allclose(got, ref, rtol=1e-9, atol=1e-14 * np.abs(ref).max())
+
+
+@pytest.mark.parametrize("hidden, level, offset", [
+    (dict(flutes=(0.060, 0.75)), 1.0, 700),
+    (dict(flutes=(0.060, 0.75)), 3.0, 2100),
+    (dict(flutes=(0.025, 0.85)), 1.0, 1400),
+    (dict(flutes=(0.040, 0.75)), 1.0, 2800),
+], ids=["longer-deeper", "longer-deeper-x3", "shorter-shallower", "deeper"])
+def test_flutes_other_than_the_models_are_the_flutes_and_nothing_else(hidden, level, offset):
+    d = diagnose(hl.model(), real_noise.with_real_noise(hl.measure(**hidden), offset, level))
+    assert d.explained, d.report
+    (found,) = d.effects
+    assert (found.name, found.where) == ("fluted-section", "tool"), _summary(d)
+    length, ratio = hidden["flutes"]
+    assert found.values["length"] == pytest.approx(length, abs=1e-3)
+    assert found.values["diameter_ratio"] == pytest.approx(ratio, abs=0.01)
+
+
+@pytest.mark.parametrize("rig", ["large", "small"])
+def test_other_flutes_with_a_sensor_are_both_and_predict_points_not_fitted(rig):
+    """The pair that a section change ending short of the tip stood in for; the refined model then predicts the
+    FE rig 50 mm back on the tool and at the holder's tip, which were not measured."""
+    if rig == "large":
+        model, flutes, measure = hl.model(), (0.060, 0.75), hl.measure
+        truth = hl.measure(points=("tool.tip-50 mm", "holder.tip"), flutes=flutes, sensor_kg=0.003)
+    else:
+        model, flutes = hd.nominal_model(flutes=(0.03, 0.8)), (0.045, 0.75)
+
+        def measure(**kw):
+            return hd.measure(noise=0.0, phase_deg=0.0, floor=0.0, **kw)
+        truth = measure(points=("tool.tip-50 mm", "holder.tip"), flutes=flutes, sensor_kg=0.003)
+    d = diagnose(model, real_noise.with_real_noise(measure(flutes=flutes, sensor_kg=0.003), 900))
+    assert d.explained, d.report
+    assert sorted(e.name for e in d.effects) == ["fluted-section", "sensor-mass"], _summary(d)
+    (found,) = [e for e in d.effects if e.name == "fluted-section"]
+    assert found.values["length"] == pytest.approx(flutes[0], abs=1e-3)
+    assert found.values["diameter_ratio"] == pytest.approx(flutes[1], abs=0.01)
+    (sensor,) = [e for e in d.effects if e.name == "sensor-mass"]
+    assert sensor.values["mass"] == pytest.approx(0.003, rel=0.05)
+    given = model.attach(Mass("sensor", "tool.tip", "3 g"))  # the sensor known, the flutes as drawn
+    for frf in truth:
+        f = frf.frequency
+        saved = d.refined_assembly.frf(frf.outputs[0], "tool.tip:y", f).data[:, 0, 0]
+        drawn = given.frf(frf.outputs[0], "tool.tip:y", f).data[:, 0, 0]
+        exact = frf.data[:, 0, 0]
+        error, off = (float(np.sqrt(np.mean(np.abs(np.log(h / exact)) ** 2))) for h in (saved, drawn))
+        assert error < 0.02 and error < 0.1 * off, (frf.outputs, error, off)
+
+
+def test_the_large_rig_exact_and_with_a_nut_under_real_noise():
+    """The second rig's neighbours that were right before: the exact model explained with nothing, a nut found."""
+    d = diagnose(hl.model(), real_noise.with_real_noise(hl.measure(), 300, 3.0))
+    assert d.explained and not d.effects, _summary(d)
+    d = diagnose(hl.model(), real_noise.with_real_noise(hl.measure(nut=(0.15, 5e-5, 0.040)), 1700))
+    assert d.explained, d.report
+    (found,) = d.effects
+    assert found.name == "added-mass" and found.values["mass"] == pytest.approx(0.15, rel=0.02)
+    assert found.values["position"] == pytest.approx(0.040, abs=1e-3)
+
+
+def test_a_preferred_name_replaces_its_equal_in_the_pool_of_pairs_even_after_the_pool_is_full():
+    """The fluted segment's od (what the user measures) and the flutes' ratio (the model's guess) set the same
+    section; the ratio ranked fifth, just after the od, and the pool of four pairs took the od."""
+    from types import SimpleNamespace
+
+    from substructure.diagnose.refine import _distinct
+    from substructure.updating.likelihood import Likelihood, measured_frfs
+    from substructure.updating.parameters import model_parameters, parameter_change
+
+    model = hl.model()
+    measured, _ = measured_frfs(hl.measure(flutes=(0.060, 0.75)), None)
+    lik = Likelihood(model, measured)
+    params = {p.path: p for p in model_parameters(model)}
+
+    def single(path, value):
+        change = parameter_change(params[path])
+        return SimpleNamespace(change=change, values={"value": value},
+                               fit=SimpleNamespace(changes=[(change, {"value": value})]))
+
+    singles = [single("joints.holder-tool.k.yf", 2e7), single("components.tool.overhang", 0.17),
+               single("joints.spindle-holder.k.tm", 3e6), single("components.tool.segments.1.od", 0.01875),
+               single("components.tool.segments.1.flutes.diameter_ratio", 0.75)]
+    pool = _distinct(lik.subsample(7), singles, 4)
+    assert [s.change.where for s in pool] == ["joints.holder-tool.k.yf", "components.tool.overhang",
+                                              "joints.spindle-holder.k.tm",
+                                              "components.tool.segments.1.flutes.diameter_ratio"]
+    assert [s.change.where for s in _distinct(lik.subsample(7), singles[:4], 4)][-1].endswith(".od")
