@@ -54,12 +54,14 @@ def model() -> Assembly:
 
 def measure(points=("tool.tip",), sensor_kg: float = 0.0, flutes: tuple[float, float] = FLUTES,
             nut: tuple[float, float, float] | None = None, ht_scale: float = 1.0,
-            tool_E: float = 580e9, tool_rho: float = 14500.0, tool_nu: float = 0.22) -> list[FRF]:
+            tool_E: float = 580e9, tool_rho: float = 14500.0, tool_nu: float = 0.22,
+            bearings: tuple[float, float] = (1.0, 1.0)) -> list[FRF]:
     """Exact FRFs of the rig with hidden effects (response at each point, the hammer at the tool's tip).
 
     points: ``tool.tip``, ``tool.tip-X mm`` or ``holder.tip``; flutes: the tool's real fluted tip (length m,
     diameter ratio); nut: (mass kg, rotary inertia kg m^2, x m) on the holder; ht_scale: the holder-tool
-    joint's k_yf times this; tool_E, tool_rho, tool_nu: the tool's material.
+    joint's k_yf times this; tool_E, tool_rho, tool_nu: the tool's material; bearings: (rear, front) factors on
+    the stiffness of the bearing pairs.
     """
     m = fe.Model()
     lengths = {"holder": sum(h[0] for h in HOLDER), "tool": TOOL_LENGTH}
@@ -84,8 +86,9 @@ def measure(points=("tool.tip",), sensor_kg: float = 0.0, flutes: tuple[float, f
                     (fluted, fe.fluted(TOOL_OD, ratio, material))], points=wanted["tool"])
     m.add_joint((s, sum(x[0] for x in SPINDLE)), (h, 0.0), np.diag(K_SH), np.diag(C_SH))
     m.add_joint((h, lengths["holder"]), (t, 0.0), np.diag([K_HT[0] * ht_scale, K_HT[1]]), np.diag(C_HT))
-    for x in BEARINGS:
-        m.add_support((s, x), [[BEARING_K, 0], [0, 0]], [[BEARING_C, 0], [0, 0]])
+    for i, x in enumerate(BEARINGS):
+        factor = bearings[0] if i < 2 else bearings[1]
+        m.add_support((s, x), [[BEARING_K * factor, 0], [0, 0]], [[BEARING_C, 0], [0, 0]])
     if sensor_kg:
         m.add_mass((t, TOOL_LENGTH), sensor_kg, 0.0)
     if nut:

@@ -502,15 +502,41 @@ def full_fits(likelihood, current: Sequence[tuple], chosen: Sequence[Scored],
             break
         if progress:
             progress(f"fitting {s.change.effect} at {s.change.where} with {len(current)} effect(s) added")
+        held = list(s.start if s.start is not None else current)
         try:
-            result = fit(likelihood, list(s.start if s.start is not None else current) + [(s.change, s.values)])
+            result = fit(likelihood, held + [(s.change, s.values)])
         except (SubstructureError, ValueError, FloatingPointError) as exc:
             if progress:
                 progress(f"  skipped {s.change.effect} at {s.change.where}: {exc}")
             continue
+        result = _from_own_start(likelihood, held, s, result)
         out.append(Scored(s.change, dict(result.changes[-1][1]), result.chi2, result))
     out.sort(key=lambda s: s.chi2)
     return out
+
+
+def _from_own_start(likelihood, held: list, s: Scored, result):
+    """The fit again from the candidate's own start when it ended with its main parameter on a bound.
+
+    The scan's grid is coarse (half a decade for a factor over four) and a
+    minimum can be narrower: both rear bearings of a machine spindle half as
+    stiff sit between the grid's 0.32 and 1, both far off, while the far end
+    of the range (100) fits fairly, and the fit that starts there stays on
+    the bound.  The start of a change is the model as given (or the effect's
+    own starting values), nearest the basin a drawing's error lies in; the
+    better of the two fits is kept.
+    """
+    main = s.change.specs[0]
+    index = len(result.changes) - 1
+    on = dict(zip(result.names, result.at_bound)).get((index, main.name), False)
+    own = {spec.name: spec.start for spec in s.change.specs}
+    if not on or np.isclose(s.values.get(main.name, np.nan), own[main.name], rtol=1e-9, atol=0.0):
+        return result
+    try:
+        again = fit(likelihood, held + [(s.change, own)])
+    except (SubstructureError, ValueError, FloatingPointError):
+        return result
+    return again if again.chi2 < result.chi2 else result
 
 
 def rank(fitted: Sequence[Scored], n: int, p_now: int) -> list[Scored]:
@@ -569,7 +595,11 @@ def preference(change: Change) -> float:
         return 2.5 if measured else 2
     if getattr(change, "linked", False):
         return 1
-    return 3
+    return ELEMENT
+
+
+ELEMENT = 3
+"""The :func:`preference` of an element at a fitted place (a body, a spring, a section change)."""
 
 
 def choose(ranked: Sequence[Scored], n: int, p_now: int) -> tuple[Scored, list[Scored], float]:
@@ -624,4 +654,4 @@ def physical(change: Change, values: dict) -> bool:
     return True
 
 
-__all__ += ["shortlist", "rank", "physical", "preference", "choose", "MEASURED"]
+__all__ += ["shortlist", "rank", "physical", "preference", "choose", "MEASURED", "ELEMENT"]
