@@ -117,17 +117,6 @@ def test_other_flutes_with_a_sensor_are_both_and_predict_points_not_fitted(rig):
         assert error < 0.02 and error < 0.1 * off, (frf.outputs, error, off)
 
 
-def test_the_large_rig_exact_and_with_a_nut_under_real_noise():
-    """The second rig's neighbours that were right before: the exact model explained with nothing, a nut found."""
-    d = diagnose(hl.model(), real_noise.with_real_noise(hl.measure(), 300, 3.0))
-    assert d.explained and not d.effects, _summary(d)
-    d = diagnose(hl.model(), real_noise.with_real_noise(hl.measure(nut=(0.15, 5e-5, 0.040)), 1700))
-    assert d.explained, d.report
-    (found,) = d.effects
-    assert found.name == "added-mass" and found.values["mass"] == pytest.approx(0.15, rel=0.02)
-    assert found.values["position"] == pytest.approx(0.040, abs=1e-3)
-
-
 def test_a_preferred_name_replaces_its_equal_in_the_pool_of_pairs_even_after_the_pool_is_full():
     """The fluted segment's od (what the user measures) and the flutes' ratio (the model's guess) set the same
     section; the ratio ranked fifth, just after the od, and the pool of four pairs took the od."""
@@ -155,3 +144,31 @@ def test_a_preferred_name_replaces_its_equal_in_the_pool_of_pairs_even_after_the
                                               "joints.spindle-holder.k.tm",
                                               "components.tool.segments.1.flutes.diameter_ratio"]
     assert [s.change.where for s in _distinct(lik.subsample(7), singles[:4], 4)][-1].endswith(".od")
+
+
+@pytest.mark.parametrize("hidden, values, stays", [
+    (dict(flutes=(0.030, 0.8)), {"diameter_ratio": 0.8, "start": 0.046, "length": 0.030}, False),
+    (dict(neck=(0.026, 0.020, 0.009)), {"diameter_ratio": 0.75, "start": 0.026, "length": 0.020}, True),
+], ids=["over-the-tip", "a-neck"])
+def test_a_section_change_over_the_tools_tip_is_reported_as_the_flutes_it_is(hidden, values, stays):
+    """The review tries the catalogue's effects on the element's component in its place: a section change at 0.8
+    over a tool's last 30 mm is flutes there (a path that found it so was reported as a section change); a neck
+    in the middle of the tool stays what it is."""
+    from substructure.diagnose.refine import _review
+    from substructure.updating.fit import fit
+    from substructure.updating.likelihood import Likelihood, measured_frfs
+
+    model = hd.nominal_model()
+    measured, _ = measured_frfs(hd.measure(seed=5, **hidden), None)
+    lik = Likelihood(model, measured)
+    section = SectionChange("tool", 0.076)
+    found = fit(lik, [(section, values)])
+    cands = [effect_change(EFFECTS[name], "tool", model) for name in ("fluted-section", "tapered-tool")]
+    kept, chi2, _ = _review(lik, list(found.changes), found.chi2, {}, {}, [], lambda changes: True, None,
+                            cands=cands)
+    ((change, got),) = kept
+    if stays:
+        assert change is section and chi2 == found.chi2
+    else:
+        assert change.key == cands[0].key and chi2 <= found.chi2 * (1 + 1e-6)
+        assert got == pytest.approx({"diameter_ratio": 0.8, "length": 0.030}, rel=1e-3)

@@ -15,7 +15,9 @@ found in it would be fitted to the noise, stacked on the explanation).  Then
   inside the indifference region is an alternative explanation (reported
   as ambiguous), and replaces it when it is preferred (a named effect of
   the catalogue before a linked parameter, before a single parameter,
-  before an element; :func:`~substructure.diagnose.search.preference`);
+  before an element; :func:`~substructure.diagnose.search.preference`),
+  and for an element the catalogue's effects on the same component too,
+  from their starts (flutes for a section change over a tool's tip);
 * the parsimony check compares an explanation of two or more changes by
   BIC with every single candidate of the first step and the best pairs
   fitted from the values of the best singles that change the model in
@@ -55,10 +57,12 @@ from ..updating.fit import Fit, fit, to_u
 from ..updating.selection import INDIFFERENCE, bic, consistency, significance
 from ..updating.likelihood import Likelihood
 from .crossval import cross_validate
+from .effects import EffectChange
 from .modes import mode_starts
 from .pairs import OTHER_FIRSTS, other_paths
 from .scan import places, trials
-from .search import Budget, Scored, _p, choose, full_fits, physical, preference, rank, screen, shortlist
+from .search import (ELEMENT, Budget, Scored, _p, choose, full_fits, physical, preference, rank, screen,
+                     shortlist)
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
 __all__ = ["Outcome", "refine"]
@@ -124,7 +128,7 @@ def _prune(lik, current, chi2_now, say, refits: dict | None = None):
 
 
 def _review(lik, current, chi2_now, steps_fitted, steps_inside, dropped, passive, say,
-            settings: DiagnoseSettings = DEFAULT_SETTINGS):
+            settings: DiagnoseSettings = DEFAULT_SETTINGS, cands=()):
     """Alternatives of each kept change; preferred ones replace it (see the module docstring)."""
     n = lik.n
     alternatives: dict = {}
@@ -135,8 +139,14 @@ def _review(lik, current, chi2_now, steps_fitted, steps_inside, dropped, passive
         pool = [s for s in steps_fitted.get(change.key, []) + dropped if s.change.key not in keys
                 and preference(s.change) < preference(change)]
         pool.sort(key=lambda s: (preference(s.change), s.chi2))
+        pool = pool[:settings.review_pool]
+        if preference(change) >= ELEMENT:
+            # an element at a fitted place may be a named effect of the same component under another name (a
+            # section change over a tool's last 30 mm at 0.8 is flutes there): those effects, from their starts
+            pool = [Scored(c, {spec.name: spec.start for spec in c.specs}, np.inf) for c in cands
+                    if isinstance(c, EffectChange) and c.where == change.where and c.key not in keys] + pool
         found = []
-        for s in pool[:settings.review_pool]:
+        for s in pool:
             trial = current[:i] + [(s.change, s.values)] + current[i + 1:]
             if s.fit is None and s.start is not None:  # screened only: with the values it screened at
                 trial = [(c, dict(v)) for c, v in s.start[:i]] + [(s.change, s.values)] + current[i + 1:]
@@ -504,7 +514,7 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     current, chi2_now, dropped = _prune(lik, current, chi2_now, say, refits)  # nothing to drop from one change
     pruned = sorted(c.key for c, _ in current)
     current, chi2_now, alternatives = _review(lik, current, chi2_now, steps_fitted, steps_inside, dropped,
-                                              passive, say, settings)
+                                              passive, say, settings, cands)
     rivals: list = []
     if len(current) >= 2:
         before = [c.key for c, _ in current]
