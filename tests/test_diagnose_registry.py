@@ -1,5 +1,7 @@
 """Users' effects: registered for a block or passed per call; they never change a built-in answer."""
 
+import re
+
 import attrs
 import pytest
 
@@ -85,3 +87,34 @@ def test_users_effects_have_slots_of_their_own_in_the_shortlist():
     kept = shortlist(scored, 1000.0, 2000, 2000, 10, DEFAULT_SETTINGS)
     assert sum(s.change in user for s in kept) == DEFAULT_SETTINGS.shortlist_max
     assert all(any(s.change is c for s in kept) for c in catalogue + params)
+
+
+@pytest.mark.parametrize("starts, message", [
+    ([{"extra_length": float("nan")}], "scan_starts[0]['extra_length']: got nan; expected a finite number"),
+    ([{"extra_length": "long"}], "scan_starts[0]['extra_length']: got 'long'; expected a finite number"),
+    ([{"length": 0.01}], "scan_starts[0]: unknown parameters ['length']; expected some of extra_length"),
+    ([0.01], "scan_starts[0]: got 0.01; expected a dict of parameter values"),
+    ([{}], "scan_starts[0]: got {}; expected a dict"),
+])
+def test_an_effects_scan_starts_are_checked_where_they_enter(starts, message):
+    """A user's effect that gives the scan bad starts is refused with what was wrong (the diagnosis skips the
+    candidate and says so); good starts are clipped to the parameter's bounds at that place."""
+    from substructure.diagnose.effects import effect_change
+    from substructure.errors import InvalidValueError
+
+    class Bad(ToolOverhang):
+        @classmethod
+        def scan_starts(cls, assembly, where):
+            return starts
+
+    with pytest.raises(InvalidValueError, match=re.escape(message)):
+        effect_change(Bad, "tool", hd.nominal_model())
+
+    class Good(ToolOverhang):
+        @classmethod
+        def scan_starts(cls, assembly, where):
+            return [{"extra_length": 1e3}, {"extra_length": 0.002}]
+
+    change = effect_change(Good, "tool", hd.nominal_model())
+    (spec,) = change.specs
+    assert change.trials == ({"extra_length": spec.upper}, {"extra_length": 0.002})

@@ -35,7 +35,7 @@ effects are in :mod:`substructure.diagnose.catalogue`.
 from __future__ import annotations
 
 import contextlib
-from typing import ClassVar, Sequence
+from typing import ClassVar, Mapping, Sequence
 
 import attrs
 import numpy as np
@@ -369,9 +369,7 @@ class EffectChange(Change):
             specs.append(ParamSpec(p.name, p.unit, lo, hi, float(np.clip(start.get(p.name, p.start), lo, hi)),
                                    p.log and lo > 0))
         self.specs = tuple(specs)
-        limits = {spec.name: (spec.lower, spec.upper) for spec in specs}
-        self.trials = tuple({k: float(np.clip(v, *limits[k])) for k, v in trial.items() if k in limits}
-                            for trial in cls.scan_starts(assembly, where))
+        self.trials = _scan_starts(cls, where, assembly, {spec.name: (spec.lower, spec.upper) for spec in specs})
 
     def instance(self, values) -> Effect:
         """The effect at this change's place with these values (SI)."""
@@ -384,6 +382,31 @@ class EffectChange(Change):
     def apply_si(self, structure, values):
         """The SI structure with the effect applied (the effect's ``apply_si``, :meth:`Change.apply_si`)."""
         return self.instance(values).apply_si(structure)
+
+
+def _scan_starts(cls: type, where: str, assembly: Assembly, limits: dict) -> tuple[dict, ...]:
+    """``cls.scan_starts`` checked: mappings of its parameters' names to finite numbers, clipped to the bounds."""
+    out = []
+    for k, trial in enumerate(cls.scan_starts(assembly, where)):
+        if not isinstance(trial, Mapping) or not trial:
+            raise InvalidValueError(f"effect {cls.name!r} at {where}: scan_starts[{k}]: got {trial!r}; expected a "
+                                    f"dict of parameter values such as {{{next(iter(limits))!r}: 1.0}}")
+        unknown = sorted(set(trial) - set(limits))
+        if unknown:
+            raise InvalidValueError(f"effect {cls.name!r} at {where}: scan_starts[{k}]: unknown parameters "
+                                    f"{unknown}; expected some of {', '.join(limits)}")
+        values = {}
+        for name, value in trial.items():
+            try:
+                value = float(value)
+            except (TypeError, ValueError):
+                value = float("nan")
+            if not np.isfinite(value):
+                raise InvalidValueError(f"effect {cls.name!r} at {where}: scan_starts[{k}][{name!r}]: got "
+                                        f"{trial[name]!r}; expected a finite number (SI)")
+            values[name] = float(np.clip(value, *limits[name]))
+        out.append(values)
+    return tuple(out)
 
 
 def effect_change(cls: type, where: str, assembly: Assembly, shift: float = 0.0) -> Change:
