@@ -297,13 +297,15 @@ def fluted_tip(tool: Beam) -> tuple[float, float]:
         ``(0.0, 1.0)`` for a tool whose last segment has no flutes; else the
         fluted tip's length and its last segment's ``diameter_ratio``.
     """
-    length, ratio = 0.0, 1.0
+    last = tool.segments[-1]
+    if last.flutes is None:
+        return 0.0, 1.0
+    length = 0.0
     for seg in reversed(tool.segments):
-        if not seg.flutes:
+        if seg.flutes is None:
             break
         length += seg.length_m
-        ratio = ratio if length > seg.length_m else seg.flutes.diameter_ratio
-    return length, ratio
+    return length, last.flutes.diameter_ratio
 
 
 def flute_tip(tool: Beam, length_m: float, ratio: float) -> Beam:
