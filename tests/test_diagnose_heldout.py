@@ -16,7 +16,6 @@ import pytest
 import hidden_data as hd
 from substructure import Frequency, Mass
 from substructure.diagnose import DiagnoseSettings, diagnose
-from substructure.diagnose import refine as refine_module
 from substructure.updating import set_parameters
 
 ALL = Frequency.from_range("20 Hz", "5000 Hz", "4 Hz")
@@ -127,14 +126,14 @@ def test_the_same_tool_fitted_below_3_khz_is_the_truths_two_changes():
     assert sensor.values["mass"] == pytest.approx(0.003, rel=0.1)
 
 
-def test_without_pairs_from_other_first_changes_a_composite_is_not_claimed(monkeypatch):
+def test_without_pairs_from_other_first_changes_a_composite_is_not_claimed():
     """The same data without the pairs from other first changes (nor the search of an element's size at each
     place, which finds a section at the tool's tip as heavy as the sensor: ``place_search=0``): the search ends
     with three or more changes (one a joint at its nominal values), close to the noise, and the verdict does not
     claim them."""
-    monkeypatch.setattr(refine_module, "OTHER_FIRSTS", 0)
     frfs = hd.measure(seed=21, tool_length=0.072, sensor_kg=0.003)
-    d = diagnose(hd.nominal_model(), frfs, band=(20.0, 3000.0), settings=DiagnoseSettings(place_search=0))
+    d = diagnose(hd.nominal_model(), frfs, band=(20.0, 3000.0), settings=DiagnoseSettings(place_search=0,
+                                                                                         other_firsts=0))
     assert not d.explained
     assert d.report[0].startswith("unexplained: no candidate explains the data"), d.report
     assert len(d.final_effects) >= 3

@@ -13,10 +13,10 @@ exist.
 So when the forward path did not reach the noise with at most
 two changes (``DiagnoseSettings.most_changes``),
 :func:`other_paths` repeats its second step from each of the
-:data:`OTHER_FIRSTS` best other singles of the first step that change the
+``DiagnoseSettings.other_firsts`` best other singles of the first step that change the
 model in different ways: every candidate is screened with that single held
 (and refitted to first order, as the forward step does), the
-:data:`SECONDS` best of the shortlist are fitted on all lines with it, and
+``DiagnoseSettings.pair_seconds`` best of the shortlist are fitted on all lines with it, and
 the one :func:`~substructure.diagnose.search.choose` takes (the preferred
 name among those the data cannot tell apart) makes a pair.  Where the path
 did reach the noise with two changes, its first choice may still have stood
@@ -39,17 +39,11 @@ from .scan import places
 from .search import _p, choose, full_fits, physical, rank, screen, shortlist
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
-__all__ = ["OTHER_FIRSTS", "SECONDS", "other_paths"]
-
-OTHER_FIRSTS = 3
-"""Singles of the first step (best first, changing the model in different ways) from which a second step is
-screened when the forward path did not reach the noise with at most two changes."""
-SECONDS = 3
-"""Shortlisted second changes fitted on all lines with each of those singles."""
+__all__ = ["other_paths"]
 
 
 def other_paths(lik, screen_lik, lik0, firsts: list, cands: list, passive: Callable, say=None,
-                settings: DiagnoseSettings = DEFAULT_SETTINGS, seconds: int = SECONDS,
+                settings: DiagnoseSettings = DEFAULT_SETTINGS, seconds: int | None = None,
                 with_mode_starts: bool = True) -> list:
     """Pairs of changes from other first changes (see the module docstring).
 
@@ -71,8 +65,9 @@ def other_paths(lik, screen_lik, lik0, firsts: list, cands: list, passive: Calla
         Progress.
     settings : DiagnoseSettings
         The diagnosis's settings.
-    seconds : int, default SECONDS
-        Shortlisted second changes fitted on all lines with each single.
+    seconds : int, optional
+        Shortlisted second changes fitted on all lines with each single
+        (default ``settings.pair_seconds``).
     with_mode_starts : bool, default True
         Screen from the starts the mode shifts predict as well as from the
         scan's own.
@@ -97,7 +92,8 @@ def other_paths(lik, screen_lik, lik0, firsts: list, cands: list, passive: Calla
             scored = screen(screen_lik, held, remaining, chi2_s, n, None, starts, settings=settings)
         except (ValueError, ArithmeticError, SubstructureError):
             continue
-        chosen = shortlist(scored, chi2_s, screen_lik.n, n, _p(held), settings)[:seconds]
+        count = settings.pair_seconds if seconds is None else seconds
+        chosen = shortlist(scored, chi2_s, screen_lik.n, n, _p(held), settings)[:count]
         done = [s for s in full_fits(lik, held, chosen) if physical(s.change, s.values) and passive(s.fit.changes)]
         if not done:
             continue

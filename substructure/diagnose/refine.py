@@ -59,7 +59,7 @@ from ..updating.likelihood import Likelihood
 from .crossval import cross_validate
 from .effects import EffectChange
 from .modes import mode_starts
-from .pairs import OTHER_FIRSTS, other_paths
+from .pairs import other_paths
 from .scan import places, trials
 from .search import (ELEMENT, Budget, Scored, _p, choose, full_fits, physical, preference, rank, screen,
                      shortlist)
@@ -524,7 +524,7 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
         # its first choice may be the wrong one: where the path did not reach the noise with two changes, and where
         # it did (a stand-in completed by an invented second change), from fewer other firsts
         # the path's own first change (or the same change under another name) is not started from again
-        starts = OTHER_FIRSTS if failed else settings.confirm_firsts
+        starts = settings.other_firsts if failed else settings.confirm_firsts
         if starts:
             singles = [s for s in first_fitted if s.fit is not None]
             firsts = [s for s in _distinct(screen_lik, singles, starts + 1, settings)

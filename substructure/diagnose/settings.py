@@ -284,6 +284,14 @@ class DiagnoseSettings:
         Most evaluations of a pair's fit on the screening lines (default 40).
     pairs_fitted : int
         Pairs (best on the screening lines) fitted on all lines (default 2).
+    other_firsts : int
+        Where the forward path did not reach the noise with at most
+        ``most_changes`` changes, the other singles of the first step (best
+        first) from which a second step is screened: its first choice may be
+        the wrong one (default 3; 0: not tried).
+    pair_seconds : int
+        Shortlisted second changes of that step fitted on all lines with each
+        single (default 3).
     confirm_firsts : int
         Where the forward path reached the noise with two changes, the other
         singles of the first step (best first) from which a second step is
@@ -401,6 +409,8 @@ class DiagnoseSettings:
     same_direction: float = attrs.field(default=0.995, validator=_number(0.0, 1.0))
     pair_screen_evaluations: int = attrs.field(default=40, validator=_count())
     pairs_fitted: int = attrs.field(default=2, validator=_count(0))
+    other_firsts: int = attrs.field(default=3, validator=_count(0))
+    pair_seconds: int = attrs.field(default=3, validator=_count())
     confirm_firsts: int = attrs.field(default=1, validator=_count(0))
     confirm_screen_step: int = attrs.field(default=2, validator=_count())
     other_starts: int = attrs.field(default=2, validator=_count(0))
