@@ -193,6 +193,15 @@ def fit(likelihood, changes: Sequence[tuple], free: Sequence[bool] | None = None
             size.append(r.size)
         return r
 
+    def together(_fun, points):
+        # scipy's finite-difference steps, evaluated together (``Likelihood.residuals``: the same numbers as one
+        # by one, in one coupling where the steps keep the model's layout); one by one when a step cannot be held
+        us = list(points)
+        try:
+            return likelihood.residuals([model_of(u) for u in us])
+        except (SubstructureError, ValueError, FloatingPointError):
+            return [residual(u) for u in us]
+
     if not slots:
         r = likelihood.residual(changes)
         return Fit(tuple(changes), tuple({} for _ in changes), np.zeros((0, 0)), (), float(r @ r), r.size, 1, ())
@@ -202,7 +211,7 @@ def fit(likelihood, changes: Sequence[tuple], free: Sequence[bool] | None = None
     span = np.maximum(hi - lo, 1e-12)
     u0 = np.clip(u0, lo + 1e-9 * span, hi - 1e-9 * span)
     result = least_squares(residual, u0, bounds=(lo, hi), method="trf", x_scale=1.0, diff_step=1e-6,
-                           ftol=FTOL, xtol=XTOL, max_nfev=max_nfev or 30 * (len(slots) + 1))
+                           ftol=FTOL, xtol=XTOL, max_nfev=max_nfev or 30 * (len(slots) + 1), workers=together)
     u, f0, jac = result.x, result.fun, result.jac
     chi2 = float(f0 @ f0)
     n, p = f0.size, len(slots)
