@@ -264,8 +264,19 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
             w = w - basis @ (basis.T @ w)
         return float(w @ w)
 
-    def chi2_of(changes_now) -> float:
-        return projected(likelihood.residual(changes_now))
+    def chi2_of(models) -> list[float]:
+        # several models evaluated together (the same numbers as one by one); one that cannot be held costs inf
+        try:
+            return [projected(w) for w in likelihood.residuals(models)]
+        except (SubstructureError, ValueError, FloatingPointError):
+            pass
+        costs = []
+        for model in models:
+            try:
+                costs.append(projected(likelihood.residual(model)))
+            except (SubstructureError, ValueError, FloatingPointError):
+                costs.append(math.inf)
+        return costs
 
     scanned = []
     for n, change in enumerate(changes, start=1):
@@ -343,11 +354,11 @@ def _refined(s: Scored, chi2_of, current, thorough: bool, settings: DiagnoseSett
     if not hi > lo:
         return s
 
-    def cost(u):
-        try:
-            return chi2_of(list(current) + [(s.change, {**s.values, main.name: from_u(main, u)})])
-        except (SubstructureError, ValueError, FloatingPointError):
-            return math.inf
+    def costs_at(us) -> list[float]:
+        return chi2_of([list(current) + [(s.change, {**s.values, main.name: from_u(main, u)})] for u in us])
+
+    def cost(u) -> float:
+        return costs_at([u])[0]
 
     best_u, best_c = u0, float(s.chi2)
     bracket = None
@@ -357,7 +368,7 @@ def _refined(s: Scored, chi2_of, current, thorough: bool, settings: DiagnoseSett
         sub = step / settings.polish_points
         pts = [u for u in u0 + sub * np.arange(-settings.polish_points + 1, settings.polish_points)
                if lo < u < hi and u != u0]
-        costs = [cost(u) for u in pts]
+        costs = costs_at(pts)
         if costs and min(costs) < best_c:
             j = int(np.argmin(costs))
             best_u, best_c = float(pts[j]), float(costs[j])
@@ -366,7 +377,8 @@ def _refined(s: Scored, chi2_of, current, thorough: bool, settings: DiagnoseSett
         # the slope at the scan's best, then Brent's down it (a change smaller than a grid step scans no
         # better than the model, but the slope shows it)
         tiny = step / float(settings.slope_divisions)
-        down = [(c, u) for c, u in ((cost(u), u) for u in (u0 - tiny, u0 + tiny) if lo <= u <= hi) if c < best_c]
+        near = [u for u in (u0 - tiny, u0 + tiny) if lo <= u <= hi]
+        down = [(c, u) for c, u in zip(costs_at(near), near) if c < best_c]
         if down:
             best_c, best_u = min(down)
             bracket = (lo, u0) if best_u < u0 else (u0, hi)
