@@ -85,3 +85,31 @@ def test_the_pair_found_predicts_points_that_were_not_measured():
             misfit(stand_in.refined_assembly)
         assert saved < 0.02 and saved < 0.1 * given, (point, saved, given)
         assert saved < other, (point, saved, other)
+
+
+def test_the_second_changes_fitted_include_a_preferred_name_the_screening_cannot_tell_apart():
+    """Of a shortlist only the first ``count`` are fitted with each other first change; a catalogue effect that
+    screens as well as one of them (parameters counted: a body near the tip with its position against a sensor
+    at the tip) is fitted too, one that screens clearly worse or is not preferred is not."""
+    from substructure.diagnose.effects import EFFECTS, EffectChange
+    from substructure.diagnose.pairs import _with_preferred
+    from substructure.diagnose.search import Scored
+    from substructure.updating.elements import AddedMass
+    from substructure.updating.parameters import model_parameters, parameter_change
+
+    model = hd.nominal_model()
+    body = AddedMass("tool", 0.076, 0.05)  # mass, inertia and position: three parameters
+    sensor = EffectChange(EFFECTS["sensor-mass"], "tool.tip", model)  # mass and inertia
+    param = parameter_change(model_parameters(model)[0])
+    n = 834  # residuals of the screening lines: ln n = 6.7 per parameter
+    assert len(body.specs) == 3 and len(sensor.specs) == 2
+    # the parameter (one) has a BIC 6.9 below the body's
+    alike = [Scored(body, {}, 267.6), Scored(sensor, {}, 273.2), Scored(param, {}, 280.0)]
+    assert [s.change for s in _with_preferred(alike, 1, n, 2)] == [body, sensor, param]
+    # worse by 19 in chi^2, 12 in BIC: told apart, and a model parameter two places down is preferred too
+    apart = [Scored(body, {}, 267.6), Scored(sensor, {}, 286.6), Scored(param, {}, 2000.0)]
+    assert [s.change for s in _with_preferred(apart, 1, n, 2)] == [body]
+    # the sensor first: nothing less preferred joins it
+    assert [s.change for s in _with_preferred([Scored(sensor, {}, 267.6), Scored(body, {}, 267.7)], 1, n, 2)] \
+        == [sensor]
+    assert _with_preferred([], 1, n, 2) == []

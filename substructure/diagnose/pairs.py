@@ -36,7 +36,8 @@ from typing import Callable
 from ..errors import SubstructureError
 from .modes import mode_starts
 from .scan import places
-from .search import _p, choose, full_fits, physical, rank, screen, shortlist
+from ..updating.selection import indifferent
+from .search import _p, choose, full_fits, physical, preference, rank, screen, shortlist
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
 __all__ = ["other_paths"]
@@ -93,7 +94,8 @@ def other_paths(lik, screen_lik, lik0, firsts: list, cands: list, passive: Calla
         except (ValueError, ArithmeticError, SubstructureError):
             continue
         count = settings.pair_seconds if seconds is None else seconds
-        chosen = shortlist(scored, chi2_s, screen_lik.n, n, _p(held), settings)[:count]
+        chosen = _with_preferred(shortlist(scored, chi2_s, screen_lik.n, n, _p(held), settings), count,
+                                 screen_lik.n, _p(held))
         done = [s for s in full_fits(lik, held, chosen) if physical(s.change, s.values) and passive(s.fit.changes)]
         if not done:
             continue
@@ -103,3 +105,21 @@ def other_paths(lik, screen_lik, lik0, firsts: list, cands: list, passive: Calla
             out.append((pair, best.chi2))
     return out
 
+
+
+def _with_preferred(shortlisted: list, count: int, n_lines: int, p_now: int) -> list:
+    """The ``count`` best of the shortlist, and every later one of a preferred name that the screening cannot
+    tell from one of those (``indifferent`` on the screening lines, parameters counted).
+
+    Only the first ``count`` are fitted on all lines, and :func:`~substructure.diagnose.search.choose` prefers
+    names only among what was fitted: a body 0.2 mm from the tool's tip screens a little better than a sensor
+    at the tip (its position fits some noise too), yet on all lines the two are alike and the sensor is the
+    name to give.
+    """
+    first = list(shortlisted[:count])
+    if not first:
+        return first
+    s2 = max(1.0, min(s.chi2 for s in shortlisted) / max(n_lines - p_now - max(s.k for s in shortlisted), 1))
+    return first + [s for s in shortlisted[count:]
+                    if any(preference(s.change) < preference(t.change)
+                           and indifferent(s.chi2, p_now + s.k, t.chi2, p_now + t.k, n_lines, s2) for t in first)]
