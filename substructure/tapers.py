@@ -37,7 +37,7 @@ import numpy as np
 from ._chains import _phase, _stack_sections
 from .sections import Section, shear_coefficient
 from .errors import InvalidValueError
-from .units import Q_, quantity
+from .units import quantity
 
 if TYPE_CHECKING:  # beams imports this module (Segment delegates its tapers to it); the annotations only
     from .beams import Segment
@@ -69,10 +69,13 @@ def _steps(value) -> int | None:
     return int(value)
 
 
-def _taper_arrays(seg: Segment, t: np.ndarray):
-    """``EI, kGA, rhoA, rhoI`` arrays of a tapered segment at fractions ``t`` of its length (SI)."""
+def _taper_arrays(seg: Segment, t: np.ndarray, part: tuple[float, float] = (0.0, 1.0)):
+    """``EI, kGA, rhoA, rhoI`` arrays of a tapered segment at fractions ``t`` of its length (SI), or of the
+    part of it between the fractions ``part`` (as :func:`split` cuts it, without building the parts)."""
     assert seg._taper is not None  # called for tapered segments only
     od0, od1, id0, id1 = seg._taper
+    if part != (0.0, 1.0):
+        t = part[0] + (part[1] - part[0]) * t
     od = od0 + (od1 - od0) * t
     idd = id0 + (id1 - id0) * t
     if seg.flutes is not None:
@@ -104,7 +107,7 @@ _GAUSS = math.sqrt(3.0) / 6.0          # Gauss points of a step at its middle -+
 _CF = (0.5 + math.sqrt(3.0) / 3.0, 0.5 - math.sqrt(3.0) / 3.0)  # commutator-free Magnus weights
 
 
-def _magnus_sections(seg: Segment, n: int) -> list[Section]:
+def _magnus_sections(seg: Segment, n: int, part: tuple[float, float] = (0.0, 1.0)) -> list[Section]:
     """The ``2 n`` uniform half-steps of the fourth-order commutator-free Magnus scheme.
 
     Over a step of length ``h`` with the section ``S1`` at its base-side
@@ -115,11 +118,11 @@ def _magnus_sections(seg: Segment, n: int) -> list[Section]:
     entries, and ``c1 + c2 = 1``, so each factor is the transfer matrix of a
     uniform section over ``h/2``: ``1/EI = c1/EI1 + c2/EI2``, ``1/kGA``
     likewise, ``rhoA = c1 rhoA1 + c2 rhoA2``, ``rhoI`` likewise.  The
-    sections do not depend on the frequency.
+    sections do not depend on the frequency.  ``part``: of the part between these fractions of the segment.
     """
     middle = (np.arange(n) + 0.5) / n
     t = np.column_stack([middle - _GAUSS / n, middle + _GAUSS / n]).ravel()
-    ei, kga, rhoa, rhoi = _taper_arrays(seg, t)
+    ei, kga, rhoa, rhoi = _taper_arrays(seg, t, part)
     out = []
     for k in range(n):
         i, j = 2 * k, 2 * k + 1
@@ -131,20 +134,21 @@ def _magnus_sections(seg: Segment, n: int) -> list[Section]:
     return out
 
 
-def _auto_steps(seg: Segment, omega_max: float = 0.0) -> int:
+def _auto_steps(seg: Segment, omega_max: float = 0.0, part: tuple[float, float] = (0.0, 1.0)) -> int:
     """Steps such that no section property changes by more than TAPER_STEP_RATIO over one
     step and, at ``omega_max``, no step is longer than TAPER_STEP_PHASE over the bending wavenumber.
 
     The largest logarithmic slope of ``|EI|``, ``|kGA|``, ``rhoA`` and ``rhoI``
     along the segment (from 257 samples) times the length over the ratio;
-    the largest ``k L`` of the end sections over the phase.
+    the largest ``k L`` of the end sections over the phase.  ``part``: of the
+    part between these fractions of the segment.
     """
     t = np.linspace(0.0, 1.0, 257)
-    slopes = [np.max(np.abs(np.diff(np.log(np.abs(p))))) * (t.size - 1) for p in _taper_arrays(seg, t)]
+    slopes = [np.max(np.abs(np.diff(np.log(np.abs(p))))) * (t.size - 1) for p in _taper_arrays(seg, t, part)]
     n = math.ceil(max(slopes) / TAPER_STEP_RATIO - 1e-9)
     if omega_max > 0.0:
-        kl = max(_phase(sec, seg.length_m, omega_max) for sec in _taper_sections(seg, np.array([0.0, 1.0])))
-        n = max(n, math.ceil(kl / TAPER_STEP_PHASE - 1e-9))
+        ends = Section(*_taper_arrays(seg, np.array([0.0, 1.0]), part))  # both ends in one kernel call
+        n = max(n, math.ceil(_phase(ends, seg.length_m * (part[1] - part[0]), omega_max) / TAPER_STEP_PHASE - 1e-9))
     return max(1, n)
 
 
@@ -354,16 +358,20 @@ def piecewise_sections(segments: Sequence[Segment], omega_max: float = 0.0,
             continue
         tol = 1e-12 * max(x1, 1e-300)
         inner = [float(p) for p in positions if x0 + tol < p < x1 - tol]
-        parts, starts, rest, start = [], [], seg, x0
-        for p in inner:
-            first, rest = rest.split(Q_(p - start, "m"))
-            parts.append(first)
-            starts.append(start)
-            start = p
-        parts.append(rest)
-        starts.append(start)
-        for part, a, b in zip(parts, starts, [*inner, x1]):
-            pieces = piece_sections(part, None, omega_max)
+        # the parts between the points, as split() cuts them (its share of the steps given, too), as fractions of
+        # the segment: their sections without building the parts
+        stops = [*inner, x1]
+        steps: list = [None] * len(stops)
+        if seg.taper_steps is not None:
+            rest = seg.taper_steps
+            for k, (a, b) in enumerate(zip([x0, *inner], inner)):
+                steps[k] = max(1, round(rest * (b - a) / (x1 - a)))
+                rest = max(1, rest - steps[k])
+            steps[-1] = rest
+        length = x1 - x0
+        for a, b, n in zip([x0, *inner], stops, steps):
+            part = ((a - x0) / length, (b - x0) / length)
+            pieces = _magnus_sections(seg, n if n is not None else _auto_steps(seg, omega_max, part), part)
             sections.extend(pieces)
             n = len(pieces)
             bounds.extend(a + (b - a) * np.arange(1, n) / n)

@@ -218,6 +218,26 @@ def test_split_gives_the_same_beam():
         seg.split("60 mm")
 
 
+@pytest.mark.parametrize("steps", [None, 9])
+def test_points_inside_a_taper_are_cuts_as_split_makes_them(steps):
+    """Points inside a taper step each part between them as Segment.split cuts it (the parts are not built
+    there): the same receptances as the split segments given as separate segments, to rounding, with
+    automatic steps and with ``taper_steps`` shared out between the parts."""
+    seg = Segment("60 mm", "40 mm", "10 mm", STEEL_D, od_tip="20 mm", id_tip="8 mm", taper_steps=steps)
+    f = np.linspace(100.0, 12000.0, 60)
+    cuts = [0.013, 0.031, 0.047]
+    parts, rest, start = [], seg, 0.0
+    for x in cuts:
+        first, rest = rest.split(f"{(x - start) * 1e3!r} mm")
+        parts.append(first)
+        start = x
+    parts.append(rest)
+    points = [0.0, *cuts, 0.06]
+    inside = stepped_beam_receptance([seg], points, f)
+    split = stepped_beam_receptance(parts, points, f)
+    assert (np.abs(inside - split) / np.abs(split).max(axis=-1, keepdims=True)).max() < 1e-9
+
+
 def test_batch_with_tapers_equals_single_configurations():
     configs = [
         [Segment("30 mm", "63 mm", material=STEEL0), Segment(f"{L} mm", "40 mm", "12 mm", STEEL0,
