@@ -34,9 +34,9 @@ from __future__ import annotations
 from typing import Callable
 
 from ..errors import SubstructureError
+from ..updating.selection import indifferent
 from .modes import mode_starts
 from .scan import places
-from ..updating.selection import indifferent
 from .search import _p, choose, full_fits, physical, preference, rank, screen, shortlist
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
@@ -104,7 +104,6 @@ def other_paths(lik, screen_lik, lik0, firsts: list, cands: list, passive: Calla
         if all(physical(c, v) for c, v in pair):
             out.append((pair, best.chi2))
     return out
-
 
 
 def _with_preferred(shortlisted: list, count: int, n_lines: int, p_now: int) -> list:
