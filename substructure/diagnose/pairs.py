@@ -16,7 +16,8 @@ two changes (``DiagnoseSettings.most_changes``),
 ``DiagnoseSettings.other_firsts`` best other singles of the first step that change the
 model in different ways: every candidate is screened with that single held
 (and refitted to first order, as the forward step does), the
-``DiagnoseSettings.pair_seconds`` best of the shortlist are fitted on all lines with it, and
+``DiagnoseSettings.pair_seconds`` best of the shortlist are fitted on all lines with it (and any later one of
+a preferred name that the screening cannot tell from one of them), and
 the one :func:`~substructure.diagnose.search.choose` takes (the preferred
 name among those the data cannot tell apart) makes a pair.  Where the path
 did reach the noise with two changes, its first choice may still have stood
