@@ -172,3 +172,25 @@ def test_a_section_change_over_the_tools_tip_is_reported_as_the_flutes_it_is(hid
     else:
         assert change.key == cands[0].key and chi2 <= found.chi2 * (1 + 1e-6)
         assert got == pytest.approx({"diameter_ratio": 0.8, "length": 0.030}, rel=1e-3)
+
+
+@pytest.mark.parametrize("path, value", [
+    ("components.tool.overhang", 0.080), ("components.tool.bore", 0.002), ("components.tool.segments.0.od", 0.0118),
+])
+def test_a_sliver_left_by_flutes_does_not_refuse_later_values_on_the_tool(path, value):
+    """Flutes whose start falls within a micrometre of a segment's end leave a sliver in the SI form (its cut is
+    not moved to the end: that would stop the flutes' length from moving in a finite difference).  A later value
+    on that tool was refused for the sliver ("a segment shorter than 1 um"): the overhang after flutes was never
+    a candidate.  Now only what the value makes is refused, and the result is the assembly's (written back
+    without the sliver)."""
+    from substructure.updating.paths import apply_path_si, set_parameters
+
+    model = hd.nominal_model()
+    effect = _flutes(0.8, 0.030 + 3e-10)  # starts 0.3 nm before the step at 46 mm
+    structure = effect.apply_si(Structure.from_assembly(model))
+    assert structure.beams["tool"].length.min() < 1e-9
+    got = Evaluator(OUT, IN, F)(apply_path_si(structure, path, value))
+    ref = set_parameters(effect.apply(model), {path: value}).frf(OUT, IN, F).data
+    np.testing.assert_allclose(got, ref, rtol=1e-6, atol=1e-12 * np.abs(ref).max())
+    with pytest.raises(Exception, match="shorter than 1 um"):  # what the value itself makes is still refused
+        apply_path_si(structure, "components.tool.segments.0.length", 5e-7)

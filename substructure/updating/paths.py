@@ -49,7 +49,7 @@ def _bore_inserts_si(structure, path: str, name: str, od: float, material: str, 
         if hit.any():
             ins = other.insert.copy()
             ins[hit, 1] = value
-            out = out.with_beam(_section_checked(path, other.evolve(insert=ins)))
+            out = out.with_beam(_section_checked(path, other.evolve(insert=ins), other))
     for other in structure.opaque.values():
         bored = None if other.name == name else _bored_shank(other, material, od, value)
         if bored is not None:
@@ -85,19 +85,29 @@ def _geometry(beam, path: str, rest: list[str], value: float):
     return beam.evolve(ratio=ratio)
 
 
-def _section_checked(path: str, beam):
-    """``beam`` if every segment is one the assembly holds (the checks of :class:`~substructure.beams.Segment`),
-    else an error naming the value: the SI form refuses what the assembly would (a fit counts the trial as
-    infeasible), so that a fitted value always writes back."""
+def _problems(beam) -> tuple:
+    """``(what, mask)`` of every check of :class:`~substructure.beams.Segment` on the beam's arrays."""
     insert_od, insert_id = beam.insert[:, 0], beam.insert[:, 1]
     sizes = np.concatenate([beam.length, beam.od, beam.id, beam.ratio, insert_od, insert_id])
-    problems = (("a size that is not a finite number", ~np.isfinite(sizes)),
-                ("a segment shorter than 1 um", beam.length < 1e-6),
-                ("an outer diameter under 1 um", beam.od < 1e-6),
-                ("a bore as wide as the section", beam.id >= beam.od * beam.ratio),
-                ("an insert wider than its bore", (insert_od > 0) & (insert_od > beam.id)),
-                ("an insert's bore as wide as the insert", (insert_od > 0) & (insert_id >= insert_od)))
-    for what, bad in problems:
+    return (("a size that is not a finite number", ~np.isfinite(sizes)),
+            ("a segment shorter than 1 um", beam.length < 1e-6),
+            ("an outer diameter under 1 um", beam.od < 1e-6),
+            ("a bore as wide as the section", beam.id >= beam.od * beam.ratio),
+            ("an insert wider than its bore", (insert_od > 0) & (insert_od > beam.id)),
+            ("an insert's bore as wide as the insert", (insert_od > 0) & (insert_id >= insert_od)))
+
+
+def _section_checked(path: str, beam, before=None):
+    """``beam`` if every segment is one the assembly holds (the checks of :class:`~substructure.beams.Segment`),
+    else an error naming the value: the SI form refuses what the assembly would (a fit counts the trial as
+    infeasible), so that a fitted value always writes back.  Given the beam ``before`` the value was set (of
+    the same segments), only what the value makes is refused: a sliver that a change added earlier cut (a
+    section change or flutes starting within a micrometre of a segment's end; written back without it) does
+    not refuse every later value on the beam."""
+    old = _problems(before) if before is not None and before.length.size == beam.length.size else None
+    for k, (what, bad) in enumerate(_problems(beam)):
+        if old is not None:
+            bad = bad & ~old[k][1]
         if np.any(bad):
             raise InvalidValueError(f"parameter {path!r}: the value makes {what} in {beam.name!r}")
     return beam
@@ -503,11 +513,11 @@ def _component_si(structure, path: str, name: str, rest: tuple, value: float):
         return out
     beam = structure.beam(name)
     if rest[0] in ("segments", "overhang"):
-        return structure.with_beam(_section_checked(path, _geometry(beam, path, list(rest), value)))
+        return structure.with_beam(_section_checked(path, _geometry(beam, path, list(rest), value), beam))
     if rest == ("bore",):  # every segment without an insert: a coolant bore, a hollow shank
         value = 0.0 if value < 1e-6 else value
         bore = np.where(beam.insert[:, 0] > 0, beam.id, value)
-        out = structure.with_beam(_section_checked(path, beam.evolve(id=bore)))
+        out = structure.with_beam(_section_checked(path, beam.evolve(id=bore), beam))
         return _bore_inserts_si(out, path, name, float(beam.od[0]), beam.material_names[0], value)
     if rest[0] in _COMPONENT_KEYS:  # its material: E, rho, loss_factor as factors, material.X as values
         mat, column = beam.material.copy(), _MAT_COLUMN[rest[-1]]
