@@ -264,6 +264,46 @@ def test_a_change_smaller_than_a_grid_step_is_still_screened():
     assert abs(found.values["value"] - 0.0775) < 5e-4
 
 
+def test_a_candidate_some_of_whose_trials_the_model_cannot_hold_is_still_screened():
+    """With a section change from 18 to 69 mm held, the overhang's grid reaches lengths shorter than the tool's
+    first segment: those trials cannot be held, and the whole candidate was skipped ("a segment shorter than
+    1 um"), so a longer tool could not be found after a section change.  Now such trials cost infinity and the
+    others stand; a candidate none of whose trials can be held is still skipped with the reason."""
+    from substructure.diagnose.effects import Effect, Parameter, effect_change, registry
+    from substructure.diagnose.search import candidates, screen
+    from substructure.errors import InvalidValueError
+    from substructure.updating.elements import SectionChange
+    from substructure.updating.likelihood import Likelihood, measured_frfs
+
+    model = hd.nominal_model()
+    measured, _ = measured_frfs(hd.measure(seed=9, tool_length=0.080), None)
+    lik = Likelihood(model, measured)
+    sub = lik.subsample(10)
+    held = [(SectionChange("tool", 0.076), {"diameter_ratio": 0.97, "start": 0.018, "length": 0.051})]
+    overhang = [c for c in candidates(model, ["tool.tip:y"], registry()) if c.where == "components.tool.overhang"]
+    said: list = []
+    (found,) = screen(sub, held, overhang, sub.chi2(held), lik.n, said.append)
+    assert not any("skipped" in line for line in said)
+    assert abs(found.values["value"] - 0.080) < 1e-3
+
+    class Refused(Effect):
+        """Every value refused by the model."""
+
+        name = "refused-always"
+        parameters = (Parameter("ratio", "dimensionless", 0.5, 1.0, 0.9, log=False),)
+        explanation = "a test effect whose every value the model refuses"
+
+        def apply(self, assembly):
+            raise InvalidValueError("ratio: refused here")
+
+        def apply_si(self, structure):
+            raise InvalidValueError("ratio: refused here")
+
+    said.clear()
+    assert screen(sub, held, [effect_change(Refused, "tool", model)], sub.chi2(held), lik.n, said.append) == []
+    assert any("skipped refused-always at tool: ratio: refused here" in line for line in said), said
+
+
 def test_a_ring_on_a_bar_tapped_at_its_middle_could_sit_either_side():
     """A free bar tapped and measured at its middle cannot tell a ring at 60 mm from one at 140 mm (the point
     FRF is the same by symmetry): the diagnosis finds one, fits the mirror as well from its own scan, and

@@ -264,18 +264,22 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
             w = w - basis @ (basis.T @ w)
         return float(w @ w)
 
-    def chi2_of(models) -> list[float]:
+    def chi2_of(models, none_held_raises: bool = False) -> list[float]:
         # several models evaluated together (the same numbers as one by one); one that cannot be held costs inf
+        # (a trial of the scan beyond what the model holds: a shorter overhang than a section change leaves);
+        # none held: the first one's error, when asked
         try:
             return [projected(w) for w in likelihood.residuals(models)]
-        except (SubstructureError, ValueError, FloatingPointError):
-            pass
+        except (SubstructureError, ValueError, FloatingPointError) as exc:
+            first = exc
         costs = []
         for model in models:
             try:
                 costs.append(projected(likelihood.residual(model)))
             except (SubstructureError, ValueError, FloatingPointError):
                 costs.append(math.inf)
+        if none_held_raises and not np.isfinite(costs).any():
+            raise first
         return costs
 
     scanned = []
@@ -288,7 +292,7 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
             # evaluated together (the same numbers as one by one), then an element's size searched at each of
             # its places
             def evaluate(batch, change=change) -> list[float]:
-                return [projected(w) for w in likelihood.residuals([list(current) + [(change, t)] for t in batch])]
+                return chi2_of([list(current) + [(change, t)] for t in batch], none_held_raises=True)
 
             costs = evaluate(tried)
             try:
