@@ -25,7 +25,11 @@ found in it would be fitted to the noise, stacked on the explanation).  Then
   is kept, those within the indifference region are its rivals; when the
   forward path did not reach the noise with two changes, pairs found by
   second steps from other singles join them
-  (:mod:`substructure.diagnose.pairs`);
+  (:mod:`substructure.diagnose.pairs`), and where it did, those from the
+  best other single and, for a first change that is an element at a
+  fitted place, from the catalogue's effects on its component
+  (:func:`_named_firsts`); a single such element that reached the noise
+  is checked against the pairs from those alone;
 * the cross-validation drops a kept change whose explanation does not
   predict held-back lines better than the one without it
   (:mod:`substructure.diagnose.crossval`);
@@ -310,6 +314,24 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
     return kept, kept_chi2, rivals
 
 
+def _named_firsts(lik, first, first_scored, firsts, passive, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> list:
+    """Where the path's first change is an element at a fitted place (a section change, the generic stand-in),
+    the catalogue's effects on the same component that improved the model in the first step (best first, at
+    most ``settings.confirm_named``, those not among ``firsts``), each fitted on all lines from its screened
+    values: the other firsts of the confirming step besides.
+
+    A tapered tool with a 3 g sensor came back as a section change over most of the tool and a 0.9 mm bore:
+    the taper alone screened too far behind the section change to be fitted in the first step, so no pair
+    started from it; with it, the taper and the sensor describe the data better with fewer parameters.
+    """
+    if preference(first) < ELEMENT or not settings.confirm_named:
+        return []
+    taken = {s.change.key for s in firsts} | {first.key}
+    named = [s for s in first_scored if isinstance(s.change, EffectChange) and s.change.where == first.where
+             and s.change.key not in taken][:settings.confirm_named]
+    return [s for s in full_fits(lik, [], named) if physical(s.change, s.values) and passive(s.fit.changes)]
+
+
 PLACING = ("position", "start", "inset", "inset_tip")
 """Parameters that place a change along a component: where a second minimum lives (a body either side of a
 symmetric point, springs further in at another stiffness)."""
@@ -516,7 +538,19 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     current, chi2_now, alternatives = _review(lik, current, chi2_now, steps_fitted, steps_inside, dropped,
                                               passive, say, settings, cands)
     rivals: list = []
-    if len(current) >= 2:
+    # a single element at a fitted place that reached the noise (a section change) may stand in for a named effect
+    # of its component with a change it hides (a taper with a sensor): the pairs from those, cheaply screened
+    named = _named_firsts(lik, current[0][0], first_scored, [], passive, settings) if len(current) == 1 else []
+    if named:
+        more = other_paths(lik, screen_lik.subsample(settings.confirm_screen_step), lik0, named, cands, passive,
+                           say, settings, seconds=1, with_mode_starts=False)
+        before = [c.key for c, _ in current]
+        current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, [], passive, say, settings, more)
+        if [c.key for c, _ in current] != before:  # a pair: each must still earn its place
+            current, chi2_now, late = _prune(lik, current, chi2_now, say, refits)
+            dropped += late
+            alternatives = {c.key: [] for c, _ in current}
+    if len(current) >= 2 and not named:
         before = [c.key for c, _ in current]
         more = []
         failed = len(current) > settings.most_changes or not consistency(lik, lik.log_ratios(current),
@@ -528,11 +562,12 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
         if starts:
             singles = [s for s in first_fitted if s.fit is not None]
             firsts = [s for s in _distinct(screen_lik, singles, starts + 1, settings)
-                      if s.change.key != path[0][1].key]
+                      if s.change.key != path[0][1].key][:starts]
             if failed:
-                more = other_paths(lik, screen_lik, lik0, firsts[:starts], cands, passive, say, settings)
+                more = other_paths(lik, screen_lik, lik0, firsts, cands, passive, say, settings)
             else:  # a cheaper screening: one second change per first, fitted on all lines
-                more = other_paths(lik, screen_lik.subsample(settings.confirm_screen_step), lik0, firsts[:starts],
+                firsts += _named_firsts(lik, path[0][1], first_scored, firsts, passive, settings)
+                more = other_paths(lik, screen_lik.subsample(settings.confirm_screen_step), lik0, firsts,
                                    cands, passive, say, settings, seconds=1, with_mode_starts=False)
         current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
                                                settings, more)

@@ -302,6 +302,13 @@ class DiagnoseSettings:
     confirm_screen_step : int
         That second step screens every this-many-th line of the screening
         subsample, from the scan's own starts (default 2).
+    confirm_named : int
+        Where that path's first change is an element at a fitted place (a
+        section change: the generic stand-in), the catalogue's effects on the
+        same component that improved the model in the first step (best
+        first, at most this many) are fitted on all lines and start that
+        second step too: a tapered tool with a sensor otherwise came back as
+        a section change and a bore (default 2; 0: not tried).
     other_starts : int
         Starts per placed change from which other values of the same change are
         fitted (default 2).
@@ -413,6 +420,7 @@ class DiagnoseSettings:
     pair_seconds: int = attrs.field(default=3, validator=_count())
     confirm_firsts: int = attrs.field(default=1, validator=_count(0))
     confirm_screen_step: int = attrs.field(default=2, validator=_count())
+    confirm_named: int = attrs.field(default=2, validator=_count(0))
     other_starts: int = attrs.field(default=2, validator=_count(0))
     other_apart: float = attrs.field(default=0.05, validator=_number(0.0, 1.0))
     other_apart_std: float = attrs.field(default=3.0, validator=_number(0.0, lo_open=False))
