@@ -72,6 +72,30 @@ def test_an_exact_model_is_consistent_with_real_noise(exact, real_residual, offs
     assert _consistent(hd.nominal_model(), _with(exact, exact.data[:, 0, 0] * rho))
 
 
+def test_a_few_lines_far_off_do_not_make_an_exact_model_inconsistent(exact, real_residual):
+    """At this placement of the real residual at three times its level, four lines at 12-16 Hz carry 40 % of
+    chi^2 for the exact model (scores of 1,300 to 1,900 where the noise model expects 1): the global test, which
+    took lines of known variance uncapped, called the exact model inconsistent, and a diagnosis of a softer joint
+    added an invented ground spring and still said unexplained.  Every line now enters the global test capped as
+    in the band test; a model that is off over many lines (a 0.5 g sensor, a joint 0.97 times as stiff) is still
+    refused at the same placement."""
+    n = exact.frequency.n
+    start = 33100 % (real_residual.size - n)
+    rho = np.exp(3.0 * np.log(real_residual[start:start + n]))
+    assert _consistent(hd.nominal_model(), _with(exact, exact.data[:, 0, 0] * rho))
+    for hidden in (dict(sensor_kg=0.0005), dict(ht_scale=0.97)):
+        wrong = hd.measure(noise=0.0, phase_deg=0.0, floor=0.0, **hidden)[0]
+        assert not _consistent(hd.nominal_model(), _with(wrong, wrong.data[:, 0, 0] * rho)), hidden
+
+
+def test_a_softer_joint_under_those_lines_is_the_joint_and_nothing_else():
+    d = diagnose(hd.nominal_model(), real_noise.with_real_noise(
+        hd.measure(noise=0.0, phase_deg=0.0, floor=0.0, ht_scale=0.7), 33100, 3.0))
+    assert d.explained, d.report
+    (found,) = d.effects
+    assert (found.name, found.where) == ("joint-stiffness", "holder-tool")
+
+
 def test_real_noise_that_turns_a_driving_points_sign_is_not_a_reversed_sign(exact, real_residual):
     """Ten times the real residual's log turns the imaginary part of the driving point positive on lines
     holding most of |Im H| (its phase errors are not centred), the mark of a reversed sign by passivity
