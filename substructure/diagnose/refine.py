@@ -538,12 +538,16 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     current, chi2_now, alternatives = _review(lik, current, chi2_now, steps_fitted, steps_inside, dropped,
                                               passive, say, settings, cands)
     rivals: list = []
+
+    def confirming(firsts: list) -> list:  # a cheaper screening: one second change per first, fitted on all lines
+        return other_paths(lik, screen_lik.subsample(settings.confirm_screen_step), lik0, firsts, cands, passive,
+                           say, settings, seconds=1, with_mode_starts=False)
+
     # a single element at a fitted place that reached the noise (a section change) may stand in for a named effect
     # of its component with a change it hides (a taper with a sensor): the pairs from those, cheaply screened
     named = _named_firsts(lik, current[0][0], first_scored, [], passive, settings) if len(current) == 1 else []
     if named:
-        more = other_paths(lik, screen_lik.subsample(settings.confirm_screen_step), lik0, named, cands, passive,
-                           say, settings, seconds=1, with_mode_starts=False)
+        more = confirming(named)
         before = [c.key for c, _ in current]
         current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, [], passive, say, settings, more)
         if [c.key for c, _ in current] != before:  # a pair: each must still earn its place
@@ -559,16 +563,14 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
         # it did (a stand-in completed by an invented second change), from fewer other firsts
         # the path's own first change (or the same change under another name) is not started from again
         starts = settings.other_firsts if failed else settings.confirm_firsts
-        if starts:
-            singles = [s for s in first_fitted if s.fit is not None]
-            firsts = [s for s in _distinct(screen_lik, singles, starts + 1, settings)
-                      if s.change.key != path[0][1].key][:starts]
-            if failed:
-                more = other_paths(lik, screen_lik, lik0, firsts, cands, passive, say, settings)
-            else:  # a cheaper screening: one second change per first, fitted on all lines
-                firsts += _named_firsts(lik, path[0][1], first_scored, firsts, passive, settings)
-                more = other_paths(lik, screen_lik.subsample(settings.confirm_screen_step), lik0, firsts,
-                                   cands, passive, say, settings, seconds=1, with_mode_starts=False)
+        singles = [s for s in first_fitted if s.fit is not None]
+        firsts = [s for s in _distinct(screen_lik, singles, starts + 1, settings)
+                  if s.change.key != path[0][1].key][:starts] if starts else []
+        if failed:
+            more = other_paths(lik, screen_lik, lik0, firsts, cands, passive, say, settings) if firsts else []
+        else:  # the named effects of a first change that is an element too (even with confirm_firsts 0)
+            firsts += _named_firsts(lik, path[0][1], first_scored, firsts, passive, settings)
+            more = confirming(firsts) if firsts else []
         current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
                                                settings, more)
         if len(current) > 1 and sorted(c.key for c, _ in current) != pruned:
