@@ -175,6 +175,8 @@ def over_lines(kernel, n: int, *args) -> bool:
     bool
         The ``and`` of the kernel's results (True for kernels that return nothing).
     """
+    if n < 2 * MIN_LINES_PER_TASK:  # the usual call of a fit: not split (and the environment not read)
+        return kernel(*args, 0, n) is not False
     n_threads = threads()
     n_tasks = min(4 * n_threads, n // MIN_LINES_PER_TASK) if n_threads > 1 else 1
     if n_tasks <= 1:

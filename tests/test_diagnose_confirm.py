@@ -39,10 +39,18 @@ def test_a_tapered_tool_with_a_sensor_is_the_taper_and_the_sensor(seed):
     assert sensor.values["mass"] == pytest.approx(0.002, rel=0.1)
 
 
+HSS_AND_SENSOR = dict(tool_E=210e9, tool_rho=8100.0, tool_nu=0.29, sensor_kg=0.002)
+
+
+@pytest.fixture(scope="module")
+def hss_seed_7():
+    """The HSS tool with its sensor (seed 7) diagnosed once for the two tests that read it."""
+    return diagnose(hd.nominal_model(), hd.measure(seed=7, **HSS_AND_SENSOR))
+
+
 @pytest.mark.parametrize("seed", [7, 0])
-def test_an_hss_tool_with_a_sensor_is_the_material_and_the_sensor(seed):
-    d = diagnose(hd.nominal_model(), hd.measure(seed=seed, tool_E=210e9, tool_rho=8100.0, tool_nu=0.29,
-                                                sensor_kg=0.002))
+def test_an_hss_tool_with_a_sensor_is_the_material_and_the_sensor(seed, hss_seed_7):
+    d = hss_seed_7 if seed == 7 else diagnose(hd.nominal_model(), hd.measure(seed=seed, **HSS_AND_SENSOR))
     assert d.explained, d.report
     assert _names(d) == ["model-parameter", "sensor-mass"], [repr(e) for e in d.effects]
     assert _hss_and_sensor(d), [repr(e) for e in d.effects]
@@ -65,14 +73,14 @@ def test_pairs_the_forward_path_found_right_stay_as_they_are():
         assert np.isfinite(d.final_error) and d.final_error <= 1.5 * d.noise_floor
 
 
-def test_the_pair_found_predicts_points_that_were_not_measured():
+def test_the_pair_found_predicts_points_that_were_not_measured(hss_seed_7):
     """Checked on what it was not fitted to: the HSS tool with its sensor, fitted to the tool tip, against the FE
     rig at a point 30 mm back on the tool and at the holder's tip (no noise): within 0.02 and ten times better
     than the model as given; the stand-in pair the step replaced does worse there."""
     from substructure.diagnose.compare import error
 
-    hss = dict(tool_E=210e9, tool_rho=8100.0, tool_nu=0.29, sensor_kg=0.002)
-    found = diagnose(hd.nominal_model(), hd.measure(seed=7, **hss))
+    hss = HSS_AND_SENSOR
+    found = hss_seed_7
     stand_in = diagnose(hd.nominal_model(), hd.measure(seed=7, **hss), settings=DiagnoseSettings(confirm_firsts=0))
     assert _hss_and_sensor(found)
     for truth in hd.measure(noise=0.0, phase_deg=0.0, floor=0.0, points=("tool.tip-30 mm", "holder.tip"), **hss):
