@@ -279,6 +279,19 @@ def test_keys_a_later_diagnosis_adds_are_shown(with_taps):
     assert later.to_json()["diagnosis"]["explained"] is False
 
 
+def test_what_the_data_allow_as_well_is_shown_beside_the_change(with_taps):
+    """``equivalents``: another way of changing the same part, said under the change it could stand for; an entry
+    pointing nowhere (a hand-edited file) is shown without the change, not a crash."""
+    other = {"of": 0, "effect": "added-mass", "where": "tool@75 mm", "error": 0.01,
+             "parameters": {"mass": {"value": 0.002, "unit": "kg"}}}
+    later = attrs.evolve(with_taps, diagnosis=_LaterDiagnosis(with_taps.diagnosis, {
+        "equivalents": [other, {**other, "of": 7}, {**other, "of": "x"}, "not an entry"]}))
+    page = later.to_html()
+    assert "As well as sensor-mass at tool.tip, the data allow added-mass at tool@75 mm (" in page
+    assert page.count("the data allow added-mass at tool@75 mm") == 3 and "As well as ? at ?" in page
+    assert "not an entry" not in page
+
+
 def test_catalogue_holder_taper_and_a_turning_cut(tmp_path):
     base = default_assembly()
     holder = Holder.from_catalog("HSK-A63 shrink-fit", bore="12 mm", gauge_length="80 mm")

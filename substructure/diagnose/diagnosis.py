@@ -281,6 +281,14 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         for c, v, chi2 in outcome.alternatives.get(missing.change.key, []):
             alt = [(c, v) if x is missing.change else (x, y) for x, y in current]
             ambiguous.append((Found(c, v), lik.rms(lik.log_ratios(alt))))
+    # the other kept changes' alternatives inside the indifference region (the first's are ``ambiguous``)
+    equivalents = []
+    for i, found in enumerate(final_effects):
+        if missing is not None and found.change.key == missing.change.key:
+            continue
+        for c, v, chi2 in outcome.alternatives.get(found.change.key, []):
+            alt = [(c, v) if x is found.change else (x, y) for x, y in current]
+            equivalents.append((i, Found(c, v), lik.rms(lik.log_ratios(alt))))
     names = tuple(dict.fromkeys(a.name for a, _ in ambiguous))
     sep = None
     if missing is not None and ambiguous:
@@ -353,7 +361,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
                         refinement=tuple(steps)),
         alternatives=Alternatives(ambiguous=tuple(ambiguous), ambiguous_with=names,
                                   suggestion=None if sep is None else sep["text"], separation=sep,
-                                  rivals=tuple(rivals)),
+                                  rivals=tuple(rivals), equivalents=tuple(equivalents)),
         search=search, settings=settings,
     )
 

@@ -313,6 +313,13 @@ class Alternatives:
         Whole explanations as good as the one reported that are different
         structures, each with the measurement that separates it; when there
         are any, the verdict is not explained.
+    equivalents : tuple of (int, Found, float)
+        Alternatives of the other kept changes inside the indifference
+        region: the index of the change in ``final_effects`` that each
+        could stand for (the rest of the model as found), the alternative,
+        and the error with it.  Changes of the same parts (a holder's
+        density or a body on that holder), so not rivals: the preferred one
+        is reported, and these are what the data allow as well.
     """
 
     ambiguous: tuple = attrs.field(default=(), eq=False)
@@ -320,6 +327,7 @@ class Alternatives:
     suggestion: str | None = None
     separation: dict | None = attrs.field(default=None, eq=False)
     rivals: tuple = attrs.field(default=(), eq=False)
+    equivalents: tuple = attrs.field(default=(), eq=False)
 
 
 def _read(record: str, name: str):
@@ -344,7 +352,7 @@ class Diagnosis:
     ``correlation``, ``baseline``, ``final``, ``error_check`` (of ``measures``);
     ``final_effects``, ``refined_assembly``, ``candidates``, ``refinement``
     (of ``changes``); ``ambiguous``, ``ambiguous_with``, ``suggestion``,
-    ``separation``, ``rivals`` (of ``alternatives``).
+    ``separation``, ``rivals``, ``equivalents`` (of ``alternatives``).
 
     Parameters
     ----------
@@ -395,6 +403,7 @@ class Diagnosis:
     suggestion = _read("alternatives", "suggestion")
     separation = _read("alternatives", "separation")
     rivals = _read("alternatives", "rivals")
+    equivalents = _read("alternatives", "equivalents")
 
     @property
     def effects(self) -> list[Found]:
@@ -439,6 +448,7 @@ class Diagnosis:
             "ambiguous": [{**_effect_json(a), "error": _finite(err)} for a, err in self.ambiguous],
             "separation": self.separation,
             "rivals": [{"effects": [_effect_json(f) for f in r.founds], "separation": sep} for r, sep in self.rivals],
+            "equivalents": [{"of": int(i), **_effect_json(a), "error": _finite(err)} for i, a, err in self.equivalents],
             "search": dict(self.search),
             "report": list(self.report),
             "settings": self.settings.to_json(),

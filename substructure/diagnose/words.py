@@ -583,6 +583,10 @@ def summary(result, model_name: str, measured: int) -> list[str]:
             lines.append(f"{label if i == 0 else 'and'}: {e.name} at {e.where}")
             lines.append(f"  {parameter_values(e)}")
             lines.append(f"  why: {e.explanation}")
+            same = [a for j, a, _ in result.equivalents if j == i]
+            if same:
+                lines.append("  as well (the data cannot tell them apart): "
+                             + "; ".join(f"{a.name} at {a.where} ({parameter_values(a)})" for a in same[:3]))
         if result.ambiguous:
             alts = "; ".join(f"{a.name} at {a.where} ({parameter_values(a)})" for a, _ in result.ambiguous[:3])
             lines.append(f"  equally possible: {alts}")

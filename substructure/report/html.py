@@ -314,7 +314,7 @@ def _params(parameters: Any) -> str:
 # "settings" (every threshold and grid the diagnosis ran with) is there to reproduce it, not for the reader
 _SHOWN = {"metric", "baseline_error", "noise_floor", "missing_effect", "ambiguous_with", "candidates", "refinement",
           "missing_where", "suggestion", "band_hz", "final_error", "final_effects", "modes", "error_bands_hz",
-          "explained", "settings"}
+          "explained", "settings", "equivalents"}
 
 
 def _diagnosis(report: Any) -> str:
@@ -359,6 +359,12 @@ def _diagnosis(report: Any) -> str:
     if data.get("ambiguous_with"):
         out.append(f"<p>Equally possible: {esc(', '.join(map(str, data['ambiguous_with'])))}. To tell them apart: "
                    f"{esc(data.get('suggestion') or '')}</p>")
+    for q in [q for q in data.get("equivalents") or [] if isinstance(q, dict)]:
+        of = q.get("of")
+        kept = effects[of] if isinstance(of, int) and 0 <= of < len(effects) else {}
+        out.append(f"<p>As well as {esc(kept.get('effect', '?'))} at {esc(kept.get('where', '?'))}, the data allow "
+                   f"{esc(q.get('effect'))} at {esc(q.get('where'))} ({_params(q.get('parameters'))}): the same part "
+                   "changed another way, which this test cannot tell apart.</p>")
     steps = [s for s in data.get("refinement") or [] if isinstance(s, dict)]
     out.append("<h3>The error falling as effects are added</h3>"
                + figure(fall, "error fall", "The model's error after each step, against the noise floor (the "
