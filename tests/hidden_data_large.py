@@ -55,13 +55,15 @@ def model() -> Assembly:
 def measure(points=("tool.tip",), sensor_kg: float = 0.0, flutes: tuple[float, float] = FLUTES,
             nut: tuple[float, float, float] | None = None, ht_scale: float = 1.0,
             tool_E: float = 580e9, tool_rho: float = 14500.0, tool_nu: float = 0.22,
-            bearings: tuple[float, float] = (1.0, 1.0)) -> list[FRF]:
+            bearings: tuple[float, float] = (1.0, 1.0), shank_taper: float | None = None) -> list[FRF]:
     """Exact FRFs of the rig with hidden effects (response at each point, the hammer at the tool's tip).
 
     points: ``tool.tip``, ``tool.tip-X mm`` or ``holder.tip``; flutes: the tool's real fluted tip (length m,
     diameter ratio); nut: (mass kg, rotary inertia kg m^2, x m) on the holder; ht_scale: the holder-tool
     joint's k_yf times this; tool_E, tool_rho, tool_nu: the tool's material; bearings: (rear, front) factors on
-    the stiffness of the bearing pairs.
+    the stiffness of the bearing pairs; shank_taper: the tool's plain length tapering linearly (16 uniform
+    pieces) as if from 20 mm at its base to this diameter [m] at its tip, its fluted tip left at 20 mm (not the
+    library's tapered tool, which tapers the flutes too).
     """
     m = fe.Model()
     lengths = {"holder": sum(h[0] for h in HOLDER), "tool": TOOL_LENGTH}
@@ -82,8 +84,13 @@ def measure(points=("tool.tip",), sensor_kg: float = 0.0, flutes: tuple[float, f
                    points=wanted["holder"] + ([nut[2]] if nut else []))
     material = fe.Material(tool_E, tool_nu, tool_rho, 0.002)
     fluted, ratio = flutes
-    t = m.add_beam([(TOOL_LENGTH - fluted, fe.section(TOOL_OD, 0.0, material)),
-                    (fluted, fe.fluted(TOOL_OD, ratio, material))], points=wanted["tool"])
+    plain_length = TOOL_LENGTH - fluted
+    if shank_taper is None:
+        shank = [(plain_length, fe.section(TOOL_OD, 0.0, material))]
+    else:
+        shank = [(plain_length / 16, fe.section(TOOL_OD + (shank_taper - TOOL_OD) * (k + 0.5) / 16 * plain_length
+                                                / TOOL_LENGTH, 0.0, material)) for k in range(16)]
+    t = m.add_beam(shank + [(fluted, fe.fluted(TOOL_OD, ratio, material))], points=wanted["tool"])
     m.add_joint((s, sum(x[0] for x in SPINDLE)), (h, 0.0), np.diag(K_SH), np.diag(C_SH))
     m.add_joint((h, lengths["holder"]), (t, 0.0), np.diag([K_HT[0] * ht_scale, K_HT[1]]), np.diag(C_HT))
     for i, x in enumerate(BEARINGS):

@@ -64,3 +64,26 @@ def test_a_fit_that_ends_on_its_bound_is_fitted_again_from_the_models_value():
     inside = fit(lik, [(change, {"value": 0.6})])
     assert not inside.at_bound[0]
     assert _from_own_start(lik, [], Scored(change, {"value": 0.6}, inside.chi2, inside), inside) is inside
+
+
+def test_a_sensor_the_data_cannot_tell_from_thicker_flutes_is_said_beside_them():
+    """The tool's shank tapering to 17 mm at 110 mm (its flutes not: not the catalogue's taper) with a 2 g
+    sensor, under another real test's residual (a free-free beam's).  The taper (0.85) with the sensor, and the
+    taper with flutes a little thicker and longer than drawn (0.815 over 44.5 mm), fit within the indifference
+    region; both act on the tool, so neither is a rival of the other.  Here the flutes are reported (at other
+    placements of the noise the sensor, with the flutes beside it); the sensor, with its true mass, is said
+    under them as what the data allow as well, not dropped."""
+    from substructure.diagnose.words import summary
+
+    data = real_noise.with_real_noise(hl.measure(shank_taper=0.017, sensor_kg=0.002), 680, 1.0,
+                                      real_noise.free_free_residual())
+    d = diagnose(hl.model(), data)
+    assert d.explained, d.report
+    assert [e.name for e in d.effects] == ["fluted-section", "tapered-tool"], _summary(d)
+    assert d.effects[1].values["tip_ratio"] == pytest.approx(0.85, abs=0.005)
+    ((i, sensor, error),) = d.equivalents
+    assert i == 0 and sensor.name == "sensor-mass" and sensor.where == "tool.tip"
+    assert sensor.values["mass"] == pytest.approx(0.002, rel=0.05)
+    assert error <= 1.05 * d.final_error
+    assert any(line.startswith("  as well (the data cannot tell them apart): sensor-mass at tool.tip")
+               for line in summary(d, "m", 1))

@@ -297,7 +297,13 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     if final_fit is not None and final_fit.p > 1:
         labels = [f"{current[i][0].effect}@{current[i][0].where}:{name}" for i, name in final_fit.names]
         correlation = {"parameters": labels, "matrix": [[_finite(x) for x in row] for row in final_fit.correlation]}
-    rivals = _distinct_rivals(assembly, measured, final_effects, outcome, say, settings) if explained else []
+    rivals, replaced = _distinct_rivals(assembly, measured, final_effects, outcome, say, settings) if explained \
+        else ([], [])
+    for i, found, rival in replaced:  # a same-part rival's replacement of one kept change, not listed yet
+        if (i, found.change.key) not in {(j, a.change.key) for j, a, _ in equivalents} and not (
+                missing is not None and final_effects[i].change.key == missing.change.key
+                and found.change.key in {a.change.key for a, _ in ambiguous}):
+            equivalents.append((i, found, lik.rms(lik.log_ratios([(f.change, f.values) for f in rival]))))
     final = _comparisons(lik, final_ratios, floors, settings)
     report = unexplained_report(lik, assembly, current, baseline, cons, final_error, floor, explained, say,
                                 settings, check) if not explained else ()
@@ -434,12 +440,17 @@ def _distinct_rivals(assembly, measured, final_effects, outcome, say,
     would tell the two apart (``chi^2 > INDIFFERENCE`` over the band);
     otherwise it is an equivalent description (a joint's stiffness as a
     named effect or as its matrix entry) and the preferred one stands.  At
-    most ``settings.rivals_checked`` rivals are checked.
+    most ``settings.rivals_checked`` rivals are checked.  A rival that acts on
+    the same parts (components and joints by name) is not a different
+    structure either; where it replaces one kept change by another, that
+    other is what the data allow as well instead of it (``equivalents``).
 
     Returns
     -------
-    list of (Explanation, dict)
-        The distinct rivals with their separating measurement.
+    (list of (Explanation, dict), list of (int, Found, list of Found))
+        The distinct rivals with their separating measurement, and the
+        same-part replacements: the index of the kept change, the change
+        that fits as well in its place, and the whole rival.
     """
     from .report import Explanation, separation
 
@@ -454,18 +465,23 @@ def _distinct_rivals(assembly, measured, final_effects, outcome, say,
     pool = [(chi2, founds) for chi2, founds in pool if not keys < {f.change.key for f in founds}]
     kept = Explanation(final_effects)
     kept_sites = frozenset().union(*(sites(assembly, f.change, f.values) for f in final_effects))
-    out = []
+    out, replaced = [], []
     for _, founds in pool[:settings.rivals_checked]:
         same_changes = {f.change.key for f in founds} == keys
         if not same_changes and frozenset().union(*(sites(assembly, f.change, f.values) for f in founds)) == kept_sites:
-            continue  # the same parts changed: an equivalent description
+            # the same parts changed: an equivalent description; one kept change replaced is said beside it
+            new = [f for f in founds if f.change.key not in keys]
+            gone = [i for i, f in enumerate(final_effects) if f.change.key not in {g.change.key for g in founds}]
+            if len(new) == 1 and len(gone) == 1:
+                replaced.append((gone[0], new[0], founds))
+            continue
         rival = Explanation(founds)
         sep = separation(assembly, measured, kept, rival, say, contact_only=True, settings=settings)
         if sep is not None and sep["chi2"] > INDIFFERENCE:
             if say:
                 say(f"rival explanation {rival.name} at {rival.where}: {sep['text']}")
             out.append((rival, sep))
-    return out
+    return out, replaced
 
 
 PHYSICAL_ENDS = ("position", "start", "inset", "inset_tip", "length", "end")

@@ -314,12 +314,14 @@ class Alternatives:
         structures, each with the measurement that separates it; when there
         are any, the verdict is not explained.
     equivalents : tuple of (int, Found, float)
-        Alternatives of the other kept changes inside the indifference
-        region: the index of the change in ``final_effects`` that each
-        could stand for (the rest of the model as found), the alternative,
-        and the error with it.  Changes of the same parts (a holder's
-        density or a body on that holder), so not rivals: the preferred one
-        is reported, and these are what the data allow as well.
+        What the data allow as well instead of a kept change, beyond
+        ``ambiguous``: the alternatives of its step inside the indifference
+        region and the replacements by rivals on the same parts; each with
+        the index of the change in ``final_effects`` it could stand for,
+        the alternative, and the error of the explanation with it.  They
+        change the same parts another way (a holder's density or a body on
+        that holder), so they are not rivals: the preferred one is reported,
+        and these beside it.
     """
 
     ambiguous: tuple = attrs.field(default=(), eq=False)
