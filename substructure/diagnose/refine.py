@@ -577,7 +577,7 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
             # what the review and the parsimony check put in must each still earn its place
             current, chi2_now, late = _prune(lik, current, chi2_now, say, refits)
             dropped += late
-        if [c.key for c, _ in current] != before:
+        if sorted(c.key for c, _ in current) != sorted(before):  # the same changes in another order keep theirs
             alternatives = {c.key: [] for c, _ in current}
     kept = [c.key for c, _ in current]
     unchanged = kept == [change.key for _, change, _, _ in path]

@@ -589,7 +589,9 @@ def preference(change: Change) -> float:
     the user measures on the part (:data:`MEASURED`: a fluted segment's
     ``od`` and its flutes' ``diameter_ratio`` set the same equivalent
     section, and the ratio is the model's guess); 3: an element at a
-    fitted place.
+    fitted place; 3.5: a number known to a few per cent
+    (``ModelParameter.known``: a holder's steel, whose density 12 % higher
+    fits as well as the nut on it that the model lacks).
 
     Parameters
     ----------
@@ -604,6 +606,8 @@ def preference(change: Change) -> float:
     if isinstance(change, EffectChange):
         return 0
     if isinstance(change, ParameterChange):
+        if getattr(change.parameter, "known", False):
+            return ELEMENT + 0.5
         if change.parameter.linked:
             return 1
         parts = change.parameter.path.split(".")

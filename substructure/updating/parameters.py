@@ -56,7 +56,7 @@ from typing import Mapping
 import attrs
 import numpy as np
 
-from ..components import Spindle, Tool, own_parameters
+from ..components import Holder, Spindle, Tool, own_parameters
 from ..errors import InvalidValueError
 from ..joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint
 from ..materials import Material
@@ -100,6 +100,11 @@ class ModelParameter:
     linked : bool
         Several numbers moved as one (an overhang, a component's material, a
         joint's whole stiffness, a set of supports).
+    known : bool
+        A number known to a few per cent, whose change more likely stands in
+        for something the model lacks (a holder's steel: its density 12 %
+        higher is a nut on it); the diagnosis reports an element that fits
+        as well before it (:func:`substructure.diagnose.search.preference`).
     """
 
     path: str
@@ -110,6 +115,7 @@ class ModelParameter:
     log: bool
     description: str
     linked: bool = False
+    known: bool = False
 
     def spec(self) -> ParamSpec:
         """The fitted parameter ``value``, starting at the nominal value.
@@ -303,8 +309,10 @@ def model_parameters(assembly) -> list[ModelParameter]:
                 value = own.E.m_as("Pa") if prop == "E" else own.rho_si
                 engineering = ENGINEERING_E if prop == "E" else ENGINEERING_RHO
                 lo, hi = (x / value for x in _within(value, 0.25, 4.0, engineering))
-            out.append(_linked(f"{base}.{prop}", "dimensionless", 1.0, lo, hi,
-                               f"{text} of {comp.name} only, as a factor"))
+            factor = _linked(f"{base}.{prop}", "dimensionless", 1.0, lo, hi, f"{text} of {comp.name} only, as a factor")
+            # a holder is steel: its E and rho are known to a few per cent (its material as a whole may differ)
+            out.append(attrs.evolve(factor, known=True) if isinstance(comp, Holder) and prop != "loss_factor"
+                       else factor)
     for name, m in materials.items():
         p = f"materials.{name}"
         E, rho = m.E.m_as("Pa"), m.rho_si
