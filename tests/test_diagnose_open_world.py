@@ -222,6 +222,33 @@ def test_a_rival_that_changes_another_part_is_not_claimed():
     assert sites(model, other, {}) == frozenset({"component:holder"})
 
 
+def test_a_rival_on_the_same_part_is_what_the_data_allow_as_well():
+    """The same-part rival of the test above is not dropped without a word: it replaces the kept change (index 0)
+    in ``equivalents``; the one on another part is a rival, not a replacement; nor is the kept change itself at
+    other values (a second minimum)."""
+    from substructure.diagnose.diagnosis import _same_part_replacements
+    from substructure.diagnose.refine import Outcome
+    from substructure.diagnose.result import Found
+    from substructure.updating.elements import AddedMass
+    from substructure.updating.parameters import parameter_change
+
+    model = hd.nominal_model()
+    params = {p.path: p for p in model_parameters(model)}
+    kept = parameter_change(params["joints.holder-tool.k.yf"])
+    same = parameter_change(params["joints.holder-tool.k"])
+    other = AddedMass("holder", 0.066, 0.5)
+    final = (Found(kept, {"value": 1.144e7}),)
+
+    def outcome(alternatives, rivals=()):
+        return Outcome([(kept, {"value": 1.144e7})], None, [], [], [], {kept.key: alternatives}, list(rivals))
+
+    ((i, found, rival),) = _same_part_replacements(model, final, outcome([(same, {"value": 0.8}, 0.0)]))
+    assert i == 0 and found.change is same and found.values == {"value": 0.8} and [f.change for f in rival] == [same]
+    assert _same_part_replacements(model, final, outcome([(other, {"mass": 0.05, "inertia": 1e-6,
+                                                                   "position": 0.05}, 0.0)])) == []
+    assert _same_part_replacements(model, final, outcome([], [([(kept, {"value": 2e7})], 0.0, 0.0)])) == []
+
+
 def test_parsimony_prefers_a_fair_single_to_a_greedy_path_that_compensates():
     """Three changes where one does the work: the single (fitted from its own start) has the lower BIC."""
     from substructure.diagnose.refine import _parsimony

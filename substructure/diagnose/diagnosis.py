@@ -297,9 +297,9 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     if final_fit is not None and final_fit.p > 1:
         labels = [f"{current[i][0].effect}@{current[i][0].where}:{name}" for i, name in final_fit.names]
         correlation = {"parameters": labels, "matrix": [[_finite(x) for x in row] for row in final_fit.correlation]}
-    rivals, replaced = _distinct_rivals(assembly, measured, final_effects, outcome, say, settings) if explained \
-        else ([], [])
-    for i, found, rival in replaced:  # a same-part rival's replacement of one kept change, not listed yet
+    rivals = _distinct_rivals(assembly, measured, final_effects, outcome, say, settings) if explained else []
+    # a same-part rival's replacement of one kept change, not listed yet
+    for i, found, rival in _same_part_replacements(assembly, final_effects, outcome, settings):
         if (i, found.change.key) not in {(j, a.change.key) for j, a, _ in equivalents} and not (
                 missing is not None and final_effects[i].change.key == missing.change.key
                 and found.change.key in {a.change.key for a, _ in ambiguous}):
@@ -426,34 +426,17 @@ def sites(assembly, change, values) -> frozenset:
     return frozenset(out)
 
 
-def _distinct_rivals(assembly, measured, final_effects, outcome, say,
-                     settings: DiagnoseSettings = DEFAULT_SETTINGS) -> list:
-    """Rival explanations inside the indifference region that are different structures.
+def _rival_pool(assembly, final_effects, outcome, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> list:
+    """The rivals to check, best first: ``(founds, same_parts)`` for at most ``settings.rivals_checked``.
 
     A rival is a whole explanation of the parsimony check
     (:func:`substructure.diagnose.refine.refine`), the kept one with one
     change replaced by an alternative of its step, or the kept changes at
     other values that fit as well (a second minimum); one that holds every
-    kept change and more is not (the data do not decide the extra).  It is a *different
-    structure* when some measurement with the test's sensors on (a point or
-    cross FRF at the ends, quarter points and middles of the components)
-    would tell the two apart (``chi^2 > INDIFFERENCE`` over the band);
-    otherwise it is an equivalent description (a joint's stiffness as a
-    named effect or as its matrix entry) and the preferred one stands.  At
-    most ``settings.rivals_checked`` rivals are checked.  A rival that acts on
-    the same parts (components and joints by name) is not a different
-    structure either; where it replaces one kept change by another, that
-    other is what the data allow as well instead of it (``equivalents``).
-
-    Returns
-    -------
-    (list of (Explanation, dict), list of (int, Found, list of Found))
-        The distinct rivals with their separating measurement, and the
-        same-part replacements: the index of the kept change, the change
-        that fits as well in its place, and the whole rival.
+    kept change and more is not (the data do not decide the extra).
+    ``same_parts``: it is other changes acting on the same parts
+    (components and joints by name, :func:`sites`) as the kept ones.
     """
-    from .report import Explanation, separation
-
     pool = [(chi2, [Found(c, v) for c, v in changes]) for changes, chi2, _ in outcome.rivals]
     for i, found in enumerate(final_effects):
         for c, v, chi2 in outcome.alternatives.get(found.change.key, []):
@@ -463,17 +446,36 @@ def _distinct_rivals(assembly, measured, final_effects, outcome, say,
     # a rival that holds every kept change plus more is not another explanation: the data do not decide the extra
     # (the same changes at other values are another explanation: a second minimum of the same changes)
     pool = [(chi2, founds) for chi2, founds in pool if not keys < {f.change.key for f in founds}]
-    kept = Explanation(final_effects)
     kept_sites = frozenset().union(*(sites(assembly, f.change, f.values) for f in final_effects))
-    out, replaced = [], []
-    for _, founds in pool[:settings.rivals_checked]:
-        same_changes = {f.change.key for f in founds} == keys
-        if not same_changes and frozenset().union(*(sites(assembly, f.change, f.values) for f in founds)) == kept_sites:
-            # the same parts changed: an equivalent description; one kept change replaced is said beside it
-            new = [f for f in founds if f.change.key not in keys]
-            gone = [i for i, f in enumerate(final_effects) if f.change.key not in {g.change.key for g in founds}]
-            if len(new) == 1 and len(gone) == 1:
-                replaced.append((gone[0], new[0], founds))
+    return [(founds, {f.change.key for f in founds} != keys
+             and frozenset().union(*(sites(assembly, f.change, f.values) for f in founds)) == kept_sites)
+            for _, founds in pool[:settings.rivals_checked]]
+
+
+def _distinct_rivals(assembly, measured, final_effects, outcome, say,
+                     settings: DiagnoseSettings = DEFAULT_SETTINGS) -> list:
+    """Rival explanations inside the indifference region that are different structures.
+
+    A rival (:func:`_rival_pool`) is a *different structure* when some
+    measurement with the test's sensors on (a point or cross FRF at the
+    ends, quarter points and middles of the components) would tell the two
+    apart (``chi^2 > INDIFFERENCE`` over the band); otherwise it is an
+    equivalent description (a joint's stiffness as a named effect or as its
+    matrix entry) and the preferred one stands.  One that changes the same
+    parts is an equivalent description too (:func:`_same_part_replacements`
+    says what it replaces).
+
+    Returns
+    -------
+    list of (Explanation, dict)
+        The distinct rivals with their separating measurement.
+    """
+    from .report import Explanation, separation
+
+    kept = Explanation(final_effects)
+    out = []
+    for founds, same_parts in _rival_pool(assembly, final_effects, outcome, settings):
+        if same_parts:
             continue
         rival = Explanation(founds)
         sep = separation(assembly, measured, kept, rival, say, contact_only=True, settings=settings)
@@ -481,7 +483,26 @@ def _distinct_rivals(assembly, measured, final_effects, outcome, say,
             if say:
                 say(f"rival explanation {rival.name} at {rival.where}: {sep['text']}")
             out.append((rival, sep))
-    return out, replaced
+    return out
+
+
+def _same_part_replacements(assembly, final_effects, outcome, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> list:
+    """The rivals on the same parts that replace one kept change by another: what the data allow as well.
+
+    Returns
+    -------
+    list of (int, Found, list of Found)
+        The index of the kept change, the change that fits as well in its
+        place, and the whole rival.
+    """
+    keys = {f.change.key for f in final_effects}
+    out = []
+    for founds, same_parts in _rival_pool(assembly, final_effects, outcome, settings):
+        new = [f for f in founds if f.change.key not in keys]
+        gone = [i for i, f in enumerate(final_effects) if f.change.key not in {g.change.key for g in founds}]
+        if same_parts and len(new) == 1 and len(gone) == 1:
+            out.append((gone[0], new[0], founds))
+    return out
 
 
 PHYSICAL_ENDS = ("position", "start", "inset", "inset_tip", "length", "end")
