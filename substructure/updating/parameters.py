@@ -104,7 +104,7 @@ class ModelParameter:
         A number known to a few per cent, whose change more likely stands in
         for something the model lacks (a holder's steel: its density 12 %
         higher is a nut on it); the diagnosis reports an element that fits
-        as well before it (:func:`substructure.diagnose.search.preference`).
+        as well before it (the diagnosis's order of preference, docs/diagnose.md).
     """
 
     path: str
