@@ -276,19 +276,15 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     for c, v in current:
         refined = c.apply(refined, v)
     missing = steps[1].added if len(steps) > 1 else None
-    ambiguous = []
-    if missing is not None:
-        for c, v, chi2 in outcome.alternatives.get(missing.change.key, []):
-            alt = [(c, v) if x is missing.change else (x, y) for x, y in current]
-            ambiguous.append((Found(c, v), lik.rms(lik.log_ratios(alt))))
+    def instead(change) -> list:  # a kept change's alternatives of its step, each with the error in its place
+        return [(Found(c, v), lik.rms(lik.log_ratios([(c, v) if x is change else (x, y) for x, y in current])))
+                for c, v, _ in outcome.alternatives.get(change.key, [])]
+
+    ambiguous = instead(missing.change) if missing is not None else []
     # the other kept changes' alternatives inside the indifference region (the first's are ``ambiguous``)
-    equivalents = []
-    for i, found in enumerate(final_effects):
-        if missing is not None and found.change.key == missing.change.key:
-            continue
-        for c, v, chi2 in outcome.alternatives.get(found.change.key, []):
-            alt = [(c, v) if x is found.change else (x, y) for x, y in current]
-            equivalents.append((i, Found(c, v), lik.rms(lik.log_ratios(alt))))
+    equivalents = [(i, alt, err) for i, found in enumerate(final_effects)
+                   if missing is None or found.change.key != missing.change.key
+                   for alt, err in instead(found.change)]
     names = tuple(dict.fromkeys(a.name for a, _ in ambiguous))
     sep = None
     if missing is not None and ambiguous:
