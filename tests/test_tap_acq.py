@@ -359,6 +359,36 @@ def test_binary_uff_58b_and_units_in_the_labels_alone(tmp_path):
     assert np.allclose(record.response, a, rtol=1e-5, atol=1e-6)
 
 
+def test_a_tap_file_cut_short_or_of_one_record_is_said_so_not_misread(tmp_path):
+    """A universal file copied only in part: a record that lost samples is named with what its header announced;
+    a file that ends inside a record is truncated (not read as the records before the cut); one record is not a
+    tap; records of no force say what each holds."""
+    _, f, a = samples()
+    lines = write_uff(tmp_path / "whole.uff", [(f, 13, "N"), (a, 12, "m/s^2")]).read_text().splitlines()
+    assert read_tap_uff(tmp_path / "whole.uff").force.size == f.size
+    closing = [k for k, line in enumerate(lines) if line.strip() == "-1"]
+    for name, kept, message in [
+        ("first.uff", lines[:closing[1] - 40] + lines[closing[1]:],
+         r"first.uff, record 0: its header announces 2048 samples but it holds 1888: the file is truncated"),
+        ("second.uff", lines[:-41] + lines[-1:], r"second.uff, record 1: its header announces 2048 samples but it "
+                                                 r"holds 1888"),
+        ("ends.uff", lines[:len(lines) * 3 // 4], r"ends.uff: the file is truncated: it does not end with the '-1' "
+                                                   r"line that closes a record \(the last type-58 record starts at "),
+    ]:
+        (tmp_path / name).write_text("\n".join(kept) + "\n")
+        for read in (read_tap_uff, read_taps_uff):
+            with pytest.raises(FileFormatError, match=message):
+                read(tmp_path / name)
+    one = write_uff(tmp_path / "one.uff", [(a, 12, "m/s^2")])
+    with pytest.raises(FileFormatError, match=r"one.uff: one type-58 record; a tap needs two time records"):
+        read_tap_uff(one)
+    accelerations = write_uff(tmp_path / "acc.uff", [(a, 12, "m/s^2"), (a, 0, "g")])
+    with pytest.raises(FileFormatError, match=r"acc.uff: 0 force records among 2 type-58 records; give the force "
+                                              r"record's index \(--force-record, 0-based\); they hold 0 acceleration, "
+                                              r"1 acceleration$"):
+        read_tap_uff(accelerations)
+
+
 def test_uff_abscissa_not_time_or_uneven_is_refused(tmp_path):
     _, f, a = samples()
     path = write_uff(tmp_path / "hz.uff", [(a, 12, "m/s^2"), (f, 13, "N")], abscissa_spec=18, abscissa_label="Hz")

@@ -21,6 +21,8 @@ are, the time step from ``wf_increment``; :func:`read_tap_tdms`, in
 
 from __future__ import annotations
 
+import contextlib
+import io
 import os
 import warnings
 from typing import Any
@@ -461,9 +463,13 @@ def _uff_records(path) -> tuple[str, list[dict], list[str | None]]:
     or unit label (``force``, a response quantity, ``response`` or None: not known)."""
     import pyuff
 
+    from ..frf.files.uff_reader import check_complete
+
     name = check_readable_file(path, "tap record", MAX_RECORD_BYTES)
+    check_complete(name)  # a file cut off in a record: said so, not read as the records before the cut
     try:
-        sets = pyuff.UFF(name).read_sets()
+        with contextlib.redirect_stdout(io.StringIO()):  # pyuff prints some records it reads (not ours to show)
+            sets = pyuff.UFF(name).read_sets()
     except Exception as exc:  # pyuff raises many kinds for broken files
         raise FileFormatError(f"{name}: cannot read the universal file ({exc})") from None
     sets = sets if isinstance(sets, list) else [sets]
@@ -474,6 +480,13 @@ def _uff_records(path) -> tuple[str, list[dict], list[str | None]]:
         if int(r.get("func_type", 0)) != 1:
             raise FileFormatError(f"{name}, record {k}: function type {r.get('func_type')}; expected 1 (time "
                                   "response): a tap record holds the time signals, not an FRF")
+        announced, held = r.get("num_pts"), np.asarray(r.get("data", [])).size
+        if announced is not None and int(announced) != held:
+            raise FileFormatError(f"{name}, record {k}: its header announces {int(announced)} samples but it holds "
+                                  f"{held}: the file is truncated or damaged; copy or export it again")
+    if len(records) < 2:
+        raise FileFormatError(f"{name}: one type-58 record; a tap needs two time records, the force and the "
+                              "response, sampled together")
     for k, r in enumerate(records):
         _check_abscissa(name, k, r)
     kinds = [_uff_kind(name, records, k) for k in range(len(records))]
@@ -508,17 +521,19 @@ def _uff_kind(name: str, records: list[dict], k: int) -> str | None:
 
 def _uff_pair(name: str, records: list[dict], kinds: list, force_record, response_record) -> tuple[int, int]:
     """The indices of the force and the response record: given, or the one candidate of each."""
+    # what each record holds by its data type or unit label, for the messages
+    held = ", ".join(f"{k} {q or 'not said'}" for k, q in enumerate(kinds))
     if force_record is None:
         found = [k for k, q in enumerate(kinds) if q == "force"]
         if len(found) != 1:
             raise FileFormatError(f"{name}: {len(found)} force records among {len(records)} type-58 records; "
-                                  "give the force record's index (--force-record, 0-based)")
+                                  f"give the force record's index (--force-record, 0-based); they hold {held}")
         force_record = found[0]
     if response_record is None:
         found = [k for k, q in enumerate(kinds) if (q in RESPONSES or q == "response") and k != force_record]
         if len(found) != 1:
             raise FileFormatError(f"{name}: {len(found)} response records among {len(records)} type-58 records; "
-                                  "give the response record's index (--response-record, 0-based)")
+                                  f"give the response record's index (--response-record, 0-based); they hold {held}")
         response_record = found[0]
     for option, k in (("force_record", force_record), ("response_record", response_record)):
         if not 0 <= k < len(records):

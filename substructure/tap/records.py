@@ -144,7 +144,8 @@ def channel_to_si(values: np.ndarray, unit: Any, field: str, expected: tuple[str
         raise UnitError(f"{field}: the channel is already in {unit:~}, not a voltage; {sensitivity_option} "
                         f"({sensitivity!s}) applies to a channel in mV or V: leave it out or fix the header")
     if kind not in expected:
-        raise UnitError(f"{field}: the unit {unit:~} is {'a ' + kind if kind else 'of no known quantity'}; "
+        said = (f"an {kind}" if kind[0] in "aeiou" else f"a {kind}") if kind else "of no known quantity"
+        raise UnitError(f"{field}: the unit {unit:~} is {said}; "
                         f"expected {names} (or a voltage with a sensitivity)")
     si = RESPONSE_QUANTITIES[kind][0] if kind != "force" else "N"
     return values * ureg.Quantity(1.0, unit).m_as(si), kind

@@ -108,8 +108,11 @@ def _latin1_labels(uff, position: int, dset: dict) -> None:
             dset[key] = lines[head + offset][47:67].decode("latin-1").strip()
 
 
-def _check_complete(name: str) -> None:
-    """A universal file starts and ends with a ``-1`` line; otherwise it is something else, or was cut off."""
+def check_complete(name: str) -> None:
+    """A universal file starts and ends with a ``-1`` line; otherwise it is something else, or was cut off.
+
+    The readers of FRFs here and of tap records (:mod:`substructure.io.tap_files`) check it first.
+    """
     size = os.path.getsize(name)
     if size == 0:
         raise FileFormatError(f"{name}: the file is empty; no type-58 record")
@@ -217,7 +220,7 @@ def read_uff(path: str | os.PathLike, record: int | None = None, quantity: str |
     name = check_file(path, "universal file", MAX_DATA_BYTES)
     if quantity is not None and quantity not in QUANTITIES:
         raise InvalidValueError(f"quantity: got {quantity!r}; expected one of {', '.join(QUANTITIES)}")
-    _check_complete(name)
+    check_complete(name)
     try:
         uff = pyuff.UFF(name)
         types = [int(t) for t in uff.get_set_types()]
@@ -321,7 +324,7 @@ def read_uff_coherence(path: str | os.PathLike, record: int) -> tuple[np.ndarray
     from ..._files import MAX_DATA_BYTES, check_file
 
     name = check_file(path, "universal file", MAX_DATA_BYTES)
-    _check_complete(name)
+    check_complete(name)
     try:
         uff = pyuff.UFF(name)
         positions = [k for k, t in enumerate(uff.get_set_types()) if int(t) == 58]
