@@ -258,6 +258,79 @@ def lvm(segments, x_columns="One", sep="\t", decimal=".", units=("N", "g")):
     return "\r\n".join(out) + "\r\n"
 
 
+def labview_no_x(force, accel, said=None, comment="", empty=False, x_cell=""):
+    """A .lvm file as LabVIEW itself writes one without x columns: the heading X_Value over an empty first cell of
+    every row, the units in Y_Unit_Label only, decimal commas; a channel without samples as empty cells."""
+    n = force.size if said is None else said
+    extra = ["0"] if empty else []
+    out = ["LabVIEW Measurement\t", "Writer_Version\t2", "Reader_Version\t2", "Separator\tTab",
+           "Decimal_Separator\t,", "Multi_Headings\tYes", "X_Columns\tNo", "Time_Pref\tAbsolute",
+           "***End_of_Header***\t", "\t", "\t".join(["Channels", str(2 + len(extra))] + [""] * 2),
+           "\t".join(["Samples", str(n), str(n)] + extra + [""]),
+           "\t".join(["Y_Unit_Label", "Newtons", "m/s^2"] + ["Volts"] * len(extra) + [""]),
+           "\t".join(["X_Dimension"] + ["Time"] * (2 + len(extra)) + [""]),
+           "\t".join(["X0"] + ["0,0000000000000000E+0"] * (2 + len(extra)) + [""]),
+           "\t".join(["Delta_X"] + [f"{1 / FS:.6E}".replace(".", ",")] * (2 + len(extra)) + [""]),
+           "***End_of_Header***\t\t\t\t",
+           "\t".join(["X_Value", "Excitation (Trigger)", "Response (Trigger)"] + ["Untitled"] * len(extra)
+                     + ["Comment"])]
+    for fv, av in zip(force, accel):
+        cells = [x_cell, f"{fv:.6f}".replace(".", ","), f"{av:.6f}".replace(".", ",")]
+        out.append("\t".join(cells + [""] * len(extra) + ([comment] if comment else [])))
+    return "\r\n".join(out) + "\r\n"
+
+
+def test_lvm_as_labview_writes_it_without_an_x_column(tmp_path):
+    """LabVIEW's own files with X_Columns No: an empty cell under the heading X_Value on every row, words in
+    brackets in the channels' names ('Excitation (Trigger)') and the units in Y_Unit_Label (Newtons), the Comment
+    column's text after the numbers, a channel without samples written as empty cells, the rows of several writes
+    under one segment header; a segment holding fewer rows than its header announces is refused as truncated, and
+    values under X_Value where the file says it has no x column are checked as an x column (here refused)."""
+    t, f, a = samples()
+    f, a = np.round(f, 6), np.round(a, 6)
+    for case, text in [("plain", labview_no_x(f, a)), ("comment", labview_no_x(f, a, comment="OK")),
+                       ("empty", labview_no_x(f, a, empty=True, comment="LOST COMMUNICATION")),
+                       ("two writes", labview_no_x(f, a, said=f.size // 2))]:
+        path = tmp_path / f"{case}.lvm"
+        path.write_text(text, newline="")
+        (record,) = read_tap_lvm(path)
+        assert record.sample_rate == pytest.approx(FS, rel=1e-6), case
+        assert np.array_equal(record.force, f) and np.allclose(record.response, a, rtol=1e-12, atol=0), case
+        assert record.force_column == "Excitation (Trigger) [N]" and record.response_column.endswith("[m/s^2]")
+    path = tmp_path / "cut.lvm"
+    path.write_text(labview_no_x(f[:100], a[:100], said=f.size), newline="")
+    with pytest.raises(FileFormatError, match=r"cut.lvm, segment 1 \(header ending on line 17\): the segment header "
+                                              r"announces 2048 samples but its rows hold 100: the file is truncated"):
+        read_tap_lvm(path)
+    path = tmp_path / "x.lvm"
+    path.write_text(labview_no_x(f, a, x_cell="0,1"), newline="")
+    with pytest.raises(FileFormatError, match=r"x.lvm, segment 1 .*: X_Value 0.1 on row 1 where X0 \+ n Delta_X is "
+                                              r"0.0; expected the x column of a uniform time axis"):
+        read_tap_lvm(path)
+
+
+def test_of_two_channels_a_response_and_one_in_volts_the_volts_are_the_hammer(tmp_path):
+    """As LabVIEW logs a hammer through a plain voltage input: 'Voltage' in Volts beside 'Acceleration' in g (x
+    columns of their own): the voltage channel is the force, read through the hammer's sensitivity; without the
+    sensitivity the message asks for it; with a third channel the rule does not guess."""
+    t, f, a = samples()
+    volts, g = np.round(f * 2.25e-3, 9), np.round(a / G, 6)
+    path = tmp_path / "v.lvm"
+    path.write_text(lvm([(0.0, 1 / FS, volts, g)], "Multi", units=("Volts", "g")).replace("Hammer", "Voltage")
+                    .replace("Accel", "Acceleration"), newline="")
+    (record,) = read_tap_lvm(path, hammer_sensitivity="2.25 mV/N")
+    assert record.force_column == "Voltage [V]" and np.allclose(record.force, f, rtol=0, atol=2.3e-4)  # 1e-6 V rounding
+    assert record.quantity == "acceleration" and np.allclose(record.response, a, rtol=1e-6, atol=1e-5)
+    with pytest.raises(FileFormatError, match=r"v.lvm: column 'Voltage \[V\]': the channel is a voltage \(V\); give "
+                                              r"the sensor's sensitivity with hammer sensitivity"):
+        read_tap_lvm(path)
+    three = tmp_path / "three.csv"
+    three.write_text("time [s],voltage [V],acceleration [g],acceleration 2 [g]\n"
+                     + rows([t, volts, g, g]), newline="")
+    with pytest.raises(FileFormatError, match=r"three.csv, line 1: 0 force columns"):
+        read_tap_csv(three, hammer_sensitivity="2.25 mV/N")
+
+
 @pytest.mark.parametrize("x_columns, sep, decimal", [("One", "\t", "."), ("No", "\t", ","), ("One", ",", "."),
                                                     ("Multi", "\t", ".")])
 def test_lvm_one_segment(tmp_path, x_columns, sep, decimal):

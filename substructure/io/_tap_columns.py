@@ -252,6 +252,10 @@ def choose(columns: Columns, parsed: list[Any], dims: list[str | None], name: st
     if chosen_force is None:
         forces = [k for k in others if k != chosen_resp and (
             dims[k] == "force" or (dims[k] in ("voltage", None) and _FORCE_NAME.search(columns.names[k])))]
+        if not forces and len(others) == 2 and sorted(dims[k] == "voltage" for k in others) == [False, True] \
+                and any(dims[k] in ("acceleration", "velocity", "displacement") for k in others):
+            # two channels, a response and one in volts (a hammer seen as its voltage): the other channel
+            forces = [k for k in others if dims[k] == "voltage"]
         if len(forces) != 1:
             raise FileFormatError(f"{where}: {len(forces)} force columns ({listing}); expected one column in N "
                                   "(or named 'force' or 'hammer', in mV with a hammer sensitivity); choose it "

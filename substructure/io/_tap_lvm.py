@@ -66,6 +66,30 @@ def _number(text: str, decimal_comma: bool, where: str) -> float:
         raise FileFormatError(f"{where} is {text!r}; expected a number") from None
 
 
+def _rows_as_written(body: bytes, first_line: int, names: list[str], sep: str, decimal_comma: bool, name: str,
+                     comment: bool) -> tuple[list[str], np.ndarray]:
+    """The rows of a segment as LabVIEW writes them, and the names of the columns kept.
+
+    The text of the ``Comment`` column after the numbers is left out, and so
+    are the columns empty on every row: the heading ``X_Value`` over empty
+    cells (``X_Columns`` ``No``), the channels without samples (``Samples``
+    0).  Read line by line: only when the table is not a plain one.
+    """
+    rows = []
+    for raw in body.split(b"\n"):
+        line = raw.decode("utf-8", errors="replace").rstrip("\r")
+        cells = line.split(sep) if line.strip() else []
+        rows.append(cells[:len(names)] if comment and len(cells) > len(names) else cells)
+    full = [cells for cells in rows if len(cells) == len(names)]
+    keep = [j for j in range(len(names)) if any(cells[j].strip() for cells in full)] if full else []
+    if not full or len(keep) == len(names):
+        keep = list(range(len(names)))
+    text = "\n".join(sep.join(cells[j] for j in keep) if len(cells) == len(names) else sep.join(cells)
+                     for cells in rows)
+    kept = [names[j] for j in keep]
+    return kept, parse_rows((text + "\n").encode("utf-8"), first_line, len(kept), sep, decimal_comma, kept, name)
+
+
 def read_segments(data: bytes, name: str) -> list[Segment]:
     """The segments of a LabVIEW measurement file, each with its channels' names and units.
 
@@ -108,8 +132,9 @@ def read_segments(data: bytes, name: str) -> list[Segment]:
         names_end = data.find(b"\n", names_start)
         names_end = len(data) if names_end < 0 else names_end
         names = [c.strip() for c in _text(data[names_start:names_end]).rstrip("\r").split(sep)]
+        comment = False
         while names and (not names[-1] or names[-1] == "Comment"):
-            names.pop()
+            comment |= names.pop() == "Comment"
         body_start = names_end + 1
         names_line = data.count(b"\n", 0, names_start) + 1
         if names and all(is_number(c, decimal_comma) for c in names):  # no line of names: the rows start at once
@@ -121,10 +146,25 @@ def read_segments(data: bytes, name: str) -> list[Segment]:
         tag_line = _TAG_LINE.search(data, body_start, end) if end != len(data) else None
         body_end = tag_line.start() if tag_line else end
         x_cols = [j for j, n in enumerate(names) if n == "X_Value"]
-        if x_columns == "No" and x_cols:
+        # LabVIEW writes the heading X_Value over an empty first cell of every row when it writes no x column
+        if x_columns == "No" and x_cols and x_cols != [0]:
             raise FileFormatError(f"{where}: an X_Value column where the file header says X_Columns No")
-        table = parse_rows(data, data.count(b"\n", 0, body_start) + 1, len(names), sep, decimal_comma, names, name,
-                           body_start, body_end)
+        first_row = data.count(b"\n", 0, body_start) + 1
+        samples = [int(v) for v in tags.get("Samples", []) if v.isdigit()]
+        try:
+            table = parse_rows(data, first_row, len(names), sep, decimal_comma, names, name, body_start, body_end)
+        except FileFormatError:
+            if not (x_columns == "No" and x_cols) and not comment and 0 not in samples:
+                raise
+            names, table = _rows_as_written(data[body_start:body_end], first_row, names, sep, decimal_comma, name,
+                                            comment)
+            x_cols = [j for j, n in enumerate(names) if n == "X_Value"]
+            if x_columns == "No" and x_cols:
+                raise FileFormatError(f"{where}: values under X_Value where the file header says X_Columns No") \
+                    from None
+        if samples and max(samples) > table.shape[0]:
+            raise FileFormatError(f"{where}: the segment header announces {max(samples)} samples but its rows hold "
+                                  f"{table.shape[0]}: the file is truncated or damaged; copy or export it again")
         steps = tags.get("Delta_X")
         if not steps:
             raise FileFormatError(f"{where}: no Delta_X; expected the time step of the channels")
@@ -148,8 +188,11 @@ def read_segments(data: bytes, name: str) -> list[Segment]:
         channel_names, channel_units = [], []
         for pos, j in enumerate(keep):
             plain, unit = name_and_unit(names[j])
-            channel_names.append(plain)
-            channel_units.append(unit or (units[pos] if pos < len(units) else None))
+            said = units[pos] if pos < len(units) else None
+            # the segment header's unit first: LabVIEW's channel names carry other words in brackets
+            # ('Excitation (Trigger)'); the name's own unit where the header has none
+            channel_names.append(plain if said is None or unit is None else names[j])
+            channel_units.append(said if said is not None else unit)
         segments.append(Segment(Columns(channel_names, channel_units, names_line),
                                 table[:, keep], delta_x, x0, data.count(b"\n", 0, body_start) + 1))
         seg_start = body_end
