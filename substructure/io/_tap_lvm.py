@@ -156,8 +156,18 @@ def read_segments(data: bytes, name: str) -> list[Segment]:
         except FileFormatError:
             if not (x_columns == "No" and x_cols) and not comment and 0 not in samples:
                 raise
-            names, table = _rows_as_written(data[body_start:body_end], first_row, names, sep, decimal_comma, name,
-                                            comment)
+            body = data[body_start:body_end]
+            s = sep.encode()
+            table = None
+            if x_columns == "No" and x_cols and not re.search(rb"(?m)^(?!" + re.escape(s) + rb"|\r?$)", body):
+                try:  # every row starts with the empty cell: the rest is a plain table (the usual LabVIEW file)
+                    table = parse_rows(body.replace(b"\n" + s, b"\n").removeprefix(s), first_row, len(names) - 1,
+                                       sep, decimal_comma, names[1:], name)
+                    names = names[1:]
+                except FileFormatError:
+                    table = None
+            if table is None:
+                names, table = _rows_as_written(body, first_row, names, sep, decimal_comma, name, comment)
             x_cols = [j for j, n in enumerate(names) if n == "X_Value"]
             if x_columns == "No" and x_cols:
                 raise FileFormatError(f"{where}: values under X_Value where the file header says X_Columns No") \
