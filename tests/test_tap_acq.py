@@ -13,7 +13,7 @@ import pytest
 
 from substructure.cli import main
 from substructure.datasets import impact_records
-from substructure.errors import FileFormatError
+from substructure.errors import FileFormatError, SubstructureWarning
 from substructure.io import _tap_table
 from substructure.io.tap_files import read_tap_csv, read_tap_lvm, read_tap_uff, read_taps_uff
 
@@ -329,6 +329,43 @@ def test_of_two_channels_a_response_and_one_in_volts_the_volts_are_the_hammer(tm
                      + rows([t, volts, g, g]), newline="")
     with pytest.raises(FileFormatError, match=r"three.csv, line 1: 0 force columns"):
         read_tap_csv(three, hammer_sensitivity="2.25 mV/N")
+
+
+def labview_one(force, accel, logger, logger_dt):
+    """A .lvm file of LabVIEW with one x column, commas, the tags written under their channels' columns: a force
+    in N, a channel without a unit, an acceleration in g and a logger channel of ``logger`` samples, each
+    ``logger_dt`` apart (empty cells after them)."""
+    n, dt = force.size, f"{1 / FS:.6E}"
+    out = ["LabVIEW Measurement,", "Writer_Version,2", "Reader_Version,2", "Separator,Comma", "Decimal_Separator,.",
+           "Multi_Headings,No", "X_Columns,One", "Time_Pref,Relative", "***End_of_Header***,", ",",
+           "Channels,4,,,,", f"Samples,{n},{n},{n},{logger},", "Y_Unit_Label,N,,g,,",
+           "X_Dimension,Time,Time,Time,Time,", "X0,0.0000000000000000E+0" + ",0.0000000000000000E+0" * 3 + ",",
+           f"Delta_X,{dt},{dt},{dt},{logger_dt},", "***End_of_Header***,,,,,", "X_Value,Force,Aux,Accel,Logger,Comment"]
+    for k in range(n):
+        out.append(",".join([f"{k / FS:.6f}", f"{force[k]:.6f}", "0.000000", f"{accel[k]:.6f}",
+                             f"{100.0 * k:.6f}" if k < logger else ""]))
+    return "\r\n".join(out) + "\r\n"
+
+
+def test_lvm_tags_are_read_under_their_channels_and_a_channel_of_another_rate_is_left_out(tmp_path):
+    """A tag cell left empty under a channel (no unit for 'Aux') does not hand the next channel's unit to it: the
+    acceleration keeps its g (read before as 'Aux' in g: the wrong channel, silently); a channel whose samples end
+    early (a logger's five readings a second beside the tap's channels) is left out with a warning, not refused as
+    empty cells."""
+    t, f, a = samples()
+    f, a = np.round(f, 6), np.round(a, 6)
+    path = tmp_path / "logger.lvm"
+    path.write_text(labview_one(f, a, 5, "1.000000"), newline="")
+    with pytest.warns(SubstructureWarning, match=r"logger.lvm, segment 1 .*: 'Logger' hold fewer samples than the "
+                                                 r"other channels .*: left out"):
+        (record,) = read_tap_lvm(path)
+    assert record.force_column == "Force [N]" and record.response_column == "Accel [g]"
+    assert np.array_equal(record.force, f) and np.allclose(record.response, a * G, rtol=1e-12, atol=0)
+    path = tmp_path / "all.lvm"  # every channel at the tap's rate: 'Aux' and 'Logger' without units, not read
+    path.write_text(labview_one(f, a, f.size, f"{1 / FS:.6E}"), newline="")
+    (record,) = read_tap_lvm(path)
+    assert record.force_column == "Force [N]" and record.response_column == "Accel [g]"  # not 'Aux [g]'
+    assert np.allclose(record.response, a * G, rtol=1e-12, atol=0)
 
 
 @pytest.mark.parametrize("x_columns, sep, decimal", [("One", "\t", "."), ("No", "\t", ","), ("One", ",", "."),

@@ -51,12 +51,31 @@ def _text(raw: bytes) -> str:
 
 
 def _tags(text: str, sep: str) -> dict[str, list[str]]:
+    """Each tag's values, in their places (the empty cells between them kept, the trailing ones not)."""
     tags: dict[str, list[str]] = {}
     for line in text.splitlines():
         cells = [c.strip() for c in line.split(sep)]
         if cells and cells[0]:
-            tags[cells[0]] = [c for c in cells[1:] if c]
+            values = cells[1:]
+            while values and not values[-1]:
+                values.pop()
+            tags[cells[0]] = values
     return tags
+
+
+def _of_channel(values: list[str], heading: list[str], j: int) -> str:
+    """A segment tag's value for the channel of column ``j`` of the heading ('' for none).
+
+    LabVIEW writes a tag's values under the columns of their channels (empty
+    under the x columns of ``X_Columns`` ``Multi``, and under channels
+    without a value); values written one a channel with no empty cell
+    between them are read in the channels' order.
+    """
+    if "" in values:
+        k = j - (1 if heading and heading[0] == "X_Value" else 0)
+    else:
+        k = [i for i, n in enumerate(heading) if n != "X_Value"].index(j)
+    return values[k] if 0 <= k < len(values) else ""
 
 
 def _number(text: str, decimal_comma: bool, where: str) -> float:
@@ -67,13 +86,15 @@ def _number(text: str, decimal_comma: bool, where: str) -> float:
 
 
 def _rows_as_written(body: bytes, first_line: int, names: list[str], sep: str, decimal_comma: bool, name: str,
-                     comment: bool) -> tuple[list[str], np.ndarray]:
-    """The rows of a segment as LabVIEW writes them, and the names of the columns kept.
+                     comment: bool) -> tuple[list[int], list[int], np.ndarray]:
+    """The rows of a segment as LabVIEW writes them: the columns kept, those left out as short, the table.
 
     The text of the ``Comment`` column after the numbers is left out, and so
-    are the columns empty on every row: the heading ``X_Value`` over empty
-    cells (``X_Columns`` ``No``), the channels without samples (``Samples``
-    0).  Read line by line: only when the table is not a plain one.
+    are the columns empty on every row (the heading ``X_Value`` over empty
+    cells of ``X_Columns`` ``No``, a channel without samples) and the
+    channels whose samples end before the others' (empty cells after them:
+    a channel of another rate).  Read line by line: only when the table is
+    not a plain one.
     """
     rows = []
     for raw in body.split(b"\n"):
@@ -81,13 +102,19 @@ def _rows_as_written(body: bytes, first_line: int, names: list[str], sep: str, d
         cells = line.split(sep) if line.strip() else []
         rows.append(cells[:len(names)] if comment and len(cells) > len(names) else cells)
     full = [cells for cells in rows if len(cells) == len(names)]
-    keep = [j for j in range(len(names)) if any(cells[j].strip() for cells in full)] if full else []
-    if not full or len(keep) == len(names):
-        keep = list(range(len(names)))
+    keep, short = list(range(len(names))), []
+    if full:
+        filled = np.array([[bool(c.strip()) for c in cells] for cells in full])
+        ends = filled.sum(axis=0)
+        leading = np.array([filled[:n, j].all() for j, n in enumerate(ends)])  # filled, then empty to the end
+        short = [j for j in range(len(names)) if 0 < ends[j] < len(full) and leading[j] and names[j] != "X_Value"]
+        kept = [j for j in range(len(names)) if ends[j] > 0 and j not in short]
+        keep = kept if kept else keep
     text = "\n".join(sep.join(cells[j] for j in keep) if len(cells) == len(names) else sep.join(cells)
                      for cells in rows)
-    kept = [names[j] for j in keep]
-    return kept, parse_rows((text + "\n").encode("utf-8"), first_line, len(kept), sep, decimal_comma, kept, name)
+    labels = [names[j] for j in keep]
+    return keep, short, parse_rows((text + "\n").encode("utf-8"), first_line, len(keep), sep, decimal_comma, labels,
+                                   name)
 
 
 def read_segments(data: bytes, name: str) -> list[Segment]:
@@ -145,37 +172,50 @@ def read_segments(data: bytes, name: str) -> list[Segment]:
         end = marks[k + 2] if k + 2 < len(marks) else len(data)
         tag_line = _TAG_LINE.search(data, body_start, end) if end != len(data) else None
         body_end = tag_line.start() if tag_line else end
-        x_cols = [j for j, n in enumerate(names) if n == "X_Value"]
+        heading = names
+        x_cols = [j for j, n in enumerate(heading) if n == "X_Value"]
         # LabVIEW writes the heading X_Value over an empty first cell of every row when it writes no x column
         if x_columns == "No" and x_cols and x_cols != [0]:
             raise FileFormatError(f"{where}: an X_Value column where the file header says X_Columns No")
         first_row = data.count(b"\n", 0, body_start) + 1
-        samples = [int(v) for v in tags.get("Samples", []) if v.isdigit()]
+        samples = [int(v) if v.isdigit() else -1 for v in tags.get("Samples", [])]
+        cols, short = list(range(len(heading))), []
         try:
-            table = parse_rows(data, first_row, len(names), sep, decimal_comma, names, name, body_start, body_end)
+            table = parse_rows(data, first_row, len(heading), sep, decimal_comma, heading, name, body_start, body_end)
         except FileFormatError:
-            if not (x_columns == "No" and x_cols) and not comment and 0 not in samples:
+            if not (x_columns == "No" and x_cols) and not comment and len(set(v for v in samples if v >= 0)) < 2:
                 raise
             body = data[body_start:body_end]
             s = sep.encode()
             table = None
             if x_columns == "No" and x_cols and not re.search(rb"(?m)^(?!" + re.escape(s) + rb"|\r?$)", body):
                 try:  # every row starts with the empty cell: the rest is a plain table (the usual LabVIEW file)
-                    table = parse_rows(body.replace(b"\n" + s, b"\n").removeprefix(s), first_row, len(names) - 1,
-                                       sep, decimal_comma, names[1:], name)
-                    names = names[1:]
+                    table = parse_rows(body.replace(b"\n" + s, b"\n").removeprefix(s), first_row, len(heading) - 1,
+                                       sep, decimal_comma, heading[1:], name)
+                    cols = cols[1:]
                 except FileFormatError:
                     table = None
             if table is None:
-                names, table = _rows_as_written(body, first_row, names, sep, decimal_comma, name, comment)
-            x_cols = [j for j, n in enumerate(names) if n == "X_Value"]
-            if x_columns == "No" and x_cols:
+                cols, short, table = _rows_as_written(body, first_row, heading, sep, decimal_comma, name, comment)
+            if x_columns == "No" and any(heading[j] == "X_Value" for j in cols):
                 raise FileFormatError(f"{where}: values under X_Value where the file header says X_Columns No") \
                     from None
-        if samples and max(samples) > table.shape[0]:
-            raise FileFormatError(f"{where}: the segment header announces {max(samples)} samples but its rows hold "
+        if short:
+            warnings.warn(f"{where}: {', '.join(repr(heading[j]) for j in short)} hold fewer samples than the other "
+                          "channels (another rate, or a logger's readings): left out", SubstructureWarning,
+                          stacklevel=3)
+        x_cols = [k for k, j in enumerate(cols) if heading[j] == "X_Value"]
+        keep = [k for k, j in enumerate(cols) if heading[j] != "X_Value"]
+
+        def tag(key: str, j: int) -> str:
+            return _of_channel(tags.get(key, []), heading, j)
+
+        counts = [tag("Samples", cols[k]) for k in keep]
+        announced = max((int(v) for v in counts if v.isdigit()), default=0)
+        if announced > table.shape[0]:
+            raise FileFormatError(f"{where}: the segment header announces {announced} samples but its rows hold "
                                   f"{table.shape[0]}: the file is truncated or damaged; copy or export it again")
-        steps = tags.get("Delta_X")
+        steps = [v for v in (tag("Delta_X", cols[k]) for k in keep) if v]
         if not steps:
             raise FileFormatError(f"{where}: no Delta_X; expected the time step of the channels")
         deltas = {_number(v, decimal_comma, f"{where}: Delta_X") for v in steps}
@@ -184,8 +224,7 @@ def read_segments(data: bytes, name: str) -> list[Segment]:
         delta_x = deltas.pop()
         if not delta_x > 0:
             raise FileFormatError(f"{where}: Delta_X {steps[0]}; expected a positive time step")
-        x0 = _number((tags.get("X0") or ["0"])[0], decimal_comma, f"{where}: X0")
-        keep = [j for j in range(len(names)) if j not in x_cols]
+        x0 = _number(next((v for v in (tag("X0", cols[k]) for k in keep) if v), "0"), decimal_comma, f"{where}: X0")
         if x_cols and table.shape[0]:
             expected = x0 + np.arange(table.shape[0]) * delta_x
             for j in x_cols:
@@ -194,14 +233,13 @@ def read_segments(data: bytes, name: str) -> list[Segment]:
                     raise FileFormatError(f"{where}: X_Value {float(table[worst, j])!r} on row {worst + 1} where "
                                           f"X0 + n Delta_X is {float(expected[worst])!r}; expected the x column of a "
                                           "uniform time axis")
-        units = [unit_label(u) for u in tags.get("Y_Unit_Label", [])]
         channel_names, channel_units = [], []
-        for pos, j in enumerate(keep):
-            plain, unit = name_and_unit(names[j])
-            said = units[pos] if pos < len(units) else None
+        for k in keep:
+            plain, unit = name_and_unit(heading[cols[k]])
+            said = unit_label(tag("Y_Unit_Label", cols[k]))
             # the segment header's unit first: LabVIEW's channel names carry other words in brackets
             # ('Excitation (Trigger)'); the name's own unit where the header has none
-            channel_names.append(plain if said is None or unit is None else names[j])
+            channel_names.append(plain if said is None or unit is None else heading[cols[k]])
             channel_units.append(said if said is not None else unit)
         segments.append(Segment(Columns(channel_names, channel_units, names_line),
                                 table[:, keep], delta_x, x0, data.count(b"\n", 0, body_start) + 1))
