@@ -96,6 +96,25 @@ def test_the_sample_rate_comes_from_wf_increment_or_the_option(records, tmp_path
         read_tap_tdms(path, sample_rate="51.2 kHz")
 
 
+def test_a_channel_of_another_rate_beside_the_tap_is_not_read(records, tmp_path):
+    """A logger's channel in the tap's group (five readings, a second apart): the force and the response are read at
+    their own rate; a force and a response at two rates stay refused."""
+    r = records[0]
+    dt = 1.0 / r.sample_rate
+    path = _write(tmp_path / "log.tdms", {"g": [_channel("g", "force", r.force, "N", dt),
+                                               _channel("g", "acc", r.response, "m/s^2", dt),
+                                               _channel("g", "supply", np.full(5, 24.0), "V", 1.0)]})
+    (tap,) = read_tap_tdms(path)
+    assert tap.sample_rate == pytest.approx(r.sample_rate) and tap.response_column == "acc [m/s^2]"
+    np.testing.assert_allclose(tap.force, r.force, rtol=0, atol=0)
+    path = _write(tmp_path / "two.tdms", {"g": [_channel("g", "force", r.force, "N", dt),
+                                               _channel("g", "acc", r.response, "m/s^2", 2 * dt),
+                                               _channel("g", "supply", np.full(5, 24.0), "V", 1.0)]})
+    with pytest.raises(FileFormatError, match=r"group 'g': the channels' time steps \(wf_increment\) differ: "
+                                              r"3.90625e-05, 7.8125e-05 s"):
+        read_tap_tdms(path)
+
+
 @pytest.mark.parametrize("case, message", [
     ("steps", r"group 'g': the channels' time steps \(wf_increment\) differ: 3.90625e-05, 7.8125e-05 s"),
     ("no unit", r"group 'g': channel 'acc' has no unit; expected its property unit_string"),

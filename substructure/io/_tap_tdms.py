@@ -134,11 +134,15 @@ def _group_record(name: str, where: str, source: str, channels: list, sensitivit
     channels = [c for c, _ in kept]
     samples = [got[0] for _, got in kept]
     columns = Columns([c.name for c in channels], [got[1] for _, got in kept], None)
-    steps = {_step(c, where) for c in channels if "wf_increment" in c.properties}
+    per = {k: _step(c, where) for k, c in enumerate(channels) if "wf_increment" in c.properties}
+    parsed, dims, errors = units_of_columns(columns, where)
+    t_col, f_col, r_col = choose(columns, parsed, dims, where, force_column, response_column,
+                                 bool(per) or sample_rate is not None, rate_hint="the channels' wf_increment property")
+    # the time steps of the force and the response (a channel of another rate beside them is not read)
+    steps = {per[k] for k in (f_col, r_col) if k in per} if len(set(per.values())) > 1 else set(per.values())
     if len(steps) > 1:
         raise FileFormatError(f"{where}: the channels' time steps (wf_increment) differ: "
                               f"{', '.join(f'{s:.10g}' for s in sorted(steps))} s; expected one sample rate")
-    parsed, dims, errors = units_of_columns(columns, where)
     stated = None
     if steps:
         stated = (1.0 / steps.pop(), "the channels' wf_increment")
@@ -148,8 +152,10 @@ def _group_record(name: str, where: str, source: str, channels: list, sensitivit
             raise FileFormatError(f"{where}: wf_increment {1.0 / stated[0]!r} s is {stated[0]:.10g} Hz, "
                                   f"--sample-rate {hz:.10g} Hz; leave the option out or fix the file")
         stated = stated or (hz, "--sample-rate")
-    t_col, f_col, r_col = choose(columns, parsed, dims, where, force_column, response_column, stated is not None,
-                                 rate_hint="the channels' wf_increment property")
+    if stated is None and t_col is None:
+        raise FileFormatError(f"{where}: no column in units of time ({', '.join(columns.labels)}) and no sample "
+                              "rate; give the rate with --sample-rate (e.g. '51.2 kHz', sample_rate=) or the "
+                              "channels' wf_increment property")
     labels = columns.labels
     for k in (f_col, r_col):
         if columns.units[k] is None:
