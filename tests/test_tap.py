@@ -341,6 +341,29 @@ def test_csv_in_g_and_in_millivolts_reads_in_si(tmp_path):
     assert read_tap_csv(v).quantity == "velocity" and np.allclose(read_tap_csv(v).response, x * 1e-3)
 
 
+def test_a_header_written_as_a_comment_as_numpy_savetxt_writes_it(tmp_path):
+    """``numpy.savetxt(..., header=...)`` puts the header after '# ': a comment line right above the rows that
+    names every column with its unit is the header (whatever its separator); a comment that does not stays a
+    comment, and the file without a header is refused as before."""
+    t, f = half_sine()
+    x = simulate(f, "acceleration")
+    table = np.column_stack([t, f, x])
+    for case, kw in [("spaces", dict(header="time(s) force(N) acceleration(m/s^2)")),
+                     ("commas", dict(header="time [s], force [N], acceleration [m/s^2]")),
+                     ("tabs", dict(header="time [s]\tforce [N]\tacceleration [m/s^2]", delimiter="\t")),
+                     ("under notes", dict(header="tap 3, operator K\ntime(s), \t force(N), \t acceleration(m/s^2)"))]:
+        path = tmp_path / f"{case.replace(' ', '_')}.txt"
+        np.savetxt(path, table, **kw)
+        record = read_tap_csv(path)
+        assert record.force_column == "force [N]" and record.response_column == "acceleration [m/s^2]", case
+        np.testing.assert_allclose(record.force, f, rtol=1e-15, atol=0)
+        np.testing.assert_allclose(record.response, x, rtol=1e-15, atol=0)
+    path = tmp_path / "notes.txt"
+    np.savetxt(path, table, header="three channels: time force acceleration")
+    with pytest.raises(FileFormatError, match=r"notes.txt, line 2: numbers with no header above them"):
+        read_tap_csv(path)
+
+
 @pytest.mark.parametrize("text, message", [
     ("", r"e.csv: the file is empty"),
     ("time [s],force,acceleration [m/s^2]\n0,1,2\n", r"e.csv, line 1: column 2 'force' has no unit"),

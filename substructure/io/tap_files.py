@@ -103,8 +103,13 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
         (1 if sep is not None and len(row.split(sep)) > 1 and not row.split(sep)[-1].strip() else 0)
     content = [(n, t) for n, t in head if t.strip() and not t.lstrip().startswith("#")]
     if not content:
-        raise FileFormatError(f"{name}, line {first_line}: numbers with no header above them; expected a header "
-                              "naming each column, e.g. 'time [s],force [N],acceleration [m/s^2]'")
+        # a header written as a comment, as numpy.savetxt(header=...) writes it ('# time(s) force(N) ...')
+        last = [(n, t) for n, t in head if t.strip()][-1:]
+        found = _comment_header(last[0][1], sep, ncols) if last and last[0][1].lstrip().startswith("#") else None
+        if found is None:
+            raise FileFormatError(f"{name}, line {first_line}: numbers with no header above them; expected a header "
+                                  "naming each column, e.g. 'time [s],force [N],acceleration [m/s^2]'")
+        content = [(last[0][0], sep.join(found) if sep is not None else "  ".join(found))]
     h_line, h_text = content[-1]
     cells = header_cells(h_text.lstrip("\ufeff"), sep, ncols)
     above = header_cells(content[-2][1].lstrip("\ufeff"), sep, ncols) if len(content) > 1 and is_unit_row(cells) \
@@ -136,6 +141,17 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
     time_s = time_axis(time, rate, table.shape[0], name)
     return build_record(name, time_s, table[:, f_col], parsed[f_col], labels[f_col], table[:, r_col],
                         parsed[r_col], labels[r_col], sensitivity, hammer_sensitivity, quantity)
+
+
+def _comment_header(line: str, sep: str | None, ncols: int) -> list[str] | None:
+    """The cells of a comment line that names every column with its unit (None when it does not)."""
+    body = line.strip().lstrip("#").strip()
+    for split in dict.fromkeys((sep, ",", ";", "\t", None)):
+        cells = [c.strip().rstrip(",;").strip().strip('"') for c in header_cells(body, split, ncols)]
+        cells = [c for c in cells if c]
+        if len(cells) == ncols and all(name_and_unit(c)[1] is not None for c in cells):
+            return cells
+    return None
 
 
 def _text_bytes(path: str | os.PathLike, name: str) -> bytes:
