@@ -284,3 +284,26 @@ def test_write_uff_input_errors(tmp_path):
     assert not (tmp_path / "a.uff").exists()
     with pytest.raises(FileFormatError, match="no_such_dir"):
         write_uff(random_frf(), tmp_path / "no_such_dir" / "a.uff")
+
+
+def test_an_frf_saved_by_numpy_savetxt_with_its_header_reads_back(tmp_path):
+    """``numpy.savetxt(..., header=...)`` writes the header as a comment ('# frequency_hz,real,imag') and, by
+    default, separates the columns by blanks: the comment right above the rows is the header when the file reads
+    with it, and blank-separated columns are read as the rows show them; a comment that is not a header (the
+    window's line) leaves the file without one, refused as before."""
+    f = np.linspace(20.0, 5000.0, 50)
+    h = 1e-7 / (1 - (f / 1000.0) ** 2 + 0.05j * f / 1000.0)
+    table = np.column_stack([f, h.real, h.imag])
+    for case, kw in [("commas", dict(header="frequency_hz,real,imag", delimiter=",")),
+                     ("units", dict(header="Frequency [Hz];Real [mm/N];Imag [mm/N]", delimiter=";")),
+                     ("blanks", dict(header="frequency_hz real imag")),
+                     ("blank units", dict(header="Frequency [Hz]  Real [m/N]  Imag [m/N]"))]:
+        path = tmp_path / f"{case.replace(' ', '_')}.csv"
+        np.savetxt(path, table * ([1.0, 1e3, 1e3] if case == "units" else 1.0), **kw)
+        frf = read_csv(path)
+        np.testing.assert_allclose(frf.frequency.hz, f, rtol=1e-15)
+        np.testing.assert_allclose(frf.data[:, 0, 0], h, rtol=1e-14, err_msg=case)
+    path = tmp_path / "window.csv"
+    path.write_text("# window_tau_s = 0.04\n20,1e-7,0\n30,1e-7,0\n")
+    with pytest.raises(FileFormatError, match=r"window.csv, line 2: column '20'; expected frequency"):
+        read_csv(path)

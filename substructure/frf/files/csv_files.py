@@ -284,6 +284,25 @@ def _read_csv(path, output: str, input: str,
     comments = 0
     while comments < len(numbered) and numbered[comments][1].strip().lstrip("\ufeff").startswith("#"):
         comments += 1
+    if 0 < comments < len(numbered) and _NUMERIC_ROW.match(numbered[comments][1]):
+        # no header but a comment right above the rows, as numpy.savetxt(header=...) writes one: the header when
+        # the file reads with it
+        line, text = numbered[comments - 1]
+        trial = numbered[:comments - 1] + [(line, text.strip().lstrip("\ufeff").lstrip("#").strip())] + \
+            numbered[comments:]
+        try:
+            return _read_numbered(trial, comments - 1, name, output, input, quantity, window)
+        except FileFormatError:
+            pass
+    return _read_numbered(numbered, comments, name, output, input, quantity, window)
+
+
+_NUMERIC_ROW = re.compile(r"^\s*[-+.\d]+(?:[eE][-+]?\d+)?(?:[\s,;]+[-+.\deE]+)*[\s,;]*$")
+
+
+def _read_numbered(numbered: list, comments: int, name: str, output: str, input: str, quantity: str | None,
+                   window: float | None) -> tuple[FRF, np.ndarray, dict[str, np.ndarray], float | None]:
+    """:func:`_read_csv` on the file's non-blank lines, the first ``comments`` of them comments."""
     first, header = numbered[min(comments, len(numbered) - 1)]
     columns = header.replace(" ", "").lstrip("\ufeff")
     if columns not in _HEADERS and columns.startswith(CSV_HEADER + ",") and \

@@ -138,7 +138,15 @@ def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None
         raise FileFormatError(f"{name}: only comment lines; expected a header such as 'frequency_hz,real,imag'")
     first, header = rows[0]
     delimiter = ";" if ";" in header else "\t" if "\t" in header else ","
-    cells = list(csv.reader([line for _, line in rows], delimiter=delimiter))
+    if delimiter not in header and len(rows) > 1 and not any(d in rows[1][1] for d in ";\t,"):
+        # columns separated by blanks (numpy.savetxt's default): the header split as the first row is, its
+        # cells by runs of two blanks when single blanks are inside them ('Frequency [Hz]')
+        width = len(rows[1][1].split())
+        heads = [[c for c in re.split(pattern, header.strip()) if c] for pattern in (r"\s{2,}", r"\s+")]
+        delimiter = " "
+        cells = [next((h for h in heads if len(h) == width), heads[0])] + [line.split() for _, line in rows[1:]]
+    else:
+        cells = list(csv.reader([line for _, line in rows], delimiter=delimiter))
     cells = [[c.strip() for c in row] for row in cells]
     for row in cells:
         while row and row[-1] == "":  # an empty trailing column (a spreadsheet's last separator)
