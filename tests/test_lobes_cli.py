@@ -95,6 +95,20 @@ def test_modes_file_with_sdm_reports_its_discretisation(capsys, modes_file):
     assert all(2e-4 < a < 5e-3 for a in result["depth_limit_m"])
 
 
+def test_semi_discretization_says_its_steps_on_stderr_unless_quiet(capsys, modes_file):
+    """A run takes minutes at low speeds: each step of the search, then the recommendation's new runs, is a line on
+    standard error; the JSON on standard output is the same with --quiet, which prints none."""
+    argv = ["lobes", "--modes", modes_file, *BENCH_CUT, "--method", "sdm", "--speeds", "10000:16000:1000", "--json"]
+    status, out, err = run(capsys, *argv)
+    assert status == 0, err
+    lines = err.splitlines()
+    assert lines and all(line.startswith("substructure: ") for line in lines)
+    assert any("coarse scan of the depths, step 1: 7 of 7 speeds" in line for line in lines)
+    assert any("narrowing the limits to 0.5%" in line for line in lines)
+    status, quiet, err = run(capsys, *argv, "--quiet")
+    assert status == 0 and err == "" and json.loads(quiet) == json.loads(out)
+
+
 def test_assembly_and_point_with_band_and_plot(capsys, tmp_path):
     png = tmp_path / "lobes.png"
     status, out, err = run(capsys, "lobes", "--assembly", ASSEMBLY, "--at", "tool.tip", "--band", "500:5000",

@@ -76,6 +76,16 @@ def test_semi_discretization_is_converged_and_reports_its_discretisation(immersi
     assert fixed.discretisation["intervals_in_cut"] == [40, 40]
 
 
+def test_the_progress_lines_do_not_change_the_lobes():
+    speeds = spindle_speeds("8000 rpm", "20000 rpm", "1000 rpm")
+    lines: list[str] = []
+    said = sdm(MODEL, benchmark_cut(1.0), speeds, progress=lines.append)
+    plain = sdm(MODEL, benchmark_cut(1.0), speeds)
+    np.testing.assert_array_equal(said.depth_limit_m, plain.depth_limit_m)
+    assert lines[0] == "semi-discretization: coarse scan of the depths, step 1: 13 of 13 speeds"
+    assert any(line.startswith("semi-discretization: narrowing the limits to 0.5%: ") for line in lines)
+
+
 def test_zero_order_is_within_10_percent_of_semi_discretization_for_the_slot():
     speeds = spindle_speeds("5000 rpm", "25000 rpm", "50 rpm")
     cut = benchmark_cut(1.0)

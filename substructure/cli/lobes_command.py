@@ -6,7 +6,7 @@ import argparse
 import warnings
 
 from ..errors import SubstructureError, WindowedFRFWarning
-from ._common import (UsageError, check_outputs, positive_arg, check_plot, draw_to, grid_text,
+from ._common import (PROG, UsageError, check_outputs, positive_arg, check_plot, draw_to, grid_text,
                       one_line, point_arg, print_json)
 from ._cutting import (
     MILLING_DEFAULT_NOTE,
@@ -91,8 +91,14 @@ def _lobes_structure(args: argparse.Namespace):
 
 
 def run(args: argparse.Namespace) -> int:
+    import sys
+
     import attrs
     import numpy as np
+
+    def progress(text: str) -> None:  # semi-discretization takes minutes at low speeds: its steps on stderr
+        if not args.quiet:
+            print(f"{PROG}: {text}", file=sys.stderr, flush=True)
 
     from ..frf import FRF
     from ..stability import (MillingCut, ModalFitter, ModalFitWarning, ModalModel, NoRecommendationError, recommend,
@@ -128,7 +134,7 @@ def run(args: argparse.Namespace) -> int:
             if max(fit.modal_error_ for fit in fits) > 0.2:
                 warnings.warn(f"the fitted modes miss the FRF by {errors}; choose the band with --band LO:HI",
                               ModalFitWarning, stacklevel=2)
-        lobes = sdm(structure, cut, args.speeds, intervals=args.intervals)
+        lobes = sdm(structure, cut, args.speeds, intervals=args.intervals, progress=progress)
         if band is not None:
             lobes = attrs.evolve(lobes, band=band)
         info = lobes.discretisation
@@ -139,6 +145,9 @@ def run(args: argparse.Namespace) -> int:
     best = why = None
     if limits is not None:
         try:
+            if args.method == "sdm":
+                progress("the recommendation: the lowest limit within each candidate's speed window, by new runs "
+                         "of semi-discretization")
             best = recommend(lobes, cut, limits, margin=args.margin, speed_tolerance=args.speed_tolerance)
         except NoRecommendationError as exc:  # the lobes stand; the recommendation is absent, with the reason
             why = one_line(exc)
@@ -244,4 +253,5 @@ def add_parser(commands) -> None:
     lobes.add_argument("--plot", metavar="FILE.png", help="plot the lobes to an image file")
     lobes.add_argument("--overwrite", action="store_true", help="let --plot replace an existing file")
     lobes.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
+    lobes.add_argument("--quiet", action="store_true", help="no progress lines on standard error (--method sdm)")
     lobes.set_defaults(run=run)

@@ -41,7 +41,7 @@ limit.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -141,7 +141,7 @@ def _reference_depth(model: ModalModel, cut: Any) -> float:
     return float(model.arrays()["stiffness"].min() / max(scale, 1e-300))
 
 
-def _bracket(model: ModalModel, plan: _Plan, speeds: np.ndarray, ladder: np.ndarray):
+def _bracket(model: ModalModel, plan: _Plan, speeds: np.ndarray, ladder: np.ndarray, progress=None):
     """Coarse scan up the depth ladder, speed by speed, until the first unstable depth.
 
     All speeds still searching are evaluated in one batch per rung; a speed
@@ -157,9 +157,13 @@ def _bracket(model: ModalModel, plan: _Plan, speeds: np.ndarray, ladder: np.ndar
     rung = np.zeros(ns, dtype=int)  # next rung to try going up
     up, down = np.arange(ns), np.zeros(0, dtype=int)
     evaluations, halvings = 0, 0
+    step = 0
     while up.size or down.size:
         trial = np.concatenate([ladder[rung[up]], hi[down] / 2.0])
         who = np.concatenate([up, down])
+        step += 1
+        if progress:
+            progress(f"semi-discretization: coarse scan of the depths, step {step}: {who.size} of {ns} speeds")
         rho, mu = _critical(model, plan, speeds[who], trial)
         evaluations += who.size
         bad = rho > 1.0
@@ -178,7 +182,7 @@ def _bracket(model: ModalModel, plan: _Plan, speeds: np.ndarray, ladder: np.ndar
 
 
 def _refine(model: ModalModel, plan: _Plan, speeds: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-            mu_hi: np.ndarray, rho_lo: np.ndarray, rtol: float) -> int:
+            mu_hi: np.ndarray, rho_lo: np.ndarray, rtol: float, progress=None) -> int:
     """Shrink every finite bracket to ``hi / lo <= 1 + rtol`` in place; returns the evaluations.
 
     Regula falsi on ``log(rho)`` against ``log(depth)`` with the Illinois
@@ -199,6 +203,8 @@ def _refine(model: ModalModel, plan: _Plan, speeds: np.ndarray, lo: np.ndarray, 
         active, g_lo, g_hi, side = active[wide], g_lo[wide], g_hi[wide], side[wide]
         if not active.size:
             break
+        if progress:
+            progress(f"semi-discretization: narrowing the limits to {rtol:.1%}: {active.size} of {speeds.size} speeds")
         x0, x1 = np.log(lo[active]), np.log(hi[active])
         x = x0 + (x1 - x0) * g_lo / (g_lo - g_hi)
         x = np.clip(x, x0 + 0.45 * tol, x1 - 0.45 * tol)
@@ -215,7 +221,7 @@ def _refine(model: ModalModel, plan: _Plan, speeds: np.ndarray, lo: np.ndarray, 
 
 
 def _continue(model: ModalModel, plan: _Plan, speeds: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-              mu_hi: np.ndarray, rho_lo: np.ndarray, rtol: float, coarse_ratio: float) -> int:
+              mu_hi: np.ndarray, rho_lo: np.ndarray, rtol: float, coarse_ratio: float, progress=None) -> int:
     """Continuation along the speeds: look for a neighbour's lobe below a speed's limit.
 
     The coarse scan can step over a narrow unstable band (near the tip of a
@@ -240,6 +246,8 @@ def _continue(model: ModalModel, plan: _Plan, speeds: np.ndarray, lo: np.ndarray
         todo[:] = False
         if not who.size:
             continue
+        if progress:
+            progress(f"semi-discretization: {check.size} of {speeds.size} speeds probed below a neighbour's lobe")
         rho, mu = _critical(model, plan, speeds[who], depth)
         evaluations += who.size
         changed = []
@@ -276,7 +284,8 @@ def _continue(model: ModalModel, plan: _Plan, speeds: np.ndarray, lo: np.ndarray
 
 def sdm(modes: ModalModel, cut: Any, speeds: Any, *, intervals: int | None = None, min_intervals: int = 20,
         max_phase_step: float = 0.2, rtol: float = 0.005, depth_range: tuple[Any, Any] | None = None,
-        coarse_ratio: float = 2.0 ** 0.5, label: str | None = None) -> Lobes:
+        coarse_ratio: float = 2.0 ** 0.5, label: str | None = None,
+        progress: Callable[[str], None] | None = None) -> Lobes:
     """Stability lobes by semi-discretization.
 
     Parameters
@@ -313,6 +322,11 @@ def sdm(modes: ModalModel, cut: Any, speeds: Any, *, intervals: int | None = Non
         than a rung, below the first unstable rung, can be missed.
     label : str, optional
         Legend label.
+    progress : callable, optional
+        Called with a line at each step of the search (the coarse scan, the
+        narrowing of the limits, the probes below a neighbour's lobe): at low
+        speeds, with many intervals per delay period, a run takes minutes.
+        The result does not depend on it.
 
     Returns
     -------
@@ -344,9 +358,9 @@ def sdm(modes: ModalModel, cut: Any, speeds: Any, *, intervals: int | None = Non
             raise InvalidValueError(f"depth_range: got {depth_range!r}; expected 0 < low < high")
         ladder = np.geomspace(lo, hi, int(np.ceil(np.log(hi / lo) / np.log(coarse_ratio))) + 1)
     ns = speeds_rpm.size
-    lo_d, hi_d, mu_hi, rho_lo, evaluations = _bracket(model, plan, speeds_rpm, ladder)
-    evaluations += _refine(model, plan, speeds_rpm, lo_d, hi_d, mu_hi, rho_lo, rtol)
-    evaluations += _continue(model, plan, speeds_rpm, lo_d, hi_d, mu_hi, rho_lo, rtol, coarse_ratio)
+    lo_d, hi_d, mu_hi, rho_lo, evaluations = _bracket(model, plan, speeds_rpm, ladder, progress)
+    evaluations += _refine(model, plan, speeds_rpm, lo_d, hi_d, mu_hi, rho_lo, rtol, progress)
+    evaluations += _continue(model, plan, speeds_rpm, lo_d, hi_d, mu_hi, rho_lo, rtol, coarse_ratio, progress)
     found = np.isfinite(hi_d)
     limit = np.where(found, np.sqrt(lo_d * hi_d), np.inf)
     counts = plan.intervals_for(speeds_rpm)
