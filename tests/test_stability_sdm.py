@@ -82,7 +82,8 @@ def test_the_progress_lines_do_not_change_the_lobes():
     said = sdm(MODEL, benchmark_cut(1.0), speeds, progress=lines.append)
     plain = sdm(MODEL, benchmark_cut(1.0), speeds)
     np.testing.assert_array_equal(said.depth_limit_m, plain.depth_limit_m)
-    assert lines[0] == "semi-discretization: coarse scan of the depths, step 1: 13 of 13 speeds"
+    assert lines[0].startswith("semi-discretization: 13 speeds, ") and "eigenvalue problems of order up to" in lines[0]
+    assert lines[1] == "semi-discretization: coarse scan of the depths, step 1: 13 of 13 speeds"
     assert any(line.startswith("semi-discretization: narrowing the limits to 0.5%: ") for line in lines)
 
 

@@ -358,6 +358,12 @@ def sdm(modes: ModalModel, cut: Any, speeds: Any, *, intervals: int | None = Non
             raise InvalidValueError(f"depth_range: got {depth_range!r}; expected 0 < low < high")
         ladder = np.geomspace(lo, hi, int(np.ceil(np.log(hi / lo) / np.log(coarse_ratio))) + 1)
     ns = speeds_rpm.size
+    if progress:
+        counts = plan.intervals_for(speeds_rpm)
+        order = max(plan.grid(int(m)).size for m in np.unique(counts)) * len({m.direction for m in model.modes}) \
+            + 2 * len(model.modes)
+        progress(f"semi-discretization: {ns} speeds, {int(counts.min())} to {int(counts.max())} intervals in the "
+                 f"cut per delay period (eigenvalue problems of order up to {order}: the lowest speeds cost most)")
     lo_d, hi_d, mu_hi, rho_lo, evaluations = _bracket(model, plan, speeds_rpm, ladder, progress)
     evaluations += _refine(model, plan, speeds_rpm, lo_d, hi_d, mu_hi, rho_lo, rtol, progress)
     evaluations += _continue(model, plan, speeds_rpm, lo_d, hi_d, mu_hi, rho_lo, rtol, coarse_ratio, progress)
