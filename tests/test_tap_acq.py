@@ -368,6 +368,27 @@ def test_lvm_tags_are_read_under_their_channels_and_a_channel_of_another_rate_is
     assert np.allclose(record.response, a * G, rtol=1e-12, atol=0)
 
 
+def test_lvm_tags_under_x_columns_of_their_own_are_read_by_place(tmp_path):
+    """X_Columns Multi as LabVIEW writes it: each tag's value under its channel, empty under the x columns, and
+    the unit of the middle channel left empty: the acceleration keeps its g."""
+    t, f, a = samples()
+    f, a = np.round(f, 6), np.round(a, 6)
+    n, dt = f.size, f"{1 / FS:.6E}"
+    out = ["LabVIEW Measurement\t", "Writer_Version\t2", "Reader_Version\t2", "Separator\tTab",
+           "Decimal_Separator\t.", "Multi_Headings\tYes", "X_Columns\tMulti", "Time_Pref\tRelative",
+           "***End_of_Header***\t", "\t", "Channels\t3\t\t\t\t\t", f"Samples\t{n}\t\t{n}\t\t{n}\t",
+           "Y_Unit_Label\tN\t\t\t\tg\t", "X_Dimension\tTime\t\tTime\t\tTime\t", "X0\t0.0\t\t0.0\t\t0.0\t",
+           f"Delta_X\t{dt}\t\t{dt}\t\t{dt}\t", "***End_of_Header***\t\t\t\t\t\t",
+           "X_Value\tForce\tX_Value\tAux\tX_Value\tAccel\tComment"]
+    out += ["\t".join([f"{k / FS:.6f}", f"{f[k]:.6f}", f"{k / FS:.6f}", "0.000000", f"{k / FS:.6f}", f"{a[k]:.6f}"])
+            for k in range(n)]
+    path = tmp_path / "multi.lvm"
+    path.write_text("\r\n".join(out) + "\r\n", newline="")
+    (record,) = read_tap_lvm(path)
+    assert record.force_column == "Force [N]" and record.response_column == "Accel [g]"
+    assert record.sample_rate == pytest.approx(FS) and np.allclose(record.response, a * G, rtol=1e-12, atol=0)
+
+
 @pytest.mark.parametrize("x_columns, sep, decimal", [("One", "\t", "."), ("No", "\t", ","), ("One", ",", "."),
                                                     ("Multi", "\t", ".")])
 def test_lvm_one_segment(tmp_path, x_columns, sep, decimal):

@@ -273,6 +273,11 @@ def choose(columns: Columns, parsed: list[Any], dims: list[str | None], name: st
                                       "NAME or INDEX (response_column=)")
             chosen_resp = responses[0]
     if t_col is None and not has_rate:
-        raise FileFormatError(f"{where}: no column in units of time ({', '.join(labels)}) and no sample rate; "
-                              f"give the rate with --sample-rate (e.g. '51.2 kHz', sample_rate=) or {rate_hint}")
+        raise no_rate(where, labels, rate_hint)
     return t_col, chosen_force, chosen_resp
+
+
+def no_rate(where: str, labels: list[str], rate_hint: str) -> FileFormatError:
+    """The error of a record without a time column or a sample rate (``rate_hint``: where the file could say it)."""
+    return FileFormatError(f"{where}: no column in units of time ({', '.join(labels)}) and no sample rate; give the "
+                           f"rate with --sample-rate (e.g. '51.2 kHz', sample_rate=) or {rate_hint}")

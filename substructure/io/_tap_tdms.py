@@ -20,7 +20,7 @@ from ..errors import FileFormatError
 from ..tap.records import TapRecord
 from . import check_readable_file
 from ._tap_build import MAX_RECORD_BYTES, build_record, option_rate, time_axis, units_of_columns
-from ._tap_columns import Columns, choose, unit_label
+from ._tap_columns import Columns, choose, no_rate, unit_label
 
 __all__ = ["read_tap_tdms"]
 
@@ -152,10 +152,8 @@ def _group_record(name: str, where: str, source: str, channels: list, sensitivit
             raise FileFormatError(f"{where}: wf_increment {1.0 / stated[0]!r} s is {stated[0]:.10g} Hz, "
                                   f"--sample-rate {hz:.10g} Hz; leave the option out or fix the file")
         stated = stated or (hz, "--sample-rate")
-    if stated is None and t_col is None:
-        raise FileFormatError(f"{where}: no column in units of time ({', '.join(columns.labels)}) and no sample "
-                              "rate; give the rate with --sample-rate (e.g. '51.2 kHz', sample_rate=) or the "
-                              "channels' wf_increment property")
+    if stated is None and t_col is None:  # the steps are those of channels not read
+        raise no_rate(where, columns.labels, "the channels' wf_increment property")
     labels = columns.labels
     for k in (f_col, r_col):
         if columns.units[k] is None:

@@ -143,6 +143,11 @@ def _steps(model: ModalModel, grid: _Grid, speed_rpm: np.ndarray, depth_m: np.nd
     return phi, r0, r1, select, free
 
 
+def monodromy_order(model: ModalModel, grid: _Grid) -> int:
+    """The order ``N = 2d + K p`` of the monodromy matrix (d modes, K grid intervals, p directions with modes)."""
+    return 2 * len(model.modes) + grid.size * int(np.unique(model.arrays()["direction"]).size)
+
+
 def _monodromy(model: ModalModel, grid: _Grid, speed_rpm: np.ndarray, depth_m: np.ndarray) -> np.ndarray:
     """Monodromy matrices for pairs (speed, depth), shape ``(B, N, N)``, ``N = 2d + K p``.
 
@@ -244,7 +249,7 @@ def _critical(model: ModalModel, plan: _Plan, speed_rpm: np.ndarray, depth_m: np
         grid = plan.grid(int(m))
         pairs = np.flatnonzero(counts == m)
         p = np.unique(model.arrays()["direction"]).size
-        per_pair = int(grid.cutting.sum()) * (2 * d + 2 * p) ** 2 * 12 + 4 * (2 * d + grid.size * p) ** 2
+        per_pair = int(grid.cutting.sum()) * (2 * d + 2 * p) ** 2 * 12 + 4 * monodromy_order(model, grid) ** 2
         chunk = max(1, min(int(2e7 // per_pair), -(-pairs.size // _workers())))
         tasks += [(grid, pairs[s:s + chunk]) for s in range(0, pairs.size, chunk)]
 

@@ -47,7 +47,7 @@ import numpy as np
 
 from ..errors import InvalidValueError
 from ..units import Q_, to_si
-from ._semidiscrete import _chatter, _critical, _Plan, expm_batch
+from ._semidiscrete import _chatter, _critical, _Plan, expm_batch, monodromy_order
 from .speeds import as_speed_rpm
 from .modal import ModalModel
 from .result import Lobes
@@ -360,8 +360,7 @@ def sdm(modes: ModalModel, cut: Any, speeds: Any, *, intervals: int | None = Non
     ns = speeds_rpm.size
     if progress:
         counts = plan.intervals_for(speeds_rpm)
-        order = max(plan.grid(int(m)).size for m in np.unique(counts)) * len({m.direction for m in model.modes}) \
-            + 2 * len(model.modes)
+        order = max(monodromy_order(model, plan.grid(int(m))) for m in np.unique(counts))
         progress(f"semi-discretization: {ns} speeds, {int(counts.min())} to {int(counts.max())} intervals in the "
                  f"cut per delay period (eigenvalue problems of order up to {order}: the lowest speeds cost most)")
     lo_d, hi_d, mu_hi, rho_lo, evaluations = _bracket(model, plan, speeds_rpm, ladder, progress)
