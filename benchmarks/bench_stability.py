@@ -40,6 +40,44 @@ def benchmarks():
            lambda: (_fitted(), MillingCut(4, "12 mm", "3 mm", kt="625 MPa", kn="100 MPa"),
                     spindle_speeds("8000 rpm", "20000 rpm", "245 rpm")),
            lambda args: sdm(*args), 1)
+    yield ("stability_sdm_fitted_slot_2000_rpm_5_speeds",
+           lambda: (_fitted(), _slot(), spindle_speeds("2000 rpm", "2200 rpm", "50 rpm")),
+           lambda args: sdm(*args), 1)
+
+
+def _slot() -> MillingCut:
+    return MillingCut(4, "12 mm", "12 mm", kt="767 MPa", kn="169 MPa", milling="up")
+
+
+def _all_over_arnoldi() -> dict:
+    """All eigenvalues (LAPACK) over Arnoldi iterations for one monodromy matrix of order about 2,000."""
+    import time
+
+    from threadpoolctl import threadpool_limits
+
+    from substructure.stability import _semidiscrete as semi
+
+    model = _fitted()
+    plan = semi._Plan(model, _slot(), None, 20, 0.2)
+    speed, depth = np.array([2000.0]), np.array([2e-4])
+    u = semi._monodromy(model, plan.grid(int(plan.intervals_for(speed)[0])), speed, depth)
+    with threadpool_limits(limits=1, user_api="blas"):
+        t0 = time.perf_counter()
+        full = np.abs(np.linalg.eigvals(u)).max()
+        t1 = time.perf_counter()
+        mu = semi._largest(u)[0]
+        t2 = time.perf_counter()
+    assert abs(abs(mu[0]) - full) <= 1e-9 * full
+    return {"stability_sdm_all_eigenvalues_over_arnoldi": (t1 - t0) / (t2 - t1),
+            "stability_sdm_monodromy_order": u.shape[1]}
+
+
+_all_over_arnoldi.names = ("stability_sdm_all_eigenvalues_over_arnoldi",
+                           "stability_sdm_monodromy_order")
+
+
+def figures():
+    yield ("stability_sdm_all_eigenvalues_over_arnoldi", _all_over_arnoldi)
 
 
 def _fitted():

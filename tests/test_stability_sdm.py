@@ -183,3 +183,37 @@ def test_a_speed_stable_over_the_whole_range_has_no_limit():
     lobes = sdm(MODEL, benchmark_cut(1.0), Q_([16000.0], "rpm"), depth_range=("0.01 mm", "0.1 mm"))
     assert np.isinf(lobes.depth_limit_m[0]) and np.isnan(lobes.chatter_frequency_hz[0])
     assert lobes.to_json()["depth_limit_m"] == [None]
+
+
+semidiscrete = importlib.import_module("substructure.stability._semidiscrete")
+
+
+@pytest.mark.parametrize("model, cut", [
+    (MODEL, benchmark_cut(1.0)),
+    (ModalModel([Mode("x", "900 Hz", 0.02, "1e7 N/m"), Mode("y", "900 Hz", 0.02, "1e7 N/m"),
+                 Mode("x", "2500 Hz", 0.03, "3e7 N/m")]), benchmark_cut(0.3)),
+    (ModalModel([Mode("x", "900 Hz", 0.02, "1e7 N/m"), Mode("y", "900 Hz", 0.02, "1e7 N/m")]),
+     TurningCut("1500 MPa", orientation=0.6)),  # two equal multipliers in modulus
+], ids=["one-mode-slot", "three-modes-xy", "turning-equal-xy"])
+def test_arnoldi_gives_the_largest_multiplier_of_the_full_eigenvalue_problem(model, cut):
+    """Large monodromy matrices: Arnoldi iterations, checked against all eigenvalues (LAPACK)."""
+    grid = semidiscrete._Plan(model, cut, 420, 20, 0.2).grid(420)
+    u = semidiscrete._monodromy(model, grid, np.array([3000.0, 9000.0]), np.array([2e-3, 3e-4]))
+    assert u.shape[1] >= semidiscrete.ARNOLDI_ORDER
+    mu, vec = semidiscrete._largest(u, vectors=True)
+    full = np.linalg.eigvals(u)
+    np.testing.assert_allclose(np.abs(mu), np.abs(full).max(axis=1), rtol=1e-9)
+    residual = np.linalg.norm(np.einsum("bij,bj->bi", u, vec) - mu[:, None] * vec, axis=1)
+    assert np.all(residual < 1e-9 * np.abs(mu) * np.linalg.norm(vec, axis=1))
+
+
+def test_the_lobes_are_the_same_through_arnoldi_iterations(monkeypatch):
+    """Every eigenvalue problem through Arnoldi: the same limits, chatter and bifurcations as through LAPACK."""
+    speeds = spindle_speeds("9000 rpm", "21000 rpm", "1000 rpm")
+    cut = benchmark_cut(0.05)
+    full = sdm(MODEL, cut, speeds)
+    monkeypatch.setattr(semidiscrete, "ARNOLDI_ORDER", 0)
+    arnoldi = sdm(MODEL, cut, speeds)
+    np.testing.assert_allclose(arnoldi.depth_limit_m, full.depth_limit_m, rtol=1e-9)
+    np.testing.assert_allclose(arnoldi.chatter_frequency_hz, full.chatter_frequency_hz, rtol=1e-9)
+    assert arnoldi.bifurcation == full.bifurcation and "flip" in full.bifurcation and "hopf" in full.bifurcation
