@@ -105,6 +105,9 @@ def test_semi_discretization_says_its_steps_on_stderr_unless_quiet(capsys, modes
     assert lines and all(line.startswith("substructure: ") for line in lines)
     assert any("coarse scan of the depths, step 1: 7 of 7 speeds" in line for line in lines)
     assert any("narrowing the limits to 0.5%" in line for line in lines)
+    new_runs = [line for line in lines if "semi-discretization: a new run on " in line]
+    recommended = json.loads(out)["recommended"]
+    assert recommended is not None and new_runs  # each of the recommendation's new runs is a line
     status, quiet, err = run(capsys, *argv, "--quiet")
     assert status == 0 and err == "" and json.loads(quiet) == json.loads(out)
 

@@ -16,6 +16,7 @@ from substructure.stability import (MachineLimits, MillingCut, ModalModel, Mode,
                                     cut_power, flexible_band, lobes_band, recommend, removal_rate, sdm,
                                     spindle_speeds, workpiece, workpieces, load_workpieces, xy_frf, zoa)
 from substructure.stability.cutting import MAX_SPEEDS
+from substructure.stability.result import sampled_window_minimum
 from substructure.units import Q_
 
 SPEEDS = spindle_speeds("3000 rpm", "24000 rpm", "25 rpm")
@@ -350,3 +351,60 @@ def test_size_limits_are_named_before_anything_big_is_allocated():
     h = FRF.single(f, 1.0 / (1e7 * (1 - (f.hz / 1500) ** 2 + 0.04j * f.hz / 1500)), output="x", input="x")
     with pytest.raises(InvalidValueError, match="MAX_LOBE_POINTS"):
         zoa(h, thesis_cut(), SPEEDS)
+
+
+def test_window_samples_cover_each_window_and_windows_of_one_width_share_them():
+    seen: list[np.ndarray] = []
+
+    def evaluate(n):
+        seen.append(np.array(n))
+        return 1.0 + (n - 12000.0) ** 2 * 1e-6, np.zeros(n.size)  # lowest at 12,000 rpm
+
+    x = 0.03
+    centres = np.array([11000.0, 11050.0, 13000.0])
+    depth, at, _ = sampled_window_minimum(evaluate, centres * (1 - x), centres * (1 + x))
+    first = seen[0]
+    for lo, hi in zip(centres * (1 - x), centres * (1 + x)):
+        inside = first[(first >= lo) & (first <= hi)]
+        assert inside.size >= 33 and lo in inside and hi in inside
+        assert np.diff(np.log(np.unique(inside))).max() <= np.log(hi / lo) / 32 * (1 + 1e-9)
+    assert at[0] == pytest.approx(11000.0 * (1 + x)) and at[2] == pytest.approx(13000.0 * (1 - x))
+    assert at[1] == pytest.approx(11050.0 * (1 + x))
+    assert depth[0] == pytest.approx(1.0 + (11330.0 - 12000.0) ** 2 * 1e-6)
+    sampled_window_minimum(evaluate, np.array([11025.0]) * (1 - x), np.array([11025.0]) * (1 + x))
+    ladder = lambda s: set(s[(s > 11050.0 * (1 - x)) & (s < 11000.0 * (1 + x))].tolist())  # noqa: E731
+    assert ladder(seen[1]) - {11025.0 * (1 - x), 11025.0 * (1 + x)} <= ladder(first)  # the same speeds again
+
+
+def test_semi_discretization_windows_evaluate_a_speed_once():
+    k = 0.03993 * (2 * np.pi * 922) ** 2
+    model = ModalModel([Mode("x", "922 Hz", 0.011, Q_(k, "N/m"))])
+    cut = MillingCut(2, "10 mm", "5 mm", kt="6e8 Pa", kn="2e8 Pa", milling="down")
+    lines: list[str] = []
+    lobes = sdm(model, cut, spindle_speeds("9000 rpm", "16000 rpm", "250 rpm"), progress=lines.append)
+    before = len(lines)
+    lo, hi = np.array([11000.0, 11100.0]) * 0.97, np.array([11000.0, 11100.0]) * 1.03
+    first = lobes.window_minimum(lo, hi)
+    runs = lines[before:]
+    assert len(runs) == 1 and runs[0].startswith("semi-discretization: a new run on ")
+    assert int(runs[0].split("a new run on ")[1].split()[0]) < 2 * 33  # the two windows share most samples
+    again = lobes.window_minimum(lo, hi)
+    assert len(lines) == before + 1  # nothing new to compute
+    for a, b in zip(first, again):
+        np.testing.assert_array_equal(a, b)
+    depth, chatter = lobes.limit_on(lobes.spindle_speed_rpm)  # the lobes' own speeds keep their limits
+    np.testing.assert_array_equal(depth, lobes.depth_limit_m)
+    assert len(lines) == before + 1
+    fine = sdm(model, cut, Q_(np.linspace(lo[0], hi[0], 41), "rpm"))
+    assert first[0][0] <= fine.depth_limit_m.min() * (1 + 0.01)  # bracket rtol 0.5 %
+
+
+def test_semi_discretization_lobes_pickle_without_their_progress_lines():
+    import pickle
+
+    model = ModalModel([Mode("x", "922 Hz", 0.011, "1.34e6 N/m")])
+    cut = MillingCut(2, "10 mm", "5 mm", kt="6e8 Pa", kn="2e8 Pa", milling="down")
+    lines: list[str] = []
+    lobes = sdm(model, cut, spindle_speeds("10000 rpm", "11000 rpm", "500 rpm"), progress=lambda t: lines.append(t))
+    again = pickle.loads(pickle.dumps(lobes))  # a lambda does not pickle: it is left behind
+    np.testing.assert_array_equal(again.limit_on([10250.0])[0], lobes.limit_on([10250.0])[0])

@@ -185,16 +185,22 @@ class Lobes:
         (ndarray, ndarray)
             Zero order: exactly what :func:`~substructure.stability.zoa` gives
             on these speeds (from the stored lobes, no new eigenvalues);
-            semi-discretization: a new run on these speeds; results without a
-            source: linear interpolation.
+            semi-discretization: a new run on the speeds not computed before
+            (the lobes' own speeds and those of earlier calls keep their
+            values); results without a source: linear interpolation.
         """
-        n = np.atleast_1d(np.asarray(speed_rpm, dtype=float))
-        lo, hi = self.spindle_speed_rpm[0], self.spindle_speed_rpm[-1]
-        if np.any(n < lo * (1 - 1e-12)) or np.any(n > hi * (1 + 1e-12)):
-            raise InvalidValueError(f"speed_rpm: expected speeds within the computed range {lo:g}..{hi:g} rpm")
+        n = self._within(speed_rpm, "speed_rpm")
         if self.source is not None:
             return self.source.limit(n)
         return self.limit_at(n), np.interp(n, self.spindle_speed_rpm, self.chatter_frequency_hz)
+
+    def _within(self, speed_rpm: Any, field: str) -> np.ndarray:
+        """Speeds as an array, refused outside the computed range."""
+        n = np.atleast_1d(np.asarray(speed_rpm, dtype=float))
+        lo, hi = self.spindle_speed_rpm[0], self.spindle_speed_rpm[-1]
+        if np.any(n < lo * (1 - 1e-12)) or np.any(n > hi * (1 + 1e-12)):
+            raise InvalidValueError(f"{field}: expected speeds within the computed range {lo:g}..{hi:g} rpm")
+        return n
 
     def window_minimum(self, lo_rpm: Any, hi_rpm: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The lowest depth limit over speed windows ``[lo, hi]`` [rpm].
@@ -212,15 +218,18 @@ class Lobes:
             FRF lines (the envelope is piecewise linear between lines; its
             minimum over a window lies at an end or at a vertex of a lobe that
             is a local minimum of that lobe, and all of those are evaluated).
-            Semi-discretization: the minimum over 33 speeds per window, each
-            a new run.  Without a source: the computed speeds in the window
+            Semi-discretization: the minimum over the computed speeds in
+            the window, its ends and at least 32 speeds inside it on a
+            geometric ladder that windows of the same relative width share
+            (so that overlapping windows, and later calls, evaluate a speed
+            once: see :meth:`limit_on`).  Without a source: the computed speeds in the window
             and its interpolated ends.
         """
         lo = np.atleast_1d(np.asarray(lo_rpm, dtype=float))
         hi = np.atleast_1d(np.asarray(hi_rpm, dtype=float))
         if lo.shape != hi.shape or np.any(hi < lo):
             raise InvalidValueError("lo_rpm, hi_rpm: expected windows with lo <= hi, of the same shape")
-        self.limit_on(np.concatenate([lo, hi]))  # range check
+        self._within(np.concatenate([lo, hi]), "speed_rpm")
         if self.source is not None and hasattr(self.source, "window_minimum"):
             return self.source.window_minimum(lo, hi)
         return sampled_window_minimum(self.limit_on, lo, hi, self.spindle_speed_rpm)
@@ -343,28 +352,37 @@ def sampled_window_minimum(evaluate, lo: np.ndarray, hi: np.ndarray, speeds: np.
                            count: int = 33) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Window minima by evaluating a limit on samples of each window.
 
+    The samples are each window's ends, the computed speeds inside it and
+    the points of a geometric ladder of speeds inside it, the ladder's step
+    the narrowest window's relative width over ``count - 1`` rounded down to
+    a fixed scale (``2**(k/8)``): windows of one relative width (a speed
+    tolerance) share their samples, within one call and between calls.
+
     Parameters
     ----------
     evaluate : callable
         ``evaluate(speeds_rpm) -> (depth_m, chatter_hz)``.
     lo, hi : ndarray
-        Window ends in rpm.
+        Window ends in rpm (positive).
     speeds : ndarray, optional
         Computed speeds [rpm]; those inside a window are evaluated too.
     count : int, default 33
-        Evenly spaced speeds per window, its ends included.
+        Fewest samples per window, its ends included.
 
     Returns
     -------
     (depth_m, speed_rpm, chatter_hz) : ndarrays
         Per window: the lowest sampled limit, where, and its chatter frequency.
     """
-    t = np.linspace(0.0, 1.0, count)
-    grid = lo[:, None] + (hi - lo)[:, None] * t[None, :]
-    if speeds is not None:
-        extra = [np.sort(np.concatenate([g, speeds[(speeds > a) & (speeds < b)]])) for g, a, b in zip(grid, lo, hi)]
-    else:
-        extra = list(grid)
+    width = np.log(hi / lo)
+    step = width[width > 0].min(initial=np.inf) / (count - 1)
+    step = 2.0 ** (np.floor(8.0 * np.log2(step)) / 8.0) if np.isfinite(step) else np.inf
+    extra = []
+    for a, b in zip(lo, hi):
+        ladder = (np.exp(np.arange(np.ceil(np.log(a) / step), np.floor(np.log(b) / step) + 1) * step)
+                  if np.isfinite(step) else np.empty(0))
+        inside = speeds[(speeds > a) & (speeds < b)] if speeds is not None else np.empty(0)
+        extra.append(np.unique(np.concatenate([[a, b], ladder[(ladder > a) & (ladder < b)], inside])))
     flat = np.concatenate(extra)
     depth, chatter = evaluate(flat)
     bounds = np.cumsum([0] + [e.size for e in extra])

@@ -328,7 +328,9 @@ def sdm(modes: ModalModel, cut: Any, speeds: Any, *, intervals: int | None = Non
         Legend label.
     progress : callable, optional
         Called with a line at each step of the search (the coarse scan, the
-        narrowing of the limits, the probes below a neighbour's lobe): at low
+        narrowing of the limits, the probes below a neighbour's lobe), and
+        with a line for each new run of the lobes at other speeds later
+        (``Lobes.limit_on``, the recommendation's speed windows): at low
         speeds, with many intervals per delay period, a run takes minutes.
         The result does not depend on it.
 
@@ -393,23 +395,37 @@ def sdm(modes: ModalModel, cut: Any, speeds: Any, *, intervals: int | None = Non
     }
     source = _SdmSource(model, cut, dict(intervals=intervals, min_intervals=min_intervals,
                                           max_phase_step=max_phase_step, rtol=rtol, depth_range=depth_range,
-                                          coarse_ratio=coarse_ratio))
+                                          coarse_ratio=coarse_ratio), speeds_rpm, limit, chatter, progress)
     return Lobes("sdm", speeds_rpm, limit, chatter, cut=cut, bifurcation=kinds, discretisation=info, label=label,
                  source=source)
 
 
 class _SdmSource:
-    """Re-runs semi-discretization with the same model, cut and settings at other speeds."""
+    """Re-runs semi-discretization with the same model, cut and settings at other speeds.
 
-    def __init__(self, model: ModalModel, cut: Any, settings: dict) -> None:
-        self.model, self.cut, self.settings = model, cut, settings
+    A speed computed once keeps its limit (the first run's speeds and those of
+    every later run): the recommendation's overlapping speed windows cost a
+    speed once.  Each new run is one line to the first run's ``progress``
+    (its own steps are not said).
+    """
+
+    def __init__(self, model: ModalModel, cut: Any, settings: dict, speeds: np.ndarray, depth: np.ndarray,
+                 chatter: np.ndarray, progress: Callable[[str], None] | None = None) -> None:
+        self.model, self.cut, self.settings, self.progress = model, cut, settings, progress
+        self.known = dict(zip(speeds.tolist(), zip(depth.tolist(), chatter.tolist())))
+
+    def __getstate__(self) -> dict:  # lobes sent to another process leave the progress lines behind
+        return {**self.__dict__, "progress": None}
 
     def limit(self, speeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        order = np.argsort(speeds)
-        unique, inverse = np.unique(speeds[order], return_inverse=True)
-        result = sdm(self.model, self.cut, Q_(unique, "rpm"), **self.settings)
-        depth, chatter = np.empty(speeds.size), np.empty(speeds.size)
-        depth[order] = result.depth_limit_m[inverse]
-        chatter[order] = result.chatter_frequency_hz[inverse]
-        return depth, chatter
+        new = np.unique([n for n in speeds.tolist() if n not in self.known])
+        if new.size:
+            if self.progress:
+                self.progress(f"semi-discretization: a new run on {new.size} speeds, {new[0]:.6g} to "
+                              f"{new[-1]:.6g} rpm")
+            result = sdm(self.model, self.cut, Q_(new, "rpm"), **self.settings)
+            self.known.update(zip(new.tolist(), zip(result.depth_limit_m.tolist(),
+                                                    result.chatter_frequency_hz.tolist())))
+        found = np.array([self.known[n] for n in speeds.tolist()], dtype=float).reshape(-1, 2)
+        return found[:, 0], found[:, 1]
 
