@@ -16,7 +16,7 @@ from substructure.stability import (MachineLimits, MillingCut, ModalModel, Mode,
                                     cut_power, flexible_band, lobes_band, recommend, removal_rate, sdm,
                                     spindle_speeds, workpiece, workpieces, load_workpieces, xy_frf, zoa)
 from substructure.stability.cutting import MAX_SPEEDS
-from substructure.stability.result import sampled_window_minimum
+from substructure.stability.result import Lobes, sampled_window_minimum
 from substructure.units import Q_
 
 SPEEDS = spindle_speeds("3000 rpm", "24000 rpm", "25 rpm")
@@ -408,3 +408,14 @@ def test_semi_discretization_lobes_pickle_without_their_progress_lines():
     lobes = sdm(model, cut, spindle_speeds("10000 rpm", "11000 rpm", "500 rpm"), progress=lambda t: lines.append(t))
     again = pickle.loads(pickle.dumps(lobes))  # a lambda does not pickle: it is left behind
     np.testing.assert_array_equal(again.limit_on([10250.0])[0], lobes.limit_on([10250.0])[0])
+
+
+def test_speeds_outside_the_computed_range_are_refused_by_name():
+    lobes = Lobes("sdm", np.array([1000.0, 2000.0, 3000.0]), np.array([1e-3, 2e-3, 1.5e-3]), np.full(3, 900.0))
+    with pytest.raises(InvalidValueError, match=r"lo_rpm, hi_rpm: expected speeds within the computed range 1000"):
+        lobes.window_minimum([500.0], [1500.0])
+    with pytest.raises(InvalidValueError, match="speed_rpm: expected speeds within"):
+        lobes.limit_on([3500.0])
+    depth, at, _ = lobes.window_minimum([1500.0, 1000.0], [1500.0, 3000.0])  # a window of no width is its speed
+    np.testing.assert_allclose(depth, [1.5e-3, 1e-3])
+    np.testing.assert_allclose(at, [1500.0, 1000.0])

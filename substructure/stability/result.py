@@ -229,7 +229,7 @@ class Lobes:
         hi = np.atleast_1d(np.asarray(hi_rpm, dtype=float))
         if lo.shape != hi.shape or np.any(hi < lo):
             raise InvalidValueError("lo_rpm, hi_rpm: expected windows with lo <= hi, of the same shape")
-        self._within(np.concatenate([lo, hi]), "speed_rpm")
+        self._within(np.concatenate([lo, hi]), "lo_rpm, hi_rpm")
         if self.source is not None and hasattr(self.source, "window_minimum"):
             return self.source.window_minimum(lo, hi)
         return sampled_window_minimum(self.limit_on, lo, hi, self.spindle_speed_rpm)
