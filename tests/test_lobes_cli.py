@@ -295,3 +295,16 @@ def test_too_many_intervals_is_refused_by_name(capsys, modes_file):
     code, _, err = run(capsys, "lobes", "--modes", modes_file, *BENCH_CUT, "--method", "sdm", "--intervals", "100000",
                        "--speeds", "10000:11000:500")
     assert code == 1 and "MAX_INTERVALS" in err
+
+
+def test_the_summary_says_the_order_of_the_eigenvalue_problems_and_how_they_were_solved(capsys, modes_file):
+    argv = ["lobes", "--modes", modes_file, *BENCH_CUT, "--method", "sdm", "--speeds", "12000:12500:500", "--quiet"]
+    status, out, err = run(capsys, *argv)
+    assert status == 0, err
+    line = next(x for x in out.splitlines() if x.startswith("discretisation: "))
+    assert "(monodromy matrices of order " in line and "Arnoldi" not in line
+    status, out, err = run(capsys, *argv, "--intervals", "450")
+    assert status == 0, err
+    line = next(x for x in out.splitlines() if x.startswith("discretisation: "))
+    assert line.startswith("discretisation: 450 intervals in the cut per delay period (monodromy matrices of order "
+                           "452, the largest multipliers by Arnoldi iterations from order 400)")

@@ -68,6 +68,8 @@ def test_semi_discretization_is_converged_and_reports_its_discretisation(immersi
     assert info["max_phase_step_rad"] == 0.2 and info["depth_rtol"] == 0.005
     lo, hi = info["intervals_in_cut"]
     assert 20 <= lo <= hi
+    assert info["monodromy_order"] == [2 + k for k in info["intervals_per_period"]]  # one mode, one direction
+    assert info["arnoldi_from_order"] == 400
     change = np.abs(default.depth_limit_m / fine.depth_limit_m - 1)
     assert np.median(change) < 0.005
     for i in floors(fine.depth_limit_m):  # where the limit matters most; flanks shift with the speed

@@ -140,8 +140,12 @@ def run(args: argparse.Namespace) -> int:
         info = lobes.discretisation
         method = "semi-discretization (updated first order, Insperger & Stepan 2004)"
         lo, hi = info["intervals_in_cut"]
+        n_lo, n_hi = info["monodromy_order"]
+        big = "" if n_hi < info["arnoldi_from_order"] else (
+            f", the largest multipliers by Arnoldi iterations from order {info['arnoldi_from_order']}")
         notes.append(f"discretisation: {lo}" + (f" to {hi}" if hi != lo else "") + " intervals in the cut per "
-                     f"delay period; boundary to {info['depth_rtol']:.1%}")
+                     f"delay period (monodromy matrices of order {n_lo}" + (f" to {n_hi}" if n_hi != n_lo else "")
+                     + f"{big}); boundary to {info['depth_rtol']:.1%}")
     best = why = None
     if limits is not None:
         try:

@@ -51,6 +51,7 @@ import numpy as np
 
 from ..errors import InvalidValueError
 from ..units import Q_, to_si
+from . import _semidiscrete
 from ._semidiscrete import _chatter, _critical, _Plan, expm_batch, monodromy_order
 from .speeds import as_speed_rpm
 from .modal import ModalModel
@@ -386,6 +387,8 @@ def sdm(modes: ModalModel, cut: Any, speeds: Any, *, intervals: int | None = Non
         "scheme": SCHEME,
         "intervals_in_cut": [int(counts.min()), int(counts.max())],
         "intervals_per_period": [plan.grid(int(m)).size for m in (counts.min(), counts.max())],
+        "monodromy_order": [monodromy_order(model, plan.grid(int(m))) for m in (counts.min(), counts.max())],
+        "arnoldi_from_order": _semidiscrete.ARNOLDI_ORDER,
         "max_phase_step_rad": None if intervals is not None else max_phase_step,
         "reference_frequency_hz": plan.reference_hz,
         "depth_rtol": rtol,
