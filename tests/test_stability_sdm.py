@@ -219,3 +219,20 @@ def test_the_lobes_are_the_same_through_arnoldi_iterations(monkeypatch):
     np.testing.assert_allclose(arnoldi.depth_limit_m, full.depth_limit_m, rtol=1e-9)
     np.testing.assert_allclose(arnoldi.chatter_frequency_hz, full.chatter_frequency_hz, rtol=1e-9)
     assert arnoldi.bifurcation == full.bifurcation and "flip" in full.bifurcation and "hopf" in full.bifurcation
+
+
+def test_where_arnoldi_does_not_converge_all_eigenvalues_answer(monkeypatch):
+    import scipy.sparse.linalg
+
+    grid = semidiscrete._Plan(MODEL, benchmark_cut(1.0), 420, 20, 0.2).grid(420)
+    u = semidiscrete._monodromy(MODEL, grid, np.array([3000.0]), np.array([2e-3]))
+    expected = np.abs(np.linalg.eigvals(u)).max()
+
+    def no_convergence(*args, **kwargs):
+        raise scipy.sparse.linalg.ArpackNoConvergence("no convergence", np.empty(0), np.empty((0, 0)))
+
+    monkeypatch.setattr(scipy.sparse.linalg, "eigs", no_convergence)
+    assert abs(semidiscrete._largest(u)[0][0]) == pytest.approx(expected, rel=1e-12)
+    u[0, 0, 5] = np.nan
+    with pytest.raises(np.linalg.LinAlgError, match="infs or NaNs"):
+        semidiscrete._largest(u)

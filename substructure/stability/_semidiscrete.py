@@ -273,10 +273,13 @@ def _largest(u: np.ndarray, vectors: bool = False) -> tuple[np.ndarray, np.ndarr
     mu = np.empty(rows.size, dtype=complex)
     vec = np.empty((rows.size, u.shape[-1]), dtype=complex) if vectors else None
     for j in rows:
-        try:
-            w, v = eigs(u[j], k=_RITZ, which="LM", v0=start, tol=0.0, return_eigenvectors=True)
-        except (ArpackNoConvergence, ArpackError):
-            w, v = np.linalg.eig(u[j])
+        found = None
+        if np.isfinite(u[j]).all():  # else LAPACK below says what is wrong (ARPACK fails less clearly)
+            try:
+                found = eigs(u[j], k=_RITZ, which="LM", v0=start, tol=0.0, return_eigenvectors=True)
+            except (ArpackNoConvergence, ArpackError):
+                pass
+        w, v = found if found is not None else np.linalg.eig(u[j])
         k = int(np.argmax(np.abs(w)))
         mu[j] = w[k]
         if vec is not None:
