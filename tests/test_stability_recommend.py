@@ -419,3 +419,14 @@ def test_speeds_outside_the_computed_range_are_refused_by_name():
     depth, at, _ = lobes.window_minimum([1500.0, 1000.0], [1500.0, 3000.0])  # a window of no width is its speed
     np.testing.assert_allclose(depth, [1.5e-3, 1e-3])
     np.testing.assert_allclose(at, [1500.0, 1000.0])
+
+
+def test_a_narrow_window_beside_a_wide_one_samples_each_by_its_own_width():
+    seen: list[int] = []
+
+    def evaluate(n):
+        seen.append(n.size)
+        return np.ones(n.size), np.zeros(n.size)
+
+    sampled_window_minimum(evaluate, np.array([1000.0, 2000.0]), np.array([3000.0, 2001.0]))
+    assert 66 <= seen[0] <= 2 * 37  # about 33 each, not the narrow window's spacing over the wide one

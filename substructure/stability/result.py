@@ -354,9 +354,9 @@ def sampled_window_minimum(evaluate, lo: np.ndarray, hi: np.ndarray, speeds: np.
 
     The samples are each window's ends, the computed speeds inside it and
     the points of a geometric ladder of speeds inside it, the ladder's step
-    the narrowest window's relative width over ``count - 1`` rounded down to
-    a fixed scale (``2**(k/8)``): windows of one relative width (a speed
-    tolerance) share their samples, within one call and between calls.
+    the window's relative width over ``count - 1`` rounded down to a fixed
+    scale (``2**(k/8)``): windows of one relative width (a speed tolerance)
+    share their samples, within one call and between calls.
 
     Parameters
     ----------
@@ -374,13 +374,12 @@ def sampled_window_minimum(evaluate, lo: np.ndarray, hi: np.ndarray, speeds: np.
     (depth_m, speed_rpm, chatter_hz) : ndarrays
         Per window: the lowest sampled limit, where, and its chatter frequency.
     """
-    width = np.log(hi / lo)
-    step = width[width > 0].min(initial=np.inf) / (count - 1)
-    step = 2.0 ** (np.floor(8.0 * np.log2(step)) / 8.0) if np.isfinite(step) else np.inf
     extra = []
     for a, b in zip(lo, hi):
-        ladder = (np.exp(np.arange(np.ceil(np.log(a) / step), np.floor(np.log(b) / step) + 1) * step)
-                  if np.isfinite(step) else np.empty(0))
+        ladder = np.empty(0)
+        if b > a:
+            step = 2.0 ** (np.floor(8.0 * np.log2(np.log(b / a) / (count - 1))) / 8.0)
+            ladder = np.exp(np.arange(np.ceil(np.log(a) / step), np.floor(np.log(b) / step) + 1) * step)
         inside = speeds[(speeds > a) & (speeds < b)] if speeds is not None else np.empty(0)
         extra.append(np.unique(np.concatenate([[a, b], ladder[(ladder > a) & (ladder < b)], inside])))
     flat = np.concatenate(extra)
