@@ -77,12 +77,8 @@ def read_taps_uff(path: str | os.PathLike, sensitivity: Any = None, hammer_sensi
 
     Parameters
     ----------
-    path : str or path-like
-        The file.
-    sensitivity, hammer_sensitivity : str or pint.Quantity, optional
-        As for :func:`~substructure.io.tap_files.read_tap_csv`, for records whose unit label is a voltage.
-    quantity : {"acceleration", "velocity", "displacement"}, optional
-        What the responses are (as for :func:`~substructure.io.tap_files.read_tap_uff`).
+    path, sensitivity, hammer_sensitivity, quantity
+        As for :func:`~substructure.io.tap_files.read_tap_uff` (``quantity``: what the responses are).
 
     Returns
     -------

@@ -222,8 +222,8 @@ class Lobes:
             the window, its ends and at least 32 speeds inside it on a
             geometric ladder that windows of the same relative width share
             (so that overlapping windows, and later calls, evaluate a speed
-            once: see :meth:`limit_on`).  Without a source: the computed speeds in the window
-            and its interpolated ends.
+            once: see :meth:`limit_on`).  Without a source: the same
+            samples, interpolated.
         """
         lo = np.atleast_1d(np.asarray(lo_rpm, dtype=float))
         hi = np.atleast_1d(np.asarray(hi_rpm, dtype=float))

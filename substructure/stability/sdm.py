@@ -35,12 +35,12 @@ of the steps (a loop over the K intervals, never over speeds) and the
 eigenvalues of small monodromy matrices; from order
 :data:`~substructure.stability._semidiscrete.ARNOLDI_ORDER` up (low speeds)
 only the largest multipliers are computed, by implicitly restarted Arnoldi
-iterations (ARPACK through SciPy), 20 to 50 times faster than all
-eigenvalues at orders 2,000 to 5,000.  :func:`sdm` finds the boundary for all speeds at once: a
-coarse scan up a geometric depth ladder to each speed's first unstable
-depth, regula falsi on the spectral radius inside each bracket, and a
-continuation along the speeds that looks for a neighbour's lobe below each
-limit.
+iterations (ARPACK through SciPy), about 20 to 50 times faster than all
+eigenvalues at orders 2,000 to 5,000.  :func:`sdm` finds the boundary for
+all speeds at once: a coarse scan up a geometric depth ladder to each
+speed's first unstable depth, regula falsi on the spectral radius inside
+each bracket, and a continuation along the speeds that looks for a
+neighbour's lobe below each limit.
 """
 
 from __future__ import annotations
