@@ -25,7 +25,8 @@ from substructure import datasets
 from substructure.diagnose import diagnose
 from substructure.smoothing import choose_window, smooth
 from substructure.updating import Likelihood, estimate_noise, measured_frfs
-from substructure.updating.selection import consistency
+from substructure.diagnose import words
+from substructure.updating.selection import OUTLYING_RUN, consistency, outlying_runs
 
 
 @pytest.fixture(scope="module")
@@ -281,3 +282,36 @@ def test_a_nut_that_a_noisy_test_cannot_tell_from_a_denser_holder_is_the_nut_and
                                                     / truth.data[:, 0, 0])) ** 2)))
                 for a in (d.refined_assembly, denser_model)]
         assert errs[0] < 3e-3 and errs[0] < 0.3 * errs[1], (truth.outputs, errs)
+
+
+def _runs(frf: FRF) -> list:
+    measured, _ = measured_frfs([frf])
+    lik = Likelihood(hd.nominal_model(), measured)
+    return outlying_runs(lik, lik.log_ratios([]))
+
+
+@pytest.mark.parametrize("level, offset", [(1.0, 808), (3.0, 1650), (10.0, 1800), (5.0, 33100)])
+def test_the_real_noises_own_outliers_make_no_run_beyond_the_noise(exact, real_residual, level, offset):
+    """Real noise puts a few lines in a row beyond the noise's tail (3 to 6 at these placements): not a run worth
+    a note, which takes :data:`OUTLYING_RUN` lines."""
+    n = exact.frequency.n
+    start = offset % (real_residual.size - n)
+    rho = np.exp(level * np.log(real_residual[start:start + n]))
+    assert _runs(_with(exact, exact.data[:, 0, 0] * rho)) == []
+
+
+@pytest.mark.parametrize("centre_hz, width_hz", [(40.0, 8.0), (1500.0, 10.0)])
+def test_a_misfit_on_a_few_neighbouring_lines_is_said_where_the_tests_do_not_judge_it(exact, centre_hz, width_hz):
+    """A smooth 50 % bump a few lines wide on exact data: the capped tests pass it as outliers (explained), and
+    the diagnosis says where, that the lines are judged as outliers only, and what to do."""
+    f = exact.frequency.hz
+    bumped = exact.data[:, 0, 0] * (1.0 + 0.5 * np.exp(-0.5 * ((f - centre_hz) / width_hz) ** 2))
+    near = np.abs(f - centre_hz) <= 5 * width_hz  # the bump's 2e-6 beyond
+    ((item, lo, hi, count),) = _runs(_with(exact, bumped))
+    assert item == 0 and OUTLYING_RUN <= count <= near.sum()
+    assert f[near][0] <= lo < centre_hz < hi <= f[near][-1]
+    d = diagnose(hd.nominal_model(), [_with(exact, bumped)], progress=False)
+    notes = [r for r in d.report if words.OUTLYING_MARK in r]
+    assert len(notes) == 1 and f"{lo:.4g}-{hi:.4g} Hz" in notes[0] and "--band" in notes[0], d.report
+    if d.explained:
+        assert any("on the lines the tests judge" in line for line in words.summary(d, "rig", 1))

@@ -38,7 +38,7 @@ from ..assembly import Assembly
 from ..errors import InvalidValueError
 from ..frf import FRF
 from ..updating.likelihood import Likelihood, measured_frfs
-from ..updating.selection import INDIFFERENCE, consistency, error_check
+from ..updating.selection import INDIFFERENCE, consistency, error_check, outlying_runs
 from .compare import METRIC, Comparison, _pairs, frac, error_bands
 from .effects import Effect, registry
 from .refine import refine as refine_model
@@ -334,8 +334,10 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     if search["cut"] and not explained:
         report = list(report) + [words.budget_cut(search["cut_at"])]
     # facts of the data, whatever the verdict
-    for m, alive, (_, lacking) in zip(lik.measured, lik.alive, lik.windows()):
+    runs = outlying_runs(lik, final_ratios)
+    for item, (m, alive, (_, lacking)) in enumerate(zip(lik.measured, lik.alive, lik.windows())):
         which, hz = getattr(m.measurement, "describe", lambda: m.label)(), m.frf.frequency.hz
+        report = list(report) + [words.outlying(which, lo, hi, count) for i, lo, hi, count in runs if i == item]
         tau = getattr(m.measurement, "window_tau", None)
         if tau is not None:
             report = list(report) + [words.windowed(which, tau, float(hz[0]), float(hz[-1]), m.noise.correlation,

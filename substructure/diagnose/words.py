@@ -17,13 +17,15 @@ from typing import Iterable, Sequence
 
 __all__ = [
     "UNEXPLAINED", "values_text", "bound_text", "partial", "too_many_changes", "bounded", "on_bound",
-    "not_unique", "tell_apart", "budget_cut", "windowed", "unexplained", "error_lives", "error_spread", "best_partial",
-    "nothing_improves", "mode_line", "signature_line", "level_line", "separation_text", "parameter_values",
-    "summary",
+    "not_unique", "tell_apart", "budget_cut", "windowed", "outlying", "unexplained", "error_lives", "error_spread",
+    "best_partial", "nothing_improves", "mode_line", "signature_line", "level_line", "separation_text",
+    "parameter_values", "summary",
 ]
 
 UNEXPLAINED = "unexplained: no candidate explains the data"
 """How the first line of every unexplained verdict begins."""
+OUTLYING_MARK = "the model and the data differ far beyond the noise"
+"""How the note on a run of lines far beyond the noise (:func:`outlying`) begins, after the measurement."""
 
 
 def values_text(change, values) -> str:
@@ -277,6 +279,30 @@ def truncated(which: str, error: float, at_hz: float) -> str:
     return (f"{which}: the taps ended while the response still rang; the error that leaves (up to {error:.2g} "
             f"relative, near {at_hz:.4g} Hz) is counted as noise, so that less can be told there (a longer record "
             "would not need it)")
+
+
+def outlying(which: str, lo_hz: float, hi_hz: float, count: int) -> str:
+    """The note that neighbouring lines of a measurement lie far beyond its noise (judged as outliers only).
+
+    Parameters
+    ----------
+    which : str
+        The measurement (``response / excitation``).
+    lo_hz, hi_hz : float
+        The run's first and last line [Hz].
+    count : int
+        Its number of lines.
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    return (f"{which}: {OUTLYING_MARK} on {count} neighbouring lines at "
+            f"{lo_hz:.4g}-{hi_hz:.4g} Hz; the tests count each such line as an outlier of the data (as a double hit "
+            "or the first lines of a short record make), so a difference confined there is not judged: if these "
+            "lines are to be trusted (coherence near 1), the model misses something there; if not, leave them out "
+            "with --band")
 
 
 def empty_lines(which: str, hz) -> str:
@@ -575,7 +601,9 @@ def summary(result, model_name: str, measured: int) -> list[str]:
         lines.append("  most of the error is in " + ", ".join(f"{lo:.0f}-{hi:.0f} Hz ({share:.0%})"
                                                            for lo, hi, share in base.bands))
     if result.missing_effect is None:
-        lines.append("the model is as good as the data allow: nothing is missing" if result.explained
+        judged = (" on the lines the tests judge (see the note on lines far beyond the noise)"
+                  if any(OUTLYING_MARK in r for r in result.report) else "")
+        lines.append(f"the model is as good as the data allow: nothing is missing{judged}" if result.explained
                      else "no candidate explains the difference significantly")
     else:
         label = "missing effect" if result.explained else "best partial explanation (partial)"
