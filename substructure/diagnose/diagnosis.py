@@ -334,7 +334,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     if search["cut"] and not explained:
         report = list(report) + [words.budget_cut(search["cut_at"])]
     # facts of the data, whatever the verdict
-    runs = outlying_runs(lik, final_ratios)
+    runs = outlying_runs(lik, final_ratios) if cons.consistent else []  # else the failing bands say where
     for item, (m, alive, (_, lacking)) in enumerate(zip(lik.measured, lik.alive, lik.windows())):
         which, hz = getattr(m.measurement, "describe", lambda: m.label)(), m.frf.frequency.hz
         report = list(report) + [words.outlying(which, lo, hi, count) for i, lo, hi, count in runs if i == item]

@@ -187,7 +187,11 @@ def candidates(assembly, measured_points: Sequence[str], effects: dict, open_wor
             except (SubstructureError, ValueError) as exc:
                 if progress:
                     progress(f"  skipped {name} at {where}: {exc}")
-    return out
+    empty = [c for c in out if any(not spec.upper > spec.lower for spec in c.specs)]
+    for c in empty:  # a search of no width (a cross term bounded by the diagonal terms of a joint with k_yf = 0)
+        if progress:
+            progress(f"  skipped {c.effect} at {c.where}: a parameter's search range is empty")
+    return [c for c in out if c not in empty]
 
 
 @attrs.frozen
