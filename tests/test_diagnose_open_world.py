@@ -371,3 +371,29 @@ def test_a_measured_dimension_gives_way_to_a_number_of_the_model():
     joint = parameter_change(params["joints.holder-tool.k.yf"])
     overhang = parameter_change(params["components.tool.overhang"])
     assert preference(overhang) < preference(ratio) == preference(joint) < preference(od)
+
+
+def test_a_candidate_whose_search_range_is_empty_is_skipped_and_said():
+    """A joint with k_yf = 0 bounds its cross term's search to 0..0 (3 sqrt(k_yf k_tm) either side): no such
+    candidate is screened (a scan of no width divided by it), and the progress says why."""
+    import attrs
+    import warnings
+
+    from substructure import default_assembly
+    from substructure.diagnose.effects import registry
+    from substructure.diagnose.search import candidates
+
+    model = default_assembly()
+    joint = model.joint("holder-tool")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        soft = model.with_joint(attrs.evolve(joint, k={"yf": "0 N/m", "tm": "8e4 N*m/rad"}))
+    said = []
+    found = candidates(soft, ["tool.tip:y"], registry(), progress=said.append)
+    assert found and all(spec.upper > spec.lower for c in found for spec in c.specs)
+    assert any("search range is empty" in line and "holder-tool" in line for line in said), said
+    everything = candidates(model, ["tool.tip:y"], registry())
+    # the cross terms (bounded by k_yf) and k_yf itself (no scale to search from) are all that go
+    assert {c.key for c in everything} - {c.key for c in found} == {
+        ("joint-cross-coupling", "holder-tool"), ("model-parameter", "joints.holder-tool.k.yf"),
+        ("model-parameter", "joints.holder-tool.k.ym")}
