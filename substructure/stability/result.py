@@ -18,6 +18,7 @@ import attrs
 import numpy as np
 
 from ..errors import InvalidValueError, SubstructureWarning
+from .speeds import rpm_values
 
 __all__ = ["Lobes", "LobesBand", "lobes_band", "StabilityWarning", "sampled_window_minimum"]
 
@@ -116,29 +117,49 @@ class Lobes:
 
     # -- reading the diagram ----------------------------------------------------
     def limit_at(self, speed_rpm: Any) -> np.ndarray:
-        """Depth limit in m at speeds in rpm (plain numbers), linearly interpolated.
+        """Depth limit in m at speeds within the computed range, linearly interpolated.
 
         Parameters
         ----------
-        speed_rpm : float or array_like
-            Spindle speeds in rpm.
+        speed_rpm : float, array_like, str or pint.Quantity
+            Spindle speeds: plain numbers in rpm, or with an angular-speed
+            unit (``"12000 rpm"``, ``Q_(1200, "rad/s")``); within the
+            computed range.
+
+        Raises
+        ------
+        InvalidValueError
+            For speeds that are not finite or lie outside the computed range.
+        UnitError
+            For a speed in Hz or 1/s (ambiguous, see
+            :func:`~substructure.stability.as_speed_rpm`) or in a unit that
+            is not a speed.
 
         Returns
         -------
         ndarray
-            The depth limits in m.
+            The depth limits in m, the shape of ``speed_rpm``.
         """
-        return np.interp(np.asarray(speed_rpm, float), self.spindle_speed_rpm, self.depth_limit_m)
+        n = self._speeds(speed_rpm, "speed_rpm")
+        return np.interp(n, self.spindle_speed_rpm, self.depth_limit_m)
 
     def is_stable(self, speed_rpm: Any, depth_m: Any) -> np.ndarray:
-        """Whether cuts at these speeds [rpm] and depths [m] are below the limit.
+        """Whether cuts at these speeds and depths [m] are below the limit.
 
         Parameters
         ----------
-        speed_rpm : float or array_like
-            Spindle speeds in rpm.
+        speed_rpm : float, array_like, str or pint.Quantity
+            Spindle speeds, as :meth:`limit_at` takes them (plain numbers in
+            rpm; within the computed range).
         depth_m : float or array_like
             Axial depths of cut in m.
+
+        Raises
+        ------
+        InvalidValueError
+            For speeds that are not finite or lie outside the computed range.
+        UnitError
+            For a speed in Hz or 1/s, or in a unit that is not a speed.
 
         Returns
         -------
@@ -177,8 +198,9 @@ class Lobes:
 
         Parameters
         ----------
-        speed_rpm : array_like
-            Spindle speeds in rpm (plain numbers) within the computed range.
+        speed_rpm : array_like, str or pint.Quantity
+            Spindle speeds within the computed range, as :meth:`limit_at`
+            takes them (plain numbers in rpm).
 
         Returns
         -------
@@ -194,13 +216,26 @@ class Lobes:
             return self.source.limit(n)
         return self.limit_at(n), np.interp(n, self.spindle_speed_rpm, self.chatter_frequency_hz)
 
-    def _within(self, speed_rpm: Any, field: str) -> np.ndarray:
-        """Speeds as an array, refused outside the computed range."""
-        n = np.atleast_1d(np.asarray(speed_rpm, dtype=float))
+    def _speeds(self, speed_rpm: Any, field: str) -> np.ndarray:
+        """Speeds in rpm (plain numbers, or converted from their unit), the shape given, checked.
+
+        Refused: values that are not finite and speeds outside the computed range.
+        """
+        n = rpm_values(speed_rpm, field)
+        bad = n[~np.isfinite(n)]
+        if bad.size:
+            raise InvalidValueError(f"{field}: got {bad[0]:g}; expected finite speeds in rpm")
         lo, hi = self.spindle_speed_rpm[0], self.spindle_speed_rpm[-1]
-        if np.any(n < lo * (1 - 1e-12)) or np.any(n > hi * (1 + 1e-12)):
-            raise InvalidValueError(f"{field}: expected speeds within the computed range {lo:g}..{hi:g} rpm")
+        bad = n[(n < lo * (1 - 1e-12)) | (n > hi * (1 + 1e-12))]
+        if bad.size:
+            more = f" (and {bad.size - 1} more)" if bad.size > 1 else ""
+            raise InvalidValueError(
+                f"{field}: expected speeds within the computed range {lo:g}..{hi:g} rpm; got {bad[0]:g} rpm{more}")
         return n
+
+    def _within(self, speed_rpm: Any, field: str) -> np.ndarray:
+        """Speeds as a 1-D array (at least), refused when not finite or outside the computed range."""
+        return np.atleast_1d(self._speeds(speed_rpm, field))
 
     def window_minimum(self, lo_rpm: Any, hi_rpm: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The lowest depth limit over speed windows ``[lo, hi]`` [rpm].
