@@ -131,3 +131,36 @@ def test_speeds_with_a_unit_read_as_the_same_speed_in_rpm():
         lobes.limit_on(Q_(100.0, "rad/s"))  # 955 rpm
     depth, _ = lobes.limit_on(Q_(1200.0, "rad/s"))
     assert depth[0] == pytest.approx(lobes.limit_on([1200.0 * 60.0 / (2.0 * np.pi)])[0][0], rel=1e-12)
+
+
+def test_speed_windows_that_are_not_windows_are_refused_naming_the_parameter():
+    lobes = zoa(model(), CUT, SPEEDS)
+    with pytest.raises(InvalidValueError, match="lo_rpm: got nan; expected finite speeds"):
+        lobes.window_minimum(np.nan, 8000.0)  # it was sampled from 8000 alone
+    with pytest.raises(InvalidValueError, match="lo_rpm: got nan; expected finite speeds"):
+        lobes.window_minimum(np.nan, np.nan)  # it said inf: stable at any depth
+    with pytest.raises(InvalidValueError, match="hi_rpm: got inf; expected finite speeds"):
+        lobes.window_minimum([6000.0], [np.inf])
+    with pytest.raises(InvalidValueError, match="lo_rpm: got no values; expected one or more window ends"):
+        lobes.window_minimum([], [])
+    with pytest.raises(InvalidValueError, match=r"hi_rpm: got shape \(1, 1\); expected one number or a 1-D array"):
+        lobes.window_minimum([6000.0], [[8000.0]])
+    with pytest.raises(InvalidValueError, match="lo_rpm, hi_rpm: got 2 and 1 ends; expected as many"):
+        lobes.window_minimum([6000.0, 7000.0], [8000.0])
+    with pytest.raises(InvalidValueError, match=r"lo_rpm, hi_rpm: got the window 9000\.\.8000 rpm \(index 1\); "
+                                                 r"expected lo <= hi"):
+        lobes.window_minimum([6000.0, 9000.0], [7000.0, 8000.0])
+    with pytest.raises(UnitError, match="lo_rpm: got a speed in Hz"):
+        lobes.window_minimum("100 Hz", 8000.0)
+
+
+def test_speed_windows_with_a_unit_give_the_plain_rpm_windows_minimum():
+    lobes = zoa(model(), CUT, SPEEDS)
+    plain = lobes.window_minimum([6000.0], [8000.0])
+    for lo, hi in (("6000 rpm", "8000 rpm"), (Q_([6000.0], "rpm"), [8000.0]), (6000.0, Q_(8000.0, "turn/min"))):
+        for a, b in zip(lobes.window_minimum(lo, hi), plain):
+            np.testing.assert_allclose(a, b, rtol=1e-12)
+    rad_s = Q_([700.0, 900.0], "rad/s")
+    by_hand = np.array([700.0, 900.0]) * 60.0 / (2.0 * np.pi)  # 6685 and 8594 rpm
+    for a, b in zip(lobes.window_minimum(rad_s[:1], rad_s[1:]), lobes.window_minimum(by_hand[:1], by_hand[1:])):
+        np.testing.assert_allclose(a, b, rtol=1e-12)

@@ -242,8 +242,19 @@ class Lobes:
 
         Parameters
         ----------
-        lo_rpm, hi_rpm : array_like
-            Window ends in rpm, within the computed range (same shapes).
+        lo_rpm, hi_rpm : float, array_like, str or pint.Quantity
+            Window ends within the computed range, as :meth:`limit_at` takes
+            speeds (plain numbers in rpm, or with an angular-speed unit): one
+            number or a 1-D array each, of the same length, ``lo <= hi``.
+
+        Raises
+        ------
+        InvalidValueError
+            For ends that are empty, not one number or a 1-D array, of
+            different lengths, not finite, reversed (``lo > hi``) or outside
+            the computed range.
+        UnitError
+            For ends in Hz or 1/s, or in a unit that is not a speed.
 
         Returns
         -------
@@ -260,10 +271,8 @@ class Lobes:
             once: see :meth:`limit_on`).  Without a source: the same
             samples, interpolated.
         """
-        lo = np.atleast_1d(np.asarray(lo_rpm, dtype=float))
-        hi = np.atleast_1d(np.asarray(hi_rpm, dtype=float))
-        if lo.shape != hi.shape or np.any(hi < lo):
-            raise InvalidValueError("lo_rpm, hi_rpm: expected windows with lo <= hi, of the same shape")
+        lo, hi = (_window_ends(rpm_values(v, f), f) for v, f in ((lo_rpm, "lo_rpm"), (hi_rpm, "hi_rpm")))
+        _check_windows(lo, hi, "lo_rpm, hi_rpm")
         self._within(np.concatenate([lo, hi]), "lo_rpm, hi_rpm")
         if self.source is not None and hasattr(self.source, "window_minimum"):
             return self.source.window_minimum(lo, hi)
@@ -381,6 +390,29 @@ class LobesBand:
         """
         return {"spindle_speed_rpm": self.spindle_speed_rpm.tolist(), "lower_m": _json_numbers(self.lower_m),
                 "upper_m": _json_numbers(self.upper_m)}
+
+
+def _window_ends(ends: np.ndarray, field: str) -> np.ndarray:
+    """Window ends as a non-empty 1-D array of finite numbers, else refused naming ``field``."""
+    if ends.ndim > 1:
+        raise InvalidValueError(f"{field}: got shape {ends.shape}; expected one number or a 1-D array of window ends")
+    ends = np.atleast_1d(ends)
+    if ends.size == 0:
+        raise InvalidValueError(f"{field}: got no values; expected one or more window ends")
+    bad = ends[~np.isfinite(ends)]
+    if bad.size:
+        raise InvalidValueError(f"{field}: got {bad[0]:g}; expected finite speeds in rpm")
+    return ends
+
+
+def _check_windows(lo: np.ndarray, hi: np.ndarray, fields: str) -> None:
+    """Refuse window ends of different lengths and reversed windows (lo > hi), naming ``fields``."""
+    if lo.shape != hi.shape:
+        raise InvalidValueError(f"{fields}: got {lo.size} and {hi.size} ends; expected as many of one as of the other")
+    reversed_ = np.flatnonzero(lo > hi)
+    if reversed_.size:
+        i = int(reversed_[0])
+        raise InvalidValueError(f"{fields}: got the window {lo[i]:g}..{hi[i]:g} rpm (index {i}); expected lo <= hi")
 
 
 def sampled_window_minimum(evaluate, lo: np.ndarray, hi: np.ndarray, speeds: np.ndarray | None = None,
