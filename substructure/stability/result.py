@@ -405,6 +405,14 @@ def _window_ends(ends: np.ndarray, field: str) -> np.ndarray:
     return ends
 
 
+def _plain_numbers(value: Any, field: str) -> np.ndarray:
+    """``value`` as a float array, refused naming ``field`` when it is not numbers."""
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidValueError(f"{field}: got {value!r}; expected speeds in rpm as plain numbers") from None
+
+
 def _check_windows(lo: np.ndarray, hi: np.ndarray, fields: str) -> None:
     """Refuse window ends of different lengths and reversed windows (lo > hi), naming ``fields``."""
     if lo.shape != hi.shape:
@@ -429,18 +437,36 @@ def sampled_window_minimum(evaluate, lo: np.ndarray, hi: np.ndarray, speeds: np.
     ----------
     evaluate : callable
         ``evaluate(speeds_rpm) -> (depth_m, chatter_hz)``.
-    lo, hi : ndarray
-        Window ends in rpm (positive).
-    speeds : ndarray, optional
+    lo, hi : array_like
+        Window ends in rpm (plain numbers): finite, positive, one number or
+        a 1-D array each, of the same length, ``lo <= hi``.
+    speeds : array_like, optional
         Computed speeds [rpm]; those inside a window are evaluated too.
     count : int, default 33
-        Fewest samples per window, its ends included.
+        Fewest samples per window, its ends included: a whole number >= 2.
+
+    Raises
+    ------
+    InvalidValueError
+        For windows that are empty, not finite, not positive, reversed or
+        of different lengths, and for a ``count`` that is not a whole
+        number >= 2.
 
     Returns
     -------
     (depth_m, speed_rpm, chatter_hz) : ndarrays
         Per window: the lowest sampled limit, where, and its chatter frequency.
     """
+    if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 2:
+        raise InvalidValueError(
+            f"count: got {count!r}; expected a whole number >= 2 (samples per window, its ends included)")
+    lo, hi = (_window_ends(_plain_numbers(v, f), f) for v, f in ((lo, "lo"), (hi, "hi")))
+    for ends, field in ((lo, "lo"), (hi, "hi")):
+        if np.any(ends <= 0):
+            raise InvalidValueError(f"{field}: got {ends[ends <= 0][0]:g}; expected positive speeds in rpm")
+    _check_windows(lo, hi, "lo, hi")
+    if speeds is not None:
+        speeds = _plain_numbers(speeds, "speeds").ravel()
     extra = []
     for a, b in zip(lo, hi):
         ladder = np.empty(0)
