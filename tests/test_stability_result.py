@@ -164,3 +164,12 @@ def test_speed_windows_with_a_unit_give_the_plain_rpm_windows_minimum():
     by_hand = np.array([700.0, 900.0]) * 60.0 / (2.0 * np.pi)  # 6685 and 8594 rpm
     for a, b in zip(lobes.window_minimum(rad_s[:1], rad_s[1:]), lobes.window_minimum(by_hand[:1], by_hand[1:])):
         np.testing.assert_allclose(a, b, rtol=1e-12)
+
+
+def test_best_speeds_take_a_whole_number_of_speeds():
+    lobes = zoa(model(), CUT, SPEEDS)
+    for count in (0, -1, 2.5, 3.0, "3", True, None):
+        with pytest.raises(InvalidValueError, match=r"count: got .*; expected a whole number >= 1"):
+            lobes.best_speeds(count)  # -1 gave three speeds, 2.5 a TypeError
+    assert lobes.best_speeds(np.int64(2)) == lobes.best_speeds(2) == lobes.best_speeds(3)[:2]
+    assert len(lobes.best_speeds(1)) == 1

@@ -177,13 +177,20 @@ class Lobes:
         Parameters
         ----------
         count : int
-            How many speeds.
+            How many speeds at most: a whole number >= 1.
+
+        Raises
+        ------
+        InvalidValueError
+            For a ``count`` that is not a whole number >= 1.
 
         Returns
         -------
         list of tuple
             ``(speed in rpm, depth limit in m)``, deepest first.
         """
+        if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
+            raise InvalidValueError(f"count: got {count!r}; expected a whole number >= 1 (how many speeds)")
         a = np.where(np.isfinite(self.depth_limit_m), self.depth_limit_m, np.nan)
         if a.size < 3 or np.all(np.isnan(a)):
             return []
