@@ -430,3 +430,27 @@ def test_a_narrow_window_beside_a_wide_one_samples_each_by_its_own_width():
 
     sampled_window_minimum(evaluate, np.array([1000.0, 2000.0]), np.array([3000.0, 2001.0]))
     assert 66 <= seen[0] <= 2 * 37  # about 33 each, not the narrow window's spacing over the wide one
+
+
+def test_sampled_window_minima_refuse_windows_and_counts_they_cannot_sample():
+    def evaluate(n):
+        return np.abs(np.sin(n / 700.0)) + 0.1, n / 60.0
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no numpy warnings on the way to the message
+        for lo, hi, message in (
+                ([-5.0], [8000.0], "lo: got -5; expected positive speeds"),
+                ([0.0], [8000.0], "lo: got 0; expected positive speeds"),
+                ([], [], "lo: got no values; expected one or more window ends"),
+                ([6000.0], [np.nan], "hi: got nan; expected finite speeds"),
+                ([9000.0], [8000.0], r"lo, hi: got the window 9000\.\.8000 rpm \(index 0\); expected lo <= hi"),
+                ([6000.0, 7000.0], [8000.0], "lo, hi: got 2 and 1 ends"),
+                ([[6000.0]], [[8000.0]], r"lo: got shape \(1, 1\)"),
+                (["6000 rpm"], [8000.0], r"lo: got \['6000 rpm'\]; expected speeds in rpm as plain numbers")):
+            with pytest.raises(InvalidValueError, match=message):
+                sampled_window_minimum(evaluate, lo, hi)
+        for count in (0, 1, 2.5, True):
+            with pytest.raises(InvalidValueError, match=f"count: got {count!r}; expected a whole number >= 2"):
+                sampled_window_minimum(evaluate, np.array([6000.0]), np.array([8000.0]), count=count)
+        depth, at, _ = sampled_window_minimum(evaluate, 6000.0, 8000.0, count=2)  # the ends and a ladder point
+        assert 6000.0 <= at[0] <= 8000.0 and depth[0] == pytest.approx(evaluate(at)[0][0])

@@ -18,6 +18,7 @@ import attrs
 import numpy as np
 
 from ..errors import InvalidValueError, SubstructureWarning
+from .speeds import rpm_values
 
 __all__ = ["Lobes", "LobesBand", "lobes_band", "StabilityWarning", "sampled_window_minimum"]
 
@@ -116,29 +117,49 @@ class Lobes:
 
     # -- reading the diagram ----------------------------------------------------
     def limit_at(self, speed_rpm: Any) -> np.ndarray:
-        """Depth limit in m at speeds in rpm (plain numbers), linearly interpolated.
+        """Depth limit in m at speeds within the computed range, linearly interpolated.
 
         Parameters
         ----------
-        speed_rpm : float or array_like
-            Spindle speeds in rpm.
+        speed_rpm : float, array_like, str or pint.Quantity
+            Spindle speeds: plain numbers in rpm, or with an angular-speed
+            unit (``"12000 rpm"``, ``Q_(1200, "rad/s")``); within the
+            computed range.
+
+        Raises
+        ------
+        InvalidValueError
+            For speeds that are not finite or lie outside the computed range.
+        UnitError
+            For a speed in Hz or 1/s (ambiguous, see
+            :func:`~substructure.stability.as_speed_rpm`) or in a unit that
+            is not a speed.
 
         Returns
         -------
         ndarray
-            The depth limits in m.
+            The depth limits in m, the shape of ``speed_rpm``.
         """
-        return np.interp(np.asarray(speed_rpm, float), self.spindle_speed_rpm, self.depth_limit_m)
+        n = self._speeds(speed_rpm, "speed_rpm")
+        return np.interp(n, self.spindle_speed_rpm, self.depth_limit_m)
 
     def is_stable(self, speed_rpm: Any, depth_m: Any) -> np.ndarray:
-        """Whether cuts at these speeds [rpm] and depths [m] are below the limit.
+        """Whether cuts at these speeds and depths [m] are below the limit.
 
         Parameters
         ----------
-        speed_rpm : float or array_like
-            Spindle speeds in rpm.
+        speed_rpm : float, array_like, str or pint.Quantity
+            Spindle speeds, as :meth:`limit_at` takes them (plain numbers in
+            rpm; within the computed range).
         depth_m : float or array_like
             Axial depths of cut in m.
+
+        Raises
+        ------
+        InvalidValueError
+            For speeds that are not finite or lie outside the computed range.
+        UnitError
+            For a speed in Hz or 1/s, or in a unit that is not a speed.
 
         Returns
         -------
@@ -156,13 +177,20 @@ class Lobes:
         Parameters
         ----------
         count : int
-            How many speeds.
+            How many speeds at most: a whole number >= 1.
+
+        Raises
+        ------
+        InvalidValueError
+            For a ``count`` that is not a whole number >= 1.
 
         Returns
         -------
         list of tuple
             ``(speed in rpm, depth limit in m)``, deepest first.
         """
+        if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
+            raise InvalidValueError(f"count: got {count!r}; expected a whole number >= 1 (how many speeds)")
         a = np.where(np.isfinite(self.depth_limit_m), self.depth_limit_m, np.nan)
         if a.size < 3 or np.all(np.isnan(a)):
             return []
@@ -177,8 +205,9 @@ class Lobes:
 
         Parameters
         ----------
-        speed_rpm : array_like
-            Spindle speeds in rpm (plain numbers) within the computed range.
+        speed_rpm : array_like, str or pint.Quantity
+            Spindle speeds within the computed range, as :meth:`limit_at`
+            takes them (plain numbers in rpm).
 
         Returns
         -------
@@ -194,21 +223,45 @@ class Lobes:
             return self.source.limit(n)
         return self.limit_at(n), np.interp(n, self.spindle_speed_rpm, self.chatter_frequency_hz)
 
-    def _within(self, speed_rpm: Any, field: str) -> np.ndarray:
-        """Speeds as an array, refused outside the computed range."""
-        n = np.atleast_1d(np.asarray(speed_rpm, dtype=float))
+    def _speeds(self, speed_rpm: Any, field: str) -> np.ndarray:
+        """Speeds in rpm (plain numbers, or converted from their unit), the shape given, checked.
+
+        Refused: values that are not finite and speeds outside the computed range.
+        """
+        n = rpm_values(speed_rpm, field)
+        bad = n[~np.isfinite(n)]
+        if bad.size:
+            raise InvalidValueError(f"{field}: got {bad[0]:g}; expected finite speeds in rpm")
         lo, hi = self.spindle_speed_rpm[0], self.spindle_speed_rpm[-1]
-        if np.any(n < lo * (1 - 1e-12)) or np.any(n > hi * (1 + 1e-12)):
-            raise InvalidValueError(f"{field}: expected speeds within the computed range {lo:g}..{hi:g} rpm")
+        bad = n[(n < lo * (1 - 1e-12)) | (n > hi * (1 + 1e-12))]
+        if bad.size:
+            more = f" (and {bad.size - 1} more)" if bad.size > 1 else ""
+            raise InvalidValueError(
+                f"{field}: expected speeds within the computed range {lo:g}..{hi:g} rpm; got {bad[0]:g} rpm{more}")
         return n
+
+    def _within(self, speed_rpm: Any, field: str) -> np.ndarray:
+        """Speeds as a 1-D array (at least), refused when not finite or outside the computed range."""
+        return np.atleast_1d(self._speeds(speed_rpm, field))
 
     def window_minimum(self, lo_rpm: Any, hi_rpm: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The lowest depth limit over speed windows ``[lo, hi]`` [rpm].
 
         Parameters
         ----------
-        lo_rpm, hi_rpm : array_like
-            Window ends in rpm, within the computed range (same shapes).
+        lo_rpm, hi_rpm : float, array_like, str or pint.Quantity
+            Window ends within the computed range, as :meth:`limit_at` takes
+            speeds (plain numbers in rpm, or with an angular-speed unit): one
+            number or a 1-D array each, of the same length, ``lo <= hi``.
+
+        Raises
+        ------
+        InvalidValueError
+            For ends that are empty, not one number or a 1-D array, of
+            different lengths, not finite, reversed (``lo > hi``) or outside
+            the computed range.
+        UnitError
+            For ends in Hz or 1/s, or in a unit that is not a speed.
 
         Returns
         -------
@@ -225,10 +278,8 @@ class Lobes:
             once: see :meth:`limit_on`).  Without a source: the same
             samples, interpolated.
         """
-        lo = np.atleast_1d(np.asarray(lo_rpm, dtype=float))
-        hi = np.atleast_1d(np.asarray(hi_rpm, dtype=float))
-        if lo.shape != hi.shape or np.any(hi < lo):
-            raise InvalidValueError("lo_rpm, hi_rpm: expected windows with lo <= hi, of the same shape")
+        lo, hi = (_window_ends(rpm_values(v, f), f) for v, f in ((lo_rpm, "lo_rpm"), (hi_rpm, "hi_rpm")))
+        _check_windows(lo, hi, "lo_rpm, hi_rpm")
         self._within(np.concatenate([lo, hi]), "lo_rpm, hi_rpm")
         if self.source is not None and hasattr(self.source, "window_minimum"):
             return self.source.window_minimum(lo, hi)
@@ -348,6 +399,37 @@ class LobesBand:
                 "upper_m": _json_numbers(self.upper_m)}
 
 
+def _window_ends(ends: np.ndarray, field: str) -> np.ndarray:
+    """Window ends as a non-empty 1-D array of finite numbers, else refused naming ``field``."""
+    if ends.ndim > 1:
+        raise InvalidValueError(f"{field}: got shape {ends.shape}; expected one number or a 1-D array of window ends")
+    ends = np.atleast_1d(ends)
+    if ends.size == 0:
+        raise InvalidValueError(f"{field}: got no values; expected one or more window ends")
+    bad = ends[~np.isfinite(ends)]
+    if bad.size:
+        raise InvalidValueError(f"{field}: got {bad[0]:g}; expected finite speeds in rpm")
+    return ends
+
+
+def _plain_numbers(value: Any, field: str) -> np.ndarray:
+    """``value`` as a float array, refused naming ``field`` when it is not numbers."""
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidValueError(f"{field}: got {value!r}; expected speeds in rpm as plain numbers") from None
+
+
+def _check_windows(lo: np.ndarray, hi: np.ndarray, fields: str) -> None:
+    """Refuse window ends of different lengths and reversed windows (lo > hi), naming ``fields``."""
+    if lo.shape != hi.shape:
+        raise InvalidValueError(f"{fields}: got {lo.size} and {hi.size} ends; expected as many of one as of the other")
+    reversed_ = np.flatnonzero(lo > hi)
+    if reversed_.size:
+        i = int(reversed_[0])
+        raise InvalidValueError(f"{fields}: got the window {lo[i]:g}..{hi[i]:g} rpm (index {i}); expected lo <= hi")
+
+
 def sampled_window_minimum(evaluate, lo: np.ndarray, hi: np.ndarray, speeds: np.ndarray | None = None,
                            count: int = 33) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Window minima by evaluating a limit on samples of each window.
@@ -362,18 +444,36 @@ def sampled_window_minimum(evaluate, lo: np.ndarray, hi: np.ndarray, speeds: np.
     ----------
     evaluate : callable
         ``evaluate(speeds_rpm) -> (depth_m, chatter_hz)``.
-    lo, hi : ndarray
-        Window ends in rpm (positive).
-    speeds : ndarray, optional
+    lo, hi : array_like
+        Window ends in rpm (plain numbers): finite, positive, one number or
+        a 1-D array each, of the same length, ``lo <= hi``.
+    speeds : array_like, optional
         Computed speeds [rpm]; those inside a window are evaluated too.
     count : int, default 33
-        Fewest samples per window, its ends included.
+        Fewest samples per window, its ends included: a whole number >= 2.
+
+    Raises
+    ------
+    InvalidValueError
+        For windows that are empty, not finite, not positive, reversed or
+        of different lengths, and for a ``count`` that is not a whole
+        number >= 2.
 
     Returns
     -------
     (depth_m, speed_rpm, chatter_hz) : ndarrays
         Per window: the lowest sampled limit, where, and its chatter frequency.
     """
+    if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 2:
+        raise InvalidValueError(
+            f"count: got {count!r}; expected a whole number >= 2 (samples per window, its ends included)")
+    lo, hi = (_window_ends(_plain_numbers(v, f), f) for v, f in ((lo, "lo"), (hi, "hi")))
+    for ends, field in ((lo, "lo"), (hi, "hi")):
+        if np.any(ends <= 0):
+            raise InvalidValueError(f"{field}: got {ends[ends <= 0][0]:g}; expected positive speeds in rpm")
+    _check_windows(lo, hi, "lo, hi")
+    if speeds is not None:
+        speeds = _plain_numbers(speeds, "speeds").ravel()
     extra = []
     for a, b in zip(lo, hi):
         ladder = np.empty(0)

@@ -3,7 +3,8 @@
 Every speed the stability methods take goes through here.  A speed must
 carry an angle-per-time unit (rpm, turn/min, rad/s); a speed in Hz is
 refused, because pint converts rpm to Hz as an angular velocity (off by
-``2*pi``).  Grids are limited to :data:`MAX_SPEEDS` speeds.
+``2*pi``).  Reading a result (``rpm_values``) takes plain numbers as rpm
+too.  Grids are limited to :data:`MAX_SPEEDS` speeds.
 """
 
 from __future__ import annotations
@@ -68,6 +69,20 @@ def as_speed_rpm(value: Any, field: str = "speeds") -> np.ndarray:
     ndarray
         The speeds in rpm, 1-D, strictly increasing.
     """
+    if not isinstance(value, (str, pint.Quantity)):
+        raise _speed_error(field, value)
+    speeds = np.atleast_1d(_quantity_rpm(value, field))
+    if speeds.ndim != 1 or speeds.size == 0:
+        raise InvalidValueError(f"{field}: got shape {speeds.shape}; expected a non-empty 1-D array of speeds")
+    if not np.all(np.isfinite(speeds)) or np.any(speeds <= 0):
+        raise InvalidValueError(f"{field}: expected finite, positive spindle speeds; got {speeds.min():g} rpm")
+    if np.any(np.diff(speeds) <= 0):
+        raise InvalidValueError(f"{field}: expected strictly increasing spindle speeds")
+    return speeds
+
+
+def _quantity_rpm(value: str | pint.Quantity, field: str) -> np.ndarray:
+    """A string or quantity in an angular-speed unit as rpm, of any shape; Hz and bare 1/s refused."""
     if isinstance(value, str):
         try:
             value = Q_(value)
@@ -85,14 +100,44 @@ def as_speed_rpm(value: Any, field: str = "speeds") -> np.ndarray:
                 "give rpm, or convert revolutions per second with substructure.units.hz_to_rpm"
             )
         raise _speed_error(field, value)
-    speeds = np.atleast_1d(np.asarray(value.m_as("rpm"), dtype=float))
-    if speeds.ndim != 1 or speeds.size == 0:
-        raise InvalidValueError(f"{field}: got shape {speeds.shape}; expected a non-empty 1-D array of speeds")
-    if not np.all(np.isfinite(speeds)) or np.any(speeds <= 0):
-        raise InvalidValueError(f"{field}: expected finite, positive spindle speeds; got {speeds.min():g} rpm")
-    if np.any(np.diff(speeds) <= 0):
-        raise InvalidValueError(f"{field}: expected strictly increasing spindle speeds")
-    return speeds
+    return np.asarray(value.m_as("rpm"), dtype=float)
+
+
+def rpm_values(value: Any, field: str) -> np.ndarray:
+    """Spindle speeds in rpm as an array of the shape given, converted but not otherwise checked.
+
+    What reading a result takes (:meth:`~substructure.stability.Lobes.limit_at` and its
+    neighbours): plain numbers are rpm; a string or a quantity is converted from its
+    angular-speed unit as :func:`as_speed_rpm` converts it (Hz refused).
+
+    Parameters
+    ----------
+    value : float, array_like, str or pint.Quantity
+        E.g. ``12000``, ``[9000, 12000]``, ``"12000 rpm"``, ``Q_(1200, "rad/s")``.
+    field : str
+        Name used in error messages.
+
+    Raises
+    ------
+    UnitError
+        For a unit that is not an angular speed, and for Hz or 1/s.
+    InvalidValueError
+        For values that are not numbers.
+
+    Returns
+    -------
+    ndarray
+        The speeds in rpm, the shape of ``value``.
+    """
+    if isinstance(value, (str, pint.Quantity)):
+        return _quantity_rpm(value, field)
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidValueError(
+            f"{field}: got {show_value(value)}; expected spindle speeds in rpm: numbers, or a string or "
+            "quantity with an angular-speed unit such as '12000 rpm' or Q_(1200, 'rad/s')"
+        ) from None
 
 
 def spindle_speeds(start: Any, stop: Any, step: Any) -> pint.Quantity:
