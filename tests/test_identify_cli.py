@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from substructure import Frequency, Sensor, default_assembly, save_assembly
+from substructure import Frequency, Sensor, default_assembly, load_assembly, save_assembly
 from substructure.cli import main
 from substructure.measurements import MeasurementSet
 from substructure.synthetic import simulate, write_measurement_set
@@ -50,3 +50,31 @@ def test_identify_human_output_and_errors(files, capsys):
                  "--joint", "holder-tool", "--band", "3000:1000"]) == 2
     err = capsys.readouterr().err
     assert "LO < HI" in err and "Traceback" not in err
+
+
+def test_a_value_on_the_bound_of_its_search_is_printed_without_a_standard_deviation(files, capsys):
+    # c_tm starts at 2500 times its true value (4 N*m*s/rad): the fit runs to the lower bound of its search, 10
+    model = load_assembly(files / "model.toml")
+    far = model.with_joint(model.joint("holder-tool").with_parameters(c={"tm": "1e4 N*m*s/rad"}))
+    save_assembly(far, files / "far.toml", overwrite=True)
+    args = ["identify", str(files / "far.toml"), str(files / "measurements.toml"), "--joint", "holder-tool",
+            "--parameters", "c_tm"]
+    assert main(args) == 0
+    text = capsys.readouterr().out
+    line = next(s for s in text.splitlines() if s.strip().startswith("c_tm ="))
+    assert "bound of its search" in line and "not a measurement" in line and "+-" not in line
+    assert "note: c_tm = " in text and "widen the band (--band" in text
+    assert main(args + ["--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["at_bound"] == ["c_tm"]
+    assert out["parameters"]["c_tm"]["at_bound"] == "lower" and out["c"]["tm"] == pytest.approx(10.0)
+    assert out["parameters"]["c_tm"]["std"] is None and out["c_std"]["tm"] is None
+    assert out["parameters"]["c_tm"]["search"][0] < out["parameters"]["c_tm"]["search"][1]
+
+
+def test_values_inside_their_search_carry_no_bound(files, capsys):
+    assert main(["identify", str(files / "model.toml"), str(files / "measurements.toml"), "--joint", "holder-tool",
+                 "--parameters", "k_yf,c_yf", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["at_bound"] == [] and out["parameters"]["k_yf"]["at_bound"] is None
+    assert out["parameters"]["k_yf"]["std"] > 0

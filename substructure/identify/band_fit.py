@@ -175,8 +175,18 @@ class JointIdentifier:
         (:func:`substructure.updating.selection.consistency`).
     residual_rms_ : float
         RMS of the complex log ratio of model to measurement over the band.
+    at_bound_ : dict of str to str
+        The fitted parameters that ended on a bound of their search, each
+        with ``"lower"`` or ``"upper"``: their values are not measurements (the
+        data in the band do not determine them, or the true value lies beyond
+        the search) and their standard deviations are NaN.  Empty when every
+        fitted value lies inside its search.
+    search_ : dict of str to (float, float)
+        The search range of each fitted parameter (SI): a factor of 1000
+        either side of its start for the diagonal terms, ``+-3 sqrt(k_yf k_tm)``
+        (``+-3 sqrt(c_yf c_tm)``) for the cross terms.
     warnings_ : list of str
-        Misfit, passivity and reciprocity findings.
+        Misfit, passivity and reciprocity findings, and the values on a bound.
     n_lines_ : int
         Number of frequency lines (over all FRFs) in the fit.
     """
@@ -328,6 +338,17 @@ class JointIdentifier:
                          "by the misfit; run `substructure diagnose` to find what is missing")
         if self.bootstrap:
             self.std_ = self._bootstrap(lik, result)
+        specs = {spec.name: spec for spec in result.changes[0][0].specs}
+        self.search_ = {p: (float(specs[p].lower), float(specs[p].upper)) for p in self.fitted_}
+        self.at_bound_ = {}
+        for (_, p), hit in zip(result.names, result.at_bound):
+            if hit:
+                lo, hi = self.search_[p]
+                middle = np.sqrt(lo * hi) if specs[p].log else 0.5 * (lo + hi)
+                self.at_bound_[p] = "lower" if self.values_[p] <= middle else "upper"
+                self.std_[p] = float("nan")
+        notes += [_bound_note(p, self.values_[p], side, self.search_[p], specs[p].log)
+                  for p, side in self.at_bound_.items()]
         self.band_ = band
         self.cost_ = float(result.chi2)
         self.residual_rms_ = float(np.sqrt(np.mean(np.concatenate([np.abs(r) ** 2 for r in ratios]))))
@@ -390,6 +411,17 @@ class JointIdentifier:
             The receptances with the fitted joint (m/N, ...).
         """
         return assembly.with_joint(self.joint_).frf(outputs, inputs, frequency)
+
+
+def _bound_note(name: str, value: float, side: str, search: tuple[float, float], log: bool) -> str:
+    """The note of a fitted value on a bound of its search: not a measurement, and what to do."""
+    unit = _UNITS[name]
+    width = ("a factor of 1000 either side of its start" if log
+             else f"{search[0]:.4g} to {search[1]:.4g} {unit}, three times the geometric mean of the diagonal terms")
+    return (f"{name} = {value:.4g} {unit} is on the {side} bound of its search ({width}), not a measurement: the "
+            f"data in the band do not determine it, or its true value lies beyond the search; widen the band "
+            f"(--band, band=), fit without {name} (--parameters, parameters=; it keeps the assembly's value) or "
+            "start it from a better value (the joint's value in the assembly file, or initial= in Python)")
 
 
 def _passivity(joint: Joint) -> list[str]:
