@@ -162,3 +162,21 @@ def test_values_inside_their_search_are_not_on_a_bound():
     assert ident.search_["k_yf"] == pytest.approx((1.43e4, 1.43e10))
     assert all(np.isfinite(ident.std_[p]) and ident.std_[p] > 0 for p in ("k_yf", "c_yf"))
     assert not any("bound" in w for w in ident.warnings_)
+
+
+def test_a_joint_value_that_cannot_start_the_search_is_refused_naming_joint_and_parameter():
+    asm = default_assembly()
+    h = asm.receptance("tool.tip:y", frequency=Frequency.from_range("1000 Hz", "5000 Hz", "4 Hz"))
+    zero = asm.with_joint(asm.joint("holder-tool").with_parameters(k={"yf": "0 N/m"}))
+    with pytest.raises(InvalidValueError, match=r"joint 'holder-tool' has k_yf = 0 N/m in the assembly; .*"
+                                                r"give the joint a positive k_yf in the assembly file"):
+        JointIdentifier("holder-tool").fit(zero, [h])
+    ident = JointIdentifier("holder-tool", parameters=("k_yf",), initial={"k_yf": 1e7}).fit(zero, [h])
+    assert ident.values_["k_yf"] == pytest.approx(1.43e7, rel=1e-3)
+
+
+def test_a_parameter_named_twice_is_refused():
+    asm = default_assembly()
+    h = asm.receptance("tool.tip:y", frequency=Frequency.from_range("1000 Hz", "5000 Hz", "4 Hz"))
+    with pytest.raises(InvalidValueError, match="parameters: k_yf named twice"):
+        JointIdentifier("holder-tool", parameters=("k_yf", "c_yf", "k_yf")).fit(asm, [h])

@@ -78,3 +78,17 @@ def test_values_inside_their_search_carry_no_bound(files, capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["at_bound"] == [] and out["parameters"]["k_yf"]["at_bound"] is None
     assert out["parameters"]["k_yf"]["std"] > 0
+
+
+def test_a_zero_joint_value_and_a_parameter_named_twice_are_refused_in_cli_words(files, capsys):
+    model = load_assembly(files / "model.toml")
+    zero = model.with_joint(model.joint("holder-tool").with_parameters(k={"yf": "0 N/m"}))
+    save_assembly(zero, files / "zero.toml", overwrite=True)
+    assert main(["identify", str(files / "zero.toml"), str(files / "measurements.toml"),
+                 "--joint", "holder-tool"]) == 1
+    err = capsys.readouterr().err
+    assert "joint 'holder-tool' has k_yf = 0 N/m in the assembly" in err
+    assert "positive k_yf in the assembly file" in err and "Traceback" not in err
+    assert main(["identify", str(files / "model.toml"), str(files / "measurements.toml"),
+                 "--joint", "holder-tool", "--parameters", "k_yf,k_yf"]) == 2
+    assert "argument --parameters: k_yf named twice" in capsys.readouterr().err

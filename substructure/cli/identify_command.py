@@ -30,6 +30,10 @@ def run(args: argparse.Namespace) -> int:
         p.strip() for p in args.parameters.split(",") if p.strip())
     if not parameters:
         raise UsageError("argument --parameters: got an empty list; give 'auto' or names such as k_yf,k_tm")
+    twice = sorted({p for p in parameters if parameters.count(p) > 1}) if parameters != "auto" else []
+    if twice:
+        raise UsageError(f"argument --parameters: {', '.join(twice)} named twice in {args.parameters!r}; "
+                         "name each parameter once")
     report = identify_joint(assembly, measurements, args.joint, band=args.band, parameters=parameters,
                             bootstrap=args.bootstrap)
     if args.plot:

@@ -211,6 +211,10 @@ class JointIdentifier:
             raise InvalidValueError(
                 f"parameters: got {list(self.parameters)}; expected 'auto' or some of {', '.join(PARAMETERS)}"
             )
+        twice = sorted({p for p in self.parameters if self.parameters.count(p) > 1})
+        if twice:
+            raise InvalidValueError(f"parameters: {', '.join(twice)} named twice in {list(self.parameters)}; "
+                                    "name each parameter once")
         if not (isinstance(self.bootstrap, int) and self.bootstrap >= 0):
             raise InvalidValueError(f"bootstrap: got {self.bootstrap!r}; expected an integer >= 0")
 
@@ -269,11 +273,15 @@ class JointIdentifier:
         nominal = _joint_values(template) if not template.rigid else {p: 0.0 for p in PARAMETERS}
         nominal.update(self.initial)
         names = DIAGONAL if self.parameters == "auto" else self.parameters
-        missing = [p for p in names if p not in CROSS and nominal[p] <= 0]
+        missing = [p for p in names if p not in CROSS and not nominal[p] > 0]
         if missing:
+            given = ("is rigid" if template.rigid and not self.initial else
+                     "has " + ", ".join(f"{p} = {nominal[p]:.4g} {_UNITS[p]}" for p in missing))
             raise InvalidValueError(
-                f"initial: the assembly gives no starting value for {', '.join(missing)} of joint "
-                f"{self.joint!r}; pass initial={{...}} in SI units"
+                f"joint {self.joint!r} {given} in the assembly; the fit of {', '.join(missing)} starts from the "
+                f"joint's value and searches a factor of 1000 either side of it, so it needs a value > 0: give the "
+                f"joint a positive {', '.join(missing)} in the assembly file, the start of the search "
+                f"(initial={{...}} in SI units in Python)"
             )
         start_joint = self._joint(template, {p: nominal[p] for p in PARAMETERS if nominal[p] != 0 or p in CROSS})
         model = assembly.with_joint(start_joint)
