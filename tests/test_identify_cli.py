@@ -92,3 +92,16 @@ def test_a_zero_joint_value_and_a_parameter_named_twice_are_refused_in_cli_words
     assert main(["identify", str(files / "model.toml"), str(files / "measurements.toml"),
                  "--joint", "holder-tool", "--parameters", "k_yf,k_yf"]) == 2
     assert "argument --parameters: k_yf named twice" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("command", ["identify", "diagnose"])
+def test_a_data_file_off_a_uniform_grid_is_named_with_its_set_entry_and_line(files, capsys, tmp_path, command):
+    grid = Frequency.from_range("100 Hz", "2000 Hz", "10 Hz")
+    hz = [float(f) for i, f in enumerate(grid.hz) if i != 50]
+    (tmp_path / "tip.csv").write_text("frequency_hz,real,imag\n" + "".join(f"{f!r},1e-6,1e-8\n" for f in hz))
+    (tmp_path / "set.toml").write_text('[[frf]]\nresponse = "tool.tip"\nexcitation = "tool.tip"\nfile = "tip.csv"\n')
+    extra = ["--joint", "holder-tool"] if command == "identify" else []
+    assert main([command, str(files / "model.toml"), str(tmp_path / "set.toml"), *extra]) == 1
+    err = capsys.readouterr().err
+    assert "set.toml, line 4: frf[0].file: " in err and "tip.csv, line 52: at 610 Hz" in err
+    assert "need equally spaced lines" in err and "Traceback" not in err and "interpolate" not in err
