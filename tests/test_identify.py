@@ -137,3 +137,46 @@ def test_closed_form_diagonal_model_eq_2_4():
         _check_recovers(closed_form(*args, at="tool.tip", at_a=at_a, at_b=at_b, model=model), asm.joint("holder-tool"))
     with pytest.raises(InvalidValueError, match="model"):
         closed_form(*args, at="tool.tip", at_a=at_a, at_b=at_b, model="banded")
+
+
+def test_a_parameter_the_data_do_not_determine_is_reported_on_its_bound_not_as_a_measurement():
+    asm = default_assembly()
+    grid = Frequency.from_range("1000 Hz", "5000 Hz", "4 Hz")
+    truth = asm.with_joint(asm.joint("holder-tool").with_parameters(c={"tm": "1e-6 N*m*s/rad"}))
+    h = _noisy(truth.receptance("tool.tip:y", frequency=grid), 0.02, 0)
+    ident = JointIdentifier("holder-tool", parameters=("c_tm",)).fit(asm, [h])
+    assert ident.at_bound_ == {"c_tm": "lower"}
+    assert ident.search_["c_tm"] == pytest.approx((4e-3, 4e3))
+    assert ident.values_["c_tm"] == pytest.approx(4e-3)
+    assert np.isnan(ident.std_["c_tm"])  # no standard deviation: not a measurement
+    note = next(w for w in ident.warnings_ if "bound" in w)
+    assert "c_tm = 0.004 N*m*s/rad is on the lower bound of its search" in note
+    assert "not a measurement" in note and "widen the band" in note and "initial=" in note
+
+
+def test_values_inside_their_search_are_not_on_a_bound():
+    asm = default_assembly()
+    h = _noisy(asm.receptance("tool.tip:y", frequency=Frequency.from_range("1000 Hz", "5000 Hz", "4 Hz")), 0.02, 1)
+    ident = JointIdentifier("holder-tool", parameters=("k_yf", "c_yf")).fit(asm, [h])
+    assert ident.at_bound_ == {}
+    assert ident.search_["k_yf"] == pytest.approx((1.43e4, 1.43e10))
+    assert all(np.isfinite(ident.std_[p]) and ident.std_[p] > 0 for p in ("k_yf", "c_yf"))
+    assert not any("bound" in w for w in ident.warnings_)
+
+
+def test_a_joint_value_that_cannot_start_the_search_is_refused_naming_joint_and_parameter():
+    asm = default_assembly()
+    h = asm.receptance("tool.tip:y", frequency=Frequency.from_range("1000 Hz", "5000 Hz", "4 Hz"))
+    zero = asm.with_joint(asm.joint("holder-tool").with_parameters(k={"yf": "0 N/m"}))
+    with pytest.raises(InvalidValueError, match=r"joint 'holder-tool' has k_yf = 0 N/m in the assembly; .*"
+                                                r"give the joint a positive k_yf in the assembly file"):
+        JointIdentifier("holder-tool").fit(zero, [h])
+    ident = JointIdentifier("holder-tool", parameters=("k_yf",), initial={"k_yf": 1e7}).fit(zero, [h])
+    assert ident.values_["k_yf"] == pytest.approx(1.43e7, rel=1e-3)
+
+
+def test_a_parameter_named_twice_is_refused():
+    asm = default_assembly()
+    h = asm.receptance("tool.tip:y", frequency=Frequency.from_range("1000 Hz", "5000 Hz", "4 Hz"))
+    with pytest.raises(InvalidValueError, match="parameters: k_yf named twice"):
+        JointIdentifier("holder-tool", parameters=("k_yf", "c_yf", "k_yf")).fit(asm, [h])

@@ -402,3 +402,25 @@ def test_validate_of_a_file_names_frf_tables(tmp_path, tip_file):
     ms = loads_measurements(GOOD + 'sensors = ["laser"]\n', tmp_path, "set.toml")
     with pytest.raises(MeasurementSetError, match=r"(?s)set\.toml.*frf\[0\]\.sensors: no sensor 'laser'"):
         ms.validate(make_assembly())
+
+
+def test_a_data_file_off_a_uniform_grid_is_refused_naming_set_entry_file_and_line(tmp_path, tip_file):
+    lines = tip_file.read_text().splitlines()
+    del lines[10]  # the line at 190 Hz: a 20 Hz step among 10 Hz ones
+    tip_file.write_text("\n".join(lines) + "\n")
+    message = error_of(tmp_path, GOOD)
+    assert re.search(r"set\.toml, line 4: frf\[0\]\.file: .*tip\.csv, line 11: at 200 Hz: 20 Hz after the line "
+                     r"before, where the grid's step is 10 Hz: identify and diagnose .* need equally spaced lines; "
+                     r"write the data on one frequency step", message), message
+
+
+@pytest.mark.parametrize("quantity, article", [("receptance", "the model has no receptance at 0 Hz"),
+                                               ("accelerance", "an accelerance has no receptance at 0 Hz")])
+def test_a_0_hz_line_is_dropped_with_a_warning_naming_the_entry(tmp_path, quantity, article):
+    grid = Frequency.from_range("0 Hz", "100 Hz", "10 Hz")
+    FRF.single(grid, np.linspace(1e-6, 2e-6, grid.n) + 1e-8j).to_csv(tmp_path / "tip.csv")
+    text = GOOD + f'quantity = "{quantity}"\n'
+    with pytest.warns(UserWarning, match=rf"set\.toml, line 4: frf\[0\]\.file: tip\.csv: dropped the 0 Hz line: "
+                                         rf"{article}"):
+        ms = loads_measurements(text, tmp_path, "set.toml")
+    assert ms.measurements[0].frf.frequency.hz[0] == pytest.approx(10.0)

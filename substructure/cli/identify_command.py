@@ -30,6 +30,10 @@ def run(args: argparse.Namespace) -> int:
         p.strip() for p in args.parameters.split(",") if p.strip())
     if not parameters:
         raise UsageError("argument --parameters: got an empty list; give 'auto' or names such as k_yf,k_tm")
+    twice = sorted({p for p in parameters if parameters.count(p) > 1}) if parameters != "auto" else []
+    if twice:
+        raise UsageError(f"argument --parameters: {', '.join(twice)} named twice in {args.parameters!r}; "
+                         "name each parameter once")
     report = identify_joint(assembly, measurements, args.joint, band=args.band, parameters=parameters,
                             bootstrap=args.bootstrap)
     if args.plot:
@@ -46,8 +50,14 @@ def run(args: argparse.Namespace) -> int:
     units = {"k": ("N/m", "N", "N/rad", "N*m/rad"), "c": ("N*s/m", "N*s", "N*s/rad", "N*m*s/rad")}
     for kind, values, stds in (("k", report.k, report.k_std), ("c", report.c, report.c_std)):
         for (entry, value), unit in zip(values.items(), units[kind]):
-            fitted = f"{kind}_{entry}" in report.fitted or (entry == "tf" and f"{kind}_ym" in report.fitted)
-            tail = f" +- {stds[entry]:.3g} {unit}" if fitted else f" {unit} (kept from the model)"
+            name = f"{kind}_ym" if entry == "tf" else f"{kind}_{entry}"
+            fitted = name in report.fitted
+            if name in report.at_bound:
+                lower, upper = report.search[name]
+                tail = (f" {unit}: on the {report.at_bound[name]} bound of its search ({lower:.4g} to {upper:.4g} "
+                        f"{unit}), not a measurement")
+            else:
+                tail = f" +- {stds[entry]:.3g} {unit}" if fitted else f" {unit} (kept from the model)"
             print(f"  {kind}_{entry} = {value:.4g}{tail}")
     for note in report.warnings:
         print(f"note: {note}")

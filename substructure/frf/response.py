@@ -474,8 +474,9 @@ class FRF:
             raise InvalidValueError(f"decay: got {decay!r}; expected a finite rate >= 0 in 1/s (1/tau of the window)")
         omega = self.frequency.omega - 1j * decay if decay else self.frequency.omega
         if omega[0] == 0.0:
+            article = "an" if self.quantity[0] in "aeiou" else "a"
             raise InvalidValueError(
-                f"frequency: the grid starts at 0 Hz, where a {self.quantity} has no "
+                f"frequency: the grid starts at 0 Hz, where {article} {self.quantity} has no "
                 "receptance; crop it first, e.g. frf.crop(lo='1 Hz')"
             )
         factor = 1j * omega if self.quantity == "mobility" else -(omega**2)

@@ -175,8 +175,18 @@ class JointIdentifier:
         (:func:`substructure.updating.selection.consistency`).
     residual_rms_ : float
         RMS of the complex log ratio of model to measurement over the band.
+    at_bound_ : dict of str to str
+        The fitted parameters that ended on a bound of their search, each
+        with ``"lower"`` or ``"upper"``: their values are not measurements (the
+        data in the band do not determine them, or the true value lies beyond
+        the search) and their standard deviations are NaN.  Empty when every
+        fitted value lies inside its search.
+    search_ : dict of str to (float, float)
+        The search range of each fitted parameter (SI): a factor of 1000
+        either side of its start for the diagonal terms, ``+-3 sqrt(k_yf k_tm)``
+        (``+-3 sqrt(c_yf c_tm)``) for the cross terms.
     warnings_ : list of str
-        Misfit, passivity and reciprocity findings.
+        Misfit, passivity and reciprocity findings, and the values on a bound.
     n_lines_ : int
         Number of frequency lines (over all FRFs) in the fit.
     """
@@ -201,6 +211,10 @@ class JointIdentifier:
             raise InvalidValueError(
                 f"parameters: got {list(self.parameters)}; expected 'auto' or some of {', '.join(PARAMETERS)}"
             )
+        twice = sorted({p for p in self.parameters if self.parameters.count(p) > 1})
+        if twice:
+            raise InvalidValueError(f"parameters: {', '.join(twice)} named twice in {list(self.parameters)}; "
+                                    "name each parameter once")
         if not (isinstance(self.bootstrap, int) and self.bootstrap >= 0):
             raise InvalidValueError(f"bootstrap: got {self.bootstrap!r}; expected an integer >= 0")
 
@@ -259,11 +273,15 @@ class JointIdentifier:
         nominal = _joint_values(template) if not template.rigid else {p: 0.0 for p in PARAMETERS}
         nominal.update(self.initial)
         names = DIAGONAL if self.parameters == "auto" else self.parameters
-        missing = [p for p in names if p not in CROSS and nominal[p] <= 0]
+        missing = [p for p in names if p not in CROSS and not nominal[p] > 0]
         if missing:
+            given = ("is rigid" if template.rigid and not self.initial else
+                     "has " + ", ".join(f"{p} = {nominal[p]:.4g} {_UNITS[p]}" for p in missing))
             raise InvalidValueError(
-                f"initial: the assembly gives no starting value for {', '.join(missing)} of joint "
-                f"{self.joint!r}; pass initial={{...}} in SI units"
+                f"joint {self.joint!r} {given} in the assembly; the fit of {', '.join(missing)} starts from the "
+                f"joint's value and searches a factor of 1000 either side of it, so it needs a value > 0: give the "
+                f"joint a positive {', '.join(missing)} in the assembly file, the start of the search "
+                f"(initial={{...}} in SI units in Python)"
             )
         start_joint = self._joint(template, {p: nominal[p] for p in PARAMETERS if nominal[p] != 0 or p in CROSS})
         model = assembly.with_joint(start_joint)
@@ -328,6 +346,17 @@ class JointIdentifier:
                          "by the misfit; run `substructure diagnose` to find what is missing")
         if self.bootstrap:
             self.std_ = self._bootstrap(lik, result)
+        specs = {spec.name: spec for spec in result.changes[0][0].specs}
+        self.search_ = {p: (float(specs[p].lower), float(specs[p].upper)) for p in self.fitted_}
+        self.at_bound_ = {}
+        for (_, p), hit in zip(result.names, result.at_bound):
+            if hit:
+                lo, hi = self.search_[p]
+                middle = np.sqrt(lo * hi) if specs[p].log else 0.5 * (lo + hi)
+                self.at_bound_[p] = "lower" if self.values_[p] <= middle else "upper"
+                self.std_[p] = float("nan")
+        notes += [_bound_note(p, self.values_[p], side, self.search_[p], specs[p].log)
+                  for p, side in self.at_bound_.items()]
         self.band_ = band
         self.cost_ = float(result.chi2)
         self.residual_rms_ = float(np.sqrt(np.mean(np.concatenate([np.abs(r) ** 2 for r in ratios]))))
@@ -390,6 +419,17 @@ class JointIdentifier:
             The receptances with the fitted joint (m/N, ...).
         """
         return assembly.with_joint(self.joint_).frf(outputs, inputs, frequency)
+
+
+def _bound_note(name: str, value: float, side: str, search: tuple[float, float], log: bool) -> str:
+    """The note of a fitted value on a bound of its search: not a measurement, and what to do."""
+    unit = _UNITS[name]
+    width = ("a factor of 1000 either side of its start" if log
+             else f"{search[0]:.4g} to {search[1]:.4g} {unit}, three times the geometric mean of the diagonal terms")
+    return (f"{name} = {value:.4g} {unit} is on the {side} bound of its search ({width}), not a measurement: the "
+            f"data in the band do not determine it, or its true value lies beyond the search; widen the band "
+            f"(--band, band=), fit without {name} (--parameters, parameters=; it keeps the assembly's value) or "
+            "start it from a better value (the joint's value in the assembly file, or initial= in Python)")
 
 
 def _passivity(joint: Joint) -> list[str]:

@@ -77,6 +77,13 @@ class IdentificationReport:
         ``chi^2`` per degree of freedom (about 1 when the model fits; dimensionless).
     correlation : tuple of tuple of float
         Correlations of the fitted parameters, in the order of ``fitted``.
+    at_bound : dict
+        The fitted parameters (``c_tm``, ...) that ended on a bound of their
+        search, each with ``"lower"`` or ``"upper"``: their values are not
+        measurements and their standard deviations are NaN (a note in
+        ``warnings`` says what to do).  Empty when every value lies inside.
+    search : dict
+        The search range ``(lower, upper)`` of each fitted parameter (SI).
     """
 
     joint: str
@@ -96,6 +103,8 @@ class IdentificationReport:
     consistent: bool = True
     chi2_reduced: float = float("nan")
     correlation: tuple = ()
+    at_bound: dict = attrs.field(factory=dict)
+    search: dict = attrs.field(factory=dict)
 
     def to_json(self) -> dict:
         """The JSON object of docs/file-formats.md (SI units, Hz; strict JSON), plus a few added keys.
@@ -104,7 +113,9 @@ class IdentificationReport:
         -------
         dict
             ``joint``, ``band_hz``, ``k``, ``c``, ``k_std``, ``c_std``, ``warnings``, ``fitted``,
-            ``residual_rms``, ``model``, ``consistent``, ``chi2_reduced``, ``parameters``, ``correlation``.
+            ``residual_rms``, ``model``, ``consistent``, ``chi2_reduced``, ``parameters`` (each with
+            ``at_bound``: null, ``"lower"`` or ``"upper"``, and ``search``: ``[lower, upper]``), ``correlation``,
+            ``at_bound`` (the names of the parameters on a bound of their search).
         """
         return {
             "joint": self.joint,
@@ -120,8 +131,11 @@ class IdentificationReport:
             "consistent": bool(self.consistent),
             "chi2_reduced": _finite(self.chi2_reduced),
             "parameters": {name: {"value": _finite(self._value(name)), "unit": _UNITS[name],
-                                  "std": _finite(self._std(name))} for name in self.fitted},
+                                  "std": _finite(self._std(name)), "at_bound": self.at_bound.get(name),
+                                  "search": [_finite(x) for x in self.search[name]] if name in self.search else None}
+                           for name in self.fitted},
             "correlation": [[_finite(x) for x in row] for row in self.correlation],
+            "at_bound": [name for name in self.fitted if name in self.at_bound],
         }
 
     def _value(self, name: str) -> float:
@@ -261,6 +275,7 @@ def identify_joint(assembly: Assembly, measurements, joint: str, band="auto",
         warnings=tuple(notes), measured=first.frf, initial=initial, predicted=predicted,
         residual_rms=ident.residual_rms_, closed_form=result, model=ident.model_, consistent=ident.consistent_,
         chi2_reduced=ident.chi2_reduced_, correlation=tuple(tuple(float(x) for x in row) for row in ident.correlation_),
+        at_bound=dict(ident.at_bound_), search=dict(ident.search_),
     )
 
 

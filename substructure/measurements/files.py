@@ -37,6 +37,22 @@ _CSV = (".csv",)
 _UFF = (".uff", ".unv")
 
 
+
+def _irregular_step(hz: np.ndarray) -> tuple[int, str] | None:
+    """The first line that breaks a uniform frequency step (a leading 0 Hz line, dropped later, aside), in words.
+
+    Identification and diagnosis estimate each line's noise from its neighbours (Savitzky-Golay smoothing),
+    which needs equally spaced lines; the tolerance is the smoother's.
+    """
+    first = 1 if hz.size > 1 and hz[0] == 0.0 else 0
+    steps = np.diff(hz[first:])
+    if steps.size < 2 or not np.ptp(steps) > 1e-6 * steps.mean():
+        return None
+    k = int(np.argmax(np.abs(steps - steps[0]) > 1e-6 * steps.mean()))
+    return (first + k + 1, f"{steps[k]:.6g} Hz after the line before, where the grid's step is {steps[0]:.6g} Hz: "
+            "identify and diagnose estimate each line's noise from its neighbours and need equally spaced lines; "
+            "write the data on one frequency step (as `substructure tap` writes them)")
+
 class _LocatedError(FileFormatError):
     """An error already naming the measurement file and the key path."""
 
@@ -129,6 +145,12 @@ class _Reader:
             beyond = _beyond_physical(frf.frequency.hz, frf.data, frf.quantity)  # a measured FRF's range
             if beyond is not None:
                 k, what = beyond
+                where = (f"line {lines_of[k]}" if lines_of is not None else
+                         f"type-58 record {record or 0}, value {k + 1} of {frf.frequency.n}")
+                raise FileFormatError(f"{path}, {where}: at {frf.frequency.hz[k]:g} Hz: {what}")
+            irregular = _irregular_step(frf.frequency.hz)
+            if irregular is not None:
+                k, what = irregular
                 where = (f"line {lines_of[k]}" if lines_of is not None else
                          f"type-58 record {record or 0}, value {k + 1} of {frf.frequency.n}")
                 raise FileFormatError(f"{path}, {where}: at {frf.frequency.hz[k]:g} Hz: {what}")
@@ -236,10 +258,13 @@ class _Reader:
         if "force_noise" in columns and force_window is None:
             raise self.error(index, "force_window_s", f"missing; {file} has a force_noise column, correlated over "
                                                       "1 / force_window_s hertz (the force window's length in s)")
-        if raw.quantity != "receptance" and raw.frequency.hz[0] == 0.0:
+        if raw.frequency.hz[0] == 0.0:
+            why = ("the model has no receptance at 0 Hz (its free-free components have no static receptance), so "
+                   "identify and diagnose cannot compare it" if raw.quantity == "receptance" else
+                   f"{'an' if raw.quantity[0] in 'aeiou' else 'a'} {raw.quantity} has no receptance at 0 Hz")
             warnings.warn(
                 f"{self.doc.where(self.parts(index, 'file'))}: frf[{index}].file: {file}: dropped the 0 Hz "
-                f"line: a {raw.quantity} has no receptance at 0 Hz",
+                f"line: {why}",
                 SubstructureWarning, stacklevel=2,
             )
             raw = raw.crop(lo=raw.frequency.hz[1])
