@@ -424,3 +424,22 @@ def test_a_0_hz_line_is_dropped_with_a_warning_naming_the_entry(tmp_path, quanti
                                          rf"{article}"):
         ms = loads_measurements(text, tmp_path, "set.toml")
     assert ms.measurements[0].frf.frequency.hz[0] == pytest.approx(10.0)
+
+
+@pytest.mark.parametrize("decimals, read", [(2, True), (3, True), (1, False)])
+def test_frequencies_written_rounded_are_read_as_the_uniform_grid_they_round(tmp_path, decimals, read):
+    """A 0.15625 Hz step (a 6.4 s record) written with 2 or 3 decimals lies 3 % or 0.3 % of a step off its grid:
+    read as the grid, the values untouched; with 1 decimal (32 % off) it is refused."""
+    hz = 20.0 + 0.15625 * np.arange(400)
+    h = 1e-6 / (1 - (hz / 60.0) ** 2 + 0.04j * hz / 60.0)
+    rows = "".join(f"{f:.{decimals}f},{float(v.real)!r},{float(v.imag)!r}\n" for f, v in zip(hz, h))
+    (tmp_path / "tip.csv").write_text("frequency_hz,real,imag\n" + rows)
+    if not read:
+        assert re.search(r"tip\.csv, line \d+: at .* Hz: .* need equally spaced lines; .* rounded within 0\.25 of "
+                         r"a step are read as their grid", error_of(tmp_path, GOOD))
+        return
+    ms = loads_measurements(GOOD, tmp_path, "set.toml")
+    frf = ms.measurements[0].frf
+    np.testing.assert_allclose(frf.frequency.hz, hz, rtol=0, atol=0.5 * 10.0**-decimals / 10)  # 10 x the rounding
+    np.testing.assert_allclose(np.diff(frf.frequency.hz), np.diff(frf.frequency.hz)[0], rtol=1e-9)
+    np.testing.assert_array_equal(frf.data[:, 0, 0], h)

@@ -13,13 +13,14 @@ import warnings
 from pathlib import Path
 from typing import Any
 
+import attrs
 import numpy as np
 
 from .._files import MAX_DATA_BYTES, read_text
 from .._files import check_file as check_readable_file
 from .._toml import TomlDocument, loads_toml
 from ..errors import FileFormatError, InvalidValueError, SubstructureError, SubstructureWarning
-from ..frf import FRF, QUANTITIES
+from ..frf import FRF, QUANTITIES, Frequency
 from ..frf.files._common import _beyond_physical
 from ..frf.files.csv_files import _read_csv
 from ..frf.files.uff_reader import read_uff, read_uff_coherence
@@ -38,20 +39,41 @@ _UFF = (".uff", ".unv")
 
 
 
-def _irregular_step(hz: np.ndarray) -> tuple[int, str] | None:
-    """The first line that breaks a uniform frequency step (a leading 0 Hz line, dropped later, aside), in words.
 
-    Identification and diagnosis estimate each line's noise from its neighbours (Savitzky-Golay smoothing),
-    which needs equally spaced lines; the tolerance is the smoother's.
+ROUNDED_STEP_SHARE = 0.25
+"""How far a data file's frequencies may lie off the uniform grid fitted to them (least squares), as a share of
+the step, and still be read as that grid: frequencies written rounded (``%.2f`` of a 0.15625 Hz step lies up to
+0.005 Hz, 3 % of the step, off it).  A quarter of a step, as for the times of a tap record
+(``substructure.io.tap_files.ROUNDED_TIME_TOLERANCE``): no line can then be taken for its neighbour."""
+
+
+def _uniform_grid(hz: np.ndarray) -> tuple[np.ndarray | None, tuple[int, str] | None]:
+    """A data file's frequencies as the uniform grid they stand for, or the first line that breaks it, in words.
+
+    Identification and diagnosis estimate each line's noise from its neighbours (Savitzky-Golay smoothing), which
+    needs equally spaced lines.  Frequencies within :data:`ROUNDED_STEP_SHARE` of a step of the uniform grid
+    fitted to them (least squares; a leading 0 Hz line, dropped later, aside) are that grid, written rounded.
     """
     first = 1 if hz.size > 1 and hz[0] == 0.0 else 0
+    n = hz.size - first
+    if n < 3:
+        return hz, None
     steps = np.diff(hz[first:])
-    if steps.size < 2 or not np.ptp(steps) > 1e-6 * steps.mean():
-        return None
-    k = int(np.argmax(np.abs(steps - steps[0]) > 1e-6 * steps.mean()))
-    return (first + k + 1, f"{steps[k]:.6g} Hz after the line before, where the grid's step is {steps[0]:.6g} Hz: "
-            "identify and diagnose estimate each line's noise from its neighbours and need equally spaced lines; "
-            "write the data on one frequency step (as `substructure tap` writes them)")
+    if not np.ptp(steps) > 1e-6 * steps.mean():  # uniform as written (the smoother's tolerance): kept
+        return hz, None
+    index = np.arange(n)
+    step, start = np.polyfit(index, hz[first:], 1)  # least squares: the rounding of every line averaged out
+    grid = start + step * index
+    off = np.abs(hz[first:] - grid)
+    if off.max() <= ROUNDED_STEP_SHARE * step:
+        return np.concatenate([hz[:first], grid]), None
+    jump = np.abs(steps - steps[0]) > 2 * ROUNDED_STEP_SHARE * steps[0]  # where the step changes, else the drift
+    k = int(np.argmax(jump)) if jump.any() else max(int(np.argmax(off)) - 1, 0)
+    return None, (first + k + 1, f"{steps[k]:.6g} Hz after the line before, where the grid's step is {steps[0]:.6g} "
+                  "Hz: identify and diagnose estimate each line's noise from its neighbours and need equally spaced "
+                  "lines; write the data on one frequency step (as `substructure tap` writes them; frequencies "
+                  f"rounded within {ROUNDED_STEP_SHARE:g} of a step are read as their grid)")
+
 
 class _LocatedError(FileFormatError):
     """An error already naming the measurement file and the key path."""
@@ -148,7 +170,9 @@ class _Reader:
                 where = (f"line {lines_of[k]}" if lines_of is not None else
                          f"type-58 record {record or 0}, value {k + 1} of {frf.frequency.n}")
                 raise FileFormatError(f"{path}, {where}: at {frf.frequency.hz[k]:g} Hz: {what}")
-            irregular = _irregular_step(frf.frequency.hz)
+            grid, irregular = _uniform_grid(frf.frequency.hz)
+            if grid is not None and not np.array_equal(grid, frf.frequency.hz):
+                frf = attrs.evolve(frf, frequency=Frequency(grid))
             if irregular is not None:
                 k, what = irregular
                 where = (f"line {lines_of[k]}" if lines_of is not None else
