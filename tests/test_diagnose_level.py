@@ -51,8 +51,11 @@ def test_a_miscalibrated_test_is_unexplained_and_the_report_says_why():
     assert not d.explained
     assert d.report[0].startswith("unexplained: no candidate explains the data")
     (line,) = [x for x in d.report if "calibration" in x]
-    assert "1.1 times" in line
+    assert "1.1 times" in line and "no change of the structure is fitted" in line
     assert np.isfinite(d.final_error)
+    # nothing stacked on the wrong level: no change fitted, no partial explanation, no claim that none improves
+    assert not d.effects and len(d.refinement) == 1
+    assert not any("partial" in x or "no candidate improves" in x for x in d.report), d.report
 
 
 def _bumped(frf, height):

@@ -203,7 +203,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     Diagnosis
         The verdict, the candidates, the refinement and the refined model.
     """
-    from .report import Explanation, separation, unexplained_report, values_text
+    from .report import Explanation, level_signature, separation, unexplained_report, values_text
 
     if settings is None:
         settings = DEFAULT_SETTINGS
@@ -245,6 +245,13 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     lacking = _peak_lines(baseline, settings)
     screen_lik = lik.subsample(max(1, lik.lines.size // settings.screen_lines), keep=lacking)
     limit = 0 if cons.consistent else (max_steps if refine else 1)
+    if limit and level_signature(baseline, floor, settings)[0]:
+        # every FRF a constant factor times the model with every mode in place: a calibration or unit error, which
+        # no change of the structure makes (changes fitted to it would only be stacked on the wrong level)
+        limit = 0
+        if say:
+            say("every measured FRF is a constant factor times the model with every mode in place: a calibration "
+                "or unit error; no change of the structure is fitted")
     outcome = refine_model(lik, screen_lik, cands, limit, lambda changes: _passive(lik, changes), say, meter,
                            lacking=bool(len(lacking)), settings=settings)
     current = outcome.current

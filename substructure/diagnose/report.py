@@ -275,9 +275,10 @@ def unexplained_report(lik, assembly, current, baseline, cons, final_error: floa
         lines.append(words.error_lives(merged[:settings.report_bands]))
     elif cons.chi2_reduced > cons.threshold:
         lines.append(words.error_spread())
+    level = level_signature(baseline, floor, settings)[0]
     if current:
         lines.append(words.best_partial([(c.effect, c.place(v), values_text(c, v)) for c, v in current]))
-    else:
+    elif not level:  # with a calibration's signature no change of the structure is fitted (the line below says why)
         lines.append(words.nothing_improves())
     try:  # the signature of the data against the model as given: what kind of change is missing
         first = lik.measured[0]
@@ -287,7 +288,7 @@ def unexplained_report(lik, assembly, current, baseline, cons, final_error: floa
     except (SubstructureError, ValueError) as exc:
         if say:
             say(f"signature skipped: {exc}")
-    lines += level_signature(baseline, floor, settings)[0]
+    lines += level
     return lines
 
 

@@ -515,7 +515,8 @@ def level_line(factors: Sequence[tuple[str, str, float]]) -> str:
     return (f"signature: the measurement is a constant factor times the model over the whole band with every mode "
             f"in place ({text}): a calibration or unit error (the hammer's or the sensor's sensitivity, g taken "
             f"for m/s^2) scales an FRF like this, while a change of the structure would have to scale every mass "
-            f"and stiffness alike; check the calibration before the model")
+            f"and stiffness alike; check the calibration before the model (no change of the structure is fitted "
+            f"to such data)")
 
 
 def separation_text(a_name: str, a_where: str, b_name: str, b_where: str, value: float, indifference: float,
