@@ -308,3 +308,37 @@ def test_the_summary_says_the_order_of_the_eigenvalue_problems_and_how_they_were
     line = next(x for x in out.splitlines() if x.startswith("discretisation: "))
     assert line.startswith("discretisation: 450 intervals in the cut per delay period (monodromy matrices of order "
                            "452, the largest multipliers by Arnoldi iterations from order 400)")
+
+
+def test_a_fixed_interval_count_too_coarse_for_the_modes_is_refused_naming_the_least(capsys, modes_file):
+    argv = ["lobes", "--modes", modes_file, *BENCH_CUT, "--method", "sdm", "--speeds", "15000:16000:500", "--quiet"]
+    phase = 2 * np.pi * 922 * 60.0 / (2 * 15000)  # the slot: the tooth cuts through the whole delay period
+    for count in ("1", "2", "25"):
+        code, out, err = run(capsys, *argv, "--intervals", count)
+        assert code == 1 and out == ""
+        assert f"--intervals: got {count}; at 15000 rpm one interval spans a phase step of " \
+               f"{phase / int(count):.3g} rad" in err and "at least 26 intervals" in err
+    code, out, err = run(capsys, *argv, "--intervals", "26")
+    assert code == 0, err
+    assert "discretisation: 26 intervals in the cut" in out
+
+
+def test_a_driving_point_frf_with_the_wrong_sign_of_its_imaginary_part_is_refused(capsys, frf_files, tmp_path):
+    x = frf_files[2]
+    rng = np.random.default_rng(7)
+    h = x.data[:, 0, 0]
+    noisy = h + 0.05 * np.abs(h) * (rng.standard_normal(h.size) + 1j * rng.standard_normal(h.size))
+    flipped = np.imag(noisy) > 0
+    assert flipped.any()  # measured noise flips a few lines near the antiresonances: accepted
+    cases = {"noisy": (noisy, None), "negated": (-h, "100% of the lines"), "conjugated": (np.conj(h), "100%")}
+    for name, (data, refused) in cases.items():
+        path = tmp_path / f"{name}.csv"
+        FRF.single(x.frequency, data, output="tool.tip:y", input="tool.tip:y").to_csv(path)
+        code, out, err = run(capsys, "lobes", "--frf", path, *THESIS_CUT, "--speeds", "5000:6000:500")
+        if refused is None:
+            assert code == 0, err
+        else:
+            assert code == 1 and out == ""
+            assert f"{path}: Im(H) > 0 on {refused}" in err and "sign" in err and "conjugate" in err
+    code, _, err = run(capsys, "lobes", "--frf", frf_files[0], "--frf-y", tmp_path / "negated.csv", *THESIS_CUT)
+    assert code == 1 and "negated.csv: Im(H) > 0" in err

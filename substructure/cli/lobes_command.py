@@ -40,6 +40,23 @@ def _window(args: argparse.Namespace) -> dict | None:
     return taus if any(t is not None for t in taus.values()) else None
 
 
+def _check_sign(path, frf) -> None:
+    """Refuse a driving-point receptance whose imaginary part is positive where most of ``|Im H|`` lies."""
+    import numpy as np
+
+    from ..frf import REVERSED_SHARE, reversed_share
+
+    h = frf.data[:, 0, 0]
+    share = reversed_share(h)
+    if share > REVERSED_SHARE:
+        lines = float(np.mean(np.imag(h[np.isfinite(h)]) > 0))
+        raise SubstructureError(
+            f"{path}: Im(H) > 0 on {lines:.0%} of the lines, holding {share:.0%} of |Im H| (a tool point's "
+            "receptance has Im(H) <= 0, but for noise near its antiresonances): its sign is reversed (a channel's "
+            "polarity: negate the data) or the data follow the other convention, exp(-i omega t) (take their "
+            "conjugate); as they are, the lobes would be many times too deep")
+
+
 def _lobes_structure(args: argparse.Namespace):
     """The structure, a line describing it, the band chosen, the tool and the window removed (or None)."""
     from ..frf import FRF
@@ -81,6 +98,9 @@ def _lobes_structure(args: argparse.Namespace):
             warnings.simplefilter("ignore", WindowedFRFWarning)
             x = FRF.from_csv(args.frf)
             y = FRF.from_csv(args.frf_y) if args.frf_y else None
+        for path, one in ((args.frf, x), (args.frf_y, y)):
+            if one is not None:
+                _check_sign(path, one)
         frf = xy_frf(x, y)
         what = f"FRF from {args.frf}" + (f" (x) and {args.frf_y} (y)" if args.frf_y else ", y = x (a symmetric tool)")
     frf, band = choose_band(frf, band)
@@ -103,6 +123,7 @@ def run(args: argparse.Namespace) -> int:
     from ..frf import FRF
     from ..stability import (MillingCut, ModalFitter, ModalFitWarning, ModalModel, NoRecommendationError, recommend,
                              sdm, zoa)
+    from ..stability.sdm import check_intervals
 
     check_plot(args.plot)
     check_outputs([("--plot", args.plot)], [args.assembly, args.frf, args.frf_y, args.modes, args.workpiece_table,
@@ -134,6 +155,7 @@ def run(args: argparse.Namespace) -> int:
             if max(fit.modal_error_ for fit in fits) > 0.2:
                 warnings.warn(f"the fitted modes miss the FRF by {errors}; choose the band with --band LO:HI",
                               ModalFitWarning, stacklevel=2)
+        check_intervals(structure, cut, args.speeds, args.intervals, name="--intervals")
         lobes = sdm(structure, cut, args.speeds, intervals=args.intervals, progress=progress)
         if band is not None:
             lobes = attrs.evolve(lobes, band=band)
