@@ -342,3 +342,20 @@ def test_a_driving_point_frf_with_the_wrong_sign_of_its_imaginary_part_is_refuse
             assert f"{path}: Im(H) > 0 on {refused}" in err and "sign" in err and "conjugate" in err
     code, _, err = run(capsys, "lobes", "--frf", frf_files[0], "--frf-y", tmp_path / "negated.csv", *THESIS_CUT)
     assert code == 1 and "negated.csv: Im(H) > 0" in err
+
+
+def test_a_band_that_misses_the_resonance_is_said(capsys, modes_file, tmp_path):
+    f = np.arange(10.0, 2000.0, 0.5)
+    k = 0.03993 * (2 * np.pi * 922) ** 2
+    h = 1.0 / (k * (1 - (f / 922) ** 2 + 2j * 0.011 * f / 922))
+    path = tmp_path / "one.csv"
+    FRF.single(Frequency(f), h, output="t:y", input="t:y").to_csv(path)
+    argv = ["lobes", "--frf", path, *BENCH_CUT, "--speeds", "15000:16000:500"]
+    for method in ("zoa", "sdm"):
+        code, out, err = run(capsys, *argv, "--band", "10:300", "--method", method, "--quiet")
+        assert code == 1 and out == "" and "never negative from 10 to 300 Hz: the band holds no resonance" in err
+    code, out, err = run(capsys, *argv, "--band", "1000:1001")
+    assert code == 0 and "first line of the band (1000 Hz)" in err
+    assert "\nwarning: zoa: the oriented FRF's most negative real part, the absolute limit, is at the first line" in out
+    code, out, _ = run(capsys, *argv, "--band", "1000:1001", "--json")
+    assert any(n.startswith("warning: zoa:") and "1000 Hz" in n for n in json.loads(out)["notes"])

@@ -211,3 +211,21 @@ def test_no_chatter_possible_gives_no_limit():
     lobes = zoa(model, TurningCut("2000 MPa"), SPEEDS)
     assert np.all(np.isinf(lobes.depth_limit_m)) and lobes.absolute_limit_m == np.inf
     assert lobes.to_json()["absolute_limit_m"] is None
+
+
+def test_a_band_without_the_resonance_is_an_error_and_a_minimum_on_its_edge_a_warning():
+    f = np.arange(10.0, 2000.0, 0.25)
+    r = f / FN
+    frf = FRF.single(Frequency(f), 1.0 / (K * (1 - r ** 2 + 2j * ZETA * r)), output="t:y", input="t:y")
+    cut = benchmark_cut(1.0)
+    modes = ModalModel([Mode(d, Q_(FN, "Hz"), ZETA, Q_(K, "N/m")) for d in "xy"])  # y = x, as one FRF means
+    closed = zoa(modes, cut, SPEEDS).absolute_limit_m
+    with pytest.raises(InvalidValueError, match=r"never negative from 10 to 300 Hz: the band holds no resonance"):
+        zoa(frf, cut, SPEEDS, band=(10.0, 300.0))  # Re H > 0 below the mode
+    with pytest.warns(StabilityWarning, match=r"at the first line of the band \(1000 Hz\): the minimum may lie "):
+        edge = zoa(frf, cut, SPEEDS, band=(1000.0, 1001.0))
+    assert edge.absolute_limit_m > 2 * closed  # far too deep: why it is said
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        whole = zoa(frf, cut, SPEEDS, band=(500.0, 1500.0))
+    assert whole.absolute_limit_m == pytest.approx(closed, rel=1e-3)

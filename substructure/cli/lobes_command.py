@@ -110,6 +110,21 @@ def _lobes_structure(args: argparse.Namespace):
     return (frf if window is None else window.frf), f"{what}, {grid_text(frf.frequency)}", band, tool, window
 
 
+def _zoa_noted(structure, cut, speeds, band, notes: list[str]):
+    """``zoa`` of the structure; its warning that the absolute limit sits on an edge of the band is also a note."""
+    from ..stability import StabilityWarning, zoa
+    from ..stability.zoa import EDGE_WARNING
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        lobes = zoa(structure, cut, speeds, band=band if band is not None else "auto")
+    for item in caught:
+        if issubclass(item.category, StabilityWarning) and str(item.message).startswith(EDGE_WARNING.split("{")[0]):
+            notes.append(f"warning: {item.message}")
+        warnings.warn_explicit(item.message, item.category, item.filename, item.lineno)
+    return lobes
+
+
 def run(args: argparse.Namespace) -> int:
     import sys
 
@@ -122,7 +137,7 @@ def run(args: argparse.Namespace) -> int:
 
     from ..frf import FRF
     from ..stability import (MillingCut, ModalFitter, ModalFitWarning, ModalModel, NoRecommendationError, recommend,
-                             sdm, zoa)
+                             sdm)
     from ..stability.sdm import check_intervals
 
     check_plot(args.plot)
@@ -143,10 +158,11 @@ def run(args: argparse.Namespace) -> int:
     cut = cut_from_args(args, tool, notes)
     limits = limits_from_args(args, tool, notes) if isinstance(cut, MillingCut) else None
     if args.method == "zoa":
-        lobes = zoa(structure, cut, args.speeds, band=band if band is not None else "auto")
+        lobes = _zoa_noted(structure, cut, args.speeds, band, notes)
         method = "zero-order approximation (Altintas & Budak 1995)"
     else:
         if isinstance(structure, FRF):  # semi-discretization needs modes: fit them to x and y (without the window)
+            _zoa_noted(structure, cut, args.speeds[:1], band, notes)  # the band's resonance: as for zoa
             fits = [ModalFitter().fit(FRF.single(structure.frequency, structure.data[:, i, i], output=d, input=d), d)
                     for i, d in enumerate("xy")]
             structure = ModalModel([m for fit in fits for m in fit.modes_])

@@ -42,6 +42,13 @@ MAX_LOBE_POINTS = 5_000_000
 """Most points (FRF lines x lobes x 2 branches) the zero order builds, about 40 MB per array."""
 
 
+EDGE_WARNING = ("zoa: the oriented FRF's most negative real part, the absolute limit, is at the {edge} line of the "
+                "band ({hz:g} Hz): the minimum may lie outside it (a mode outside the band), and the limit be too "
+                "deep; extend the band")
+"""The warning when the absolute limit of FRF data sits on an edge of the band (not the lower edge the automatic
+band chose above a mass line)."""
+
+
 def zoa_eigenvalues(k0: np.ndarray, g: np.ndarray) -> np.ndarray:
     """Eigenvalues of ``K0 @ G`` per line, shape ``(n, 2)``, ordered to follow each branch.
 
@@ -205,16 +212,18 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
     Raises
     ------
     InvalidValueError
-        When the lobes would need more than ``MAX_LOBE_POINTS`` (5,000,000) points
+        For FRF data whose oriented real part is never negative in the band
+        (no resonance in it), and when the lobes would need more than ``MAX_LOBE_POINTS`` (5,000,000) points
         (FRF lines x lobes x 2): crop or thin the FRF, or raise the lowest
         speed.
 
     Warns
     -----
     StabilityWarning
-        When the absolute limit lies at the first or last line of FRF data:
-        the FRF band may leave out what limits the cut (e.g. the rigid-body
-        region of a free-free model); crop or extend it.
+        When the absolute limit lies at the first or last line of FRF data
+        (:data:`EDGE_WARNING`): the minimum may lie outside the band; extend
+        it.  Not at the first line of a band chosen automatically above a
+        rigid-body mass line.
     """
     speeds_rpm = as_speed_rpm(speeds)
     structure, used = choose_band(structure, band)
@@ -226,6 +235,11 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
         valid = lam.real > 1e-300
         a = np.where(valid, 1.0 / (2.0 * lam.real), np.inf)  # (m, 2)
         theta = np.pi + 2.0 * np.angle(lam)  # in (0, 2 pi) where valid
+    if not valid.any() and isinstance(structure, FRF):
+        raise InvalidValueError(
+            f"zoa: the oriented FRF's real part is never negative from {f[0]:g} to {f[-1]:g} Hz: the band holds no "
+            "resonance of the tool point (no limit can be found there, which is not a cut free of chatter); give "
+            "the FRF around the tool's modes (band=(lo, hi); --band LO:HI on the command line)")
     if not valid.any():
         return Lobes("zoa", speeds_rpm, np.full(speeds_rpm.size, np.inf), np.full(speeds_rpm.size, np.nan),
                      cut=cut, absolute_limit_m=float("inf"), label=label, band=used)
@@ -234,12 +248,10 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
     i, branch = np.unravel_index(flat, a.shape)
     if isinstance(structure, FRF):
         a_abs, f_abs = _refine_data(f, a[:, branch], i)
-        if i in (0, f.size - 1) and not (i == 0 and used is not None and used.excluded_hz is not None):
-            warnings.warn(
-                f"zoa: the absolute limit is at the {'first' if i == 0 else 'last'} line of the FRF "
-                f"({f[i]:g} Hz); the FRF band may leave out what limits the cut (a free-free model's "
-                "rigid-body motion, a mode outside the band): crop or extend the band", StabilityWarning,
-                stacklevel=2)
+        if i in (0, f.size - 1) and not (i == 0 and used is not None and used.excluded_hz is not None
+                                         and used.kind != "user"):
+            warnings.warn(EDGE_WARNING.format(edge="first" if i == 0 else "last", hz=f[i]), StabilityWarning,
+                          stacklevel=2)
     else:
         a_abs, f_abs = _refine_model(structure, k0, f, i, branch)
     # lobes: n = 60 f / (N (theta / 2 pi + k)), k = 0 .. k_max over both branches
