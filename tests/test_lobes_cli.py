@@ -359,3 +359,23 @@ def test_a_band_that_misses_the_resonance_is_said(capsys, modes_file, tmp_path):
     assert "\nwarning: zoa: the oriented FRF's most negative real part, the absolute limit, is at the first line" in out
     code, out, _ = run(capsys, *argv, "--band", "1000:1001", "--json")
     assert any(n.startswith("warning: zoa:") and "1000 Hz" in n for n in json.loads(out)["notes"])
+
+
+def test_options_that_would_be_unused_are_refused(capsys, modes_file, tmp_path):
+    turning = ["lobes", "--modes", modes_file, "--turning", "--kf", "2000 MPa", "--speeds", "15000:16000:500"]
+    for extra in (["--max-speed", "20000"], ["--margin", "0.3"], ["--power", "5 kW"], ["--max-depth", "2 mm"]):
+        code, out, err = run(capsys, *turning, *extra)
+        assert code == 2 and out == "" and f"--turning: {extra[0]} sets the machinist's recommendation" in err
+    milling = ["lobes", "--modes", modes_file, *BENCH_CUT, "--speeds", "15000:16000:500"]
+    for extra in (["--cutting-data", tmp_path / "missing.toml"], ["--tool-material", "hss"]):
+        code, out, err = run(capsys, *milling, *extra)
+        assert code == 2 and out == "" and f"{extra[0]} goes with --workpiece NAME" in err
+
+
+def test_a_normal_coefficient_given_with_a_workpiece_is_said_to_override_the_table(capsys, modes_file):
+    code, out, err = run(capsys, "lobes", "--modes", modes_file, "--teeth", "2", "--diameter", "12 mm",
+                         "--immersion", "1", "--workpiece", "aluminium-7075", "--kr", "0.5", "--speeds",
+                         "15000:16000:500")
+    assert code == 0, err
+    assert "workpiece: --kr 0.5 overrides the table's normal coefficient" in out
+    assert "Kn = 383.5 MPa (Kn/Kt = 0.5)" in out  # 0.5 x the table's Kt of 767.01 MPa

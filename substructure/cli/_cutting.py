@@ -201,6 +201,13 @@ def cut_from_args(args: argparse.Namespace, tool: Any, notes: list[str]):
         given = [name for name, value in milling_only.items() if value is not None]
         if given:
             raise UsageError(f"--turning takes --kf [--orientation U]; {', '.join(given)} describe a milling cut")
+        unused = machine_given(args) + [name for name, value, default in (
+            ("--margin", getattr(args, "margin", 0.2), 0.2),
+            ("--speed-tolerance", getattr(args, "speed_tolerance", 0.03), 0.03)) if value != default]
+        if unused:
+            verb = "sets" if len(unused) == 1 else "set"
+            raise UsageError(f"--turning: {', '.join(unused)} {verb} the machinist's recommendation, which is for "
+                             "milling cuts (a turning cut gets the lobes only): leave them out")
         if args.kf is None:
             raise UsageError("--turning needs --kf PRESSURE (the cutting pressure, e.g. '2000 MPa')")
         return TurningCut(args.kf, args.orientation if args.orientation is not None else 1.0)
@@ -235,14 +242,22 @@ def cut_from_args(args: argparse.Namespace, tool: Any, notes: list[str]):
         raise UsageError("give --radial-depth or --immersion, not both")
     if args.kn is not None and args.kr is not None:
         raise UsageError("give --kn (a pressure) or --kr (the ratio Kn/Kt), not both")
-    if args.workpiece_table is not None and args.workpiece is None:
-        raise UsageError("--workpiece-table goes with --workpiece NAME")
+    for name, value in (("--workpiece-table", args.workpiece_table),
+                        ("--cutting-data", getattr(args, "cutting_data", None)),
+                        ("--tool-material", getattr(args, "tool_material", None))):
+        if value is not None and args.workpiece is None:
+            raise UsageError(f"{name} goes with --workpiece NAME" + ("" if name == "--workpiece-table" else
+                             " (the cutting-speed and feed check is of a workpiece from the table)"))
     milling = milling_of(args, notes)
     if args.workpiece is not None:
         if args.kt is not None:
             raise UsageError("give --workpiece NAME or --kt, not both (the table gives Kt)")
         entry = workpiece(args.workpiece, args.workpiece_table)
         notes.append(f"workpiece: {entry.describe()}")
+        for name, value in (("--kn", args.kn), ("--kr", args.kr)):
+            if value is not None:
+                notes.append(f"workpiece: {name} {value} overrides the table's normal coefficient: the cut's Kn "
+                             "(the cut: line) is from it")
         feed = args.feed_per_tooth
         if feed is None:
             data = cutting_data_of(args, entry, tool, notes)
