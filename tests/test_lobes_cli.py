@@ -168,7 +168,8 @@ def test_turning(capsys, modes_file):
     (["--speeds", "50 Hz:300 Hz:1 Hz"], 2, "rpm"),
     (["--speeds", "1000:2000:50:5"], 2, "START:STOP:STEP"),  # START:STOP alone has a default step
     (["--diameter", "12"], 1, "diameter"),
-    (["--kr", "100 MPa"], 2, "--kr"),
+    (["--kr", "100 MPa"], 2, "--kr: got '100 MPa'; expected the ratio Kn/Kt, a plain number such as 0.3 (a "
+                              "pressure such as '100 MPa' is the normal coefficient itself: give it with --kn)"),
 ])
 def test_bad_cut_or_speeds_are_clear_errors(capsys, frf_files, argv, status, message):
     args = dict(zip(THESIS_CUT[::2], THESIS_CUT[1::2]))

@@ -104,6 +104,16 @@ def speed_arg(text: str) -> str:
     return text
 
 
+def kr_arg(text: str) -> float:
+    """``--kr``: the ratio Kn/Kt, a plain number; a pressure is refused with the hint that it belongs in ``--kn``."""
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"got {text!r}; expected the ratio Kn/Kt, a plain number such as 0.3 (a pressure such as '100 MPa' "
+            "is the normal coefficient itself: give it with --kn)") from None
+
+
 def add_cut_options(parser: argparse.ArgumentParser) -> None:
     """Add the groups "milling cut", "machine and recommendation" and "turning" to a command's parser."""
     cutting = parser.add_argument_group("milling cut")
@@ -117,7 +127,7 @@ def add_cut_options(parser: argparse.ArgumentParser) -> None:
                          help="down (= climb) or up (= conventional) milling; default up, said in every output")
     cutting.add_argument("--kt", metavar="PRESSURE", help="tangential cutting coefficient, e.g. '625 MPa'")
     cutting.add_argument("--kn", metavar="PRESSURE", help="normal (radial) cutting coefficient, e.g. '100 MPa'")
-    cutting.add_argument("--kr", type=float, metavar="RATIO", help="or the ratio Kn/Kt, e.g. 0.16")
+    cutting.add_argument("--kr", type=kr_arg, metavar="RATIO", help="or the ratio Kn/Kt, e.g. 0.16")
     cutting.add_argument("--workpiece", metavar="NAME",
                          help="cutting coefficients from the table, e.g. aluminium-7075, steel-1045 (instead of --kt)")
     cutting.add_argument("--workpiece-table", metavar="FILE.toml", help="your own table of workpieces, searched first")
