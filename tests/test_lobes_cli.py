@@ -380,3 +380,17 @@ def test_a_normal_coefficient_given_with_a_workpiece_is_said_to_override_the_tab
     assert code == 0, err
     assert "workpiece: --kr 0.5 overrides the table's normal coefficient" in out
     assert "Kn = 383.5 MPa (Kn/Kt = 0.5)" in out  # 0.5 x the table's Kt of 767.01 MPa
+
+
+def test_low_speed_turning_from_modes_is_within_the_cap_and_meets_the_closed_form(capsys, modes_file):
+    status, out, err = run(capsys, "lobes", "--modes", modes_file, "--turning", "--kf", "2000MPa", "--speeds",
+                           "500:3000:10", "--json")
+    assert status == 0, err
+    k = 0.03993 * (2 * np.pi * 922) ** 2
+    closed = 2 * k * 0.011 * 1.011 / 2e9  # b_lim = -1 / (2 Kf min Re G)
+    depth = np.array(json.loads(out)["depth_limit_m"])
+    assert depth.size == 251 and depth.min() == pytest.approx(closed, rel=2e-4) and depth.min() >= closed
+    status, out, err = run(capsys, "lobes", "--modes", modes_file, "--turning", "--kf", "2000MPa", "--speeds",
+                           "20:3000:10")
+    assert status == 1 and out == "" and "raise the lowest spindle speed to 37.59 rpm or more (--speeds" in err
+    assert "crop the FRF" not in err

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 import warnings
 
 import numpy as np
@@ -229,3 +230,28 @@ def test_a_band_without_the_resonance_is_an_error_and_a_minimum_on_its_edge_a_wa
         warnings.simplefilter("error")
         whole = zoa(frf, cut, SPEEDS, band=(500.0, 1500.0))
     assert whole.absolute_limit_m == pytest.approx(closed, rel=1e-3)
+
+
+def test_low_speed_turning_from_modes_takes_a_graded_grid_within_the_cap(monkeypatch):
+    """The default grid (a relative step of zeta / 50 from 0.3 to 3 f_n) times the lobes below 700 rpm exceeds
+    MAX_LOBE_POINTS: the lines are graded around the mode instead, against the closed form and the default grid."""
+    cut = TurningCut("2000 MPa")
+    closed = 2 * K * ZETA * (1 + ZETA) / 2e9  # -1 / (2 Kf min Re G), min Re G = -1 / (4 k zeta (1 + zeta))
+    low = zoa(benchmark_model(), cut, spindle_speeds("500 rpm", "3000 rpm", "10 rpm"))
+    assert low.absolute_limit_m == pytest.approx(closed, rel=1e-9)
+    assert low.depth_limit_m.min() == pytest.approx(closed, rel=2e-4)  # dense lobes reach down to it
+    assert np.all(low.depth_limit_m >= closed * (1 - 1e-9))
+    speeds = spindle_speeds("1000 rpm", "3000 rpm", "10 rpm")  # the default grid fits: 3.5e6 points
+    default = zoa(benchmark_model(), cut, speeds)
+    module = sys.modules[zoa.__module__]
+    monkeypatch.setattr(module, "MAX_LOBE_POINTS", 1_000_000)
+    graded = zoa(benchmark_model(), cut, speeds)
+    np.testing.assert_allclose(graded.depth_limit_m, default.depth_limit_m, rtol=5e-4)
+    np.testing.assert_allclose(graded.chatter_frequency_hz, default.chatter_frequency_hz, rtol=1e-5)
+    with pytest.raises(InvalidValueError, match=r"lines graded around the modes x \d+ lobes x 2 = .* down to 100 rpm, "
+                                                r"more than the limit MAX_LOBE_POINTS = 1e\+06 .*; raise the lowest "
+                                                r"spindle speed to ([0-9.]+) rpm or more") as info:
+        zoa(benchmark_model(), cut, spindle_speeds("100 rpm", "3000 rpm", "10 rpm"))
+    lowest = float(str(info.value).split("spindle speed to ")[1].split(" rpm")[0])
+    assert zoa(benchmark_model(), cut, Q_([np.ceil(lowest), 3000.0], "rpm")).absolute_limit_m == \
+        pytest.approx(closed, rel=1e-9)
