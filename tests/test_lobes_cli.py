@@ -394,3 +394,25 @@ def test_low_speed_turning_from_modes_is_within_the_cap_and_meets_the_closed_for
                            "20:3000:10")
     assert status == 1 and out == "" and "raise the lowest spindle speed to 37.59 rpm or more (--speeds" in err
     assert "crop the FRF" not in err
+
+
+def test_semi_discretization_of_a_fine_frf_checks_its_band_without_building_zero_order_lobes(capsys, tmp_path):
+    """136,000 lines x 21 lobes x 2 at 3000 rpm exceed MAX_LOBE_POINTS: the zero order's lobes are not needed by
+    sdm, only its checks of the band; the limit meets sdm on the modes themselves."""
+    k = 0.03993 * (2 * np.pi * 922) ** 2
+    f = np.arange(300.0, 2000.0, 0.0125)
+    h = 1.0 / (k * (1 - (f / 922) ** 2 + 2j * 0.011 * f / 922))
+    path = tmp_path / "fine.csv"
+    FRF.single(Frequency(f), h, output="t:y", input="t:y").to_csv(path)
+    cut = ["--teeth", "2", "--diameter", "10 mm", "--immersion", "0.5", "--kt", "600 MPa", "--kn", "200 MPa"]
+    status, out, err = run(capsys, "lobes", "--frf", path, *cut, "--method", "sdm", "--speeds", "3000:3100:100",
+                           "--json")
+    assert status == 0, err
+    modes = tmp_path / "modes.csv"
+    ModalModel([Mode(d, "922 Hz", 0.011, Q_(k, "N/m")) for d in "xy"]).to_csv(modes)
+    _, direct, _ = run(capsys, "lobes", "--modes", modes, *cut, "--method", "sdm", "--speeds", "3000:3100:100",
+                       "--json")
+    np.testing.assert_allclose(json.loads(out)["depth_limit_m"], json.loads(direct)["depth_limit_m"], rtol=0.01)
+    status, out, err = run(capsys, "lobes", "--frf", path, *cut, "--method", "sdm", "--speeds", "3000:3100:100",
+                           "--band", "300:800")
+    assert status == 1 and "never negative from 300 to 800 Hz: the band holds no resonance" in err

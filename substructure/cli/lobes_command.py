@@ -110,19 +110,21 @@ def _lobes_structure(args: argparse.Namespace):
     return (frf if window is None else window.frf), f"{what}, {grid_text(frf.frequency)}", band, tool, window
 
 
-def _zoa_noted(structure, cut, speeds, band, notes: list[str]):
-    """``zoa`` of the structure; its warning that the absolute limit sits on an edge of the band is also a note."""
+def _zoa_noted(structure, cut, speeds, band, notes: list[str], lobes: bool = True):
+    """``zoa`` of the structure (or, without ``lobes``, only its checks of the band: ``check_band``); its warning
+    that the absolute limit sits on an edge of the band is also a note."""
     from ..stability import StabilityWarning, zoa
-    from ..stability.zoa import EDGE_WARNING
+    from ..stability.zoa import EDGE_WARNING, check_band
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        lobes = zoa(structure, cut, speeds, band=band if band is not None else "auto")
+        band = band if band is not None else "auto"
+        result = zoa(structure, cut, speeds, band=band) if lobes else check_band(structure, cut, band)
     for item in caught:
         if issubclass(item.category, StabilityWarning) and str(item.message).startswith(EDGE_WARNING.split("{")[0]):
             notes.append(f"warning: {item.message}")
         warnings.warn_explicit(item.message, item.category, item.filename, item.lineno)
-    return lobes
+    return result
 
 
 def run(args: argparse.Namespace) -> int:
@@ -162,7 +164,7 @@ def run(args: argparse.Namespace) -> int:
         method = "zero-order approximation (Altintas & Budak 1995)"
     else:
         if isinstance(structure, FRF):  # semi-discretization needs modes: fit them to x and y (without the window)
-            _zoa_noted(structure, cut, args.speeds[:1], band, notes)  # the band's resonance: as for zoa
+            _zoa_noted(structure, cut, args.speeds, band, notes, lobes=False)  # the band's resonance: as for zoa
             fits = [ModalFitter().fit(FRF.single(structure.frequency, structure.data[:, i, i], output=d, input=d), d)
                     for i, d in enumerate("xy")]
             structure = ModalModel([m for fit in fits for m in fit.modes_])

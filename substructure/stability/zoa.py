@@ -37,7 +37,7 @@ from .speeds import as_speed_rpm
 from .result import Lobes, StabilityWarning
 from .structure import xy_receptance
 
-__all__ = ["zoa", "zoa_eigenvalues", "MAX_LOBE_POINTS", "graded_frequency", "GRADED_STEPS"]
+__all__ = ["zoa", "zoa_eigenvalues", "MAX_LOBE_POINTS", "graded_frequency", "GRADED_STEPS", "check_band"]
 
 MAX_LOBE_POINTS = 5_000_000
 """Most points (FRF lines x lobes x 2 branches) the zero order builds, about 40 MB per array."""
@@ -224,6 +224,54 @@ def _lines(structure: Any, frequency: Frequency | None, k0: np.ndarray, teeth: i
     return f, lam, valid, a, theta, k_max
 
 
+def _absolute(structure: Any, used: Any, k0: np.ndarray, f: np.ndarray, a: np.ndarray,
+              valid: np.ndarray) -> tuple[float, float] | None:
+    """The absolute limit and its frequency (None: no line gives a lobe); for FRF data the band's checks."""
+    if not valid.any() and isinstance(structure, FRF):
+        raise InvalidValueError(
+            f"zoa: the oriented FRF's real part is never negative from {f[0]:g} to {f[-1]:g} Hz: the band holds no "
+            "resonance of the tool point (no limit can be found there, which is not a cut free of chatter); give "
+            "the FRF around the tool's modes (band=(lo, hi); --band LO:HI on the command line)")
+    if not valid.any():
+        return None
+    i, branch = np.unravel_index(np.argmin(a, axis=None), a.shape)
+    if not isinstance(structure, FRF):
+        return _refine_model(structure, k0, f, i, branch)
+    if i in (0, f.size - 1) and not (i == 0 and used is not None and used.excluded_hz is not None
+                                     and used.kind != "user"):
+        warnings.warn(EDGE_WARNING.format(edge="first" if i == 0 else "last", hz=f[i]), StabilityWarning,
+                      stacklevel=3)
+    return _refine_data(f, a[:, branch], i)
+
+
+def check_band(structure: Any, cut: Any, band: Any = "auto") -> None:
+    """The checks :func:`zoa` makes of FRF data in the band, without its lobes (which grow as the speeds fall).
+
+    Parameters
+    ----------
+    structure : FRF or ModalModel
+        As for :func:`zoa`.
+    cut : MillingCut or TurningCut
+        The cut (its mean force matrix orients the FRF).
+    band : "auto", "all", (lo_hz, hi_hz) or FlexibleBand, default "auto"
+        As for :func:`zoa`.
+
+    Raises
+    ------
+    InvalidValueError
+        For FRF data whose oriented real part is never negative in the band (no resonance in it).
+
+    Warns
+    -----
+    StabilityWarning
+        When the absolute limit lies at the first or last line of FRF data (:data:`EDGE_WARNING`).
+    """
+    structure, used = choose_band(structure, band)
+    k0 = cut.mean_force_matrix()
+    f, _, valid, a, _, _ = _lines(structure, None, k0, cut.regenerations_per_revolution, np.inf)
+    _absolute(structure, used, k0, f, a, valid)
+
+
 def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = None,
         label: str | None = None, band: Any = "auto") -> Lobes:
     """Stability lobes by the zero-order approximation.
@@ -299,25 +347,11 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
         raise InvalidValueError(
             f"zoa: {what} x {k_max + 1} lobes x 2 = {points:.3g} lobe points down to {speeds_rpm[0]:g} rpm, more "
             f"than the limit MAX_LOBE_POINTS = {MAX_LOBE_POINTS:.3g} (about 40 MB per array); {change}")
-    if not valid.any() and isinstance(structure, FRF):
-        raise InvalidValueError(
-            f"zoa: the oriented FRF's real part is never negative from {f[0]:g} to {f[-1]:g} Hz: the band holds no "
-            "resonance of the tool point (no limit can be found there, which is not a cut free of chatter); give "
-            "the FRF around the tool's modes (band=(lo, hi); --band LO:HI on the command line)")
-    if not valid.any():
+    absolute = _absolute(structure, used, k0, f, a, valid)
+    if absolute is None:
         return Lobes("zoa", speeds_rpm, np.full(speeds_rpm.size, np.inf), np.full(speeds_rpm.size, np.nan),
                      cut=cut, absolute_limit_m=float("inf"), label=label, band=used)
-    # absolute limit
-    flat = np.argmin(a, axis=None)
-    i, branch = np.unravel_index(flat, a.shape)
-    if isinstance(structure, FRF):
-        a_abs, f_abs = _refine_data(f, a[:, branch], i)
-        if i in (0, f.size - 1) and not (i == 0 and used is not None and used.excluded_hz is not None
-                                         and used.kind != "user"):
-            warnings.warn(EDGE_WARNING.format(edge="first" if i == 0 else "last", hz=f[i]), StabilityWarning,
-                          stacklevel=2)
-    else:
-        a_abs, f_abs = _refine_model(structure, k0, f, i, branch)
+    a_abs, f_abs = absolute
     k = np.arange(k_max + 1)
     phase = theta.T[:, None, :] / (2.0 * np.pi) + k[None, :, None]  # (2, K, m)
     with np.errstate(divide="ignore"):
