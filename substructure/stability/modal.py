@@ -241,8 +241,9 @@ class ModalModel:
                 if column is None:  # not one field's value: said as it is
                     raise FileFormatError(f"{name}, line {line}: {exc}") from None
                 header = _COLUMNS[column - 1]
+                unit = ": a wrong unit?" if rest.endswith("a wrong unit?") else ""  # positive, out of range
                 raise FileFormatError(f"{name}, line {line}, column {column} ({header}): got {row[column - 1]!r}; "
-                                      f"expected {_EXPECTED[header]}") from None
+                                      f"expected {_EXPECTED[header]}{unit}") from None
             key = (mode.direction, f)
             if key in seen:
                 first, others = seen[key]
