@@ -192,10 +192,13 @@ def test_the_noise_estimate_refuses_an_overflowing_frf_from_python():
 
 
 @pytest.mark.parametrize("row, message", [
-    ("y,1e-300,0.02,1e7", "line 2: frequency: got 1e-300 Hz; expected 0.1 to 1e+06 Hz"),
-    ("y,2e6,0.02,1e7", "line 2: frequency: got 2e+06 Hz; expected 0.1 to 1e+06 Hz"),
-    ("y,900,0.02,1e-300", "line 2: stiffness: got 1e-300 N/m; expected 1 to 1e+12 N/m"),
-    ("y,900,0.02,1e300", "line 2: stiffness: got 1e+300 N/m; expected 1 to 1e+12 N/m"),
+    ("y,1e-300,0.02,1e7", "line 2, column 2 (frequency_hz): got '1e-300'; expected a natural frequency in Hz, 0.1 to "
+                          "1e+06 (MODE_FREQUENCY_RANGE_HZ): a wrong unit?"),
+    ("y,2e6,0.02,1e7", "line 2, column 2 (frequency_hz): got '2e6'; expected a natural frequency in Hz, 0.1 to 1e+06"),
+    ("y,900,0.02,1e-300", "line 2, column 4 (stiffness_n_per_m): got '1e-300'; expected a modal stiffness in N/m, 1 to "
+                          "1e+12 (MODE_STIFFNESS_RANGE_N_PER_M): a wrong unit?"),
+    ("y,900,0.02,1e300", "line 2, column 4 (stiffness_n_per_m): got '1e300'; expected a modal stiffness in N/m, "
+                         "1 to 1e+12"),
 ])
 @pytest.mark.parametrize("method", ["zoa", "sdm"])
 def test_a_mode_outside_the_physical_range_is_refused_with_file_and_line(tmp_path, capsys, row, message, method):

@@ -168,7 +168,8 @@ def test_turning(capsys, modes_file):
     (["--speeds", "50 Hz:300 Hz:1 Hz"], 2, "rpm"),
     (["--speeds", "1000:2000:50:5"], 2, "START:STOP:STEP"),  # START:STOP alone has a default step
     (["--diameter", "12"], 1, "diameter"),
-    (["--kr", "100 MPa"], 2, "--kr"),
+    (["--kr", "100 MPa"], 2, "--kr: got '100 MPa'; expected the ratio Kn/Kt, a plain number such as 0.3 (a "
+                              "pressure such as '100 MPa' is the normal coefficient itself: give it with --kn)"),
 ])
 def test_bad_cut_or_speeds_are_clear_errors(capsys, frf_files, argv, status, message):
     args = dict(zip(THESIS_CUT[::2], THESIS_CUT[1::2]))
@@ -308,3 +309,110 @@ def test_the_summary_says_the_order_of_the_eigenvalue_problems_and_how_they_were
     line = next(x for x in out.splitlines() if x.startswith("discretisation: "))
     assert line.startswith("discretisation: 450 intervals in the cut per delay period (monodromy matrices of order "
                            "452, the largest multipliers by Arnoldi iterations from order 400)")
+
+
+def test_a_fixed_interval_count_too_coarse_for_the_modes_is_refused_naming_the_least(capsys, modes_file):
+    argv = ["lobes", "--modes", modes_file, *BENCH_CUT, "--method", "sdm", "--speeds", "15000:16000:500", "--quiet"]
+    phase = 2 * np.pi * 922 * 60.0 / (2 * 15000)  # the slot: the tooth cuts through the whole delay period
+    for count in ("1", "2", "25"):
+        code, out, err = run(capsys, *argv, "--intervals", count)
+        assert code == 1 and out == ""
+        assert f"--intervals: got {count}; at 15000 rpm one interval spans a phase step of " \
+               f"{phase / int(count):.3g} rad" in err and "at least 26 intervals" in err
+    code, out, err = run(capsys, *argv, "--intervals", "26")
+    assert code == 0, err
+    assert "discretisation: 26 intervals in the cut" in out
+
+
+def test_a_driving_point_frf_with_the_wrong_sign_of_its_imaginary_part_is_refused(capsys, frf_files, tmp_path):
+    x = frf_files[2]
+    rng = np.random.default_rng(7)
+    h = x.data[:, 0, 0]
+    noisy = h + 0.05 * np.abs(h) * (rng.standard_normal(h.size) + 1j * rng.standard_normal(h.size))
+    flipped = np.imag(noisy) > 0
+    assert flipped.any()  # measured noise flips a few lines near the antiresonances: accepted
+    cases = {"noisy": (noisy, None), "negated": (-h, "100% of the lines"), "conjugated": (np.conj(h), "100%")}
+    for name, (data, refused) in cases.items():
+        path = tmp_path / f"{name}.csv"
+        FRF.single(x.frequency, data, output="tool.tip:y", input="tool.tip:y").to_csv(path)
+        code, out, err = run(capsys, "lobes", "--frf", path, *THESIS_CUT, "--speeds", "5000:6000:500")
+        if refused is None:
+            assert code == 0, err
+        else:
+            assert code == 1 and out == ""
+            assert f"{path}: Im(H) > 0 on {refused}" in err and "sign" in err and "conjugate" in err
+    code, _, err = run(capsys, "lobes", "--frf", frf_files[0], "--frf-y", tmp_path / "negated.csv", *THESIS_CUT)
+    assert code == 1 and "negated.csv: Im(H) > 0" in err
+
+
+def test_a_band_that_misses_the_resonance_is_said(capsys, modes_file, tmp_path):
+    f = np.arange(10.0, 2000.0, 0.5)
+    k = 0.03993 * (2 * np.pi * 922) ** 2
+    h = 1.0 / (k * (1 - (f / 922) ** 2 + 2j * 0.011 * f / 922))
+    path = tmp_path / "one.csv"
+    FRF.single(Frequency(f), h, output="t:y", input="t:y").to_csv(path)
+    argv = ["lobes", "--frf", path, *BENCH_CUT, "--speeds", "15000:16000:500"]
+    for method in ("zoa", "sdm"):
+        code, out, err = run(capsys, *argv, "--band", "10:300", "--method", method, "--quiet")
+        assert code == 1 and out == "" and "never negative from 10 to 300 Hz: the band holds no resonance" in err
+    code, out, err = run(capsys, *argv, "--band", "1000:1001")
+    assert code == 0 and "first line of the band (1000 Hz)" in err
+    assert "\nwarning: zoa: the oriented FRF's most negative real part, the absolute limit, is at the first line" in out
+    code, out, _ = run(capsys, *argv, "--band", "1000:1001", "--json")
+    assert any(n.startswith("warning: zoa:") and "1000 Hz" in n for n in json.loads(out)["notes"])
+
+
+def test_options_that_would_be_unused_are_refused(capsys, modes_file, tmp_path):
+    turning = ["lobes", "--modes", modes_file, "--turning", "--kf", "2000 MPa", "--speeds", "15000:16000:500"]
+    for extra in (["--max-speed", "20000"], ["--margin", "0.3"], ["--power", "5 kW"], ["--max-depth", "2 mm"]):
+        code, out, err = run(capsys, *turning, *extra)
+        assert code == 2 and out == "" and f"--turning: {extra[0]} sets the machinist's recommendation" in err
+    milling = ["lobes", "--modes", modes_file, *BENCH_CUT, "--speeds", "15000:16000:500"]
+    for extra in (["--cutting-data", tmp_path / "missing.toml"], ["--tool-material", "hss"]):
+        code, out, err = run(capsys, *milling, *extra)
+        assert code == 2 and out == "" and f"{extra[0]} goes with --workpiece NAME" in err
+
+
+def test_a_normal_coefficient_given_with_a_workpiece_is_said_to_override_the_table(capsys, modes_file):
+    code, out, err = run(capsys, "lobes", "--modes", modes_file, "--teeth", "2", "--diameter", "12 mm",
+                         "--immersion", "1", "--workpiece", "aluminium-7075", "--kr", "0.5", "--speeds",
+                         "15000:16000:500")
+    assert code == 0, err
+    assert "workpiece: --kr 0.5 overrides the table's normal coefficient" in out
+    assert "Kn = 383.5 MPa (Kn/Kt = 0.5)" in out  # 0.5 x the table's Kt of 767.01 MPa
+
+
+def test_low_speed_turning_from_modes_is_within_the_cap_and_meets_the_closed_form(capsys, modes_file):
+    status, out, err = run(capsys, "lobes", "--modes", modes_file, "--turning", "--kf", "2000MPa", "--speeds",
+                           "500:3000:10", "--json")
+    assert status == 0, err
+    k = 0.03993 * (2 * np.pi * 922) ** 2
+    closed = 2 * k * 0.011 * 1.011 / 2e9  # b_lim = -1 / (2 Kf min Re G)
+    depth = np.array(json.loads(out)["depth_limit_m"])
+    assert depth.size == 251 and depth.min() == pytest.approx(closed, rel=2e-4) and depth.min() >= closed
+    status, out, err = run(capsys, "lobes", "--modes", modes_file, "--turning", "--kf", "2000MPa", "--speeds",
+                           "20:3000:10")
+    assert status == 1 and out == "" and "raise the lowest spindle speed to 37.59 rpm or more (--speeds" in err
+    assert "crop the FRF" not in err
+
+
+def test_semi_discretization_of_a_fine_frf_checks_its_band_without_building_zero_order_lobes(capsys, tmp_path):
+    """136,000 lines x 21 lobes x 2 at 3000 rpm exceed MAX_LOBE_POINTS: the zero order's lobes are not needed by
+    sdm, only its checks of the band; the limit meets sdm on the modes themselves."""
+    k = 0.03993 * (2 * np.pi * 922) ** 2
+    f = np.arange(300.0, 2000.0, 0.0125)
+    h = 1.0 / (k * (1 - (f / 922) ** 2 + 2j * 0.011 * f / 922))
+    path = tmp_path / "fine.csv"
+    FRF.single(Frequency(f), h, output="t:y", input="t:y").to_csv(path)
+    cut = ["--teeth", "2", "--diameter", "10 mm", "--immersion", "0.5", "--kt", "600 MPa", "--kn", "200 MPa"]
+    status, out, err = run(capsys, "lobes", "--frf", path, *cut, "--method", "sdm", "--speeds", "3000:3100:100",
+                           "--json")
+    assert status == 0, err
+    modes = tmp_path / "modes.csv"
+    ModalModel([Mode(d, "922 Hz", 0.011, Q_(k, "N/m")) for d in "xy"]).to_csv(modes)
+    _, direct, _ = run(capsys, "lobes", "--modes", modes, *cut, "--method", "sdm", "--speeds", "3000:3100:100",
+                       "--json")
+    np.testing.assert_allclose(json.loads(out)["depth_limit_m"], json.loads(direct)["depth_limit_m"], rtol=0.01)
+    status, out, err = run(capsys, "lobes", "--frf", path, *cut, "--method", "sdm", "--speeds", "3000:3100:100",
+                           "--band", "300:800")
+    assert status == 1 and "never negative from 300 to 800 Hz: the band holds no resonance" in err

@@ -56,13 +56,52 @@ def test_csv_round_trip_and_errors(tmp_path):
     with pytest.raises(FileFormatError, match="bad.csv, line 3.*direction"):
         ModalModel.from_csv(bad)
     bad.write_text(MODES_CSV_HEADER + "\nx,900,abc,1e7\n")
-    with pytest.raises(FileFormatError, match="line 2.*numbers"):
+    with pytest.raises(FileFormatError, match=r"line 2, column 3 \(damping_ratio\): cannot read 'abc' as a number"):
         ModalModel.from_csv(bad)
     bad.write_text("direction,frequency,zeta,k\nx,900,0.02,1e7\n")
     with pytest.raises(FileFormatError, match="header"):
         ModalModel.from_csv(bad)
     with pytest.raises(FileFormatError, match="no such file"):
         ModalModel.from_csv(tmp_path / "missing.csv")
+
+
+@pytest.mark.parametrize("row, column, message", [
+    ("x,922,0.011,-1.34e6", "column 4 (stiffness_n_per_m): got '-1.34e6'", "a modal stiffness in N/m, 1 to 1e+12"),
+    ("x,922,0.011,0", "column 4 (stiffness_n_per_m): got '0'", "a modal stiffness in N/m"),
+    ("x,922,0.011,inf", "column 4 (stiffness_n_per_m): got 'inf'", "a modal stiffness in N/m"),
+    ("x,0,0.011,1.34e6", "column 2 (frequency_hz): got '0'", "a natural frequency in Hz, 0.1 to 1e+06"),
+    ("x,922,nan,1.34e6", "column 3 (damping_ratio): got 'nan'", "a damping ratio 0 < zeta < 1"),
+    ("x,922,1.1%,1.34e6", "column 3 (damping_ratio): cannot read '1.1%' as a number", "not 1.1%"),
+    ("X,922,0.011,1.34e6", "column 1 (direction): got 'X'", "'x' (feed) or 'y' (normal)"),
+])
+def test_a_bad_cell_is_named_by_line_and_column_as_written(tmp_path, row, column, message):
+    bad = tmp_path / "bad.csv"
+    bad.write_text(f"{MODES_CSV_HEADER}\ny,900,0.02,1e7\n{row}\n")
+    with pytest.raises(FileFormatError) as info:
+        ModalModel.from_csv(bad)
+    text = str(info.value)
+    assert text.startswith(f"{bad}, line 3, {column}; expected ") and message in text
+    assert "Quantity" not in text and "<Q" not in text
+
+
+def test_a_mode_listed_twice_is_refused_naming_both_lines(tmp_path):
+    bad = tmp_path / "dup.csv"
+    bad.write_text(f"{MODES_CSV_HEADER}\nx,922,0.011,1.34e6\ny,922,0.011,1.34e6\n\nx,922,0.011,1.34e6\n")
+    with pytest.raises(FileFormatError, match=r"dup.csv, line 5 \(x, 922 Hz\) repeats line 2: one mode listed "
+                                              r"twice would be counted twice \(the depth limit halved\)"):
+        ModalModel.from_csv(bad)
+    bad.write_text(f"{MODES_CSV_HEADER}\nx,922,0.011,1.34e6\nx,922.0,0.02,3e6\n")
+    with pytest.raises(FileFormatError, match=r"line 3 \(x, 922.0 Hz\) has the direction and natural frequency of "
+                                              r"line 2: two modes at exactly one frequency in one direction are one"):
+        ModalModel.from_csv(bad)
+    bad.write_text(f"{MODES_CSV_HEADER}\nx,922,0.011,1.34e6\ny,922,0.011,1.34e6\nx,922.5,0.011,1.34e6\n")
+    assert len(ModalModel.from_csv(bad).modes) == 3  # the same mode in x and y, and a close one: three modes
+
+
+def test_a_mode_given_as_quantities_is_refused_in_plain_words():
+    with pytest.raises(InvalidValueError) as info:
+        Mode("x", "922 Hz", 0.011, Q_(-1.34e6, "N/m"))
+    assert "<Quantity" not in str(info.value) and "-1.34e+06" in str(info.value)
 
 
 def noisy_frf(noise=0.01, seed=1) -> FRF:

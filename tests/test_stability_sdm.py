@@ -236,3 +236,21 @@ def test_where_arnoldi_does_not_converge_all_eigenvalues_answer(monkeypatch):
     u[0, 0, 5] = np.nan
     with pytest.raises(np.linalg.LinAlgError, match="infs or NaNs"):
         semidiscrete._largest(u)
+
+
+def test_a_fixed_count_too_coarse_for_the_mode_is_refused_and_the_least_one_is_within_its_bound():
+    cut = benchmark_cut(1.0)  # the slot: the tooth cuts the whole delay period of 60 / (2 n) s
+    speeds = Q_([15000.0, 15500.0, 16000.0], "rpm")
+    phase = 2 * np.pi * FN * 60.0 / (2 * 15000.0)  # of the mode over the cut at the lowest speed
+    least = int(np.ceil(phase / np.sqrt(sdm_module.FIXED_INTERVALS_ERROR / sdm_module.ERROR_COEFFICIENT)))
+    assert least == 26
+    for coarse in (1, 2, 5, least - 1):
+        with pytest.raises(InvalidValueError, match=rf"^intervals: got {coarse}; .*phase step of "
+                                                    rf"{phase / coarse:.3g} rad.* at least {least} intervals"):
+            sdm(MODEL, cut, speeds, intervals=coarse)
+    fine = sdm(MODEL, cut, speeds, max_phase_step=0.05, rtol=0.001).depth_limit_m
+    at_least = sdm(MODEL, cut, speeds, intervals=least, rtol=0.001)
+    assert at_least.discretisation["intervals_in_cut"] == [least, least]
+    error = np.abs(at_least.depth_limit_m / fine - 1)
+    assert np.all(error < sdm_module.FIXED_INTERVALS_ERROR)
+    assert np.all(error > 0.1 * sdm_module.FIXED_INTERVALS_ERROR)  # the count is not needlessly fine

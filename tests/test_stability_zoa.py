@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 import warnings
 
 import numpy as np
@@ -211,3 +212,46 @@ def test_no_chatter_possible_gives_no_limit():
     lobes = zoa(model, TurningCut("2000 MPa"), SPEEDS)
     assert np.all(np.isinf(lobes.depth_limit_m)) and lobes.absolute_limit_m == np.inf
     assert lobes.to_json()["absolute_limit_m"] is None
+
+
+def test_a_band_without_the_resonance_is_an_error_and_a_minimum_on_its_edge_a_warning():
+    f = np.arange(10.0, 2000.0, 0.25)
+    r = f / FN
+    frf = FRF.single(Frequency(f), 1.0 / (K * (1 - r ** 2 + 2j * ZETA * r)), output="t:y", input="t:y")
+    cut = benchmark_cut(1.0)
+    modes = ModalModel([Mode(d, Q_(FN, "Hz"), ZETA, Q_(K, "N/m")) for d in "xy"])  # y = x, as one FRF means
+    closed = zoa(modes, cut, SPEEDS).absolute_limit_m
+    with pytest.raises(InvalidValueError, match=r"never negative from 10 to 300 Hz: the band holds no resonance"):
+        zoa(frf, cut, SPEEDS, band=(10.0, 300.0))  # Re H > 0 below the mode
+    with pytest.warns(StabilityWarning, match=r"at the first line of the band \(1000 Hz\): the minimum may lie "):
+        edge = zoa(frf, cut, SPEEDS, band=(1000.0, 1001.0))
+    assert edge.absolute_limit_m > 2 * closed  # far too deep: why it is said
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        whole = zoa(frf, cut, SPEEDS, band=(500.0, 1500.0))
+    assert whole.absolute_limit_m == pytest.approx(closed, rel=1e-3)
+
+
+def test_low_speed_turning_from_modes_takes_a_graded_grid_within_the_cap(monkeypatch):
+    """The default grid (a relative step of zeta / 50 from 0.3 to 3 f_n) times the lobes below 700 rpm exceeds
+    MAX_LOBE_POINTS: the lines are graded around the mode instead, against the closed form and the default grid."""
+    cut = TurningCut("2000 MPa")
+    closed = 2 * K * ZETA * (1 + ZETA) / 2e9  # -1 / (2 Kf min Re G), min Re G = -1 / (4 k zeta (1 + zeta))
+    low = zoa(benchmark_model(), cut, spindle_speeds("500 rpm", "3000 rpm", "10 rpm"))
+    assert low.absolute_limit_m == pytest.approx(closed, rel=1e-9)
+    assert low.depth_limit_m.min() == pytest.approx(closed, rel=2e-4)  # dense lobes reach down to it
+    assert np.all(low.depth_limit_m >= closed * (1 - 1e-9))
+    speeds = spindle_speeds("1000 rpm", "3000 rpm", "10 rpm")  # the default grid fits: 3.5e6 points
+    default = zoa(benchmark_model(), cut, speeds)
+    module = sys.modules[zoa.__module__]
+    monkeypatch.setattr(module, "MAX_LOBE_POINTS", 1_000_000)
+    graded = zoa(benchmark_model(), cut, speeds)
+    np.testing.assert_allclose(graded.depth_limit_m, default.depth_limit_m, rtol=5e-4)
+    np.testing.assert_allclose(graded.chatter_frequency_hz, default.chatter_frequency_hz, rtol=1e-5)
+    with pytest.raises(InvalidValueError, match=r"lines graded around the modes x \d+ lobes x 2 = .* down to 100 rpm, "
+                                                r"more than the limit MAX_LOBE_POINTS = 1e\+06 .*; raise the lowest "
+                                                r"spindle speed to ([0-9.]+) rpm or more") as info:
+        zoa(benchmark_model(), cut, spindle_speeds("100 rpm", "3000 rpm", "10 rpm"))
+    lowest = float(str(info.value).split("spindle speed to ")[1].split(" rpm")[0])
+    assert zoa(benchmark_model(), cut, Q_([np.ceil(lowest), 3000.0], "rpm")).absolute_limit_m == \
+        pytest.approx(closed, rel=1e-9)

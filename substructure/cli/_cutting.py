@@ -104,6 +104,16 @@ def speed_arg(text: str) -> str:
     return text
 
 
+def kr_arg(text: str) -> float:
+    """``--kr``: the ratio Kn/Kt, a plain number; a pressure is refused with the hint that it belongs in ``--kn``."""
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"got {text!r}; expected the ratio Kn/Kt, a plain number such as 0.3 (a pressure such as '100 MPa' "
+            "is the normal coefficient itself: give it with --kn)") from None
+
+
 def add_cut_options(parser: argparse.ArgumentParser) -> None:
     """Add the groups "milling cut", "machine and recommendation" and "turning" to a command's parser."""
     cutting = parser.add_argument_group("milling cut")
@@ -117,7 +127,7 @@ def add_cut_options(parser: argparse.ArgumentParser) -> None:
                          help="down (= climb) or up (= conventional) milling; default up, said in every output")
     cutting.add_argument("--kt", metavar="PRESSURE", help="tangential cutting coefficient, e.g. '625 MPa'")
     cutting.add_argument("--kn", metavar="PRESSURE", help="normal (radial) cutting coefficient, e.g. '100 MPa'")
-    cutting.add_argument("--kr", type=float, metavar="RATIO", help="or the ratio Kn/Kt, e.g. 0.16")
+    cutting.add_argument("--kr", type=kr_arg, metavar="RATIO", help="or the ratio Kn/Kt, e.g. 0.16")
     cutting.add_argument("--workpiece", metavar="NAME",
                          help="cutting coefficients from the table, e.g. aluminium-7075, steel-1045 (instead of --kt)")
     cutting.add_argument("--workpiece-table", metavar="FILE.toml", help="your own table of workpieces, searched first")
@@ -201,6 +211,13 @@ def cut_from_args(args: argparse.Namespace, tool: Any, notes: list[str]):
         given = [name for name, value in milling_only.items() if value is not None]
         if given:
             raise UsageError(f"--turning takes --kf [--orientation U]; {', '.join(given)} describe a milling cut")
+        unused = machine_given(args) + [name for name, value, default in (
+            ("--margin", getattr(args, "margin", 0.2), 0.2),
+            ("--speed-tolerance", getattr(args, "speed_tolerance", 0.03), 0.03)) if value != default]
+        if unused:
+            verb = "sets" if len(unused) == 1 else "set"
+            raise UsageError(f"--turning: {', '.join(unused)} {verb} the machinist's recommendation, which is for "
+                             "milling cuts (a turning cut gets the lobes only): leave them out")
         if args.kf is None:
             raise UsageError("--turning needs --kf PRESSURE (the cutting pressure, e.g. '2000 MPa')")
         return TurningCut(args.kf, args.orientation if args.orientation is not None else 1.0)
@@ -235,14 +252,22 @@ def cut_from_args(args: argparse.Namespace, tool: Any, notes: list[str]):
         raise UsageError("give --radial-depth or --immersion, not both")
     if args.kn is not None and args.kr is not None:
         raise UsageError("give --kn (a pressure) or --kr (the ratio Kn/Kt), not both")
-    if args.workpiece_table is not None and args.workpiece is None:
-        raise UsageError("--workpiece-table goes with --workpiece NAME")
+    for name, value in (("--workpiece-table", args.workpiece_table),
+                        ("--cutting-data", getattr(args, "cutting_data", None)),
+                        ("--tool-material", getattr(args, "tool_material", None))):
+        if value is not None and args.workpiece is None:
+            raise UsageError(f"{name} goes with --workpiece NAME" + ("" if name == "--workpiece-table" else
+                             " (the cutting-speed and feed check is of a workpiece from the table)"))
     milling = milling_of(args, notes)
     if args.workpiece is not None:
         if args.kt is not None:
             raise UsageError("give --workpiece NAME or --kt, not both (the table gives Kt)")
         entry = workpiece(args.workpiece, args.workpiece_table)
         notes.append(f"workpiece: {entry.describe()}")
+        for name, value in (("--kn", args.kn), ("--kr", args.kr)):
+            if value is not None:
+                notes.append(f"workpiece: {name} {value} overrides the table's normal coefficient: the cut's Kn "
+                             "(the cut: line) is from it")
         feed = args.feed_per_tooth
         if feed is None:
             data = cutting_data_of(args, entry, tool, notes)

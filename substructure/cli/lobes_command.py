@@ -40,6 +40,23 @@ def _window(args: argparse.Namespace) -> dict | None:
     return taus if any(t is not None for t in taus.values()) else None
 
 
+def _check_sign(path, frf) -> None:
+    """Refuse a driving-point receptance whose imaginary part is positive where most of ``|Im H|`` lies."""
+    import numpy as np
+
+    from ..frf import REVERSED_SHARE, reversed_share
+
+    h = frf.data[:, 0, 0]
+    share = reversed_share(h)
+    if share > REVERSED_SHARE:
+        lines = float(np.mean(np.imag(h[np.isfinite(h)]) > 0))
+        raise SubstructureError(
+            f"{path}: Im(H) > 0 on {lines:.0%} of the lines, holding {share:.0%} of |Im H| (a tool point's "
+            "receptance has Im(H) <= 0, but for noise near its antiresonances): its sign is reversed (a channel's "
+            "polarity: negate the data) or the data follow the other convention, exp(-i omega t) (take their "
+            "conjugate); as they are, the lobes would be many times too deep")
+
+
 def _lobes_structure(args: argparse.Namespace):
     """The structure, a line describing it, the band chosen, the tool and the window removed (or None)."""
     from ..frf import FRF
@@ -81,6 +98,9 @@ def _lobes_structure(args: argparse.Namespace):
             warnings.simplefilter("ignore", WindowedFRFWarning)
             x = FRF.from_csv(args.frf)
             y = FRF.from_csv(args.frf_y) if args.frf_y else None
+        for path, one in ((args.frf, x), (args.frf_y, y)):
+            if one is not None:
+                _check_sign(path, one)
         frf = xy_frf(x, y)
         what = f"FRF from {args.frf}" + (f" (x) and {args.frf_y} (y)" if args.frf_y else ", y = x (a symmetric tool)")
     frf, band = choose_band(frf, band)
@@ -88,6 +108,23 @@ def _lobes_structure(args: argparse.Namespace):
     # fitted modes, or the lobes would promise depths the tool cannot take
     window = None if taus is None else window_removed(frf, taus)
     return (frf if window is None else window.frf), f"{what}, {grid_text(frf.frequency)}", band, tool, window
+
+
+def _zoa_noted(structure, cut, speeds, band, notes: list[str], lobes: bool = True):
+    """``zoa`` of the structure (or, without ``lobes``, only its checks of the band: ``check_band``); its warning
+    that the absolute limit sits on an edge of the band is also a note."""
+    from ..stability import StabilityWarning, zoa
+    from ..stability.zoa import EDGE_WARNING, check_band
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        band = band if band is not None else "auto"
+        result = zoa(structure, cut, speeds, band=band) if lobes else check_band(structure, cut, band)
+    for item in caught:
+        if issubclass(item.category, StabilityWarning) and str(item.message).startswith(EDGE_WARNING.split("{")[0]):
+            notes.append(f"warning: {item.message}")
+        warnings.warn_explicit(item.message, item.category, item.filename, item.lineno)
+    return result
 
 
 def run(args: argparse.Namespace) -> int:
@@ -102,7 +139,8 @@ def run(args: argparse.Namespace) -> int:
 
     from ..frf import FRF
     from ..stability import (MillingCut, ModalFitter, ModalFitWarning, ModalModel, NoRecommendationError, recommend,
-                             sdm, zoa)
+                             sdm)
+    from ..stability.sdm import check_intervals
 
     check_plot(args.plot)
     check_outputs([("--plot", args.plot)], [args.assembly, args.frf, args.frf_y, args.modes, args.workpiece_table,
@@ -122,10 +160,11 @@ def run(args: argparse.Namespace) -> int:
     cut = cut_from_args(args, tool, notes)
     limits = limits_from_args(args, tool, notes) if isinstance(cut, MillingCut) else None
     if args.method == "zoa":
-        lobes = zoa(structure, cut, args.speeds, band=band if band is not None else "auto")
+        lobes = _zoa_noted(structure, cut, args.speeds, band, notes)
         method = "zero-order approximation (Altintas & Budak 1995)"
     else:
         if isinstance(structure, FRF):  # semi-discretization needs modes: fit them to x and y (without the window)
+            _zoa_noted(structure, cut, args.speeds, band, notes, lobes=False)  # the band's resonance: as for zoa
             fits = [ModalFitter().fit(FRF.single(structure.frequency, structure.data[:, i, i], output=d, input=d), d)
                     for i, d in enumerate("xy")]
             structure = ModalModel([m for fit in fits for m in fit.modes_])
@@ -134,6 +173,7 @@ def run(args: argparse.Namespace) -> int:
             if max(fit.modal_error_ for fit in fits) > 0.2:
                 warnings.warn(f"the fitted modes miss the FRF by {errors}; choose the band with --band LO:HI",
                               ModalFitWarning, stacklevel=2)
+        check_intervals(structure, cut, args.speeds, args.intervals, name="--intervals")
         lobes = sdm(structure, cut, args.speeds, intervals=args.intervals, progress=progress)
         if band is not None:
             lobes = attrs.evolve(lobes, band=band)

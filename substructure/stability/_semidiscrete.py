@@ -221,6 +221,10 @@ class _Plan:
         self.teeth = cut.regenerations_per_revolution
         self._grids: dict[int, _Grid] = {}
 
+    def cut_phase(self, speed_rpm: np.ndarray) -> np.ndarray:
+        """``omega_ref * T_cut`` [rad]: the phase of the reference mode over the cutting part of a delay period."""
+        return 2 * np.pi * self.reference_hz * self.cut_fraction * 60.0 / (self.teeth * np.asarray(speed_rpm))
+
     def intervals_for(self, speed_rpm: np.ndarray) -> np.ndarray:
         if self.fixed is not None:
             return np.full(speed_rpm.size, int(self.fixed))

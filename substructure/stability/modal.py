@@ -30,7 +30,7 @@ import pint
 from .._files import decode_text, read_bytes
 from ..errors import FileFormatError, InvalidValueError, SubstructureWarning
 from ..frf import FRF, Frequency
-from ..units import Q_, dimensionless, quantity
+from ..units import Q_, dimensionless, quantity, show_value
 from .structure import XY_LABELS, _one_entry, xy_receptance
 
 __all__ = ["Mode", "ModalModel", "ModalFitter", "fit_modes", "MODES_CSV_HEADER", "MODE_FREQUENCY_RANGE_HZ",
@@ -58,6 +58,18 @@ MODE_STIFFNESS_RANGE_N_PER_M = (1.0, 1e12)
 FIT_DAMPING_RANGE = (1e-5, 0.5)
 
 
+_COLUMNS = MODES_CSV_HEADER.split(",")
+_FIELDS = {"direction": 1, "frequency": 2, "damping_ratio": 3, "stiffness": 4}  # Mode's field -> column
+_EXPECTED = {
+    "direction": "'x' (feed) or 'y' (normal)",
+    "frequency_hz": (f"a natural frequency in Hz, {MODE_FREQUENCY_RANGE_HZ[0]:g} to {MODE_FREQUENCY_RANGE_HZ[1]:g} "
+                     "(MODE_FREQUENCY_RANGE_HZ)"),
+    "damping_ratio": "a damping ratio 0 < zeta < 1, a plain number (0.011, not 1.1%)",
+    "stiffness_n_per_m": (f"a modal stiffness in N/m, {MODE_STIFFNESS_RANGE_N_PER_M[0]:g} to "
+                          f"{MODE_STIFFNESS_RANGE_N_PER_M[1]:g} (MODE_STIFFNESS_RANGE_N_PER_M)"),
+}
+
+
 class ModalFitWarning(SubstructureWarning):
     """A modal fit is poor, or leaves out part of the data (cross terms)."""
 
@@ -72,7 +84,7 @@ def _in_range(field: str, dimension: str, unit: str, limits: tuple[float, float]
     def convert(value: Any) -> pint.Quantity:
         q = quantity(value, field, dimension)
         if q.magnitude <= 0:
-            raise InvalidValueError(f"{field}: got {value!r}; expected a positive value")
+            raise InvalidValueError(f"{field}: got {show_value(value)}; expected a positive value")
         lo, hi = limits
         v = float(q.m_as(unit))
         if not lo <= v <= hi:
@@ -86,7 +98,7 @@ def _in_range(field: str, dimension: str, unit: str, limits: tuple[float, float]
 def _zeta(value: Any) -> float:
     z = dimensionless(value, "damping_ratio")
     if not 0.0 < z < 1.0:
-        raise InvalidValueError(f"damping_ratio: got {value!r}; expected 0 < zeta < 1 (an underdamped mode)")
+        raise InvalidValueError(f"damping_ratio: got {show_value(value)}; expected 0 < zeta < 1 (an underdamped mode)")
     return z
 
 
@@ -181,7 +193,10 @@ class ModalModel:
     def from_csv(cls, path: Any) -> ModalModel:
         """Read a file with the header ``direction,frequency_hz,damping_ratio,stiffness_n_per_m``.
 
-        Numbers are in Hz and N/m; errors name the file and the line.
+        Numbers are in Hz and N/m; errors name the file, the line and the column, the cell as written
+        and what was expected.  A row with the direction and natural frequency of an earlier one is
+        refused, naming both lines: the modes of a file are summed, and one mode listed twice would
+        halve the depth limit.
 
         Parameters
         ----------
@@ -206,17 +221,41 @@ class ModalModel:
         if ",".join(c.strip() for c in header) != MODES_CSV_HEADER:
             raise FileFormatError(f"{name}, line {line}: header {','.join(header)!r}; expected {MODES_CSV_HEADER!r}")
         modes = []
+        seen: dict[tuple[str, float], tuple[int, tuple[float, float]]] = {}
         for line, row in rows[1:]:
             if len(row) != 4:
                 raise FileFormatError(f"{name}, line {line}: expected 4 values ({MODES_CSV_HEADER}), got {len(row)}")
+            values = []
+            for column, (field, cell) in enumerate(zip(_COLUMNS[1:], row[1:]), start=2):
+                try:
+                    values.append(float(cell))
+                except ValueError:
+                    raise FileFormatError(f"{name}, line {line}, column {column} ({field}): cannot read {cell!r} as a "
+                                          f"number; expected {_EXPECTED[field]}") from None
+            f, z, k = values
             try:
-                f, z, k = (float(c) for c in row[1:])
-            except ValueError:
-                raise FileFormatError(f"{name}, line {line}: cannot read {row[1:]} as numbers") from None
-            try:
-                modes.append(Mode(row[0].strip(), Q_(f, "Hz"), z, Q_(k, "N/m")))
+                mode = Mode(row[0].strip(), Q_(f, "Hz"), z, Q_(k, "N/m"))
             except InvalidValueError as exc:
-                raise FileFormatError(f"{name}, line {line}: {exc}") from None
+                field, _, rest = str(exc).partition(": ")
+                column = _FIELDS.get(field)
+                if column is None:  # not one field's value: said as it is
+                    raise FileFormatError(f"{name}, line {line}: {exc}") from None
+                header = _COLUMNS[column - 1]
+                unit = ": a wrong unit?" if rest.endswith("a wrong unit?") else ""  # positive, out of range
+                raise FileFormatError(f"{name}, line {line}, column {column} ({header}): got {row[column - 1]!r}; "
+                                      f"expected {_EXPECTED[header]}{unit}") from None
+            key = (mode.direction, f)
+            if key in seen:
+                first, others = seen[key]
+                what = ("repeats line {first}: one mode listed twice would be counted twice (the depth limit "
+                        "halved); give it once" if others == (z, k) else
+                        "has the direction and natural frequency of line {first}: two modes at exactly one "
+                        "frequency in one direction are one mode; give it once, with its damping ratio and "
+                        "stiffness")
+                raise FileFormatError(f"{name}, line {line} ({mode.direction}, {row[1].strip()} Hz) "
+                                      + what.format(first=first)) from None
+            seen[key] = (line, (z, k))
+            modes.append(mode)
         if not modes:
             raise FileFormatError(f"{name}: no modes after the header")
         return cls(modes)

@@ -59,10 +59,26 @@ from .result import Lobes
 from .structure import xy_receptance
 from .zoa import zoa_eigenvalues
 
-__all__ = ["sdm", "spectral_radius", "expm_batch", "SCHEME", "MAX_INTERVALS"]
+__all__ = ["sdm", "spectral_radius", "expm_batch", "check_intervals", "SCHEME", "MAX_INTERVALS", "ERROR_COEFFICIENT",
+           "FIXED_INTERVALS_ERROR", "MAX_FIXED_PHASE_STEP"]
 
 MAX_INTERVALS = 2000
 """Most intervals per delay period: the monodromy matrix grows with them (``2 d + K p`` square)."""
+
+ERROR_COEFFICIENT = 0.15
+"""The first-order method's relative error on the limit is at most about ``ERROR_COEFFICIENT * step**2``.
+
+``step`` is the phase ``omega_ref * dt`` [rad] of one interval.  Measured
+against a fine run on one mode of 922 Hz (damping 0.011), two or three
+teeth: 0.05 at a/D = 0.25 (up milling), 0.08 at a/D = 0.5, 0.1 in the slot
+(down milling, the Insperger-Stepan benchmark); 0.15 is taken as the bound.
+"""
+
+FIXED_INTERVALS_ERROR = 0.03
+"""The largest error estimate (relative, on the limit) a fixed count of intervals may have at the lowest speed."""
+
+MAX_FIXED_PHASE_STEP = (FIXED_INTERVALS_ERROR / ERROR_COEFFICIENT) ** 0.5
+"""The largest phase step [rad] of an interval with a fixed count (about 0.447 rad: 3 % at 0.15 step^2)."""
 
 SCHEME = ("updated first-order semi-discretization (Insperger & Stepan 2004), "
           "grid aligned with tooth entry and exit, one step per free-vibration stretch")
@@ -83,6 +99,47 @@ def _check_intervals(intervals: Any) -> None:
             f"intervals: got {intervals}; the limit is MAX_INTERVALS = {MAX_INTERVALS} per delay period (the "
             "monodromy matrix and its memory grow with the square of the count); the default "
             "(intervals=None) chooses the count from the modes")
+
+
+def check_intervals(modes: ModalModel, cut: Any, speeds: Any, intervals: int | None, name: str = "intervals") -> None:
+    """Refuse a fixed count of intervals too coarse for the modes at the lowest speed.
+
+    Parameters
+    ----------
+    modes : ModalModel
+        Modal parameters (their reference frequency sets the phase step).
+    cut : MillingCut or TurningCut
+        The cut (the cutting part of the delay period).
+    speeds : pint.Quantity
+        Spindle speeds in rpm; the lowest has the longest intervals.
+    intervals : int or None
+        The count; None (chosen per speed) is always accepted.
+    name : str, default "intervals"
+        How the count is named in the message (``--intervals`` on the command line).
+
+    Raises
+    ------
+    InvalidValueError
+        When one interval spans more than :data:`MAX_FIXED_PHASE_STEP` of the
+        reference mode's phase (error estimate above
+        :data:`FIXED_INTERVALS_ERROR`); the message gives the least count.
+    """
+    if intervals is None:
+        return
+    model = _check_model(modes)
+    _check_intervals(intervals)
+    speeds_rpm = as_speed_rpm(speeds)
+    plan = _Plan(model, cut, intervals, 20, 0.2)
+    phase = float(plan.cut_phase(speeds_rpm.min()))
+    step = phase / intervals
+    if step > MAX_FIXED_PHASE_STEP:
+        least = int(np.ceil(phase / MAX_FIXED_PHASE_STEP))
+        raise InvalidValueError(
+            f"{name}: got {intervals}; at {speeds_rpm.min():g} rpm one interval spans a phase step of {step:.3g} rad "
+            f"of the {plan.reference_hz:.4g} Hz mode, an error of up to about {ERROR_COEFFICIENT:g} step^2 = "
+            f"{ERROR_COEFFICIENT * step ** 2:.1%} on the limit; at most {MAX_FIXED_PHASE_STEP:.3g} rad "
+            f"({FIXED_INTERVALS_ERROR:.0%}) is accepted: give at least {least} intervals, or leave the count out "
+            "to have it chosen per speed")
 
 
 def _depths_m(depths: Any) -> np.ndarray:
@@ -304,7 +361,10 @@ def sdm(modes: ModalModel, cut: Any, speeds: Any, *, intervals: int | None = Non
         Spindle speeds in rpm, strictly increasing.
     intervals : int, optional
         Intervals in the cutting part of the delay period, the same at every
-        speed.  Default: chosen per speed (see ``max_phase_step``).
+        speed.  Default: chosen per speed (see ``max_phase_step``).  A count
+        whose interval at the lowest speed spans more than
+        :data:`MAX_FIXED_PHASE_STEP` of the reference mode's phase is refused
+        (:func:`check_intervals`), naming the least count accepted.
     min_intervals : int, default 20
         Fewest intervals in the cut when they are chosen per speed.
     max_phase_step : float, default 0.2
@@ -312,7 +372,8 @@ def sdm(modes: ModalModel, cut: Any, speeds: Any, *, intervals: int | None = Non
         per speed (``omega_ref``: the highest natural frequency among the
         dominant modes).  The first-order method's error on the limit is
         about ``0.1 * max_phase_step**2`` (0.4 % at 0.2 rad on the
-        Insperger-Stepan benchmark).
+        Insperger-Stepan benchmark; at most about :data:`ERROR_COEFFICIENT`
+        times the square).
         The result reports the discretisation used (``Lobes.discretisation``).
     rtol : float, default 0.005
         Relative width of the final bracket of the boundary; the reported
@@ -346,7 +407,17 @@ def sdm(modes: ModalModel, cut: Any, speeds: Any, *, intervals: int | None = Non
         raise InvalidValueError(f"rtol: got {rtol!r}; expected a relative tolerance in (0, 0.5)")
     if not coarse_ratio > 1.0:
         raise InvalidValueError(f"coarse_ratio: got {coarse_ratio!r}; expected a ratio > 1")
-    _check_intervals(intervals)
+    check_intervals(model, cut, speeds, intervals)
+    return _sdm(model, cut, speeds_rpm, intervals=intervals, min_intervals=min_intervals,
+                max_phase_step=max_phase_step, rtol=rtol, depth_range=depth_range, coarse_ratio=coarse_ratio,
+                label=label, progress=progress)
+
+
+def _sdm(model: ModalModel, cut: Any, speeds_rpm: np.ndarray, *, intervals: int | None, min_intervals: int,
+         max_phase_step: float, rtol: float, depth_range: tuple[Any, Any] | None, coarse_ratio: float,
+         label: str | None, progress: Callable[[str], None] | None) -> Lobes:
+    """:func:`sdm` on checked arguments (a fixed count is not checked again: the recommendation's speed windows
+    reach a little below the speeds it was checked on)."""
     plan = _Plan(model, cut, intervals, min_intervals, max_phase_step)
     need = int(plan.intervals_for(speeds_rpm).max())
     if need > MAX_INTERVALS:
@@ -426,7 +497,8 @@ class _SdmSource:
             if self.progress:
                 self.progress(f"semi-discretization: a new run on {new.size} speeds, {new[0]:.6g} to "
                               f"{new[-1]:.6g} rpm")
-            result = sdm(self.model, self.cut, Q_(new, "rpm"), **self.settings)
+            result = _sdm(self.model, self.cut, as_speed_rpm(Q_(new, "rpm")), label=None, progress=None,
+                          **self.settings)
             self.known.update(zip(new.tolist(), zip(result.depth_limit_m.tolist(),
                                                     result.chatter_frequency_hz.tolist())))
         found = np.array([self.known[n] for n in speeds.tolist()], dtype=float).reshape(-1, 2)

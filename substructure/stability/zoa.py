@@ -32,14 +32,57 @@ import numpy as np
 from ..errors import InvalidValueError
 from ..frf import FRF, Frequency
 from .band import choose_band
+from .modal import ModalModel
 from .speeds import as_speed_rpm
 from .result import Lobes, StabilityWarning
 from .structure import xy_receptance
 
-__all__ = ["zoa", "zoa_eigenvalues", "MAX_LOBE_POINTS"]
+__all__ = ["zoa", "zoa_eigenvalues", "MAX_LOBE_POINTS", "graded_frequency", "GRADED_STEPS", "check_band"]
 
 MAX_LOBE_POINTS = 5_000_000
 """Most points (FRF lines x lobes x 2 branches) the zero order builds, about 40 MB per array."""
+
+
+GRADED_STEPS = 50
+"""Lines per damping ratio of the graded grid of a modal model (:func:`graded_frequency`): the relative step is
+``zeta / GRADED_STEPS`` at a mode, as on the model's default grid, and ``|ln(f / f_n)| / GRADED_STEPS`` away from it,
+where the receptance changes by about ``1 / GRADED_STEPS`` of itself from line to line."""
+
+
+def graded_frequency(model: ModalModel) -> Frequency:
+    """Lines from 0.3 f_min to 3 f_max, as fine as the default grid at the modes and coarser away from them.
+
+    At ``f`` the relative step is ``min_i max(zeta_i, |ln(f / f_i)|) / GRADED_STEPS`` over the modes ``i``: a
+    mode's half-power band holds ``2 GRADED_STEPS`` lines, and between the modes the step grows with the distance
+    from the nearest one, where the receptance varies on that scale.  For one mode about
+    ``GRADED_STEPS (2 + ln(1.2 / zeta) + ln(1.1 / zeta))`` lines (566 for zeta = 0.011) instead of the default
+    grid's ``ln(10) GRADED_STEPS / zeta`` (10,469).
+
+    Parameters
+    ----------
+    model : ModalModel
+        The modes.
+
+    Returns
+    -------
+    Frequency
+        The lines, in Hz.
+    """
+    a = model.arrays()
+    ln_fn, zeta = np.log(a["frequency_hz"]), a["damping_ratio"]
+    ln_f, ln_hi = np.log(0.3 * a["frequency_hz"].min()), np.log(3.0 * a["frequency_hz"].max())
+    lines = [ln_f]
+    while ln_f < ln_hi:
+        ln_f += float(np.min(np.maximum(zeta, np.abs(ln_f - ln_fn)))) / GRADED_STEPS
+        lines.append(min(ln_f, ln_hi))
+    return Frequency.from_hz(np.exp(lines))
+
+
+EDGE_WARNING = ("zoa: the oriented FRF's most negative real part, the absolute limit, is at the {edge} line of the "
+                "band ({hz:g} Hz): the minimum may lie outside it (a mode outside the band), and the limit be too "
+                "deep; extend the band")
+"""The warning when the absolute limit of FRF data sits on an edge of the band (not the lower edge the automatic
+band chose above a mass line)."""
 
 
 def zoa_eigenvalues(k0: np.ndarray, g: np.ndarray) -> np.ndarray:
@@ -168,6 +211,67 @@ class _ZoaEnvelope:
         return d, at, fc
 
 
+def _lines(structure: Any, frequency: Frequency | None, k0: np.ndarray, teeth: int, lowest_rpm: float):
+    """Lines, eigenvalues, where they give a lobe, depths, phases and the last lobe needed down to ``lowest_rpm``."""
+    f, g = xy_receptance(structure, frequency)
+    lam = zoa_eigenvalues(k0, g)  # (m, 2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        valid = lam.real > 1e-300
+        a = np.where(valid, 1.0 / (2.0 * lam.real), np.inf)  # (m, 2)
+        theta = np.pi + 2.0 * np.angle(lam)  # in (0, 2 pi) where valid
+    # lobes: n = 60 f / (N (theta / 2 pi + k)), k = 0 .. k_max over both branches
+    k_max = int(np.ceil(60.0 * f[valid.any(axis=1)].max() / (teeth * lowest_rpm))) if valid.any() else 0
+    return f, lam, valid, a, theta, k_max
+
+
+def _absolute(structure: Any, used: Any, k0: np.ndarray, f: np.ndarray, a: np.ndarray,
+              valid: np.ndarray) -> tuple[float, float] | None:
+    """The absolute limit and its frequency (None: no line gives a lobe); for FRF data the band's checks."""
+    if not valid.any() and isinstance(structure, FRF):
+        raise InvalidValueError(
+            f"zoa: the oriented FRF's real part is never negative from {f[0]:g} to {f[-1]:g} Hz: the band holds no "
+            "resonance of the tool point (no limit can be found there, which is not a cut free of chatter); give "
+            "the FRF around the tool's modes (band=(lo, hi); --band LO:HI on the command line)")
+    if not valid.any():
+        return None
+    i, branch = np.unravel_index(np.argmin(a, axis=None), a.shape)
+    if not isinstance(structure, FRF):
+        return _refine_model(structure, k0, f, i, branch)
+    if i in (0, f.size - 1) and not (i == 0 and used is not None and used.excluded_hz is not None
+                                     and used.kind != "user"):
+        warnings.warn(EDGE_WARNING.format(edge="first" if i == 0 else "last", hz=f[i]), StabilityWarning,
+                      stacklevel=3)
+    return _refine_data(f, a[:, branch], i)
+
+
+def check_band(structure: Any, cut: Any, band: Any = "auto") -> None:
+    """The checks :func:`zoa` makes of FRF data in the band, without its lobes (which grow as the speeds fall).
+
+    Parameters
+    ----------
+    structure : FRF or ModalModel
+        As for :func:`zoa`.
+    cut : MillingCut or TurningCut
+        The cut (its mean force matrix orients the FRF).
+    band : "auto", "all", (lo_hz, hi_hz) or FlexibleBand, default "auto"
+        As for :func:`zoa`.
+
+    Raises
+    ------
+    InvalidValueError
+        For FRF data whose oriented real part is never negative in the band (no resonance in it).
+
+    Warns
+    -----
+    StabilityWarning
+        When the absolute limit lies at the first or last line of FRF data (:data:`EDGE_WARNING`).
+    """
+    structure, used = choose_band(structure, band)
+    k0 = cut.mean_force_matrix()
+    f, _, valid, a, _, _ = _lines(structure, None, k0, cut.regenerations_per_revolution, np.inf)
+    _absolute(structure, used, k0, f, a, valid)
+
+
 def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = None,
         label: str | None = None, band: Any = "auto") -> Lobes:
     """Stability lobes by the zero-order approximation.
@@ -185,8 +289,9 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
         Spindle speeds in rpm, strictly increasing
         (:func:`~substructure.stability.spindle_speeds`).
     frequency : Frequency, optional
-        For a modal model: the lines to evaluate on (default: a grid refined
-        around every mode).
+        For a modal model: the lines to evaluate on (default: the model's
+        default grid, or :func:`graded_frequency` when that grid times the
+        lobes down to the lowest speed exceeds ``MAX_LOBE_POINTS``).
     label : str, optional
         Legend label of the result.
     band : "auto", "all", (lo_hz, hi_hz) or FlexibleBand, default "auto"
@@ -205,51 +310,48 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
     Raises
     ------
     InvalidValueError
-        When the lobes would need more than ``MAX_LOBE_POINTS`` (5,000,000) points
+        For FRF data whose oriented real part is never negative in the band
+        (no resonance in it), and when the lobes would need more than ``MAX_LOBE_POINTS`` (5,000,000) points
         (FRF lines x lobes x 2): crop or thin the FRF, or raise the lowest
-        speed.
+        speed.  A modal model whose default grid is too fine for the lobes
+        down to the lowest speed is evaluated on :func:`graded_frequency`
+        instead (as fine at the modes, coarser away from them); beyond that
+        the message names the lowest speed that fits.
 
     Warns
     -----
     StabilityWarning
-        When the absolute limit lies at the first or last line of FRF data:
-        the FRF band may leave out what limits the cut (e.g. the rigid-body
-        region of a free-free model); crop or extend it.
+        When the absolute limit lies at the first or last line of FRF data
+        (:data:`EDGE_WARNING`): the minimum may lie outside the band; extend
+        it.  Not at the first line of a band chosen automatically above a
+        rigid-body mass line.
     """
     speeds_rpm = as_speed_rpm(speeds)
     structure, used = choose_band(structure, band)
-    f, g = xy_receptance(structure, frequency)
     k0 = cut.mean_force_matrix()
-    lam = zoa_eigenvalues(k0, g)  # (m, 2)
     teeth = cut.regenerations_per_revolution
-    with np.errstate(divide="ignore", invalid="ignore"):
-        valid = lam.real > 1e-300
-        a = np.where(valid, 1.0 / (2.0 * lam.real), np.inf)  # (m, 2)
-        theta = np.pi + 2.0 * np.angle(lam)  # in (0, 2 pi) where valid
-    if not valid.any():
+    f, lam, valid, a, theta, k_max = _lines(structure, frequency, k0, teeth, speeds_rpm[0])
+    points = 2 * (k_max + 1) * f.size
+    graded = points > MAX_LOBE_POINTS and frequency is None and isinstance(structure, ModalModel)
+    if graded:  # the default grid is fine everywhere: at low speeds too many lines for so many lobes
+        f, lam, valid, a, theta, k_max = _lines(structure, graded_frequency(structure), k0, teeth, speeds_rpm[0])
+        points = 2 * (k_max + 1) * f.size
+    if points > MAX_LOBE_POINTS:
+        most = MAX_LOBE_POINTS // (2 * f.size) - 1  # lobes that fit
+        lowest = 60.0 * f[valid.any(axis=1)].max() / (teeth * most) if most > 0 else np.inf
+        what = (f"{f.size} lines graded around the modes" if graded else
+                f"{f.size} {'FRF' if isinstance(structure, FRF) else 'frequency'} lines")
+        change = (f"raise the lowest spindle speed to {lowest:.4g} rpm or more (--speeds on the command line)" if graded
+                  else "crop the FRF to the band that matters, use fewer lines, or raise the lowest spindle speed "
+                  "(fewer lobes)")
+        raise InvalidValueError(
+            f"zoa: {what} x {k_max + 1} lobes x 2 = {points:.3g} lobe points down to {speeds_rpm[0]:g} rpm, more "
+            f"than the limit MAX_LOBE_POINTS = {MAX_LOBE_POINTS:.3g} (about 40 MB per array); {change}")
+    absolute = _absolute(structure, used, k0, f, a, valid)
+    if absolute is None:
         return Lobes("zoa", speeds_rpm, np.full(speeds_rpm.size, np.inf), np.full(speeds_rpm.size, np.nan),
                      cut=cut, absolute_limit_m=float("inf"), label=label, band=used)
-    # absolute limit
-    flat = np.argmin(a, axis=None)
-    i, branch = np.unravel_index(flat, a.shape)
-    if isinstance(structure, FRF):
-        a_abs, f_abs = _refine_data(f, a[:, branch], i)
-        if i in (0, f.size - 1) and not (i == 0 and used is not None and used.excluded_hz is not None):
-            warnings.warn(
-                f"zoa: the absolute limit is at the {'first' if i == 0 else 'last'} line of the FRF "
-                f"({f[i]:g} Hz); the FRF band may leave out what limits the cut (a free-free model's "
-                "rigid-body motion, a mode outside the band): crop or extend the band", StabilityWarning,
-                stacklevel=2)
-    else:
-        a_abs, f_abs = _refine_model(structure, k0, f, i, branch)
-    # lobes: n = 60 f / (N (theta / 2 pi + k)), k = 0 .. k_max over both branches
-    k_max = int(np.ceil(60.0 * f[valid.any(axis=1)].max() / (teeth * speeds_rpm[0])))
-    points = 2 * (k_max + 1) * f.size
-    if points > MAX_LOBE_POINTS:
-        raise InvalidValueError(
-            f"zoa: {f.size} FRF lines x {k_max + 1} lobes x 2 = {points:.3g} lobe points, more than the limit "
-            f"MAX_LOBE_POINTS = {MAX_LOBE_POINTS:.3g} (about 40 MB per array); crop the FRF to the band that "
-            "matters, use fewer lines, or raise the lowest spindle speed (fewer lobes)")
+    a_abs, f_abs = absolute
     k = np.arange(k_max + 1)
     phase = theta.T[:, None, :] / (2.0 * np.pi) + k[None, :, None]  # (2, K, m)
     with np.errstate(divide="ignore"):
