@@ -540,6 +540,37 @@ def test_uff_abscissa_not_time_or_uneven_is_refused(tmp_path):
 
 
 
+def test_uff_abscissa_in_milliseconds_is_converted_to_seconds(tmp_path):
+    """A time axis labelled 'ms' (or 'us') is read in its unit: the same samples with the abscissa in s and in ms
+    give the same record and the same FRF (it was read as seconds: a sample rate 1000 times too low); a unit that
+    cannot be read, a decreasing or a standing abscissa are refused as such."""
+    from substructure.tap import process_taps
+
+    tap = impact_records()[0]
+    t = tap.time - tap.time[0]
+    channels = [(tap.force, 13, "N"), (tap.response / G, 0, "g")]
+    seconds = read_tap_uff(write_uff(tmp_path / "s.uff", channels, x=t))
+    for label, scale in (("ms", 1e3), ("us", 1e6)):
+        other = read_tap_uff(write_uff(tmp_path / f"{label}.uff", channels, abscissa_label=label, x=t * scale))
+        assert other.sample_rate == pytest.approx(seconds.sample_rate, rel=1e-9)
+        assert np.allclose(other.time, seconds.time, rtol=0, atol=1e-9 / seconds.sample_rate)
+        a, b = process_taps(seconds), process_taps(other)
+        assert np.allclose(b.frf.frequency.hz, a.frf.frequency.hz, rtol=1e-9)
+        assert np.allclose(b.frf.data, a.frf.data, rtol=1e-6, atol=1e-9 * np.abs(a.frf.data).max())
+        assert np.allclose(b.coherence, a.coherence, atol=1e-9)
+    path = write_uff(tmp_path / "furlong.uff", channels, abscissa_label="blips", x=t)
+    with pytest.raises(FileFormatError, match=r"furlong.uff, record 0: abscissa unit label 'blips' "
+                                              r"is not a unit read here; expected a time unit"):
+        read_tap_uff(path)
+    path = write_uff(tmp_path / "down.uff", channels, x=1.0 - t)
+    with pytest.raises(FileFormatError, match=r"down.uff, record 0: the abscissa decreases \(from 1.0 s to "
+                                              r"3.90625e-05 s over 25600 samples, a step of -3.90625e-05 s\)"):
+        read_tap_uff(path)
+    path = write_uff(tmp_path / "still.uff", channels, x=0 * t)
+    with pytest.raises(FileFormatError, match=r"still.uff, record 0: the abscissa does not advance"):
+        read_tap_uff(path)
+
+
 def test_a_universal_file_of_several_taps_reads_as_one_tap_each(tmp_path, capsys):
     taps = impact_records()[:3]  # the shipped real taps, as an acquisition system exports a test's hits
     # (times written as x values with five digits, as pyuff writes them: the uniform clock read back)
