@@ -89,6 +89,16 @@ def test_the_window_is_applied_only_when_the_response_has_not_died_out():
     assert forced.tau is not None and forced.window == "asked for"
 
 
+def test_exponential_takes_true_false_or_none_and_refuses_other_values():
+    """numpy's booleans are booleans; 0, 1, "no" are refused (0 applied the window: it is not ``False``)."""
+    assert process_taps([tap()], exponential=np.False_).tau is None
+    assert process_taps([tap()], exponential=np.True_).tau is not None
+    for value in (0, 1, "no", 0.0):
+        with pytest.raises(InvalidValueError, match=rf"exponential: got {value!r} \({type(value).__name__}\); "
+                                                    r"expected True, False or None"):
+            process_taps([tap()], exponential=value)
+
+
 def test_acceleration_is_converted_to_receptance():
     """Through the window the taps measure the system at s = i omega + 1/tau: the accelerance s^2 H(s), and the
     receptance it converts to is H(s) (divided by s^2, not by (i omega)^2, which left a phase error of

@@ -161,7 +161,7 @@ def process_taps(
     ------
     InvalidValueError
         For records of different sample rates or quantities, an unknown
-        estimator, records shorter than one tap, or no tap kept (the
+        estimator, an ``exponential`` other than True, False or None, records shorter than one tap, or no tap kept (the
         reasons listed).
     SwappedChannelsError
         When a record's force looks like a response (naming file and columns).
@@ -171,6 +171,10 @@ def process_taps(
                     tau=(tau, "s", False), window_end=(window_end, "", False),
                     force_window_extra=(force_window_extra, "pulse widths", True),
                     hammer_band_db=(hammer_band_db, "dB", False))
+    if exponential is not None and not isinstance(exponential, (bool, np.bool_)):
+        raise InvalidValueError(f"exponential: got {exponential!r} ({type(exponential).__name__}); expected True, "
+                                "False or None (the window only when the response still rings at the tap's end)")
+    exponential = None if exponential is None else bool(exponential)
     if exponential is False and tau is not None:
         raise InvalidValueError(f"tau: got {tau!r} s with exponential=False; a time constant asks for the window")
     if estimator not in ESTIMATORS:
