@@ -160,6 +160,28 @@ def test_tap_options_out_of_range_are_refused_by_name(records, tmp_path, capsys,
     assert code != 0 and message in err and not (tmp_path / "frf.csv").exists()
 
 
+def test_a_record_file_given_twice_is_refused_naming_it(records, tmp_path, capsys):
+    """The same file twice (also by another path to it) would be its taps averaged twice: coherence 1."""
+    folder, paths = records
+    link = tmp_path / "link.csv"
+    link.symlink_to(paths[0])
+    for again in (paths[0], str(folder / "." / "tap1.csv"), str(link)):
+        code, _, err = run(capsys, "tap", paths[0], paths[1], again, "--out", tmp_path / "frf.csv")
+        assert code != 0 and not (tmp_path / "frf.csv").exists()
+        assert f"{again}: the record file is given more than once (also as {paths[0]}); expected each record once" \
+            in err
+
+
+def test_the_same_tap_twice_in_python_is_refused():
+    from substructure.tap import process_taps
+
+    taps = impact_records()[:3]
+    with pytest.raises(InvalidValueError, match=r"records\[2\] \(.*\): the same force and response samples as "
+                                                r"records\[0\] \(.*\); expected each tap once"):
+        process_taps([taps[0], taps[1], taps[0]])
+    assert process_taps(taps).averages == 3
+
+
 def test_process_taps_refuses_settings_out_of_range():
     records = impact_records()[:2]
     from substructure.tap import process_taps

@@ -75,6 +75,13 @@ def run(args: argparse.Namespace) -> int:
             raise UsageError(f"{path}: expected a tap record in a .csv, .uff or .unv file (or text in .txt, "
                              ".dat or .asc, a LabVIEW .lvm file, an NI .tdms file, a MATLAB .mat file, a .uf "
                              "universal file)")
+    given: dict[Path, str] = {}
+    for path in args.records:  # one file twice is its taps averaged twice: coherence 1, the scatter understated
+        resolved = Path(path).resolve()
+        if resolved in given:
+            raise UsageError(f"{path}: the record file is given more than once (also as {given[resolved]}); "
+                             "expected each record once (its taps would be averaged twice)")
+        given[resolved] = path
     if args.out and Path(args.out).suffix.lower() != ".csv":
         raise UsageError(f"argument --out: {args.out!r}: expected a .csv file (frequency_hz,real,imag,coherence)")
     if args.measurements:

@@ -11,6 +11,7 @@ is dropped.  See docs/tap.md for the equations.
 
 from __future__ import annotations
 
+import hashlib
 from typing import Any, Sequence
 
 import attrs
@@ -58,6 +59,16 @@ def _records(records: Any) -> tuple[TapRecord, ...]:
     for i, r in enumerate(items):
         if not isinstance(r, TapRecord):
             raise InvalidValueError(f"records[{i}]: got {type(r).__name__}; expected a TapRecord")
+    seen: dict[bytes, int] = {}
+    for i, r in enumerate(items):  # one tap given twice is averaged as two: coherence 1, the scatter understated
+        digest = hashlib.sha256(np.ascontiguousarray(r.force).tobytes() + b"|"
+                                + np.ascontiguousarray(r.response).tobytes()).digest()
+        if digest in seen:
+            j = seen[digest]
+            raise InvalidValueError(f"records[{i}] ({r.source}): the same force and response samples as records[{j}] "
+                                    f"({items[j].source}); expected each tap once (a tap given twice is averaged as "
+                                    "two, its coherence 1 and its scatter understated)")
+        seen[digest] = i
     first = items[0]
     for r in items[1:]:
         if abs(r.sample_rate - first.sample_rate) > 1e-6 * first.sample_rate:
