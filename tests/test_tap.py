@@ -251,6 +251,25 @@ def test_a_hit_at_the_end_of_the_record_is_said_so_not_swapped():
         process_taps([TapRecord(t, x * 1e7, f * 1e-7, "displacement", "early.csv")])
 
 
+def test_a_tap_hit_near_its_record_s_end_is_rejected_not_every_tap_cut_to_it():
+    """Three good taps and one hit 10 ms before its record ends: the late one is rejected as cut short (by file and
+    number), the FRF is that of the three good ones (it was every tap cut to 150 samples, windowed with tau 2 ms)."""
+    good = [tap(peak, source=f"good{k}.csv") for k, peak in enumerate((40.0, 55.0, 70.0))]
+    late = tap(60.0, start=0.99, source="late.csv")
+    alone, both = process_taps(good), process_taps([good[0], late, good[1], good[2]])
+    assert both.averages == 3 and [t.number for t in both.rejected] == [2]
+    (rejected,) = both.rejected
+    assert rejected.source == "late.csv" and rejected.peak_force == pytest.approx(60.0, rel=0.02)
+    assert rejected.reason.startswith("cut short: the record ends 0.01494 s after this tap's start (t = 0.9851 s), "
+                                      "under 0.25 of the taps' median 0.9949 s")
+    assert both.tap_samples == alone.tap_samples and both.tau is None and alone.shortest is None
+    assert np.array_equal(both.frf.data, alone.frf.data) and np.array_equal(both.coherence, alone.coherence)
+    # taps of records of different lengths are all cut to the shortest kept one, which the result names
+    mixed = process_taps([tap(40.0, source="long.csv"), tap(55.0, n=N // 2, source="half.csv")])
+    assert mixed.averages == 2 and mixed.tap_samples <= N // 2 - 51
+    assert mixed.shortest == "tap 2 (half.csv): its record ends 0.4949 s after its start"
+
+
 def test_a_force_within_its_noise_is_no_hit():
     rng = np.random.default_rng(7)
     t = np.arange(N) / FS

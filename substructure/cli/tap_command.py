@@ -154,7 +154,9 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     print(f"records: {len(records)}, {result.sample_rate:g} Hz, {result.tap_samples} samples per tap "
-          f"({result.tap_samples / result.sample_rate:g} s)")
+          f"({result.tap_samples / result.sample_rate:g} s" + ("" if result.shortest is None else
+                                                                f"; every tap cut to the shortest, {result.shortest}")
+          + ")")
     print(f"taps: {len(result.taps)} found, {result.averages} averaged ({result.estimator}), "
           f"{len(result.rejected)} rejected")
     for tap in result.taps:

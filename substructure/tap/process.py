@@ -27,7 +27,7 @@ from .records import RESPONSE_QUANTITIES, TapRecord
 from .result import Tap, TapResult
 
 __all__ = ["process_taps", "ESTIMATORS", "EXP_WINDOW_END", "FORCE_WINDOW_EXTRA", "FORCE_WINDOW_BEFORE",
-           "HAMMER_BAND_DB"]
+           "HAMMER_BAND_DB", "SHORT_TAP_SHARE"]
 
 ESTIMATORS = ("H1", "H2", "Hv")
 """The FRF estimators: H1 = Gfx/Gff (noise on the response), H2 = Gxx/Gxf (noise on the force), Hv (both)."""
@@ -42,6 +42,11 @@ FORCE_WINDOW_BEFORE = 1.0
 """The force window opens this many pulse widths before the force crosses the trigger level (the pulse's rise
 below that level is kept; the pre-trigger's noise before it is not: left in, it is a smooth random error of H1
 over hundreds of hertz, largest relative to the response's noise at the resonances)."""
+
+SHORT_TAP_SHARE = 0.25
+"""Without ``tap_length`` every tap is cut to the shortest; a tap whose record ends sooner after its start than
+this share of the taps' median length (a hit near the record's end) is rejected as cut short instead: its response
+is hardly recorded, and cutting every other tap to it would coarsen the grid and window them all."""
 
 HAMMER_BAND_DB = 20.0
 """The hammer's usable band ends where the force spectrum has fallen this many dB below its low-frequency level."""
@@ -135,7 +140,10 @@ def process_taps(
         trigger crossing after the previous tap ended.  Default: one tap per
         record, from the pre-trigger to the end of the shortest record
         (shortened to the nearest length below whose FFT is fast:
-        ``scipy.fft.prev_fast_len``).
+        ``scipy.fft.prev_fast_len``); a tap whose record ends sooner after
+        its start than :data:`SHORT_TAP_SHARE` of the taps' median length is
+        rejected as cut short instead (``TapResult.shortest`` names the tap
+        that set the length).
     pre_trigger : float
         Time kept before the trigger crossing, in s.
     exponential : bool or None
@@ -195,6 +203,7 @@ def process_taps(
     pre = max(int(round(float(pre_trigger) * rate)), 0)
     taps: list[Tap] = []
     cuts: list[tuple[TapRecord, int, int]] = []  # record, first sample, tap index in taps
+    peaks: dict[int, float] = {}  # without tap_length: per tap index, its peak force in the whole record
     if tap_length is not None:
         length = int(round(float(tap_length) * rate))
         if length < 16:
@@ -205,6 +214,7 @@ def process_taps(
         if tap_length is None:
             first = find_pulse(record.force, trigger_fraction, no_hit_factor)
             starts = [0 if isinstance(first, str) else max(first.start - pre, 0)]
+            peaks[len(taps)] = 0.0 if isinstance(first, str) else first.peak_force
         else:
             starts = tap_starts(record.force, length, pre, trigger_fraction, no_hit_factor)
             if not starts:
@@ -219,6 +229,22 @@ def process_taps(
             else:
                 cuts.append((record, s, len(taps)))
             taps.append(tap)
+    shortest = None  # without tap_length: the tap whose length all are cut to, in words
+    if tap_length is None and len(cuts) > 1:
+        spans = np.array([len(r) - s for r, s, _ in cuts])
+        median = float(np.median(spans))
+        for (r, s, index), span in zip(cuts, spans.tolist()):
+            if span < SHORT_TAP_SHARE * median:
+                taps[index] = attrs.evolve(taps[index], peak_force=peaks[index], reason=(
+                    f"cut short: the record ends {span / rate:.4g} s after this tap's start (t = "
+                    f"{taps[index].start_s:.4g} s), under {SHORT_TAP_SHARE:g} of the taps' median {median / rate:.4g} "
+                    "s: its response is hardly recorded (every tap is cut to the shortest kept one)"))
+        cuts = [c for c in cuts if taps[c[2]].reason is None]
+        spans = np.array([len(r) - s for r, s, _ in cuts])
+        if cuts and spans.max() > spans.min():
+            k = int(np.argmin(spans))
+            shortest = (f"tap {taps[cuts[k][2]].number} ({cuts[k][0].source}): its record ends "
+                        f"{spans[k] / rate:.4g} s after its start")
     if not cuts:
         reasons = "; ".join(f"tap {t.number} ({t.source}): {t.reason}" for t in taps)
         raise InvalidValueError(f"no tap kept: {reasons}")
@@ -352,7 +378,8 @@ def process_taps(
     receptance = measured.to_receptance(1.0 / tau if tau else 0.0)
     return TapResult(receptance, measured, coherence[keep], estimator, tuple(taps), tau,
                      hammer_band, float(hammer_band_db), spectra, rate, length, why, v_f,
-                     float(np.sqrt(np.mean(noise_sd**2))), width, None if truncation is None else truncation[keep])
+                     float(np.sqrt(np.mean(noise_sd**2))), width, None if truncation is None else truncation[keep],
+                     shortest)
 
 
 def _noise_outside(force: np.ndarray, window: np.ndarray) -> float:

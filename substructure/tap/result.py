@@ -138,6 +138,10 @@ class TapResult:
         (``substructure.tap.record_end.truncation_variance``); None
         when the response died out.  The diagnosis's noise model adds it as
         it adds ``force_noise``.
+    shortest : str or None
+        Without ``tap_length``, when the kept taps' records ended at different
+        times after their starts: the tap that set ``tap_samples`` (every tap
+        is cut to it), in words; None otherwise.
     """
 
     frf: FRF
@@ -156,6 +160,7 @@ class TapResult:
     force_noise_rms: float = 0.0
     force_window_s: float = 0.0
     truncation: np.ndarray | None = None
+    shortest: str | None = None
 
     @property
     def averages(self) -> int:
