@@ -9,7 +9,7 @@ from scipy import optimize, signal
 from substructure.datasets import free_free_beam_frfs, impact_records
 from substructure.errors import FileFormatError, InvalidValueError
 from substructure.io.tap_files import read_tap_csv, read_tap_uff
-from substructure.tap import SwappedChannelsError, TapRecord, added_damping, process_taps
+from substructure.tap import ESTIMATORS, SwappedChannelsError, TapRecord, added_damping, process_taps
 
 FS = 10240.0
 N = 10240  # 1 s
@@ -165,6 +165,31 @@ def test_the_hammer_s_noise_before_the_pulse_is_outside_the_force_window():
 
     assert np.array_equal(shuffled(hit - 45, hit - 12), base)  # before the window (a pulse is ~6 samples)
     assert not np.array_equal(shuffled(hit - 5, hit), base)  # inside it
+
+
+@pytest.mark.parametrize("estimator", ESTIMATORS)
+def test_the_frf_and_coherence_do_not_depend_on_the_channels_scale(estimator):
+    """Force and response multiplied by 1e150 or 1e-150 (together, or one alone but for Hv, a total least squares
+    in the channels' units): the FRF scaled by their ratio,
+    the same coherence, windows, band and noise in proportion (their squares overflowed or underflowed: a
+    coherence of 0 on every line)."""
+    records = _noisy(4, out_noise=2e-7, in_noise=0.05)
+    base = process_taps(records, estimator)
+    assert np.median(base.coherence) < 0.999  # noisy: a coherence that can move
+    together = ((1e150, 1e150), (1e-150, 1e-150))  # Hv weighs the channels' errors in their units: only together
+    for f_scale, x_scale in together + (() if estimator == "Hv" else ((1e150, 1.0), (1.0, 1e-150), (1e-150, 1e150))):
+        scaled = [TapRecord(r.time, r.force * f_scale, r.response * x_scale, r.quantity, r.source)
+                  for r in records]
+        got = process_taps(scaled, estimator)
+        assert np.allclose(got.frf.data, base.frf.data * (x_scale / f_scale), rtol=1e-9, atol=0)
+        assert np.allclose(got.coherence, base.coherence, rtol=0, atol=1e-9)
+        assert got.tau == base.tau and got.window == base.window and got.hammer_band_hz == base.hammer_band_hz
+        assert got.force_noise_rms == pytest.approx(base.force_noise_rms * f_scale, rel=1e-9)
+        assert [t.peak_force for t in got.taps] == pytest.approx([t.peak_force * f_scale for t in base.taps],
+                                                                 rel=1e-12)
+        assert np.allclose(got.force_spectra_db, base.force_spectra_db + 20 * np.log10(f_scale), rtol=0, atol=1e-9)
+        for a, b in ((got.force_noise, base.force_noise), (got.truncation, base.truncation)):
+            assert (a is None) == (b is None) and (a is None or np.allclose(a, b, rtol=1e-9, atol=0))
 
 
 def test_input_noise_biases_h1_down_and_not_h2():

@@ -254,6 +254,10 @@ def process_taps(
         raise InvalidValueError(f"{cuts[0][0].source}: the taps are {length} samples long; expected more")
     force = np.stack([r.force[s:s + length] for r, s, _ in cuts])
     response = np.stack([r.response[s:s + length] for r, s, _ in cuts])
+    # the spectra, their products and the mean squares of the end of the taps are formed of the channels each
+    # divided by a power of two near its peak (exact: the FRF and coherence do not depend on the channels' scale;
+    # squares of 1e160 N overflowed, of 1e-170 N underflowed, to a coherence of 0), the scales undone after
+    f_scale, x_scale = _scale(force), _scale(response)
     hz = np.fft.rfftfreq(length, dt)
     # judge each tap; the windows of the kept ones
     force_window = np.zeros_like(force)
@@ -293,7 +297,7 @@ def process_taps(
         if reason is None:
             kept.append(row)
     # the usable band per tap (kept or not), from the force in its window
-    power = np.abs(scipy.fft.rfft((force - baseline[:, None]) * force_window, axis=1)) ** 2
+    power = np.abs(scipy.fft.rfft((force - baseline[:, None]) / f_scale * force_window, axis=1)) ** 2
     bands = _band_end(power, hz, hammer_band_db)
     for row, (_, _, index) in enumerate(cuts):
         if taps[index].peak_force > 0:
@@ -302,8 +306,8 @@ def process_taps(
         reasons = "; ".join(f"tap {t.number} ({t.source}): {t.reason}" for t in taps)
         raise InvalidValueError(f"no tap kept: {reasons}")
     rows = np.array(kept)
-    f = force[rows] - baseline[rows, None]
-    x = response[rows].copy()
+    f = (force[rows] - baseline[rows, None]) / f_scale
+    x = response[rows] / x_scale
     quiet = np.argmax(force_window[rows] > 0, axis=1)  # the samples before the force window: no pulse yet
     for i, p in enumerate(quiet.tolist()):  # per tap, not per line: the response's offset before the hit
         # from the quiet samples only: what a filter of the acquisition spreads ahead of the pulse (a linear-phase
@@ -312,7 +316,7 @@ def process_taps(
         if p >= 8:
             x[i] -= x[i, :p].mean()
     f = f * force_window[rows]
-    noise_sd = np.array([_noise_outside(force[r] - baseline[r], force_window[r]) for r in rows.tolist()])
+    noise_sd = np.array([_noise_outside(force[r] - baseline[r], force_window[r]) for r in rows.tolist()]) / f_scale
     end = the_end(x, quiet, [taps[cuts[r][2]].number for r in rows])
     why: str | None = None  # said by the end of the taps, when the default decides
     response_noise = noise_variance(x, quiet)
@@ -346,12 +350,15 @@ def process_taps(
             h = gfx / gff
         elif estimator == "H2":
             h = gxx / np.conj(gfx)
-        else:
-            root = np.hypot(gff - gxx, 2.0 * np.abs(gfx))  # two forms of one root, each free of cancellation
-            h = np.where(gff >= gxx, 2.0 * gfx / (gff - gxx + root), (gxx - gff + root) / (2.0 * np.conj(gfx)))
+        else:  # total least squares weighs both channels in their own units: the response's scale put back
+            ratio = x_scale / f_scale
+            a, b, c = gff, gxx * ratio**2, gfx * ratio  # the spectra of the force and the response, both / f_scale
+            root = np.hypot(a - b, 2.0 * np.abs(c))  # two forms of one root, each free of cancellation
+            h = np.where(a >= b, 2.0 * c / (a - b + root), (b - a + root) / (2.0 * np.conj(c))) / ratio
         coherence = np.abs(gfx) ** 2 / (gff * gxx)
     coherence = np.clip(np.nan_to_num(coherence, nan=0.0), 0.0, 1.0)
     h = np.nan_to_num(h)
+    h_scaled, h = h, h * (x_scale / f_scale)
     keep = hz > 0.0
     if band is not None:
         lo, hi = band
@@ -361,7 +368,7 @@ def process_taps(
                                     f"in steps of {hz[1]:g} Hz)")
     kind = RESPONSE_QUANTITIES[items[0].quantity][1]
     measured = FRF.single(Frequency.from_hz(hz[keep]), h[keep], quantity=kind)
-    spectra = 10.0 * np.log10(np.maximum(np.abs(F[:, keep]) ** 2, 1e-300))
+    spectra = 10.0 * np.log10(np.maximum(np.abs(F[:, keep]) ** 2, 1e-300)) + 20.0 * np.log10(f_scale)
     hammer_band = float(_band_end(gff[None, :], hz, hammer_band_db)[0])
     # the noise of the force channel in F: per tap sigma^2 sum(w^2) dt^2, the same on every line; in H1 =
     # sum X F* / sum |F|^2 a relative error whose variance is sum_j n_j |F_j|^2 / (sum_j |F_j|^2)^2
@@ -371,15 +378,22 @@ def process_taps(
     # an H2 is compared as gamma^2 H2, which is this H1 (Measurement.h1_frf): its hammer noise is the same
     v_f = np.where(np.isfinite(v_f), v_f, np.inf)[keep] if estimator != "Hv" else None
     width = float(np.mean(np.sum(w_f, axis=1) ** 2 / np.sum(w_f**2, axis=1))) * dt
-    truncation = truncation_variance(x, F, w, response_noise, h, dt)
+    truncation = truncation_variance(x, F, w, response_noise, h_scaled, dt)
     if why is None:
         why = window_words(end, truncation, told_apart(x, response_noise))
     # through the window the taps measured the structure at omega - i/tau: so is its receptance
     receptance = measured.to_receptance(1.0 / tau if tau else 0.0)
     return TapResult(receptance, measured, coherence[keep], estimator, tuple(taps), tau,
                      hammer_band, float(hammer_band_db), spectra, rate, length, why, v_f,
-                     float(np.sqrt(np.mean(noise_sd**2))), width, None if truncation is None else truncation[keep],
-                     shortest)
+                     float(np.sqrt(np.mean(noise_sd**2)) * f_scale), width,
+                     None if truncation is None else truncation[keep], shortest)
+
+
+def _scale(channels: np.ndarray) -> float:
+    """The power of two nearest above the channels' largest magnitude (1 for channels of zeros): dividing by it
+    is exact and brings them to [0.5, 1)."""
+    peak = float(np.max(np.abs(channels))) if channels.size else 0.0
+    return float(np.ldexp(1.0, int(np.frexp(peak)[1]))) if np.isfinite(peak) and peak > 0 else 1.0
 
 
 def _noise_outside(force: np.ndarray, window: np.ndarray) -> float:
