@@ -192,6 +192,14 @@ def test_the_frf_and_coherence_do_not_depend_on_the_channels_scale(estimator):
             assert (a is None) == (b is None) and (a is None or np.allclose(a, b, rtol=1e-9, atol=0))
 
 
+def test_peaks_of_lines_above_the_hammer_s_band_are_none():
+    """A result kept to lines above the hammer's usable band has no peaks to report (not a crop's error)."""
+    result = process_taps([tap(peak) for peak in (40.0, 55.0)])
+    above = process_taps([tap(peak) for peak in (40.0, 55.0)], band=(result.hammer_band_hz + 100.0, 5000.0))
+    assert result.hammer_band_hz < 4900.0 and above.frf.frequency.hz[0] > result.hammer_band_hz
+    assert above.peaks().size == 0
+
+
 def test_input_noise_biases_h1_down_and_not_h2():
     records = _noisy(30, in_noise=0.3)
     kw = dict(exponential=False, force_window_extra=1e9)  # keep the force's noise over the whole tap

@@ -182,6 +182,29 @@ def test_the_same_tap_twice_in_python_is_refused():
     assert process_taps(taps).averages == 3
 
 
+def test_a_band_above_the_hammer_s_or_the_records_band_is_refused_at_the_option(records, tmp_path, capsys):
+    """The shipped taps: 25600 Hz, the hammer's usable band to about 7 kHz: a band above it (below the Nyquist
+    frequency) is refused naming --band and both limits (it was an internal message of a crop); above Nyquist
+    likewise; a band reaching into the usable band is kept; --band takes LO:HI only, and says so."""
+    from substructure.tap import process_taps
+
+    _, paths = records
+    usable = process_taps(impact_records()).hammer_band_hz
+    assert 5000 < usable < 11000
+    code, _, err = run(capsys, "tap", *paths, "--band", "11000:12000", "--out", tmp_path / "frf.csv")
+    assert code != 0 and not (tmp_path / "frf.csv").exists()
+    assert (f"argument --band: got 11000:12000 Hz, above the hammer's usable band (up to {usable:.0f} Hz, where its "
+            "force spectrum has fallen 20 dB; the Nyquist frequency is 12800 Hz)") in err
+    code, _, err = run(capsys, "tap", *paths, "--band", "13000:14000")
+    assert code != 0 and ("argument --band: got 13000:14000 Hz; the records' lines end at the Nyquist frequency, "
+                          "12800 Hz") in err
+    code, out, err = run(capsys, "tap", *paths, "--band", f"{usable - 500:.0f}:12000")
+    assert code == 0, err
+    for text in ("100", "auto"):
+        code, _, err = run(capsys, "tap", paths[0], "--band", text)
+        assert code != 0 and f"argument --band: got {text!r}; expected LO:HI in Hz, e.g. 1200:1700" in err
+
+
 def test_process_taps_refuses_settings_out_of_range():
     records = impact_records()[:2]
     from substructure.tap import process_taps

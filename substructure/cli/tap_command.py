@@ -104,11 +104,20 @@ def run(args: argparse.Namespace) -> int:
     if args.no_exponential_window and args.tau is not None:
         raise UsageError("--tau sets the exponential window's time constant; it cannot go with --no-exponential-window")
     records = [record for path in args.records for record in _read(path, args)]
+    nyquist = records[0].sample_rate / 2.0
+    if args.band is not None and args.band[0] >= nyquist:
+        raise UsageError(f"argument --band: got {args.band[0]:g}:{args.band[1]:g} Hz; the records' lines end at "
+                         f"the Nyquist frequency, {nyquist:g} Hz: expected a band starting below it")
     result = process_taps(records, args.estimator, tap_length=args.tap_length,
                           pre_trigger=PRE_TRIGGER_S if args.pre_trigger is None else args.pre_trigger,
                           exponential=True if args.exponential_window else False if args.no_exponential_window
                           else None, tau=args.tau, band=args.band,
                           hammer_band_db=HAMMER_BAND_DB if args.hammer_band_db is None else args.hammer_band_db)
+    if args.band is not None and args.band[0] > result.hammer_band_hz:
+        raise UsageError(f"argument --band: got {args.band[0]:g}:{args.band[1]:g} Hz, above the hammer's usable "
+                         f"band (up to {result.hammer_band_hz:.0f} Hz, where its force spectrum has fallen "
+                         f"{result.hammer_band_db:g} dB; the Nyquist frequency is {nyquist:g} Hz): the taps do not "
+                         f"excite it; expected a band starting below {result.hammer_band_hz:.0f} Hz")
     if args.reverse_polarity:  # one channel's sign reversed: the FRF negated, its coherence and noise as they are
         import attrs
 

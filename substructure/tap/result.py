@@ -190,11 +190,15 @@ class TapResult:
         Returns
         -------
         numpy.ndarray
-            The peak frequencies in Hz, ascending.
+            The peak frequencies in Hz, ascending; none when the FRF's lines
+            (its ``band``) lie above the hammer's usable band and ``hi`` is not given.
         """
         hz = self.measured.frequency.hz
         lo = hz[0] if lo is None else lo
-        hi = min(self.hammer_band_hz, hz[-1]) if hi is None else hi
+        if hi is None:
+            hi = min(self.hammer_band_hz, hz[-1])
+            if hi < lo:  # every line above the hammer's usable band: no peak to trust
+                return np.zeros(0)
         frf = self.measured.crop(lo, hi)
         if frf.frequency.n < 3:
             return np.zeros(0)
