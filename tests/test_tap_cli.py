@@ -151,6 +151,10 @@ def _frf(n=5):
     (["--tap-length", "nan"], "argument --tap-length: got nan; expected a finite number > 0"),
     (["--pre-trigger", "-1"], "argument --pre-trigger: got -1.0; expected a finite number >= 0"),
     (["--hammer-band-db", "-5"], "argument --hammer-band-db: got -5.0; expected a finite number > 0"),
+    (["--tap-length", "0.004"], "argument --tap-length: got 0.004 s, not longer than --pre-trigger 0.005 s (its "
+                                "default); expected a tap longer than the time kept before its hit"),
+    (["--tap-length", "0.1", "--pre-trigger", "0.1"], "argument --tap-length: got 0.1 s, not longer than "
+                                                      "--pre-trigger 0.1 s; expected a tap longer"),
     (["--no-exponential-window", "--tau", "0.1"], "--tau sets the exponential window's time constant; it cannot "
                                                   "go with --no-exponential-window"),
 ])
@@ -210,6 +214,7 @@ def test_process_taps_refuses_settings_out_of_range():
     from substructure.tap import process_taps
 
     for kw, message in ((dict(tap_length=float("nan")), "tap_length: got nan s; expected a finite number > 0"),
+                        (dict(tap_length=0.004), "tap_length: got 0.004 s, not longer than pre_trigger 0.005 s"),
                         (dict(pre_trigger=-0.1), "pre_trigger: got -0.1 s; expected a finite number >= 0"),
                         (dict(tau=float("inf")), "tau: got inf s; expected a finite number > 0"),
                         (dict(hammer_band_db=0.0), "hammer_band_db: got 0.0 dB; expected a finite number > 0"),

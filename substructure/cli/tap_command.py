@@ -101,6 +101,11 @@ def run(args: argparse.Namespace) -> int:
     for option, value, zero in (("--tap-length", args.tap_length, False), ("--pre-trigger", args.pre_trigger, True),
                                 ("--tau", args.tau, False), ("--hammer-band-db", args.hammer_band_db, False)):
         positive_arg(option, value, zero)
+    pre_trigger = PRE_TRIGGER_S if args.pre_trigger is None else args.pre_trigger
+    if args.tap_length is not None and not args.tap_length > pre_trigger:
+        raise UsageError(f"argument --tap-length: got {args.tap_length:g} s, not longer than --pre-trigger "
+                         f"{pre_trigger:g} s{' (its default)' if args.pre_trigger is None else ''}; expected a tap "
+                         "longer than the time kept before its hit")
     if args.no_exponential_window and args.tau is not None:
         raise UsageError("--tau sets the exponential window's time constant; it cannot go with --no-exponential-window")
     records = [record for path in args.records for record in _read(path, args)]
@@ -109,7 +114,7 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"argument --band: got {args.band[0]:g}:{args.band[1]:g} Hz; the records' lines end at "
                          f"the Nyquist frequency, {nyquist:g} Hz: expected a band starting below it")
     result = process_taps(records, args.estimator, tap_length=args.tap_length,
-                          pre_trigger=PRE_TRIGGER_S if args.pre_trigger is None else args.pre_trigger,
+                          pre_trigger=pre_trigger,
                           exponential=True if args.exponential_window else False if args.no_exponential_window
                           else None, tau=args.tau, band=args.band,
                           hammer_band_db=HAMMER_BAND_DB if args.hammer_band_db is None else args.hammer_band_db)

@@ -190,6 +190,9 @@ def process_taps(
                     tau=(tau, "s", False), window_end=(window_end, "", False),
                     force_window_extra=(force_window_extra, "pulse widths", True),
                     hammer_band_db=(hammer_band_db, "dB", False))
+    if tap_length is not None and not float(tap_length) > float(pre_trigger):
+        raise InvalidValueError(f"tap_length: got {tap_length!r} s, not longer than pre_trigger {pre_trigger!r} s; "
+                                "expected a tap longer than the time kept before its hit")
     if exponential is not None and not isinstance(exponential, (bool, np.bool_)):
         raise InvalidValueError(f"exponential: got {exponential!r} ({type(exponential).__name__}); expected True, "
                                 "False or None (the window only when the response still rings at the tap's end)")
