@@ -271,6 +271,20 @@ def test_a_dead_response_channel_is_said_dead_not_clipped():
             process_taps(records)
 
 
+def test_a_dead_force_channel_is_said_dead_not_swapped():
+    """A hammer channel of zeros beside a ringing response was called swapped channels: it is a dead channel,
+    rejected by its tap as a dead response channel is (one tap a record, or in a record cut with tap_length)."""
+    t, f = half_sine(50.0)
+    dead = TapRecord(t, np.zeros(N), simulate(f), "displacement", "dead.csv")
+    result = process_taps([tap(), dead])
+    (rejected,) = result.rejected
+    assert rejected.source == "dead.csv" and rejected.reason.startswith(
+        "dead channel: column 'force' is 0 throughout the tap (a sensor not connected")
+    with pytest.raises(InvalidValueError, match=r"no tap kept: tap 1 \(dead.csv\): dead channel: column 'force' is "
+                                                r"0 throughout the record"):
+        process_taps([dead], tap_length=0.5)
+
+
 def test_a_hit_at_the_end_of_the_record_is_said_so_not_swapped():
     """A hit in the record's last samples: the response has hardly begun; it is not a swapped record."""
     rng = np.random.default_rng(4)

@@ -222,8 +222,8 @@ def process_taps(
             starts = tap_starts(record.force, length, pre, trigger_fraction, no_hit_factor)
             if not starts:
                 taps.append(Tap(len(taps) + 1, record.source, 0.0,
-                                reason="no hit: the force never exceeds "
-                                       f"{no_hit_factor:g} times its noise in the record"))
+                                reason=_dead(record.force_column, record.force, "record") or "no hit: the force never "
+                                f"exceeds {no_hit_factor:g} times its noise in the record"))
         for s in starts:
             tap = Tap(len(taps) + 1, record.source, float(record.time[s] - record.time[0]))
             if tap_length is not None and s + length > len(record):  # the record ends inside this tap
@@ -271,7 +271,7 @@ def process_taps(
         tap = taps[index]
         pulse = find_pulse(force[row], trigger_fraction, no_hit_factor)
         if isinstance(pulse, str):
-            taps[index] = attrs.evolve(tap, reason=pulse)
+            taps[index] = attrs.evolve(tap, reason=_dead(record.force_column, force[row], "tap") or pulse)
             continue
         width = (pulse.end - pulse.start) * dt
         tap = attrs.evolve(tap, peak_force=pulse.peak_force, pulse_width_s=width)
@@ -284,9 +284,8 @@ def process_taps(
                       f"{pulse.peak_force:.3g} N had ended)")
         for name, channel in ((record.force_column, force[row]), (record.response_column, response[row])):
             run, where = longest_flat_run(channel)
-            if reason is None and channel.max() == channel.min():  # not an overload: nothing was measured
-                reason = (f"dead channel: column {name!r} is {channel[0]:.4g} throughout the tap (a sensor not "
-                          "connected, not powered, or a wrong channel)")
+            if reason is None:
+                reason = _dead(name, channel, "tap")
             if reason is None and run >= clip_run:
                 value = channel.max() if where == "maximum" else channel.min()
                 reason = (f"clipped: column {name!r} stays at its {where} ({value:.4g}) for {run} samples "
@@ -390,6 +389,15 @@ def process_taps(
                      hammer_band, float(hammer_band_db), spectra, rate, length, why, v_f,
                      float(np.sqrt(np.mean(noise_sd**2)) * f_scale), width,
                      None if truncation is None else truncation[keep], shortest)
+
+
+def _dead(name: str, channel: np.ndarray, span: str) -> str | None:
+    """The reason of a tap whose column ``name`` is one number throughout its ``span`` (nothing was measured: not
+    an overload, not a missing hit), else None."""
+    if channel.size == 0 or channel.max() != channel.min():
+        return None
+    return (f"dead channel: column {name!r} is {channel[0]:.4g} throughout the {span} (a sensor not connected, not "
+            "powered, or a wrong channel)")
 
 
 def _scale(channels: np.ndarray) -> float:
