@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 from scipy import optimize, signal
@@ -283,6 +285,16 @@ def test_a_dead_force_channel_is_said_dead_not_swapped():
     with pytest.raises(InvalidValueError, match=r"no tap kept: tap 1 \(dead.csv\): dead channel: column 'force' is "
                                                 r"0 throughout the record"):
         process_taps([dead], tap_length=0.5)
+
+
+def test_a_record_of_complex_samples_is_refused_by_its_field():
+    t, f = half_sine(50.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # numpy's warning of a dropped imaginary part is no answer
+        for field, args in (("force", (t, f + 1j * f, f)), ("response", (t, f, f.astype(complex)))):
+            with pytest.raises(InvalidValueError, match=rf"{field}: got complex samples \(complex128\); expected "
+                                                        r"real samples of a time record"):
+                TapRecord(*args)
 
 
 def test_a_hit_at_the_end_of_the_record_is_said_so_not_swapped():

@@ -450,6 +450,20 @@ def test_lvm_errors(tmp_path):
         read_tap_lvm(path, sample_rate="10 kHz")
 
 
+@pytest.mark.parametrize("line, message", [
+    ("dt = -0.0001", r"line 1: 'dt' is -0.0001 s; expected a positive time step"),
+    ("Sample interval: 0 ms", r"line 1: 'Sample interval' is 0 ms; expected a positive time step"),
+    ("Sample rate: -10240 Hz", r"line 1: a sample rate of -10240 Hz; expected a positive rate"),
+])
+def test_a_preamble_s_time_step_that_is_not_positive_is_named_as_written(tmp_path, line, message):
+    """A negative or zero step is named by the step the file states, not by the rate it would give."""
+    _, f, a = samples()
+    path = tmp_path / "step.csv"
+    path.write_text(line + "\nforce [N],acceleration [m/s^2]\n" + rows([f, a]))
+    with pytest.raises(FileFormatError, match=r"step.csv, " + message):
+        read_tap_csv(path)
+
+
 # -- 5. UFF ----------------------------------------------------------------------------------------------------------
 
 def write_uff(path, channels, binary=0, abscissa_spec=17, abscissa_label="s", x=None):
