@@ -327,6 +327,7 @@ def test_a_tap_hit_near_its_record_s_end_is_rejected_not_every_tap_cut_to_it():
     mixed = process_taps([tap(40.0, source="long.csv"), tap(55.0, n=N // 2, source="half.csv")])
     assert mixed.averages == 2 and mixed.tap_samples <= N // 2 - 51
     assert mixed.shortest == "tap 2 (half.csv): its record ends 0.4949 s after its start"
+    assert mixed.summary()["shortest"] == mixed.shortest and both.summary()["shortest"] is None
 
 
 def test_a_force_within_its_noise_is_no_hit():

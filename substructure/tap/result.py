@@ -317,7 +317,7 @@ class TapResult:
             not applied), ``hammer_band_hz``, ``force_noise_rms_n``, ``force_window_s``,
             ``force_scatter`` (:meth:`force_scatter`), ``truncation_error``
             (:meth:`truncation_error` as ``{"error", "frequency_hz"}``, or
-            None), ``per_tap``.
+            None), ``shortest`` (the tap that set the taps' length, or None), ``per_tap``.
         """
         values = self.frf.data[:, 0, 0]
         return {
@@ -338,6 +338,7 @@ class TapResult:
             "force_scatter": self.force_scatter(),
             "truncation_error": None if (cut := self.truncation_error()) is None else
             {"error": cut[0], "frequency_hz": cut[1]},
+            "shortest": self.shortest,
             "per_tap": [{"tap": t.number, "file": t.source, "start_s": t.start_s, "peak_force_n": t.peak_force,
                          "pulse_width_s": t.pulse_width_s, "band_hz": t.band_hz, "kept": t.kept}
                         for t in self.taps],
