@@ -179,9 +179,10 @@ def process_taps(
     Raises
     ------
     InvalidValueError
-        For records of different sample rates or quantities, an unknown
-        estimator, an ``exponential`` other than True, False or None, records shorter than one tap, or no tap kept (the
-        reasons listed).
+        For records of different sample rates or quantities, the same tap
+        twice, an unknown estimator, an ``exponential`` other than True,
+        False or None, a ``tap_length`` not longer than ``pre_trigger``,
+        records shorter than one tap, or no tap kept (the reasons listed).
     SwappedChannelsError
         When a record's force looks like a response (naming file and columns).
     """
