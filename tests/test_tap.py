@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 from scipy import optimize, signal
@@ -9,7 +11,7 @@ from scipy import optimize, signal
 from substructure.datasets import free_free_beam_frfs, impact_records
 from substructure.errors import FileFormatError, InvalidValueError
 from substructure.io.tap_files import read_tap_csv, read_tap_uff
-from substructure.tap import SwappedChannelsError, TapRecord, added_damping, process_taps
+from substructure.tap import ESTIMATORS, SwappedChannelsError, TapRecord, added_damping, process_taps
 
 FS = 10240.0
 N = 10240  # 1 s
@@ -89,6 +91,16 @@ def test_the_window_is_applied_only_when_the_response_has_not_died_out():
     assert forced.tau is not None and forced.window == "asked for"
 
 
+def test_exponential_takes_true_false_or_none_and_refuses_other_values():
+    """numpy's booleans are booleans; 0, 1, "no" are refused (0 applied the window: it is not ``False``)."""
+    assert process_taps([tap()], exponential=np.False_).tau is None
+    assert process_taps([tap()], exponential=np.True_).tau is not None
+    for value in (0, 1, "no", 0.0):
+        with pytest.raises(InvalidValueError, match=rf"exponential: got {value!r} \({type(value).__name__}\); "
+                                                    r"expected True, False or None"):
+            process_taps([tap()], exponential=value)
+
+
 def test_acceleration_is_converted_to_receptance():
     """Through the window the taps measure the system at s = i omega + 1/tau: the accelerance s^2 H(s), and the
     receptance it converts to is H(s) (divided by s^2, not by (i omega)^2, which left a phase error of
@@ -155,6 +167,39 @@ def test_the_hammer_s_noise_before_the_pulse_is_outside_the_force_window():
 
     assert np.array_equal(shuffled(hit - 45, hit - 12), base)  # before the window (a pulse is ~6 samples)
     assert not np.array_equal(shuffled(hit - 5, hit), base)  # inside it
+
+
+@pytest.mark.parametrize("estimator", ESTIMATORS)
+def test_the_frf_and_coherence_do_not_depend_on_the_channels_scale(estimator):
+    """Force and response multiplied by 1e150 or 1e-150 (together, or one alone but for Hv, a total least squares
+    in the channels' units): the FRF scaled by their ratio,
+    the same coherence, windows, band and noise in proportion (their squares overflowed or underflowed: a
+    coherence of 0 on every line)."""
+    records = _noisy(4, out_noise=2e-7, in_noise=0.05)
+    base = process_taps(records, estimator)
+    assert np.median(base.coherence) < 0.999  # noisy: a coherence that can move
+    together = ((1e150, 1e150), (1e-150, 1e-150))  # Hv weighs the channels' errors in their units: only together
+    for f_scale, x_scale in together + (() if estimator == "Hv" else ((1e150, 1.0), (1.0, 1e-150), (1e-150, 1e150))):
+        scaled = [TapRecord(r.time, r.force * f_scale, r.response * x_scale, r.quantity, r.source)
+                  for r in records]
+        got = process_taps(scaled, estimator)
+        assert np.allclose(got.frf.data, base.frf.data * (x_scale / f_scale), rtol=1e-9, atol=0)
+        assert np.allclose(got.coherence, base.coherence, rtol=0, atol=1e-9)
+        assert got.tau == base.tau and got.window == base.window and got.hammer_band_hz == base.hammer_band_hz
+        assert got.force_noise_rms == pytest.approx(base.force_noise_rms * f_scale, rel=1e-9)
+        assert [t.peak_force for t in got.taps] == pytest.approx([t.peak_force * f_scale for t in base.taps],
+                                                                 rel=1e-12)
+        assert np.allclose(got.force_spectra_db, base.force_spectra_db + 20 * np.log10(f_scale), rtol=0, atol=1e-9)
+        for a, b in ((got.force_noise, base.force_noise), (got.truncation, base.truncation)):
+            assert (a is None) == (b is None) and (a is None or np.allclose(a, b, rtol=1e-9, atol=0))
+
+
+def test_peaks_of_lines_above_the_hammer_s_band_are_none():
+    """A result kept to lines above the hammer's usable band has no peaks to report (not a crop's error)."""
+    result = process_taps([tap(peak) for peak in (40.0, 55.0)])
+    above = process_taps([tap(peak) for peak in (40.0, 55.0)], band=(result.hammer_band_hz + 100.0, 5000.0))
+    assert result.hammer_band_hz < 4900.0 and above.frf.frequency.hz[0] > result.hammer_band_hz
+    assert above.peaks().size == 0
 
 
 def test_input_noise_biases_h1_down_and_not_h2():
@@ -228,6 +273,30 @@ def test_a_dead_response_channel_is_said_dead_not_clipped():
             process_taps(records)
 
 
+def test_a_dead_force_channel_is_said_dead_not_swapped():
+    """A hammer channel of zeros beside a ringing response was called swapped channels: it is a dead channel,
+    rejected by its tap as a dead response channel is (one tap a record, or in a record cut with tap_length)."""
+    t, f = half_sine(50.0)
+    dead = TapRecord(t, np.zeros(N), simulate(f), "displacement", "dead.csv")
+    result = process_taps([tap(), dead])
+    (rejected,) = result.rejected
+    assert rejected.source == "dead.csv" and rejected.reason.startswith(
+        "dead channel: column 'force' is 0 throughout the tap (a sensor not connected")
+    with pytest.raises(InvalidValueError, match=r"no tap kept: tap 1 \(dead.csv\): dead channel: column 'force' is "
+                                                r"0 throughout the record"):
+        process_taps([dead], tap_length=0.5)
+
+
+def test_a_record_of_complex_samples_is_refused_by_its_field():
+    t, f = half_sine(50.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # numpy's warning of a dropped imaginary part is no answer
+        for field, args in (("force", (t, f + 1j * f, f)), ("response", (t, f, f.astype(complex)))):
+            with pytest.raises(InvalidValueError, match=rf"{field}: got complex samples \(complex128\); expected "
+                                                        r"real samples of a time record"):
+                TapRecord(*args)
+
+
 def test_a_hit_at_the_end_of_the_record_is_said_so_not_swapped():
     """A hit in the record's last samples: the response has hardly begun; it is not a swapped record."""
     rng = np.random.default_rng(4)
@@ -239,6 +308,26 @@ def test_a_hit_at_the_end_of_the_record_is_said_so_not_swapped():
         t, f = half_sine(50.0)
         x = simulate(f)
         process_taps([TapRecord(t, x * 1e7, f * 1e-7, "displacement", "early.csv")])
+
+
+def test_a_tap_hit_near_its_record_s_end_is_rejected_not_every_tap_cut_to_it():
+    """Three good taps and one hit 10 ms before its record ends: the late one is rejected as cut short (by file and
+    number), the FRF is that of the three good ones (it was every tap cut to 150 samples, windowed with tau 2 ms)."""
+    good = [tap(peak, source=f"good{k}.csv") for k, peak in enumerate((40.0, 55.0, 70.0))]
+    late = tap(60.0, start=0.99, source="late.csv")
+    alone, both = process_taps(good), process_taps([good[0], late, good[1], good[2]])
+    assert both.averages == 3 and [t.number for t in both.rejected] == [2]
+    (rejected,) = both.rejected
+    assert rejected.source == "late.csv" and rejected.peak_force == pytest.approx(60.0, rel=0.02)
+    assert rejected.reason.startswith("cut short: the record ends 0.01494 s after this tap's start (t = 0.9851 s), "
+                                      "under 0.25 of the taps' median 0.9949 s")
+    assert both.tap_samples == alone.tap_samples and both.tau is None and alone.shortest is None
+    assert np.array_equal(both.frf.data, alone.frf.data) and np.array_equal(both.coherence, alone.coherence)
+    # taps of records of different lengths are all cut to the shortest kept one, which the result names
+    mixed = process_taps([tap(40.0, source="long.csv"), tap(55.0, n=N // 2, source="half.csv")])
+    assert mixed.averages == 2 and mixed.tap_samples <= N // 2 - 51
+    assert mixed.shortest == "tap 2 (half.csv): its record ends 0.4949 s after its start"
+    assert mixed.summary()["shortest"] == mixed.shortest and both.summary()["shortest"] is None
 
 
 def test_a_force_within_its_noise_is_no_hit():

@@ -450,6 +450,20 @@ def test_lvm_errors(tmp_path):
         read_tap_lvm(path, sample_rate="10 kHz")
 
 
+@pytest.mark.parametrize("line, message", [
+    ("dt = -0.0001", r"line 1: 'dt' is -0.0001 s; expected a positive time step"),
+    ("Sample interval: 0 ms", r"line 1: 'Sample interval' is 0 ms; expected a positive time step"),
+    ("Sample rate: -10240 Hz", r"line 1: a sample rate of -10240 Hz; expected a positive rate"),
+])
+def test_a_preamble_s_time_step_that_is_not_positive_is_named_as_written(tmp_path, line, message):
+    """A negative or zero step is named by the step the file states, not by the rate it would give."""
+    _, f, a = samples()
+    path = tmp_path / "step.csv"
+    path.write_text(line + "\nforce [N],acceleration [m/s^2]\n" + rows([f, a]))
+    with pytest.raises(FileFormatError, match=r"step.csv, " + message):
+        read_tap_csv(path)
+
+
 # -- 5. UFF ----------------------------------------------------------------------------------------------------------
 
 def write_uff(path, channels, binary=0, abscissa_spec=17, abscissa_label="s", x=None):
@@ -538,6 +552,37 @@ def test_uff_abscissa_not_time_or_uneven_is_refused(tmp_path):
     with pytest.raises(FileFormatError, match=r"uneven.uff, record 0: uneven abscissa"):
         read_tap_uff(path)
 
+
+
+def test_uff_abscissa_in_milliseconds_is_converted_to_seconds(tmp_path):
+    """A time axis labelled 'ms' (or 'us') is read in its unit: the same samples with the abscissa in s and in ms
+    give the same record and the same FRF (it was read as seconds: a sample rate 1000 times too low); a unit that
+    cannot be read, a decreasing or a standing abscissa are refused as such."""
+    from substructure.tap import process_taps
+
+    tap = impact_records()[0]
+    t = tap.time - tap.time[0]
+    channels = [(tap.force, 13, "N"), (tap.response / G, 0, "g")]
+    seconds = read_tap_uff(write_uff(tmp_path / "s.uff", channels, x=t))
+    for label, scale in (("ms", 1e3), ("us", 1e6)):
+        other = read_tap_uff(write_uff(tmp_path / f"{label}.uff", channels, abscissa_label=label, x=t * scale))
+        assert other.sample_rate == pytest.approx(seconds.sample_rate, rel=1e-9)
+        assert np.allclose(other.time, seconds.time, rtol=0, atol=1e-9 / seconds.sample_rate)
+        a, b = process_taps(seconds), process_taps(other)
+        assert np.allclose(b.frf.frequency.hz, a.frf.frequency.hz, rtol=1e-9)
+        assert np.allclose(b.frf.data, a.frf.data, rtol=1e-6, atol=1e-9 * np.abs(a.frf.data).max())
+        assert np.allclose(b.coherence, a.coherence, atol=1e-9)
+    path = write_uff(tmp_path / "furlong.uff", channels, abscissa_label="blips", x=t)
+    with pytest.raises(FileFormatError, match=r"furlong.uff, record 0: abscissa unit label 'blips' "
+                                              r"is not a unit read here; expected a time unit"):
+        read_tap_uff(path)
+    path = write_uff(tmp_path / "down.uff", channels, x=1.0 - t)
+    with pytest.raises(FileFormatError, match=r"down.uff, record 0: the abscissa decreases \(from 1.0 s to "
+                                              r"3.90625e-05 s over 25600 samples, a step of -3.90625e-05 s\)"):
+        read_tap_uff(path)
+    path = write_uff(tmp_path / "still.uff", channels, x=0 * t)
+    with pytest.raises(FileFormatError, match=r"still.uff, record 0: the abscissa does not advance"):
+        read_tap_uff(path)
 
 
 def test_a_universal_file_of_several_taps_reads_as_one_tap_each(tmp_path, capsys):

@@ -151,6 +151,10 @@ def _frf(n=5):
     (["--tap-length", "nan"], "argument --tap-length: got nan; expected a finite number > 0"),
     (["--pre-trigger", "-1"], "argument --pre-trigger: got -1.0; expected a finite number >= 0"),
     (["--hammer-band-db", "-5"], "argument --hammer-band-db: got -5.0; expected a finite number > 0"),
+    (["--tap-length", "0.004"], "argument --tap-length: got 0.004 s, not longer than --pre-trigger 0.005 s (its "
+                                "default); expected a tap longer than the time kept before its hit"),
+    (["--tap-length", "0.1", "--pre-trigger", "0.1"], "argument --tap-length: got 0.1 s, not longer than "
+                                                      "--pre-trigger 0.1 s; expected a tap longer"),
     (["--no-exponential-window", "--tau", "0.1"], "--tau sets the exponential window's time constant; it cannot "
                                                   "go with --no-exponential-window"),
 ])
@@ -160,11 +164,57 @@ def test_tap_options_out_of_range_are_refused_by_name(records, tmp_path, capsys,
     assert code != 0 and message in err and not (tmp_path / "frf.csv").exists()
 
 
+def test_a_record_file_given_twice_is_refused_naming_it(records, tmp_path, capsys):
+    """The same file twice (also by another path to it) would be its taps averaged twice: coherence 1."""
+    folder, paths = records
+    link = tmp_path / "link.csv"
+    link.symlink_to(paths[0])
+    for again in (paths[0], str(folder / "." / "tap1.csv"), str(link)):
+        code, _, err = run(capsys, "tap", paths[0], paths[1], again, "--out", tmp_path / "frf.csv")
+        assert code != 0 and not (tmp_path / "frf.csv").exists()
+        assert f"{again}: the record file is given more than once (also as {paths[0]}); expected each record once" \
+            in err
+
+
+def test_the_same_tap_twice_in_python_is_refused():
+    from substructure.tap import process_taps
+
+    taps = impact_records()[:3]
+    with pytest.raises(InvalidValueError, match=r"records\[2\] \(.*\): the same force and response samples as "
+                                                r"records\[0\] \(.*\); expected each tap once"):
+        process_taps([taps[0], taps[1], taps[0]])
+    assert process_taps(taps).averages == 3
+
+
+def test_a_band_above_the_hammer_s_or_the_records_band_is_refused_at_the_option(records, tmp_path, capsys):
+    """The shipped taps: 25600 Hz, the hammer's usable band to about 7 kHz: a band above it (below the Nyquist
+    frequency) is refused naming --band and both limits (it was an internal message of a crop); above Nyquist
+    likewise; a band reaching into the usable band is kept; --band takes LO:HI only, and says so."""
+    from substructure.tap import process_taps
+
+    _, paths = records
+    usable = process_taps(impact_records()).hammer_band_hz
+    assert 5000 < usable < 11000
+    code, _, err = run(capsys, "tap", *paths, "--band", "11000:12000", "--out", tmp_path / "frf.csv")
+    assert code != 0 and not (tmp_path / "frf.csv").exists()
+    assert (f"argument --band: got 11000:12000 Hz, above the hammer's usable band (up to {usable:.0f} Hz, where its "
+            "force spectrum has fallen 20 dB; the Nyquist frequency is 12800 Hz)") in err
+    code, _, err = run(capsys, "tap", *paths, "--band", "13000:14000")
+    assert code != 0 and ("argument --band: got 13000:14000 Hz; the records' lines end at the Nyquist frequency, "
+                          "12800 Hz") in err
+    code, out, err = run(capsys, "tap", *paths, "--band", f"{usable - 500:.0f}:12000")
+    assert code == 0, err
+    for text in ("100", "auto"):
+        code, _, err = run(capsys, "tap", paths[0], "--band", text)
+        assert code != 0 and f"argument --band: got {text!r}; expected LO:HI in Hz, e.g. 1200:1700" in err
+
+
 def test_process_taps_refuses_settings_out_of_range():
     records = impact_records()[:2]
     from substructure.tap import process_taps
 
     for kw, message in ((dict(tap_length=float("nan")), "tap_length: got nan s; expected a finite number > 0"),
+                        (dict(tap_length=0.004), "tap_length: got 0.004 s, not longer than pre_trigger 0.005 s"),
                         (dict(pre_trigger=-0.1), "pre_trigger: got -0.1 s; expected a finite number >= 0"),
                         (dict(tau=float("inf")), "tau: got inf s; expected a finite number > 0"),
                         (dict(hammer_band_db=0.0), "hammer_band_db: got 0.0 dB; expected a finite number > 0"),

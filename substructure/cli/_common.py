@@ -243,15 +243,17 @@ def check_outputs(outputs: Iterable[tuple[str, Any]], inputs: Iterable[Any], ove
         check_writable(path, overwrite, option)
 
 
-def band_arg(text: str):
-    """``auto`` or ``LO:HI``: plain numbers in Hz, or frequencies with units (rad/s, rpm converted)."""
+def band_arg(text: str, auto: bool = True):
+    """``auto`` (unless ``auto`` is False) or ``LO:HI``: plain numbers in Hz, or frequencies with units (rad/s,
+    rpm converted)."""
     from ..units import frequency_hz
 
-    if text.strip() == "auto":
+    if auto and text.strip() == "auto":
         return "auto"
     parts = text.split(":")
     if len(parts) != 2 or not all(_LEADING_NUMBER.match(p) for p in parts):
-        raise argparse.ArgumentTypeError(f"got {text!r}; expected auto or LO:HI in Hz, e.g. 1200:1700")
+        raise argparse.ArgumentTypeError(f"got {text!r}; expected {'auto or ' if auto else ''}LO:HI in Hz, "
+                                         "e.g. 1200:1700")
     values = []
     for part in parts:
         try:
@@ -273,10 +275,7 @@ def band_arg(text: str):
 
 def band_range_arg(text: str):
     """``LO:HI`` as :func:`band_arg`, without ``auto``."""
-    band = band_arg(text)
-    if band == "auto":
-        raise argparse.ArgumentTypeError("expected LO:HI in Hz, e.g. 200:3000")
-    return band
+    return band_arg(text, auto=False)
 
 
 def measurement_inputs(path) -> list:

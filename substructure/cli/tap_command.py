@@ -75,6 +75,13 @@ def run(args: argparse.Namespace) -> int:
             raise UsageError(f"{path}: expected a tap record in a .csv, .uff or .unv file (or text in .txt, "
                              ".dat or .asc, a LabVIEW .lvm file, an NI .tdms file, a MATLAB .mat file, a .uf "
                              "universal file)")
+    given: dict[Path, str] = {}
+    for path in args.records:  # one file twice is its taps averaged twice: coherence 1, the scatter understated
+        resolved = Path(path).resolve()
+        if resolved in given:
+            raise UsageError(f"{path}: the record file is given more than once (also as {given[resolved]}); "
+                             "expected each record once (its taps would be averaged twice)")
+        given[resolved] = path
     if args.out and Path(args.out).suffix.lower() != ".csv":
         raise UsageError(f"argument --out: {args.out!r}: expected a .csv file (frequency_hz,real,imag,coherence)")
     if args.measurements:
@@ -94,14 +101,28 @@ def run(args: argparse.Namespace) -> int:
     for option, value, zero in (("--tap-length", args.tap_length, False), ("--pre-trigger", args.pre_trigger, True),
                                 ("--tau", args.tau, False), ("--hammer-band-db", args.hammer_band_db, False)):
         positive_arg(option, value, zero)
+    pre_trigger = PRE_TRIGGER_S if args.pre_trigger is None else args.pre_trigger
+    if args.tap_length is not None and not args.tap_length > pre_trigger:
+        raise UsageError(f"argument --tap-length: got {args.tap_length:g} s, not longer than --pre-trigger "
+                         f"{pre_trigger:g} s{' (its default)' if args.pre_trigger is None else ''}; expected a tap "
+                         "longer than the time kept before its hit")
     if args.no_exponential_window and args.tau is not None:
         raise UsageError("--tau sets the exponential window's time constant; it cannot go with --no-exponential-window")
     records = [record for path in args.records for record in _read(path, args)]
+    nyquist = records[0].sample_rate / 2.0
+    if args.band is not None and args.band[0] >= nyquist:
+        raise UsageError(f"argument --band: got {args.band[0]:g}:{args.band[1]:g} Hz; the records' lines end at "
+                         f"the Nyquist frequency, {nyquist:g} Hz: expected a band starting below it")
     result = process_taps(records, args.estimator, tap_length=args.tap_length,
-                          pre_trigger=PRE_TRIGGER_S if args.pre_trigger is None else args.pre_trigger,
+                          pre_trigger=pre_trigger,
                           exponential=True if args.exponential_window else False if args.no_exponential_window
                           else None, tau=args.tau, band=args.band,
                           hammer_band_db=HAMMER_BAND_DB if args.hammer_band_db is None else args.hammer_band_db)
+    if args.band is not None and args.band[0] > result.hammer_band_hz:
+        raise UsageError(f"argument --band: got {args.band[0]:g}:{args.band[1]:g} Hz, above the hammer's usable "
+                         f"band (up to {result.hammer_band_hz:.0f} Hz, where its force spectrum has fallen "
+                         f"{result.hammer_band_db:g} dB; the Nyquist frequency is {nyquist:g} Hz): the taps do not "
+                         f"excite it; expected a band starting below {result.hammer_band_hz:.0f} Hz")
     if args.reverse_polarity:  # one channel's sign reversed: the FRF negated, its coherence and noise as they are
         import attrs
 
@@ -147,7 +168,9 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     print(f"records: {len(records)}, {result.sample_rate:g} Hz, {result.tap_samples} samples per tap "
-          f"({result.tap_samples / result.sample_rate:g} s)")
+          f"({result.tap_samples / result.sample_rate:g} s" + ("" if result.shortest is None else
+                                                                f"; every tap cut to the shortest, {result.shortest}")
+          + ")")
     print(f"taps: {len(result.taps)} found, {result.averages} averaged ({result.estimator}), "
           f"{len(result.rejected)} rejected")
     for tap in result.taps:

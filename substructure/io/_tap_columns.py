@@ -163,7 +163,7 @@ def rate_from_lines(lines: list[tuple[int, str]], name: str, decimal_comma: bool
                 raise FileFormatError(f"{name}, line {number}: {match.group(1)!r} gives different values "
                                       f"({', '.join(f'{v:g}' for v in values)}); expected one sample rate for "
                                       "all channels")
-            hz = _to_hz(values[0], unit_text, kind, f"{name}, line {number}")
+            hz = _to_hz(values[0], unit_text, kind, f"{name}, line {number}", match.group(1))
             found.append((hz, number, match.group(1)))
             break
     if not found:
@@ -176,7 +176,9 @@ def rate_from_lines(lines: list[tuple[int, str]], name: str, decimal_comma: bool
     return hz, number
 
 
-def _to_hz(value: float, unit_text: str | None, kind: str, where: str) -> float:
+def _to_hz(value: float, unit_text: str | None, kind: str, where: str, key: str = "") -> float:
+    """The sample rate in Hz of a preamble's ``value`` of a rate or a step (``kind``) in ``unit_text``; ``key``:
+    the name the file gives it, for messages (a step is named as written, not as the rate it gives)."""
     from ..units import ureg
 
     if unit_text and _SAMPLES_PER_SECOND.match(unit_text.strip()):
@@ -195,6 +197,10 @@ def _to_hz(value: float, unit_text: str | None, kind: str, where: str) -> float:
     else:
         raise FileFormatError(f"{where}: the sample {'rate' if kind == 'rate' else 'interval'} is in "
                               f"{unit_text!r}; expected {'Hz' if kind == 'rate' else 's'}")
+    if kind == "step" and not (q.magnitude > 0 and hz < float("inf")):
+        written = f"{value:g}" + (f" {unit_text}" if unit_text else "")
+        raise FileFormatError(f"{where}: {key or 'the sample interval'!r} is {written}; expected a positive time "
+                              "step")
     if not hz > 0 or hz == float("inf"):
         raise FileFormatError(f"{where}: a sample rate of {hz:g} Hz; expected a positive rate")
     return float(hz)

@@ -20,6 +20,7 @@ import numpy as np
 
 from ..errors import FileFormatError, SubstructureError
 from ..tap.records import RESPONSE_QUANTITIES, TIME_STEP_TOLERANCE, TapRecord, channel_to_si, unit_of
+from ..units import magnitude_in
 from . import check_readable_file
 from ._tap_build import MAX_RECORD_BYTES, RESPONSES, check_quantity_option, quantity_of, regular
 
@@ -224,24 +225,34 @@ def _uff_tap(name: str, records: list[dict], kinds: list, pair: tuple[int, int],
 
 
 def _check_abscissa(name: str, k: int, record: dict) -> None:
-    """Refuse a record whose abscissa is not time (by its data type or unit label) or not uniformly spaced."""
+    """Refuse a record whose abscissa is not time (by its data type or unit label), not increasing or not
+    uniformly spaced; convert it to seconds by its unit label (``ms``, ``us``, ``min``; none: seconds)."""
     spec = int(record.get("abscissa_spec_data_type", 0) or 0)
     label = str(record.get("abscissa_axis_units_lab", "") or "").strip()
     if spec not in (0, 17):
         raise FileFormatError(f"{name}, record {k}: abscissa of specific data type {spec}; expected 17 (time) "
                               "or 0: a tap record is sampled in time")
+    to_seconds = 1.0
     if label and label.upper() not in ("NONE", "N/A", "NA", "-"):
         try:
-            time_like = (1.0 * unit_of(label, f"{name}, record {k}")).check("[time]")
+            unit = unit_of(label, f"{name}, record {k}")
         except SubstructureError:
-            time_like = False
-        if not time_like:
+            raise FileFormatError(f"{name}, record {k}: abscissa unit label {label!r} is not a unit read here; "
+                                  "expected a time unit (s, ms, us)") from None
+        if not (1.0 * unit).check("[time]"):
             raise FileFormatError(f"{name}, record {k}: abscissa in {label!r}; expected a time in s")
-    x = record["x"] = regular(np.asarray(record.get("x", []), dtype=np.float64))  # times written rounded: the clock
+        to_seconds = magnitude_in(1.0 * unit, "s")
+    x = regular(np.asarray(record.get("x", []), dtype=np.float64))  # times written rounded: the clock
+    x = record["x"] = x * to_seconds if to_seconds != 1.0 else x
     if x.size > 2:
         step = np.diff(x)
         mean = (x[-1] - x[0]) / (x.size - 1)
-        if not mean > 0 or np.any(np.abs(step - mean) > TIME_STEP_TOLERANCE * mean):
+        if not mean > 0:
+            how = "decreases" if mean < 0 else "does not advance"
+            raise FileFormatError(f"{name}, record {k}: the abscissa {how} (from {float(x[0])!r} s to "
+                                  f"{float(x[-1])!r} s over {x.size} samples, a step of {float(mean)!r} s); "
+                                  "expected time increasing at a uniform step")
+        if np.any(np.abs(step - mean) > TIME_STEP_TOLERANCE * mean):
             worst = int(np.argmax(np.abs(step - mean))) + 1
             raise FileFormatError(f"{name}, record {k}: uneven abscissa (sample {worst}: step "
                                   f"{float(step[worst - 1])!r} s, mean {float(mean)!r} s); expected uniform sampling "

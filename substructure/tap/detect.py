@@ -252,8 +252,11 @@ def crest_factor(values: np.ndarray) -> float:
         ``max|v - mean| / rms(v - mean)``; 0 for a constant channel.
     """
     centred = values - np.mean(values)
-    rms = float(np.sqrt(np.mean(centred**2)))
-    return float(np.max(np.abs(centred)) / rms) if rms > 0 else 0.0
+    peak = float(np.max(np.abs(centred))) if centred.size else 0.0
+    if not peak > 0:
+        return 0.0
+    # relative to the peak: the squares of channels of 1e160 or 1e-170 would overflow or underflow
+    return float(1.0 / np.sqrt(np.mean((centred / peak) ** 2)))
 
 
 def check_swapped(force: np.ndarray, response: np.ndarray, dt: float, source: str, force_column: str,
@@ -280,6 +283,8 @@ def check_swapped(force: np.ndarray, response: np.ndarray, dt: float, source: st
     SwappedChannelsError
         Naming the file and both columns.
     """
+    if force.size and force.max() == force.min():  # a dead hammer channel is said so by its tap, not swapped
+        return
     c_force, c_response = crest_factor(force), crest_factor(response)
     if c_response > CREST_FACTOR_PULSE and c_response > c_force:
         # a hit in the record's last 5 %: the response has hardly begun, and a pulse in both columns says

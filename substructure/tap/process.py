@@ -11,6 +11,7 @@ is dropped.  See docs/tap.md for the equations.
 
 from __future__ import annotations
 
+import hashlib
 from typing import Any, Sequence
 
 import attrs
@@ -26,7 +27,7 @@ from .records import RESPONSE_QUANTITIES, TapRecord
 from .result import Tap, TapResult
 
 __all__ = ["process_taps", "ESTIMATORS", "EXP_WINDOW_END", "FORCE_WINDOW_EXTRA", "FORCE_WINDOW_BEFORE",
-           "HAMMER_BAND_DB"]
+           "HAMMER_BAND_DB", "SHORT_TAP_SHARE"]
 
 ESTIMATORS = ("H1", "H2", "Hv")
 """The FRF estimators: H1 = Gfx/Gff (noise on the response), H2 = Gxx/Gxf (noise on the force), Hv (both)."""
@@ -41,6 +42,11 @@ FORCE_WINDOW_BEFORE = 1.0
 """The force window opens this many pulse widths before the force crosses the trigger level (the pulse's rise
 below that level is kept; the pre-trigger's noise before it is not: left in, it is a smooth random error of H1
 over hundreds of hertz, largest relative to the response's noise at the resonances)."""
+
+SHORT_TAP_SHARE = 0.25
+"""Without ``tap_length`` every tap is cut to the shortest; a tap whose record ends sooner after its start than
+this share of the taps' median length (a hit near the record's end) is rejected as cut short instead: its response
+is hardly recorded, and cutting every other tap to it would coarsen the grid and window them all."""
 
 HAMMER_BAND_DB = 20.0
 """The hammer's usable band ends where the force spectrum has fallen this many dB below its low-frequency level."""
@@ -58,6 +64,16 @@ def _records(records: Any) -> tuple[TapRecord, ...]:
     for i, r in enumerate(items):
         if not isinstance(r, TapRecord):
             raise InvalidValueError(f"records[{i}]: got {type(r).__name__}; expected a TapRecord")
+    seen: dict[bytes, int] = {}
+    for i, r in enumerate(items):  # one tap given twice is averaged as two: coherence 1, the scatter understated
+        digest = hashlib.sha256(np.ascontiguousarray(r.force).tobytes() + b"|"
+                                + np.ascontiguousarray(r.response).tobytes()).digest()
+        if digest in seen:
+            j = seen[digest]
+            raise InvalidValueError(f"records[{i}] ({r.source}): the same force and response samples as records[{j}] "
+                                    f"({items[j].source}); expected each tap once (a tap given twice is averaged as "
+                                    "two, its coherence 1 and its scatter understated)")
+        seen[digest] = i
     first = items[0]
     for r in items[1:]:
         if abs(r.sample_rate - first.sample_rate) > 1e-6 * first.sample_rate:
@@ -124,7 +140,10 @@ def process_taps(
         trigger crossing after the previous tap ended.  Default: one tap per
         record, from the pre-trigger to the end of the shortest record
         (shortened to the nearest length below whose FFT is fast:
-        ``scipy.fft.prev_fast_len``).
+        ``scipy.fft.prev_fast_len``); a tap whose record ends sooner after
+        its start than :data:`SHORT_TAP_SHARE` of the taps' median length is
+        rejected as cut short instead (``TapResult.shortest`` names the tap
+        that set the length).
     pre_trigger : float
         Time kept before the trigger crossing, in s.
     exponential : bool or None
@@ -160,9 +179,10 @@ def process_taps(
     Raises
     ------
     InvalidValueError
-        For records of different sample rates or quantities, an unknown
-        estimator, records shorter than one tap, or no tap kept (the
-        reasons listed).
+        For records of different sample rates or quantities, the same tap
+        twice, an unknown estimator, an ``exponential`` other than True,
+        False or None, a ``tap_length`` not longer than ``pre_trigger``,
+        records shorter than one tap, or no tap kept (the reasons listed).
     SwappedChannelsError
         When a record's force looks like a response (naming file and columns).
     """
@@ -171,6 +191,13 @@ def process_taps(
                     tau=(tau, "s", False), window_end=(window_end, "", False),
                     force_window_extra=(force_window_extra, "pulse widths", True),
                     hammer_band_db=(hammer_band_db, "dB", False))
+    if tap_length is not None and not float(tap_length) > float(pre_trigger):
+        raise InvalidValueError(f"tap_length: got {tap_length!r} s, not longer than pre_trigger {pre_trigger!r} s; "
+                                "expected a tap longer than the time kept before its hit")
+    if exponential is not None and not isinstance(exponential, (bool, np.bool_)):
+        raise InvalidValueError(f"exponential: got {exponential!r} ({type(exponential).__name__}); expected True, "
+                                "False or None (the window only when the response still rings at the tap's end)")
+    exponential = None if exponential is None else bool(exponential)
     if exponential is False and tau is not None:
         raise InvalidValueError(f"tau: got {tau!r} s with exponential=False; a time constant asks for the window")
     if estimator not in ESTIMATORS:
@@ -180,6 +207,7 @@ def process_taps(
     pre = max(int(round(float(pre_trigger) * rate)), 0)
     taps: list[Tap] = []
     cuts: list[tuple[TapRecord, int, int]] = []  # record, first sample, tap index in taps
+    peaks: dict[int, float] = {}  # without tap_length: per tap index, its peak force in the whole record
     if tap_length is not None:
         length = int(round(float(tap_length) * rate))
         if length < 16:
@@ -190,12 +218,13 @@ def process_taps(
         if tap_length is None:
             first = find_pulse(record.force, trigger_fraction, no_hit_factor)
             starts = [0 if isinstance(first, str) else max(first.start - pre, 0)]
+            peaks[len(taps)] = 0.0 if isinstance(first, str) else first.peak_force
         else:
             starts = tap_starts(record.force, length, pre, trigger_fraction, no_hit_factor)
             if not starts:
                 taps.append(Tap(len(taps) + 1, record.source, 0.0,
-                                reason="no hit: the force never exceeds "
-                                       f"{no_hit_factor:g} times its noise in the record"))
+                                reason=_dead(record.force_column, record.force, "record") or "no hit: the force never "
+                                f"exceeds {no_hit_factor:g} times its noise in the record"))
         for s in starts:
             tap = Tap(len(taps) + 1, record.source, float(record.time[s] - record.time[0]))
             if tap_length is not None and s + length > len(record):  # the record ends inside this tap
@@ -204,6 +233,22 @@ def process_taps(
             else:
                 cuts.append((record, s, len(taps)))
             taps.append(tap)
+    shortest = None  # without tap_length: the tap whose length all are cut to, in words
+    if tap_length is None and len(cuts) > 1:
+        spans = np.array([len(r) - s for r, s, _ in cuts])
+        median = float(np.median(spans))
+        for (r, s, index), span in zip(cuts, spans.tolist()):
+            if span < SHORT_TAP_SHARE * median:
+                taps[index] = attrs.evolve(taps[index], peak_force=peaks[index], reason=(
+                    f"cut short: the record ends {span / rate:.4g} s after this tap's start (t = "
+                    f"{taps[index].start_s:.4g} s), under {SHORT_TAP_SHARE:g} of the taps' median {median / rate:.4g} "
+                    "s: its response is hardly recorded (every tap is cut to the shortest kept one)"))
+        cuts = [c for c in cuts if taps[c[2]].reason is None]
+        spans = np.array([len(r) - s for r, s, _ in cuts])
+        if cuts and spans.max() > spans.min():
+            k = int(np.argmin(spans))
+            shortest = (f"tap {taps[cuts[k][2]].number} ({cuts[k][0].source}): its record ends "
+                        f"{spans[k] / rate:.4g} s after its start")
     if not cuts:
         reasons = "; ".join(f"tap {t.number} ({t.source}): {t.reason}" for t in taps)
         raise InvalidValueError(f"no tap kept: {reasons}")
@@ -213,6 +258,10 @@ def process_taps(
         raise InvalidValueError(f"{cuts[0][0].source}: the taps are {length} samples long; expected more")
     force = np.stack([r.force[s:s + length] for r, s, _ in cuts])
     response = np.stack([r.response[s:s + length] for r, s, _ in cuts])
+    # the spectra, their products and the mean squares of the end of the taps are formed of the channels each
+    # divided by a power of two near its peak (exact: the FRF and coherence do not depend on the channels' scale;
+    # squares of 1e160 N overflowed, of 1e-170 N underflowed, to a coherence of 0), the scales undone after
+    f_scale, x_scale = _scale(force), _scale(response)
     hz = np.fft.rfftfreq(length, dt)
     # judge each tap; the windows of the kept ones
     force_window = np.zeros_like(force)
@@ -223,7 +272,7 @@ def process_taps(
         tap = taps[index]
         pulse = find_pulse(force[row], trigger_fraction, no_hit_factor)
         if isinstance(pulse, str):
-            taps[index] = attrs.evolve(tap, reason=pulse)
+            taps[index] = attrs.evolve(tap, reason=_dead(record.force_column, force[row], "tap") or pulse)
             continue
         width = (pulse.end - pulse.start) * dt
         tap = attrs.evolve(tap, peak_force=pulse.peak_force, pulse_width_s=width)
@@ -236,9 +285,8 @@ def process_taps(
                       f"{pulse.peak_force:.3g} N had ended)")
         for name, channel in ((record.force_column, force[row]), (record.response_column, response[row])):
             run, where = longest_flat_run(channel)
-            if reason is None and channel.max() == channel.min():  # not an overload: nothing was measured
-                reason = (f"dead channel: column {name!r} is {channel[0]:.4g} throughout the tap (a sensor not "
-                          "connected, not powered, or a wrong channel)")
+            if reason is None:
+                reason = _dead(name, channel, "tap")
             if reason is None and run >= clip_run:
                 value = channel.max() if where == "maximum" else channel.min()
                 reason = (f"clipped: column {name!r} stays at its {where} ({value:.4g}) for {run} samples "
@@ -252,7 +300,7 @@ def process_taps(
         if reason is None:
             kept.append(row)
     # the usable band per tap (kept or not), from the force in its window
-    power = np.abs(scipy.fft.rfft((force - baseline[:, None]) * force_window, axis=1)) ** 2
+    power = np.abs(scipy.fft.rfft((force - baseline[:, None]) / f_scale * force_window, axis=1)) ** 2
     bands = _band_end(power, hz, hammer_band_db)
     for row, (_, _, index) in enumerate(cuts):
         if taps[index].peak_force > 0:
@@ -261,8 +309,8 @@ def process_taps(
         reasons = "; ".join(f"tap {t.number} ({t.source}): {t.reason}" for t in taps)
         raise InvalidValueError(f"no tap kept: {reasons}")
     rows = np.array(kept)
-    f = force[rows] - baseline[rows, None]
-    x = response[rows].copy()
+    f = (force[rows] - baseline[rows, None]) / f_scale
+    x = response[rows] / x_scale
     quiet = np.argmax(force_window[rows] > 0, axis=1)  # the samples before the force window: no pulse yet
     for i, p in enumerate(quiet.tolist()):  # per tap, not per line: the response's offset before the hit
         # from the quiet samples only: what a filter of the acquisition spreads ahead of the pulse (a linear-phase
@@ -271,7 +319,7 @@ def process_taps(
         if p >= 8:
             x[i] -= x[i, :p].mean()
     f = f * force_window[rows]
-    noise_sd = np.array([_noise_outside(force[r] - baseline[r], force_window[r]) for r in rows.tolist()])
+    noise_sd = np.array([_noise_outside(force[r] - baseline[r], force_window[r]) for r in rows.tolist()]) / f_scale
     end = the_end(x, quiet, [taps[cuts[r][2]].number for r in rows])
     why: str | None = None  # said by the end of the taps, when the default decides
     response_noise = noise_variance(x, quiet)
@@ -305,12 +353,15 @@ def process_taps(
             h = gfx / gff
         elif estimator == "H2":
             h = gxx / np.conj(gfx)
-        else:
-            root = np.hypot(gff - gxx, 2.0 * np.abs(gfx))  # two forms of one root, each free of cancellation
-            h = np.where(gff >= gxx, 2.0 * gfx / (gff - gxx + root), (gxx - gff + root) / (2.0 * np.conj(gfx)))
+        else:  # total least squares weighs both channels in their own units: the response's scale put back
+            ratio = x_scale / f_scale
+            a, b, c = gff, gxx * ratio**2, gfx * ratio  # the spectra of the force and the response, both / f_scale
+            root = np.hypot(a - b, 2.0 * np.abs(c))  # two forms of one root, each free of cancellation
+            h = np.where(a >= b, 2.0 * c / (a - b + root), (b - a + root) / (2.0 * np.conj(c))) / ratio
         coherence = np.abs(gfx) ** 2 / (gff * gxx)
     coherence = np.clip(np.nan_to_num(coherence, nan=0.0), 0.0, 1.0)
     h = np.nan_to_num(h)
+    h_scaled, h = h, h * (x_scale / f_scale)
     keep = hz > 0.0
     if band is not None:
         lo, hi = band
@@ -320,7 +371,7 @@ def process_taps(
                                     f"in steps of {hz[1]:g} Hz)")
     kind = RESPONSE_QUANTITIES[items[0].quantity][1]
     measured = FRF.single(Frequency.from_hz(hz[keep]), h[keep], quantity=kind)
-    spectra = 10.0 * np.log10(np.maximum(np.abs(F[:, keep]) ** 2, 1e-300))
+    spectra = 10.0 * np.log10(np.maximum(np.abs(F[:, keep]) ** 2, 1e-300)) + 20.0 * np.log10(f_scale)
     hammer_band = float(_band_end(gff[None, :], hz, hammer_band_db)[0])
     # the noise of the force channel in F: per tap sigma^2 sum(w^2) dt^2, the same on every line; in H1 =
     # sum X F* / sum |F|^2 a relative error whose variance is sum_j n_j |F_j|^2 / (sum_j |F_j|^2)^2
@@ -330,14 +381,31 @@ def process_taps(
     # an H2 is compared as gamma^2 H2, which is this H1 (Measurement.h1_frf): its hammer noise is the same
     v_f = np.where(np.isfinite(v_f), v_f, np.inf)[keep] if estimator != "Hv" else None
     width = float(np.mean(np.sum(w_f, axis=1) ** 2 / np.sum(w_f**2, axis=1))) * dt
-    truncation = truncation_variance(x, F, w, response_noise, h, dt)
+    truncation = truncation_variance(x, F, w, response_noise, h_scaled, dt)
     if why is None:
         why = window_words(end, truncation, told_apart(x, response_noise))
     # through the window the taps measured the structure at omega - i/tau: so is its receptance
     receptance = measured.to_receptance(1.0 / tau if tau else 0.0)
     return TapResult(receptance, measured, coherence[keep], estimator, tuple(taps), tau,
                      hammer_band, float(hammer_band_db), spectra, rate, length, why, v_f,
-                     float(np.sqrt(np.mean(noise_sd**2))), width, None if truncation is None else truncation[keep])
+                     float(np.sqrt(np.mean(noise_sd**2)) * f_scale), width,
+                     None if truncation is None else truncation[keep], shortest)
+
+
+def _dead(name: str, channel: np.ndarray, span: str) -> str | None:
+    """The reason of a tap whose column ``name`` is one number throughout its ``span`` (nothing was measured: not
+    an overload, not a missing hit), else None."""
+    if channel.size == 0 or channel.max() != channel.min():
+        return None
+    return (f"dead channel: column {name!r} is {channel[0]:.4g} throughout the {span} (a sensor not connected, not "
+            "powered, or a wrong channel)")
+
+
+def _scale(channels: np.ndarray) -> float:
+    """The power of two nearest above the channels' largest magnitude (1 for channels of zeros): dividing by it
+    is exact and brings them to [0.5, 1)."""
+    peak = float(np.max(np.abs(channels))) if channels.size else 0.0
+    return float(np.ldexp(1.0, int(np.frexp(peak)[1]))) if np.isfinite(peak) and peak > 0 else 1.0
 
 
 def _noise_outside(force: np.ndarray, window: np.ndarray) -> float:

@@ -176,7 +176,14 @@ def _sensitivity(value: Any, option: str):
 
 def _array(value: Any, field: str) -> np.ndarray:
     try:
-        array = np.array(value, dtype=np.float64)
+        raw = np.asarray(value)
+    except (TypeError, ValueError):
+        raise InvalidValueError(f"{field}: got {type(value).__name__}; expected a 1-D array of numbers") from None
+    if np.iscomplexobj(raw):  # numpy would drop the imaginary part with a warning
+        raise InvalidValueError(f"{field}: got complex samples ({raw.dtype}); expected real samples of a time "
+                                "record (a spectrum is not a tap record)")
+    try:
+        array = np.array(raw, dtype=np.float64)
     except (TypeError, ValueError):
         raise InvalidValueError(f"{field}: got {type(value).__name__}; expected a 1-D array of numbers") from None
     if array.ndim != 1:

@@ -138,6 +138,10 @@ class TapResult:
         (``substructure.tap.record_end.truncation_variance``); None
         when the response died out.  The diagnosis's noise model adds it as
         it adds ``force_noise``.
+    shortest : str or None
+        Without ``tap_length``, when the kept taps' records ended at different
+        times after their starts: the tap that set ``tap_samples`` (every tap
+        is cut to it), in words; None otherwise.
     """
 
     frf: FRF
@@ -156,6 +160,7 @@ class TapResult:
     force_noise_rms: float = 0.0
     force_window_s: float = 0.0
     truncation: np.ndarray | None = None
+    shortest: str | None = None
 
     @property
     def averages(self) -> int:
@@ -185,11 +190,15 @@ class TapResult:
         Returns
         -------
         numpy.ndarray
-            The peak frequencies in Hz, ascending.
+            The peak frequencies in Hz, ascending; none when the FRF's lines
+            (its ``band``) lie above the hammer's usable band and ``hi`` is not given.
         """
         hz = self.measured.frequency.hz
         lo = hz[0] if lo is None else lo
-        hi = min(self.hammer_band_hz, hz[-1]) if hi is None else hi
+        if hi is None:
+            hi = min(self.hammer_band_hz, hz[-1])
+            if hi < lo:  # every line above the hammer's usable band: no peak to trust
+                return np.zeros(0)
         frf = self.measured.crop(lo, hi)
         if frf.frequency.n < 3:
             return np.zeros(0)
@@ -308,7 +317,7 @@ class TapResult:
             not applied), ``hammer_band_hz``, ``force_noise_rms_n``, ``force_window_s``,
             ``force_scatter`` (:meth:`force_scatter`), ``truncation_error``
             (:meth:`truncation_error` as ``{"error", "frequency_hz"}``, or
-            None), ``per_tap``.
+            None), ``shortest`` (the tap that set the taps' length, or None), ``per_tap``.
         """
         values = self.frf.data[:, 0, 0]
         return {
@@ -329,6 +338,7 @@ class TapResult:
             "force_scatter": self.force_scatter(),
             "truncation_error": None if (cut := self.truncation_error()) is None else
             {"error": cut[0], "frequency_hz": cut[1]},
+            "shortest": self.shortest,
             "per_tap": [{"tap": t.number, "file": t.source, "start_s": t.start_s, "peak_force_n": t.peak_force,
                          "pulse_width_s": t.pulse_width_s, "band_hz": t.band_hz, "kept": t.kept}
                         for t in self.taps],
