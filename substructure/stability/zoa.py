@@ -225,9 +225,11 @@ def _lines(structure: Any, frequency: Frequency | None, k0: np.ndarray, teeth: i
 
 
 def _absolute(structure: Any, used: Any, k0: np.ndarray, f: np.ndarray, a: np.ndarray,
-              valid: np.ndarray) -> tuple[float, float] | None:
+              valid: np.ndarray, lam: np.ndarray) -> tuple[float, float] | None:
     """The absolute limit and its frequency (None: no line gives a lobe); for FRF data the band's checks."""
-    if not valid.any() and isinstance(structure, FRF):
+    # the sign decides whether the band holds a resonance, whatever the scale (a cutting pressure of 1e-300 Pa
+    # leaves every line below ``valid``'s floor: no finite limit, which is not a band without a resonance)
+    if not (lam.real > 0).any() and isinstance(structure, FRF):
         raise InvalidValueError(
             f"zoa: the oriented FRF's real part is never negative from {f[0]:g} to {f[-1]:g} Hz: the band holds no "
             "resonance of the tool point (no limit can be found there, which is not a cut free of chatter); give "
@@ -268,8 +270,8 @@ def check_band(structure: Any, cut: Any, band: Any = "auto") -> None:
     """
     structure, used = choose_band(structure, band)
     k0 = cut.mean_force_matrix()
-    f, _, valid, a, _, _ = _lines(structure, None, k0, cut.regenerations_per_revolution, np.inf)
-    _absolute(structure, used, k0, f, a, valid)
+    f, lam, valid, a, _, _ = _lines(structure, None, k0, cut.regenerations_per_revolution, np.inf)
+    _absolute(structure, used, k0, f, a, valid, lam)
 
 
 def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = None,
@@ -347,7 +349,7 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
         raise InvalidValueError(
             f"zoa: {what} x {k_max + 1} lobes x 2 = {points:.3g} lobe points down to {speeds_rpm[0]:g} rpm, more "
             f"than the limit MAX_LOBE_POINTS = {MAX_LOBE_POINTS:.3g} (about 40 MB per array); {change}")
-    absolute = _absolute(structure, used, k0, f, a, valid)
+    absolute = _absolute(structure, used, k0, f, a, valid, lam)
     if absolute is None:
         return Lobes("zoa", speeds_rpm, np.full(speeds_rpm.size, np.inf), np.full(speeds_rpm.size, np.nan),
                      cut=cut, absolute_limit_m=float("inf"), label=label, band=used)
