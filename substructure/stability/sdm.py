@@ -120,9 +120,9 @@ def check_intervals(modes: ModalModel, cut: Any, speeds: Any, intervals: int | N
     Raises
     ------
     InvalidValueError
-        When one interval spans more than :data:`MAX_FIXED_PHASE_STEP` of the
+        When one interval spans more than ``MAX_FIXED_PHASE_STEP`` of the
         reference mode's phase (error estimate above
-        :data:`FIXED_INTERVALS_ERROR`); the message gives the least count.
+        ``FIXED_INTERVALS_ERROR``); the message gives the least count.
     """
     if intervals is None:
         return
@@ -363,8 +363,8 @@ def sdm(modes: ModalModel, cut: Any, speeds: Any, *, intervals: int | None = Non
         Intervals in the cutting part of the delay period, the same at every
         speed.  Default: chosen per speed (see ``max_phase_step``).  A count
         whose interval at the lowest speed spans more than
-        :data:`MAX_FIXED_PHASE_STEP` of the reference mode's phase is refused
-        (:func:`check_intervals`), naming the least count accepted.
+        ``MAX_FIXED_PHASE_STEP`` of the reference mode's phase is refused
+        (``check_intervals``), naming the least count accepted.
     min_intervals : int, default 20
         Fewest intervals in the cut when they are chosen per speed.
     max_phase_step : float, default 0.2
@@ -372,7 +372,7 @@ def sdm(modes: ModalModel, cut: Any, speeds: Any, *, intervals: int | None = Non
         per speed (``omega_ref``: the highest natural frequency among the
         dominant modes).  The first-order method's error on the limit is
         about ``0.1 * max_phase_step**2`` (0.4 % at 0.2 rad on the
-        Insperger-Stepan benchmark; at most about :data:`ERROR_COEFFICIENT`
+        Insperger-Stepan benchmark; at most about ``ERROR_COEFFICIENT``
         times the square).
         The result reports the discretisation used (``Lobes.discretisation``).
     rtol : float, default 0.005

@@ -44,7 +44,7 @@ MAX_LOBE_POINTS = 5_000_000
 
 
 GRADED_STEPS = 50
-"""Lines per damping ratio of the graded grid of a modal model (:func:`graded_frequency`): the relative step is
+"""Lines per damping ratio of the graded grid of a modal model (``graded_frequency``): the relative step is
 ``zeta / GRADED_STEPS`` at a mode, as on the model's default grid, and ``|ln(f / f_n)| / GRADED_STEPS`` away from it,
 where the receptance changes by about ``1 / GRADED_STEPS`` of itself from line to line."""
 
@@ -266,7 +266,7 @@ def check_band(structure: Any, cut: Any, band: Any = "auto") -> None:
     Warns
     -----
     StabilityWarning
-        When the absolute limit lies at the first or last line of FRF data (:data:`EDGE_WARNING`).
+        When the absolute limit lies at the first or last line of FRF data (``EDGE_WARNING``).
     """
     structure, used = choose_band(structure, band)
     k0 = cut.mean_force_matrix()
@@ -292,7 +292,7 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
         (:func:`~substructure.stability.spindle_speeds`).
     frequency : Frequency, optional
         For a modal model: the lines to evaluate on (default: the model's
-        default grid, or :func:`graded_frequency` when that grid times the
+        default grid, or ``graded_frequency`` when that grid times the
         lobes down to the lowest speed exceeds ``MAX_LOBE_POINTS``).
     label : str, optional
         Legend label of the result.
@@ -316,7 +316,7 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
         (no resonance in it), and when the lobes would need more than ``MAX_LOBE_POINTS`` (5,000,000) points
         (FRF lines x lobes x 2): crop or thin the FRF, or raise the lowest
         speed.  A modal model whose default grid is too fine for the lobes
-        down to the lowest speed is evaluated on :func:`graded_frequency`
+        down to the lowest speed is evaluated on ``graded_frequency``
         instead (as fine at the modes, coarser away from them); beyond that
         the message names the lowest speed that fits.
 
@@ -324,7 +324,7 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
     -----
     StabilityWarning
         When the absolute limit lies at the first or last line of FRF data
-        (:data:`EDGE_WARNING`): the minimum may lie outside the band; extend
+        (``EDGE_WARNING``): the minimum may lie outside the band; extend
         it.  Not at the first line of a band chosen automatically above a
         rigid-body mass line.
     """
