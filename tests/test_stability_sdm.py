@@ -254,3 +254,19 @@ def test_a_fixed_count_too_coarse_for_the_mode_is_refused_and_the_least_one_is_w
     error = np.abs(at_least.depth_limit_m / fine - 1)
     assert np.all(error < sdm_module.FIXED_INTERVALS_ERROR)
     assert np.all(error > 0.1 * sdm_module.FIXED_INTERVALS_ERROR)  # the count is not needlessly fine
+
+
+def test_speeds_too_low_for_the_most_intervals_name_the_lowest_speed_that_fits():
+    """The count of intervals grows as 1 / speed: the message names the lowest speed within MAX_INTERVALS (checked
+    here on the plan of intervals), the options that help, and no Python-only advice alone."""
+    import re
+
+    cut = benchmark_cut(1.0)
+    with pytest.raises(InvalidValueError) as info:
+        sdm(MODEL, cut, Q_([100.0, 200.0], "rpm"))
+    text = str(info.value)
+    assert "--speeds" in text and "--method zoa" in text, text
+    lowest = float(re.search(r"start the speeds at (\S+) rpm", text).group(1))
+    plan = sdm_module._Plan(MODEL, cut, None, 20, 0.2)
+    assert plan.intervals_for(np.array([lowest])).max() <= sdm_module.MAX_INTERVALS
+    assert plan.intervals_for(np.array([0.97 * lowest])).max() > sdm_module.MAX_INTERVALS

@@ -306,7 +306,8 @@ class ModalModel:
             raise InvalidValueError(
                 f"modes: the default grid for damping ratio {a['damping_ratio'].min():.3g} needs {count:.3g} lines "
                 f"(a relative step of zeta/50 from 0.3 f_min to 3 f_max), more than MAX_DEFAULT_LINES = "
-                f"{MAX_DEFAULT_LINES:.3g}; give the lines yourself (frequency=Frequency(...)), or check the damping")
+                f"{MAX_DEFAULT_LINES:.3g}; check the damping (a ratio: 0.02 for 2 %; the damping_ratio column of a "
+                "modes file), or give the lines yourself (frequency=Frequency(...) in Python)")
         n = int(np.ceil(count))
         return Frequency.from_hz(np.geomspace(lo, hi, n))
 

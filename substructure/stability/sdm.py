@@ -421,10 +421,14 @@ def _sdm(model: ModalModel, cut: Any, speeds_rpm: np.ndarray, *, intervals: int 
     plan = _Plan(model, cut, intervals, min_intervals, max_phase_step)
     need = int(plan.intervals_for(speeds_rpm).max())
     if need > MAX_INTERVALS:
+        lowest = float(speeds_rpm[0]) * need / MAX_INTERVALS  # the count falls as 1 / speed
+        while int(plan.intervals_for(np.array([lowest])).max()) > MAX_INTERVALS:
+            lowest *= 1.01
         raise InvalidValueError(
             f"speeds: the lowest speed {speeds_rpm[0]:g} rpm needs {need} intervals per delay period for a phase "
             f"step of {max_phase_step:g} rad at {plan.reference_hz:.4g} Hz, more than MAX_INTERVALS = "
-            f"{MAX_INTERVALS}; raise the lowest speed or max_phase_step")
+            f"{MAX_INTERVALS}; start the speeds at {lowest:.5g} rpm or above (--speeds), take the zero-order "
+            "method at these speeds (--method zoa), or a larger max_phase_step (in Python)")
     if depth_range is None:
         ref = _reference_depth(model, cut)
         lo, hi = ref / 4.0, ref * 64.0
