@@ -18,6 +18,7 @@ from substructure import (
     decouple,
     remove_mass,
 )
+from substructure.errors import SubstructureWarning
 
 
 def stacked(frf):
@@ -168,8 +169,25 @@ def test_loop_and_branch_topologies(grid):
 def test_disconnected_components_have_zero_cross_receptance(grid):
     a = Tool("a", [Segment("50 mm", "20 mm")])
     b = Tool("b", [Segment("50 mm", "20 mm")])
-    frf = Assembly("apart", components=(a, b)).frf(["a.tip"], ["b.tip"], frequency=grid)
+    with pytest.warns(SubstructureWarning, match=r"'apart' falls into 2 pieces that no joint connects \(a; b\)"):
+        frf = Assembly("apart", components=(a, b)).frf(["a.tip"], ["b.tip"], frequency=grid)
     assert np.all(frf.data == 0)
+
+
+def test_a_joint_left_out_is_warned_of_naming_the_pieces():
+    """The built-in assembly without its holder-tool joint: the tool floats free (its own receptance at the tip),
+    and the warning names the pieces; the SI form the fits evaluate warns the same way."""
+    from substructure import default_assembly
+    from substructure.updating import Structure
+
+    d = default_assembly()
+    apart = Assembly("x", components=tuple(d.components), joints=(d.joint("spindle-holder"),))
+    with pytest.warns(SubstructureWarning, match=r"'x' falls into 2 pieces .* \(spindle, holder; tool\)"):
+        h = apart.receptance("tool.tip:y", frequency=[500.0]).data.ravel()
+    alone = Assembly("t", components=(d.component("tool"),)).receptance("tool.tip:y", frequency=[500.0])
+    np.testing.assert_allclose(h, alone.data.ravel())
+    with pytest.warns(SubstructureWarning, match="falls into 2 pieces"):
+        Structure.from_assembly(apart)
 
 
 @settings(max_examples=15, deadline=None)

@@ -12,17 +12,18 @@ structure give plans that match item by item).
 
 from __future__ import annotations
 
+import warnings
 from typing import Any, Sequence
 
 import numpy as np
 
 from ..components.protocol import receptances
 from ..coupling import Link, couple_substructures
-from ..errors import AssemblyError, InvalidValueError
+from ..errors import AssemblyError, InvalidValueError, SubstructureWarning
 from ..joints import dynamic_stiffness
 from ..points import DOFS, PointRef, parse_point
 
-__all__ = ["expand_points", "plan", "couple"]
+__all__ = ["expand_points", "plan", "couple", "check_connected"]
 
 
 def expand_points(points: Sequence[str] | str):
@@ -59,6 +60,51 @@ def expand_points(points: Sequence[str] | str):
     return labels, dof_index, refs
 
 
+def check_connected(assembly) -> None:
+    """Warn of an assembly whose components fall into pieces that no joint connects.
+
+    A component joined to nothing is computed as if it floated free: a tool whose joint to the holder was left
+    out gives the free tool's receptance, a plausible number for the wrong structure.  Pieces apart are a model
+    all the same (the receptances between them are zero), so this is a warning, not an error.  Supports to the
+    ground, sensors and masses join nothing to anything.
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model.
+
+    Warns
+    -----
+    SubstructureWarning
+        Naming the pieces, when there are two or more.
+    """
+    names = [c.name for c in assembly.components]
+    if len(names) < 2:
+        return
+    index = {n: c for c in assembly.components for n in c.component_names}
+    parent = {n: n for n in names}
+
+    def root(n: str) -> str:
+        while parent[n] != n:
+            parent[n] = parent[parent[n]]
+            n = parent[n]
+        return n
+
+    for j in assembly.joints:
+        a, b = (root(index[parse_point(p).component].name) for p in j.between)
+        parent[a] = b
+    pieces: dict[str, list[str]] = {}
+    for n in names:
+        pieces.setdefault(root(n), []).append(n)
+    if len(pieces) > 1:
+        listed = "; ".join(", ".join(piece) for piece in pieces.values())
+        warnings.warn(
+            f"assembly {assembly.name!r} falls into {len(pieces)} pieces that no joint connects ({listed}): each is "
+            "computed as if it floated free, with no receptance between them; if a joint was left out, join every "
+            "component to the others (Assembly.connect, [[joints]] in an assembly file)", SubstructureWarning,
+            stacklevel=4)
+
+
 def plan(assembly, refs: Sequence[PointRef]):
     """What a computation needs: the nodes per component and the links, in order.
 
@@ -83,6 +129,7 @@ def plan(assembly, refs: Sequence[PointRef]):
         ``(key_a, key_b or None, object, label)`` for sensors, masses,
         supports and joints.
     """
+    check_connected(assembly)
     nodes: dict[Any, tuple[Any, PointRef]] = {}
     # component name -> component (names are unique in an assembly)
     index = {n: c for c in assembly.components for n in c.component_names}

@@ -23,6 +23,7 @@ import attrs
 import numpy as np
 
 from .._blocks import angular_lines, takes_decay
+from ..assembly.plan import check_connected
 from ..beams import Flutes, Insert, Segment, shear_coefficient, stepped_beam_receptance_si
 from ..components import Beam, is_plain_beam
 from ..errors import UnknownPointError
@@ -393,6 +394,7 @@ class Structure:
         Structure
             The SI form.
         """
+        check_connected(assembly)
         beams, opaque, order, sources = {}, {}, [], {}
         for comp in assembly.components:
             order.append(comp.name)
