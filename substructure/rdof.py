@@ -190,6 +190,38 @@ def _point(value: Any, field: str) -> PointRef:
         raise UnknownPointError(f"{field}: {exc}") from None
 
 
+def _check_names_agree(refs: list, x: np.ndarray, names: dict) -> None:
+    """Refuse positions that contradict what the point names say of them.
+
+    A name measured from the base (``base``, ``@40 mm``) fixes the position; names measured back from the tip
+    (``tip``, ``tip-5 mm``) fix their distances from each other (the component's length is not known here).
+    """
+    tip_lengths = []
+    for i, ref in enumerate(refs):
+        d = 0.0 if ref.distance is None else float(ref.distance.m_as("m"))
+        if ref.where in ("base", "at"):
+            implied, given = d, float(x[i])
+        elif ref.where in ("tip", "from_tip"):
+            tip_lengths.append((i, float(x[i]) + d))  # the component's length, as this point's position says
+            continue
+        else:  # a measured component's own label: nothing to compare
+            continue
+        if abs(implied - given) > 1e-9 + 1e-6 * max(abs(implied), abs(given)):
+            raise InvalidValueError(
+                f"{names['positions']}[{i}]: got {given * 1e3:.6g} mm for {ref.point}, which its name places at "
+                f"{implied * 1e3:.6g} mm from the base; give the positions in the points' order (positions_from "
+                "reads them from the model)")
+    for (i, length), (j, other) in zip(tip_lengths, tip_lengths[1:]):
+        if abs(length - other) > 1e-9 + 1e-6 * max(abs(length), abs(other)):
+            gap = (float(x[j]) - float(x[i])) * 1e3
+            said = ((0.0 if refs[i].distance is None else refs[i].distance.m_as("mm"))
+                    - (0.0 if refs[j].distance is None else refs[j].distance.m_as("mm")))
+            raise InvalidValueError(
+                f"{names['positions']}[{i}], {names['positions']}[{j}]: {refs[j].point} is {gap:+.6g} mm from "
+                f"{refs[i].point} by the positions given, {said:+.6g} mm by their names; give the positions in the "
+                "points' order (positions_from reads them from the model)")
+
+
 def _stencil(points: Any, positions: Any, at: Any, at_position: Any, suffix: str = ""):
     """Labels of the measured y DOFs, the transformation, and the point's name."""
     names = {"points": f"points{suffix}", "positions": f"positions{suffix}", "at": f"at{suffix}"}
@@ -240,6 +272,7 @@ def _stencil(points: Any, positions: Any, at: Any, at_position: Any, suffix: str
     else:
         x0 = to_si(at_position, f"at_position{suffix}", "m")
     _check_distinct(x, point_names)
+    _check_names_agree(refs, x, names)
     return [f"{p}:y" for p in point_names], transformation(x, x0), at_name
 
 

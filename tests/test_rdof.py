@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from substructure import FRF, Frequency, MeasuredComponent, Segment, Tool
+from substructure import FRF, Frequency, MeasuredComponent, Segment, Tool, default_assembly
 from substructure.errors import InvalidValueError, UnitError, UnknownPointError
 from substructure.rdof import (
     estimate_rotational,
@@ -240,3 +240,26 @@ def test_estimate_errors(points, positions, at, error, match):
     h = exact(["tip-5 mm", "tip"])
     with pytest.raises(error, match=match):
         estimate_rotational(h, points, positions, at)
+
+
+@pytest.mark.parametrize("positions, match", [
+    (["60 mm", "10 mm", "20 mm"], r"positions\[0\], positions\[1\]: tool\.tip-5 mm is -50 mm from tool\.tip by the "
+                                  r"positions given, -5 mm by their names"),
+    (["66 mm", "71 mm", "76 mm"], r"tool\.tip-5 mm is \+5 mm from tool\.tip .* -5 mm by their names"),
+])
+def test_positions_that_contradict_the_point_names_are_refused(positions, match):
+    """Names measured back from the tip fix the points' distances from each other: positions in another order or
+    scale gave numbers for a stencil that is not the one measured."""
+    asm = default_assembly()
+    pts = ["tool.tip", "tool.tip-5 mm", "tool.tip-10 mm"]
+    ty = asm.frf([p + ":y" for p in pts], [p + ":y" for p in pts], frequency=Frequency.from_range("100 Hz", "2000 Hz",
+                                                                                                  "100 Hz"))
+    with pytest.raises(InvalidValueError, match=match):
+        estimate_rotational(ty, pts, positions, "tool.tip")
+    right = estimate_rotational(ty, pts, positions_from(asm, pts), "tool.tip")
+    shifted = estimate_rotational(ty, pts, ["86 mm", "81 mm", "76 mm"], "tool.tip")  # the tip-relative names agree
+    np.testing.assert_allclose(shifted.data, right.data, rtol=1e-12)
+    with pytest.raises(InvalidValueError, match=r"positions\[0\]: got 5 mm for tool@6 mm, which its name places at "
+                                                r"6 mm from the base"):
+        estimate_rotational(asm.frf(["tool@6 mm:y", "tool@16 mm:y"], frequency=[100.0]), ["tool@6 mm", "tool@16 mm"],
+                            ["5 mm", "16 mm"], "tool@6 mm")
