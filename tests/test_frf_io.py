@@ -170,7 +170,7 @@ def test_write_uff_replaces_an_existing_file(tmp_path):
     path = tmp_path / "tip.uff"
     write_uff(random_frf(2, 2, seed=1), path)
     small = random_frf(seed=2, frequency=Frequency.from_range("100 Hz", "110 Hz", "2 Hz"))
-    write_uff(small, path)
+    write_uff(small, path, overwrite=True)
     assert list(pyuff.UFF(str(path)).get_set_types()) == [58]
     back = read_uff(path)
     assert back.frequency == small.frequency
@@ -359,3 +359,20 @@ def test_csv_units_in_the_header_that_contradict_the_quantity_given(tmp_path):
     mm = (tmp_path / "a.csv").read_text().replace("m/(N s^2)", "mm/(N s^2)")  # not SI: converted
     (tmp_path / "d.csv").write_text(mm)
     np.testing.assert_allclose(read_csv(tmp_path / "d.csv").data, frf.data * 1e-3, rtol=1e-15)
+
+
+@pytest.mark.parametrize("write", [
+    lambda frf, path, **kw: frf.to_csv(path, **kw), lambda frf, path, **kw: write_csv(frf, path, **kw),
+    lambda frf, path, **kw: frf.to_uff(path, **kw), lambda frf, path, **kw: write_uff(frf, path, **kw),
+])
+def test_frf_writers_keep_an_existing_file_unless_told(tmp_path, write):
+    from substructure.errors import OutputExistsError
+
+    path = tmp_path / "tip.data"
+    path.write_text("the user's file\n")
+    with pytest.raises(OutputExistsError, match=rf"{path}: the file exists; pass overwrite=True to replace it"):
+        write(random_frf(), path)
+    assert path.read_text() == "the user's file\n"
+    assert isinstance(OutputExistsError("x"), FileExistsError)
+    write(random_frf(), path, overwrite=True)
+    assert path.read_text() != "the user's file\n"

@@ -505,17 +505,28 @@ class FRF:
 
         return draw_frf(self, ax=ax, **kw)
 
-    def to_csv(self, path: Any) -> None:
+    def to_csv(self, path: Any, overwrite: bool = False) -> None:
         """Write a 1x1 FRF to a CSV file (:func:`substructure.io.frf_files.write_csv`).
+
+        A mobility or an accelerance is written with its unit in the header,
+        so that :meth:`from_csv` reads it back as what it is.
 
         Parameters
         ----------
         path : str or os.PathLike
             The file.
+        overwrite : bool, default False
+            Whether an existing file may be replaced.
+
+        Raises
+        ------
+        OutputExistsError
+            (a ``FileExistsError``) When ``path`` exists and ``overwrite`` is
+            false, naming the path.
         """
         from .files.csv_files import write_csv
 
-        write_csv(self, path)
+        write_csv(self, path, overwrite=overwrite)
 
     @classmethod
     def from_csv(cls, path: Any, output: str = "response", input: str = "excitation",
@@ -543,17 +554,25 @@ class FRF:
 
         return read_csv(path, output=output, input=input, quantity=quantity)
 
-    def to_uff(self, path: Any) -> None:
+    def to_uff(self, path: Any, overwrite: bool = False) -> None:
         """Write type-58 records, one per entry (:func:`substructure.io.frf_files.write_uff`).
 
         Parameters
         ----------
         path : str or os.PathLike
             The file.
+        overwrite : bool, default False
+            Whether an existing file may be replaced.
+
+        Raises
+        ------
+        OutputExistsError
+            (a ``FileExistsError``) When ``path`` exists and ``overwrite`` is
+            false, naming the path.
         """
         from .files.uff_writer import write_uff
 
-        write_uff(self, path)
+        write_uff(self, path, overwrite=overwrite)
 
     @classmethod
     def from_uff(cls, path: Any, record: int | None = None, quantity: str | None = None) -> FRF:
