@@ -376,3 +376,21 @@ def test_frf_writers_keep_an_existing_file_unless_told(tmp_path, write):
     assert isinstance(OutputExistsError("x"), FileExistsError)
     write(random_frf(), path, overwrite=True)
     assert path.read_text() != "the user's file\n"
+
+
+def test_labels_are_checked_where_an_frf_is_made(tmp_path):
+    grid = Frequency.from_range("100 Hz", "200 Hz", "10 Hz")
+    for field, label, why in [("output", "tool tip", "not a point name"),
+                              ("input", "tool.tip", "a point without its DOF"),
+                              ("output", "a.tip:z", "unknown DOF 'z'"), ("input", "tool tip:y", "'tool tip' is not")]:
+        kwargs = {"output": "tool.tip:y", "input": "tool.tip:y", field: label}
+        with pytest.raises(InvalidValueError, match=rf"^{field}: got the label '{label}' \({why}.*expected 'POINT:y' "
+                                                    r"or 'POINT:theta'"):
+            FRF.single(grid, np.ones(grid.n), **kwargs)
+    with pytest.raises(InvalidValueError, match=r"outputs: got the label 'tool\.tip'"):
+        FRF(grid, np.ones((grid.n, 1, 1)), ("tool.tip",), ("tool.tip:y",))
+    FRF.single(grid, np.ones(grid.n)).to_csv(tmp_path / "a.csv")
+    with pytest.raises(InvalidValueError, match=r"^output: got the label 'tool tip'"):
+        FRF.from_csv(tmp_path / "a.csv", output="tool tip")
+    for label in ("tool.tip-5 mm:theta", "spindle@310 mm:y", "a:y", "x", "response"):  # points, plain names
+        assert FRF.single(grid, np.ones(grid.n), output=label, input=label).outputs == (label,)

@@ -18,7 +18,7 @@ import attrs
 import numpy as np
 
 from ..errors import FrequencyAxisMismatchError, InvalidValueError, NonReciprocalWarning, UnknownPointError
-from ._fields import _check_frequency, _check_quantity, _complex_array, _labels, _scalar
+from ._fields import check_label, _check_frequency, _check_quantity, _complex_array, _labels, _scalar
 from .axis import _GRID_RTOL, Frequency
 from .files._common import register_frf_class
 from .peaks import local_maxima
@@ -104,6 +104,10 @@ class FRF:
         FRF
             The one-entry FRF.
         """
+        for field, label in (("output", output), ("input", input)):
+            if not isinstance(label, str) or not label.strip() or label != label.strip():
+                raise InvalidValueError(f"{field}: got {label!r}; expected a DOF label such as 'tool.tip:y'")
+            check_label(field, label)
         values = np.asarray(values)
         if values.ndim != 1:
             raise InvalidValueError(f"values: got shape {values.shape}; expected a 1-D array of n_freq values")
