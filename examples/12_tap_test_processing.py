@@ -121,7 +121,8 @@ print(f"{with_bounce.averages} taps averaged; the FRF equals the one without the
 # -----------------------
 # The receptance with its coherence column, and a set naming it with the
 # number of averages; reading the set gives both back.
-write_csv(result.frf, out / "12_tool_tip.csv", coherence=result.coherence)
+# (overwrite=True: this example's own output, written anew on each run)
+write_csv(result.frf, out / "12_tool_tip.csv", overwrite=True, coherence=result.coherence)
 (out / "12_tests.toml").write_text(
     'name = "pyFRF impact records"\n\n[[frf]]\nresponse = "tool.tip"\nexcitation = "tool.tip"\n'
     f'file = "12_tool_tip.csv"\nquantity = "receptance"\naverages = {result.averages}\n'

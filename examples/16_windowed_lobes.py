@@ -77,7 +77,7 @@ result = process_taps(records, exponential=True)
 print(f"window: tau = {result.tau:.4g} s ({result.window})")
 frf = result.frf.crop(100.0, 3000.0)
 path = out / "16_windowed_tap.csv"
-write_csv(frf, path, window_tau=result.tau)
+write_csv(frf, path, overwrite=True, window_tau=result.tau)  # this example's own output, written anew each run
 print(f"    wrote {path}; its window line says tau = {read_csv_window(path):.4g} s")
 
 # %%

@@ -35,7 +35,7 @@ def _library_writer(writer: int, path: str, barrier) -> None:
     frf = frf_of(writer)
     barrier.wait()
     for _ in range(3):
-        write_csv(frf, path)
+        write_csv(frf, path, overwrite=True)
 
 
 def _command_writer(writer: int, path: str, barrier) -> None:

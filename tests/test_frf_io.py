@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from substructure.errors import FileFormatError, InvalidValueError
 from substructure.frf import FRF, Frequency
-from substructure.io.frf_files import read_csv, read_uff, write_csv, write_uff
+from substructure.io.frf_files import read_csv, read_csv_with_coherence, read_uff, write_csv, write_uff
 
 # pyuff's ASCII writer keeps 12 significant digits (E20.11): 5e-12 relative per part.
 UFF_RTOL = 5e-12
@@ -170,7 +170,7 @@ def test_write_uff_replaces_an_existing_file(tmp_path):
     path = tmp_path / "tip.uff"
     write_uff(random_frf(2, 2, seed=1), path)
     small = random_frf(seed=2, frequency=Frequency.from_range("100 Hz", "110 Hz", "2 Hz"))
-    write_uff(small, path)
+    write_uff(small, path, overwrite=True)
     assert list(pyuff.UFF(str(path)).get_set_types()) == [58]
     back = read_uff(path)
     assert back.frequency == small.frequency
@@ -307,3 +307,90 @@ def test_an_frf_saved_by_numpy_savetxt_with_its_header_reads_back(tmp_path):
     path.write_text("# window_tau_s = 0.04\n20,1e-7,0\n30,1e-7,0\n")
     with pytest.raises(FileFormatError, match=r"window.csv, line 2: column '20'; expected frequency"):
         read_csv(path)
+
+
+@pytest.mark.parametrize("quantity, header", [
+    ("receptance", "frequency_hz,real,imag"),
+    ("mobility", "frequency_hz,real [m/(N s)],imag [m/(N s)]"),
+    ("accelerance", "frequency_hz,real [m/(N s^2)],imag [m/(N s^2)]"),
+])
+def test_csv_keeps_the_quantity(tmp_path, quantity, header):
+    """A mobility or an accelerance is written with its unit in the header and reads back as what it is."""
+    grid = Frequency.from_range("100 Hz", "3000 Hz", "10 Hz")
+    h = 1 / (1e7 * (1 - (grid.hz / 1000) ** 2 + 0.05j * grid.hz / 1000))
+    factor = {"receptance": 1, "mobility": 1j * grid.omega, "accelerance": -grid.omega**2}[quantity]
+    frf = FRF.single(grid, h * factor, output="tool.tip:y", input="tool.tip:y", quantity=quantity)
+    path = tmp_path / "tip.csv"
+    frf.to_csv(path)
+    assert path.read_text().splitlines()[0] == header
+    back = FRF.from_csv(path, output="tool.tip:y", input="tool.tip:y")
+    assert back == frf and back.quantity == quantity
+    assert read_csv(path, output="tool.tip:y", input="tool.tip:y", quantity=quantity) == frf
+    np.testing.assert_allclose(back.to_receptance().data[:, 0, 0], h, rtol=1e-12)
+
+
+def test_csv_quantity_of_a_rotation_and_with_the_coherence(tmp_path):
+    grid = Frequency.from_range("100 Hz", "300 Hz", "10 Hz")
+    frf = FRF.single(grid, np.linspace(1, 2, grid.n) * (1 - 1j), output="tool.tip:theta", input="tool.tip:theta",
+                     quantity="accelerance")
+    gamma = np.linspace(0.5, 1, grid.n)
+    write_csv(frf, tmp_path / "r.csv", coherence=gamma)
+    assert (tmp_path / "r.csv").read_text().splitlines()[0] == \
+        "frequency_hz,real [1/(N m s^2)],imag [1/(N m s^2)],coherence"
+    back, coherence = read_csv_with_coherence(tmp_path / "r.csv", output="tool.tip:theta", input="tool.tip:theta")
+    assert back == frf
+    np.testing.assert_array_equal(coherence, gamma)
+
+
+def test_csv_units_in_the_header_that_contradict_the_quantity_given(tmp_path):
+    grid = Frequency.from_range("100 Hz", "300 Hz", "10 Hz")
+    frf = FRF.single(grid, np.linspace(1, 2, grid.n) + 1j, quantity="accelerance")
+    frf.to_csv(tmp_path / "a.csv")
+    with pytest.raises(FileFormatError, match=r"a\.csv, line 1: the header's units are those of an accelerance, "
+                                              r"but the quantity given is receptance"):
+        read_csv(tmp_path / "a.csv", quantity="receptance")
+    text = (tmp_path / "a.csv").read_text().replace("imag [m/(N s^2)]", "imag [m/N]")
+    (tmp_path / "b.csv").write_text(text)
+    with pytest.raises(FileFormatError, match=r"b\.csv, line 1: the real and imaginary parts have different units"):
+        read_csv(tmp_path / "b.csv")
+    (tmp_path / "c.csv").write_text(text.replace("[m/(N s^2)]", "[kg]").replace("[m/N]", "[kg]"))
+    with pytest.raises(FileFormatError, match=r"c\.csv, line 1: column 'real \[kg\]': the unit 'kg' is not that of"):
+        read_csv(tmp_path / "c.csv")
+    mm = (tmp_path / "a.csv").read_text().replace("m/(N s^2)", "mm/(N s^2)")  # not SI: converted
+    (tmp_path / "d.csv").write_text(mm)
+    np.testing.assert_allclose(read_csv(tmp_path / "d.csv").data, frf.data * 1e-3, rtol=1e-15)
+
+
+@pytest.mark.parametrize("write", [
+    lambda frf, path, **kw: frf.to_csv(path, **kw), lambda frf, path, **kw: write_csv(frf, path, **kw),
+    lambda frf, path, **kw: frf.to_uff(path, **kw), lambda frf, path, **kw: write_uff(frf, path, **kw),
+])
+def test_frf_writers_keep_an_existing_file_unless_told(tmp_path, write):
+    from substructure.errors import OutputExistsError
+
+    path = tmp_path / "tip.data"
+    path.write_text("the user's file\n")
+    with pytest.raises(OutputExistsError, match=rf"{path}: the file exists; pass overwrite=True to replace it"):
+        write(random_frf(), path)
+    assert path.read_text() == "the user's file\n"
+    assert isinstance(OutputExistsError("x"), FileExistsError)
+    write(random_frf(), path, overwrite=True)
+    assert path.read_text() != "the user's file\n"
+
+
+def test_labels_are_checked_where_an_frf_is_made(tmp_path):
+    grid = Frequency.from_range("100 Hz", "200 Hz", "10 Hz")
+    for field, label, why in [("output", "tool tip", "not a point name"),
+                              ("input", "tool.tip", "a point without its DOF"),
+                              ("output", "a.tip:z", "unknown DOF 'z'"), ("input", "tool tip:y", "'tool tip' is not")]:
+        kwargs = {"output": "tool.tip:y", "input": "tool.tip:y", field: label}
+        with pytest.raises(InvalidValueError, match=rf"^{field}: got the label '{label}' \({why}.*expected 'POINT:y' "
+                                                    r"or 'POINT:theta'"):
+            FRF.single(grid, np.ones(grid.n), **kwargs)
+    with pytest.raises(InvalidValueError, match=r"outputs: got the label 'tool\.tip'"):
+        FRF(grid, np.ones((grid.n, 1, 1)), ("tool.tip",), ("tool.tip:y",))
+    FRF.single(grid, np.ones(grid.n)).to_csv(tmp_path / "a.csv")
+    with pytest.raises(InvalidValueError, match=r"^output: got the label 'tool tip'"):
+        FRF.from_csv(tmp_path / "a.csv", output="tool tip")
+    for label in ("tool.tip-5 mm:theta", "spindle@310 mm:y", "a:y", "x", "response"):  # points, plain names
+        assert FRF.single(grid, np.ones(grid.n), output=label, input=label).outputs == (label,)

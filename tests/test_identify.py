@@ -180,3 +180,14 @@ def test_a_parameter_named_twice_is_refused():
     h = asm.receptance("tool.tip:y", frequency=Frequency.from_range("1000 Hz", "5000 Hz", "4 Hz"))
     with pytest.raises(InvalidValueError, match="parameters: k_yf named twice"):
         JointIdentifier("holder-tool", parameters=("k_yf", "c_yf", "k_yf")).fit(asm, [h])
+
+
+def test_band_mean_refuses_a_band_without_lines(assembly):
+    result = _closed_form_on_model(assembly, "holder-tool", "tool.tip")
+    k = result.band_mean("k_yf", (500, 1500))
+    np.testing.assert_allclose(k, assembly.joint("holder-tool").k.get("yf"), rtol=1e-6)
+    with pytest.raises(InvalidValueError, match=r"band: \(6000, 7000\) holds no line of the result's frequencies "
+                                                r"20\.\.5000 Hz"):
+        result.band_mean("k_yf", (6000, 7000))
+    with pytest.raises(InvalidValueError, match=r"band: got 500; expected \(lo, hi\) in Hz"):
+        result.band_mean("k_yf", 500)

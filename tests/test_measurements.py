@@ -443,3 +443,22 @@ def test_frequencies_written_rounded_are_read_as_the_uniform_grid_they_round(tmp
     np.testing.assert_allclose(frf.frequency.hz, hz, rtol=0, atol=0.5 * 10.0**-decimals / 10)  # 10 x the rounding
     np.testing.assert_allclose(np.diff(frf.frequency.hz), np.diff(frf.frequency.hz)[0], rtol=1e-9)
     np.testing.assert_array_equal(frf.data[:, 0, 0], h)
+
+
+@pytest.mark.parametrize("quantity", ["receptance", "mobility", "accelerance"])
+def test_a_csv_file_says_its_quantity(tmp_path, model, quantity):
+    """A mobility or an accelerance written to CSV is read by a measurement set as what it is, with or without
+    the quantity key; a key that says another quantity than the file is refused naming the key."""
+    h = model.entry("tool.tip:y", "tool.tip:y")
+    factor = {"receptance": 1, "mobility": 1j * GRID.omega, "accelerance": -GRID.omega**2}[quantity]
+    FRF.single(GRID, h * factor, "tool.tip:y", "tool.tip:y", quantity=quantity).to_csv(tmp_path / "tip.csv")
+    entry = '[[frf]]\nresponse = "tool.tip"\nexcitation = "tool.tip"\nfile = "tip.csv"\n'
+    for key in ("", f'quantity = "{quantity}"\n'):
+        m = loads_measurements(entry + key, tmp_path, "set.toml").measurements[0]
+        assert m.quantity == quantity and m.frf.quantity == "receptance"
+        np.testing.assert_allclose(m.values, h, rtol=1e-12)
+    if quantity != "receptance":
+        with pytest.raises(FileFormatError, match=r"set\.toml.*frf\[0\]\.quantity: 'receptance' contradicts the "
+                                                  rf"data file: .*tip\.csv, line 1: the header's units are those of "
+                                                  rf"an? {quantity}, but the quantity given is receptance"):
+            loads_measurements(entry + 'quantity = "receptance"\n', tmp_path, "set.toml")

@@ -253,7 +253,7 @@ def test_measurement_file_averages_and_coherence_column(tmp_path):
     (tmp_path / "a.csv").write_text(text)
     with pytest.raises(FileFormatError, match=r"a.csv, line 4: coherence is 1.3"):
         load_measurements(tmp_path / "set.toml")
-    write_csv(frf, tmp_path / "a.csv")  # an old three-column file: no coherence
+    write_csv(frf, tmp_path / "a.csv", overwrite=True)  # an old three-column file: no coherence
     assert load_measurements(tmp_path / "set.toml").measurements[0].coherence is None
 
 

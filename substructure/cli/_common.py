@@ -174,7 +174,7 @@ def save_plot(frf: FRF, path: str | os.PathLike, title: str, overwrite: bool = T
     save_figure(fig, path, overwrite)
 
 
-def write_frf(frf: FRF, path: str, overwrite: bool = True) -> None:
+def write_frf(frf: FRF, path: str, overwrite: bool = False) -> None:
     """Write an FRF to a CSV or UFF file, chosen by the suffix (atomically)."""
     from ..io.frf_files import write_csv, write_uff
 

@@ -8,15 +8,55 @@ from __future__ import annotations
 
 import math
 import numbers
+import re
 from typing import Any, cast
 
 import numpy as np
 
-from ..errors import InvalidValueError
+from ..errors import InvalidValueError, SubstructureError
 from .axis import Frequency, _readonly
 
 QUANTITIES = ("receptance", "mobility", "accelerance")
 """The quantities an FRF may hold: displacement, velocity or acceleration per load."""
+
+
+_WORD = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+
+
+def check_label(field: str, label: str) -> None:
+    """Refuse a DOF label that is neither ``POINT:y`` / ``POINT:theta`` nor a plain channel name.
+
+    A label is a point (:func:`substructure.points.parse_point`, e.g.
+    ``"tool.tip-5 mm"``) or a plain name (``"a"``) followed by ``:y`` or
+    ``:theta`` (conventions.md), or a plain name alone (letters, digits and
+    ``_``: a channel or a direction such as ``"x"``, the default
+    ``"response"``), or a universal file's ``node2:dir3`` of another
+    program's record.  Anything else (``"tool tip"``, a point without its DOF
+    ``"tool.tip"``, ``"tool.tip:z"``) would fail far from where it was given.
+    """
+    from ..points import parse_point
+
+    if _WORD.match(label):
+        return
+    name, _, dof = label.rpartition(":")
+    if name and _WORD.match(name) and re.match(r"^dir-?\d+$", dof):
+        return  # a universal file's node and direction code from another program (NODE:dirCODE)
+    if name and dof in ("y", "theta"):
+        if _WORD.match(name):
+            return
+        try:
+            parse_point(label)
+            return
+        except SubstructureError:
+            pass
+    if not name:
+        why = "a point without its DOF" if "." in label or "@" in label else "not a point name"
+    elif dof not in ("y", "theta"):
+        why = f"unknown DOF {dof!r}"
+    else:
+        why = f"{name!r} is not a point name"
+    raise InvalidValueError(f"{field}: got the label {label!r} ({why}); expected 'POINT:y' or 'POINT:theta' "
+                            "(e.g. 'tool.tip:y', 'tool.tip-5 mm:theta'), or a plain name of letters, digits and _")
 
 
 def _labels(field: str):
@@ -33,6 +73,7 @@ def _labels(field: str):
                     f"{field}: got the label {label!r}; expected a non-empty string "
                     "without surrounding spaces, e.g. 'tool.tip:y'"
                 )
+            check_label(field, label)
         if len(set(labels)) != len(labels):
             twice = sorted({x for x in labels if labels.count(x) > 1})
             raise InvalidValueError(f"{field}: the labels {twice} appear more than once")

@@ -18,7 +18,7 @@ import attrs
 import numpy as np
 
 from ..errors import FrequencyAxisMismatchError, InvalidValueError, NonReciprocalWarning, UnknownPointError
-from ._fields import _check_frequency, _check_quantity, _complex_array, _labels, _scalar
+from ._fields import check_label, _check_frequency, _check_quantity, _complex_array, _labels, _scalar
 from .axis import _GRID_RTOL, Frequency
 from .files._common import register_frf_class
 from .peaks import local_maxima
@@ -104,6 +104,10 @@ class FRF:
         FRF
             The one-entry FRF.
         """
+        for field, label in (("output", output), ("input", input)):
+            if not isinstance(label, str) or not label.strip() or label != label.strip():
+                raise InvalidValueError(f"{field}: got {label!r}; expected a DOF label such as 'tool.tip:y'")
+            check_label(field, label)
         values = np.asarray(values)
         if values.ndim != 1:
             raise InvalidValueError(f"values: got shape {values.shape}; expected a 1-D array of n_freq values")
@@ -505,17 +509,28 @@ class FRF:
 
         return draw_frf(self, ax=ax, **kw)
 
-    def to_csv(self, path: Any) -> None:
+    def to_csv(self, path: Any, overwrite: bool = False) -> None:
         """Write a 1x1 FRF to a CSV file (:func:`substructure.io.frf_files.write_csv`).
+
+        A mobility or an accelerance is written with its unit in the header,
+        so that :meth:`from_csv` reads it back as what it is.
 
         Parameters
         ----------
         path : str or os.PathLike
             The file.
+        overwrite : bool, default False
+            Whether an existing file may be replaced.
+
+        Raises
+        ------
+        OutputExistsError
+            (a ``FileExistsError``) When ``path`` exists and ``overwrite`` is
+            false, naming the path.
         """
         from .files.csv_files import write_csv
 
-        write_csv(self, path)
+        write_csv(self, path, overwrite=overwrite)
 
     @classmethod
     def from_csv(cls, path: Any, output: str = "response", input: str = "excitation",
@@ -543,17 +558,25 @@ class FRF:
 
         return read_csv(path, output=output, input=input, quantity=quantity)
 
-    def to_uff(self, path: Any) -> None:
+    def to_uff(self, path: Any, overwrite: bool = False) -> None:
         """Write type-58 records, one per entry (:func:`substructure.io.frf_files.write_uff`).
 
         Parameters
         ----------
         path : str or os.PathLike
             The file.
+        overwrite : bool, default False
+            Whether an existing file may be replaced.
+
+        Raises
+        ------
+        OutputExistsError
+            (a ``FileExistsError``) When ``path`` exists and ``overwrite`` is
+            false, naming the path.
         """
         from .files.uff_writer import write_uff
 
-        write_uff(self, path)
+        write_uff(self, path, overwrite=overwrite)
 
     @classmethod
     def from_uff(cls, path: Any, record: int | None = None, quantity: str | None = None) -> FRF:

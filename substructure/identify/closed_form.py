@@ -150,8 +150,21 @@ class ClosedFormResult:
         -------
         float
             The mean, in the parameter's SI unit.
+
+        Raises
+        ------
+        InvalidValueError
+            For a band that is not two limits, or that holds no line of the
+            result's frequencies (naming the band and the result's range).
         """
-        mask = self.frequency.band_mask(*band)
+        try:
+            lo, hi = band
+        except (TypeError, ValueError):
+            raise InvalidValueError(f"band: got {band!r}; expected (lo, hi) in Hz, e.g. (500, 1500)") from None
+        mask = self.frequency.band_mask(lo, hi)
+        if not mask.any():
+            raise InvalidValueError(f"band: ({lo!r}, {hi!r}) holds no line of the result's frequencies "
+                                    f"{self.frequency.start:g}..{self.frequency.stop:g} Hz; choose a band within them")
         return float(np.mean(self.parameter(name)[mask]))
 
     def plot(self, names=("k_yf", "c_yf"), band=None, fitted=None, ax=None, measured=None):

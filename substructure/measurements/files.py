@@ -22,6 +22,7 @@ from .._toml import TomlDocument, loads_toml
 from ..errors import FileFormatError, InvalidValueError, SubstructureError, SubstructureWarning
 from ..frf import FRF, QUANTITIES, Frequency
 from ..frf.files._common import _beyond_physical
+from ..frf.files._common import QuantityContradiction
 from ..frf.files.csv_files import _read_csv
 from ..frf.files.uff_reader import read_uff, read_uff_coherence
 from ..points import check_name
@@ -181,6 +182,9 @@ class _Reader:
             return frf, columns, window
         except _LocatedError:
             raise
+        except QuantityContradiction as exc:  # the file says another quantity than the key
+            raise self.error(index, "quantity", f"{quantity!r} contradicts the data file: {exc}; leave the key out "
+                             "or correct it") from None
         except FileFormatError as exc:  # names the data file (and its line)
             raise self.error(index, "file", str(exc)) from None
         except SubstructureError as exc:

@@ -285,7 +285,7 @@ def _write_frf(data: dict, path: Path) -> None:
     values = np.asarray(data["real"]) + 1j * np.asarray(data["imag"])
     frf = FRF.single(Frequency.from_hz(np.asarray(data["frequency_hz"])), values, output=data["label"],
                      input=data["label"])
-    write_csv(frf, path)
+    write_csv(frf, path, overwrite=True)  # the study's own store (StudyStore.check guards the user's files)
 
 
 def _crashed(task: dict, exc: BaseException) -> dict:

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import InvalidValueError
+from ...errors import FileFormatError, InvalidValueError
 
 # The FRF class, registered by substructure.frf.response when it is defined: these modules read
 # and write FRFs (FRF.to_csv, FRF.from_uff use them) and so cannot import the module that
@@ -90,3 +90,14 @@ def _refuse_all_zero(frf: Any, name: str) -> None:
             "which readers refuse as a dead channel"
         )
 
+
+
+class QuantityContradiction(FileFormatError):
+    """A file whose header's units say another quantity than the one the caller gave (a ``FileFormatError``)."""
+
+
+def _contradiction(name: str, line: int, said: str, quantity: str) -> QuantityContradiction:
+    """The error for a header whose units say ``said`` where the caller gave ``quantity``."""
+    article = "an" if said[0] in "aeiou" else "a"
+    return QuantityContradiction(f"{name}, line {line}: the header's units are those of {article} {said}, but the "
+                                 f"quantity given is {quantity}")

@@ -3,6 +3,9 @@
 One FRF per file, header ``frequency_hz,real,imag``, one line per frequency,
 receptance in m/N unless told otherwise; values are written with every
 digit (``repr``) so that a written file reads back to the same floats.  A
+mobility or an accelerance is written with its SI unit in the header,
+``frequency_hz,real [m/(N s^2)],imag [m/(N s^2)]``, so that it reads back as
+what it is (here and in other programs); a receptance keeps the plain header.  A
 fourth column ``coherence`` (the ordinary coherence of a tap test, in
 [0, 1]) may follow, and after it ``force_noise`` (the variance of H1's
 relative error that the hammer's noise gives, per line, a tap test's;
@@ -31,7 +34,8 @@ import numpy as np
 from ...errors import FileFormatError, InvalidValueError, WindowedFRFWarning
 from .._fields import window_tau as _window_tau
 from ..axis import MAX_GRID_LINES, Frequency
-from ._common import _refuse_all_zero, _require_frf, _shown, frf_class
+from ._common import _contradiction, _refuse_all_zero, _require_frf, _shown, frf_class
+from .uff_units import _TIME_EXPONENT, _exponents, _unit_of_label
 
 if TYPE_CHECKING:  # the annotations only (frf.response imports this module)
     from ..response import FRF
@@ -47,23 +51,69 @@ _HEADERS = (CSV_HEADER, COHERENCE_HEADER, FORCE_NOISE_HEADER, COHERENCE_HEADER +
 WINDOW_KEY = "window_tau_s"
 """The comment line before the header that gives the exponential window's time constant [s]."""
 _WINDOW_LINE = re.compile(r"#\s*window_tau_s\s*(?:=\s*(.*?))?\s*$")
+_UNIT_CELL = re.compile(r"^(?P<name>real|imag)\s*\[(?P<unit>[^\[\]]*)\]$")
 
 
-def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coherence=None, force_noise=None,
+def _quantity_of_unit(unit: str, cell: str, name: str, line: int) -> tuple[str, float]:
+    """``(quantity, factor to SI)`` of the unit of the package's own value columns, a displacement or a rotation
+    (or its velocity, acceleration) per force or moment: ``m/N``, ``m/(N s^2)``, ``1/(N m s)``, ``mm/N``, ``g/N``."""
+    try:
+        q = _unit_of_label(unit)
+    except ValueError:
+        q = None
+    exps = _exponents(q) if q is not None else None
+    kind = _TIME_EXPONENT.get(exps[2]) if exps is not None and exps[0] == -1 and exps[1] in (1, 0, -1) else None
+    if kind is None:
+        raise FileFormatError(f"{name}, line {line}: column {_shown(cell)}: the unit {_shown(unit)} is not that of a "
+                              "receptance, mobility or accelerance (e.g. m/N, m/(N s), m/(N s^2), 1/N, 1/(N m))")
+    assert q is not None and exps is not None  # kind is found only for a unit read
+    return kind, float(q.m_as(f"meter ** {exps[1]} / newton * second ** {exps[2]}"))
+
+
+def _units_header(header: str, name: str, line: int) -> tuple[str, str, float] | None:
+    """The package's header with the value columns' unit, ``frequency_hz,real [U],imag [U][,...]``:
+    ``(the header without the units, quantity, factor to SI)``; None for any other header."""
+    cells = [c.strip() for c in header.lstrip("\ufeff").split(",")]
+    if len(cells) < 3 or cells[0] != "frequency_hz":
+        return None
+    real, imag = _UNIT_CELL.match(cells[1]), _UNIT_CELL.match(cells[2])
+    if real is None or imag is None or (real["name"], imag["name"]) != ("real", "imag"):
+        return None
+    plain = ",".join(["frequency_hz", "real", "imag"] + cells[3:])
+    if plain not in _HEADERS:
+        return None
+    if real["unit"].replace(" ", "") != imag["unit"].replace(" ", ""):
+        raise FileFormatError(f"{name}, line {line}: the real and imaginary parts have different units "
+                              f"({_shown(real['unit'])} and {_shown(imag['unit'])}); expected one unit")
+    kind, factor = _quantity_of_unit(real["unit"], cells[1], name, line)
+    return plain, kind, factor
+
+
+def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = False, coherence=None, force_noise=None,
               truncation=None, window_tau: float | None = None) -> None:
     """Write a one-entry FRF to a CSV file ``frequency_hz,real,imag`` (``,coherence`` when given).
+
+    A receptance is written under the plain header ``frequency_hz,real,imag``
+    (m/N for ``y/f``).  A mobility or an accelerance is written with the SI
+    unit of its values in the header, e.g.
+    ``frequency_hz,real [m/(N s^2)],imag [m/(N s^2)]`` for an accelerance
+    ``y/f`` (:meth:`FRF.unit`), so that :func:`read_csv`, a measurement set
+    and other programs read it back as what it is.
 
     Parameters
     ----------
     frf : FRF
         Shape ``(n_freq, 1, 1)``; select one entry of a larger FRF first,
         e.g. ``frf["tool.tip:y", "tool.tip:y"]``.  The data are written as
-        they are (the file does not record labels or quantity).
+        they are; the file records the quantity (the unit in the header of a
+        mobility or an accelerance), not the labels.
     path : str or path-like
         The file, written through a temporary file and an atomic rename
         (:func:`substructure.io.replacing`).
-    overwrite : bool, default True
-        Whether an existing file may be replaced.
+    overwrite : bool, default False
+        Whether an existing file may be replaced; without it an existing
+        file is refused (:class:`~substructure.errors.OutputExistsError`, a
+        ``FileExistsError``, naming the path).
     coherence : array of float, optional
         The coherence (dimensionless, in [0, 1]) on the FRF's lines, written
         as a fourth column ``coherence``.
@@ -88,6 +138,8 @@ def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coheren
         or a force noise or truncation without a coherence, of another
         length, negative or NaN, or a window time constant that is not a
         number > 0.
+    OutputExistsError
+        When ``path`` exists and ``overwrite`` is false.
     """
     from ..._files import write_text
 
@@ -105,13 +157,16 @@ def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = True, coheren
     values = frf.data[:, 0, 0]
     _refuse_all_zero(frf, os.fspath(path))
     header, columns = CSV_HEADER, [frf.frequency.hz, values.real, values.imag]
+    if frf.quantity != "receptance":  # the unit says what the values are
+        unit = frf.unit(frf.outputs[0], frf.inputs[0])
+        header = f"frequency_hz,real [{unit}],imag [{unit}]"
     if coherence is not None:
         gamma = np.asarray(coherence, dtype=np.float64)
         if gamma.shape != (frf.frequency.n,) or not np.all((gamma >= 0) & (gamma <= 1)):
             raise InvalidValueError(
                 f"coherence: cannot write {os.fspath(path)}: expected {frf.frequency.n} values in [0, 1], one per line"
             )
-        header, columns = COHERENCE_HEADER, columns + [gamma]
+        header, columns = header + ",coherence", columns + [gamma]
     for column, given in zip(_VARIANCE_COLUMNS, (force_noise, truncation)):
         if given is None:
             continue
@@ -305,6 +360,12 @@ def _read_numbered(numbered: list, comments: int, name: str, output: str, input:
     """:func:`_read_csv` on the file's non-blank lines, the first ``comments`` of them comments."""
     first, header = numbered[min(comments, len(numbered) - 1)]
     columns = header.replace(" ", "").lstrip("\ufeff")
+    said, factor = None, 1.0
+    units = _units_header(header, name, first)
+    if units is not None:  # the package's header with the unit of a mobility or an accelerance
+        columns, said, factor = units
+        if quantity is not None and quantity != said:
+            raise _contradiction(name, first, said, quantity)
     if columns not in _HEADERS and columns.startswith(CSV_HEADER + ",") and \
             set(columns.split(",")[3:]) <= {"coherence", *_VARIANCE_COLUMNS}:
         raise FileFormatError(f"{name}, line {first}: the columns {_shown(columns)} are the package's in another "
@@ -358,7 +419,9 @@ def _read_numbered(numbered: list, comments: int, name: str, output: str, input:
             k = int(np.argmax(bad))
             raise FileFormatError(f"{name}, line {lines_of[k]}: {column} is {float(found[column][k])!r}; expected "
                                   "a variance >= 0 (inf where the FRF carries nothing)")
-    frf = _checked_csv(table[:, :3], lines_of, name, output, input, quantity or "receptance")
+    if factor != 1.0:
+        table[:, 1:3] *= factor
+    frf = _checked_csv(table[:, :3], lines_of, name, output, input, quantity or said or "receptance")
     return frf, lines_of, found, window
 
 

@@ -24,8 +24,8 @@ import numpy as np
 
 from ...errors import FileFormatError
 from ...units import bare_unit
-from ._common import _shown
-from .uff_units import _TIME_EXPONENT, _a, _exponents, _unit_of_label
+from ._common import _contradiction, _shown
+from .uff_units import _TIME_EXPONENT, _exponents, _unit_of_label
 
 __all__ = ["parse_export"]
 
@@ -198,8 +198,7 @@ def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None
             raise FileFormatError(f"{name}, line {first}: column {_shown(vcells[0])} has no unit; give it "
                                   "(e.g. 'Magnitude [m/N]') or say the quantity")
     if kind is not None and quantity is not None and kind != quantity:
-        raise FileFormatError(f"{name}, line {first}: the header's units are those of "
-                              f"{_a(kind)}, but the quantity given is {quantity}")
+        raise _contradiction(name, first, kind, quantity)
     data = cells[1:]
     lines = np.array([n for n, _ in rows[1:]])
     for n, row in zip(lines, data):

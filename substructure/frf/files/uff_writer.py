@@ -60,8 +60,8 @@ def _uff_grid(hz: np.ndarray, name: str) -> tuple[int, str]:
     return 1, f"grid start={grid[0]!r} step={grid[1]!r} n={hz.size}"
 
 
-def write_uff(frf: FRF, path: str | os.PathLike, overwrite: bool = True) -> None:
-    """Write an FRF as ASCII type-58 records, one per entry, replacing the file.
+def write_uff(frf: FRF, path: str | os.PathLike, overwrite: bool = False) -> None:
+    """Write an FRF as ASCII type-58 records, one per entry.
 
     Entries are written output by output, input by input, each with the
     data types and unit exponents of UFF 58 (ordinate: displacement,
@@ -79,8 +79,15 @@ def write_uff(frf: FRF, path: str | os.PathLike, overwrite: bool = True) -> None
         At least 2 frequency lines; labels of at most ~68 ASCII characters.
     path : str or path-like
         The universal file (``.uff`` or ``.unv``).
-    overwrite : bool, default True
-        Whether an existing file may be replaced.
+    overwrite : bool, default False
+        Whether an existing file may be replaced; without it an existing
+        file is refused.
+
+    Raises
+    ------
+    OutputExistsError
+        (a ``FileExistsError``) When ``path`` exists and ``overwrite`` is
+        false, naming the path.
     """
     import pyuff
 
