@@ -104,3 +104,24 @@ def test_categorical_feature():
     assert b > 1.3 * a
     with pytest.raises(InvalidValueError, match="hydraulic"):
         model.predict({"tool_diameter": "14 mm", "holder_type": "hydraulic"})
+
+
+def test_prediction_refuses_what_it_cannot_answer(table42):
+    model = GPSurrogate().fit(table42)
+    with pytest.raises(InvalidValueError, match="features: got None; expected a mapping.*tool_diameter, gauge_length"):
+        model.predict(None)
+    with pytest.raises(InvalidValueError, match="features: got 14; expected a mapping"):
+        model.predict([14])
+    pred = model.predict({"tool_diameter": "14 mm", "gauge_length": "90 mm"})
+    for call in (pred.value, pred.std, lambda p: pred.interval(p, 0.95)):
+        with pytest.raises(InvalidValueError, match="'k_tm', which was not predicted; the prediction has k_yf"):
+            call("k_tm")
+    for level in (1.5, 0, 1, -0.2, float("nan"), "0.95"):
+        with pytest.raises(InvalidValueError, match="level: got .*strictly between 0 and 1"):
+            pred.interval("k_yf", level)
+    lo, hi = pred.interval("k_yf", 0.5)
+    assert 0 < lo[0] < pred.value("k_yf")[0] < hi[0]
+    for n in (0, -3, 2.5, True):
+        with pytest.raises(InvalidValueError, match="n: got .*whole number of samples >= 1"):
+            pred.sample(n)
+    assert pred.sample(1)["k_yf"].shape == (1,) and pred.sample(np.int64(3))["k_yf"].shape == (3,)

@@ -21,7 +21,7 @@ Predicting far outside the features of the table warns
 from __future__ import annotations
 
 import warnings
-from typing import Any, Mapping, Sequence
+from typing import Any, Iterable, Mapping, Sequence
 
 import attrs
 import numpy as np
@@ -65,6 +65,11 @@ class Prediction:
     log_std: dict
     units: dict
 
+    def _check_parameter(self, parameter: str) -> None:
+        if not isinstance(parameter, str) or parameter not in self.log_mean:
+            raise InvalidValueError(f"parameter: got {parameter!r}, which was not predicted; the prediction has "
+                                    f"{', '.join(self.log_mean)} (a surrogate predicts what it was fitted on)")
+
     def value(self, parameter: str) -> np.ndarray:
         """The median prediction ``exp(log_mean)``.
 
@@ -78,6 +83,7 @@ class Prediction:
         ndarray
             One value per feature set, in ``units[parameter]``.
         """
+        self._check_parameter(parameter)
         return np.exp(self.log_mean[parameter])
 
     def std(self, parameter: str) -> np.ndarray:
@@ -93,6 +99,7 @@ class Prediction:
         ndarray
             One value per feature set, in ``units[parameter]``.
         """
+        self._check_parameter(parameter)
         s = self.log_std[parameter]
         return self.value(parameter) * np.sqrt(np.expm1(s**2)) * np.exp(s**2 / 2)
 
@@ -111,6 +118,10 @@ class Prediction:
         lower, upper : ndarray
             One bound per feature set, in ``units[parameter]``.
         """
+        self._check_parameter(parameter)
+        if isinstance(level, bool) or not isinstance(level, (int, float, np.number)) or not 0 < level < 1:
+            raise InvalidValueError(f"level: got {level!r}; expected a probability strictly between 0 and 1, "
+                                    "e.g. 0.95")
         z = norm.ppf(0.5 + level / 2)
         m, s = self.log_mean[parameter], self.log_std[parameter]
         return np.exp(m - z * s), np.exp(m + z * s)
@@ -136,6 +147,8 @@ class Prediction:
         dict
             ``{parameter: ndarray of n values}``, in ``units[parameter]``.
         """
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+            raise InvalidValueError(f"n: got {n!r}; expected a whole number of samples >= 1")
         rng = np.random.default_rng(rng)
         p = (np.arange(n) + 0.5) / n
         out = {}
@@ -289,7 +302,15 @@ class JointSurrogate(BaseEstimator):
         if isinstance(features, (str, bytes)):
             raise InvalidValueError(f"features: got the string {features!r}; expected a mapping such as "
                                     "{'tool_diameter': '14 mm', 'gauge_length': '90 mm'} (or a list of them)")
-        rows = [features] if isinstance(features, Mapping) else list(features)
+        expected = ("expected a mapping such as {'tool_diameter': '14 mm', 'gauge_length': '90 mm'} "
+                    f"(or a list of them) with the table's features {', '.join(self.encoder_.names)}")
+        if isinstance(features, Mapping):
+            rows = [features]
+        else:
+            rows = list(features) if isinstance(features, Iterable) else [features]
+            wrong = [r for r in rows if not isinstance(r, Mapping)]
+            if wrong:
+                raise InvalidValueError(f"features: got {wrong[0]!r}; {expected}")
         if not rows:
             raise InvalidValueError("features: got no feature sets")
         table = JointTable.empty({"k_yf": "N/m"}, self.encoder_.units)
