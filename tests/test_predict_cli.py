@@ -65,3 +65,11 @@ def test_predict_with_an_assembly_gives_the_frf_band(tmp_path, capsys):
     assert main(["predict", str(table), "--features", "tool_diameter=12 mm,gauge_length=80 mm",
                  "--assembly", str(assembly)]) == 2
     assert "go together" in capsys.readouterr().err
+
+
+def test_predict_refuses_non_positive_sizes(table_csv, capsys):
+    for value in ("-14 mm", "0 mm"):
+        assert main(["predict", table_csv, "--features", f"tool_diameter={value},gauge_length=90 mm"]) == 1
+        captured = capsys.readouterr()
+        assert f"--features: tool_diameter is {value}; expected a size > 0" in captured.err
+        assert captured.out == "" and "Traceback" not in captured.err

@@ -74,3 +74,22 @@ def test_toml_round_trip_and_errors(tmp_path):
         JointTable.from_toml(bad)
     with pytest.raises(FileFormatError, match="no such file"):
         JointTable.from_toml(tmp_path / "missing.toml")
+
+
+def test_sizes_must_be_positive(tmp_path):
+    path = tmp_path / "neg.csv"
+    path.write_text("tool_diameter [mm],gauge_length [mm],k_yf [N/m]\n12,76,1.43e7\n-12,81,1.95e7\n16,85,1.2e7\n")
+    with pytest.raises(FileFormatError, match=r"neg.csv, line 3: tool_diameter is -12 mm; expected a size > 0"):
+        JointTable.from_csv(path)
+    path.write_text("tool_diameter [mm],gauge_length [mm],k_yf [N/m]\n12,0,1.43e7\n")
+    with pytest.raises(FileFormatError, match=r"line 2: gauge_length is 0 mm; expected a size > 0"):
+        JointTable.from_csv(path)
+    table = thesis_table_4_2()
+    with pytest.raises(InvalidValueError, match=r"row: tool_diameter is -1.4 cm; expected a size > 0"):
+        table.append({"tool_diameter": "-1.4 cm", "gauge_length": "90 mm", "k_yf": "1e7 N/m"})
+    with pytest.raises(InvalidValueError, match=r"features: gauge_length is 0 mm; expected a size > 0"):
+        table.feature_values({"tool_diameter": "14 mm", "gauge_length": "0 mm"})
+    # a feature that is not a length (a clamping torque here) may be any finite number
+    signed = JointTable.from_rows([{"tool_diameter": "12 mm", "offset_torque": f"{t} N*m", "k_yf": "1e7 N/m"}
+                                   for t in (-2, 0, 3)])
+    assert list(signed.feature("offset_torque")) == [-2, 0, 3]

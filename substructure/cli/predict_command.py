@@ -49,7 +49,8 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError("give --features NAME=VALUE,... (or --cross-validate)")
     if bool(args.assembly) != bool(args.joint):
         raise UsageError("--assembly and --joint go together: the assembly file and the joint to replace")
-    features = _features(args.features)  # read before the fit: a mistake costs no time
+    features = _features(args.features)  # read and checked before the fit: a mistake costs no time
+    table.feature_values(features, field="--features")
     targets = [args.target] if args.target else None
     model = surrogate.fit(table, targets)
     prediction = model.predict(features)

@@ -2,8 +2,8 @@
 
 :data:`PARAMETER_UNITS` gives the SI unit of each joint parameter; the
 checks here read a column's header (``NAME [unit]``), make sure a parameter's
-unit has its dimension, that the direct terms are positive or non-negative
-and every value finite, and convert a value with a unit into the column's
+unit has its dimension, that the direct terms are positive or non-negative,
+sizes (features that are lengths) positive and every value finite, and convert a value with a unit into the column's
 unit.  :class:`~substructure.surrogate.JointTable` uses them when it is
 built, read and appended to.
 """
@@ -104,6 +104,16 @@ def _check_columns(parameters: Mapping[str, str], features: Mapping[str, str | N
         if bad.any():
             i = int(np.argmax(bad))
             raise error(f"{locate(i)}: {name} is {values[i]}; expected a finite value")
+        if _is_size(unit):
+            wrong = values <= 0
+            if wrong.any():
+                i = int(np.argmax(wrong))
+                raise error(f"{locate(i)}: {name} is {values[i]:g} {unit}; expected a size > 0 ({name} is a length)")
+
+
+def _is_size(unit: str | None) -> bool:
+    """Whether a feature in ``unit`` is a size (a length: a diameter, a gauge length), which must be positive."""
+    return unit is not None and _dimension(unit) == "[length]"
 
 
 def _to_unit(value: Any, unit: str, field: str) -> float:

@@ -34,7 +34,7 @@ import pint
 from ..errors import FileFormatError, InvalidValueError, UnitError
 from ..units import ureg
 from .columns import (
-    PARAMETER_UNITS, _HEADER, _check_columns, _check_parameter_unit, _check_unit, _dimension, _to_unit,
+    PARAMETER_UNITS, _HEADER, _check_columns, _check_parameter_unit, _check_unit, _dimension, _is_size, _to_unit,
 )
 
 __all__ = ["JointTable", "PARAMETER_UNITS", "thesis_table_4_2"]
@@ -371,6 +371,9 @@ class JointTable:
                 out[name] = value.strip()
             else:
                 out[name] = _to_unit(value, unit, name)
+                if _is_size(unit) and out[name] <= 0:
+                    raise InvalidValueError(f"{field}: {name} is {value!s}; expected a size > 0 ({name} is a length, "
+                                            f"in {unit} in the table)")
         return out
 
     # -- changes -----------------------------------------------------------------------------
