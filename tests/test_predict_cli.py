@@ -73,3 +73,12 @@ def test_predict_refuses_non_positive_sizes(table_csv, capsys):
         captured = capsys.readouterr()
         assert f"--features: tool_diameter is {value}; expected a size > 0" in captured.err
         assert captured.out == "" and "Traceback" not in captured.err
+
+
+def test_predict_plot_needs_something_to_draw(table_csv, tmp_path, capsys):
+    plot = tmp_path / "x.png"
+    assert main(["predict", table_csv, "--features", "tool_diameter=14 mm,gauge_length=90 mm",
+                 "--plot", str(plot)]) == 2
+    captured = capsys.readouterr()
+    assert "--plot draws the FRF band of --assembly" in captured.err and "--cross-validate" in captured.err
+    assert captured.out == "" and not plot.exists()

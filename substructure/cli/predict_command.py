@@ -27,6 +27,9 @@ def run(args: argparse.Namespace) -> int:
     from ..io.assembly_toml import load_assembly
     from ..surrogate import JointTable, cross_validate, make_surrogate
 
+    if args.plot and not args.cross_validate and not args.assembly:
+        raise UsageError("--plot draws the FRF band of --assembly A.toml --joint NAME or the parity plot of "
+                         "--cross-validate, and neither is given; add one of them or leave out --plot")
     check_plot(args.plot)
     check_outputs([("--plot", args.plot)], [args.table, args.assembly], args.overwrite)
     count_arg("--samples", args.samples, minimum=1)
@@ -97,7 +100,8 @@ def add_parser(commands) -> None:
     pred.add_argument("--at", default="tool.tip", metavar="POINT[:dof]", help="FRF point (default tool.tip:y)")
     pred.add_argument("--samples", type=int, default=64, metavar="N",
                       help="samples of the predictive distribution for the FRF band (default 64)")
-    pred.add_argument("--plot", metavar="FILE.png", help="parity plot of the cross-validation, or the FRF band")
+    pred.add_argument("--plot", metavar="FILE.png",
+                      help="the FRF band of --assembly, or the parity plot of --cross-validate")
     pred.add_argument("--overwrite", action="store_true", help="let --plot replace an existing file")
     pred.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
     pred.set_defaults(run=run)
