@@ -82,3 +82,11 @@ def test_predict_plot_needs_something_to_draw(table_csv, tmp_path, capsys):
     captured = capsys.readouterr()
     assert "--plot draws the FRF band of --assembly" in captured.err and "--cross-validate" in captured.err
     assert captured.out == "" and not plot.exists()
+
+
+def test_predict_refuses_a_test_listed_twice(tmp_path, capsys):
+    path = tmp_path / "dup.csv"
+    path.write_text("tool_diameter [mm],gauge_length [mm],k_yf [N/m]\n" + "12,76,1.43e7\n" * 3)
+    assert main(["predict", str(path), "--features", "tool_diameter=12 mm,gauge_length=76 mm"]) == 1
+    err = capsys.readouterr().err
+    assert "dup.csv, line 3: the same joint as line 2" in err and "the same test listed twice" in err

@@ -125,3 +125,28 @@ def test_prediction_refuses_what_it_cannot_answer(table42):
         with pytest.raises(InvalidValueError, match="n: got .*whole number of samples >= 1"):
             pred.sample(n)
     assert pred.sample(1)["k_yf"].shape == (1,) and pred.sample(np.int64(3))["k_yf"].shape == (3,)
+
+
+def _repeated_tests():
+    """Four tools, each tested three times (measured values scattering by a few %)."""
+    rows = []
+    for d, L, k in ((10, 70, 0.9e7), (12, 76, 1.43e7), (16, 83, 2.2e7), (20, 95, 3.4e7)):
+        for f in (0.97, 1.0, 1.04):
+            rows.append({"tool_diameter": f"{d} mm", "gauge_length": f"{L} mm", "k_yf": f"{k * f!r} N/m"})
+    return JointTable.from_rows(rows)
+
+
+def test_repeated_tests_count_once_and_are_held_out_together():
+    table = _repeated_tests()
+    assert len(table) == 12 and len(table.feature_groups()) == 4
+    cv = cross_validate(GPSurrogate(), table, "k_yf", "loo")
+    assert [list(f["held_out"]) for f in cv.folds] == [[0, 1, 2], [3, 4, 5], [6, 7, 8], [9, 10, 11]]
+    # the held-out tool is not in the training set: its error is that of a tool never seen, not ~0
+    assert cv.mean_abs_percent_error > 5.0
+    first_three = JointTable(table.parameters, table.features, {k: v[:9] for k, v in table.columns.items()})
+    with pytest.raises(InvalidValueError, match="9 rows of 3 distinct tools .* leaves 2 to fit"):
+        cross_validate(GPSurrogate(), first_three, "k_yf", "loo")
+    two_tools = JointTable(table.parameters, table.features, {k: v[:6] for k, v in table.columns.items()})
+    with pytest.raises(InvalidValueError, match="6 rows but 2 distinct tools .*a surrogate needs at least 3"):
+        GPSurrogate().fit(two_tools)
+    assert GPSurrogate().fit(first_three).predict({"tool_diameter": "12 mm", "gauge_length": "76 mm"}).std("k_yf") > 0

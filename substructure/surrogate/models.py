@@ -268,7 +268,8 @@ class JointSurrogate(BaseEstimator):
         Parameters
         ----------
         table : JointTable
-            At least 3 rows; the target values must be positive (logarithms are learnt).
+            At least 3 rows of distinct features (repeated tests of one tool count once); the target values
+            must be positive (logarithms are learnt).
         targets : str or sequence of str, optional
             Parameters to learn, e.g. ``"k_yf"``; default all of the table's.
 
@@ -283,7 +284,7 @@ class JointSurrogate(BaseEstimator):
         targets = list(table.parameters) if targets is None else list(targets)
         for t in targets:
             table._check_parameter(t)
-        table.check_not_empty(3, "a surrogate")
+        table.check_distinct_features(3, "a surrogate")
         self.encoder_ = _Encoder(table)
         X = self.encoder_.encode_columns(table.columns)
         self.targets_ = tuple(targets)
