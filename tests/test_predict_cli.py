@@ -90,3 +90,16 @@ def test_predict_refuses_a_test_listed_twice(tmp_path, capsys):
     assert main(["predict", str(path), "--features", "tool_diameter=12 mm,gauge_length=76 mm"]) == 1
     err = capsys.readouterr().err
     assert "dup.csv, line 3: the same joint as line 2" in err and "the same test listed twice" in err
+
+
+def test_predict_json_flags_extrapolation(table_csv, capsys):
+    assert main(["predict", table_csv, "--features", "tool_diameter=40 mm,gauge_length=90 mm", "--json"]) == 0
+    captured = capsys.readouterr()
+    out = json.loads(captured.out)
+    flag = {"feature": "tool_diameter", "value": 40.0, "unit": "mm", "table_min": 10.0, "table_max": 20.0,
+            "side": "above", "distance": 20.0, "times_range": 2.0}
+    assert out["extrapolation"] == [flag] and out["parameters"]["k_yf"]["extrapolation"] == [flag]
+    assert "warning" in captured.err
+    assert main(["predict", table_csv, "--features", "tool_diameter=14 mm,gauge_length=90 mm", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["extrapolation"] == [] and out["parameters"]["k_yf"]["extrapolation"] == []

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -150,3 +152,27 @@ def test_repeated_tests_count_once_and_are_held_out_together():
     with pytest.raises(InvalidValueError, match="6 rows but 2 distinct tools .*a surrogate needs at least 3"):
         GPSurrogate().fit(two_tools)
     assert GPSurrogate().fit(first_three).predict({"tool_diameter": "12 mm", "gauge_length": "76 mm"}).std("k_yf") > 0
+
+
+def test_prediction_records_extrapolation(table42):
+    model = GPSurrogate().fit(table42)
+    inside = model.predict({"tool_diameter": "14 mm", "gauge_length": "90 mm"})
+    assert inside.outside() == [] and inside.to_json()["k_yf"]["extrapolation"] == []
+    # a little outside: no warning (within 0.25 times the range), but recorded
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ExtrapolationWarning)
+        near = model.predict({"tool_diameter": "21 mm", "gauge_length": "90 mm"})
+    assert near.outside() == [{"feature": "tool_diameter", "value": 21.0, "unit": "mm", "table_min": 10.0,
+                               "table_max": 20.0, "side": "above", "distance": 1.0, "times_range": 0.1}]
+    with pytest.warns(ExtrapolationWarning):
+        far = model.predict([{"tool_diameter": "14 mm", "gauge_length": "90 mm"},
+                             {"tool_diameter": "5 mm", "gauge_length": "146 mm"}])
+    assert far.outside(0) == []
+    entries = far.to_json(1)["k_yf"]["extrapolation"]
+    assert [(e["feature"], e["side"]) for e in entries] == [("tool_diameter", "below"), ("gauge_length", "above")]
+    assert entries[0]["distance"] == pytest.approx(5.0) and entries[0]["times_range"] == pytest.approx(0.5)
+    assert entries[1]["distance"] == pytest.approx(40.0) and entries[1]["times_range"] == pytest.approx(40 / 41)
+    # a prediction built by hand knows of no extrapolation
+    from substructure.surrogate import Prediction
+
+    assert Prediction({"k_yf": np.zeros(1)}, {"k_yf": np.ones(1)}, {"k_yf": "N/m"}).outside() == []

@@ -67,7 +67,8 @@ def run(args: argparse.Namespace) -> int:
         if args.plot:
             draw_to(args.plot, args.overwrite, lambda: band.plot(label=f"{args.model} prediction"))
     if args.json:
-        out = {"model": args.model, "features": features, "parameters": result}
+        out = {"model": args.model, "features": features, "parameters": result,
+               "extrapolation": prediction.outside()}
         if band is not None:
             out["frf"] = {"at": point_arg(args.at), "joint": args.joint, **band.to_json()}
         return print_json(out)
