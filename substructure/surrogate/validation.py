@@ -174,11 +174,13 @@ def cross_validate(surrogate: JointSurrogate, table: JointTable, target: str, sc
     smallest = min(len({tool_of[i] for i in range(n)} - {tool_of[i] for i in g}) for g in groups)
     if smallest < 3:
         rows = "1 row" if n == 1 else f"{n} rows"
-        what = "tool" if len(tools) == 1 else "tools"
+        held = "one row" if len(tools) == n else "one tool (every row of its features)"
+        if len(tools) < n:
+            rows += f" of {len(tools)} distinct tools (feature sets)"
         raise InvalidValueError(
-            f"cross-validation ({scheme}): the joint table has {rows} of {len(tools)} distinct {what} (feature "
-            f"sets); holding out {'one tool' if scheme == 'loo' else 'the largest group'} leaves {smallest} to "
-            "fit, and a surrogate needs at least 3"
+            f"cross-validation ({scheme}): the joint table has {rows}; holding out "
+            f"{held if scheme == 'loo' else 'the largest group'} leaves {smallest} to fit, and a surrogate "
+            "needs at least 3"
         )
     y = table.values(target)
     folds = []
