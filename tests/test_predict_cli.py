@@ -65,3 +65,41 @@ def test_predict_with_an_assembly_gives_the_frf_band(tmp_path, capsys):
     assert main(["predict", str(table), "--features", "tool_diameter=12 mm,gauge_length=80 mm",
                  "--assembly", str(assembly)]) == 2
     assert "go together" in capsys.readouterr().err
+
+
+def test_predict_refuses_non_positive_sizes(table_csv, capsys):
+    for value in ("-14 mm", "0 mm"):
+        assert main(["predict", table_csv, "--features", f"tool_diameter={value},gauge_length=90 mm"]) == 1
+        captured = capsys.readouterr()
+        assert f"--features: tool_diameter is {value}; expected a size > 0" in captured.err
+        assert captured.out == "" and "Traceback" not in captured.err
+
+
+def test_predict_plot_needs_something_to_draw(table_csv, tmp_path, capsys):
+    plot = tmp_path / "x.png"
+    assert main(["predict", table_csv, "--features", "tool_diameter=14 mm,gauge_length=90 mm",
+                 "--plot", str(plot)]) == 2
+    captured = capsys.readouterr()
+    assert "--plot draws the FRF band of --assembly" in captured.err and "--cross-validate" in captured.err
+    assert captured.out == "" and not plot.exists()
+
+
+def test_predict_refuses_a_test_listed_twice(tmp_path, capsys):
+    path = tmp_path / "dup.csv"
+    path.write_text("tool_diameter [mm],gauge_length [mm],k_yf [N/m]\n" + "12,76,1.43e7\n" * 3)
+    assert main(["predict", str(path), "--features", "tool_diameter=12 mm,gauge_length=76 mm"]) == 1
+    err = capsys.readouterr().err
+    assert "dup.csv, line 3: the same joint as line 2" in err and "the same test listed twice" in err
+
+
+def test_predict_json_flags_extrapolation(table_csv, capsys):
+    assert main(["predict", table_csv, "--features", "tool_diameter=40 mm,gauge_length=90 mm", "--json"]) == 0
+    captured = capsys.readouterr()
+    out = json.loads(captured.out)
+    flag = {"feature": "tool_diameter", "value": 40.0, "unit": "mm", "table_min": 10.0, "table_max": 20.0,
+            "side": "above", "distance": 20.0, "times_range": 2.0}
+    assert out["extrapolation"] == [flag] and out["parameters"]["k_yf"]["extrapolation"] == [flag]
+    assert "warning" in captured.err
+    assert main(["predict", table_csv, "--features", "tool_diameter=14 mm,gauge_length=90 mm", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["extrapolation"] == [] and out["parameters"]["k_yf"]["extrapolation"] == []

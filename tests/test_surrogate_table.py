@@ -74,3 +74,38 @@ def test_toml_round_trip_and_errors(tmp_path):
         JointTable.from_toml(bad)
     with pytest.raises(FileFormatError, match="no such file"):
         JointTable.from_toml(tmp_path / "missing.toml")
+
+
+def test_sizes_must_be_positive(tmp_path):
+    path = tmp_path / "neg.csv"
+    path.write_text("tool_diameter [mm],gauge_length [mm],k_yf [N/m]\n12,76,1.43e7\n-12,81,1.95e7\n16,85,1.2e7\n")
+    with pytest.raises(FileFormatError, match=r"neg.csv, line 3: tool_diameter is -12 mm; expected a size > 0"):
+        JointTable.from_csv(path)
+    path.write_text("tool_diameter [mm],gauge_length [mm],k_yf [N/m]\n12,0,1.43e7\n")
+    with pytest.raises(FileFormatError, match=r"line 2: gauge_length is 0 mm; expected a size > 0"):
+        JointTable.from_csv(path)
+    table = thesis_table_4_2()
+    with pytest.raises(InvalidValueError, match=r"row: tool_diameter is -1.4 cm; expected a size > 0"):
+        table.append({"tool_diameter": "-1.4 cm", "gauge_length": "90 mm", "k_yf": "1e7 N/m"})
+    with pytest.raises(InvalidValueError, match=r"features: gauge_length is 0 mm; expected a size > 0"):
+        table.feature_values({"tool_diameter": "14 mm", "gauge_length": "0 mm"})
+    # a feature that is not a length (a clamping torque here) may be any finite number
+    signed = JointTable.from_rows([{"tool_diameter": "12 mm", "offset_torque": f"{t} N*m", "k_yf": "1e7 N/m"}
+                                   for t in (-2, 0, 3)])
+    assert list(signed.feature("offset_torque")) == [-2, 0, 3]
+
+
+def test_the_same_test_twice_is_refused_repeated_tests_are_kept(tmp_path):
+    path = tmp_path / "dup.csv"
+    path.write_text("tool_diameter [mm],gauge_length [mm],k_yf [N/m]\n12,76,1.43e7\n# again\n12,76,1.43e7\n"
+                    "16,85,1.2e7\n")
+    with pytest.raises(FileFormatError, match=r"dup.csv, line 4: the same joint as line 2 in every feature and "
+                                              r"parameter \(tool_diameter, gauge_length, k_yf\): the same test listed"):
+        JointTable.from_csv(path)
+    row = {"tool_diameter": "12 mm", "gauge_length": "76 mm", "k_yf": "1.43e7 N/m"}
+    with pytest.raises(InvalidValueError, match=r"row 2: the same joint as row 1"):
+        JointTable.from_rows([row, dict(row, gauge_length="80 mm"), row][::2])
+    # the same tool tested again, with another measured value: a repeated test, kept
+    table = JointTable.from_rows([row, dict(row, k_yf="1.5e7 N/m"), dict(row, tool_diameter="16 mm")])
+    assert len(table) == 3 and table.feature_groups() == [[0, 1], [2]]
+    assert JointTable.from_rows([row]).feature_groups() == [[0]]

@@ -27,6 +27,9 @@ def run(args: argparse.Namespace) -> int:
     from ..io.assembly_toml import load_assembly
     from ..surrogate import JointTable, cross_validate, make_surrogate
 
+    if args.plot and not args.cross_validate and not args.assembly:
+        raise UsageError("--plot draws the FRF band of --assembly A.toml --joint NAME or the parity plot of "
+                         "--cross-validate, and neither is given; add one of them or leave out --plot")
     check_plot(args.plot)
     check_outputs([("--plot", args.plot)], [args.table, args.assembly], args.overwrite)
     count_arg("--samples", args.samples, minimum=1)
@@ -49,7 +52,8 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError("give --features NAME=VALUE,... (or --cross-validate)")
     if bool(args.assembly) != bool(args.joint):
         raise UsageError("--assembly and --joint go together: the assembly file and the joint to replace")
-    features = _features(args.features)  # read before the fit: a mistake costs no time
+    features = _features(args.features)  # read and checked before the fit: a mistake costs no time
+    table.feature_values(features, field="--features")
     targets = [args.target] if args.target else None
     model = surrogate.fit(table, targets)
     prediction = model.predict(features)
@@ -63,7 +67,8 @@ def run(args: argparse.Namespace) -> int:
         if args.plot:
             draw_to(args.plot, args.overwrite, lambda: band.plot(label=f"{args.model} prediction"))
     if args.json:
-        out = {"model": args.model, "features": features, "parameters": result}
+        out = {"model": args.model, "features": features, "parameters": result,
+               "extrapolation": prediction.outside()}
         if band is not None:
             out["frf"] = {"at": point_arg(args.at), "joint": args.joint, **band.to_json()}
         return print_json(out)
@@ -96,7 +101,8 @@ def add_parser(commands) -> None:
     pred.add_argument("--at", default="tool.tip", metavar="POINT[:dof]", help="FRF point (default tool.tip:y)")
     pred.add_argument("--samples", type=int, default=64, metavar="N",
                       help="samples of the predictive distribution for the FRF band (default 64)")
-    pred.add_argument("--plot", metavar="FILE.png", help="parity plot of the cross-validation, or the FRF band")
+    pred.add_argument("--plot", metavar="FILE.png",
+                      help="the FRF band of --assembly, or the parity plot of --cross-validate")
     pred.add_argument("--overwrite", action="store_true", help="let --plot replace an existing file")
     pred.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")
     pred.set_defaults(run=run)

@@ -2,8 +2,9 @@
 
 :data:`PARAMETER_UNITS` gives the SI unit of each joint parameter; the
 checks here read a column's header (``NAME [unit]``), make sure a parameter's
-unit has its dimension, that the direct terms are positive or non-negative
-and every value finite, and convert a value with a unit into the column's
+unit has its dimension, that the direct terms are positive or non-negative,
+sizes (features that are lengths) positive, every value finite and no row
+there twice, and convert a value with a unit into the column's
 unit.  :class:`~substructure.surrogate.JointTable` uses them when it is
 built, read and appended to.
 """
@@ -65,7 +66,8 @@ def _check_parameter_unit(name: str, unit: str, field: str) -> str:
 
 def _check_columns(parameters: Mapping[str, str], features: Mapping[str, str | None],
                    columns: Mapping[str, Any], locate, error=InvalidValueError) -> None:
-    """Values a joint table may hold: finite numbers, positive direct stiffness, non-negative damping and std.
+    """Values a joint table may hold: finite numbers, positive direct stiffness, non-negative damping and std,
+    positive sizes, no row twice.
 
     ``locate(i)`` names row ``i`` (0-based) in messages; ``error`` is the class raised.
     """
@@ -104,6 +106,38 @@ def _check_columns(parameters: Mapping[str, str], features: Mapping[str, str | N
         if bad.any():
             i = int(np.argmax(bad))
             raise error(f"{locate(i)}: {name} is {values[i]}; expected a finite value")
+        if _is_size(unit):
+            wrong = values <= 0
+            if wrong.any():
+                i = int(np.argmax(wrong))
+                raise error(f"{locate(i)}: {name} is {values[i]:g} {unit}; expected a size > 0 ({name} is a length)")
+    _check_duplicates(parameters, features, columns, locate, error)
+
+
+def _check_duplicates(parameters: Mapping[str, str], features: Mapping[str, str | None],
+                      columns: Mapping[str, Any], locate, error=InvalidValueError) -> None:
+    """Refuse two rows equal in every feature and parameter: the same test listed twice.
+
+    Such copies would count as independent tests and make the surrogate (and
+    its cross-validation) more certain than one test allows.  Rows with the
+    same features but other measured values are repeated tests, and stay.
+    """
+    names = [*features, *parameters]
+    if not names:
+        return
+    first: dict[tuple, int] = {}
+    for i, key in enumerate(zip(*(np.asarray(columns[n]).tolist() for n in names))):
+        if key in first:
+            j = first[key]
+            raise error(f"{locate(i)}: the same joint as {locate(j).rsplit(', ', 1)[-1]} in every feature and "
+                        f"parameter ({', '.join(names)}): the same test listed twice; keep it once (a repeated "
+                        "test has its own measured values)")
+        first[key] = i
+
+
+def _is_size(unit: str | None) -> bool:
+    """Whether a feature in ``unit`` is a size (a length: a diameter, a gauge length), which must be positive."""
+    return unit is not None and _dimension(unit) == "[length]"
 
 
 def _to_unit(value: Any, unit: str, field: str) -> float:

@@ -15,13 +15,15 @@ standard deviation, and :meth:`Prediction.interval` exact log-space intervals.
   deviation includes the scatter of the data.
 
 Predicting far outside the features of the table warns
-(:class:`ExtrapolationWarning`) and says how far.
+(:class:`ExtrapolationWarning`) and says how far; the prediction records
+every feature outside the table's range (:meth:`Prediction.outside`, and
+``extrapolation`` in its JSON).
 """
 
 from __future__ import annotations
 
 import warnings
-from typing import Any, Mapping, Sequence
+from typing import Any, Iterable, Mapping, Sequence
 
 import attrs
 import numpy as np
@@ -59,11 +61,38 @@ class Prediction:
         ``{parameter: ndarray}``: standard deviation of that logarithm (dimensionless).
     units : dict
         ``{parameter: unit}``, e.g. ``{"k_yf": "N/m"}``.
+    extrapolation : list of list of dict, optional
+        Per feature set, the numeric features outside the range of the
+        training table: ``{"feature", "value", "unit", "table_min",
+        "table_max", "side" ("below" or "above"), "distance" (in ``unit``),
+        "times_range"}`` (the distance over the table's range); an empty list
+        inside it.  Empty when not known.
     """
 
     log_mean: dict
     log_std: dict
     units: dict
+    extrapolation: list = attrs.field(factory=list)
+
+    def outside(self, index: int = 0) -> list[dict]:
+        """The features of feature set ``index`` outside the table's range (see ``extrapolation``).
+
+        Parameters
+        ----------
+        index : int
+            Which feature set.
+
+        Returns
+        -------
+        list of dict
+            One dict per feature outside the range; empty when every feature is inside it.
+        """
+        return [dict(e) for e in self.extrapolation[index]] if self.extrapolation else []
+
+    def _check_parameter(self, parameter: str) -> None:
+        if not isinstance(parameter, str) or parameter not in self.log_mean:
+            raise InvalidValueError(f"parameter: got {parameter!r}, which was not predicted; the prediction has "
+                                    f"{', '.join(self.log_mean)} (a surrogate predicts what it was fitted on)")
 
     def value(self, parameter: str) -> np.ndarray:
         """The median prediction ``exp(log_mean)``.
@@ -78,6 +107,7 @@ class Prediction:
         ndarray
             One value per feature set, in ``units[parameter]``.
         """
+        self._check_parameter(parameter)
         return np.exp(self.log_mean[parameter])
 
     def std(self, parameter: str) -> np.ndarray:
@@ -93,6 +123,7 @@ class Prediction:
         ndarray
             One value per feature set, in ``units[parameter]``.
         """
+        self._check_parameter(parameter)
         s = self.log_std[parameter]
         return self.value(parameter) * np.sqrt(np.expm1(s**2)) * np.exp(s**2 / 2)
 
@@ -111,6 +142,10 @@ class Prediction:
         lower, upper : ndarray
             One bound per feature set, in ``units[parameter]``.
         """
+        self._check_parameter(parameter)
+        if isinstance(level, bool) or not isinstance(level, (int, float, np.number)) or not 0 < level < 1:
+            raise InvalidValueError(f"level: got {level!r}; expected a probability strictly between 0 and 1, "
+                                    "e.g. 0.95")
         z = norm.ppf(0.5 + level / 2)
         m, s = self.log_mean[parameter], self.log_std[parameter]
         return np.exp(m - z * s), np.exp(m + z * s)
@@ -136,6 +171,8 @@ class Prediction:
         dict
             ``{parameter: ndarray of n values}``, in ``units[parameter]``.
         """
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+            raise InvalidValueError(f"n: got {n!r}; expected a whole number of samples >= 1")
         rng = np.random.default_rng(rng)
         p = (np.arange(n) + 0.5) / n
         out = {}
@@ -145,7 +182,10 @@ class Prediction:
         return out
 
     def to_json(self, index: int = 0) -> dict:
-        """``{name: {"value", "unit", "std", "interval_95"}}`` for feature set ``index``.
+        """``{name: {"value", "unit", "std", "interval_95", "extrapolation"}}`` for feature set ``index``.
+
+        ``extrapolation`` lists the features outside the table's range and how
+        far (:meth:`outside`); an empty list when the prediction interpolates.
 
         Parameters
         ----------
@@ -161,7 +201,8 @@ class Prediction:
         for p in self.log_mean:
             lo, hi = self.interval(p, 0.95)
             out[p] = {"value": float(self.value(p)[index]), "unit": self.units[p],
-                      "std": float(self.std(p)[index]), "interval_95": [float(lo[index]), float(hi[index])]}
+                      "std": float(self.std(p)[index]), "interval_95": [float(lo[index]), float(hi[index])],
+                      "extrapolation": self.outside(index)}
         return out
 
 
@@ -222,20 +263,33 @@ class _Encoder:
                         "add identified joints with other values (or leave the column out)"
                     )
 
-    def check_range(self, columns: Mapping[str, Sequence], tolerance: float) -> None:
+    def outside(self, columns: Mapping[str, Sequence]) -> list[list[dict]]:
+        """Per feature set, the numeric features outside the table's range and how far."""
+        n = len(next(iter(columns.values()))) if columns else 0
+        out: list[list[dict]] = [[] for _ in range(n)]
         for f in self.names:
             if self.units[f] is None or f in self.constant:
                 continue
-            lo, hi = self.lo[f], self.hi[f]
+            lo, hi = float(self.lo[f]), float(self.hi[f])
             span = max(hi - lo, 1e-12 * max(abs(hi), 1.0))
-            for v in np.asarray(columns[f], dtype=float):
+            for i, v in enumerate(np.asarray(columns[f], dtype=float)):
                 dist = lo - v if v < lo else v - hi if v > hi else 0.0
-                if dist > tolerance * span:
-                    side = "below the smallest" if v < lo else "above the largest"
+                if dist > 0:
+                    out[i].append({"feature": f, "value": float(v), "unit": self.units[f], "table_min": lo,
+                                   "table_max": hi, "side": "below" if v < lo else "above",
+                                   "distance": float(dist), "times_range": float(dist / span)})
+        return out
+
+    def check_range(self, outside: list[list[dict]], tolerance: float) -> None:
+        for entries in outside:
+            for e in entries:
+                if e["times_range"] > tolerance:
+                    side = "below the smallest" if e["side"] == "below" else "above the largest"
+                    u = e["unit"]
                     warnings.warn(
-                        f"{f} = {v:g} {self.units[f]} is {dist:g} {self.units[f]} ({dist / span:.1f} times the "
-                        f"table's range {lo:g}-{hi:g} {self.units[f]}) {side} in the table: an extrapolation, "
-                        "the prediction and its uncertainty are not to be trusted",
+                        f"{e['feature']} = {e['value']:g} {u} is {e['distance']:g} {u} ({e['times_range']:.1f} times "
+                        f"the table's range {e['table_min']:g}-{e['table_max']:g} {u}) {side} in the table: an "
+                        "extrapolation, the prediction and its uncertainty are not to be trusted",
                         ExtrapolationWarning, stacklevel=4,
                     )
 
@@ -255,7 +309,8 @@ class JointSurrogate(BaseEstimator):
         Parameters
         ----------
         table : JointTable
-            At least 3 rows; the target values must be positive (logarithms are learnt).
+            At least 3 rows of distinct features (repeated tests of one tool count once); the target values
+            must be positive (logarithms are learnt).
         targets : str or sequence of str, optional
             Parameters to learn, e.g. ``"k_yf"``; default all of the table's.
 
@@ -270,7 +325,7 @@ class JointSurrogate(BaseEstimator):
         targets = list(table.parameters) if targets is None else list(targets)
         for t in targets:
             table._check_parameter(t)
-        table.check_not_empty(3, "a surrogate")
+        table.check_distinct_features(3, "a surrogate")
         self.encoder_ = _Encoder(table)
         X = self.encoder_.encode_columns(table.columns)
         self.targets_ = tuple(targets)
@@ -289,7 +344,15 @@ class JointSurrogate(BaseEstimator):
         if isinstance(features, (str, bytes)):
             raise InvalidValueError(f"features: got the string {features!r}; expected a mapping such as "
                                     "{'tool_diameter': '14 mm', 'gauge_length': '90 mm'} (or a list of them)")
-        rows = [features] if isinstance(features, Mapping) else list(features)
+        expected = ("expected a mapping such as {'tool_diameter': '14 mm', 'gauge_length': '90 mm'} "
+                    f"(or a list of them) with the table's features {', '.join(self.encoder_.names)}")
+        if isinstance(features, Mapping):
+            rows = [features]
+        else:
+            rows = list(features) if isinstance(features, Iterable) else [features]
+            wrong = [r for r in rows if not isinstance(r, Mapping)]
+            if wrong:
+                raise InvalidValueError(f"features: got {wrong[0]!r}; {expected}")
         if not rows:
             raise InvalidValueError("features: got no feature sets")
         table = JointTable.empty({"k_yf": "N/m"}, self.encoder_.units)
@@ -318,14 +381,15 @@ class JointSurrogate(BaseEstimator):
         return self._predict_columns(self._columns(features))
 
     def _predict_columns(self, columns, check_range: bool = True) -> Prediction:
+        outside = self.encoder_.outside(columns)
         if check_range:
             self.encoder_.check_constant(columns)
-            self.encoder_.check_range(columns, self.extrapolation_tolerance)
+            self.encoder_.check_range(outside, self.extrapolation_tolerance)
         X = self.encoder_.encode_columns(columns)
         means, stds = {}, {}
         for t, model in self.models_.items():
             means[t], stds[t] = self._predict_one(model, X)
-        return Prediction(means, stds, dict(self.units_))
+        return Prediction(means, stds, dict(self.units_), outside)
 
 
 class MLPSurrogate(JointSurrogate):

@@ -34,7 +34,7 @@ import pint
 from ..errors import FileFormatError, InvalidValueError, UnitError
 from ..units import ureg
 from .columns import (
-    PARAMETER_UNITS, _HEADER, _check_columns, _check_parameter_unit, _check_unit, _dimension, _to_unit,
+    PARAMETER_UNITS, _HEADER, _check_columns, _check_parameter_unit, _check_unit, _dimension, _is_size, _to_unit,
 )
 
 __all__ = ["JointTable", "PARAMETER_UNITS", "thesis_table_4_2"]
@@ -314,6 +314,40 @@ class JointTable:
                 f"feature {name!r} is not in the table; it has {', '.join(self.features) or 'none'}")
         return self.columns[name]
 
+    def feature_groups(self) -> list[list[int]]:
+        """Rows with the same features, grouped: one group per tool (repeated tests of it together).
+
+        Returns
+        -------
+        list of list of int
+            Row indices (0-based) of each distinct feature set, in the order they first appear.
+        """
+        groups: dict[tuple, list[int]] = {}
+        keys = zip(*(np.asarray(self.columns[f]).tolist() for f in self.features)) if self.features else ()
+        for i, key in enumerate(keys):
+            groups.setdefault(key, []).append(i)
+        return list(groups.values()) if self.features else [list(range(len(self)))]
+
+    def check_distinct_features(self, minimum: int, purpose: str) -> None:
+        """Raise :class:`InvalidValueError` when fewer than ``minimum`` rows have distinct features.
+
+        Repeated tests of one tool (rows with the same features) count once:
+        they measure its scatter, not how the joint changes with the features.
+
+        Parameters
+        ----------
+        minimum : int
+            The distinct feature sets needed.
+        purpose : str
+            What needs them, for the message (e.g. ``"a surrogate"``).
+        """
+        self.check_not_empty(minimum, purpose)
+        distinct = len(self.feature_groups())
+        if distinct < minimum:
+            raise InvalidValueError(
+                f"the joint table has {len(self)} rows but {distinct} distinct tools (feature sets; rows with the "
+                f"same features are repeated tests of one tool); {purpose} needs at least {minimum}")
+
     def _check_parameter(self, parameter: str) -> None:
         if parameter not in self.parameters:
             raise InvalidValueError(
@@ -371,6 +405,9 @@ class JointTable:
                 out[name] = value.strip()
             else:
                 out[name] = _to_unit(value, unit, name)
+                if _is_size(unit) and out[name] <= 0:
+                    raise InvalidValueError(f"{field}: {name} is {value!s}; expected a size > 0 ({name} is a length, "
+                                            f"in {unit} in the table)")
         return out
 
     # -- changes -----------------------------------------------------------------------------
@@ -556,7 +593,9 @@ class JointTable:
             The description, with units.
         """
         feats = ", ".join(f"{f} [{u}]" if u else f"{f} (categorical)" for f, u in self.features.items())
-        return f"{len(self)} joints; parameters {', '.join(self.parameters)}; features {feats}"
+        tools = len(self.feature_groups())
+        rows = f"{len(self)} joints" + (f" of {tools} distinct tools" if tools < len(self) else "")
+        return f"{rows}; parameters {', '.join(self.parameters)}; features {feats}"
 
 
 def _written(text: str, path: str | Path | None) -> str:

@@ -1,10 +1,12 @@
 """Honest evaluation of the surrogates: leave-one-out and leave-one-group-out cross-validation.
 
-Each fold refits a clone of the surrogate without the held-out rows and
-predicts them; the result gives every fold's true, predicted values and
-predictive standard deviations, the mean absolute percent error, and the
-calibration of the intervals: the fraction of held-out values inside the
-68 % and 95 % intervals (nominally 0.68 and 0.95).
+Leave-one-out leaves out one tool at a time: the rows with the same
+features (repeated tests of one tool) are held out together.  Each fold
+refits a clone of the surrogate without the held-out rows and predicts
+them; the result gives every fold's true, predicted values and predictive
+standard deviations, the mean absolute percent error, and the calibration
+of the intervals: the fraction of held-out values inside the 68 % and 95 %
+intervals (nominally 0.68 and 0.95).
 """
 
 from __future__ import annotations
@@ -144,8 +146,10 @@ def cross_validate(surrogate: JointSurrogate, table: JointTable, target: str, sc
     target : str
         The parameter to predict (``k_yf``).
     scheme : str
-        ``"loo"`` (leave one row out) or ``"group:FEATURE"`` (leave out every
-        row of one value of FEATURE at a time, e.g. ``group:tool_diameter``).
+        ``"loo"`` (leave one tool out: every row of one feature set together,
+        so that repeated tests of the held-out tool are never in the training
+        set) or ``"group:FEATURE"`` (leave out every row of one value of
+        FEATURE at a time, e.g. ``group:tool_diameter``).
 
     Returns
     -------
@@ -155,8 +159,10 @@ def cross_validate(surrogate: JointSurrogate, table: JointTable, target: str, sc
     table.check_not_empty()
     table._check_parameter(target)
     n = len(table)
+    tools = table.feature_groups()
+    tool_of = {i: k for k, rows in enumerate(tools) for i in rows}
     if scheme == "loo":
-        groups = [[i] for i in range(n)]
+        groups = tools
     elif scheme.startswith("group:"):
         col = table.feature(scheme[6:])
         keys = list(dict.fromkeys(col.tolist()))
@@ -165,12 +171,15 @@ def cross_validate(surrogate: JointSurrogate, table: JointTable, target: str, sc
             raise InvalidValueError(f"{scheme}: the table has one value of {scheme[6:]} only; nothing to hold out")
     else:
         raise InvalidValueError(f"cross-validation: got {scheme!r}; expected 'loo' or 'group:FEATURE'")
-    smallest = n - max(len(g) for g in groups)
+    smallest = min(len({tool_of[i] for i in range(n)} - {tool_of[i] for i in g}) for g in groups)
     if smallest < 3:
         rows = "1 row" if n == 1 else f"{n} rows"
+        held = "one row" if len(tools) == n else "one tool (every row of its features)"
+        if len(tools) < n:
+            rows += f" of {len(tools)} distinct tools (feature sets)"
         raise InvalidValueError(
             f"cross-validation ({scheme}): the joint table has {rows}; holding out "
-            f"{'one row' if scheme == 'loo' else 'the largest group'} leaves {smallest} to fit, and a surrogate "
+            f"{held if scheme == 'loo' else 'the largest group'} leaves {smallest} to fit, and a surrogate "
             "needs at least 3"
         )
     y = table.values(target)
