@@ -67,7 +67,9 @@ def _point_dofs(frf: FRF, at: str) -> list[str]:
     present = [lbl for lbl in labels if lbl in frf.outputs and lbl in frf.inputs]
     if not present:
         raise UnknownPointError(
-            f"point {at}: not among the FRF's DOFs; outputs are {', '.join(frf.outputs)}"
+            f"point {at}: a modification there needs the point's DOFs among both the FRF's outputs and its inputs "
+            f"(a driving point: {' or '.join(labels)}); outputs are {', '.join(frf.outputs)}, inputs are "
+            f"{', '.join(frf.inputs)}"
         )
     return present
 

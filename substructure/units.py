@@ -265,6 +265,8 @@ def quantity(value: Any, field: str, dimension: str) -> pint.Quantity:
         raise UnitError(
             f"{field}: got {show_value(value)} with dimension {q.dimensionality}; expected {expected}"
         )
+    if np.iscomplexobj(q.magnitude):
+        raise InvalidValueError(f"{field}: got {show_value(value)}; expected a real value")
     if not math.isfinite(float(q.magnitude)):
         raise InvalidValueError(f"{field}: got {show_value(value)}; expected a finite value")
     return q

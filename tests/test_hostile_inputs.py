@@ -338,3 +338,30 @@ def test_holder_subclass_table_without_hooks_reads_fields(tmp_path):
     holder = Holder("holder", [Segment("16 mm", "63 mm")])
     assert loads_assembly('name = "x"\n[[components]]\nname = "holder"\ntype = "holder"\n'
                           'segments = [{ length = "16 mm", od = "63 mm" }]\n').component("holder") == holder
+
+
+def test_inputs_of_the_python_api_that_raised_raw_errors_are_named():
+    """Each of these gave a raw TypeError or ValueError from deep inside (or, for an FRF times a length, a pint
+    quantity wrapping the FRF): now an error naming the field, the value and what was expected."""
+    from substructure import Assembly, Frequency, Segment, add_mass, default_assembly
+    from substructure.errors import InvalidValueError, UnknownPointError
+    from substructure.units import Q_
+
+    d = default_assembly()
+    g = Frequency.from_range("100 Hz", "1000 Hz", "100 Hz")
+    h = d.receptance("tool.tip:y", frequency=g)
+    with pytest.raises(InvalidValueError, match=r"length: got \(1\+1j\) millimeter; expected a real value"):
+        Segment(Q_(1 + 1j, "mm"), "12 mm")
+    with pytest.raises(InvalidValueError, match=r"frequency: got \['100 Hz', '200 Hz'\]; expected a Frequency"):
+        d.receptance("tool.tip:y", frequency=["100 Hz", "200 Hz"])
+    with pytest.raises(InvalidValueError, match=r"components: got a Holder; expected a sequence of them"):
+        Assembly("a", components=d.component("holder"))
+    with pytest.raises(InvalidValueError, match=r"sensors\[0\]: got 'tip'; expected a Sensor"):
+        Assembly("a", components=(d.component("tool"),), sensors=["tip"])
+    with pytest.raises(InvalidValueError, match=r"cannot multiply an FRF by a quantity in millimeter"):
+        h * Q_(2, "mm")
+    np.testing.assert_array_equal((h * Q_(2, "")).data, 2 * h.data)  # a dimensionless quantity is a number
+    with pytest.raises(UnknownPointError, match=r"point tool\.tip: a modification there needs the point's DOFs "
+                                                r"among both the FRF's outputs and its inputs .* inputs are "
+                                                r"holder\.tip:y"):
+        add_mass(d.receptance("tool.tip:y", "holder.tip:y", frequency=g), "tool.tip", "2 g")

@@ -10,22 +10,30 @@ from __future__ import annotations
 from ..errors import InvalidValueError
 
 
-def _tuple(kind: type | None = None):
+def _tuple(kind: type | None = None, field: str = ""):
     def convert(value) -> tuple:
         if value is None:
             return ()
-        items = tuple(value)
+        try:
+            if isinstance(value, (str, bytes)):
+                raise TypeError
+            items = tuple(value)
+        except TypeError:
+            raise InvalidValueError(
+                f"{field or 'value'}: got a {type(value).__name__}; expected a sequence of them (a tuple or a "
+                f"list: {field or 'items'}=(item,) for one)") from None
         if kind is not None:
             for i, item in enumerate(items):
                 if not isinstance(item, kind):
-                    raise InvalidValueError(f"got {item!r} at position {i}; expected a {kind.__name__}")
+                    where = f"{field}[{i}]: got {item!r}" if field else f"got {item!r} at position {i}"
+                    raise InvalidValueError(f"{where}; expected a {kind.__name__}")
         return items
 
     return convert
 
 
 def _joint_check(items) -> tuple:
-    items = _tuple()(items)
+    items = _tuple(field="joints")(items)
     for i, j in enumerate(items):
         missing = [a for a in ("name", "between", "rigid", "dynamic_stiffness") if not hasattr(j, a)]
         if missing:
@@ -37,7 +45,7 @@ def _joint_check(items) -> tuple:
 
 
 def _component_check(items) -> tuple:
-    items = _tuple()(items)
+    items = _tuple(field="components")(items)
     for c in items:
         for attr in ("name", "component_names", "node_key", "receptance_matrix"):
             if not hasattr(c, attr):

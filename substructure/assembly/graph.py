@@ -58,11 +58,11 @@ class Assembly:
     name: str = attrs.field(default="assembly")
     components: tuple = attrs.field(default=(), converter=_component_check)
     joints: tuple = attrs.field(default=(), converter=_joint_check)
-    supports: tuple[Support, ...] = attrs.field(default=(), converter=_tuple(Support))  # type: ignore[misc]  # attrs plugin: converter factory
-    sensors: tuple[Sensor, ...] = attrs.field(default=(), converter=_tuple(Sensor))  # type: ignore[misc]  # attrs plugin: converter factory
+    supports: tuple[Support, ...] = attrs.field(default=(), converter=_tuple(Support, "supports"))  # type: ignore[misc]  # attrs plugin: converter factory
+    sensors: tuple[Sensor, ...] = attrs.field(default=(), converter=_tuple(Sensor, "sensors"))  # type: ignore[misc]  # attrs plugin: converter factory
     frequency: Frequency | None = attrs.field(default=None)
-    materials: tuple[Material, ...] = attrs.field(default=(), converter=_tuple(Material))  # type: ignore[misc]  # attrs plugin: converter factory
-    masses: tuple[Mass, ...] = attrs.field(default=(), converter=_tuple(Mass))  # type: ignore[misc]  # attrs plugin: converter factory
+    materials: tuple[Material, ...] = attrs.field(default=(), converter=_tuple(Material, "materials"))  # type: ignore[misc]  # attrs plugin: converter factory
+    masses: tuple[Mass, ...] = attrs.field(default=(), converter=_tuple(Mass, "masses"))  # type: ignore[misc]  # attrs plugin: converter factory
 
     def __attrs_post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.strip():

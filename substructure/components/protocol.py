@@ -100,7 +100,13 @@ def as_frequency(frequency) -> Frequency:
             f"frequency: got {frequency!r}; expected a Frequency (e.g. Frequency.from_range('20 Hz', "
             "'5000 Hz', '2 Hz')) or an array of frequencies in Hz"
         )
-    return Frequency.from_hz(np.atleast_1d(np.asarray(frequency, dtype=float)))
+    try:
+        hz = np.atleast_1d(np.asarray(frequency, dtype=float))
+    except (TypeError, ValueError):
+        raise InvalidValueError(
+            f"frequency: got {frequency!r}; expected a Frequency (e.g. Frequency.from_range('20 Hz', '5000 Hz', "
+            "'2 Hz')), a quantity of frequencies or an array of frequencies in Hz (plain numbers)") from None
+    return Frequency.from_hz(hz)
 
 
 def dof_labels(points: Iterable[str]) -> tuple[str, ...]:

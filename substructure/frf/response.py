@@ -356,6 +356,13 @@ class FRF:
         return attrs.evolve(self, data=-self.data)
 
     def __mul__(self, other: Any) -> FRF:
+        if hasattr(other, "units") and hasattr(other, "magnitude"):  # a quantity: pint would wrap the FRF in it
+            if getattr(other, "dimensionless", False):
+                other = other.m_as("dimensionless")
+            else:
+                raise InvalidValueError(
+                    f"cannot multiply an FRF by a quantity in {other.units}: an FRF's values are in the units of its "
+                    "quantity (m/N for a receptance); scale it by a plain number")
         factor = _scalar(other)
         if factor is None:
             return NotImplemented
