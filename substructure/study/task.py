@@ -141,6 +141,35 @@ def joint_at_quantile(joint, prediction: dict, q: float):
         return joint.with_parameters(k=k, c=c)
 
 
+_PASSIVE = {"k": ("a stiffness > 0", "a zero or negative"), "c": ("a damping >= 0", "a negative")}
+
+
+def _check_passive(joint: dict) -> None:
+    """Refuse a joint override whose diagonal entry (``yf``, ``tm``) would make the structure generate energy.
+
+    A stiffness ``k.yf``, ``k.tm`` must be > 0 and a damping ``c.yf``,
+    ``c.tm`` >= 0 (as in the joint table of ``substructure predict``): with
+    a negative one the structure is not passive and its stability limit
+    means nothing.  The cross entries ``ym``, ``tf`` are signed.
+    """
+    from ..units import Q_
+
+    for kind, entries in joint.items():
+        for entry in ("yf", "tm"):
+            value = (entries or {}).get(entry)
+            if value is None:
+                continue
+            try:
+                magnitude = float(Q_(value).to_base_units().magnitude)
+            except Exception:  # a unit or number the joint itself refuses, with its own message
+                continue
+            if not (magnitude > 0 if kind == "k" else magnitude >= 0):
+                expected, which = _PASSIVE[kind]
+                raise InvalidValueError(
+                    f"joint.{kind}.{entry}: got {value!r}; expected {expected} ({which} one makes a structure that "
+                    "is not passive, it could generate energy, and no stability limit of it means anything)")
+
+
 def _assembly(task: dict):
     """The combination's assembly (nominal joint), its tool, and the joint's template."""
     where = task["where"]
@@ -159,6 +188,7 @@ def _assembly(task: dict):
                       task["joint_name"])
     prediction = task["prediction"]
     if task["joint"] is not None:
+        _guard(where, "", _check_passive, task["joint"])
         joint = _guard(where, "joint", template.with_parameters, k=task["joint"].get("k"), c=task["joint"].get("c"))
     elif prediction is not None:
         if "error" in prediction:

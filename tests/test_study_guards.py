@@ -1,0 +1,79 @@
+"""Study guards: combinations whose numbers would be silently wrong fail or are flagged with their reason.
+
+A joint override that makes the structure non-passive, a tool whose first
+mode lies below the frequency grid, a tool wider than the machine holder's
+bore; results of another study or edited by hand in the output directory.
+"""
+
+from __future__ import annotations
+
+
+
+from substructure.study import Combination, Compute, Cut, Grid, Machine, Study
+
+GRID = Grid(frequency=("100 Hz", "5000 Hz", "10 Hz"), speeds=("5000 rpm", "20000 rpm", "200 rpm"))
+CUT = Cut("alu", workpiece="aluminium-7075", radial_depth="3 mm", milling="down", feed_per_tooth="0.05 mm")
+TOOL = {"diameter": "12 mm", "overhang": "76 mm", "flute_length": "30 mm", "teeth": 4}
+
+
+def _study(combos, grid=GRID, name="guards") -> Study:
+    return Study(name, [Machine("bench", limits={"max_speed": "20000 rpm"})], combos, [CUT], Compute(figures=False),
+                 grid)
+
+
+def _rows(table) -> dict:
+    return {c: (s, e) for c, s, e in zip(table["combination"], table["status"], table["error"])}
+
+
+def test_a_joint_override_that_is_not_passive_fails_its_row_naming_the_entry_and_value():
+    combos = [Combination("good", tool=TOOL, joint={"k": {"yf": "1.43e7 N/m"}}),
+              Combination("negative k", tool=TOOL, joint={"k": {"yf": "-1e7 N/m"}}),
+              Combination("zero k", tool=TOOL, joint={"k": {"tm": "0 N*m/rad"}}),
+              Combination("negative c", tool=TOOL, joint={"k": {"yf": "1.43e7 N/m"}, "c": {"yf": "-500 N*s/m"}}),
+              Combination("zero c", tool=TOOL, joint={"k": {"yf": "1.43e7 N/m"}, "c": {"yf": "0 N*s/m"}})]
+    table = _study(combos).run(scheduler="serial", progress=False)
+    rows = _rows(table)
+    assert rows["good"][0] == "ok" and rows["zero c"][0] == "ok"
+    for name, entry, value in (("negative k", "joint.k.yf", "'-1e7 N/m'"), ("zero k", "joint.k.tm", "'0 N*m/rad'"),
+                               ("negative c", "joint.c.yf", "'-500 N*s/m'")):
+        status, error = rows[name]
+        assert status == "failed", (name, error)
+        assert f"combination {name!r}" in error and f"{entry}: got {value}" in error and "not passive" in error
+    failed = table[table["status"] == "failed"]
+    assert failed["depth_m"].isna().all() and failed["spindle_speed_rpm"].isna().all()
+
+
+def test_a_non_passive_joint_in_the_csv_names_the_file_line_and_column(tmp_path):
+    (tmp_path / "lib.csv").write_text("name,tool.diameter [mm],tool.overhang [mm],tool.flute_length [mm],"
+                                      "tool.teeth,joint.k.yf [N/m],joint.c.yf [N*s/m]\n"
+                                      "A,12,76,30,4,1.43e7,\nnegc,12,76,30,4,1.43e7,-500\n")
+    (tmp_path / "study.toml").write_text(STUDY_TOML)
+    table = Study.from_file(tmp_path / "study.toml").run(scheduler="serial", progress=False)
+    rows = _rows(table)
+    assert rows["A"][0] == "ok"
+    assert rows["negc"][0] == "failed"
+    assert "lib.csv, line 3" in rows["negc"][1] and "joint.c.yf: got '-500 N*s/m'" in rows["negc"][1]
+
+
+STUDY_TOML = """\
+name = "probe"
+combinations_csv = "lib.csv"
+
+[grid]
+frequency = { start = "100 Hz", stop = "5000 Hz", step = "10 Hz" }
+speeds = { start = "5000 rpm", stop = "20000 rpm", step = "200 rpm" }
+
+[compute]
+figures = false
+
+[[machines]]
+name = "bench"
+limits = { max_speed = "20000 rpm", power = "11 kW" }
+
+[[cuts]]
+name = "alu"
+workpiece = "aluminium-7075"
+radial_depth = "3 mm"
+milling = "down"
+feed_per_tooth = "0.05 mm"
+"""
