@@ -77,3 +77,27 @@ radial_depth = "3 mm"
 milling = "down"
 feed_per_tooth = "0.05 mm"
 """
+
+
+def _tool(diameter: int, overhang: int) -> dict:
+    return {"diameter": f"{diameter} mm", "overhang": f"{overhang} mm", "flute_length": "30 mm", "teeth": 4}
+
+
+def test_a_tool_whose_first_mode_lies_below_the_grid_fails_saying_the_grid_must_start_lower():
+    """A 12 mm tool 2 m out (first mode near 9 Hz) on a grid from 100 Hz; the usual tools are not touched."""
+    joint = {"k": {"yf": "1.43e7 N/m"}}
+    normal = [(10, 65), (12, 76), (16, 92), (20, 106), (6, 60), (12, 150)]
+    combos = [Combination("2 m", tool=_tool(12, 2000), joint=joint)]
+    combos += [Combination(f"{d}x{o}", tool=_tool(d, o), joint=joint) for d, o in normal]
+    table = _study(combos).run(scheduler="serial", progress=False)
+    rows = _rows(table)
+    status, error = rows["2 m"]
+    assert status == "failed"
+    assert "below the frequency grid's first line (100 Hz)" in error and "grid.frequency.start" in error
+    assert "near 8.75 Hz" in error
+    assert table.loc[table["combination"] == "2 m", "depth_m"].isna().all()
+    assert all(rows[f"{d}x{o}"] == ("ok", "") for d, o in normal), rows
+    # a grid that starts below the mode computes it
+    low = Grid(frequency=("4 Hz", "600 Hz", "2 Hz"), speeds=("5000 rpm", "20000 rpm", "200 rpm"))
+    again = _rows(_study(combos[:1], grid=low).run(scheduler="serial", progress=False))
+    assert again["2 m"] == ("ok", "")

@@ -227,6 +227,40 @@ def _tool_mode(frf, band, near: float | None = None) -> tuple[float, float]:
     return float(f[i]), float(h[i])
 
 
+def _mode_below_grid(assembly, point: str, frequency, frf) -> tuple[str, float] | None:
+    """Why the grid misses the tool point's dominant mode (a mode below its first line) and its frequency, or None.
+
+    The tool point receptance is computed on 77 lines from a twentieth of
+    the grid's first line up to it, its rigid-body lines left out as for the
+    grid; when the lines below the grid hold a more negative real part and
+    a larger magnitude than every line of the grid, a mode below the grid
+    dominates, and the lobes from the grid alone would be far too deep.
+    Nothing flexible below the grid (a mass line only) is no finding.
+    """
+    from ..frf import Frequency
+    from ..stability import assembly_structure
+
+    f0 = float(frequency.hz[0])
+    if not f0 > 0:
+        return None
+    low = Frequency.from_range(f"{f0 / 20!r} Hz", f"{f0!r} Hz", f"{0.95 * f0 / 76!r} Hz")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            probe, _ = assembly_structure(assembly, point, low)
+    except Exception:  # a mass line only (no flexible mode below the grid), or nothing to compute there
+        return None
+    lines = probe.frequency.hz < f0
+    h, inside = probe.data[lines, 0, 0], frf.data[:, 0, 0]
+    if not h.size or not (h.real.min() < inside.real.min() and np.abs(h).max() > np.abs(inside).max()):
+        return None
+    i = int(np.argmax(np.abs(h)))
+    mode = float(probe.frequency.hz[lines][i])
+    return (f"the tool point receptance has a mode below the frequency grid's first line ({f0:g} Hz), near "
+            f"{mode:.3g} Hz, more compliant than any inside the grid (|H| {np.abs(h[i]):.3g} "
+            f"m/N against at most {np.abs(inside).max():.3g} m/N inside)"), mode
+
+
 @functools.lru_cache(maxsize=8)
 def _user_table(text: str):
     from ..stability import load_workpieces
@@ -514,6 +548,12 @@ def _compute(task: dict, out: dict) -> list[dict]:
         nominal = {"q": 0.5, "frf_band": _guard(where, f"FRF at {point}", assembly_structure, assembly, point,
                                                    frequency)}
         nominal["tool_mode"] = _tool_mode(*nominal["frf_band"])
+        below = _mode_below_grid(assembly, point, frequency, nominal["frf_band"][0])
+        if below:
+            key = ("grid.frequency.start" if grid["frequency"] is not None
+                   else "[grid] frequency (the study's; the machine's assembly [frequency] is used now)")
+            raise _Failed(f"{where}: {below[0]}; no depth from this grid can be trusted: start the frequency grid "
+                          f"below the mode, {key} = '{below[1] / 2:.2g} Hz' for instance")
         members: list[dict] = []
         envelope = None
         prediction = task["prediction"]
