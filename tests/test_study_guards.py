@@ -88,7 +88,8 @@ def test_a_tool_whose_first_mode_lies_below_the_grid_fails_saying_the_grid_must_
     joint = {"k": {"yf": "1.43e7 N/m"}}
     normal = [(10, 65), (12, 76), (16, 92), (20, 106), (6, 60), (12, 150)]
     combos = [Combination("2 m", tool=_tool(12, 2000), joint=joint)]
-    combos += [Combination(f"{d}x{o}", tool=_tool(d, o), joint=joint) for d, o in normal]
+    combos += [Combination(f"{d}x{o}", tool=_tool(d, o), joint=joint,
+                           holder={"catalog": "BT40 ER32"} if d > 12 else None) for d, o in normal]
     table = _study(combos).run(scheduler="serial", progress=False)
     rows = _rows(table)
     status, error = rows["2 m"]
@@ -101,3 +102,18 @@ def test_a_tool_whose_first_mode_lies_below_the_grid_fails_saying_the_grid_must_
     low = Grid(frequency=("4 Hz", "600 Hz", "2 Hz"), speeds=("5000 rpm", "20000 rpm", "200 rpm"))
     again = _rows(_study(combos[:1], grid=low).run(scheduler="serial", progress=False))
     assert again["2 m"] == ("ok", "")
+
+
+def test_a_tool_wider_than_the_bore_of_the_machines_holder_fails_its_row():
+    """The built-in machine's holder has a 12 mm bore: a 40 mm tool cannot go in; 10 and 12 mm tools can."""
+    combos = [Combination("40 mm", tool=_tool(40, 300)), Combination("12 mm", tool=_tool(12, 76)),
+              Combination("10 mm", tool=_tool(10, 65)),
+              Combination("40 mm in a catalogue holder", tool=_tool(40, 300), holder={"catalog": "BT40 ER32"})]
+    rows = _rows(_study(combos).run(scheduler="serial", progress=False))
+    assert rows["12 mm"] == ("ok", "") and rows["10 mm"] == ("ok", "")
+    status, error = rows["40 mm"]
+    assert status == "failed"
+    assert "combination '40 mm'" in error and "holder: the machine's holder has a 12 mm bore" in error
+    assert "shank is 40 mm" in error and "holder.catalog" in error
+    status, error = rows["40 mm in a catalogue holder"]  # checked by the catalogue, as before
+    assert status == "failed" and "holder: bore" in error

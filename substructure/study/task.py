@@ -100,7 +100,16 @@ def _holder(spec: dict | None, machine, tool):
     from ..units import format_quantity
 
     if spec is None:
-        return machine.component("holder")
+        holder = machine.component("holder")
+        tip = holder.segments[-1] if getattr(holder, "segments", None) else None
+        bore = None if tip is None else tip.insert.od if tip.insert is not None else tip.id
+        shank = tool.segments[0].od
+        if bore is not None and bore.m_as("m") > 0 and shank.m_as("m") > bore.m_as("m") * (1 + 1e-9):
+            raise InvalidValueError(
+                f"the machine's holder has a {format_quantity(bore.to('mm'))} bore; the tool's shank is "
+                f"{format_quantity(shank.to('mm'))} (tool.diameter), it cannot take it: give the combination a "
+                "holder that does (holder.catalog, e.g. 'BT40 ER32', or holder.segments)")
+        return holder
     table = dict(spec)
     if "catalog" in table and "bore" not in table:  # the tool's shank fills the bore
         table["bore"] = format_quantity(tool.segments[0].od)
