@@ -7,6 +7,10 @@ bore; results of another study or edited by hand in the output directory.
 
 from __future__ import annotations
 
+import attrs
+import pytest
+
+from substructure.errors import OutputExistsError
 
 
 from substructure.study import Combination, Compute, Cut, Grid, Machine, Study
@@ -117,3 +121,24 @@ def test_a_tool_wider_than_the_bore_of_the_machines_holder_fails_its_row():
     assert "shank is 40 mm" in error and "holder.catalog" in error
     status, error = rows["40 mm in a catalogue holder"]  # checked by the catalogue, as before
     assert status == "failed" and "holder: bore" in error
+
+
+def test_resume_into_a_directory_of_another_study_is_refused_and_keeps_its_results(tmp_path):
+    out = tmp_path / "out"
+    combos = [Combination("A", tool=TOOL, joint={"k": {"yf": "1.43e7 N/m"}})]
+    _study(combos, name="first").run(scheduler="serial", out=out, progress=False)
+    before = {p: p.stat().st_mtime_ns for p in out.rglob("*")}
+    renamed = _study(combos, name="second")
+    with pytest.raises(OutputExistsError, match=r"holds the results of study 'first'.*not of the study given "
+                                                r"\('second'.*another --out.*--overwrite"):
+        renamed.run(scheduler="serial", out=out, resume=True, progress=False)
+    regridded = _study(combos, grid=attrs.evolve(GRID, frequency=("100 Hz", "5000 Hz", "5 Hz")), name="first")
+    with pytest.raises(OutputExistsError, match=r"study 'first' on another grid \(frequency 100 Hz to 5000 Hz by "
+                                                r"10 Hz.*not of the study given \('first', frequency 100 Hz to "
+                                                r"5000 Hz by 5 Hz"):
+        regridded.run(scheduler="serial", out=out, resume=True, progress=False)
+    assert {p: p.stat().st_mtime_ns for p in out.rglob("*")} == before
+    # the same study resumes; --overwrite replaces the other study's results
+    _study(combos, name="first").run(scheduler="serial", out=out, resume=True, progress=False)
+    table = renamed.run(scheduler="serial", out=out, overwrite=True, progress=False)
+    assert list(table["status"]) == ["ok"]

@@ -42,7 +42,7 @@ from typing import Any
 from .._json import json_text
 from ..errors import InvalidValueError, OutputExistsError, SubstructureWarning
 
-__all__ = ["run_study", "Progress", "parse_scheduler", "json_text", "RESULT_FORMAT"]
+__all__ = ["run_study", "Progress", "parse_scheduler", "json_text", "RESULT_FORMAT", "study_identity"]
 
 #: The ``format`` of a combination's result file.
 RESULT_FORMAT = "substructure-study-result/1"
@@ -242,7 +242,30 @@ class _Store:
                 if record is not None:
                     finished[task["key"]] = record
 
-    def save(self, result: dict) -> dict:
+    def other_study(self, identity: dict) -> str:
+        """What another study's results in ``results/`` are (name, or the grid that differs), or ``""``.
+
+        Every result file records the study it belongs to (``study``: its
+        name and grid); files without it (older ones) or unreadable ones say
+        nothing here.
+        """
+        from ..io import read_text
+
+        folder = self.root / "results"
+        for path in sorted(folder.glob("*.json")) if folder.is_dir() else ():
+            try:
+                held = json.loads(read_text(path, "study result")).get("study")
+            except (OSError, ValueError, AttributeError):
+                continue
+            if not isinstance(held, dict) or held == identity:
+                continue
+            name = held.get("name")
+            if name != identity["name"]:
+                return f"study {name!r} ({path.name})"
+            return f"study {name!r} on another grid ({_grid_text(held.get('grid'))}; {path.name})"
+        return ""
+
+    def save(self, result: dict, identity: dict | None = None) -> dict:
         from ..io import write_bytes, write_text
 
         key = result["key"]
@@ -251,6 +274,8 @@ class _Store:
                 (self.root / folder).mkdir(parents=True, exist_ok=True)
         record = {k: v for k, v in result.items() if k not in ("figure", "frf")}
         record["format"] = RESULT_FORMAT
+        if identity is not None:
+            record["study"] = identity
         if result.get("figure") is not None:
             write_bytes(self.path("figures", key, ".png"), result["figure"])
             record["figure"] = f"figures/{key}.png"
@@ -259,6 +284,39 @@ class _Store:
             record["frf"] = f"frf/{key}.csv"
         write_text(self.path("results", key, ".json"), json_text(record) + "\n")  # last: the combination is done
         return record
+
+
+def _grid_text(grid: Any) -> str:
+    """A study's grid as a result file records it, in words: ``frequency 100 Hz to 5000 Hz by 10 Hz, ...``."""
+    if not isinstance(grid, dict):
+        return "not recorded"
+    parts = []
+    for key, value in grid.items():
+        if isinstance(value, list) and len(value) == 3:
+            parts.append(f"{key} {value[0]} to {value[1]} by {value[2]}")
+        elif value is None:
+            parts.append(f"{key} default")
+    return ", ".join(parts) or "not recorded"
+
+
+def study_identity(study) -> dict:
+    """What tells a study's results from another's in one output directory: its name and its grid.
+
+    Parameters
+    ----------
+    study : Study
+        The study.
+
+    Returns
+    -------
+    dict
+        ``{"name": str, "grid": {"frequency": [...] or None, "speeds":
+        [...], "sdm_speeds": [...] or None}}``, plain data.
+    """
+    import attrs
+
+    grid = {k: None if v is None else list(v) for k, v in attrs.asdict(study.grid).items()}
+    return json.loads(json_text({"name": study.name, "grid": grid}))
 
 
 def _rows_problem(rows: Any, task: dict) -> str:
@@ -406,8 +464,15 @@ def run_study(study, client: Any = None, out: Any = None, scheduler: str | None 
         tasks = [{**t, "compute": {**t["compute"], "figures": False, "frf_files": False}} for t in tasks]
     store = None if out is None else _Store(out, study.inputs)
     finished: dict[str, dict] = {}
+    identity = study_identity(study)
     if store is not None:
         store.check(tasks, resume, overwrite)
+        other = store.other_study(identity) if resume else ""
+        if other:
+            raise OutputExistsError(
+                f"{store.root}: holds the results of {other}, not of the study given ({study.name!r}, "
+                f"{_grid_text(identity['grid'])}); --resume (resume=True) continues the same study only: choose "
+                "another --out (out) for it, or replace those results with --overwrite (overwrite=True)")
         if resume:
             problems: list[str] = []
             store.load_all(tasks, finished, problems)
@@ -446,7 +511,7 @@ def run_study(study, client: Any = None, out: Any = None, scheduler: str | None 
                 _dashboard(own or client, report)
                 results = _on_dask(own or client, todo)
             for task, result in results:
-                record = store.save(result) if store is not None else {k: v for k, v in result.items()
+                record = store.save(result, identity) if store is not None else {k: v for k, v in result.items()
                                                                          if k not in ("figure", "frf")}
                 finished[task["key"]] = json.loads(json_text(record))
                 report.update(sum(row["status"] != "ok" for row in result["rows"]))
