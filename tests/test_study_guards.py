@@ -7,6 +7,9 @@ bore; results of another study or edited by hand in the output directory.
 
 from __future__ import annotations
 
+import io
+import json
+
 import attrs
 import pytest
 
@@ -142,3 +145,42 @@ def test_resume_into_a_directory_of_another_study_is_refused_and_keeps_its_resul
     _study(combos, name="first").run(scheduler="serial", out=out, resume=True, progress=False)
     table = renamed.run(scheduler="serial", out=out, overwrite=True, progress=False)
     assert list(table["status"]) == ["ok"]
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda r: r["rows"][0].update(depth_m=0.5), "depth_m: got 0.5; above the row's stability limit"),
+    (lambda r: r["rows"][0].update(depth_m=0.5, limit_depth_m=None), "depth_m: got 0.5; deeper than the largest"),
+    (lambda r: r["rows"][0].update(status="weird"), "status: got 'weird'; expected 'ok' or 'failed'"),
+    (lambda r: r["rows"][0].update(depth_m=-0.001), "depth_m: got -0.001; expected a number >= 0"),
+    (lambda r: r["rows"][0].update(spindle_speed_rpm=0), "spindle_speed_rpm: got 0; expected a positive number"),
+    (lambda r: r["rows"][0].update(depth_m="2 mm"), "depth_m: got '2 mm'; expected a finite number"),
+    (lambda r: r["rows"][0].update(teeth=4.5), "teeth: got 4.5; expected a whole number"),
+    (lambda r: r["rows"][0].update(error="x"), "status: 'ok' with an error"),
+])
+def test_a_hand_edited_result_is_not_trusted_on_resume_and_is_computed_again(tmp_path, edit, message):
+    out = tmp_path / "out"
+    study = _study([Combination("A", tool=TOOL, joint={"k": {"yf": "1.43e7 N/m"}})])
+    first = study.run(scheduler="serial", out=out, progress=False)
+    path = next((out / "results").glob("*.json"))
+    record = json.loads(path.read_text())
+    edit(record)
+    path.write_text(json.dumps(record))
+    with pytest.warns(UserWarning) as caught:
+        again = study.run(scheduler="serial", out=out, resume=True, progress=False)
+    text = " ".join(str(w.message) for w in caught)
+    assert str(path) in text and message in text and "computed again" in text, text
+    assert again.equals(first)
+
+
+def test_a_truncated_result_file_is_computed_again_with_a_warning(tmp_path):
+    out = tmp_path / "out"
+    study = _study([Combination("A", tool=TOOL, joint={"k": {"yf": "1.43e7 N/m"}})])
+    first = study.run(scheduler="serial", out=out, progress=False)
+    path = next((out / "results").glob("*.json"))
+    path.write_text(path.read_text()[:200])
+    lines = io.StringIO()
+    with pytest.warns(UserWarning, match="not a whole result file") as caught:
+        again = study.run(scheduler="serial", out=out, resume=True, progress=lines)
+    assert str(path) in str(caught[0].message)
+    assert "0 finished before, 1 to compute" in lines.getvalue()
+    assert again.equals(first)

@@ -220,11 +220,27 @@ class _Store:
         from ..io import read_text
 
         path = self.path("results", task["key"], ".json")
-        try:  # the checked read: a FIFO or a huge file put there is not a result (FileFormatError is a ValueError)
-            data = json.loads(read_text(path, "study result"))
-        except (OSError, ValueError):
+        if not path.exists():  # a combination never finished
             return None
-        if (not isinstance(data, dict) or data.get("format") != RESULT_FORMAT
+        try:  # the checked read: a FIFO or a huge file put there is not a result (FileFormatError is a ValueError)
+            text = read_text(path, "study result")
+        except (OSError, ValueError) as exc:
+            if problems is not None:
+                problems.append(f"{path}: {' '.join(str(exc).split())}; not trusted, computed again")
+            return None
+        try:
+            data = json.loads(text)
+        except ValueError as exc:
+            if problems is not None:
+                problems.append(f"{path}: not a whole result file (cut short or edited: {exc}); not trusted, "
+                                "computed again")
+            return None
+        if not isinstance(data, dict):
+            if problems is not None:
+                problems.append(f"{path}: not a result file (a JSON {type(data).__name__}, expected an object); "
+                                "not trusted, computed again")
+            return None
+        if (data.get("format") != RESULT_FORMAT
                 or data.get("fingerprint") != task["fingerprint"] or data.get("status") != "done"):
             return None
         why = _rows_problem(data.get("rows"), task)
@@ -331,6 +347,69 @@ def _rows_problem(rows: Any, task: dict) -> str:
         return (f"{len(rows)} rows for {len(cuts)} cut{'s' if len(cuts) != 1 else ''} ({', '.join(map(repr, cuts))})"
                 + (f", repeated: {', '.join(doubled)}" if doubled else "")
                 + ("" if keys == {task["key"]} else f", rows of other combinations ({len(keys - {task['key']})})"))
+    specs = task["cuts"] or [None]
+    for row, spec in zip(rows, specs):
+        why = _row_problem(row, task, spec)
+        if why:
+            return f"row of cut {row.get('cut')!r}: {why}" if task["cuts"] else f"its row: {why}"
+    return ""
+
+
+#: Statuses a finished result's rows may have (crashed and pending rows are never saved as done).
+_SAVED_STATUSES = ("ok", "failed")
+_POSITIVE = ("tool_diameter_m", "overhang_m", "flute_length_m", "spindle_speed_rpm", "window_lo_rpm", "window_hi_rpm",
+             "runner_up_speed_rpm", "tool_mode_hz", "tool_mode_lo_hz", "tool_mode_hi_hz", "radial_depth_m",
+             "feed_per_tooth_m", "kt_pa", "teeth", "band_members")
+_NON_NEGATIVE = ("depth_m", "limit_depth_m", "zoa_min_limit_m", "zoa_absolute_limit_m", "sdm_min_limit_m",
+                 "runner_up_depth_m", "mrr_m3_per_s", "power_w", "torque_n_m", "structure_band_lo_hz",
+                 "chatter_frequency_hz", "tool_mode_compliance_m_per_n", "kn_pa")
+
+
+def _row_problem(row: dict, task: dict, spec: dict | None) -> str:
+    """Why one saved row is not one the study could have written (a hand edit), or ``""``."""
+    import math
+
+    from .table import COLUMNS
+
+    if row.get("status") not in _SAVED_STATUSES:
+        return f"status: got {row.get('status')!r}; expected {' or '.join(map(repr, _SAVED_STATUSES))}"
+    if row.get("combination") != task["combination"] or row.get("machine") != task["machine"]["name"]:
+        return (f"combination, machine: got {row.get('combination')!r}, {row.get('machine')!r}; expected "
+                f"{task['combination']!r}, {task['machine']['name']!r}")
+    for name, kind, _ in COLUMNS:
+        value = row.get(name)
+        if value is None:
+            continue
+        if kind == "str":
+            ok = isinstance(value, str)
+            expected = "a string"
+        elif kind == "int":
+            ok = isinstance(value, int) and not isinstance(value, bool)
+            expected = "a whole number"
+        else:
+            ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+            expected = "a finite number or null"
+        if ok and name in _POSITIVE:
+            ok, expected = value > 0, "a positive number or null"
+        elif ok and name in _NON_NEGATIVE:
+            ok, expected = value >= 0, "a number >= 0 or null"
+        if not ok:
+            return f"{name}: got {value!r}; expected {expected}"
+    if row["status"] == "failed" and not row.get("error"):
+        return "status: 'failed' without an error"
+    if row["status"] == "ok" and row.get("error"):
+        return f"status: 'ok' with an error ({row['error']!r})"
+    depth, limit = row.get("depth_m"), row.get("limit_depth_m")
+    if depth is not None and limit is not None and depth > limit * (1 + 1e-9):
+        return f"depth_m: got {depth!r}; above the row's stability limit limit_depth_m = {limit!r}"
+    deepest = row.get("flute_length_m")
+    if spec is not None and spec.get("max_depth") is not None:
+        from ..units import Q_
+
+        deepest = float(Q_(spec["max_depth"]).m_as("m"))
+    if depth is not None and deepest is not None and depth > deepest * (1 + 1e-9):
+        return (f"depth_m: got {depth!r}; deeper than the largest depth {deepest!r} m (the cut's max_depth, or the "
+                "tool's flute length)")
     return ""
 
 
