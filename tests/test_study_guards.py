@@ -184,3 +184,34 @@ def test_a_truncated_result_file_is_computed_again_with_a_warning(tmp_path):
     assert str(path) in str(caught[0].message)
     assert "0 finished before, 1 to compute" in lines.getvalue()
     assert again.equals(first)
+
+
+def _cli(*argv: str) -> tuple[int, str, str]:
+    import contextlib
+
+    from substructure.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(list(argv))
+    return code, out.getvalue(), err.getvalue()
+
+
+def test_the_summary_marks_a_best_row_whose_joint_prediction_is_an_extrapolation(tmp_path):
+    from study_files import JOINTS
+
+    (tmp_path / "joints.csv").write_text(JOINTS)
+    (tmp_path / "lib.csv").write_text("name,tool.diameter [mm],tool.overhang [mm],tool.flute_length [mm],tool.teeth\n"
+                                      "far out,12,150,30,4\n")
+    (tmp_path / "study.toml").write_text(STUDY_TOML + '\n[surrogate]\ntable = "joints.csv"\nfeatures = { '
+                                         'tool_diameter = "tool.diameter", gauge_length = "tool.overhang" }\n')
+    code, stdout, stderr = _cli("study", str(tmp_path / "study.toml"), "--out", str(tmp_path / "out"), "--scheduler",
+                                "serial", "--quiet")
+    assert code == 0, stderr
+    line = next(x for x in stdout.splitlines() if "far out on bench" in x)
+    assert "(extrapolated: gauge_length = 150 mm outside the joint table's 65-106 mm" in line, stdout
+    assert "not to be trusted" in line
+    code, stdout, _ = _cli("study", str(tmp_path / "study.toml"), "--out", str(tmp_path / "out"), "--resume",
+                           "--json", "--quiet", "--scheduler", "serial")
+    best = json.loads(stdout)["best"][0]
+    assert best["extrapolated"] == ["gauge_length = 150 mm outside the joint table's 65-106 mm"]

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import signal
 import sys
 from pathlib import Path
@@ -60,7 +61,8 @@ def _report(args, study, table, out: Path) -> int:
             row = table.loc[i]
             best.append({"cut": cut, "combination": row["combination"], "machine": row["machine"],
                          "spindle_speed_rpm": row["spindle_speed_rpm"], "depth_m": row["depth_m"],
-                         "mrr_m3_per_s": row["mrr_m3_per_s"], "tool_mode_hz": row["tool_mode_hz"]})
+                         "mrr_m3_per_s": row["mrr_m3_per_s"], "tool_mode_hz": row["tool_mode_hz"],
+                         "extrapolated": _extrapolated(row["notes"])})
     failures = [{k: table.loc[i, k] for k in ("combination", "machine", "cut", "status", "error")}
                 for i in table.index[table["status"] != "ok"]]
     files = {"table_parquet": os.fspath(out / "table.parquet"), "table_csv": os.fspath(out / "table.csv"),
@@ -80,13 +82,31 @@ def _report(args, study, table, out: Path) -> int:
             cut = f"cut {b['cut']!r}: " if b["cut"] else ""
             what = (f"{b['spindle_speed_rpm']:.0f} rpm, axial depth {b['depth_m'] * 1e3:.3g} mm"
                     if b["spindle_speed_rpm"] == b["spindle_speed_rpm"] else f"tool mode {b['tool_mode_hz']:.0f} Hz")
-            print(f"  {cut}{b['combination']} on {b['machine']}: {what}")
+            caveat = (f" (extrapolated: {'; '.join(b['extrapolated'])}; the joint's prediction is not to be trusted)"
+                      if b["extrapolated"] else "")
+            print(f"  {cut}{b['combination']} on {b['machine']}: {what}{caveat}")
     for f in failures[:20]:
         cut = f" / {f['cut']}" if f["cut"] else ""
         print(f"{f['status']}: {f['combination']} on {f['machine']}{cut}: {f['error']}")
     if len(failures) > 20:
         print(f"... and {len(failures) - 20} more rows that did not succeed (see the table's status and error)")
     return 0
+
+
+_EXTRAPOLATION = re.compile(r"^(?P<value>\S+ = \S+(?: \S+)?) is .*?the table's range (?P<range>\S+(?: \S+)?)\) "
+                            r"(?:below the smallest|above the largest) in the table: an extrapolation")
+
+
+def _extrapolated(notes: str) -> list[str]:
+    """The features of a row's joint prediction outside the joint table's range, from its notes (the
+    surrogate's extrapolation warnings), as ``"gauge_length = 300 mm (table 65-106 mm)"``."""
+    out = []
+    for note in str(notes).split("; "):
+        if "an extrapolation" not in note:
+            continue
+        m = _EXTRAPOLATION.match(note)
+        out.append(f"{m['value']} outside the joint table's {m['range']}" if m else note)
+    return out
 
 
 def add_parser(commands) -> None:
