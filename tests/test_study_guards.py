@@ -215,3 +215,64 @@ def test_the_summary_marks_a_best_row_whose_joint_prediction_is_an_extrapolation
                            "--json", "--quiet", "--scheduler", "serial")
     best = json.loads(stdout)["best"][0]
     assert best["extrapolated"] == ["gauge_length = 150 mm outside the joint table's 65-106 mm"]
+
+
+HEADER = "name,tool.diameter [mm],tool.overhang [mm],tool.flute_length [mm],tool.teeth\n"
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda t: t.replace('max_speed = "20000 rpm"', 'max_speed = "20000 Hz"'),
+     "study.toml, line 13: machines[0].limits.max_speed: got a speed in Hz"),
+    (lambda t: t.replace('step = "200 rpm"', 'step = "-200 rpm"'),
+     "study.toml, line 6: grid.speeds.step: expected finite, positive spindle speeds; got -200 rpm"),
+    (lambda t: t.replace('step = "10 Hz"', 'step = "-10 Hz"'), "study.toml, line 5: grid.frequency."),
+])
+def test_errors_of_the_study_file_name_the_whole_key_path(tmp_path, edit, message):
+    (tmp_path / "lib.csv").write_text(HEADER + "A,12,76,30,4\n")
+    (tmp_path / "study.toml").write_text(edit(STUDY_TOML))
+    code, _, stderr = _cli("study", str(tmp_path / "study.toml"), "--out", str(tmp_path / "out"), "--quiet")
+    assert code != 0 and message in stderr and "Traceback" not in stderr, stderr
+
+
+@pytest.mark.parametrize("header, message", [
+    ("name,tool.diameter [N],tool.overhang [mm]", "line 2: column 'tool.diameter [N]': the unit 'N' is not that of "
+                                                  "a length (tool.diameter [mm])"),
+    ("name,tool.diameter [mm],tool.overhang [mm],joint.k.yf [N]", "column 'joint.k.yf [N]': the unit 'N' is not "
+                                                                  "that of a stiffness (joint.k.yf [N/m])"),
+    ("name,tool.diameter [mm],tool.overhang [mm],joint.c.yf [N/m]", "not that of a damping (joint.c.yf [N*s/m])"),
+    ("name,tool.diameter [mm],tool.overhang [mm],holder.gauge_length [kg]", "not that of a length"),
+    ("name,tool.diameter [mm],tool.overhang [bananas]", "is not a unit"),
+])
+def test_a_wrong_unit_in_the_csv_header_is_refused_when_the_header_is_read(tmp_path, header, message):
+    from substructure.errors import FileFormatError
+
+    cells = ",".join(["A"] + ["12"] * (header.count(",")))
+    (tmp_path / "lib.csv").write_text(f"# tools\n{header}\n{cells}\n")
+    (tmp_path / "study.toml").write_text(STUDY_TOML)
+    with pytest.raises(FileFormatError) as info:
+        Study.from_file(tmp_path / "study.toml")
+    assert "lib.csv" in str(info.value) and message in str(info.value), str(info.value)
+
+
+def test_a_negative_tool_diameter_names_the_key_and_the_value_as_written(tmp_path):
+    (tmp_path / "lib.csv").write_text(HEADER + "A,-12,76,30,4\nB,12,76,-30,4\n")
+    (tmp_path / "study.toml").write_text(STUDY_TOML)
+    rows = _rows(Study.from_file(tmp_path / "study.toml").run(scheduler="serial", progress=False))
+    assert rows["A"][0] == "failed" and "line 2" in rows["A"][1]
+    assert "tool.diameter: got '-12 mm'; expected a positive length" in rows["A"][1], rows["A"][1]
+    assert "tool.flute_length: got '-30 mm'; expected a positive length" in rows["B"][1], rows["B"][1]
+    assert "Quantity" not in rows["A"][1] + rows["B"][1]
+
+
+def test_a_cut_whose_every_row_failed_has_no_best_in_the_summary(tmp_path):
+    (tmp_path / "lib.csv").write_text(HEADER + "A,12,76,30,4\nB,10,65,25,4\n")
+    (tmp_path / "study.toml").write_text(STUDY_TOML.replace('radial_depth = "3 mm"', 'radial_depth = "30 mm"'))
+    code, stdout, stderr = _cli("study", str(tmp_path / "study.toml"), "--out", str(tmp_path / "out"), "--scheduler",
+                                "serial", "--quiet")
+    assert code == 0, stderr
+    assert "best" not in stdout.replace("no best", "")
+    assert "no best for cut 'alu': no row succeeded" in stdout and "failed: A on bench / alu" in stdout
+    code, stdout, _ = _cli("study", str(tmp_path / "study.toml"), "--out", str(tmp_path / "out"), "--resume",
+                           "--json", "--quiet", "--scheduler", "serial")
+    data = json.loads(stdout)
+    assert data["best"] == [] and data["no_ok_row"] == ["alu"]

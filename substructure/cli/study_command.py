@@ -54,8 +54,11 @@ def _report(args, study, table, out: Path) -> int:
     counts = {s: int((table["status"] == s).sum()) for s in ("ok", "failed", "crashed", "pending")}
     value, label = rank_value(table)
     best = []
+    none_ok = []  # cuts whose every row failed (or is not computed): nothing to call best
     for cut in dict.fromkeys(table["cut"].tolist()):
-        rows = table[(table["cut"] == cut) & value.notna()]
+        rows = table[(table["cut"] == cut) & (table["status"] == "ok") & value.notna()]
+        if not (table.loc[table["cut"] == cut, "status"] == "ok").any():
+            none_ok.append(cut)
         if len(rows):
             i = value[rows.index].idxmax()
             row = table.loc[i]
@@ -71,7 +74,8 @@ def _report(args, study, table, out: Path) -> int:
              "frf": os.fspath(out / "frf") if study.compute.frf_files else None}
     if args.json:
         return print_json({"study": study.name, "out": os.fspath(out), "rows": len(table), **counts,
-                           "ranked_by": label, "best": best, "failures": failures, "files": files})
+                           "ranked_by": label, "best": best, "no_ok_row": none_ok, "failures": failures,
+                           "files": files})
     print(f"study {study.name!r}: {len(table)} rows (combinations on their machines, for each cut): "
           + ", ".join(f"{n} {s}" for s, n in counts.items() if n or s == "ok"))
     print(f"table: {files['table_parquet']}, {files['table_csv']}"
@@ -85,6 +89,8 @@ def _report(args, study, table, out: Path) -> int:
             caveat = (f" (extrapolated: {'; '.join(b['extrapolated'])}; the joint's prediction is not to be trusted)"
                       if b["extrapolated"] else "")
             print(f"  {cut}{b['combination']} on {b['machine']}: {what}{caveat}")
+    for cut in none_ok:
+        print(f"no best {f'for cut {cut!r}' if cut else 'combination'}: no row succeeded (see below)")
     for f in failures[:20]:
         cut = f" / {f['cut']}" if f["cut"] else ""
         print(f"{f['status']}: {f['combination']} on {f['machine']}{cut}: {f['error']}")

@@ -85,10 +85,20 @@ def _tool(spec: dict | None, machine):
         return tool
     if "segments" in spec:
         return _component_from_table("tool", spec)
+    from ..units import quantity
+
+    for key in ("diameter", "overhang", "flute_length"):  # named as the combination gives them, with the value
+        if spec.get(key) is not None:
+            value = quantity(spec[key], f"tool.{key}", "[length]")
+            if not value.magnitude > 0:
+                raise InvalidValueError(f"tool.{key}: got {spec[key]!r}; expected a positive length")
     extra = {k: spec[k] for k in ("teeth", "helix") if k in spec}
-    tool = Tool.end_mill(spec["diameter"], spec["overhang"], spec.get("flute_length"),
-                         material=spec.get("material", "carbide"), diameter_ratio=spec.get("diameter_ratio", 0.8),
-                         **extra)
+    try:
+        tool = Tool.end_mill(spec["diameter"], spec["overhang"], spec.get("flute_length"),
+                             material=spec.get("material", "carbide"), diameter_ratio=spec.get("diameter_ratio", 0.8),
+                             **extra)
+    except SubstructureError as exc:
+        raise InvalidValueError(f"tool: {' '.join(str(exc).split())}") from None
     if "description" in spec:
         import attrs
 
@@ -189,7 +199,7 @@ def _assembly(task: dict):
     for i, s in enumerate(m["supports"]):
         machine = _guard(where, f"machine {m['name']!r}: supports[{i}]", machine.support, s["at"], k=s.get("k"),
                          c=s.get("c"))
-    tool = _guard(where, "tool", _tool, task["tool"], machine)
+    tool = _guard(where, "", _tool, task["tool"], machine)
     holder = _guard(where, "holder", _holder, task["holder"], machine, tool)
     assembly = _guard(where, "tool", machine.with_component, tool)
     assembly = _guard(where, "holder", assembly.with_component, holder)
