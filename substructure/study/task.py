@@ -112,7 +112,8 @@ def _holder(spec: dict | None, machine, tool):
     if spec is None:
         holder = machine.component("holder")
         tip = holder.segments[-1] if getattr(holder, "segments", None) else None
-        bore = None if tip is None else tip.insert.od if tip.insert is not None else tip.id
+        insert = getattr(tip, "insert", None)
+        bore = getattr(insert, "od", None) if insert is not None else getattr(tip, "id", None)
         shank = tool.segments[0].od
         if bore is not None and bore.m_as("m") > 0 and shank.m_as("m") > bore.m_as("m") * (1 + 1e-9):
             raise InvalidValueError(
