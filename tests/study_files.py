@@ -77,7 +77,7 @@ def tools_csv(n: int) -> str:
     for i in range(n):
         d = diameters[i % 3]
         overhang = 65 + (i * 7) % 28
-        holder = "BT40 ER32" if i % 4 == 3 else ""
+        holder = "BT40 ER32" if i % 4 == 3 or d > 12 else ""  # the machine's holder has a 12 mm bore
         lines.append(f"T{i:02d},{d},{overhang},{min(30, overhang - 20)},{3 + i % 2},{holder}")
     return "\n".join(lines) + "\n"
 

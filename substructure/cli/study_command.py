@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import signal
 import sys
 from pathlib import Path
@@ -53,14 +54,18 @@ def _report(args, study, table, out: Path) -> int:
     counts = {s: int((table["status"] == s).sum()) for s in ("ok", "failed", "crashed", "pending")}
     value, label = rank_value(table)
     best = []
+    none_ok = []  # cuts whose every row failed (or is not computed): nothing to call best
     for cut in dict.fromkeys(table["cut"].tolist()):
-        rows = table[(table["cut"] == cut) & value.notna()]
+        rows = table[(table["cut"] == cut) & (table["status"] == "ok") & value.notna()]
+        if not (table.loc[table["cut"] == cut, "status"] == "ok").any():
+            none_ok.append(cut)
         if len(rows):
             i = value[rows.index].idxmax()
             row = table.loc[i]
             best.append({"cut": cut, "combination": row["combination"], "machine": row["machine"],
                          "spindle_speed_rpm": row["spindle_speed_rpm"], "depth_m": row["depth_m"],
-                         "mrr_m3_per_s": row["mrr_m3_per_s"], "tool_mode_hz": row["tool_mode_hz"]})
+                         "mrr_m3_per_s": row["mrr_m3_per_s"], "tool_mode_hz": row["tool_mode_hz"],
+                         "extrapolated": _extrapolated(row["notes"])})
     failures = [{k: table.loc[i, k] for k in ("combination", "machine", "cut", "status", "error")}
                 for i in table.index[table["status"] != "ok"]]
     files = {"table_parquet": os.fspath(out / "table.parquet"), "table_csv": os.fspath(out / "table.csv"),
@@ -69,7 +74,8 @@ def _report(args, study, table, out: Path) -> int:
              "frf": os.fspath(out / "frf") if study.compute.frf_files else None}
     if args.json:
         return print_json({"study": study.name, "out": os.fspath(out), "rows": len(table), **counts,
-                           "ranked_by": label, "best": best, "failures": failures, "files": files})
+                           "ranked_by": label, "best": best, "no_ok_row": none_ok, "failures": failures,
+                           "files": files})
     print(f"study {study.name!r}: {len(table)} rows (combinations on their machines, for each cut): "
           + ", ".join(f"{n} {s}" for s, n in counts.items() if n or s == "ok"))
     print(f"table: {files['table_parquet']}, {files['table_csv']}"
@@ -80,13 +86,33 @@ def _report(args, study, table, out: Path) -> int:
             cut = f"cut {b['cut']!r}: " if b["cut"] else ""
             what = (f"{b['spindle_speed_rpm']:.0f} rpm, axial depth {b['depth_m'] * 1e3:.3g} mm"
                     if b["spindle_speed_rpm"] == b["spindle_speed_rpm"] else f"tool mode {b['tool_mode_hz']:.0f} Hz")
-            print(f"  {cut}{b['combination']} on {b['machine']}: {what}")
+            caveat = (f" (extrapolated: {'; '.join(b['extrapolated'])}; the joint's prediction is not to be trusted)"
+                      if b["extrapolated"] else "")
+            print(f"  {cut}{b['combination']} on {b['machine']}: {what}{caveat}")
+    for cut in none_ok:
+        print(f"no best {f'for cut {cut!r}' if cut else 'combination'}: no row succeeded (see below)")
     for f in failures[:20]:
         cut = f" / {f['cut']}" if f["cut"] else ""
         print(f"{f['status']}: {f['combination']} on {f['machine']}{cut}: {f['error']}")
     if len(failures) > 20:
         print(f"... and {len(failures) - 20} more rows that did not succeed (see the table's status and error)")
     return 0
+
+
+_EXTRAPOLATION = re.compile(r"^(?P<value>\S+ = \S+(?: \S+)?) is .*?the table's range (?P<range>\S+(?: \S+)?)\) "
+                            r"(?:below the smallest|above the largest) in the table: an extrapolation")
+
+
+def _extrapolated(notes: str) -> list[str]:
+    """The features of a row's joint prediction outside the joint table's range, from its notes (the
+    surrogate's extrapolation warnings), as ``"gauge_length = 300 mm (table 65-106 mm)"``."""
+    out = []
+    for note in str(notes).split("; "):
+        if "an extrapolation" not in note:
+            continue
+        m = _EXTRAPOLATION.match(note)
+        out.append(f"{m['value']} outside the joint table's {m['range']}" if m else note)
+    return out
 
 
 def add_parser(commands) -> None:

@@ -146,6 +146,29 @@ _CONVERT = {"tool.teeth": (int, "a whole number"), "tool.diameter_ratio": (float
 _BOOL = ("holder.shank_taper",)
 
 
+#: The dimension of the columns whose unit the header can be checked against (others: checked per row).
+_DIMENSIONS = {"tool.diameter": ("a length", "mm"), "tool.overhang": ("a length", "mm"),
+               "tool.flute_length": ("a length", "mm"), "tool.helix": ("an angle", "deg"),
+               "joint.k.yf": ("a stiffness", "N/m"), "joint.k.ym": ("a stiffness per radian", "N/rad"),
+               "joint.k.tf": ("a stiffness per radian", "N/rad"), "joint.k.tm": ("a rotational stiffness", "N*m/rad"),
+               "joint.c.yf": ("a damping", "N*s/m"), "joint.c.ym": ("a damping per radian", "N*s/rad"),
+               "joint.c.tf": ("a damping per radian", "N*s/rad"), "joint.c.tm": ("a rotational damping", "N*m*s/rad")}
+
+
+def _check_unit(column: str, unit: str, where: str) -> None:
+    """A header's unit that is no unit, or not of the column's dimension, is refused where the header is read."""
+    from ..units import ureg
+
+    try:
+        q = ureg.Quantity(1.0, unit)
+    except Exception:
+        raise FileFormatError(f"{where}: {unit!r} is not a unit; expected a unit such as mm, N/m") from None
+    if column in _DIMENSIONS or column.startswith("holder.") and column.endswith(("_length", "_diameter", ".bore")):
+        what, example = _DIMENSIONS.get(column, ("a length", "mm"))
+        if q.dimensionality != ureg.Quantity(1.0, example).dimensionality:
+            raise FileFormatError(f"{where}: the unit {unit!r} is not that of {what} ({column} [{example}])")
+
+
 def _csv_cell(column: str, unit: str | None, cell: str, where: str):
     if unit is not None:
         try:
@@ -209,6 +232,8 @@ def read_combinations_csv(path: Any) -> list:
         if column.startswith(("joint.k.", "joint.c.")) and unit is None:
             raise FileFormatError(f"{name}, line {numbers[0]}: column {head!r}: a joint entry needs its unit, "
                                   "e.g. joint.k.yf [N/m]")
+        if unit is not None:
+            _check_unit(column, unit, f"{name}, line {numbers[0]}: column {head!r}")
         if column in [c for c, _ in columns]:
             raise FileFormatError(f"{name}, line {numbers[0]}: column {column!r} given twice")
         columns.append((column, unit))

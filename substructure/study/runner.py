@@ -42,7 +42,7 @@ from typing import Any
 from .._json import json_text
 from ..errors import InvalidValueError, OutputExistsError, SubstructureWarning
 
-__all__ = ["run_study", "Progress", "parse_scheduler", "json_text", "RESULT_FORMAT"]
+__all__ = ["run_study", "Progress", "parse_scheduler", "json_text", "RESULT_FORMAT", "study_identity"]
 
 #: The ``format`` of a combination's result file.
 RESULT_FORMAT = "substructure-study-result/1"
@@ -220,11 +220,27 @@ class _Store:
         from ..io import read_text
 
         path = self.path("results", task["key"], ".json")
-        try:  # the checked read: a FIFO or a huge file put there is not a result (FileFormatError is a ValueError)
-            data = json.loads(read_text(path, "study result"))
-        except (OSError, ValueError):
+        if not path.exists():  # a combination never finished
             return None
-        if (not isinstance(data, dict) or data.get("format") != RESULT_FORMAT
+        try:  # the checked read: a FIFO or a huge file put there is not a result (FileFormatError is a ValueError)
+            text = read_text(path, "study result")
+        except (OSError, ValueError) as exc:
+            if problems is not None:
+                problems.append(f"{path}: {' '.join(str(exc).split())}; not trusted, computed again")
+            return None
+        try:
+            data = json.loads(text)
+        except ValueError as exc:
+            if problems is not None:
+                problems.append(f"{path}: not a whole result file (cut short or edited: {exc}); not trusted, "
+                                "computed again")
+            return None
+        if not isinstance(data, dict):
+            if problems is not None:
+                problems.append(f"{path}: not a result file (a JSON {type(data).__name__}, expected an object); "
+                                "not trusted, computed again")
+            return None
+        if (data.get("format") != RESULT_FORMAT
                 or data.get("fingerprint") != task["fingerprint"] or data.get("status") != "done"):
             return None
         why = _rows_problem(data.get("rows"), task)
@@ -242,7 +258,30 @@ class _Store:
                 if record is not None:
                     finished[task["key"]] = record
 
-    def save(self, result: dict) -> dict:
+    def other_study(self, identity: dict) -> str:
+        """What another study's results in ``results/`` are (name, or the grid that differs), or ``""``.
+
+        Every result file records the study it belongs to (``study``: its
+        name and grid); files without it (older ones) or unreadable ones say
+        nothing here.
+        """
+        from ..io import read_text
+
+        folder = self.root / "results"
+        for path in sorted(folder.glob("*.json")) if folder.is_dir() else ():
+            try:
+                held = json.loads(read_text(path, "study result")).get("study")
+            except (OSError, ValueError, AttributeError):
+                continue
+            if not isinstance(held, dict) or held == identity:
+                continue
+            name = held.get("name")
+            if name != identity["name"]:
+                return f"study {name!r} ({path.name})"
+            return f"study {name!r} on another grid ({_grid_text(held.get('grid'))}; {path.name})"
+        return ""
+
+    def save(self, result: dict, identity: dict | None = None) -> dict:
         from ..io import write_bytes, write_text
 
         key = result["key"]
@@ -251,6 +290,8 @@ class _Store:
                 (self.root / folder).mkdir(parents=True, exist_ok=True)
         record = {k: v for k, v in result.items() if k not in ("figure", "frf")}
         record["format"] = RESULT_FORMAT
+        if identity is not None:
+            record["study"] = identity
         if result.get("figure") is not None:
             write_bytes(self.path("figures", key, ".png"), result["figure"])
             record["figure"] = f"figures/{key}.png"
@@ -259,6 +300,39 @@ class _Store:
             record["frf"] = f"frf/{key}.csv"
         write_text(self.path("results", key, ".json"), json_text(record) + "\n")  # last: the combination is done
         return record
+
+
+def _grid_text(grid: Any) -> str:
+    """A study's grid as a result file records it, in words: ``frequency 100 Hz to 5000 Hz by 10 Hz, ...``."""
+    if not isinstance(grid, dict):
+        return "not recorded"
+    parts = []
+    for key, value in grid.items():
+        if isinstance(value, list) and len(value) == 3:
+            parts.append(f"{key} {value[0]} to {value[1]} by {value[2]}")
+        elif value is None:
+            parts.append(f"{key} default")
+    return ", ".join(parts) or "not recorded"
+
+
+def study_identity(study) -> dict:
+    """What tells a study's results from another's in one output directory: its name and its grid.
+
+    Parameters
+    ----------
+    study : Study
+        The study.
+
+    Returns
+    -------
+    dict
+        ``{"name": str, "grid": {"frequency": [...] or None, "speeds":
+        [...], "sdm_speeds": [...] or None}}``, plain data.
+    """
+    import attrs
+
+    grid = {k: None if v is None else list(v) for k, v in attrs.asdict(study.grid).items()}
+    return json.loads(json_text({"name": study.name, "grid": grid}))
 
 
 def _rows_problem(rows: Any, task: dict) -> str:
@@ -273,6 +347,69 @@ def _rows_problem(rows: Any, task: dict) -> str:
         return (f"{len(rows)} rows for {len(cuts)} cut{'s' if len(cuts) != 1 else ''} ({', '.join(map(repr, cuts))})"
                 + (f", repeated: {', '.join(doubled)}" if doubled else "")
                 + ("" if keys == {task["key"]} else f", rows of other combinations ({len(keys - {task['key']})})"))
+    specs = task["cuts"] or [None]
+    for row, spec in zip(rows, specs):
+        why = _row_problem(row, task, spec)
+        if why:
+            return f"row of cut {row.get('cut')!r}: {why}" if task["cuts"] else f"its row: {why}"
+    return ""
+
+
+#: Statuses a finished result's rows may have (crashed and pending rows are never saved as done).
+_SAVED_STATUSES = ("ok", "failed")
+_POSITIVE = ("tool_diameter_m", "overhang_m", "flute_length_m", "spindle_speed_rpm", "window_lo_rpm", "window_hi_rpm",
+             "runner_up_speed_rpm", "tool_mode_hz", "tool_mode_lo_hz", "tool_mode_hi_hz", "radial_depth_m",
+             "feed_per_tooth_m", "kt_pa", "teeth", "band_members")
+_NON_NEGATIVE = ("depth_m", "limit_depth_m", "zoa_min_limit_m", "zoa_absolute_limit_m", "sdm_min_limit_m",
+                 "runner_up_depth_m", "mrr_m3_per_s", "power_w", "torque_n_m", "structure_band_lo_hz",
+                 "chatter_frequency_hz", "tool_mode_compliance_m_per_n", "kn_pa")
+
+
+def _row_problem(row: dict, task: dict, spec: dict | None) -> str:
+    """Why one saved row is not one the study could have written (a hand edit), or ``""``."""
+    import math
+
+    from .table import COLUMNS
+
+    if row.get("status") not in _SAVED_STATUSES:
+        return f"status: got {row.get('status')!r}; expected {' or '.join(map(repr, _SAVED_STATUSES))}"
+    if row.get("combination") != task["combination"] or row.get("machine") != task["machine"]["name"]:
+        return (f"combination, machine: got {row.get('combination')!r}, {row.get('machine')!r}; expected "
+                f"{task['combination']!r}, {task['machine']['name']!r}")
+    for name, kind, _ in COLUMNS:
+        value = row.get(name)
+        if value is None:
+            continue
+        if kind == "str":
+            ok = isinstance(value, str)
+            expected = "a string"
+        elif kind == "int":
+            ok = isinstance(value, int) and not isinstance(value, bool)
+            expected = "a whole number"
+        else:
+            ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+            expected = "a finite number or null"
+        if ok and name in _POSITIVE:
+            ok, expected = value > 0, "a positive number or null"
+        elif ok and name in _NON_NEGATIVE:
+            ok, expected = value >= 0, "a number >= 0 or null"
+        if not ok:
+            return f"{name}: got {value!r}; expected {expected}"
+    if row["status"] == "failed" and not row.get("error"):
+        return "status: 'failed' without an error"
+    if row["status"] == "ok" and row.get("error"):
+        return f"status: 'ok' with an error ({row['error']!r})"
+    depth, limit = row.get("depth_m"), row.get("limit_depth_m")
+    if depth is not None and limit is not None and depth > limit * (1 + 1e-9):
+        return f"depth_m: got {depth!r}; above the row's stability limit limit_depth_m = {limit!r}"
+    deepest = row.get("flute_length_m")
+    if spec is not None and spec.get("max_depth") is not None:
+        from ..units import Q_
+
+        deepest = float(Q_(spec["max_depth"]).m_as("m"))
+    if depth is not None and deepest is not None and depth > deepest * (1 + 1e-9):
+        return (f"depth_m: got {depth!r}; deeper than the largest depth {deepest!r} m (the cut's max_depth, or the "
+                "tool's flute length)")
     return ""
 
 
@@ -406,8 +543,15 @@ def run_study(study, client: Any = None, out: Any = None, scheduler: str | None 
         tasks = [{**t, "compute": {**t["compute"], "figures": False, "frf_files": False}} for t in tasks]
     store = None if out is None else _Store(out, study.inputs)
     finished: dict[str, dict] = {}
+    identity = study_identity(study)
     if store is not None:
         store.check(tasks, resume, overwrite)
+        other = store.other_study(identity) if resume else ""
+        if other:
+            raise OutputExistsError(
+                f"{store.root}: holds the results of {other}, not of the study given ({study.name!r}, "
+                f"{_grid_text(identity['grid'])}); --resume (resume=True) continues the same study only: choose "
+                "another --out (out) for it, or replace those results with --overwrite (overwrite=True)")
         if resume:
             problems: list[str] = []
             store.load_all(tasks, finished, problems)
@@ -446,7 +590,7 @@ def run_study(study, client: Any = None, out: Any = None, scheduler: str | None 
                 _dashboard(own or client, report)
                 results = _on_dask(own or client, todo)
             for task, result in results:
-                record = store.save(result) if store is not None else {k: v for k, v in result.items()
+                record = store.save(result, identity) if store is not None else {k: v for k, v in result.items()
                                                                          if k not in ("figure", "frf")}
                 finished[task["key"]] = json.loads(json_text(record))
                 report.update(sum(row["status"] != "ok" for row in result["rows"]))

@@ -8,12 +8,13 @@ they are made, so that a wrong setting stops the study before any work.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from typing import Any
 
 import attrs
 
-from ..errors import InvalidValueError
+from ..errors import InvalidValueError, SubstructureError
 from .spec import plain
 
 __all__ = ["Compute", "Grid", "METHODS"]
@@ -150,14 +151,19 @@ def _range(field: str, kind: str):
         if not isinstance(value, (list, tuple)) or len(value) != 3:
             raise InvalidValueError(f"{field}: got {value!r}; expected start, stop and step with units")
         value = tuple(plain(v, field) for v in value)
-        if kind == "frequency":
-            from ..frf import Frequency
+        try:
+            if kind == "frequency":
+                from ..frf import Frequency
 
-            Frequency.from_range(*value)
-        else:
-            from ..stability import spindle_speeds
+                Frequency.from_range(*value)
+            else:
+                from ..stability import spindle_speeds
 
-            spindle_speeds(*value)
+                spindle_speeds(*value)
+        except SubstructureError as exc:  # "step: ..." is speeds.step of the grid
+            message = " ".join(str(exc).split())
+            sub = re.match(r"(start|stop|step)\b", message)
+            raise InvalidValueError(f"{field}.{message}" if sub else f"{field}: {message}") from None
         return value
 
     return convert

@@ -18,7 +18,7 @@ from typing import Any
 import attrs
 import pint
 
-from ..errors import InvalidValueError
+from ..errors import InvalidValueError, SubstructureError
 from ..units import format_quantity
 
 __all__ = ["Machine", "Combination", "Cut", "SurrogateSpec", "TOOL_KEYS", "HOLDER_KEYS", "JOINT_KEYS",
@@ -227,7 +227,11 @@ def _limits(value: Any):
         if key not in ("max_speed", "min_speed", "power", "torque"):
             raise InvalidValueError(f"limits.{key}: unknown key; allowed keys: max_speed, min_speed, power, torque "
                                     "(the largest depth is the tool's flute length, or the cut's max_depth)")
-    return MachineLimits(**{k: (tuple(tuple(p) for p in v) if isinstance(v, list) else v) for k, v in value.items()})
+    try:
+        return MachineLimits(**{k: (tuple(tuple(p) for p in v) if isinstance(v, list) else v)
+                                for k, v in value.items()})
+    except SubstructureError as exc:  # "max_speed: ..." is limits.max_speed of the machine
+        raise InvalidValueError(f"limits.{' '.join(str(exc).split())}") from None
 
 
 def _supports(value: Any) -> tuple:

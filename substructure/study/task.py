@@ -85,10 +85,20 @@ def _tool(spec: dict | None, machine):
         return tool
     if "segments" in spec:
         return _component_from_table("tool", spec)
+    from ..units import quantity
+
+    for key in ("diameter", "overhang", "flute_length"):  # named as the combination gives them, with the value
+        if spec.get(key) is not None:
+            value = quantity(spec[key], f"tool.{key}", "[length]")
+            if not value.magnitude > 0:
+                raise InvalidValueError(f"tool.{key}: got {spec[key]!r}; expected a positive length")
     extra = {k: spec[k] for k in ("teeth", "helix") if k in spec}
-    tool = Tool.end_mill(spec["diameter"], spec["overhang"], spec.get("flute_length"),
-                         material=spec.get("material", "carbide"), diameter_ratio=spec.get("diameter_ratio", 0.8),
-                         **extra)
+    try:
+        tool = Tool.end_mill(spec["diameter"], spec["overhang"], spec.get("flute_length"),
+                             material=spec.get("material", "carbide"), diameter_ratio=spec.get("diameter_ratio", 0.8),
+                             **extra)
+    except SubstructureError as exc:
+        raise InvalidValueError(f"tool: {' '.join(str(exc).split())}") from None
     if "description" in spec:
         import attrs
 
@@ -100,7 +110,17 @@ def _holder(spec: dict | None, machine, tool):
     from ..units import format_quantity
 
     if spec is None:
-        return machine.component("holder")
+        holder = machine.component("holder")
+        tip = holder.segments[-1] if getattr(holder, "segments", None) else None
+        insert = getattr(tip, "insert", None)
+        bore = getattr(insert, "od", None) if insert is not None else getattr(tip, "id", None)
+        shank = tool.segments[0].od
+        if bore is not None and bore.m_as("m") > 0 and shank.m_as("m") > bore.m_as("m") * (1 + 1e-9):
+            raise InvalidValueError(
+                f"the machine's holder has a {format_quantity(bore.to('mm'))} bore; the tool's shank is "
+                f"{format_quantity(shank.to('mm'))} (tool.diameter), it cannot take it: give the combination a "
+                "holder that does (holder.catalog, e.g. 'BT40 ER32', or holder.segments)")
+        return holder
     table = dict(spec)
     if "catalog" in table and "bore" not in table:  # the tool's shank fills the bore
         table["bore"] = format_quantity(tool.segments[0].od)
@@ -141,6 +161,35 @@ def joint_at_quantile(joint, prediction: dict, q: float):
         return joint.with_parameters(k=k, c=c)
 
 
+_PASSIVE = {"k": ("a stiffness > 0", "a zero or negative"), "c": ("a damping >= 0", "a negative")}
+
+
+def _check_passive(joint: dict) -> None:
+    """Refuse a joint override whose diagonal entry (``yf``, ``tm``) would make the structure generate energy.
+
+    A stiffness ``k.yf``, ``k.tm`` must be > 0 and a damping ``c.yf``,
+    ``c.tm`` >= 0 (as in the joint table of ``substructure predict``): with
+    a negative one the structure is not passive and its stability limit
+    means nothing.  The cross entries ``ym``, ``tf`` are signed.
+    """
+    from ..units import Q_
+
+    for kind, entries in joint.items():
+        for entry in ("yf", "tm"):
+            value = (entries or {}).get(entry)
+            if value is None:
+                continue
+            try:
+                magnitude = float(Q_(value).to_base_units().magnitude)
+            except Exception:  # a unit or number the joint itself refuses, with its own message
+                continue
+            if not (magnitude > 0 if kind == "k" else magnitude >= 0):
+                expected, which = _PASSIVE[kind]
+                raise InvalidValueError(
+                    f"joint.{kind}.{entry}: got {value!r}; expected {expected} ({which} one makes a structure that "
+                    "is not passive, it could generate energy, and no stability limit of it means anything)")
+
+
 def _assembly(task: dict):
     """The combination's assembly (nominal joint), its tool, and the joint's template."""
     where = task["where"]
@@ -151,7 +200,7 @@ def _assembly(task: dict):
     for i, s in enumerate(m["supports"]):
         machine = _guard(where, f"machine {m['name']!r}: supports[{i}]", machine.support, s["at"], k=s.get("k"),
                          c=s.get("c"))
-    tool = _guard(where, "tool", _tool, task["tool"], machine)
+    tool = _guard(where, "", _tool, task["tool"], machine)
     holder = _guard(where, "holder", _holder, task["holder"], machine, tool)
     assembly = _guard(where, "tool", machine.with_component, tool)
     assembly = _guard(where, "holder", assembly.with_component, holder)
@@ -159,6 +208,7 @@ def _assembly(task: dict):
                       task["joint_name"])
     prediction = task["prediction"]
     if task["joint"] is not None:
+        _guard(where, "", _check_passive, task["joint"])
         joint = _guard(where, "joint", template.with_parameters, k=task["joint"].get("k"), c=task["joint"].get("c"))
     elif prediction is not None:
         if "error" in prediction:
@@ -195,6 +245,40 @@ def _tool_mode(frf, band, near: float | None = None) -> tuple[float, float]:
             if abs(shift) <= 1:
                 return float(f[i] + shift * (f[i + 1] - f[i])), float(np.exp(b - 0.25 * (a - c) * shift))
     return float(f[i]), float(h[i])
+
+
+def _mode_below_grid(assembly, point: str, frequency, frf) -> tuple[str, float] | None:
+    """Why the grid misses the tool point's dominant mode (a mode below its first line) and its frequency, or None.
+
+    The tool point receptance is computed on 77 lines from a twentieth of
+    the grid's first line up to it, its rigid-body lines left out as for the
+    grid; when the lines below the grid hold a more negative real part and
+    a larger magnitude than every line of the grid, a mode below the grid
+    dominates, and the lobes from the grid alone would be far too deep.
+    Nothing flexible below the grid (a mass line only) is no finding.
+    """
+    from ..frf import Frequency
+    from ..stability import assembly_structure
+
+    f0 = float(frequency.hz[0])
+    if not f0 > 0:
+        return None
+    low = Frequency.from_range(f"{f0 / 20!r} Hz", f"{f0!r} Hz", f"{0.95 * f0 / 76!r} Hz")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            probe, _ = assembly_structure(assembly, point, low)
+    except Exception:  # a mass line only (no flexible mode below the grid), or nothing to compute there
+        return None
+    lines = probe.frequency.hz < f0
+    h, inside = probe.data[lines, 0, 0], frf.data[:, 0, 0]
+    if not h.size or not (h.real.min() < inside.real.min() and np.abs(h).max() > np.abs(inside).max()):
+        return None
+    i = int(np.argmax(np.abs(h)))
+    mode = float(probe.frequency.hz[lines][i])
+    return (f"the tool point receptance has a mode below the frequency grid's first line ({f0:g} Hz), near "
+            f"{mode:.3g} Hz, more compliant than any inside the grid (|H| {np.abs(h[i]):.3g} "
+            f"m/N against at most {np.abs(inside).max():.3g} m/N inside)"), mode
 
 
 @functools.lru_cache(maxsize=8)
@@ -484,6 +568,12 @@ def _compute(task: dict, out: dict) -> list[dict]:
         nominal = {"q": 0.5, "frf_band": _guard(where, f"FRF at {point}", assembly_structure, assembly, point,
                                                    frequency)}
         nominal["tool_mode"] = _tool_mode(*nominal["frf_band"])
+        below = _mode_below_grid(assembly, point, frequency, nominal["frf_band"][0])
+        if below:
+            key = ("grid.frequency.start" if grid["frequency"] is not None
+                   else "[grid] frequency (the study's; the machine's assembly [frequency] is used now)")
+            raise _Failed(f"{where}: {below[0]}; no depth from this grid can be trusted: start the frequency grid "
+                          f"below the mode, {key} = '{below[1] / 2:.2g} Hz' for instance")
         members: list[dict] = []
         envelope = None
         prediction = task["prediction"]
