@@ -416,3 +416,20 @@ def test_semi_discretization_of_a_fine_frf_checks_its_band_without_building_zero
     status, out, err = run(capsys, "lobes", "--frf", path, *cut, "--method", "sdm", "--speeds", "3000:3100:100",
                            "--band", "300:800")
     assert status == 1 and "never negative from 300 to 800 Hz: the band holds no resonance" in err
+
+
+def test_a_recommended_depth_of_many_diameters_with_nothing_to_bound_it_is_warned_of(capsys, modes_file):
+    """A radial immersion of 1e-6 leaves a limit of hundreds of metres on one mode: the recommendation follows it
+    when no largest depth is given (modes do not say the flute length); the warning says so, and --max-depth
+    (or a normal cut) has none."""
+    cut = ["--diameter", "12 mm", "--teeth", "2", "--milling", "down", "--kt", "600 MPa", "--kn", "200 MPa",
+           "--speeds", "15000:16000:100", "--json"]
+    status, out, _ = run(capsys, "lobes", "--modes", modes_file, "--immersion", "1e-6", *cut)
+    result = json.loads(out)
+    depth = result["recommended"]["depth_m"]
+    assert status == 0 and depth > 4 * 0.012
+    (note,) = [n for n in result["notes"] if "times the tool's diameter" in n]
+    assert f"{depth * 1e3:.4g} mm is {depth / 0.012:.3g} times" in note and "--max-depth" in note
+    for extra in (["--immersion", "1e-6", "--max-depth", "30 mm"], ["--immersion", "0.5"]):
+        status, out, _ = run(capsys, "lobes", "--modes", modes_file, *extra, *cut)
+        assert status == 0 and not [n for n in json.loads(out)["notes"] if "times the tool's diameter" in n]

@@ -348,6 +348,24 @@ def milling_of(args: argparse.Namespace, notes: list[str]) -> str:
     return "down" if given in ("down", "climb") else "up"
 
 
+DEEP_CUT_DIAMETERS = 4.0
+"""A recommended depth more than this many tool diameters, with no largest depth to bound it, is warned of:
+end mills' flutes reach about 2 to 4 diameters (a recommendation deeper than the flutes cuts with the shank)."""
+
+
+def deep_cut_note(best: Any, cut: Any, limits: Any) -> str | None:
+    """The warning for a recommended depth beyond :data:`DEEP_CUT_DIAMETERS` tool diameters that no largest depth
+    bounds (an FRF or modes do not say the flute length; a tiny radial immersion leaves a huge limit), or None."""
+    if best is None or limits is None or limits.max_depth is not None:
+        return None
+    diameter = float(cut.diameter.m_as("m"))
+    if not best.depth_m > DEEP_CUT_DIAMETERS * diameter:
+        return None
+    return (f"warning: the recommended depth {best.depth_m * 1e3:.4g} mm is {best.depth_m / diameter:.3g} times the "
+            f"tool's diameter ({diameter * 1e3:.4g} mm), and no largest depth bounds it: give --max-depth (the flute "
+            "length; --assembly takes it from the tool), as a depth beyond the flutes cannot be cut")
+
+
 def limits_from_args(args: argparse.Namespace, tool: Any, notes: list[str]):
     """The machine's limits the options give (``MachineLimits``); the largest depth defaults to the flute
     length of ``tool`` (noted in ``notes``)."""

@@ -14,6 +14,7 @@ from ._cutting import (
     add_lobes_options,
     cut_from_args,
     cutting_check,
+    deep_cut_note,
     limits_from_args,
     structure_band_arg,
     tool_of,
@@ -193,6 +194,9 @@ def run(args: argparse.Namespace) -> int:
                 progress("the recommendation: the lowest limit within each candidate's speed window, by new runs "
                          "of semi-discretization")
             best = recommend(lobes, cut, limits, margin=args.margin, speed_tolerance=args.speed_tolerance)
+            deep = deep_cut_note(best, cut, limits)
+            if deep:
+                notes.append(deep)
         except NoRecommendationError as exc:  # the lobes stand; the recommendation is absent, with the reason
             why = one_line(exc)
     else:
