@@ -622,7 +622,7 @@ def summary(result, model_name: str, measured: int) -> list[str]:
             if result.suggestion:
                 lines.append(f"  to tell them apart: {result.suggestion}")
     if len(result.refinement) > 1:
-        lines.append("refinement (watch the error fall):")
+        lines.append("refinement (watch the error fall; chi^2/nu of each step's fit, every line in full):")
         for step in result.refinement:
             what = "model as given" if step.added is None else f"+ {step.added.name} at {step.added.where}"
             lines.append(f"  step {step.step}: {what:50s} error {step.error:.4f}  chi^2/nu {step.chi2_reduced:.4g}")
@@ -634,6 +634,7 @@ def summary(result, model_name: str, measured: int) -> list[str]:
     scored = "" if check is None else (f"; {check.ratio:.2f} with each line as the noise model scores it, up to "
                                        f"{check.allowed:.2f}")
     lines.append(f"verdict: {verdict}: final error {result.final_error:.4f} ({result.final_error / floor:.2f} x the "
-                 f"noise floor{scored}), chi^2/nu = {cons.chi2_reduced:.4g} (consistent with the noise up to "
+                 f"noise floor{scored}), chi^2/nu = {cons.chi2_reduced:.4g} with each line capped at the noise's "
+                 f"0.1 % tail (consistent with the noise up to "
                  f"{cons.threshold:.4g})")
     return lines
