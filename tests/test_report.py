@@ -429,3 +429,31 @@ def test_command_errors_are_clear(capsys, files, tmp_path):
     assert status == 1 and "--overwrite" in err and out.read_text(encoding="utf-8") == "keep"
     status, _, _ = _run(capsys, "report", assembly, "--out", out, "--overwrite", "--quiet")
     assert status == 0 and out.read_text(encoding="utf-8").startswith("<!DOCTYPE html>")
+
+
+def test_an_identified_value_on_its_search_bound_reads_as_not_a_measurement_in_the_joint_table():
+    """The holder-tool joint's c_tm of 1e-6 N m s/rad, 1/4000 of the model's: its fit ends on the lower bound of its
+    search (4e-3), which the report's table says beside the value (no +- either); plain FRFs, which say nothing of
+    where they were measured, are refused by identify_joint by position."""
+    from types import SimpleNamespace
+
+    from substructure import Frequency
+    from substructure.errors import InvalidValueError
+    from substructure.measurements import Measurement
+    from substructure.report import html as report_html
+
+    asm = default_assembly()
+    truth = asm.with_joint(asm.joint("holder-tool").with_parameters(c={"tm": "1e-6 N*m*s/rad"}))
+    h = truth.receptance("tool.tip:y", frequency=Frequency.from_range("1000 Hz", "5000 Hz", "4 Hz"))
+    rng = np.random.default_rng(0)
+    noise = 0.02 * (rng.standard_normal(h.data.shape) + 1j * rng.standard_normal(h.data.shape)) / np.sqrt(2)
+    h = attrs.evolve(h, data=h.data * (1 + noise))
+    with pytest.raises(InvalidValueError, match=r"measurements\[0\]: got FRF; expected a measurement"):
+        identify_joint(asm, [h], "holder-tool", parameters=("c_tm",))
+    ident = identify_joint(asm, [Measurement.from_frf(h, "tool.tip", "tool.tip")], "holder-tool",
+                           parameters=("c_tm",))
+    assert ident.at_bound == {"c_tm": "lower"}
+    text = report_html._joints(SimpleNamespace(diagnosis=None, identifications=[ident], identification_errors=[],
+                                               assembly=asm))
+    (cell,) = [c for c in re.findall(r"<td>[^<]*</td>", text) if "bound" in c]
+    assert "0.004000" in cell and "on the lower bound of its search: not a measurement" in cell and "±" not in cell

@@ -19,7 +19,7 @@ from .._json import finite as _finite
 from .._text import plain_text
 from ..assembly import Assembly
 from ..coupling import remove_mass
-from ..errors import SubstructureError
+from ..errors import InvalidValueError, SubstructureError
 from ..frf import FRF
 from ..points import parse_point
 from ..rdof import estimate_rotational, positions_from
@@ -240,6 +240,12 @@ def identify_joint(assembly: Assembly, measurements, joint: str, band="auto",
     """
     if hasattr(measurements, "validate"):
         measurements.validate(assembly)
+    for i, m in enumerate(measurements):
+        if not (hasattr(m, "frf") and hasattr(m, "removed")):
+            raise InvalidValueError(
+                f"measurements[{i}]: got {type(m).__name__}; expected a measurement (what was measured where, with "
+                "which sensors on: Measurement.from_frf(frf, response, excitation), or a MeasurementSet); "
+                "JointIdentifier fits plain FRFs")
     ident = JointIdentifier(joint, parameters=parameters, band=band, bootstrap=bootstrap,
                             random_state=random_state).fit(assembly, list(measurements))
     notes = list(ident.warnings_)

@@ -522,7 +522,11 @@ def _joints(report: Any) -> str:
                     if ident is None:
                         row.append("–")
                     elif fitted:
-                        row.append(_entry(getattr(ident, kind)[e], getattr(ident, f"{kind}_std")[e], units[e]))
+                        name = f"{kind}_ym" if e == "tf" else f"{kind}_{e}"
+                        side = getattr(ident, "at_bound", {}).get(name)
+                        row.append(_entry(getattr(ident, kind)[e], getattr(ident, f"{kind}_std")[e], units[e])
+                                   + ("" if side is None else f" (on the {side} bound of its search: not a "
+                                                              "measurement)"))
                     else:
                         row.append("kept from the model")
                 if found:
