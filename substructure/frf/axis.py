@@ -20,6 +20,40 @@ from ..units import frequency_hz
 
 __all__ = ["Frequency", "MAX_GRID_LINES"]
 
+ROUNDED_STEP_SHARE = 0.25
+"""Largest distance, in steps, of a written value from the uniform grid fitted to them all, for the values to be
+read as that grid (times or frequencies written with few digits: ``%.2f`` of a 0.15625 Hz step lies 3 % of a step
+off it); a quarter step, so that no value can be taken for its neighbour."""
+
+
+def rounded_uniform(values: np.ndarray) -> np.ndarray | None:
+    """The uniform grid that increasing values written rounded stand for, or None when they are not one.
+
+    The grid is the least-squares line through the values against their index (the rounding of every value
+    averages out); the values stand for it when every one lies within :data:`ROUNDED_STEP_SHARE` of a step
+    of it.
+
+    Parameters
+    ----------
+    values : ndarray
+        1-D, as written.
+
+    Returns
+    -------
+    ndarray or None
+        The grid, or None (fewer than 3 values, not increasing overall, or a value farther off).
+    """
+    n = values.size
+    if n < 3 or not values[-1] > values[0]:
+        return None
+    k = np.arange(n, dtype=np.float64)
+    step = float(np.dot(k - k.mean(), values - values.mean()) / np.dot(k - k.mean(), k - k.mean()))
+    grid = (values.mean() - step * k.mean()) + k * step
+    if step > 0 and np.max(np.abs(values - grid)) <= ROUNDED_STEP_SHARE * step:
+        return grid
+    return None
+
+
 MAX_GRID_LINES = 1_000_000
 """The most lines :meth:`Frequency.from_range` builds (a grid, with FRFs on it, is held in memory).
 

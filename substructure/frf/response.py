@@ -570,16 +570,8 @@ class FRF:
 
         Parameters
         ----------
-        path : str or os.PathLike
-            The file.
-        overwrite : bool, default False
-            Whether an existing file may be replaced.
-
-        Raises
-        ------
-        OutputExistsError
-            (a ``FileExistsError``) When ``path`` exists and ``overwrite`` is
-            false, naming the path.
+        path, overwrite
+            As for :meth:`to_csv` (an existing file is kept unless ``overwrite``).
         """
         from .files.uff_writer import write_uff
 

@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import FileFormatError, SubstructureError
+from ..frf.axis import ROUNDED_STEP_SHARE, rounded_uniform
 from ..tap.records import RESPONSE_QUANTITIES, TIME_STEP_TOLERANCE, TapRecord, channel_to_si, quantity_of, unit_of
 from ._tap_columns import Columns
 
@@ -31,28 +32,22 @@ def check_quantity_option(quantity: str | None, found: str, where: str) -> None:
                               f"option says {quantity}; leave the option out or fix the file")
 
 
-ROUNDED_TIME_TOLERANCE = 0.25
+ROUNDED_TIME_TOLERANCE = ROUNDED_STEP_SHARE
 """Largest distance, in time steps, of a written time from the uniform grid fitted to them all
 (times written with few digits, e.g. six decimals at 51.2 kHz); farther (a lost or repeated sample) is refused."""
 
 
 def regular(time_s: np.ndarray) -> np.ndarray:
-    """The uniform grid fitted to the times when every time lies within a quarter step of it.
+    """The uniform grid fitted to the times when every time lies within a quarter step of it
+    (``substructure.frf.axis.rounded_uniform``).
 
     Times rounded to the digits a file writes (0.000020 for 1.953125e-05 s)
     make uneven steps of a uniform clock; the grid is what was sampled.  A
     time farther from the grid is left as written, for the record's own
     check to refuse.
     """
-    n = time_s.size
-    if n < 3 or not time_s[-1] > time_s[0]:
-        return time_s
-    k = np.arange(n, dtype=np.float64)
-    step = float(np.dot(k - k.mean(), time_s - time_s.mean()) / np.dot(k - k.mean(), k - k.mean()))
-    grid = (time_s.mean() - step * k.mean()) + k * step  # the least-squares line: the rounding averages out
-    if step > 0 and np.max(np.abs(time_s - grid)) <= ROUNDED_TIME_TOLERANCE * step:
-        return grid
-    return time_s
+    grid = rounded_uniform(time_s)
+    return time_s if grid is None else grid
 
 
 def time_axis(time: tuple | None, stated: tuple | None, n: int, name: str) -> np.ndarray:

@@ -21,6 +21,7 @@ from .._files import check_file as check_readable_file
 from .._toml import TomlDocument, loads_toml
 from ..errors import FileFormatError, InvalidValueError, SubstructureError, SubstructureWarning
 from ..frf import FRF, QUANTITIES, Frequency
+from ..frf.axis import ROUNDED_STEP_SHARE, rounded_uniform
 from ..frf.files._common import _beyond_physical
 from ..frf.files._common import QuantityContradiction
 from ..frf.files.csv_files import _read_csv
@@ -39,21 +40,13 @@ _CSV = (".csv",)
 _UFF = (".uff", ".unv")
 
 
-
-
-ROUNDED_STEP_SHARE = 0.25
-"""How far a data file's frequencies may lie off the uniform grid fitted to them (least squares), as a share of
-the step, and still be read as that grid: frequencies written rounded (``%.2f`` of a 0.15625 Hz step lies up to
-0.005 Hz, 3 % of the step, off it).  A quarter of a step, as for the times of a tap record
-(``substructure.io.tap_files.ROUNDED_TIME_TOLERANCE``): no line can then be taken for its neighbour."""
-
-
 def _uniform_grid(hz: np.ndarray) -> tuple[np.ndarray | None, tuple[int, str] | None]:
     """A data file's frequencies as the uniform grid they stand for, or the first line that breaks it, in words.
 
     Identification and diagnosis estimate each line's noise from its neighbours (Savitzky-Golay smoothing), which
-    needs equally spaced lines.  Frequencies within :data:`ROUNDED_STEP_SHARE` of a step of the uniform grid
-    fitted to them (least squares; a leading 0 Hz line, dropped later, aside) are that grid, written rounded.
+    needs equally spaced lines.  Frequencies within ``ROUNDED_STEP_SHARE`` of a step of the uniform grid
+    fitted to them (``substructure.frf.axis.rounded_uniform``; a leading 0 Hz line, dropped later, aside) are that
+    grid, written rounded.
     """
     first = 1 if hz.size > 1 and hz[0] == 0.0 else 0
     n = hz.size - first
@@ -62,12 +55,11 @@ def _uniform_grid(hz: np.ndarray) -> tuple[np.ndarray | None, tuple[int, str] | 
     steps = np.diff(hz[first:])
     if not np.ptp(steps) > 1e-6 * steps.mean():  # uniform as written (the smoother's tolerance): kept
         return hz, None
-    index = np.arange(n)
-    step, start = np.polyfit(index, hz[first:], 1)  # least squares: the rounding of every line averaged out
-    grid = start + step * index
-    off = np.abs(hz[first:] - grid)
-    if off.max() <= ROUNDED_STEP_SHARE * step:
+    grid = rounded_uniform(hz[first:])
+    if grid is not None:
         return np.concatenate([hz[:first], grid]), None
+    index = np.arange(n)
+    off = np.abs(hz[first:] - np.polyval(np.polyfit(index, hz[first:], 1), index))
     jump = np.abs(steps - steps[0]) > 2 * ROUNDED_STEP_SHARE * steps[0]  # where the step changes, else the drift
     k = int(np.argmax(jump)) if jump.any() else max(int(np.argmax(off)) - 1, 0)
     return None, (first + k + 1, f"{steps[k]:.6g} Hz after the line before, where the grid's step is {steps[0]:.6g} "
