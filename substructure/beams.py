@@ -527,6 +527,58 @@ def stepped_beam_receptance_si(
                              place=[int(i) for i in order])
 
 
+def stepped_beam_receptances_si(
+    sections: Sequence[tuple], lengths: np.ndarray, positions: Sequence[float], frequency_hz: np.ndarray,
+    decay: float = 0.0,
+) -> list[np.ndarray] | None:
+    """:func:`stepped_beam_receptance_si` of several beams of the same segment lengths at the same positions.
+
+    One call of the chain kernel over the beams (its configurations): the
+    intervals that are the same in every beam (most of them, in a scan that
+    changes one segment's section) are computed once per line.  Every
+    beam's receptances are the numbers :func:`stepped_beam_receptance_si`
+    gives it alone.
+
+    Parameters
+    ----------
+    sections : sequence of (ei, kga, rhoa, rhoi)
+        Each beam's section arrays, as :func:`stepped_beam_receptance_si`
+        takes them.
+    lengths : ndarray of float, shape (n_seg,)
+        The segment lengths [m], the same for every beam.
+    positions, frequency_hz, decay
+        As :func:`stepped_beam_receptance_si`.
+
+    Returns
+    -------
+    list of ndarray or None
+        ``(2p, 2p, n_freq)`` per beam; None when a beam is long enough at the
+        highest line that its chain must be cut (then call
+        :func:`stepped_beam_receptance_si` for each).
+    """
+    from . import _kernels
+
+    lengths = np.asarray(lengths, dtype=float)
+    order, widths, seg, nodes = _intervals(lengths, positions)
+    omega = angular_lines(frequency_hz, decay)
+    ei, kga = (np.ascontiguousarray(np.stack([np.asarray(s[k], complex) for s in sections], axis=1))
+               for k in (0, 1))
+    rhoa, rhoi = (np.ascontiguousarray(np.stack([np.asarray(s[k], float) for s in sections], axis=1))
+                  for k in (2, 3))
+    _, k_max = _kernels.segment_coefficients(ei.T, kga.T, rhoa.T, rhoi.T,
+                                             float(np.max(np.abs(omega))) if omega.size else 0.0)
+    phases = k_max[:, seg] * widths[:, 0]
+    if phases.max() > _CHUNK_KL or np.cumsum(phases, axis=1)[:, -1].max() > _CHUNK_KL:
+        return None
+    ei, kga, rhoa, rhoi = (np.ascontiguousarray(v[seg]) for v in (ei, kga, rhoa, rhoi))
+    shared = ((ei == ei[:, :1]).all(axis=1) & (kga == kga[:, :1]).all(axis=1)
+              & (rhoa == rhoa[:, :1]).all(axis=1) & (rhoi == rhoi[:, :1]).all(axis=1))
+    out = _kernels.chain_receptance(omega, ei, kga, rhoa, rhoi, np.repeat(widths, len(sections), axis=1), shared,
+                                    np.arange(seg.size, dtype=np.int64), nodes, order)
+    n = omega.size
+    return [out[..., c * n:(c + 1) * n] for c in range(len(sections))]
+
+
 def stepped_beam_receptance_batch(
     configurations: Sequence[Sequence[Segment]], ends: Sequence[str], frequency_hz: np.ndarray
 ) -> np.ndarray:

@@ -172,6 +172,35 @@ def test_batch_equals_single_configurations():
         assert np.all(np.abs(got - single) <= 1e-11 * scale)
 
 
+def test_si_beams_of_one_layout_together_are_each_the_beam_alone():
+    """stepped_beam_receptances_si: several beams of the same segment lengths at the same nodes in one kernel
+    call (the intervals alike in all computed once) give each beam's numbers alone, to the bit; a beam whose
+    chain must be cut is left to the single call (None)."""
+    from substructure import default_assembly
+    from substructure.beams import stepped_beam_receptances_si
+    from substructure.updating.structure import Structure
+
+    structure = Structure.from_assembly(default_assembly())
+    rng = np.random.default_rng(3)
+    for name, lines, decay in (("tool", 250, 0.0), ("holder", 1000, 0.0), ("spindle", 333, 40.0), ("tool", 3, 7.0)):
+        beam = structure.beams[name]
+        f = np.linspace(20.0, 5000.0, lines)
+        length = beam.total_length
+        xs = [length, 0.0, 0.37 * length, 0.5 * length]
+        n = beam.od.size
+        variants = [beam.evolve(od=beam.od * np.where(np.arange(n) == k % n, 1.0 + 0.05 * rng.random(), 1.0),
+                                material=beam.material * np.where(np.arange(n)[:, None] == (k + 1) % n,
+                                                                  [1.0 + 0.1 * rng.random(), 1, 1, 1], 1.0))
+                    for k in range(7)] + [beam]
+        together = stepped_beam_receptances_si([v.sections() for v in variants], beam.length, xs, f, decay)
+        assert together is not None and len(together) == len(variants)
+        for v, y in zip(variants, together):
+            assert np.array_equal(y, v.receptance(xs, f, decay))
+    long_bar = beam.evolve(length=beam.length * 40.0)
+    f = np.linspace(20.0, 20000.0, 50)
+    assert stepped_beam_receptances_si([long_bar.sections()] * 2, long_bar.length, [0.0], f) is None
+
+
 def test_composite_and_fluted_sections():
     steel, carbide = Material.from_catalog("steel"), Material.from_catalog("carbide")
     seg = Segment("40 mm", "40 mm", "12 mm", insert=Insert("12 mm", "carbide"))

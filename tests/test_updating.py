@@ -454,8 +454,13 @@ def test_models_evaluated_together_give_what_each_gives_alone(clean, monkeypatch
     calls = []
     engine = si_evaluator.couple_substructures
     monkeypatch.setattr(si_evaluator, "couple_substructures", lambda *a, **k: calls.append(1) or engine(*a, **k))
+    beams_at_once = []
+    kernel = si_evaluator.stepped_beam_receptances_si
+    monkeypatch.setattr(si_evaluator, "stepped_beam_receptances_si",
+                        lambda sections, *a: beams_at_once.append(len(sections)) or kernel(sections, *a))
     got = together.residuals(lists)
     assert len(calls) <= 6  # together (not one by one after a failure): one call per layout of points and links
+    assert beams_at_once and max(beams_at_once) >= 3  # the tools of one layout in one kernel call
     alone = Likelihood(model, measured)
     assert together.evaluations == len(lists)
     for changes, w in zip(lists, got):

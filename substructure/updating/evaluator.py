@@ -19,6 +19,7 @@ from typing import Sequence
 import numpy as np
 
 from .._memo import Recent, Same
+from ..beams import stepped_beam_receptances_si
 from ..components import receptances
 from ..coupling import Link, couple_substructures
 from ..errors import AssemblyError, InvalidValueError
@@ -98,12 +99,16 @@ class Evaluator:
                 self._lru.popitem(last=False)
         return y
 
-    def _receptance(self, structure: Structure, name: str, nodes: list, pin: bool) -> tuple[np.ndarray, object]:
-        """A component's receptances at the nodes, and what identifies them (for the coupling's memo)."""
+    def _receptance(self, structure: Structure, name: str, nodes: list, pin: bool,
+                    ready: dict | None = None) -> tuple[np.ndarray, object]:
+        """A component's receptances at the nodes, and what identifies them (for the coupling's memo);
+        ``ready``: beams' receptances computed already (:meth:`_beams_together`), by the same key."""
         if name in structure.beams:
             beam = structure.beams[name]
             xs = [x for x, _ in nodes]
             key = (beam.token, tuple(xs))  # a token is never reused
+            if ready and key in ready:
+                return self._store(key, lambda: ready[key], pin), key
             return self._store(key, lambda: beam.receptance(xs, self.f, self.decay), pin), key
         comp = structure.opaque[name]
         refs = [r if r is not None else _at(name, x, comp.length_m) for x, r in nodes]
@@ -145,7 +150,9 @@ class Evaluator:
         list of ndarray
             ``(n_freq, n_out, n_in)`` per structure, in order.
         """
-        prepared = [self._prepare(s) for s in structures]
+        layouts = [self._layout(s) for s in structures]
+        ready = self._beams_together(structures, layouts)
+        prepared = [self._prepare(s, layout, ready) for s, layout in zip(structures, layouts)]
         groups: dict = {}
         for i, (blocks, coupling, out_keys, _) in enumerate(prepared):
             layout = (tuple(tuple(keys) for keys, _ in blocks),
@@ -187,9 +194,8 @@ class Evaluator:
                 out[i] = self._pick(y[..., j * n:(j + 1) * n])
         return out
 
-    def _prepare(self, structure: Structure):
-        """The blocks, links, output points and memo tokens of one structure, for the engine."""
-        pin = not self._pinned  # the first structure's components are kept for good
+    def _layout(self, structure: Structure) -> tuple[dict, list, list]:
+        """Where the outputs and links of a structure sit: each component's nodes, the output nodes, the links."""
         nodes: dict[str, dict] = {}
         keys = {}
 
@@ -217,12 +223,45 @@ class Evaluator:
             if ka == kb:
                 raise AssemblyError(f"{link.key[0][:-1]} {link.key[1]!r} connects a point to itself")
             links.append((ka, kb, link))
+        for comp, at in nodes.items():  # the order the engine takes them in: along the component, then the others
+            nodes[comp] = sorted(at.items(), key=lambda kv: (kv[1][0] is None, kv[1][0] or 0.0, str(kv[0])))
+        return nodes, out_keys, links
+
+    def _beams_together(self, structures: Sequence[Structure], layouts: list) -> dict:
+        """The receptances of the beams that several structures hold changed alike (the same segment lengths and
+        nodes, other sections: the trials of a scan, a Jacobian's steps), each group in one kernel call
+        (``beams.stepped_beam_receptances_si``: the same numbers as one by one); by ``_receptance``'s key."""
+        groups: dict = {}
+        for structure, (nodes, _, _) in zip(structures, layouts):
+            for comp, items in nodes.items():
+                beam = structure.beams.get(comp)
+                if beam is None:
+                    continue
+                xs = tuple(x for _, (x, _) in items)
+                key = (beam.token, xs)
+                if key in self._pinned or key in self._lru:
+                    continue
+                groups.setdefault((comp, xs, beam.length.tobytes()), {})[key] = beam
+        ready: dict = {}
+        for (_, xs, _), members in groups.items():
+            if len(members) < 2:
+                continue
+            beams = list(members.values())
+            ys = stepped_beam_receptances_si([b.sections() for b in beams], beams[0].length, xs, self.f, self.decay)
+            if ys is not None:
+                ready.update(zip(members, (np.ascontiguousarray(y) for y in ys)))
+        return ready
+
+    def _prepare(self, structure: Structure, layout: tuple | None = None, ready: dict | None = None):
+        """The blocks, links, output points and memo tokens of one structure, for the engine."""
+        pin = not self._pinned  # the first structure's components are kept for good
+        nodes, out_keys, links = layout if layout is not None else self._layout(structure)
         blocks, block_tokens = [], []
         for comp in structure.order:
             if comp not in nodes:
                 continue
-            items = sorted(nodes[comp].items(), key=lambda kv: (kv[1][0] is None, kv[1][0] or 0.0, str(kv[0])))
-            y, token = self._receptance(structure, comp, [v for _, v in items], pin)
+            items = nodes[comp]
+            y, token = self._receptance(structure, comp, [v for _, v in items], pin, ready)
             blocks.append(([k for k, _ in items], y))
             block_tokens.append(token)
         link_tokens = [_link_token(link) for _, _, link in links]
@@ -233,4 +272,4 @@ class Evaluator:
     @staticmethod
     def _pick(y: np.ndarray) -> np.ndarray:
         """The engine's result (the outputs' and inputs' entries, ``pick``), frequency first."""
-        return np.moveaxis(y, -1, 0)
+        return y.transpose((y.ndim - 1,) + tuple(range(y.ndim - 1)))  # np.moveaxis(y, -1, 0), for less

@@ -76,11 +76,12 @@ def from_u(spec: ParamSpec, u: float) -> float:
     float
         The value (SI).
     """
+    # min and max, not np.clip: the same values, and this runs at every trial of every fit
     if spec.log:
-        v = float(np.exp(np.clip(u, np.log(spec.lower), np.log(spec.upper))))
+        v = float(np.exp(min(max(float(u), float(np.log(spec.lower))), float(np.log(spec.upper)))))
     else:
         v = float(u) * _scale(spec)
-    return float(np.clip(v, spec.lower, spec.upper))
+    return float(min(max(v, spec.lower), spec.upper))
 
 
 def _bounds_u(spec: ParamSpec) -> tuple[float, float]:

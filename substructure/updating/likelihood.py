@@ -442,8 +442,13 @@ class Likelihood:
                 [float(np.sqrt(np.mean(v))) for v in variances])
 
     def _ratios(self, predicted: list) -> list[np.ndarray]:
+        return list(self._log_ratio_array(np.array(predicted)))
+
+    def _log_ratio_array(self, predicted: np.ndarray) -> np.ndarray:
+        """Log ratios of model values ``(..., FRF, line)`` (several models at once: the same numbers, element by
+        element, as each alone)."""
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            q = np.array(predicted) / self._data
+            q = predicted / self._data
             # ln|q| + i arg q: the complex logarithm's value (to rounding), several times faster than np.log
             r = np.empty_like(q)
             r.real = np.log(np.abs(q))
@@ -453,7 +458,12 @@ class Likelihood:
             r = np.where(bad, LOG_RATIO_PENALTY * (1 + 1j), r)
         if not self._all_alive:  # a line without data: no residual
             r = np.where(self._alive, r, 0.0)
-        return list(r)
+        return r
+
+    def _whitened(self, r: np.ndarray) -> np.ndarray:
+        """:meth:`whiten` of log ratios ``(..., FRF, line)``: ``(..., 2 FRF line)``."""
+        parts = r.view(np.float64).reshape(r.shape + (2,))  # (..., FRF, line, part): real and imaginary parts
+        return (np.swapaxes(parts, -1, -2) * self._w).reshape(r.shape[:-2] + (-1,))
 
     def whiten(self, ratios: Sequence[np.ndarray]) -> np.ndarray:
         """The whitened residual vector of log ratios (real parts, then imaginary parts, per FRF).
@@ -468,8 +478,7 @@ class Likelihood:
         ndarray
             Each part divided by its standard deviation.
         """
-        r = np.array(ratios)
-        return (np.stack([r.real, r.imag], axis=1) * self._w).ravel()
+        return self._whitened(np.array(ratios, dtype=complex))
 
     def residual(self, changes: Sequence[tuple] = ()) -> np.ndarray:
         """The whitened residual vector; its sum of squares is ``chi^2``.
@@ -512,7 +521,9 @@ class Likelihood:
         except Exception:  # noqa: BLE001 - one by one, so that the error is the first model's, as with residual
             return [self.residual(changes) for changes in lists]
         self.evaluations += len(lists)
-        return [self.whiten(self._ratios(self._gather([ys[k] for ys in per_group]))) for k in range(len(lists))]
+        # every model's log ratios and whitening in one array operation (the same numbers as each alone)
+        predicted = np.array([self._gather([ys[k] for ys in per_group]) for k in range(len(lists))], dtype=complex)
+        return list(self._whitened(self._log_ratio_array(predicted)))
 
     def chi2(self, changes: Sequence[tuple] = ()) -> float:
         """``chi^2`` of the model (``-2 ln L`` up to a constant).

@@ -95,7 +95,7 @@ class BeamArrays:
     """
 
     __slots__ = ("name", "length", "od", "id", "ratio", "material", "material_names", "insert", "insert_names",
-                 "token", "_sections", "_total")
+                 "token", "_sections", "_total", "_component")
 
     def __init__(self, name, length, od, id, ratio, material, material_names, insert, insert_names):
         self.name = name
@@ -110,6 +110,7 @@ class BeamArrays:
         self.token = next(_TOKENS)
         self._sections = None
         self._total = None
+        self._component: tuple | None = None  # (template, the component): as_component's last answer
 
     @classmethod
     def from_beam(cls, beam: Beam) -> "BeamArrays":
@@ -159,6 +160,9 @@ class BeamArrays:
         Beam
             A copy of ``template`` with the arrays' segments.
         """
+        if self._component is not None and self._component[0] is template:  # the arrays are never changed
+            return self._component[1]
+
         def material(name, values):
             E, nu, rho, eta = (float(v) for v in values)
             return Material(name, Q_(E, "Pa"), nu, Q_(rho, "kg/m^3"), eta)
@@ -172,7 +176,8 @@ class BeamArrays:
             segs.append(Segment(Q_(float(self.length[i]), "m"), Q_(float(self.od[i]), "m"),
                                 Q_(float(self.id[i]), "m"), material(self.material_names[i], self.material[i]), insert,
                                 None if ratio == 1.0 else Flutes(ratio)))
-        return attrs.evolve(template, segments=segs)
+        self._component = (template, attrs.evolve(template, segments=segs))
+        return self._component[1]
 
     def evolve(self, **changes) -> "BeamArrays":
         """A copy with some arrays replaced (a new token).
@@ -366,7 +371,7 @@ class Structure:
         The component objects the beams were made from (to share arrays).
     """
 
-    __slots__ = ("assembly", "beams", "opaque", "links", "order", "sources")
+    __slots__ = ("assembly", "beams", "opaque", "links", "order", "sources", "_positions")
 
     def __init__(self, assembly, beams: dict, opaque: dict, links: tuple, order: tuple, sources: dict | None = None):
         self.assembly = assembly
@@ -375,6 +380,7 @@ class Structure:
         self.links = links
         self.order = order
         self.sources = sources or {}
+        self._positions: dict = {}  # point name -> (component, x): a structure is never changed in place
 
     @classmethod
     def from_assembly(cls, assembly, like: "Structure | None" = None) -> "Structure":
@@ -630,6 +636,13 @@ class Structure:
             if not -1e-9 * total <= x <= total * (1 + 1e-9):
                 raise UnknownPointError(f"point {comp}@{x} m: lies outside {comp!r} ({total * 1e3:.6g} mm long)")
             return comp, min(max(float(x), 0.0), total)
+        found = self._positions.get(point)
+        if found is None:
+            found = self._positions[point] = self._named_position(point)
+        return found
+
+    def _named_position(self, point: str) -> tuple[str, float | None]:
+        """:meth:`position` of a point name (kept by :meth:`position`)."""
         ref = _parse(point)
         if ref.component in self.beams:
             beam = self.beams[ref.component]
