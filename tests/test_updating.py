@@ -474,3 +474,28 @@ def test_models_evaluated_together_give_what_each_gives_alone(clean, monkeypatch
     with pytest.raises(type(one.value), match=re.escape(str(one.value))):
         counted.residuals(lists[:2] + [outside] + lists[2:])
     assert counted.evaluations == 3
+
+
+def test_evolved_beams_sections_are_those_computed_from_scratch():
+    """A beam evolved from another takes the sections of its unchanged segments from it: every section is the
+    one its arrays give computed anew, to the bit (sizes, materials, flutes, inserts, lengths changed)."""
+    from substructure import default_assembly
+    from substructure.updating.structure import Structure, _segment_sections
+
+    structure = Structure.from_assembly(default_assembly())
+    rng = np.random.default_rng(0)
+    for beam in structure.beams.values():
+        beam.sections()
+        m = beam.od.size
+        for k in range(40):
+            row = np.arange(m) == rng.integers(m)
+            change = [{"od": beam.od * np.where(row, 1.0 + 0.1 * rng.normal(), 1.0)},
+                      {"material": beam.material * np.where(row[:, None], 1.0 + 0.1 * rng.random(4), 1.0)},
+                      {"length": beam.length * 1.1},
+                      {"ratio": np.where(row, 0.8, beam.ratio)},
+                      {"insert": beam.insert * np.where(row[:, None], 1.0 + 0.01 * rng.random(6), 1.0)}][k % 5]
+            evolved = beam.evolve(**change)
+            got = evolved.sections()
+            fresh = _segment_sections(evolved.od, evolved.ratio, evolved.id, evolved.material, evolved.insert)
+            assert all(np.array_equal(g, f) for g, f in zip(got, fresh)), change
+            assert not got[0].flags.writeable  # shared between beams: never changed in place

@@ -28,6 +28,9 @@ from .structure import LinkSI, Structure, _at, _parse
 
 __all__ = ["Evaluator"]
 
+LAYOUTS_KEPT = 16
+"""How many layouts of structures (their nodes and links) an evaluator keeps."""
+
 
 def _link_token(link: "LinkSI"):
     """What a link's dynamic stiffness is computed from (None for a joint model of its own)."""
@@ -83,6 +86,7 @@ class Evaluator:
         self._size = cache
         self._memo = Recent(memo_bytes)
         self._stiffness = Recent(memo_bytes // 8)
+        self._layouts: OrderedDict = OrderedDict()
 
     def _store(self, key, compute, pin: bool):
         if key in self._pinned:
@@ -195,7 +199,29 @@ class Evaluator:
         return out
 
     def _layout(self, structure: Structure) -> tuple[dict, list, list]:
-        """Where the outputs and links of a structure sit: each component's nodes, the output nodes, the links."""
+        """Where the outputs and links of a structure sit: each component's nodes, the output nodes, the links
+        ``(node a, node b, link)``.
+
+        Kept for structures whose links join the same points, whose beams have the same lengths and whose other
+        components are the same objects (the trials of a scan that change sizes and values, not places): their
+        nodes are the same."""
+        opaque = tuple(structure.opaque.values())
+        key = (tuple((link.a, link.b) for link in structure.links),
+               tuple((name, beam.total_length) for name, beam in structure.beams.items()),
+               tuple(id(c) for c in opaque))
+        found = self._layouts.get(key)
+        if found is not None and all(a is b for a, b in zip(found[0], opaque)):  # kept with it: ids not reused
+            self._layouts.move_to_end(key)
+            nodes, out_keys, pairs = found[1]
+        else:
+            nodes, out_keys, pairs = self._new_layout(structure)
+            self._layouts[key] = (opaque, (nodes, out_keys, pairs))
+            while len(self._layouts) > LAYOUTS_KEPT:
+                self._layouts.popitem(last=False)
+        return nodes, out_keys, [(ka, kb, link) for (ka, kb), link in zip(pairs, structure.links)]
+
+    def _new_layout(self, structure: Structure) -> tuple[dict, list, list]:
+        """:meth:`_layout` computed: the nodes, the output nodes and each link's two nodes."""
         nodes: dict[str, dict] = {}
         keys = {}
 
@@ -216,16 +242,16 @@ class Evaluator:
             return k
 
         out_keys = [node(p) for p in self._points]
-        links = []
+        pairs = []
         for link in structure.links:
             ka = node(link.a)
             kb = None if link.b is None else node(link.b)
             if ka == kb:
                 raise AssemblyError(f"{link.key[0][:-1]} {link.key[1]!r} connects a point to itself")
-            links.append((ka, kb, link))
+            pairs.append((ka, kb))
         for comp, at in nodes.items():  # the order the engine takes them in: along the component, then the others
             nodes[comp] = sorted(at.items(), key=lambda kv: (kv[1][0] is None, kv[1][0] or 0.0, str(kv[0])))
-        return nodes, out_keys, links
+        return nodes, out_keys, pairs
 
     def _beams_together(self, structures: Sequence[Structure], layouts: list) -> dict:
         """The receptances of the beams that several structures hold changed alike (the same segment lengths and

@@ -70,6 +70,20 @@ def _ring(od, id_, E, nu, rho, eta):
     return E * damp * inertia, kappa * (E / (2.0 * (1.0 + nu))) * damp * area, rho * area, rho * inertia
 
 
+def _segment_sections(od, ratio, id_, material, insert) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(EI, kGA, rhoA, rhoI)`` of segments given as :class:`BeamArrays` holds them (rows of its arrays)."""
+    E, nu, rho, eta = material.T
+    parts = _ring(od * ratio, id_, E, nu, rho, eta)
+    has = insert[:, 0] > 0
+    if has.any():
+        io, ii, iE, inu, irho, ieta = insert.T
+        safe_od = np.where(has, io, 1.0)
+        extra = _ring(safe_od, np.where(has, ii, 0.0), iE, np.where(has, inu, 0.3), irho, ieta)
+        parts = tuple(p + np.where(has, e, 0.0) for p, e in zip(parts, extra))
+    return (np.asarray(parts[0], complex), np.asarray(parts[1], complex), np.asarray(parts[2], float),
+            np.asarray(parts[3], float))
+
+
 class BeamArrays:
     """A plain stepped beam as SI arrays over its segments (base to tip).
 
@@ -95,7 +109,7 @@ class BeamArrays:
     """
 
     __slots__ = ("name", "length", "od", "id", "ratio", "material", "material_names", "insert", "insert_names",
-                 "token", "_sections", "_total", "_component")
+                 "token", "_sections", "_total", "_component", "_parent")
 
     def __init__(self, name, length, od, id, ratio, material, material_names, insert, insert_names):
         self.name = name
@@ -111,6 +125,7 @@ class BeamArrays:
         self._sections = None
         self._total = None
         self._component: tuple | None = None  # (template, the component): as_component's last answer
+        self._parent: BeamArrays | None = None  # the beam this one was evolved from, its sections computed
 
     @classmethod
     def from_beam(cls, beam: Beam) -> "BeamArrays":
@@ -195,7 +210,10 @@ class BeamArrays:
         fields = {k: getattr(self, k) for k in ("name", "length", "od", "id", "ratio", "material", "material_names",
                                                "insert", "insert_names")}
         fields.update(changes)
-        return BeamArrays(**fields)
+        beam = BeamArrays(**fields)
+        if self._sections is not None:  # the sections of the segments that did not change are taken from here
+            beam._parent = self
+        return beam
 
     @property
     def total_length(self) -> float:
@@ -213,16 +231,22 @@ class BeamArrays:
             Complex ``EI`` [N m^2] and ``kappa G A`` [N], ``rho A`` [kg/m], ``rho I`` [kg m].
         """
         if self._sections is None:
-            E, nu, rho, eta = self.material.T
-            parts = _ring(self.od * self.ratio, self.id, E, nu, rho, eta)
-            has = self.insert[:, 0] > 0
-            if has.any():
-                io, ii, iE, inu, irho, ieta = self.insert.T
-                safe_od = np.where(has, io, 1.0)
-                extra = _ring(safe_od, np.where(has, ii, 0.0), iE, np.where(has, inu, 0.3), irho, ieta)
-                parts = tuple(p + np.where(has, e, 0.0) for p, e in zip(parts, extra))
-            self._sections = (np.asarray(parts[0], complex), np.asarray(parts[1], complex),
-                              np.asarray(parts[2], float), np.asarray(parts[3], float))
+            parent, self._parent = self._parent, None
+            if parent is None or parent.length.size != self.length.size:
+                self._sections = _segment_sections(self.od, self.ratio, self.id, self.material, self.insert)
+            else:  # the segments that changed computed, the others as the parent's (the same numbers)
+                rows = ((self.od != parent.od) | (self.id != parent.id) | (self.ratio != parent.ratio)
+                        | (self.material != parent.material).any(axis=1) | (self.insert != parent.insert).any(axis=1))
+                if not rows.any():
+                    self._sections = parent.sections()
+                else:
+                    new = _segment_sections(self.od[rows], self.ratio[rows], self.id[rows], self.material[rows],
+                                    self.insert[rows])
+                    self._sections = tuple(np.array(p) for p in parent.sections())
+                    for whole, part in zip(self._sections, new):
+                        whole[rows] = part
+            for a in self._sections:
+                a.flags.writeable = False  # shared with the beams evolved from this one
         return self._sections
 
     def mass(self) -> float:
