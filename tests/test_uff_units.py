@@ -301,3 +301,25 @@ def test_records_written_by_the_project_carry_their_unit_exponents(tmp_path, dof
     back = read_uff(tmp_path / "ours.uff")
     assert back.quantity == quantity and back.outputs == labels[0] and back.inputs == labels[1]
     np.testing.assert_allclose(back.data, frf.data, rtol=1e-11)
+
+
+@pytest.mark.parametrize("label", ["dB", "dB g/N", "dB re 1 g/N"])
+@pytest.mark.parametrize("quantity", [None, "accelerance"])
+def test_ordinate_in_decibels_is_refused_even_with_the_quantity(tmp_path, label, quantity):
+    """A magnitude in dB (its reference not in the file) was a raw pint error, or with the quantity given
+    read as linear values in SI units."""
+    hz = grid(start=10.0, n=20)
+    accelerance = -((2 * np.pi * hz) ** 2) * receptance(hz)
+    (tmp_path / "db.uff").write_text(record_58(accelerance, x0=10.0, num=(12, 1, 0, label)), encoding="ascii")
+    with pytest.raises(FileFormatError, match=r"db\.uff, type-58 record 0: .*decibels"):
+        read_uff(tmp_path / "db.uff", quantity=quantity)
+
+
+@pytest.mark.parametrize("label", ["%", "deg", "1", "V/V", "dB", "dB g/N"])
+def test_abscissa_labelled_with_a_ratio_is_not_taken_for_hz(tmp_path, label):
+    """An abscissa whose unit is a ratio, an angle or a percentage was read as Hz."""
+    hz = grid(start=10.0, n=20)
+    (tmp_path / "x.uff").write_text(record_58(receptance(hz), x0=10.0, num=(8, 1, 0, "m"), abscissa=(18, label)),
+                                    encoding="ascii")
+    with pytest.raises(FileFormatError, match=r"x\.uff, type-58 record 0: .*abscissa"):
+        read_uff(tmp_path / "x.uff")
