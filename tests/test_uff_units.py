@@ -323,3 +323,33 @@ def test_abscissa_labelled_with_a_ratio_is_not_taken_for_hz(tmp_path, label):
                                     encoding="ascii")
     with pytest.raises(FileFormatError, match=r"x\.uff, type-58 record 0: .*abscissa"):
         read_uff(tmp_path / "x.uff")
+
+
+@pytest.mark.parametrize("rsp, response, kind", [
+    ((1, 3), "tool.tip:theta", "translation"),   # a Z sensor taken for a rotation
+    ((1, 6), "tool.tip", "rotation"),             # a rotation (+Z) taken for y
+    ((1, -4), "tool.tip:y", "rotation"),
+])
+def test_record_direction_of_another_kind_than_the_tables_dof_is_refused(tmp_path, rsp, response, kind):
+    """Records of other programs are taken for the table's points; a rotation read as y (or a translation as
+    theta) went through silently."""
+    hz = grid(start=10.0, n=20)
+    accelerance = -((2 * np.pi * hz) ** 2) * receptance(hz)
+    (tmp_path / "d.uff").write_text(record_58(accelerance, x0=10.0, num=(12, 0, 0, "NONE"), den=(13, 0, 1, "NONE"),
+                                              rsp=rsp), encoding="ascii")
+    path = measurement_set(tmp_path, "d.uff")
+    text = path.read_text(encoding="utf-8").replace('response = "tool.tip"', f'response = "{response}"')
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(FileFormatError, match=rf"frf\[0\]\.response: .*d\.uff, type-58 record 0: its response is "
+                                              rf"a {kind} \(direction code {abs(rsp[1])}\)"):
+        load_measurements(path)
+
+
+def test_record_direction_of_the_tables_kind_is_read(tmp_path):
+    """A translation in any axis (here -Z) is the table's y, the sign of the data turned."""
+    hz = grid(start=10.0, n=20)
+    accelerance = -((2 * np.pi * hz) ** 2) * receptance(hz)
+    (tmp_path / "d.uff").write_text(record_58(accelerance, x0=10.0, num=(12, 1, 0, "m/s^2"), rsp=(1, -3)),
+                                    encoding="ascii")
+    measurement, _ = read_set(measurement_set(tmp_path, "d.uff"))
+    np.testing.assert_allclose(measurement.frf.data[:, 0, 0], -receptance(hz), rtol=SINGLE)

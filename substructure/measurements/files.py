@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import warnings
 from pathlib import Path
 from typing import Any
@@ -37,6 +38,7 @@ _FRF_KEYS = ("response", "excitation", "file", "record", "quantity", "sensors", 
              "force_window_s", "estimator", "coherence_record")
 _REQUIRED = ("response", "excitation", "file")
 _CSV = (".csv",)
+_FOREIGN_LABEL = re.compile(r"^node(?P<node>-?\d+):(?:(?P<dof>y|theta)|dir(?P<code>\d+))$")  # uff_units._label
 _UFF = (".uff", ".unv")
 
 
@@ -214,8 +216,9 @@ class _Reader:
         for label in (frf.outputs[0], frf.inputs[0]):
             try:
                 stored.append(dof_label(label))
-            except SubstructureError:
-                return frf.with_labels((response,), (excitation,))  # labels of another program: not comparable
+            except SubstructureError:  # labels of another program: their nodes are not the set's points
+                self.check_directions(index, path, record, frf, response, excitation)
+                return frf.with_labels((response,), (excitation,))
         if stored != [response, excitation]:
             raise self.error(
                 index, "record" if record is not None else "file",
@@ -223,6 +226,28 @@ class _Reader:
                 f"{stored[1]}, not {response} / {excitation} as this table says; check the record index (0-based)",
             )
         return frf.with_labels((response,), (excitation,))
+
+    def check_directions(self, index: int, path: Path, record: int | None, frf: FRF, response: str,
+                         excitation: str) -> None:
+        """A record of another program (``node<N>:<dof>``) is taken for the table's points, but its direction
+        codes must be of the same kind as the table's DOFs: a translation (1-3) for ``y``, a rotation (4-6) for
+        ``theta``; direction 0 (a scalar) says nothing."""
+        for key, label, point in (("response", frf.outputs[0], response), ("excitation", frf.inputs[0], excitation)):
+            match = _FOREIGN_LABEL.match(label)
+            if match is None:
+                continue
+            code = 2 if match["dof"] == "y" else 6 if match["dof"] == "theta" else int(match["code"])
+            if code not in range(1, 7):
+                continue
+            rotation = code > 3
+            if rotation != point.endswith(":theta"):
+                what = ("a rotation (direction code {code})" if rotation else "a translation (direction code {code})")
+                raise self.error(
+                    index, "record" if record is not None else key,
+                    f"{path}, type-58 record {record or 0}: its {'reference' if key == 'excitation' else key} is "
+                    f"{what.format(code=code)} at node {match['node']}, but this table's {key} {point} is "
+                    f"{'a rotation' if point.endswith(':theta') else 'a translation'}; check the record index "
+                    f"(0-based) or the {key}'s DOF (:y or :theta)")
 
     # -- the file, top down ----------------------------------------------------
     def measurement_set(self, data: dict, cls: Any) -> Any:
