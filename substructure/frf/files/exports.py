@@ -78,6 +78,18 @@ def _is_number(cell: str) -> bool:
     return True
 
 
+def _same_unit(a: str, b: str) -> bool:
+    """Whether two unit texts (a header's and a units row's) are the same unit, written alike or not."""
+    if a.replace(" ", "") == b.replace(" ", ""):
+        return True
+    try:
+        qa, qb = _unit_of_label(a), _unit_of_label(b)
+    except ValueError:
+        return False
+    return qa is not None and qb is not None and qa.dimensionality == qb.dimensionality and \
+        abs(float((qa / qb).to_base_units().magnitude) - 1.0) < 1e-12
+
+
 def _value_unit(unit: str | None, cell: str, name: str, line: int):
     """``(quantity, factor to SI)`` of a value column's unit; ``(None, 1)`` without one."""
     if unit is None:
@@ -155,6 +167,11 @@ def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None
     if len(cells) > 1 and cells[1] and not any(_is_number(c) for c in cells[1]):
         # a row of units under the names (an empty cell: no unit), as acquisition programs export them
         units = cells[1] + [""] * (len(columns) - len(cells[1]))
+        for (_, unit), u, cell in zip(columns, units, cells[0]):
+            if unit is not None and bare_unit(u) is not None and not _same_unit(unit, bare_unit(u)):
+                raise FileFormatError(f"{name}, line {rows[1][0]}: column {_shown(cell)}: the units row says "
+                                      f"{_shown(bare_unit(u))} but the header {_shown(unit)}; give the unit once, "
+                                      "or correct the one that is wrong")
         columns = [(kind, unit if unit is not None else bare_unit(u)) for (kind, unit), u in zip(columns, units)]
         cells, rows = [cells[0]] + cells[2:], [rows[0]] + rows[2:]
     kinds = [k for k, _ in columns]
@@ -217,6 +234,11 @@ def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None
                     raise FileFormatError(f"{name}, line {n}: {_shown(column)} is {_shown(cell)}; "
                                           "expected a number") from None
         raise  # pragma: no cover - numpy and float() disagree on a cell
+    if angle == 1.0 and (np.abs(table[:, 2]) > 2 * np.pi + 1e-9).any():
+        k = int(np.argmax(np.abs(table[:, 2]) > 2 * np.pi + 1e-9))
+        raise FileFormatError(f"{name}, line {lines[k]}: {cells[0][2]} is {_shown(data[k][2])}, beyond 2 pi: degrees "
+                              "labelled rad? Label the column 'Phase [deg]' if so; a phase in rad is read within "
+                              "[-2 pi, 2 pi] (wrap an unwrapped phase, or give it in degrees)")
     if angle is not None and (table[:, 1] < 0).any():
         k = int(np.argmax(table[:, 1] < 0))
         raise FileFormatError(f"{name}, line {lines[k]}: {cells[0][1]} is {_shown(data[k][1])}; a magnitude is >= 0 (a "

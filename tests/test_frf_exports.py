@@ -1,0 +1,65 @@
+"""CSV exports of measured FRFs as acquisition programs write them: what is read, and what is refused.
+
+The files are written here from known values (numpy) and read back by
+``substructure.io.frf_files.read_csv``; what cannot be read unambiguously
+must be refused naming the file, the line and the column.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from substructure.errors import FileFormatError
+from substructure.io.frf_files import read_csv
+
+HZ = np.array([10.0, 20.0, 30.0, 40.0])
+H = 1e-6 * np.array([1 - 0.2j, 0.5 - 1j, -0.3 - 0.6j, -0.1 - 0.1j])
+
+
+def rows(*columns, sep=";", decimal=","):
+    return "".join(sep.join(repr(float(v)).replace(".", decimal) for v in row) + "\n" for row in zip(*columns))
+
+
+def test_a_units_row_that_contradicts_the_header_is_refused(tmp_path):
+    """The header said m/N, the units row under it mm/N: the header's unit was taken, silently."""
+    path = tmp_path / "export.csv"
+    path.write_text("Frequency [Hz];Real [m/N];Imag [m/N]\nHz;mm/N;mm/N\n" + rows(HZ, H.real, H.imag),
+                    encoding="utf-8")
+    with pytest.raises(FileFormatError, match=r"export\.csv, line 2: column 'Real \[m/N\]': the units row says "
+                                              r"'mm/N' but the header 'm/N'"):
+        read_csv(path)
+
+
+def test_a_units_row_that_says_the_headers_unit_again_is_read(tmp_path):
+    path = tmp_path / "export.csv"
+    path.write_text("Frequency [Hz];Real [(m/s^2)/N];Imag [(m/s^2)/N]\n[Hz];[m/s2/N];[m s^-2 N^-1]\n"
+                    + rows(HZ, H.real, H.imag), encoding="utf-8")
+    frf = read_csv(path)
+    assert frf.quantity == "accelerance"
+    np.testing.assert_allclose(frf.data[:, 0, 0], H, rtol=1e-15)
+
+
+def test_a_frequency_hz_column_with_a_khz_units_row_is_refused(tmp_path):
+    path = tmp_path / "export.csv"
+    path.write_text("frequency_hz;real;imag\nkHz;m/N;m/N\n" + rows(HZ, H.real, H.imag), encoding="utf-8")
+    with pytest.raises(FileFormatError, match=r"line 2: column 'frequency_hz': the units row says 'kHz'"):
+        read_csv(path)
+
+
+def test_a_phase_in_degrees_labelled_rad_is_refused(tmp_path):
+    """Degrees under 'Phase [rad]' were read as radians: every value wrong, silently."""
+    path = tmp_path / "export.csv"
+    path.write_text("Frequency [Hz];Magnitude [m/N];Phase [rad]\n" + rows(HZ, np.abs(H), np.degrees(np.angle(H))),
+                    encoding="utf-8")
+    with pytest.raises(FileFormatError, match=r"export\.csv, line 2: Phase \[rad\] is '-11,3\d*', beyond 2 pi: "
+                                              r"degrees labelled rad\?"):
+        read_csv(path)
+
+
+@pytest.mark.parametrize("unit, scale", [("rad", 1.0), ("deg", 180 / np.pi)])
+def test_magnitude_and_phase_read_to_the_values_written(tmp_path, unit, scale):
+    path = tmp_path / "export.csv"
+    path.write_text(f"Frequency [Hz];Magnitude [m/N];Phase [{unit}]\n" + rows(HZ, np.abs(H), np.angle(H) * scale),
+                    encoding="utf-8")
+    np.testing.assert_allclose(read_csv(path).data[:, 0, 0], H, rtol=1e-14)
