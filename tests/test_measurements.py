@@ -462,3 +462,13 @@ def test_a_csv_file_says_its_quantity(tmp_path, model, quantity):
                                                   rf"data file: .*tip\.csv, line 1: the header's units are those of "
                                                   rf"an? {quantity}, but the quantity given is receptance"):
             loads_measurements(entry + 'quantity = "receptance"\n', tmp_path, "set.toml")
+
+
+def test_a_file_of_a_0_hz_line_and_one_more_is_refused_naming_it(tmp_path):
+    """Two lines, the first at 0 Hz: the set kept one line after dropping it, and diagnose failed later with
+    'band: got 10-10 Hz' naming no file."""
+    (tmp_path / "two.csv").write_text("frequency_hz,real,imag\n0,1e-6,0\n10,1e-6,-1e-7\n", encoding="utf-8")
+    text = '[[frf]]\nresponse = "tool.tip"\nexcitation = "tool.tip"\nfile = "two.csv"\n'
+    with pytest.raises(FileFormatError, match=r"line 4: frf\[0\]\.file: .*two\.csv: 2 frequency lines, the first "
+                                              r"at 0 Hz"):
+        loads_measurements(text, base_dir=tmp_path, source="set.toml")

@@ -304,6 +304,10 @@ class _Reader:
             raise self.error(index, "force_window_s", f"missing; {file} has a force_noise column, correlated over "
                                                       "1 / force_window_s hertz (the force window's length in s)")
         if raw.frequency.hz[0] == 0.0:
+            if raw.frequency.n < 3:
+                raise self.error(index, "file", f"{self.base_dir / file}: {raw.frequency.n} frequency lines, the first "
+                                 "at 0 Hz, which is dropped (no receptance there); an FRF needs at least 2 lines "
+                                 "besides it")
             why = ("the model has no receptance at 0 Hz (its free-free components have no static receptance), so "
                    "identify and diagnose cannot compare it" if raw.quantity == "receptance" else
                    f"{'an' if raw.quantity[0] in 'aeiou' else 'a'} {raw.quantity} has no receptance at 0 Hz")
