@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from substructure.errors import FileFormatError
-from substructure.io.frf_files import read_csv
+from substructure.io.frf_files import read_csv, read_csv_with_coherence
 
 HZ = np.array([10.0, 20.0, 30.0, 40.0])
 H = 1e-6 * np.array([1 - 0.2j, 0.5 - 1j, -0.3 - 0.6j, -0.1 - 0.1j])
@@ -63,3 +63,16 @@ def test_magnitude_and_phase_read_to_the_values_written(tmp_path, unit, scale):
     path.write_text(f"Frequency [Hz];Magnitude [m/N];Phase [{unit}]\n" + rows(HZ, np.abs(H), np.angle(H) * scale),
                     encoding="utf-8")
     np.testing.assert_allclose(read_csv(path).data[:, 0, 0], H, rtol=1e-14)
+
+
+def test_german_column_names_as_german_programs_export_them(tmp_path):
+    """'Frequenz', 'Realteil', 'Imaginärteil', 'Betrag', 'Kohärenz' were refused as unknown columns."""
+    path = tmp_path / "export.csv"
+    path.write_text("Frequenz [Hz];Realteil [µm/N];Imaginärteil [µm/N]\n" + rows(HZ, H.real * 1e6, H.imag * 1e6),
+                    encoding="utf-8")
+    np.testing.assert_allclose(read_csv(path).data[:, 0, 0], H, rtol=1e-14)
+    path.write_text("Frequenz;Betrag;Phase;Kohärenz\nHz;m/N;°;%\n"
+                    + rows(HZ, np.abs(H), np.degrees(np.angle(H)), np.full(4, 99.0)), encoding="utf-8")
+    frf, coherence = read_csv_with_coherence(path)
+    np.testing.assert_allclose(frf.data[:, 0, 0], H, rtol=1e-14)
+    np.testing.assert_allclose(coherence, 0.99)

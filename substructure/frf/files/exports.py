@@ -29,13 +29,13 @@ from .uff_units import _TIME_EXPONENT, _exponents, _unit_of_label
 
 __all__ = ["parse_export"]
 
-_NAMES = {
-    "frequency": {"frequency", "freq", "f", "frequencyhz", "freqhz", "frequencies"},
-    "real": {"real", "re", "realpart"},
-    "imag": {"imag", "im", "imaginary", "imagpart", "imaginarypart"},
-    "magnitude": {"magnitude", "mag", "amplitude", "abs", "modulus"},
-    "phase": {"phase", "angle", "arg"},
-    "coherence": {"coherence", "coh", "gamma2", "gamma^2", "γ2", "γ²", "ordinarycoherence"},
+_NAMES = {  # English, and German as German programs export them (Frequenz, Realteil, Betrag, Kohärenz)
+    "frequency": {"frequency", "freq", "f", "frequencyhz", "freqhz", "frequencies", "frequenz"},
+    "real": {"real", "re", "realpart", "realteil"},
+    "imag": {"imag", "im", "imaginary", "imagpart", "imaginarypart", "imaginärteil", "imaginaerteil", "imagteil"},
+    "magnitude": {"magnitude", "mag", "amplitude", "abs", "modulus", "betrag"},
+    "phase": {"phase", "angle", "arg", "winkel", "phasenwinkel"},
+    "coherence": {"coherence", "coh", "gamma2", "gamma^2", "γ2", "γ²", "ordinarycoherence", "kohärenz", "kohaerenz"},
 }
 _COHERENCE_UNITS = {None: 1.0, "-": 1.0, "1": 1.0, "": 1.0, "%": 0.01}
 _HEADER = re.compile(r"^\s*(?P<name>[^\[\(]*?)\s*(?:[\[\(](?P<unit>.*)[\]\)])?\s*$")
@@ -55,7 +55,7 @@ def _column(cell: str, name: str, line: int) -> tuple[str, str | None]:
         if key in names:
             return kind, unit
     # a name of several words, one of them the column's kind: 'FRF Real', 'H1 Imag', 'Coherence H1'
-    tokens = set(re.split(r"[^0-9a-zγ²^]+", raw.lower())) - {""}
+    tokens = set(re.split(r"[^0-9a-zäγ²^]+", raw.lower())) - {""}
     if "db" not in tokens:
         found = {kind for kind, names in _NAMES.items() if tokens & names}
         if len(found) == 1:
