@@ -353,3 +353,19 @@ def test_record_direction_of_the_tables_kind_is_read(tmp_path):
                                     encoding="ascii")
     measurement, _ = read_set(measurement_set(tmp_path, "d.uff"))
     np.testing.assert_allclose(measurement.frf.data[:, 0, 0], -receptance(hz), rtol=SINGLE)
+
+
+def test_a_file_of_spectra_and_an_frf_read_whole_names_the_frfs_index(tmp_path):
+    """An analyser's export, auto spectrum then FRF: read without the record, the error said to export the FRFs
+    again, though the file holds one."""
+    hz = grid(start=10.0, n=20)
+    accelerance = -((2 * np.pi * hz) ** 2) * receptance(hz)
+    (tmp_path / "test.uff").write_text(record_58(np.abs(accelerance) ** 2 + 0j, x0=10.0, func=2)
+                                       + record_58(accelerance, x0=10.0, num=(12, 1, 0, "m/s^2")), encoding="ascii")
+    with pytest.raises(FileFormatError, match=r"record 0: an auto spectrum .*; the file's FRFs are type-58 "
+                                              r"record\(s\) 1: give the index of the one meant \(record = 1"):
+        read_uff(tmp_path / "test.uff")
+    with pytest.raises(FileFormatError, match=r"frf\[0\]\.file: .*record = 1 in the measurement set"):
+        load_measurements(measurement_set(tmp_path, "test.uff"))
+    frf, _ = read_set(measurement_set(tmp_path, "test.uff", record=1))
+    assert_receptance(frf.frf)
