@@ -76,3 +76,18 @@ def test_german_column_names_as_german_programs_export_them(tmp_path):
     frf, coherence = read_csv_with_coherence(path)
     np.testing.assert_allclose(frf.data[:, 0, 0], H, rtol=1e-14)
     np.testing.assert_allclose(coherence, 0.99)
+
+
+def test_metadata_lines_without_hash_above_the_header_are_pointed_at(tmp_path):
+    """An export's block of metadata (date, channel) above the table: the error said 'column 'Date'', expected
+    frequency..., without saying where the table starts or what to do."""
+    path = tmp_path / "export.csv"
+    path.write_text("Date;2026-11-27\nChannel;Tool tip Z\n\nFrequency [Hz];Real [m/N];Imag [m/N]\n"
+                    + rows(HZ, H.real, H.imag), encoding="utf-8")
+    with pytest.raises(FileFormatError, match=r"export\.csv, line 1: 'Date;2026-11-27' is not the table's header, "
+                                              r"line 4 \('Frequency \[Hz\];Real \[m/N\];Imag \[m/N\]'\) is: start "
+                                              r"the lines above it with '#'"):
+        read_csv(path)
+    path.write_text("# Date;2026-11-27\n# Channel;Tool tip Z\n\nFrequency [Hz];Real [m/N];Imag [m/N]\n"
+                    + rows(HZ, H.real, H.imag), encoding="utf-8")
+    np.testing.assert_allclose(read_csv(path).data[:, 0, 0], H, rtol=1e-15)

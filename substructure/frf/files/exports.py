@@ -110,6 +110,25 @@ def _value_unit(unit: str | None, cell: str, name: str, line: int):
     return kind, float(q.m_as(f"meter / newton * second ** {exps[2]}"))
 
 
+def _header_below(rows: list[tuple[int, str]], name: str) -> tuple[int, str] | None:
+    """The first of ``rows`` that reads as a table's header (a frequency column first, every cell a column's
+    name), as when a block of metadata lines without ``#`` comes before the table; None without one."""
+    for number, line in rows:
+        delimiter = ";" if ";" in line else "\t" if "\t" in line else ","
+        cells = [c.strip() for c in next(csv.reader([line], delimiter=delimiter))]
+        while cells and cells[-1] == "":
+            cells.pop()
+        if len(cells) < 3:
+            continue
+        try:
+            kinds = [_column(c, name, number)[0] for c in cells]
+        except FileFormatError:
+            continue
+        if kinds[0] == "frequency":
+            return number, line
+    return None
+
+
 def parse_export(numbered: list[tuple[int, str]], name: str, quantity: str | None):
     """Read a CSV export whose header is not the package's own.
 
@@ -163,7 +182,15 @@ def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None
     for row in cells:
         while row and row[-1] == "":  # an empty trailing column (a spreadsheet's last separator)
             row.pop()
-    columns = [_column(c, name, first) for c in cells[0]]
+    try:
+        columns = [_column(c, name, first) for c in cells[0]]
+    except FileFormatError:
+        below = _header_below(rows[1:51], name)
+        if below is None:
+            raise
+        raise FileFormatError(f"{name}, line {first}: {_shown(header)} is not the table's header, line {below[0]} "
+                              f"({_shown(below[1])}) is: start the lines above it with '#' (comment lines, such as "
+                              "an export's date or channel names, are skipped)") from None
     if len(cells) > 1 and cells[1] and not any(_is_number(c) for c in cells[1]):
         # a row of units under the names (an empty cell: no unit), as acquisition programs export them
         units = cells[1] + [""] * (len(columns) - len(cells[1]))
