@@ -91,3 +91,22 @@ def test_metadata_lines_without_hash_above_the_header_are_pointed_at(tmp_path):
     path.write_text("# Date;2026-11-27\n# Channel;Tool tip Z\n\nFrequency [Hz];Real [m/N];Imag [m/N]\n"
                     + rows(HZ, H.real, H.imag), encoding="utf-8")
     np.testing.assert_allclose(read_csv(path).data[:, 0, 0], H, rtol=1e-15)
+
+
+@pytest.mark.parametrize("unit, scale", [("HZ", 1.0), ("hz", 1.0), ("KHZ", 1e-3), ("RPM", 60.0),
+                                         ("RAD/S", 2 * np.pi)])
+def test_a_frequency_unit_in_capitals_reads_as_in_a_universal_file(tmp_path, unit, scale):
+    """'RPM', 'KHZ', 'RAD/S' and 'hz' were refused in a CSV export and read in a universal file's abscissa."""
+    path = tmp_path / "export.csv"
+    path.write_text(f"Frequency [{unit}];Real [m/N];Imag [m/N]\n" + rows(HZ * scale, H.real, H.imag),
+                    encoding="utf-8")
+    np.testing.assert_allclose(read_csv(path).frequency.hz, HZ, rtol=1e-14)
+
+
+def test_mhz_in_capitals_is_not_taken_for_megahertz(tmp_path):
+    """'MHZ' was read as MHz; in capitals it may as well be mHz: refused, as in a universal file."""
+    path = tmp_path / "export.csv"
+    path.write_text("Frequency [MHZ];Real [m/N];Imag [m/N]\n" + rows(HZ * 1e-6, H.real, H.imag), encoding="utf-8")
+    with pytest.raises(FileFormatError, match=r"export\.csv, line 1: column 'Frequency \[MHZ\]': 'MHZ' is not a "
+                                              "frequency unit"):
+        read_csv(path)

@@ -25,7 +25,7 @@ import numpy as np
 from ...errors import FileFormatError
 from ...units import bare_unit
 from ._common import _contradiction, _shown
-from .uff_units import _TIME_EXPONENT, _exponents, _unit_of_label
+from .uff_units import _TIME_EXPONENT, _exponents, _frequency_unit, _unit_of_label
 
 __all__ = ["parse_export"]
 
@@ -162,7 +162,7 @@ def parse_export(numbered: list[tuple[int, str]], name: str, quantity: str | Non
 
 def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None):
     """:func:`parse_export`, and the coherence column's values in [0, 1] (None without one) as a fourth item."""
-    from ...units import cycles_per_second, ureg
+    from ...units import cycles_per_second
 
     rows = [(n, line) for n, line in numbered if not line.lstrip().startswith("#")]
     if not rows:
@@ -216,10 +216,10 @@ def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None
     if columns[0][1] is None:
         raise FileFormatError(f"{name}, line {first}: column {_shown(fcell)} has no unit; name it frequency_hz or give "
                               "the unit, e.g. 'Frequency [Hz]'")
-    try:
-        funit = ureg.Quantity(1.0, columns[0][1].replace("HZ", "Hz"))
-        ok = funit.check("1 / [time]")
-    except Exception:
+    try:  # as a universal file's abscissa: capitals (HZ, KHZ, RPM) read, MHZ (mHz or MHz?) not
+        funit = _frequency_unit(columns[0][1])
+        ok = funit is not None and funit.check("1 / [time]")
+    except ValueError:
         ok = False
     if not ok:
         raise FileFormatError(f"{name}, line {first}: column {_shown(fcell)}: {_shown(columns[0][1])} is not a "

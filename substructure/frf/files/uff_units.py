@@ -247,6 +247,15 @@ def _unit_system(dset: dict, name: str) -> tuple[float, float] | None:
     return None if length == 1.0 and force == 1.0 else (length, force)
 
 
+def _frequency_unit(label: str):
+    """:func:`_unit_of_label` of a frequency axis's label, also in capitals (``HZ``, ``KHZ``, ``RPM``, ``RAD/S``:
+    read in lower case; ``MHZ``, mHz or MHz, is unreadable)."""
+    try:
+        return _unit_of_label(label)
+    except ValueError:
+        return _unit_of_label({"hz": "Hz", "khz": "kHz"}.get(label.lower(), label.lower()))
+
+
 def _abscissa_hz(dset: dict, where: str) -> np.ndarray:
     """The abscissa in Hz: a frequency axis (a label in rad/s is divided by 2 pi); time or orders refused."""
     from ...units import cycles_per_second
@@ -260,15 +269,12 @@ def _abscissa_hz(dset: dict, where: str) -> np.ndarray:
     hz = np.asarray(dset["x"], dtype=np.float64)
     label = str(dset.get("abscissa_axis_units_lab") or "").strip()
     try:
-        unit = _unit_of_label(label)
+        unit = _frequency_unit(label)
     except ValueError:
-        try:  # labels in capitals: "HZ", "RPM", "RAD/S"
-            unit = _unit_of_label({"hz": "Hz", "khz": "kHz"}.get(label.lower(), label.lower()))
-        except ValueError:
-            raise FileFormatError(
-                f"{where}: cannot read the abscissa's unit label {label!r}; expected a frequency unit "
-                "(Hz, rad/s, rpm): convert the file, or export it with the frequency axis in Hz"
-            ) from None
+        raise FileFormatError(
+            f"{where}: cannot read the abscissa's unit label {label!r}; expected a frequency unit "
+            "(Hz, rad/s, rpm): convert the file, or export it with the frequency axis in Hz"
+        ) from None
     if unit is not None and unit.check("1 / [time]"):
         hz = np.asarray(cycles_per_second(hz * unit, "abscissa"), dtype=np.float64)
     elif unit is not None:  # a length, a time; or a ratio, an angle, a percentage: never taken as Hz
