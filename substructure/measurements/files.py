@@ -350,7 +350,8 @@ class _Reader:
                     "(same sensors and removed components); keep one",
                 )
             seen[key] = i
-            source = (os.path.realpath(self.base_dir / m.file), m.record or 0)
+            found = os.stat(self.base_dir / m.file)  # the file itself: links, hard links, a name in other case
+            source = (found.st_dev, found.st_ino, m.record or 0)
             if source in sources:
                 j = sources[source]
                 raise self.error(
