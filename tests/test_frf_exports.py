@@ -110,3 +110,16 @@ def test_mhz_in_capitals_is_not_taken_for_megahertz(tmp_path):
     with pytest.raises(FileFormatError, match=r"export\.csv, line 1: column 'Frequency \[MHZ\]': 'MHZ' is not a "
                                               "frequency unit"):
         read_csv(path)
+
+
+def test_a_coherence_in_percent_holding_fractions_is_refused(tmp_path):
+    """Fractions (0.95) under 'Coherence [%]' were read as 0.0095, a coherence that weighs every line as noise."""
+    path = tmp_path / "export.csv"
+    path.write_text("Frequency [Hz];Real [m/N];Imag [m/N];Coherence [%]\n"
+                    + rows(HZ, H.real, H.imag, np.array([0.95, 0.99, 0.98, 0.9])), encoding="utf-8")
+    with pytest.raises(FileFormatError, match=r"export\.csv, line 1: column 'Coherence \[%\]' is in %, but no line "
+                                              r"holds more than 0\.99"):
+        read_csv_with_coherence(path)
+    path.write_text("Frequency [Hz];Real [m/N];Imag [m/N];Coherence [%]\n"
+                    + rows(HZ, H.real, H.imag, np.array([95.0, 99.0, 98.0, 0.5])), encoding="utf-8")
+    np.testing.assert_allclose(read_csv_with_coherence(path)[1], [0.95, 0.99, 0.98, 0.005])

@@ -278,6 +278,10 @@ def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None
             k = int(np.argmax(bad))
             raise FileFormatError(f"{name}, line {lines[k]}: {cells[0][3]} is {_shown(data[k][3])}; expected a "
                                   f"coherence in [0, 1]{' (0 to 100 %)' if gamma_factor != 1.0 else ''}")
+        if gamma_factor != 1.0 and np.nanmax(table[:, 3]) <= 1.0:
+            raise FileFormatError(f"{name}, line {first}: column {_shown(cells[0][3])} is in %, but no line holds more "
+                                  f"than {float(np.nanmax(table[:, 3]))!r} (%): fractions in [0, 1] labelled %? Give "
+                                  "the column without a unit if so")
         coherence = np.minimum(coherence, 1.0)
         table = table[:, :3].copy()
     with np.errstate(over="ignore", invalid="ignore"):
