@@ -473,3 +473,10 @@ def test_tap_tests_outside_the_models_grid_are_said(model):
         with pytest.raises(SubstructureWarning, match=r"the tap tests \(20 to 5000 Hz\) lie outside the model's "
                                                       r"frequency grid \(10000 to 11990 Hz"):
             report(elsewhere, _taps(model), identify=None)
+
+
+def test_the_compared_band_is_written_in_plain_numbers(with_taps):
+    """A band from 20,020 Hz read 'compared from 2.002e+04 to 25000 Hz' (four digits for the first, five for
+    the last)."""
+    later = attrs.evolve(with_taps, diagnosis=_LaterDiagnosis(with_taps.diagnosis, {"band_hz": [20020.0, 125000.5]}))
+    assert "compared from 20020 to 125000 Hz" in later.to_html()
