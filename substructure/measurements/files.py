@@ -239,15 +239,14 @@ class _Reader:
             code = 2 if match["dof"] == "y" else 6 if match["dof"] == "theta" else int(match["code"])
             if code not in range(1, 7):
                 continue
-            rotation = code > 3
-            if rotation != point.endswith(":theta"):
-                what = ("a rotation (direction code {code})" if rotation else "a translation (direction code {code})")
+            kind, wanted = ("a rotation" if code > 3 else "a translation",
+                            "a rotation" if point.endswith(":theta") else "a translation")
+            if kind != wanted:
                 raise self.error(
                     index, "record" if record is not None else key,
                     f"{path}, type-58 record {record or 0}: its {'reference' if key == 'excitation' else key} is "
-                    f"{what.format(code=code)} at node {match['node']}, but this table's {key} {point} is "
-                    f"{'a rotation' if point.endswith(':theta') else 'a translation'}; check the record index "
-                    f"(0-based) or the {key}'s DOF (:y or :theta)")
+                    f"{kind} (direction code {code}) at node {match['node']}, but this table's {key} {point} is "
+                    f"{wanted}; check the record index (0-based) or the {key}'s DOF (:y or :theta)")
 
     # -- the file, top down ----------------------------------------------------
     def measurement_set(self, data: dict, cls: Any) -> Any:
