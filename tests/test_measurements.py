@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import re
 
 import numpy as np
@@ -462,3 +463,28 @@ def test_a_csv_file_says_its_quantity(tmp_path, model, quantity):
                                                   rf"data file: .*tip\.csv, line 1: the header's units are those of "
                                                   rf"an? {quantity}, but the quantity given is receptance"):
             loads_measurements(entry + 'quantity = "receptance"\n', tmp_path, "set.toml")
+
+
+def test_a_file_of_a_0_hz_line_and_one_more_is_refused_naming_it(tmp_path):
+    """Two lines, the first at 0 Hz: the set kept one line after dropping it, and diagnose failed later with
+    'band: got 10-10 Hz' naming no file."""
+    (tmp_path / "two.csv").write_text("frequency_hz,real,imag\n0,1e-6,0\n10,1e-6,-1e-7\n", encoding="utf-8")
+    text = '[[frf]]\nresponse = "tool.tip"\nexcitation = "tool.tip"\nfile = "two.csv"\n'
+    with pytest.raises(FileFormatError, match=r"line 4: frf\[0\]\.file: .*two\.csv: 2 frequency lines, the first "
+                                              r"at 0 Hz"):
+        loads_measurements(text, base_dir=tmp_path, source="set.toml")
+
+
+def test_the_same_file_under_a_hard_link_is_refused_as_read_twice(tmp_path):
+    """A hard link (or, on a case-insensitive file system, the name in other case) gave the file a second path
+    that the comparison of resolved paths did not see: one measurement read as two."""
+    (tmp_path / "a.csv").write_text("frequency_hz,real,imag\n10,1e-6,-1e-7\n20,1e-6,-2e-7\n30,1e-6,-1e-7\n",
+                                    encoding="utf-8")
+    try:
+        os.link(tmp_path / "a.csv", tmp_path / "b.csv")
+    except OSError:
+        pytest.skip("no hard links here")
+    text = ('[[frf]]\nresponse = "tool.tip"\nexcitation = "tool.tip"\nfile = "a.csv"\n'
+            '[[frf]]\nresponse = "holder.tip"\nexcitation = "tool.tip"\nfile = "b.csv"\n')
+    with pytest.raises(FileFormatError, match=r"frf\[1\]\.file: reads the same data as frf\[0\]"):
+        loads_measurements(text, base_dir=tmp_path, source="set.toml")

@@ -457,3 +457,26 @@ def test_an_identified_value_on_its_search_bound_reads_as_not_a_measurement_in_t
                                                assembly=asm))
     (cell,) = [c for c in re.findall(r"<td>[^<]*</td>", text) if "bound" in c]
     assert "0.004000" in cell and "on the lower bound of its search: not a measurement" in cell and "±" not in cell
+
+
+def test_tap_tests_outside_the_models_grid_are_said(model):
+    """Tests on lines the model's grid does not reach at all (a kHz column read as Hz, another file) gave a page
+    whose receptance and diagnosis showed different bands, without a word."""
+    import warnings
+
+    from substructure import Frequency
+    from substructure.errors import SubstructureWarning
+
+    elsewhere = attrs.evolve(model, frequency=Frequency.from_hz(np.arange(10_000.0, 12_000.0, 10.0)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", SubstructureWarning)
+        with pytest.raises(SubstructureWarning, match=r"the tap tests \(20 to 5000 Hz\) lie outside the model's "
+                                                      r"frequency grid \(10000 to 11990 Hz"):
+            report(elsewhere, _taps(model), identify=None)
+
+
+def test_the_compared_band_is_written_in_plain_numbers(with_taps):
+    """A band from 20,020 Hz read 'compared from 2.002e+04 to 25000 Hz' (four digits for the first, five for
+    the last)."""
+    later = attrs.evolve(with_taps, diagnosis=_LaterDiagnosis(with_taps.diagnosis, {"band_hz": [20020.0, 125000.5]}))
+    assert "compared from 20020 to 125000 Hz" in later.to_html()

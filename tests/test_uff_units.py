@@ -301,3 +301,71 @@ def test_records_written_by_the_project_carry_their_unit_exponents(tmp_path, dof
     back = read_uff(tmp_path / "ours.uff")
     assert back.quantity == quantity and back.outputs == labels[0] and back.inputs == labels[1]
     np.testing.assert_allclose(back.data, frf.data, rtol=1e-11)
+
+
+@pytest.mark.parametrize("label", ["dB", "dB g/N", "dB re 1 g/N"])
+@pytest.mark.parametrize("quantity", [None, "accelerance"])
+def test_ordinate_in_decibels_is_refused_even_with_the_quantity(tmp_path, label, quantity):
+    """A magnitude in dB (its reference not in the file) was a raw pint error, or with the quantity given
+    read as linear values in SI units."""
+    hz = grid(start=10.0, n=20)
+    accelerance = -((2 * np.pi * hz) ** 2) * receptance(hz)
+    (tmp_path / "db.uff").write_text(record_58(accelerance, x0=10.0, num=(12, 1, 0, label)), encoding="ascii")
+    with pytest.raises(FileFormatError, match=r"db\.uff, type-58 record 0: .*decibels"):
+        read_uff(tmp_path / "db.uff", quantity=quantity)
+
+
+@pytest.mark.parametrize("label", ["%", "deg", "1", "V/V", "dB", "dB g/N"])
+def test_abscissa_labelled_with_a_ratio_is_not_taken_for_hz(tmp_path, label):
+    """An abscissa whose unit is a ratio, an angle or a percentage was read as Hz."""
+    hz = grid(start=10.0, n=20)
+    (tmp_path / "x.uff").write_text(record_58(receptance(hz), x0=10.0, num=(8, 1, 0, "m"), abscissa=(18, label)),
+                                    encoding="ascii")
+    with pytest.raises(FileFormatError, match=r"x\.uff, type-58 record 0: .*abscissa"):
+        read_uff(tmp_path / "x.uff")
+
+
+@pytest.mark.parametrize("rsp, response, kind", [
+    ((1, 3), "tool.tip:theta", "translation"),   # a Z sensor taken for a rotation
+    ((1, 6), "tool.tip", "rotation"),             # a rotation (+Z) taken for y
+    ((1, -4), "tool.tip:y", "rotation"),
+])
+def test_record_direction_of_another_kind_than_the_tables_dof_is_refused(tmp_path, rsp, response, kind):
+    """Records of other programs are taken for the table's points; a rotation read as y (or a translation as
+    theta) went through silently."""
+    hz = grid(start=10.0, n=20)
+    accelerance = -((2 * np.pi * hz) ** 2) * receptance(hz)
+    (tmp_path / "d.uff").write_text(record_58(accelerance, x0=10.0, num=(12, 0, 0, "NONE"), den=(13, 0, 1, "NONE"),
+                                              rsp=rsp), encoding="ascii")
+    path = measurement_set(tmp_path, "d.uff")
+    text = path.read_text(encoding="utf-8").replace('response = "tool.tip"', f'response = "{response}"')
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(FileFormatError, match=rf"frf\[0\]\.response: .*d\.uff, type-58 record 0: its response is "
+                                              rf"a {kind} \(direction code {abs(rsp[1])}\)"):
+        load_measurements(path)
+
+
+def test_record_direction_of_the_tables_kind_is_read(tmp_path):
+    """A translation in any axis (here -Z) is the table's y, the sign of the data turned."""
+    hz = grid(start=10.0, n=20)
+    accelerance = -((2 * np.pi * hz) ** 2) * receptance(hz)
+    (tmp_path / "d.uff").write_text(record_58(accelerance, x0=10.0, num=(12, 1, 0, "m/s^2"), rsp=(1, -3)),
+                                    encoding="ascii")
+    measurement, _ = read_set(measurement_set(tmp_path, "d.uff"))
+    np.testing.assert_allclose(measurement.frf.data[:, 0, 0], -receptance(hz), rtol=SINGLE)
+
+
+def test_a_file_of_spectra_and_an_frf_read_whole_names_the_frfs_index(tmp_path):
+    """An analyser's export, auto spectrum then FRF: read without the record, the error said to export the FRFs
+    again, though the file holds one."""
+    hz = grid(start=10.0, n=20)
+    accelerance = -((2 * np.pi * hz) ** 2) * receptance(hz)
+    (tmp_path / "test.uff").write_text(record_58(np.abs(accelerance) ** 2 + 0j, x0=10.0, func=2)
+                                       + record_58(accelerance, x0=10.0, num=(12, 1, 0, "m/s^2")), encoding="ascii")
+    with pytest.raises(FileFormatError, match=r"record 0: an auto spectrum .*; the file's FRFs are type-58 "
+                                              r"record\(s\) 1: give the index of the one meant \(record = 1"):
+        read_uff(tmp_path / "test.uff")
+    with pytest.raises(FileFormatError, match=r"frf\[0\]\.file: .*record = 1 in the measurement set"):
+        load_measurements(measurement_set(tmp_path, "test.uff"))
+    frf, _ = read_set(measurement_set(tmp_path, "test.uff", record=1))
+    assert_receptance(frf.frf)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import warnings
 from pathlib import Path
 from typing import Any
@@ -37,6 +38,7 @@ _FRF_KEYS = ("response", "excitation", "file", "record", "quantity", "sensors", 
              "force_window_s", "estimator", "coherence_record")
 _REQUIRED = ("response", "excitation", "file")
 _CSV = (".csv",)
+_FOREIGN_LABEL = re.compile(r"^node(?P<node>-?\d+):(?:(?P<dof>y|theta)|dir(?P<code>\d+))$")  # uff_units._label
 _UFF = (".uff", ".unv")
 
 
@@ -214,8 +216,9 @@ class _Reader:
         for label in (frf.outputs[0], frf.inputs[0]):
             try:
                 stored.append(dof_label(label))
-            except SubstructureError:
-                return frf.with_labels((response,), (excitation,))  # labels of another program: not comparable
+            except SubstructureError:  # labels of another program: their nodes are not the set's points
+                self.check_directions(index, path, record, frf, response, excitation)
+                return frf.with_labels((response,), (excitation,))
         if stored != [response, excitation]:
             raise self.error(
                 index, "record" if record is not None else "file",
@@ -223,6 +226,27 @@ class _Reader:
                 f"{stored[1]}, not {response} / {excitation} as this table says; check the record index (0-based)",
             )
         return frf.with_labels((response,), (excitation,))
+
+    def check_directions(self, index: int, path: Path, record: int | None, frf: FRF, response: str,
+                         excitation: str) -> None:
+        """A record of another program (``node<N>:<dof>``) is taken for the table's points, but its direction
+        codes must be of the same kind as the table's DOFs: a translation (1-3) for ``y``, a rotation (4-6) for
+        ``theta``; direction 0 (a scalar) says nothing."""
+        for key, label, point in (("response", frf.outputs[0], response), ("excitation", frf.inputs[0], excitation)):
+            match = _FOREIGN_LABEL.match(label)
+            if match is None:
+                continue
+            code = 2 if match["dof"] == "y" else 6 if match["dof"] == "theta" else int(match["code"])
+            if code not in range(1, 7):
+                continue
+            kind, wanted = ("a rotation" if code > 3 else "a translation",
+                            "a rotation" if point.endswith(":theta") else "a translation")
+            if kind != wanted:
+                raise self.error(
+                    index, "record" if record is not None else key,
+                    f"{path}, type-58 record {record or 0}: its {'reference' if key == 'excitation' else key} is "
+                    f"{kind} (direction code {code}) at node {match['node']}, but this table's {key} {point} is "
+                    f"{wanted}; check the record index (0-based) or the {key}'s DOF (:y or :theta)")
 
     # -- the file, top down ----------------------------------------------------
     def measurement_set(self, data: dict, cls: Any) -> Any:
@@ -279,6 +303,10 @@ class _Reader:
             raise self.error(index, "force_window_s", f"missing; {file} has a force_noise column, correlated over "
                                                       "1 / force_window_s hertz (the force window's length in s)")
         if raw.frequency.hz[0] == 0.0:
+            if raw.frequency.n < 3:
+                raise self.error(index, "file", f"{self.base_dir / file}: {raw.frequency.n} frequency lines, the first "
+                                 "at 0 Hz, which is dropped (no receptance there); an FRF needs at least 2 lines "
+                                 "besides it")
             why = ("the model has no receptance at 0 Hz (its free-free components have no static receptance), so "
                    "identify and diagnose cannot compare it" if raw.quantity == "receptance" else
                    f"{'an' if raw.quantity[0] in 'aeiou' else 'a'} {raw.quantity} has no receptance at 0 Hz")
@@ -321,7 +349,8 @@ class _Reader:
                     "(same sensors and removed components); keep one",
                 )
             seen[key] = i
-            source = (os.path.realpath(self.base_dir / m.file), m.record or 0)
+            found = os.stat(self.base_dir / m.file)  # the file itself: links, hard links, a name in other case
+            source = (found.st_dev, found.st_ino, m.record or 0)
             if source in sources:
                 j = sources[source]
                 raise self.error(

@@ -24,7 +24,7 @@ from typing import Any, Callable, Sequence
 import attrs
 import numpy as np
 
-from ..errors import InvalidValueError, SubstructureError
+from ..errors import InvalidValueError, SubstructureError, SubstructureWarning
 from ._variants import _cutting, _joint_band, _lobes, _structure
 from .text import _number
 
@@ -385,6 +385,25 @@ def _joints_to_identify(assembly: Any, identify: Any) -> list[str]:
     return names
 
 
+def _tests_outside_the_grid(tests: Any, grid: Any, notes: list[str]) -> None:
+    """Say (a warning and a note) when the tap tests' lines and the model's grid do not overlap at all.
+
+    The tool point receptance, its modes and the lobes are on the model's grid, the diagnosis and the
+    identification on the tests' lines: without a line in common the page shows the two on different bands,
+    most often a frequency unit mistaken (kHz for Hz) or a grid or file that is not the one meant.
+    """
+    lo, hi = float(tests.hz[0]), float(tests.hz[-1])
+    first, last = float(grid.hz[0]), float(grid.hz[-1])
+    if lo <= last and hi >= first:
+        return
+    text = (f"the tap tests ({lo:.6g} to {hi:.6g} Hz) lie outside the model's frequency grid ({first:.6g} to "
+            f"{last:.6g} Hz, the assembly file's [frequency]): the tool point receptance, its modes and the lobes "
+            "are on the model's grid, the diagnosis and the joints on the tests' lines; check the tests' frequency "
+            "unit, or the grid")
+    warnings.warn(text, SubstructureWarning, stacklevel=3)
+    notes.append(text)
+
+
 def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any = None, *, at: str | None = None,
            speeds: Any = None, band: Any = "auto", method: str = "zoa", intervals: int | None = None,
            margin: float = 0.2, speed_tolerance: float = 0.03, identify: Any = "auto", title: str | None = None,
@@ -495,6 +514,8 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
     if measurements is not None:
         measurements.validate(assembly)  # every point, sensor and component it names: before any work
     notes = list(notes)
+    if measurements is not None:
+        _tests_outside_the_grid(measurements.frequency, assembly.frequency, notes)
     say(f"tool point receptance at {at}")
     frf = assembly.receptance(at, frequency=assembly.frequency)
     structure, chosen = _structure(assembly, at, band, frf)

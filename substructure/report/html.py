@@ -325,7 +325,7 @@ def _diagnosis(report: Any) -> str:
     out = [f'<p class="verdict {kind}">{esc(sentence)}</p>']
     n = len(report.measurements) if report.measurements is not None else 0
     band = data.get("band_hz") or [None, None]
-    out.append(f"<p>{n} measured FRF(s), compared from {fixed(band[0], '.4g')} to {fixed(band[1], '.5g')} Hz. "
+    out.append(f"<p>{n} measured FRF(s), compared from {fixed(band[0], '.6g')} to {fixed(band[1], '.6g')} Hz. "
                f"The model as given is off by {sci(data.get('baseline_error'))}; the test's own scatter (noise floor) "
                f"is {sci(floor)}; with what the diagnosis added, the model is off by {sci(data.get('final_error'))}"
                + (f" ({float(data['final_error']) / float(floor):.2g} × the noise floor)"
@@ -537,7 +537,7 @@ def _joints(report: Any) -> str:
         out.append(provenance_note(j, _provenances(report)))
         if ident is not None:
             lo, hi = ident.band
-            out.append(note(f"Identified over {lo:.5g}–{hi:.5g} Hz from every FRF measured with the joint in place; "
+            out.append(note(f"Identified over {lo:.6g}–{hi:.6g} Hz from every FRF measured with the joint in place; "
                             f"relative residual {ident.residual_rms:.3g}. "
                             + tech("band fit of constant k and c, standard deviations from the Jacobian")))
             for w in ident.warnings:

@@ -25,17 +25,17 @@ import numpy as np
 from ...errors import FileFormatError
 from ...units import bare_unit
 from ._common import _contradiction, _shown
-from .uff_units import _TIME_EXPONENT, _exponents, _unit_of_label
+from .uff_units import _TIME_EXPONENT, _exponents, _frequency_unit, _unit_of_label
 
 __all__ = ["parse_export"]
 
-_NAMES = {
-    "frequency": {"frequency", "freq", "f", "frequencyhz", "freqhz", "frequencies"},
-    "real": {"real", "re", "realpart"},
-    "imag": {"imag", "im", "imaginary", "imagpart", "imaginarypart"},
-    "magnitude": {"magnitude", "mag", "amplitude", "abs", "modulus"},
-    "phase": {"phase", "angle", "arg"},
-    "coherence": {"coherence", "coh", "gamma2", "gamma^2", "γ2", "γ²", "ordinarycoherence"},
+_NAMES = {  # English, and German as German programs export them (Frequenz, Realteil, Betrag, Kohärenz)
+    "frequency": {"frequency", "freq", "f", "frequencyhz", "freqhz", "frequencies", "frequenz"},
+    "real": {"real", "re", "realpart", "realteil"},
+    "imag": {"imag", "im", "imaginary", "imagpart", "imaginarypart", "imaginärteil", "imaginaerteil", "imagteil"},
+    "magnitude": {"magnitude", "mag", "amplitude", "abs", "modulus", "betrag"},
+    "phase": {"phase", "angle", "arg", "winkel", "phasenwinkel"},
+    "coherence": {"coherence", "coh", "gamma2", "gamma^2", "γ2", "γ²", "ordinarycoherence", "kohärenz", "kohaerenz"},
 }
 _COHERENCE_UNITS = {None: 1.0, "-": 1.0, "1": 1.0, "": 1.0, "%": 0.01}
 _HEADER = re.compile(r"^\s*(?P<name>[^\[\(]*?)\s*(?:[\[\(](?P<unit>.*)[\]\)])?\s*$")
@@ -55,7 +55,7 @@ def _column(cell: str, name: str, line: int) -> tuple[str, str | None]:
         if key in names:
             return kind, unit
     # a name of several words, one of them the column's kind: 'FRF Real', 'H1 Imag', 'Coherence H1'
-    tokens = set(re.split(r"[^0-9a-zγ²^]+", raw.lower())) - {""}
+    tokens = set(re.split(r"[^0-9a-zäγ²^]+", raw.lower())) - {""}
     if "db" not in tokens:
         found = {kind for kind, names in _NAMES.items() if tokens & names}
         if len(found) == 1:
@@ -78,6 +78,18 @@ def _is_number(cell: str) -> bool:
     return True
 
 
+def _same_unit(a: str, b: str) -> bool:
+    """Whether two unit texts (a header's and a units row's) are the same unit, written alike or not."""
+    if a.replace(" ", "") == b.replace(" ", ""):
+        return True
+    try:
+        qa, qb = _unit_of_label(a), _unit_of_label(b)
+    except ValueError:
+        return False
+    return qa is not None and qb is not None and qa.dimensionality == qb.dimensionality and \
+        abs(float((qa / qb).to_base_units().magnitude) - 1.0) < 1e-12
+
+
 def _value_unit(unit: str | None, cell: str, name: str, line: int):
     """``(quantity, factor to SI)`` of a value column's unit; ``(None, 1)`` without one."""
     if unit is None:
@@ -96,6 +108,25 @@ def _value_unit(unit: str | None, cell: str, name: str, line: int):
                               "receptance, mobility or accelerance (e.g. m/N, mm/N, um/N, (m/s^2)/N, g/N)")
     assert q is not None and exps is not None  # kind is found only for a unit read
     return kind, float(q.m_as(f"meter / newton * second ** {exps[2]}"))
+
+
+def _header_below(rows: list[tuple[int, str]], name: str) -> tuple[int, str] | None:
+    """The first of ``rows`` that reads as a table's header (a frequency column first, every cell a column's
+    name), as when a block of metadata lines without ``#`` comes before the table; None without one."""
+    for number, line in rows:
+        delimiter = ";" if ";" in line else "\t" if "\t" in line else ","
+        cells = [c.strip() for c in next(csv.reader([line], delimiter=delimiter))]
+        while cells and cells[-1] == "":
+            cells.pop()
+        if len(cells) < 3:
+            continue
+        try:
+            kinds = [_column(c, name, number)[0] for c in cells]
+        except FileFormatError:
+            continue
+        if kinds[0] == "frequency":
+            return number, line
+    return None
 
 
 def parse_export(numbered: list[tuple[int, str]], name: str, quantity: str | None):
@@ -131,7 +162,7 @@ def parse_export(numbered: list[tuple[int, str]], name: str, quantity: str | Non
 
 def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None):
     """:func:`parse_export`, and the coherence column's values in [0, 1] (None without one) as a fourth item."""
-    from ...units import cycles_per_second, ureg
+    from ...units import cycles_per_second
 
     rows = [(n, line) for n, line in numbered if not line.lstrip().startswith("#")]
     if not rows:
@@ -151,10 +182,23 @@ def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None
     for row in cells:
         while row and row[-1] == "":  # an empty trailing column (a spreadsheet's last separator)
             row.pop()
-    columns = [_column(c, name, first) for c in cells[0]]
+    try:
+        columns = [_column(c, name, first) for c in cells[0]]
+    except FileFormatError:
+        below = _header_below(rows[1:51], name)
+        if below is None:
+            raise
+        raise FileFormatError(f"{name}, line {first}: {_shown(header)} is not the table's header, line {below[0]} "
+                              f"({_shown(below[1])}) is: start the lines above it with '#' (comment lines, such as "
+                              "an export's date or channel names, are skipped)") from None
     if len(cells) > 1 and cells[1] and not any(_is_number(c) for c in cells[1]):
         # a row of units under the names (an empty cell: no unit), as acquisition programs export them
         units = cells[1] + [""] * (len(columns) - len(cells[1]))
+        for (_, unit), u, cell in zip(columns, units, cells[0]):
+            if unit is not None and bare_unit(u) is not None and not _same_unit(unit, bare_unit(u)):
+                raise FileFormatError(f"{name}, line {rows[1][0]}: column {_shown(cell)}: the units row says "
+                                      f"{_shown(bare_unit(u))} but the header {_shown(unit)}; give the unit once, "
+                                      "or correct the one that is wrong")
         columns = [(kind, unit if unit is not None else bare_unit(u)) for (kind, unit), u in zip(columns, units)]
         cells, rows = [cells[0]] + cells[2:], [rows[0]] + rows[2:]
     kinds = [k for k, _ in columns]
@@ -172,10 +216,10 @@ def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None
     if columns[0][1] is None:
         raise FileFormatError(f"{name}, line {first}: column {_shown(fcell)} has no unit; name it frequency_hz or give "
                               "the unit, e.g. 'Frequency [Hz]'")
-    try:
-        funit = ureg.Quantity(1.0, columns[0][1].replace("HZ", "Hz"))
-        ok = funit.check("1 / [time]")
-    except Exception:
+    try:  # as a universal file's abscissa: capitals (HZ, KHZ, RPM) read, MHZ (mHz or MHz?) not
+        funit = _frequency_unit(columns[0][1])
+        ok = funit is not None and funit.check("1 / [time]")
+    except ValueError:
         ok = False
     if not ok:
         raise FileFormatError(f"{name}, line {first}: column {_shown(fcell)}: {_shown(columns[0][1])} is not a "
@@ -217,6 +261,11 @@ def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None
                     raise FileFormatError(f"{name}, line {n}: {_shown(column)} is {_shown(cell)}; "
                                           "expected a number") from None
         raise  # pragma: no cover - numpy and float() disagree on a cell
+    if angle == 1.0 and (np.abs(table[:, 2]) > 2 * np.pi + 1e-9).any():
+        k = int(np.argmax(np.abs(table[:, 2]) > 2 * np.pi + 1e-9))
+        raise FileFormatError(f"{name}, line {lines[k]}: {cells[0][2]} is {_shown(data[k][2])}, beyond 2 pi: degrees "
+                              "labelled rad? Label the column 'Phase [deg]' if so; a phase in rad is read within "
+                              "[-2 pi, 2 pi] (wrap an unwrapped phase, or give it in degrees)")
     if angle is not None and (table[:, 1] < 0).any():
         k = int(np.argmax(table[:, 1] < 0))
         raise FileFormatError(f"{name}, line {lines[k]}: {cells[0][1]} is {_shown(data[k][1])}; a magnitude is >= 0 (a "
@@ -229,6 +278,10 @@ def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None
             k = int(np.argmax(bad))
             raise FileFormatError(f"{name}, line {lines[k]}: {cells[0][3]} is {_shown(data[k][3])}; expected a "
                                   f"coherence in [0, 1]{' (0 to 100 %)' if gamma_factor != 1.0 else ''}")
+        if gamma_factor != 1.0 and np.nanmax(table[:, 3]) <= 1.0:
+            raise FileFormatError(f"{name}, line {first}: column {_shown(cells[0][3])} is in %, but no line holds more "
+                                  f"than {float(np.nanmax(table[:, 3]))!r} (%): fractions in [0, 1] labelled %? Give "
+                                  "the column without a unit if so")
         coherence = np.minimum(coherence, 1.0)
         table = table[:, :3].copy()
     with np.errstate(over="ignore", invalid="ignore"):

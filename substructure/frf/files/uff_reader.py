@@ -26,15 +26,41 @@ from .uff_units import _FUNCTION_TYPES, _a, _abscissa_hz, _label, _record_quanti
 __all__ = ["read_uff", "read_uff_coherence"]
 
 
+def _is_frf(dset: dict) -> bool:
+    """Whether a type-58 record is a frequency response function (type 4, or "general" over a force)."""
+    function = int(dset.get("func_type", -1))
+    return function == 4 or (function == 0 and int(dset.get("orddenom_spec_data_type", 0) or 0) == 13)
+
+
+def _frfs_beside(uff, positions: list[int], number: int, dset: dict) -> list[int]:
+    """Reading every record, the indices of the FRFs in a file whose record ``number`` is none (an auto spectrum,
+    a coherence), as analysers export a test: the error then names the FRFs' indices to give. Empty when the
+    record is an FRF, or when the file holds no FRF at all."""
+    if _is_frf(dset) or len(positions) < 2:
+        return []
+    frfs = []
+    for k, position in enumerate(positions):
+        try:
+            other = dset if k == number else uff.read_sets(position)
+        except Exception:  # pyuff raises bare Exception; the record is read (and refused) on its own turn
+            return []
+        if _is_frf(other):
+            frfs.append(k)
+    return frfs
+
+
 def _parse_record(dset: dict, name: str, number: int, quantity: str | None,
-                  system: tuple[float, float] | None = None) -> tuple:
+                  system: tuple[float, float] | None = None, frfs: list[int] | None = None) -> tuple:
     where = f"{name}, type-58 record {number}"
     function = int(dset.get("func_type", -1))
     if function not in (0, 4) or (function == 0 and int(dset.get("orddenom_spec_data_type", 0) or 0) != 13):
         kind = _FUNCTION_TYPES.get(function, f"function type {function}")
         hint = ("; a coherence beside its FRF is read with it: give the FRF's index as record = N and this one "
                 "as coherence_record = M in the measurement set" if function == 6 else
-                "; export the FRFs (H1 or H2) from the acquisition software")
+                "; export the FRFs (H1 or H2) from the acquisition software" if not frfs else "")
+        if frfs:  # the file holds FRFs beside it: the one meant is to be named
+            hint += (f"; the file's FRFs are type-58 record(s) {', '.join(map(str, frfs))}: give the index of the one "
+                     f"meant (record = {frfs[0]} in the measurement set, read_uff(..., record={frfs[0]}))")
         raise FileFormatError(
             f"{where}: {_a(kind)} (function type {function}), not a frequency response function (type 4){hint}"
         )
@@ -253,7 +279,8 @@ def read_uff(path: str | os.PathLike, record: int | None = None, quantity: str |
             raise
         except Exception as exc:  # pyuff raises bare Exception
             raise FileFormatError(f"{name}, type-58 record {number}: cannot read it ({exc})") from None
-        parsed.append((number, *_parse_record(dset, name, number, quantity, system)))
+        frfs = _frfs_beside(uff, positions, number, dset) if record is None else []
+        parsed.append((number, *_parse_record(dset, name, number, quantity, system, frfs)))
     if len(parsed) == 1:
         _, frequency, data, output, input_, kind = parsed[0]
         return frf_class().single(frequency, data, output=output, input=input_, quantity=kind)

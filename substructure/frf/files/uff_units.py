@@ -53,6 +53,12 @@ def _a(word: str) -> str:
 
 
 _UNREADABLE = re.compile(r"[\ufffd\x00-\x1f\x7f-\x9f]")
+_DECIBEL = re.compile(r"(?i)\bdb|decibel|neper")
+
+
+class DecibelLabel(ValueError):
+    """A unit label in decibels (``dB``, ``dB g/N``): a logarithm of a ratio whose reference the file does not
+    give, never read as linear values."""
 
 
 def _unit_of_label(label: Any):
@@ -72,7 +78,17 @@ def _unit_of_label(label: Any):
         return None
     if _UNREADABLE.search(text):  # a byte that is no character (U+FFFD), a control character
         raise ValueError(text)
-    return ureg.Quantity(1.0, instrument_unit(text))
+    if _DECIBEL.search(text):
+        raise DecibelLabel(text)
+    try:
+        q = ureg.Quantity(1.0, instrument_unit(text))
+        q.dimensionality  # noqa: B018 - pint fails here on a logarithmic unit in a product
+        linear = q._is_multiplicative  # offset units (degC) are not a scale
+    except Exception:  # pint raises its own errors, AttributeError among them
+        raise ValueError(text) from None
+    if not linear:
+        raise ValueError(text)
+    return q
 
 
 def _exponents(q) -> tuple[int, int, int] | None:
@@ -87,6 +103,10 @@ def _exponents(q) -> tuple[int, int, int] | None:
     return m, n - m, t + 2 * m  # M^m L^n T^t = F^m L^(n-m) T^(t+2m)
 
 
+class DecibelRecord(FileFormatError):
+    """A record whose ordinate is labelled in decibels: refused even when the quantity is given."""
+
+
 def _frf_unit(dset: dict, where: str):
     """The FRF unit its labels give (a pint Quantity of 1 per force), None without labels.
 
@@ -99,6 +119,12 @@ def _frf_unit(dset: dict, where: str):
     for key in ("ordinate_axis_units_lab", "orddenom_axis_units_lab"):
         try:
             labels[key] = _unit_of_label(dset.get(key))
+        except DecibelLabel as exc:
+            raise DecibelRecord(
+                f"{where}: the unit label {str(exc)!r} ({key.split('_')[0]}) is in decibels, a logarithm whose "
+                "reference the file does not give; export the FRF as real and imaginary parts (or magnitude and "
+                "phase) in linear units such as m/N or g/N"
+            ) from None
         except ValueError as exc:
             raise FileFormatError(
                 f"{where}: cannot read the unit label {str(exc)!r} ({key.split('_')[0]}); give the quantity "
@@ -152,8 +178,8 @@ def _record_quantity(dset: dict, where: str, given: str | None, system: tuple[fl
     ours = ours if ours in QUANTITIES else None
     try:
         unit = _frf_unit(dset, where)
-    except FileFormatError:
-        if given is None:
+    except FileFormatError as exc:
+        if given is None or isinstance(exc, DecibelRecord):  # values in dB are never read as linear ones
             raise
         unit = None  # the user says what it is: the unreadable label is left aside
     by_label, label_factor = None, None
@@ -221,6 +247,15 @@ def _unit_system(dset: dict, name: str) -> tuple[float, float] | None:
     return None if length == 1.0 and force == 1.0 else (length, force)
 
 
+def _frequency_unit(label: str):
+    """:func:`_unit_of_label` of a frequency axis's label, also in capitals (``HZ``, ``KHZ``, ``RPM``, ``RAD/S``:
+    read in lower case; ``MHZ``, mHz or MHz, is unreadable)."""
+    try:
+        return _unit_of_label(label)
+    except ValueError:
+        return _unit_of_label({"hz": "Hz", "khz": "kHz"}.get(label.lower(), label.lower()))
+
+
 def _abscissa_hz(dset: dict, where: str) -> np.ndarray:
     """The abscissa in Hz: a frequency axis (a label in rad/s is divided by 2 pi); time or orders refused."""
     from ...units import cycles_per_second
@@ -234,20 +269,18 @@ def _abscissa_hz(dset: dict, where: str) -> np.ndarray:
     hz = np.asarray(dset["x"], dtype=np.float64)
     label = str(dset.get("abscissa_axis_units_lab") or "").strip()
     try:
-        unit = _unit_of_label(label)
+        unit = _frequency_unit(label)
     except ValueError:
-        try:  # labels in capitals: "HZ", "RPM", "RAD/S"
-            unit = _unit_of_label({"hz": "Hz", "khz": "kHz"}.get(label.lower(), label.lower()))
-        except ValueError:
-            raise FileFormatError(
-                f"{where}: cannot read the abscissa's unit label {label!r}; expected a frequency unit "
-                "(Hz, rad/s, rpm): convert the file, or export it with the frequency axis in Hz"
-            ) from None
+        raise FileFormatError(
+            f"{where}: cannot read the abscissa's unit label {label!r}; expected a frequency unit "
+            "(Hz, rad/s, rpm): convert the file, or export it with the frequency axis in Hz"
+        ) from None
     if unit is not None and unit.check("1 / [time]"):
         hz = np.asarray(cycles_per_second(hz * unit, "abscissa"), dtype=np.float64)
-    elif unit is not None and not unit.dimensionless:
+    elif unit is not None:  # a length, a time; or a ratio, an angle, a percentage: never taken as Hz
         raise FileFormatError(
-            f"{where}: the abscissa's unit is {dset.get('abscissa_axis_units_lab')!r}, not a frequency"
+            f"{where}: the abscissa's unit is {dset.get('abscissa_axis_units_lab')!r}, not a frequency (Hz, kHz, "
+            "rad/s, rpm)"
         )
     return hz
 
