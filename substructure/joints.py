@@ -180,8 +180,8 @@ def _point(value) -> str:
 
 
 def _between(value) -> tuple[str, str]:
-    if isinstance(value, str) or len(value) != 2:
-        raise InvalidValueError(f"between: got {value!r}; expected two point names")
+    if isinstance(value, (str, bytes)) or not isinstance(value, (tuple, list)) or len(value) != 2:
+        raise InvalidValueError(f"between: got {value!r}; expected two point names (a tuple or a list)")
     a, b = (_point(v) for v in value)
     if a == b:
         raise InvalidValueError(f"between: got the same point twice ({a})")

@@ -34,3 +34,34 @@ def test_a_comma_in_a_plain_number_is_refused_too():
         Material("x", "210 GPa", 0.3, "7850 kg/m^3", loss_factor="0,002")
     with pytest.raises(InvalidValueError, match=r"flutes.diameter_ratio: cannot read '0,8': a comma"):
         Flutes("0,8")
+
+
+@pytest.mark.parametrize("between", [None, 5, (p for p in ("a.tip", "b.base")), "a.tip"])
+def test_a_joint_between_that_is_not_two_points_is_named(between):
+    """None, a number or a generator gave a raw TypeError (object has no len())."""
+    with pytest.raises(InvalidValueError, match=r"between: got .*; expected two point names"):
+        Joint("j", between, k={"yf": "1e7 N/m"})
+
+
+def test_a_material_name_that_is_not_a_text():
+    """A list gave a raw TypeError (unhashable type)."""
+    with pytest.raises(InvalidValueError, match=r"material: got \[\]; expected the name of a material"):
+        get_material([])
+
+
+def test_a_helix_in_percent_is_not_taken_as_radians():
+    """'30 %' is the number 0.3, which was read as 0.3 rad: a helix of 17.2 deg."""
+    with pytest.raises(UnitError, match=r"helix: got '30 %'; expected an angle"):
+        Tool.end_mill("12 mm", "50 mm", "30 mm", helix="30 %")
+    assert Tool.end_mill("12 mm", "50 mm", "30 mm", helix="0.5 rad").helix.m_as("rad") == pytest.approx(0.5)
+
+
+@pytest.mark.parametrize("args, message", [
+    (("-12 mm", "50 mm", "30 mm"), r"diameter: got '-12 mm'; expected a positive length"),
+    (("12 mm", "-50 mm"), r"overhang: got '-50 mm'; expected a positive length"),
+    (("12 mm", "50 mm", "-30 mm"), r"flute_length: got '-30 mm'; expected a length >= 0"),
+])
+def test_end_mill_names_its_own_arguments(args, message):
+    """A negative flute length was refused as 'length: got <Quantity(-30, 'millimeter')>'."""
+    with pytest.raises(InvalidValueError, match=message):
+        Tool.end_mill(*args)
