@@ -31,6 +31,7 @@ import numpy as np
 from .assembly import Assembly, expand_points
 from .beams import stepped_beam_receptance_batch
 from .components import is_plain_beam, receptances
+from .components.beam import check_reach
 from .coupling import Link, couple_substructures
 from .errors import InvalidValueError
 from .frf import FRF, Frequency
@@ -202,6 +203,8 @@ def sweep(
             if all_beams[gi] and all(
                 r.where in ("base", "tip") for r in refs0[gi]
             ) and len({len(owners[c].segments) for c in chunk}) == 1:
+                for c in chunk:  # what Beam.receptance_matrix checks, for the batched kernel
+                    check_reach(owners[c], f)
                 y = stepped_beam_receptance_batch(
                     [owners[c].segments for c in chunk], [r.where for r in refs0[gi]], f
                 )

@@ -65,3 +65,26 @@ def test_end_mill_names_its_own_arguments(args, message):
     """A negative flute length was refused as 'length: got <Quantity(-30, 'millimeter')>'."""
     with pytest.raises(InvalidValueError, match=message):
         Tool.end_mill(*args)
+
+
+@pytest.mark.parametrize("frequency", [True, ["500", "1000"], [np.True_]])
+def test_booleans_and_texts_are_not_frequencies(frequency):
+    """True was 1 Hz, and ['500', '1000'] 500 and 1000 Hz, while '500 Hz' was refused."""
+    with pytest.raises(InvalidValueError, match=r"frequency: got .*; expected a Frequency"):
+        default_assembly().receptance("tool.tip:y", frequency=frequency)
+
+
+def test_a_frequency_far_beyond_the_beam_model_is_refused_before_the_memory_goes():
+    """A line at 3e7 Hz cut the spindle into some 3000 pieces (0.5 GB, 1 s); at 1e8 Hz 4 GB and a
+    MemoryError, at 1e12 Hz 15 GB: a frequency in the wrong unit took the machine down."""
+    d = default_assembly()
+    with pytest.raises(InvalidValueError, match=r"frequency: got a line at 3e\+07 Hz, where component 'spindle' "
+                                                r"would be cut into about .* pieces"):
+        d.receptance("tool.tip:y", frequency=[500.0, 3e7])
+    with pytest.raises(InvalidValueError, match=r"component 'tool' would be cut"):
+        d.component("tool").receptance([1e12])
+    rods = [Assembly("rod", components=(Tool("rod", [Segment(f"{L} m", "12 mm", material="carbide")]),))
+            for L in (5, 5.1)]  # some 3000 pieces at 3 MHz
+    with pytest.raises(InvalidValueError, match=r"component 'rod' would be cut"):  # the batched beams too
+        sweep(rods, "rod.tip:y", frequency=[3e6])
+    assert np.isfinite(d.receptance("tool.tip:y", frequency=[1e5]).data).all()   # a fast tap test still works

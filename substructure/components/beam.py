@@ -48,6 +48,54 @@ def _text(field: str):
     return check
 
 
+MAX_BEAM_PIECES = 2000
+"""The most pieces a beam is cut into for one computation (at its highest frequency line).
+
+The exact beam receptances are a chain cut where its ``k L`` exceeds 8 (and
+a tapered segment into steps of ``k h <= 0.6``), ``k`` the largest
+wavenumber at the highest line.  Machine-tool parts need a few pieces up to
+tens of kHz; a line at 1e8 Hz (a frequency in the wrong unit) would need
+hundreds of thousands and gigabytes of memory, and is refused before.
+"""
+
+
+def check_reach(beam: Any, frequency_hz: np.ndarray) -> None:
+    """Refuse frequency lines so high that ``beam`` would be cut into more than :data:`MAX_BEAM_PIECES` pieces.
+
+    Parameters
+    ----------
+    beam : Beam
+        A component with ``segments`` (base to tip).
+    frequency_hz : ndarray
+        The frequency lines [Hz], finite and > 0.
+
+    Raises
+    ------
+    InvalidValueError
+        Naming the component, the highest line and the pieces it would need.
+    """
+    from .._chains import _CHUNK_KL, _phases
+    from ..tapers import TAPER_STEP_PHASE, _taper_sections
+
+    f_max = float(np.max(frequency_hz)) if np.size(frequency_hz) else 0.0
+    if f_max <= 0.0:
+        return
+    # k L of each segment at the highest line (of both end sections of a tapered one), in one kernel call
+    ends = [_taper_sections(s, np.array([0.0, 1.0])) if s.is_tapered else [s.section()] for s in beam.segments]
+    phases = iter(_phases([(sec, s.length_m) for s, e in zip(beam.segments, ends) for sec in e], 2.0 * np.pi * f_max))
+    pieces = 0.0
+    for s, e in zip(beam.segments, ends):
+        phase = max(next(phases) for _ in e)
+        pieces += phase / (TAPER_STEP_PHASE if s.is_tapered else _CHUNK_KL)
+    if pieces > MAX_BEAM_PIECES:
+        raise InvalidValueError(
+            f"frequency: got a line at {f_max:g} Hz, where component {beam.name!r} would be cut into about "
+            f"{pieces:.3g} pieces (its bending waves are that short), more than {MAX_BEAM_PIECES} "
+            "(components.beam.MAX_BEAM_PIECES); the beam model is meant for the vibrations of machine-tool parts, "
+            "up to some 100 kHz: check the unit of the frequencies (plain numbers are in Hz)"
+        )
+
+
 _BEAM_METHODS = ("receptance_matrix", "position")
 """Methods whose override makes a Beam subclass something else than its segments (plain_beam False)."""
 
@@ -200,6 +248,7 @@ class Beam:
         """
         f = np.asarray(frequency_hz, dtype=float)
         _positive_frequencies(f, f"component {self.name!r}")
+        check_reach(self, f)
         return stepped_beam_receptance(self.segments, [self.position(r) for r in refs], f, decay)
 
     def _ref(self, point: str) -> PointRef:

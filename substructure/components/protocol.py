@@ -101,7 +101,10 @@ def as_frequency(frequency) -> Frequency:
             "'5000 Hz', '2 Hz')) or an array of frequencies in Hz"
         )
     try:
-        hz = np.atleast_1d(np.asarray(frequency, dtype=float))
+        given = np.asarray(frequency)
+        if given.dtype.kind not in "iuf":  # booleans (True would be 1 Hz), texts ("500" without its unit)
+            raise TypeError
+        hz = np.atleast_1d(given.astype(float))
     except (TypeError, ValueError):
         raise InvalidValueError(
             f"frequency: got {frequency!r}; expected a Frequency (e.g. Frequency.from_range('20 Hz', '5000 Hz', "
