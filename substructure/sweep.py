@@ -23,7 +23,7 @@ Examples
 from __future__ import annotations
 
 import sys
-from typing import Sequence
+from typing import Iterable, Sequence
 
 import attrs
 import numpy as np
@@ -37,7 +37,15 @@ from .errors import InvalidValueError
 from .frf import FRF, Frequency
 from .joints import dynamic_stiffness
 
-__all__ = ["SweepResult", "sweep"]
+__all__ = ["SweepResult", "sweep", "MAX_SWEEP_VALUES"]
+
+MAX_SWEEP_VALUES = 100_000_000
+"""The most receptance values a sweep returns (1.6 GB of complex numbers), checked before any work."""
+
+
+def _show(value) -> str:
+    text = repr(value)
+    return f"an object of type {type(value).__name__}" if len(text) > 80 else text
 
 
 @attrs.frozen
@@ -122,14 +130,30 @@ def sweep(
         The receptances of every variant, shape ``(n_variants, n_freq, n_out, n_in)``
         (m/N, m/(N m), rad/N, rad/(N m)).
     """
+    if isinstance(assemblies, Assembly) or not isinstance(assemblies, Iterable):
+        raise InvalidValueError(f"sweep: got {_show(assemblies)}; expected a sequence of assemblies (a list: "
+                                "[assembly] for one)")
     assemblies = list(assemblies)
     if not assemblies:
         raise InvalidValueError("sweep: got no assemblies")
+    for i, a in enumerate(assemblies):
+        if not isinstance(a, Assembly):
+            raise InvalidValueError(f"sweep: variant {i} is {_show(a)}; expected an Assembly")
+    if isinstance(chunk_lines, bool) or not isinstance(chunk_lines, (int, np.integer)) or chunk_lines < 1:
+        raise InvalidValueError(f"chunk_lines: got {chunk_lines!r}; expected a whole number of lines >= 1")
     freq = assemblies[0]._frequency(frequency)
     f = freq.hz
     n_f = f.size
     out_labels, out_idx, out_refs = expand_points(outputs)
     in_labels, in_idx, in_refs = expand_points(outputs if inputs is None else inputs)
+    values = len(assemblies) * n_f * len(out_labels) * len(in_labels)
+    if values > MAX_SWEEP_VALUES:
+        raise InvalidValueError(
+            f"sweep: {len(assemblies)} variants x {n_f} lines x {len(out_labels)} x {len(in_labels)} DOFs would be "
+            f"{values:.3g} complex values ({values * 16 / 1e9:.3g} GB), more than {MAX_SWEEP_VALUES:.0e} "
+            "(sweep.MAX_SWEEP_VALUES): sweep fewer variants at a time, over fewer lines or DOFs, or run a study "
+            "(substructure study), which saves each result as it is computed"
+        )
     refs = out_refs + in_refs
     plans = [a._plan(refs) for a in assemblies]
     _check_structure(plans, assemblies)

@@ -88,3 +88,26 @@ def test_a_frequency_far_beyond_the_beam_model_is_refused_before_the_memory_goes
     with pytest.raises(InvalidValueError, match=r"component 'rod' would be cut"):  # the batched beams too
         sweep(rods, "rod.tip:y", frequency=[3e6])
     assert np.isfinite(d.receptance("tool.tip:y", frequency=[1e5]).data).all()   # a fast tap test still works
+
+
+def test_sweep_arguments_that_are_not_what_it_takes():
+    d = default_assembly()
+    with pytest.raises(InvalidValueError, match=r"sweep: variant 1 is 2; expected an Assembly"):
+        sweep([d, 2], "tool.tip:y", frequency=GRID)
+    with pytest.raises(InvalidValueError, match=r"sweep: got an object of type Assembly; expected a sequence of "
+                                                r"assemblies \(a list: \[assembly\] for one\)"):
+        sweep(d, "tool.tip:y", frequency=GRID)
+    for chunk in ("10", 1.5, 0, True):
+        with pytest.raises(InvalidValueError, match=r"chunk_lines: got .*; expected a whole number of lines >= 1"):
+            sweep([d], "tool.tip:y", frequency=GRID, chunk_lines=chunk)
+
+
+def test_a_sweep_too_large_for_memory_is_refused_before_any_work(monkeypatch):
+    """The result was allocated whole after every variant was planned: a million variants of 2491 lines
+    asked for 40 GB."""
+    monkeypatch.setattr(sys.modules["substructure.sweep"], "MAX_SWEEP_VALUES", 10)
+    d = default_assembly()
+    with pytest.raises(InvalidValueError, match=r"sweep: 3 variants x 2 lines x 2 x 2 DOFs would be 24 complex "
+                                                r"values .* more than 1e\+01"):
+        sweep([d, d, d], "tool.tip", frequency=GRID)
+    assert sweep([d, d], "tool.tip:y", frequency=GRID).data.shape == (2, 2, 1, 1)   # 4 values: below
