@@ -111,3 +111,23 @@ def test_a_sweep_too_large_for_memory_is_refused_before_any_work(monkeypatch):
                                                 r"values .* more than 1e\+01"):
         sweep([d, d, d], "tool.tip", frequency=GRID)
     assert sweep([d, d], "tool.tip:y", frequency=GRID).data.shape == (2, 2, 1, 1)   # 4 values: below
+
+
+def test_point_names_take_spaces_around_the_minus_as_around_the_rest():
+    """'tool .tip-5 mm' and 'tool.tip-5 mm ' were read, 'tool.tip -5 mm' and 'tool.tip - 5 mm' refused."""
+    for text in ("tool.tip - 5 mm", "tool.tip -5 mm", " tool . tip - 5mm:y"):
+        assert str(parse_point(text).point) == "tool.tip-5 mm"
+    d = default_assembly()
+    np.testing.assert_array_equal(d.receptance("tool.tip - 5 mm:y", frequency=GRID).data,
+                                  d.receptance("tool.tip-5 mm:y", frequency=GRID).data)
+
+
+@pytest.mark.parametrize("text, message", [
+    ("tool.tip-5 mm-3 mm", r"the distance '5 mm-3 mm' holds a sum or a difference"),   # was tool.tip-2 mm
+    ("tool@5 mm + 3 mm", r"the distance '5 mm \+ 3 mm' holds a sum or a difference"),   # was tool@8 mm
+    ("tool.tip:y:theta", r"more than one ':'; expected one DOF suffix"),
+])
+def test_point_names_that_were_computed_or_misread(text, message):
+    with pytest.raises(UnknownPointError, match=message):
+        parse_point(text)
+    assert str(parse_point("tool@1e-3 m")) == "tool@0.001 m"   # an exponent is not a difference
