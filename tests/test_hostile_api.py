@@ -131,3 +131,15 @@ def test_point_names_that_were_computed_or_misread(text, message):
     with pytest.raises(UnknownPointError, match=message):
         parse_point(text)
     assert str(parse_point("tool@1e-3 m")) == "tool@0.001 m"   # an exponent is not a difference
+
+
+def test_a_measured_component_with_labels_that_are_not_points_is_refused_where_it_is_made():
+    """Labels 'a', 'b' were accepted, and the assembly built from it failed on point 'a' without naming the
+    measured component."""
+    y = Tool.end_mill("12 mm", "50 mm").receptance(GRID, ["tip"])
+    with pytest.raises(InvalidValueError, match=r"frf: the label 'a:y' is not a point name with its DOF"):
+        MeasuredComponent("m", FRF(y.frequency, y.data, ("a:y", "a:theta"), ("a:y", "a:theta")))
+    with pytest.raises(InvalidValueError, match=r"frf: the label 'a' is not a point name"):
+        MeasuredComponent("m", FRF(y.frequency, y.data, ("a", "b"), ("a", "b")))
+    assert Assembly("x", components=(MeasuredComponent("m", y),)).receptance("tool.tip:y", frequency=GRID).shape \
+        == (2, 1, 1)
