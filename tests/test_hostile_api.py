@@ -8,11 +8,13 @@ from __future__ import annotations
 
 import sys
 
+import attrs
 import numpy as np
 import pytest
 
-from substructure import (Assembly, Flutes, Joint, Material, MeasuredComponent, Segment, Tool, UnitError,
-                          default_assembly)
+from substructure import (Assembly, Flutes, Frequency, Joint, Material, MeasuredComponent, Segment, Tool, UnitError,
+                          add_mass, decouple, default_assembly, remove_mass)
+from substructure.coupling import modify
 from substructure.errors import InvalidValueError, UnknownPointError
 from substructure.frf import FRF
 from substructure.materials import get_material
@@ -143,3 +145,54 @@ def test_a_measured_component_with_labels_that_are_not_points_is_refused_where_i
         MeasuredComponent("m", FRF(y.frequency, y.data, ("a", "b"), ("a", "b")))
     assert Assembly("x", components=(MeasuredComponent("m", y),)).receptance("tool.tip:y", frequency=GRID).shape \
         == (2, 1, 1)
+
+
+def _as(frf, quantity):
+    omega = frf.frequency.omega
+    factor = {"mobility": 1j * omega, "accelerance": -(omega**2)}[quantity]
+    return attrs.evolve(frf, data=frf.data * factor[:, None, None], quantity=quantity)
+
+
+@pytest.mark.parametrize("quantity", ["mobility", "accelerance"])
+def test_a_mass_added_to_a_mobility_or_an_accelerance_is_added_to_what_it_measures(quantity):
+    """The receptance formula ran on the accelerance's values: a 2 g sensor added to a tool tip accelerance gave
+    values 1e5 times too small, still labelled an accelerance."""
+    d = default_assembly()
+    h = d.receptance("tool.tip:y", frequency=GRID)
+    added = add_mass(_as(h, quantity), "tool.tip", "2 g")
+    assert added.quantity == quantity
+    np.testing.assert_allclose(added.to_receptance().data, add_mass(h, "tool.tip", "2 g").data, rtol=1e-12)
+    back = remove_mass(added, "tool.tip", "2 g")
+    np.testing.assert_allclose(back.to_receptance().data, h.data, rtol=1e-9)
+
+
+def test_decoupling_an_accelerance_and_on_the_rotation_alone():
+    """decouple took an accelerance as a receptance; and at an interface of theta alone it took the joint's
+    k_yf for its k_tm (here 0: the tool was not removed at all, 1.4 % off)."""
+    grid = Frequency.from_hz([500.0, 1000.0, 1500.0])
+    joint = Joint("holder-tool", ("holder.tip", "tool.base"), k={"tm": "8e4 N*m/rad"}, c={"tm": "4 N*m*s/rad"})
+    d = default_assembly().with_joint(joint)
+    expected = d.without("tool").frf(["holder.tip:theta"], frequency=grid)
+    removed = d.component("tool").receptance(grid, ["base"]).select(["tool.base:theta"], ["tool.base:theta"])
+    alone = decouple(d.frf(["holder.tip:theta"], frequency=grid), removed, [("holder.tip", "tool.base", joint)])
+    np.testing.assert_allclose(alone.data, expected.data, rtol=1e-9)
+    both = d.frf(["holder.tip"], frequency=grid)
+    alone = decouple(_as(both, "accelerance"), d.component("tool").receptance(grid, ["base"]),
+                     [("holder.tip", "tool.base", joint)])
+    assert alone.quantity == "accelerance"
+    np.testing.assert_allclose(alone.to_receptance().data, d.without("tool").frf(["holder.tip"], frequency=grid).data,
+                               rtol=1e-9)
+
+
+def test_modifications_that_gave_raw_errors_or_refused_a_spaced_point():
+    d = default_assembly()
+    h = d.receptance("tool.tip:y", frequency=GRID)
+    for dz in (5.0, np.ones((1, 1, 7)), lambda f: 3):
+        with pytest.raises(InvalidValueError, match=r"delta_stiffness: got an array of shape .*; expected \(r, r\) or "
+                                                    r"\(r, r, 2\)"):
+            modify(h, "tool.tip:y", dz)
+    with pytest.raises(InvalidValueError, match=r"interface\[0\]: got \('holder.tip', 'tool.base'\); expected"):
+        decouple(h, h, [("holder.tip", "tool.base")])
+    with pytest.raises(InvalidValueError, match=r"frf: got str; expected an FRF"):
+        add_mass("tool.tip", "tool.tip", "2 g")
+    np.testing.assert_array_equal(add_mass(h, "tool.tip :y", "2 g").data, add_mass(h, "tool.tip:y", "2 g").data)
