@@ -15,7 +15,7 @@ import pytest
 from substructure import (Assembly, Flutes, Frequency, Joint, Material, MeasuredComponent, Segment, Tool, UnitError,
                           add_mass, decouple, default_assembly, remove_mass)
 from substructure.coupling import modify
-from substructure.errors import InvalidValueError, UnknownPointError
+from substructure.errors import InvalidValueError, NonPassiveJointWarning, UnknownPointError
 from substructure.frf import FRF
 from substructure.materials import get_material
 from substructure.points import parse_point
@@ -196,3 +196,29 @@ def test_modifications_that_gave_raw_errors_or_refused_a_spaced_point():
     with pytest.raises(InvalidValueError, match=r"frf: got str; expected an FRF"):
         add_mass("tool.tip", "tool.tip", "2 g")
     np.testing.assert_array_equal(add_mass(h, "tool.tip :y", "2 g").data, add_mass(h, "tool.tip:y", "2 g").data)
+
+
+def test_a_beams_own_receptance_takes_its_points_as_the_assembly_does():
+    """points='tip' was read letter by letter ('point tool.t'), None gave an AttributeError, a point of another
+    component was read as 'tool.holder.tip', the same place twice said 'positions: expected distinct positions',
+    and position(5) gave an AttributeError."""
+    tool = Tool.end_mill("12 mm", "50 mm", "30 mm")
+    assert tool.receptance(GRID, "tip").outputs == ("tool.tip:y", "tool.tip:theta")
+    assert tool.receptance(GRID, [" tip - 5 mm"]).outputs[0] == "tool.tip-5 mm:y"
+    with pytest.raises(UnknownPointError, match=r"point: got None; expected a point of 'tool'"):
+        tool.receptance(GRID, [None])
+    with pytest.raises(UnknownPointError, match=r"point holder.tip: not on component 'tool'"):
+        tool.receptance(GRID, ["holder.tip"])
+    with pytest.raises(InvalidValueError, match=r"points: 'tip' and '@50 mm' are the same place of 'tool'"):
+        tool.receptance(GRID, ["tip", "@50 mm"])
+    with pytest.raises(UnknownPointError, match=r"point 'tool.tip:y': a DOF suffix is not allowed here"):
+        tool.receptance(GRID, ["tip:y"])
+    with pytest.raises(UnknownPointError, match=r"point: got 5; expected a point of 'tool'"):
+        tool.position(5)
+
+
+def test_a_joint_of_1e300_n_per_m_is_checked_without_overflow():
+    """The passivity check multiplied the entries: a RuntimeWarning (an error under -W error) for k = 1e300."""
+    Joint("j", ("a.tip", "b.base"), k={"yf": "1e300 N/m", "tm": "1e300 N*m/rad"})
+    with pytest.warns(NonPassiveJointWarning, match=r"k_ym\*k_tf = 4e\+12 > k_yf\*k_tm = 1e\+12"):
+        Joint("j", ("a.tip", "b.base"), k={"yf": "1e7 N/m", "ym": "2e6 N", "tf": "2e6 N/rad", "tm": "1e5 N*m/rad"})

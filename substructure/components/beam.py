@@ -10,6 +10,7 @@ line of a component in summaries.
 
 from __future__ import annotations
 
+import re
 from typing import Any, ClassVar, Sequence
 
 import attrs
@@ -95,6 +96,8 @@ def check_reach(beam: Any, frequency_hz: np.ndarray) -> None:
             "up to some 100 kHz: check the unit of the frequencies (plain numbers are in Hz)"
         )
 
+
+_LOCAL = re.compile(r"^(tip|base)\s*($|-|:)")  # a local point name: tip, base, tip-X (and @X)
 
 _BEAM_METHODS = ("receptance_matrix", "position")
 """Methods whose override makes a Beam subclass something else than its segments (plain_beam False)."""
@@ -188,7 +191,7 @@ class Beam:
         UnknownPointError
             When the point is not on this beam or lies outside it.
         """
-        if isinstance(ref, str):
+        if not isinstance(ref, PointRef):
             ref = self._ref(ref)
         if ref.component != self.name:
             raise UnknownPointError(f"point {ref}: not on component {self.name!r}")
@@ -251,11 +254,23 @@ class Beam:
         check_reach(self, f)
         return stepped_beam_receptance(self.segments, [self.position(r) for r in refs], f, decay)
 
-    def _ref(self, point: str) -> PointRef:
-        text = point if point.startswith(self.name + ".") or point.startswith(self.name + "@") else (
-            f"{self.name}{point}" if point.startswith("@") else f"{self.name}.{point}"
-        )
-        return parse_point(text, allow_dof=False)
+    def _ref(self, point: str | PointRef) -> PointRef:
+        if isinstance(point, PointRef):
+            return parse_point(point, allow_dof=False)
+        if not isinstance(point, str) or not point.strip():
+            raise UnknownPointError(
+                f"point: got {point!r}; expected a point of {self.name!r}: 'tip', 'base', '@30 mm', 'tip-15 mm' "
+                f"or a full name such as '{self.name}.tip'"
+            )
+        text = point.strip()
+        if text.startswith("@"):
+            text = f"{self.name}{text}"
+        elif _LOCAL.match(text):
+            text = f"{self.name}.{text}"
+        ref = parse_point(text, allow_dof=False)
+        if ref.component != self.name:
+            raise UnknownPointError(f"point {ref}: not on component {self.name!r}")
+        return ref
 
     def receptance(self, frequency, points: Sequence[str] = ("tip",)) -> FRF:
         """Free-free receptance matrix between points of this beam.
@@ -275,7 +290,14 @@ class Beam:
             N in rad/N, P in rad/(N m).
         """
         freq = as_frequency(frequency)
-        refs = [self._ref(p) for p in points]
+        names = [points] if isinstance(points, str) else list(points)  # "tip" is one point, not t, i, p
+        refs = [self._ref(p) for p in names]
+        places: dict = {}
+        for i, r in enumerate(refs):
+            first = places.setdefault(self.node_key(r), i)
+            if first != i:
+                raise InvalidValueError(f"points: {names[first]!r} and {names[i]!r} are the same place of "
+                                        f"{self.name!r}; expected each point once")
         data = np.moveaxis(self.receptance_matrix(refs, freq.hz), -1, 0)
         labels = dof_labels(str(r) for r in refs)
         return FRF(freq, data, labels, labels)
