@@ -122,7 +122,7 @@ def sweep(
         in all (bounds the memory: about 0.5 kB per line for a tool of two
         points, so 25 MB at the default).
     progress : bool
-        Print the progress to standard error.
+        Print the progress to standard error (a line per percent at most).
 
     Returns
     -------
@@ -213,6 +213,7 @@ def sweep(
     per_chunk = max(1, chunk_lines // n_f)
     data = np.empty((n_var, n_f, len(rows), len(cols)), dtype=complex)
     constant_links: dict[int, np.ndarray] = {}
+    shown = -1  # the percentage last printed
     for start in range(0, n_var, per_chunk):
         chunk = range(start, min(n_var, start + per_chunk))
         n_c = len(chunk)
@@ -257,7 +258,9 @@ def sweep(
         y = couple_substructures(blocks, links, out_keys)
         y = y[np.ix_(rows, cols)].reshape(len(rows), len(cols), n_c, n_f)
         data[chunk.start : chunk.stop] = np.transpose(y, (2, 3, 0, 1))
-        if progress:
+        percent = 100 * chunk.stop // n_var
+        if progress and (percent > shown or chunk.stop == n_var):  # at most 101 lines, whatever the chunks
+            shown = percent
             print(f"sweep: {chunk.stop}/{n_var} variants", file=sys.stderr, flush=True)
     data.flags.writeable = False
     return SweepResult(freq, data, tuple(out_labels), tuple(in_labels))

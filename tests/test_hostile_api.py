@@ -222,3 +222,12 @@ def test_a_joint_of_1e300_n_per_m_is_checked_without_overflow():
     Joint("j", ("a.tip", "b.base"), k={"yf": "1e300 N/m", "tm": "1e300 N*m/rad"})
     with pytest.warns(NonPassiveJointWarning, match=r"k_ym\*k_tf = 4e\+12 > k_yf\*k_tm = 1e\+12"):
         Joint("j", ("a.tip", "b.base"), k={"yf": "1e7 N/m", "ym": "2e6 N", "tf": "2e6 N/rad", "tm": "1e5 N*m/rad"})
+
+
+def test_the_progress_of_a_long_sweep_is_a_line_per_percent_at_most(capsys):
+    """A line per chunk: with one variant per chunk, 300 variants printed 300 lines (a million, a million)."""
+    d = default_assembly().without("spindle", "holder")
+    variants = [d.with_component(Tool.end_mill("12 mm", f"{40 + 0.1 * i:.1f} mm")) for i in range(300)]
+    sweep(variants, "tool.tip:y", frequency=GRID, chunk_lines=1, progress=True)
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) == 101 and lines[0] == "sweep: 1/300 variants" and lines[-1] == "sweep: 300/300 variants"
