@@ -12,8 +12,8 @@ import attrs
 import numpy as np
 import pytest
 
-from substructure import (Assembly, Flutes, Frequency, Joint, Material, MeasuredComponent, Segment, Tool, UnitError,
-                          add_mass, decouple, default_assembly, remove_mass)
+from substructure import (Assembly, Flutes, Frequency, Holder, Joint, Material, MeasuredComponent, Segment, Tool,
+                          UnitError, add_mass, decouple, default_assembly, remove_mass)
 from substructure.coupling import modify
 from substructure.errors import InvalidValueError, NonPassiveJointWarning, UnknownPointError
 from substructure.frf import FRF
@@ -231,3 +231,15 @@ def test_the_progress_of_a_long_sweep_is_a_line_per_percent_at_most(capsys):
     sweep(variants, "tool.tip:y", frequency=GRID, chunk_lines=1, progress=True)
     lines = capsys.readouterr().err.splitlines()
     assert len(lines) == 101 and lines[0] == "sweep: 1/300 variants" and lines[-1] == "sweep: 300/300 variants"
+
+
+@pytest.mark.parametrize("key, value, message", [
+    ("gap_length", "-2 mm", r"gap_length: got '-2 mm'; expected a length >= 0"),   # was a 72 mm holder for 70 mm
+    ("flange_diameter", "-63 mm", r"flange_diameter: got '-63 mm'; expected a positive length"),   # was 'od: ...'
+    ("nut_length", "0 mm", r"nut_length: got '0 mm'; expected a positive length"),   # was 'length: ...'
+])
+def test_catalogue_lengths_are_checked_under_their_own_names(key, value, message):
+    with pytest.raises(InvalidValueError, match=message):
+        Holder.from_catalog("BT40 ER32", bore="12 mm", gauge_length="70 mm", **{key: value})
+    assert Holder.from_catalog("BT40 ER32", bore="12 mm", gauge_length="70 mm", gap_length="0 mm").length_m \
+        == pytest.approx(0.070)
