@@ -14,6 +14,7 @@ import pytest
 
 from substructure import (Assembly, Flutes, Frequency, Holder, Joint, Material, MeasuredComponent, Segment, Tool,
                           UnitError, add_mass, decouple, default_assembly, remove_mass)
+from substructure.components import own_parameters, with_parameter
 from substructure.coupling import modify
 from substructure.errors import InvalidValueError, NonPassiveJointWarning, UnknownPointError
 from substructure.frf import FRF
@@ -243,3 +244,30 @@ def test_catalogue_lengths_are_checked_under_their_own_names(key, value, message
         Holder.from_catalog("BT40 ER32", bore="12 mm", gauge_length="70 mm", **{key: value})
     assert Holder.from_catalog("BT40 ER32", bore="12 mm", gauge_length="70 mm", gap_length="0 mm").length_m \
         == pytest.approx(0.070)
+
+
+@attrs.frozen
+class _SteppedHolder(Holder):
+    """A holder with a count among its fields, as the shrink-fit holder of docs/extending.md."""
+
+    steps: int = attrs.field(default=4, kw_only=True)
+    nut_kg: float = attrs.field(default=1, kw_only=True)
+
+    def __attrs_post_init__(self):
+        if not isinstance(self.steps, int) or self.steps < 1:
+            raise InvalidValueError(f"steps: got {self.steps!r}; expected a whole number >= 1")
+
+    def receptance_matrix(self, refs, frequency_hz, decay=0.0):
+        return Holder.receptance_matrix(self, refs, frequency_hz, decay)
+
+
+def test_a_count_among_a_components_fields_is_not_a_parameter_to_fit():
+    """steps = 4 was offered to the fits as a number from 0.4 to 40: setting it to 4.37 failed in the middle of a
+    diagnosis (or, without the class's own check, made a holder of 4.37 steps); a text value gave a raw ValueError."""
+    holder = _SteppedHolder("holder", [Segment("50 mm", "40 mm")])
+    assert [p.name for p in own_parameters(holder)] == ["nut_kg"]   # 1, written as an int, is still a value
+    with pytest.raises(UnknownPointError, match=r"no parameter 'steps'; its own parameters: nut_kg"):
+        with_parameter(holder, "steps", 4.37)
+    with pytest.raises(InvalidValueError, match=r"nut_kg: got 'abc'; expected a number"):
+        with_parameter(holder, "nut_kg", "abc")
+    assert with_parameter(holder, "nut_kg", 0.4).nut_kg == 0.4
