@@ -96,6 +96,22 @@ def _check_structure(plans, assemblies) -> None:
                 f"sweep: variant {i} ({assemblies[i].name!r}) has another structure than variant 0; "
                 "a sweep needs the same components, joints, sensors and supports by name"
             )
+        # the links are coupled at variant 0's nodes: a sensor moved to another point that takes part anyway
+        # (an output) has the same nodes and names, and was computed where variant 0 has it
+        for link, ref in zip(links, ref_links):
+            ends, ref_ends = _ends(link, groups), _ends(ref, ref_groups)
+            if sorted(ends) != sorted(ref_ends):  # a joint's two ends in either order: B and -B couple alike
+                raise InvalidValueError(
+                    f"sweep: variant {i} ({assemblies[i].name!r}) has {link[3]} at {' -- '.join(ends)}, variant 0 "
+                    f"at {' -- '.join(ref_ends)}; a sweep needs each joint, sensor, mass and support at the same "
+                    "points in every variant (compute variants that move one with Assembly.frf, one by one)"
+                )
+
+
+def _ends(link, groups) -> tuple[str, ...]:
+    """The point names of a link's ends in its plan."""
+    names = {k: str(p) for _, items in groups for k, p in items}
+    return tuple(names[k] for k in link[:2] if k is not None)
 
 
 def sweep(

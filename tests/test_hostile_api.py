@@ -12,8 +12,8 @@ import attrs
 import numpy as np
 import pytest
 
-from substructure import (Assembly, Flutes, Frequency, Holder, Joint, Material, MeasuredComponent, Segment, Tool,
-                          UnitError, add_mass, decouple, default_assembly, remove_mass)
+from substructure import (Assembly, Flutes, Frequency, Holder, Joint, Material, MeasuredComponent, Segment, Sensor,
+                          Tool, UnitError, add_mass, decouple, default_assembly, remove_mass)
 from substructure.components import own_parameters, with_parameter
 from substructure.coupling import modify
 from substructure.errors import InvalidValueError, NonPassiveJointWarning, UnknownPointError
@@ -271,3 +271,18 @@ def test_a_count_among_a_components_fields_is_not_a_parameter_to_fit():
     with pytest.raises(InvalidValueError, match=r"nut_kg: got 'abc'; expected a number"):
         with_parameter(holder, "nut_kg", "abc")
     assert with_parameter(holder, "nut_kg", 0.4).nut_kg == 0.4
+
+
+def test_a_sweep_that_moves_a_sensor_between_points_it_computes_anyway_is_refused():
+    """With the sensor at two points that are both outputs, the variants had the same nodes and names and every
+    variant was computed with the sensor where variant 0 has it: variant 1 was 118 % off, silently."""
+    d = default_assembly()
+    variants = [d.attach(Sensor("acc", p, "20 g")) for p in ("tool.tip", "holder.tip")]
+    with pytest.raises(InvalidValueError, match=r"sweep: variant 1 .* has sensor 'acc' at holder.tip, variant 0 at "
+                                                r"tool.tip; a sweep needs each joint, sensor, mass and support at the "
+                                                r"same points"):
+        sweep(variants, ["tool.tip:y", "holder.tip:y"], frequency=GRID)
+    j = d.joint("holder-tool")   # a joint written the other way round couples alike: accepted, and right
+    flipped = d.with_joint(Joint(j.name, j.between[::-1], k=j.k, c=j.c))
+    result = sweep([d, flipped], "tool.tip:y", frequency=GRID)
+    np.testing.assert_allclose(result[1].data, flipped.receptance("tool.tip:y", frequency=GRID).data, rtol=1e-12)
