@@ -16,7 +16,7 @@ from substructure import (Assembly, Flutes, Frequency, Holder, Joint, Material, 
                           Tool, UnitError, add_mass, decouple, default_assembly, remove_mass)
 from substructure.components import own_parameters, with_parameter
 from substructure.coupling import modify
-from substructure.errors import InvalidValueError, NonPassiveJointWarning, UnknownPointError
+from substructure.errors import InvalidValueError, NonPassiveJointWarning, NonReciprocalWarning, UnknownPointError
 from substructure.frf import FRF
 from substructure.materials import get_material
 from substructure.points import parse_point
@@ -286,3 +286,36 @@ def test_a_sweep_that_moves_a_sensor_between_points_it_computes_anyway_is_refuse
     flipped = d.with_joint(Joint(j.name, j.between[::-1], k=j.k, c=j.c))
     result = sweep([d, flipped], "tool.tip:y", frequency=GRID)
     np.testing.assert_allclose(result[1].data, flipped.receptance("tool.tip:y", frequency=GRID).data, rtol=1e-12)
+
+
+@attrs.frozen
+class _Lump:
+    """A lumped body of one's own whose L and N differ: not a linear elastic structure."""
+
+    name: str
+    cross: float = 1e-9
+
+    @property
+    def component_names(self):
+        return frozenset({self.name})
+
+    def node_key(self, ref):
+        return (self.name, ref.where)
+
+    def receptance_matrix(self, refs, frequency_hz):
+        w2 = (2 * np.pi * np.asarray(frequency_hz)) ** 2
+        y = np.zeros((2, 2, w2.size), dtype=complex)
+        y[0, 0], y[1, 1], y[0, 1] = -1 / (0.5 * w2), -1 / (1e-4 * w2), self.cross
+        return y
+
+
+def test_a_component_of_ones_own_that_is_not_reciprocal_is_warned_of():
+    """Its receptances entered the coupling as they were: the tool point FRF was not reciprocal, without a word."""
+    d = default_assembly().without("tool")
+    lumped = d.add(_Lump("nut")).connect("holder.tip", "nut.tip", k={"yf": "1e8 N/m", "tm": "1e6 N*m/rad"})
+    with pytest.warns(NonReciprocalWarning, match=r"component 'nut' \(_Lump\): receptance_matrix gave a matrix that "
+                                                  r"is not symmetric \(nut.tip:y / nut.tip:theta and nut.tip:theta / "
+                                                  r"nut.tip:y differ by"):
+        lumped.receptance("holder.tip:y", frequency=GRID)
+    symmetric = d.add(_Lump("nut", 0.0)).connect("holder.tip", "nut.tip", k={"yf": "1e8 N/m", "tm": "1e6 N*m/rad"})
+    assert np.isfinite(symmetric.receptance("holder.tip:y", frequency=GRID).data).all()   # no warning: an error here
