@@ -43,6 +43,7 @@ from ._engine import (
 )
 from .errors import FrequencyAxisMismatchError, InvalidValueError, UnknownPointError
 from .frf import FRF
+from .points import parse_point
 
 __all__ = [
     "Connection",
@@ -61,9 +62,26 @@ __all__ = [
 # FRF-level operations
 
 
+def _receptance(frf: Any, field: str) -> FRF:
+    """The FRF as receptances: a mobility or an accelerance divided by ``i omega`` or ``-omega^2``."""
+    if not isinstance(frf, FRF):
+        raise InvalidValueError(f"{field}: got {type(frf).__name__}; expected an FRF")
+    return frf.to_receptance()
+
+
+def _as_quantity(receptance: FRF, quantity: str) -> FRF:
+    """Receptances back in ``quantity``: times ``i omega`` for a mobility, ``-omega^2`` for an accelerance."""
+    if quantity == "receptance":
+        return receptance
+    omega = receptance.frequency.omega
+    factor = 1j * omega if quantity == "mobility" else -(omega**2)
+    return attrs.evolve(receptance, data=receptance.data * factor[:, None, None], quantity=quantity)
+
+
 def _point_dofs(frf: FRF, at: str) -> list[str]:
-    point = at.split(":")[0]
-    labels = [f"{point}:y", f"{point}:theta"] if ":" not in at else [at]
+    ref = parse_point(at)  # spaces and all, as everywhere: "tool.tip :y" is tool.tip:y
+    point = str(ref.point)
+    labels = [f"{point}:y", f"{point}:theta"] if ref.dof is None else [f"{point}:{ref.dof}"]
     present = [lbl for lbl in labels if lbl in frf.outputs and lbl in frf.inputs]
     if not present:
         raise UnknownPointError(
@@ -96,11 +114,20 @@ def modify(frf: FRF, at: str, delta_stiffness) -> FRF:
     Returns
     -------
     FRF
-        The modified FRF, same labels and units.
+        The modified FRF, same labels, quantity and units (a mobility or an
+        accelerance is modified as the receptance it is).
     """
+    given = frf
+    frf = _receptance(frf, "frf")
     dofs = _point_dofs(frf, at)
     f = frf.frequency.hz
-    dz = delta_stiffness(f) if callable(delta_stiffness) else np.asarray(delta_stiffness)
+    dz = np.asarray(delta_stiffness(f) if callable(delta_stiffness) else delta_stiffness)
+    if dz.ndim not in (2, 3) or dz.shape[0] != dz.shape[1] or dz.shape[0] not in (1, 2) or (
+            dz.ndim == 3 and dz.shape[-1] not in (1, f.size)):
+        raise InvalidValueError(
+            f"delta_stiffness: got an array of shape {dz.shape}; expected (r, r) or (r, r, {f.size}) with r = 1 or 2 "
+            f"DOFs (y, theta), one slice per frequency line"
+        )
     if dz.shape[0] == 2 and len(dofs) == 1:
         idx = 0 if dofs[0].endswith(":y") else 1
         extra = dz[1 - idx, 1 - idx]
@@ -127,14 +154,14 @@ def modify(frf: FRF, at: str, delta_stiffness) -> FRF:
     v = y[o_idx, :]  # Y_p:  (r x inputs)
     s = y[np.ix_(o_idx, i_idx)]
     n = f.size
-    dz = np.broadcast_to(dz, dz.shape[:2] + (n,)) if dz.shape[-1] != n else dz
+    dz = np.broadcast_to(dz.reshape(dz.shape[:2] + (-1,)), dz.shape[:2] + (n,))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         w = interface_update(s, dz)
         uw = np.einsum("mkn,kjn->mjn", u, w)
         out = y - np.einsum("mkn,kjn->mjn", uw, v)
     if not np.all(np.isfinite(out)):
         raise InvalidValueError(f"modification at {at} is singular at some frequency line")
-    return attrs.evolve(frf, data=np.moveaxis(out, -1, 0))
+    return _as_quantity(attrs.evolve(frf, data=np.moveaxis(out, -1, 0)), given.quantity)
 
 
 def _mass_stiffness(sign: float, mass: float, inertia: float):
@@ -231,14 +258,17 @@ def decouple(coupled: FRF, removed: FRF, interface: Sequence[tuple[str, str, Any
     Returns
     -------
     FRF
-        Receptances of the remaining substructure alone, with the labels of
-        ``coupled``.
+        Receptances of the remaining substructure alone, with the labels and
+        the quantity of ``coupled`` (a mobility or an accelerance, of either
+        FRF, is decoupled as the receptance it is).
 
     Notes
     -----
     Dual decoupling: the removed substructure enters with ``-Y`` and its
     joints with ``-K``; the same engine as coupling.
     """
+    given = coupled
+    coupled, removed = _receptance(coupled, "coupled"), _receptance(removed, "removed")
     if coupled.frequency != removed.frequency:
         raise FrequencyAxisMismatchError(
             "decouple: the coupled and removed FRFs are on different frequency axes; "
@@ -254,17 +284,24 @@ def decouple(coupled: FRF, removed: FRF, interface: Sequence[tuple[str, str, Any
     y[:na, :na] = np.moveaxis(coupled.data, 0, -1)
     y[na:, na:] = -np.moveaxis(removed.data, 0, -1)
     conns = []
-    for pa, pb, joint in interface:
-        a = [labels.index(lbl) for lbl in _point_dofs(coupled, pa)]
-        b = [labels.index("removed/" + lbl) for lbl in _point_dofs(removed, pb)]
-        if len(a) != len(b):
+    for i, item in enumerate(interface):
+        if not isinstance(item, (tuple, list)) or len(item) != 3:
+            raise InvalidValueError(f"interface[{i}]: got {item!r}; expected (point_in_coupled, point_in_removed, "
+                                    "joint or None)")
+        pa, pb, joint = item
+        dofs_a, dofs_b = _point_dofs(coupled, pa), _point_dofs(removed, pb)
+        kinds = [lbl.rsplit(":", 1)[1] for lbl in dofs_a]
+        if kinds != [lbl.rsplit(":", 1)[1] for lbl in dofs_b]:
             raise InvalidValueError(f"decouple: points {pa} and {pb} have different DOFs")
+        a = [labels.index(lbl) for lbl in dofs_a]
+        b = [labels.index("removed/" + lbl) for lbl in dofs_b]
         if joint is None or getattr(joint, "rigid", False):
             k = None
         else:
             k = -joint.dynamic_stiffness(coupled.frequency.hz)
-            if len(a) == 1:
-                k = k[:1, :1]
+            if len(a) == 1:  # the joint's entry on that DOF: k_yf for y, k_tm for theta
+                d = 0 if kinds[0] == "y" else 1
+                k = k[d : d + 1, d : d + 1]
         conns.append(Connection(tuple(a), tuple(b), k, f"{pa}-{pb}"))
     out = couple(y, conns)[:na, :na]
-    return attrs.evolve(coupled, data=np.moveaxis(out, -1, 0))
+    return _as_quantity(attrs.evolve(coupled, data=np.moveaxis(out, -1, 0)), given.quantity)

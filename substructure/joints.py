@@ -150,14 +150,15 @@ def _check_matrices(k: np.ndarray, c: np.ndarray, owner: str) -> None:
             continue
         if abs(m[0, 1] - m[1, 0]) > 1e-9 * max(abs(m[0, 1]), abs(m[1, 0])):
             asym.append(f"{sym_name}_ym = {m[0, 1]:.6g} != {sym_name}_tf = {m[1, 0]:.6g}")
-        sym = 0.5 * (m + m.T)
+        sym = 0.5 * (m + m.T) / np.abs(m).max()  # scaled: the products of entries of 1e200 N/m stay finite
         det = sym[0, 0] * sym[1, 1] - sym[0, 1] ** 2
         if sym[0, 0] < 0 or sym[1, 1] < 0:
             nonpassive.append(f"{sym_name} has a negative diagonal entry")
         elif det < -1e-12 * (abs(sym[0, 0] * sym[1, 1]) + sym[0, 1] ** 2):
+            scale = float(np.abs(m).max()) * float(np.abs(m).max())  # Python floats: inf beyond 1e308, no warning
             nonpassive.append(
-                f"{sym_name}_ym*{sym_name}_tf = {sym[0, 1] ** 2:.4g} > "
-                f"{sym_name}_yf*{sym_name}_tm = {sym[0, 0] * sym[1, 1]:.4g}"
+                f"{sym_name}_ym*{sym_name}_tf = {float(sym[0, 1] ** 2) * scale:.4g} > "
+                f"{sym_name}_yf*{sym_name}_tm = {float(sym[0, 0] * sym[1, 1]) * scale:.4g}"
             )
     if asym:
         warnings.warn(
@@ -180,8 +181,8 @@ def _point(value) -> str:
 
 
 def _between(value) -> tuple[str, str]:
-    if isinstance(value, str) or len(value) != 2:
-        raise InvalidValueError(f"between: got {value!r}; expected two point names")
+    if isinstance(value, (str, bytes)) or not isinstance(value, (tuple, list)) or len(value) != 2:
+        raise InvalidValueError(f"between: got {value!r}; expected two point names (a tuple or a list)")
     a, b = (_point(v) for v in value)
     if a == b:
         raise InvalidValueError(f"between: got the same point twice ({a})")

@@ -149,6 +149,8 @@ def get_material(name: str, extra: dict[str, Material] | None = None) -> Materia
     InvalidValueError
         For an unknown name (the message lists the known ones).
     """
+    if not isinstance(name, str):
+        raise InvalidValueError(f"material: got {name!r}; expected the name of a material (a text)")
     if extra and name in extra:
         return extra[name]
     if name in CATALOG:

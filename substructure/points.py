@@ -21,6 +21,8 @@ __all__ = ["PointRef", "parse_point", "check_name", "DOFS"]
 #: ``theta`` (rad), in this order in every receptance matrix.
 DOFS = ("y", "theta")
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
+# NAME.tip-X, spaces allowed around '.' and '-' as around the other parts of a point name
+_FROM_TIP = re.compile(r"^(?P<name>[^.]*?)\s*\.\s*tip\s*-(?P<distance>.*)$")
 
 
 def check_name(value, field: str = "name") -> str:
@@ -83,6 +85,13 @@ class PointRef:
 
 
 def _distance(text: str, spec: str) -> pint.Quantity:
+    body = text.strip()
+    for i, c in enumerate(body[1:], start=1):  # "tool.tip-5 mm-3 mm": pint would compute 2 mm
+        if c in "+-" and body[:i].rstrip()[-1:] not in ("e", "E", "^", "*", "/", "("):
+            raise UnknownPointError(
+                f"point {spec!r}: the distance {body!r} holds a sum or a difference; expected one length, "
+                "as NAME@X (from the base) or NAME.tip-X (back from the tip)"
+            )
     try:
         q = quantity(text.strip(), f"point {spec!r}", "[length]")
     except (UnitError, InvalidValueError) as exc:
@@ -119,6 +128,8 @@ def parse_point(spec, *, allow_dof: bool = True) -> PointRef:
             raise UnknownPointError(f"point: got {spec!r}; expected a name like 'tool.tip'")
         text = spec.strip()
         dof = None
+        if text.count(":") > 1:
+            raise UnknownPointError(f"point {spec!r}: more than one ':'; expected one DOF suffix, ':y' or ':theta'")
         if ":" in text:
             text, dof = text.rsplit(":", 1)
             dof = dof.strip()
@@ -127,9 +138,8 @@ def parse_point(spec, *, allow_dof: bool = True) -> PointRef:
         if "@" in text:
             name, dist = text.split("@", 1)
             ref = PointRef(name.strip(), "at", _distance(dist, spec), dof)
-        elif ".tip-" in text:
-            name, dist = text.split(".tip-", 1)
-            ref = PointRef(name.strip(), "from_tip", _distance(dist, spec), dof)
+        elif from_tip := _FROM_TIP.match(text):
+            ref = PointRef(from_tip["name"], "from_tip", _distance(from_tip["distance"], spec), dof)
         elif "." in text:
             name, where = text.split(".", 1)
             ref = PointRef(name.strip(), where.strip(), None, dof)

@@ -23,7 +23,7 @@ Examples
 from __future__ import annotations
 
 import sys
-from typing import Sequence
+from typing import Iterable, Sequence
 
 import attrs
 import numpy as np
@@ -31,12 +31,21 @@ import numpy as np
 from .assembly import Assembly, expand_points
 from .beams import stepped_beam_receptance_batch
 from .components import is_plain_beam, receptances
+from .components.beam import check_reach
 from .coupling import Link, couple_substructures
 from .errors import InvalidValueError
 from .frf import FRF, Frequency
 from .joints import dynamic_stiffness
 
-__all__ = ["SweepResult", "sweep"]
+__all__ = ["SweepResult", "sweep", "MAX_SWEEP_VALUES"]
+
+MAX_SWEEP_VALUES = 100_000_000
+"""The most receptance values a sweep returns (1.6 GB of complex numbers), checked before any work."""
+
+
+def _show(value) -> str:
+    text = repr(value)
+    return f"an object of type {type(value).__name__}" if len(text) > 80 else text
 
 
 @attrs.frozen
@@ -87,6 +96,22 @@ def _check_structure(plans, assemblies) -> None:
                 f"sweep: variant {i} ({assemblies[i].name!r}) has another structure than variant 0; "
                 "a sweep needs the same components, joints, sensors and supports by name"
             )
+        # the links are coupled at variant 0's nodes: a sensor moved to another point that takes part anyway
+        # (an output) has the same nodes and names, and was computed where variant 0 has it
+        for link, ref in zip(links, ref_links):
+            ends, ref_ends = _ends(link, groups), _ends(ref, ref_groups)
+            if sorted(ends) != sorted(ref_ends):  # a joint's two ends in either order: B and -B couple alike
+                raise InvalidValueError(
+                    f"sweep: variant {i} ({assemblies[i].name!r}) has {link[3]} at {' -- '.join(ends)}, variant 0 "
+                    f"at {' -- '.join(ref_ends)}; a sweep needs each joint, sensor, mass and support at the same "
+                    "points in every variant (compute variants that move one with Assembly.frf, one by one)"
+                )
+
+
+def _ends(link, groups) -> tuple[str, ...]:
+    """The point names of a link's ends in its plan."""
+    names = {k: str(p) for _, items in groups for k, p in items}
+    return tuple(names[k] for k in link[:2] if k is not None)
 
 
 def sweep(
@@ -113,7 +138,7 @@ def sweep(
         in all (bounds the memory: about 0.5 kB per line for a tool of two
         points, so 25 MB at the default).
     progress : bool
-        Print the progress to standard error.
+        Print the progress to standard error (a line per percent at most).
 
     Returns
     -------
@@ -121,14 +146,30 @@ def sweep(
         The receptances of every variant, shape ``(n_variants, n_freq, n_out, n_in)``
         (m/N, m/(N m), rad/N, rad/(N m)).
     """
+    if isinstance(assemblies, Assembly) or not isinstance(assemblies, Iterable):
+        raise InvalidValueError(f"sweep: got {_show(assemblies)}; expected a sequence of assemblies (a list: "
+                                "[assembly] for one)")
     assemblies = list(assemblies)
     if not assemblies:
         raise InvalidValueError("sweep: got no assemblies")
+    for i, a in enumerate(assemblies):
+        if not isinstance(a, Assembly):
+            raise InvalidValueError(f"sweep: variant {i} is {_show(a)}; expected an Assembly")
+    if isinstance(chunk_lines, bool) or not isinstance(chunk_lines, (int, np.integer)) or chunk_lines < 1:
+        raise InvalidValueError(f"chunk_lines: got {chunk_lines!r}; expected a whole number of lines >= 1")
     freq = assemblies[0]._frequency(frequency)
     f = freq.hz
     n_f = f.size
     out_labels, out_idx, out_refs = expand_points(outputs)
     in_labels, in_idx, in_refs = expand_points(outputs if inputs is None else inputs)
+    values = len(assemblies) * n_f * len(out_labels) * len(in_labels)
+    if values > MAX_SWEEP_VALUES:
+        raise InvalidValueError(
+            f"sweep: {len(assemblies)} variants x {n_f} lines x {len(out_labels)} x {len(in_labels)} DOFs would be "
+            f"{values:.3g} complex values ({values * 16 / 1e9:.3g} GB), more than {MAX_SWEEP_VALUES:.0e} "
+            "(sweep.MAX_SWEEP_VALUES): sweep fewer variants at a time, over fewer lines or DOFs, or run a study "
+            "(substructure study), which saves each result as it is computed"
+        )
     refs = out_refs + in_refs
     plans = [a._plan(refs) for a in assemblies]
     _check_structure(plans, assemblies)
@@ -188,6 +229,7 @@ def sweep(
     per_chunk = max(1, chunk_lines // n_f)
     data = np.empty((n_var, n_f, len(rows), len(cols)), dtype=complex)
     constant_links: dict[int, np.ndarray] = {}
+    shown = -1  # the percentage last printed
     for start in range(0, n_var, per_chunk):
         chunk = range(start, min(n_var, start + per_chunk))
         n_c = len(chunk)
@@ -202,6 +244,8 @@ def sweep(
             if all_beams[gi] and all(
                 r.where in ("base", "tip") for r in refs0[gi]
             ) and len({len(owners[c].segments) for c in chunk}) == 1:
+                for c in chunk:  # what Beam.receptance_matrix checks, for the batched kernel
+                    check_reach(owners[c], f)
                 y = stepped_beam_receptance_batch(
                     [owners[c].segments for c in chunk], [r.where for r in refs0[gi]], f
                 )
@@ -230,7 +274,9 @@ def sweep(
         y = couple_substructures(blocks, links, out_keys)
         y = y[np.ix_(rows, cols)].reshape(len(rows), len(cols), n_c, n_f)
         data[chunk.start : chunk.stop] = np.transpose(y, (2, 3, 0, 1))
-        if progress:
+        percent = 100 * chunk.stop // n_var
+        if progress and (percent > shown or chunk.stop == n_var):  # at most 101 lines, whatever the chunks
+            shown = percent
             print(f"sweep: {chunk.stop}/{n_var} variants", file=sys.stderr, flush=True)
     data.flags.writeable = False
     return SweepResult(freq, data, tuple(out_labels), tuple(in_labels))

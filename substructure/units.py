@@ -206,6 +206,15 @@ def show_value(value: Any) -> str:
     return repr(value)
 
 
+def _no_comma(text: str, field: str, expected: str, error: type = UnitError) -> None:
+    """Refuse a comma in a value's text: pint drops it, so ``"1,5 mm"`` would be 15 mm and ``"1, 5 mm"`` 5 mm."""
+    if "," in text:
+        raise error(
+            f"{field}: cannot read {show_value(text)}: a comma is neither a decimal point nor a thousands "
+            f"separator here (write '1.5 mm', '1000 mm'); expected {expected}"
+        )
+
+
 def quantity(value: Any, field: str, dimension: str) -> pint.Quantity:
     """Return ``value`` as a scalar quantity of this registry with ``dimension``.
 
@@ -237,6 +246,7 @@ def quantity(value: Any, field: str, dimension: str) -> pint.Quantity:
             f"{field}: got the bare number {show_value(value)}; expected {expected}, with its unit"
         )
     if isinstance(value, str):
+        _no_comma(value, field, expected)
         if not _NUMBER.match(value):  # pint reads "mm" as 1 mm and "a" as 1 year
             raise UnitError(
                 f"{field}: cannot read {show_value(value)} as a quantity: it does not start with a number; "
@@ -324,6 +334,7 @@ def dimensionless(value: Any, field: str) -> float:
             )
         value = value.m_as("dimensionless")
     elif isinstance(value, str):
+        _no_comma(value, field, "a number", InvalidValueError)
         try:
             q: Any = ureg.Quantity(value)
         except Exception:

@@ -10,6 +10,7 @@ line of a component in summaries.
 
 from __future__ import annotations
 
+import re
 from typing import Any, ClassVar, Sequence
 
 import attrs
@@ -47,6 +48,56 @@ def _text(field: str):
 
     return check
 
+
+MAX_BEAM_PIECES = 2000
+"""The most pieces a beam is cut into for one computation (at its highest frequency line).
+
+The exact beam receptances are a chain cut where its ``k L`` exceeds 8 (and
+a tapered segment into steps of ``k h <= 0.6``), ``k`` the largest
+wavenumber at the highest line.  Machine-tool parts need a few pieces up to
+tens of kHz; a line at 1e8 Hz (a frequency in the wrong unit) would need
+hundreds of thousands and gigabytes of memory, and is refused before.
+"""
+
+
+def check_reach(beam: Any, frequency_hz: np.ndarray) -> None:
+    """Refuse frequency lines so high that ``beam`` would be cut into more than :data:`MAX_BEAM_PIECES` pieces.
+
+    Parameters
+    ----------
+    beam : Beam
+        A component with ``segments`` (base to tip).
+    frequency_hz : ndarray
+        The frequency lines [Hz], finite and > 0.
+
+    Raises
+    ------
+    InvalidValueError
+        Naming the component, the highest line and the pieces it would need.
+    """
+    from .._chains import _CHUNK_KL, _phases
+    from ..tapers import TAPER_STEP_PHASE, _taper_sections
+
+    f_max = float(np.max(frequency_hz)) if np.size(frequency_hz) else 0.0
+    if f_max <= 0.0:
+        return
+    # k L of each segment at the highest line (of both end sections of a tapered one), in one kernel call
+    ends = [_taper_sections(s, np.array([0.0, 1.0])) if s.is_tapered else [s.section()] for s in beam.segments]
+    phases = iter(_phases([(sec, s.length_m) for s, e in zip(beam.segments, ends) for sec in e], 2.0 * np.pi * f_max))
+    pieces = 0.0
+    for s, e in zip(beam.segments, ends):
+        phase = max(next(phases) for _ in e)
+        pieces += phase / (TAPER_STEP_PHASE if s.is_tapered else _CHUNK_KL)
+    if pieces > MAX_BEAM_PIECES:
+        raise InvalidValueError(
+            f"frequency: got a line at {f_max:g} Hz, where component {beam.name!r} would be cut into about "
+            f"{pieces:.3g} pieces (its bending waves are that short), more than {MAX_BEAM_PIECES} "
+            "(components.beam.MAX_BEAM_PIECES); the beam model is meant for the vibrations of machine-tool parts, "
+            "up to some 100 kHz: check the unit of the frequencies (plain numbers are in Hz)"
+        )
+
+
+_LOCAL = re.compile(r"^(tip|base)\s*($|-|:)")  # a local point name: tip, base, tip-X (and @X)
 
 _BEAM_METHODS = ("receptance_matrix", "position")
 """Methods whose override makes a Beam subclass something else than its segments (plain_beam False)."""
@@ -140,7 +191,7 @@ class Beam:
         UnknownPointError
             When the point is not on this beam or lies outside it.
         """
-        if isinstance(ref, str):
+        if not isinstance(ref, PointRef):
             ref = self._ref(ref)
         if ref.component != self.name:
             raise UnknownPointError(f"point {ref}: not on component {self.name!r}")
@@ -200,13 +251,26 @@ class Beam:
         """
         f = np.asarray(frequency_hz, dtype=float)
         _positive_frequencies(f, f"component {self.name!r}")
+        check_reach(self, f)
         return stepped_beam_receptance(self.segments, [self.position(r) for r in refs], f, decay)
 
-    def _ref(self, point: str) -> PointRef:
-        text = point if point.startswith(self.name + ".") or point.startswith(self.name + "@") else (
-            f"{self.name}{point}" if point.startswith("@") else f"{self.name}.{point}"
-        )
-        return parse_point(text, allow_dof=False)
+    def _ref(self, point: str | PointRef) -> PointRef:
+        if isinstance(point, PointRef):
+            return parse_point(point, allow_dof=False)
+        if not isinstance(point, str) or not point.strip():
+            raise UnknownPointError(
+                f"point: got {point!r}; expected a point of {self.name!r}: 'tip', 'base', '@30 mm', 'tip-15 mm' "
+                f"or a full name such as '{self.name}.tip'"
+            )
+        text = point.strip()
+        if text.startswith("@"):
+            text = f"{self.name}{text}"
+        elif _LOCAL.match(text):
+            text = f"{self.name}.{text}"
+        ref = parse_point(text, allow_dof=False)
+        if ref.component != self.name:
+            raise UnknownPointError(f"point {ref}: not on component {self.name!r}")
+        return ref
 
     def receptance(self, frequency, points: Sequence[str] = ("tip",)) -> FRF:
         """Free-free receptance matrix between points of this beam.
@@ -226,7 +290,14 @@ class Beam:
             N in rad/N, P in rad/(N m).
         """
         freq = as_frequency(frequency)
-        refs = [self._ref(p) for p in points]
+        names = [points] if isinstance(points, str) else list(points)  # "tip" is one point, not t, i, p
+        refs = [self._ref(p) for p in names]
+        places: dict = {}
+        for i, r in enumerate(refs):
+            first = places.setdefault(self.node_key(r), i)
+            if first != i:
+                raise InvalidValueError(f"points: {names[first]!r} and {names[i]!r} are the same place of "
+                                        f"{self.name!r}; expected each point once")
         data = np.moveaxis(self.receptance_matrix(refs, freq.hz), -1, 0)
         labels = dof_labels(str(r) for r in refs)
         return FRF(freq, data, labels, labels)

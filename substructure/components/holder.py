@@ -49,7 +49,7 @@ from .._toml import loads_toml
 from ..beams import Segment
 from ..errors import InvalidValueError
 from ..sections import Insert, _material
-from ..units import Q_, quantity
+from ..units import Q_, quantity, show_value
 from .beam import Beam
 from .protocol import register_component
 
@@ -237,6 +237,19 @@ def _table_value(table: dict, key: pint.Quantity, what: str, field: str) -> pint
     )
 
 
+_MAY_BE_ZERO = ("gap_length", "taper_bore")
+"""Catalogue lengths that may be 0 (no gap between gauge line and flange, a solid taper); the others are > 0."""
+
+
+def _catalog_length(value: Any, key: str) -> pint.Quantity:
+    """A length of the catalogue's data or its override, checked under its own name (not a segment's ``od``)."""
+    q = quantity(value, key, "[length]")
+    if q.magnitude < 0 or (q.magnitude == 0 and key not in _MAY_BE_ZERO):
+        expected = "a length >= 0" if key in _MAY_BE_ZERO else "a positive length"
+        raise InvalidValueError(f"{key}: got {show_value(value)}; expected {expected}")
+    return q
+
+
 def _angle(value: Any) -> pint.Quantity:
     """An angle with its unit (``"4.5 deg"``); a bare number is refused."""
     try:
@@ -293,10 +306,10 @@ def design(entry: str, **parameters: Any) -> HolderDesign:
         raise InvalidValueError(f"bore: missing; give the tool shank diameter, e.g. bore='16 mm' ({interface} {clamp})")
     p: dict[str, Any] = {}
     for key in _LENGTH_KEYS["interface"]:
-        p[key] = quantity(parameters.get(key, face[key]), key, "[length]")
+        p[key] = _catalog_length(parameters.get(key, face[key]), key)
     for key in _LENGTH_KEYS[kind]:
         if key in parameters:
-            p[key] = quantity(parameters[key], key, "[length]")
+            p[key] = _catalog_length(parameters[key], key)
         elif key in chuck:
             p[key] = Q_(chuck[key])
     ratio = p["taper_ratio"] = parameters.get("taper_ratio", face["taper_ratio"])

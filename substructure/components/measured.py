@@ -28,6 +28,16 @@ def _measured_frf(value) -> FRF:
             "frf: a measured component needs a square receptance matrix with the same "
             f"outputs and inputs; got outputs {value.outputs} and inputs {value.inputs}"
         )
+    for label in value.outputs:
+        try:
+            ref = parse_point(label)
+        except UnknownPointError as exc:
+            raise InvalidValueError(
+                f"frf: the label {label!r} is not a point name with its DOF ({exc}); expected labels such as "
+                "'holder.tip:y' and 'holder.tip:theta', which say the points the component is coupled at"
+            ) from None
+        if ref.dof is None:
+            raise InvalidValueError(f"frf: the label {label!r} has no DOF; expected '{label}:y' or '{label}:theta'")
     return value.to_receptance()
 
 

@@ -19,7 +19,8 @@ class, every field but ``name``) that hold a positive number or a positive
 scalar quantity: each fitted on a log scale from a tenth to ten times its
 value, as the masses of sensors and bodies are.  A field that is zero has no
 scale to search on and is left out; name it in ``parameters()`` with bounds
-of its own.
+of its own.  A field declared ``int`` is a count (the steps of a taper), not
+a value a fit may move, and is left out too.
 """
 
 from __future__ import annotations
@@ -38,6 +39,8 @@ __all__ = ["ComponentParameter", "own_parameters", "with_parameter"]
 
 
 def _finite(value, field: str) -> float:
+    if isinstance(value, (bool, str)):  # float(True) is 1.0 and float("1e3") 1000.0: neither is a value given
+        raise InvalidValueError(f"{field}: got {value!r}; expected a number")
     try:
         x = float(value)
     except (TypeError, ValueError):
@@ -105,6 +108,8 @@ def _derived(component: Any) -> tuple[ComponentParameter, ...]:
                 continue
             base_value = value.to_base_units()
             nominal, unit = float(base_value.magnitude), f"{base_value.units:~C}" or "dimensionless"
+        elif field.type in (int, "int"):  # a count (the steps of a taper): a fit would set it to 4.37
+            continue
         elif isinstance(value, (int, float)) and not isinstance(value, bool):
             nominal, unit = float(value), "dimensionless"
         else:
@@ -180,9 +185,10 @@ def with_parameter(component: Any, name: str, value: float) -> Any:
     if name not in params:
         raise UnknownPointError(f"component {component.name!r} has no parameter {name!r}; its own parameters: "
                                 f"{', '.join(params) or 'none'}")
+    value = _finite(value, name)
     hook = getattr(component, "with_parameter", None)
     if callable(hook):
-        return hook(name, float(value))
+        return hook(name, value)
     current = getattr(component, name)
     if isinstance(current, pint.Quantity):
         new = current._REGISTRY.Quantity(float(value), params[name].unit).to(current.units)

@@ -10,6 +10,7 @@ segments alone; :func:`receptances` is the checked call of a component's
 
 from __future__ import annotations
 
+import warnings
 from typing import Any, Iterable
 
 import numpy as np
@@ -17,7 +18,7 @@ import pint
 
 from ..beams import Segment
 from .._blocks import at_decay, checked_block
-from ..errors import InvalidValueError
+from ..errors import InvalidValueError, NonReciprocalWarning
 from ..frf import FRF, Frequency
 from ..points import DOFS
 
@@ -101,7 +102,10 @@ def as_frequency(frequency) -> Frequency:
             "'5000 Hz', '2 Hz')) or an array of frequencies in Hz"
         )
     try:
-        hz = np.atleast_1d(np.asarray(frequency, dtype=float))
+        given = np.asarray(frequency)
+        if given.dtype.kind not in "iuf":  # booleans (True would be 1 Hz), texts ("500" without its unit)
+            raise TypeError
+        hz = np.atleast_1d(given.astype(float))
     except (TypeError, ValueError):
         raise InvalidValueError(
             f"frequency: got {frequency!r}; expected a Frequency (e.g. Frequency.from_range('20 Hz', '5000 Hz', "
@@ -190,5 +194,29 @@ def receptances(component: Any, refs: list, frequency_hz: np.ndarray, decay: flo
         is not 0 and its ``receptance_matrix`` does not take it.
     """
     call = at_decay(component, "receptance_matrix", frequency_hz, decay)
-    return checked_block(component, "component", "receptance_matrix", lambda: call(refs), 2 * len(refs),
-                         frequency_hz)
+    y = checked_block(component, "component", "receptance_matrix", lambda: call(refs), 2 * len(refs), frequency_hz)
+    if type(component).__module__.split(".")[0] != __name__.split(".")[0]:
+        _check_reciprocal(component, y, refs, frequency_hz)
+    return y
+
+
+RECIPROCITY_TOLERANCE = 1e-6
+"""Largest ``|Y_ij - Y_ji|`` over the largest ``|Y|`` of a line that a component type of one's own may give."""
+
+
+def _check_reciprocal(component: Any, y: np.ndarray, refs: list, frequency_hz) -> None:
+    """Warn when a component type of one's own gives receptances that are not symmetric (a linear elastic
+    structure's are: ``H12 = H21``, ``L = N``); the coupled receptances would not be reciprocal either."""
+    scale = np.abs(y).max(axis=(0, 1))
+    asym = np.abs(y - np.swapaxes(y, 0, 1)).max(axis=(0, 1)) / np.where(scale > 0, scale, 1.0)
+    worst = int(np.argmax(asym))
+    if asym[worst] > RECIPROCITY_TOLERANCE:
+        i, j = np.unravel_index(np.argmax(np.abs(y[..., worst] - y[..., worst].T)), y.shape[:2])
+        f = np.atleast_1d(np.asarray(frequency_hz, dtype=float))
+        a, b = (f"{refs[k // 2]}:{DOFS[k % 2]}" for k in (i, j))
+        warnings.warn(
+            f"component {getattr(component, 'name', '?')!r} ({type(component).__name__}): receptance_matrix gave a "
+            f"matrix that is not symmetric ({a} / {b} and {b} / {a} differ by {asym[worst]:.2g} of its largest entry "
+            f"at {f[worst]:g} Hz): a linear elastic structure's are (H12 = H21, L = N), and the coupled "
+            "receptances will not be reciprocal",
+            NonReciprocalWarning, stacklevel=3)

@@ -14,7 +14,7 @@ import pint
 
 from ..beams import Flutes, Segment
 from ..errors import InvalidValueError, UnitError
-from ..units import Q_, quantity, ureg
+from ..units import Q_, quantity, show_value, ureg
 from .beam import Beam
 from .protocol import register_component
 
@@ -40,6 +40,8 @@ def _tool_helix(value):
     if not isinstance(q, pint.Quantity) or q.units == ureg.dimensionless or not q.dimensionless \
             or np.ndim(q.magnitude) != 0:
         raise UnitError(f"helix: got {value!r}; expected the helix angle with its unit, e.g. '30 deg'")
+    if dict(q.to_root_units()._units).get("radian", 0) != 1:  # "30 %" is 0.3, which pint would take as 0.3 rad
+        raise UnitError(f"helix: got {value!r}; expected an angle (deg or rad), e.g. '30 deg'")
     deg = float(q.m_as("deg"))
     if not 0.0 <= deg < 90.0:
         raise InvalidValueError(f"helix: got {value!r}; expected a helix angle in [0, 90) deg")
@@ -145,6 +147,11 @@ class Tool(Beam):
         d = quantity(diameter, "diameter", "[length]")
         total = quantity(overhang, "overhang", "[length]")
         flutes = None if flute_length is None else quantity(flute_length, "flute_length", "[length]")
+        for field, value, q in (("diameter", diameter, d), ("overhang", overhang, total)):
+            if q.magnitude <= 0:
+                raise InvalidValueError(f"{field}: got {show_value(value)}; expected a positive length")
+        if flutes is not None and flutes.magnitude < 0:
+            raise InvalidValueError(f"flute_length: got {show_value(flute_length)}; expected a length >= 0")
         extra = {"teeth": teeth, "helix": helix}
         if flutes is None or flutes.magnitude == 0:
             return cls(name, [Segment(total, d, material=material)], **extra)

@@ -1,0 +1,321 @@
+"""Hostile inputs to the Python API of components, joints, points and sweeps.
+
+Each case gave a silently wrong value, a raw Python error from deep inside, or
+gigabytes of memory before it was checked where it enters.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import attrs
+import numpy as np
+import pytest
+
+from substructure import (Assembly, Flutes, Frequency, Holder, Joint, Material, MeasuredComponent, Segment, Sensor,
+                          Tool, UnitError, add_mass, decouple, default_assembly, remove_mass)
+from substructure.components import own_parameters, with_parameter
+from substructure.coupling import modify
+from substructure.errors import InvalidValueError, NonPassiveJointWarning, NonReciprocalWarning, UnknownPointError
+from substructure.frf import FRF
+from substructure.materials import get_material
+from substructure.points import parse_point
+from substructure.sweep import sweep
+
+GRID = [500.0, 1000.0]
+
+
+@pytest.mark.parametrize("text", ["1,5 mm", "1, 5 mm", "1,000 mm"])
+def test_a_comma_in_a_value_is_refused_not_dropped(text):
+    """pint drops the comma: '1,5 mm' was a segment of 15 mm and '1, 5 mm' one of 5 mm."""
+    with pytest.raises(UnitError, match=r"length: cannot read '1, ?[05]+ mm': a comma is neither a decimal point"):
+        Segment(text, "12 mm")
+
+
+def test_a_comma_in_a_plain_number_is_refused_too():
+    with pytest.raises(InvalidValueError, match=r"loss_factor: cannot read '0,002': a comma"):
+        Material("x", "210 GPa", 0.3, "7850 kg/m^3", loss_factor="0,002")
+    with pytest.raises(InvalidValueError, match=r"flutes.diameter_ratio: cannot read '0,8': a comma"):
+        Flutes("0,8")
+
+
+@pytest.mark.parametrize("between", [None, 5, (p for p in ("a.tip", "b.base")), "a.tip"])
+def test_a_joint_between_that_is_not_two_points_is_named(between):
+    """None, a number or a generator gave a raw TypeError (object has no len())."""
+    with pytest.raises(InvalidValueError, match=r"between: got .*; expected two point names"):
+        Joint("j", between, k={"yf": "1e7 N/m"})
+
+
+def test_a_material_name_that_is_not_a_text():
+    """A list gave a raw TypeError (unhashable type)."""
+    with pytest.raises(InvalidValueError, match=r"material: got \[\]; expected the name of a material"):
+        get_material([])
+
+
+def test_a_helix_in_percent_is_not_taken_as_radians():
+    """'30 %' is the number 0.3, which was read as 0.3 rad: a helix of 17.2 deg."""
+    with pytest.raises(UnitError, match=r"helix: got '30 %'; expected an angle"):
+        Tool.end_mill("12 mm", "50 mm", "30 mm", helix="30 %")
+    assert Tool.end_mill("12 mm", "50 mm", "30 mm", helix="0.5 rad").helix.m_as("rad") == pytest.approx(0.5)
+
+
+@pytest.mark.parametrize("args, message", [
+    (("-12 mm", "50 mm", "30 mm"), r"diameter: got '-12 mm'; expected a positive length"),
+    (("12 mm", "-50 mm"), r"overhang: got '-50 mm'; expected a positive length"),
+    (("12 mm", "50 mm", "-30 mm"), r"flute_length: got '-30 mm'; expected a length >= 0"),
+])
+def test_end_mill_names_its_own_arguments(args, message):
+    """A negative flute length was refused as 'length: got <Quantity(-30, 'millimeter')>'."""
+    with pytest.raises(InvalidValueError, match=message):
+        Tool.end_mill(*args)
+
+
+@pytest.mark.parametrize("frequency", [True, ["500", "1000"], [np.True_]])
+def test_booleans_and_texts_are_not_frequencies(frequency):
+    """True was 1 Hz, and ['500', '1000'] 500 and 1000 Hz, while '500 Hz' was refused."""
+    with pytest.raises(InvalidValueError, match=r"frequency: got .*; expected a Frequency"):
+        default_assembly().receptance("tool.tip:y", frequency=frequency)
+
+
+def test_a_frequency_far_beyond_the_beam_model_is_refused_before_the_memory_goes():
+    """A line at 3e7 Hz cut the spindle into some 3000 pieces (0.5 GB, 1 s); at 1e8 Hz 4 GB and a
+    MemoryError, at 1e12 Hz 15 GB: a frequency in the wrong unit took the machine down."""
+    d = default_assembly()
+    with pytest.raises(InvalidValueError, match=r"frequency: got a line at 3e\+07 Hz, where component 'spindle' "
+                                                r"would be cut into about .* pieces"):
+        d.receptance("tool.tip:y", frequency=[500.0, 3e7])
+    with pytest.raises(InvalidValueError, match=r"component 'tool' would be cut"):
+        d.component("tool").receptance([1e12])
+    rods = [Assembly("rod", components=(Tool("rod", [Segment(f"{L} m", "12 mm", material="carbide")]),))
+            for L in (5, 5.1)]  # some 3000 pieces at 3 MHz
+    with pytest.raises(InvalidValueError, match=r"component 'rod' would be cut"):  # the batched beams too
+        sweep(rods, "rod.tip:y", frequency=[3e6])
+    assert np.isfinite(d.receptance("tool.tip:y", frequency=[1e5]).data).all()   # a fast tap test still works
+
+
+def test_sweep_arguments_that_are_not_what_it_takes():
+    d = default_assembly()
+    with pytest.raises(InvalidValueError, match=r"sweep: variant 1 is 2; expected an Assembly"):
+        sweep([d, 2], "tool.tip:y", frequency=GRID)
+    with pytest.raises(InvalidValueError, match=r"sweep: got an object of type Assembly; expected a sequence of "
+                                                r"assemblies \(a list: \[assembly\] for one\)"):
+        sweep(d, "tool.tip:y", frequency=GRID)
+    for chunk in ("10", 1.5, 0, True):
+        with pytest.raises(InvalidValueError, match=r"chunk_lines: got .*; expected a whole number of lines >= 1"):
+            sweep([d], "tool.tip:y", frequency=GRID, chunk_lines=chunk)
+
+
+def test_a_sweep_too_large_for_memory_is_refused_before_any_work(monkeypatch):
+    """The result was allocated whole after every variant was planned: a million variants of 2491 lines
+    asked for 40 GB."""
+    monkeypatch.setattr(sys.modules["substructure.sweep"], "MAX_SWEEP_VALUES", 10)
+    d = default_assembly()
+    with pytest.raises(InvalidValueError, match=r"sweep: 3 variants x 2 lines x 2 x 2 DOFs would be 24 complex "
+                                                r"values .* more than 1e\+01"):
+        sweep([d, d, d], "tool.tip", frequency=GRID)
+    assert sweep([d, d], "tool.tip:y", frequency=GRID).data.shape == (2, 2, 1, 1)   # 4 values: below
+
+
+def test_point_names_take_spaces_around_the_minus_as_around_the_rest():
+    """'tool .tip-5 mm' and 'tool.tip-5 mm ' were read, 'tool.tip -5 mm' and 'tool.tip - 5 mm' refused."""
+    for text in ("tool.tip - 5 mm", "tool.tip -5 mm", " tool . tip - 5mm:y"):
+        assert str(parse_point(text).point) == "tool.tip-5 mm"
+    d = default_assembly()
+    np.testing.assert_array_equal(d.receptance("tool.tip - 5 mm:y", frequency=GRID).data,
+                                  d.receptance("tool.tip-5 mm:y", frequency=GRID).data)
+
+
+@pytest.mark.parametrize("text, message", [
+    ("tool.tip-5 mm-3 mm", r"the distance '5 mm-3 mm' holds a sum or a difference"),   # was tool.tip-2 mm
+    ("tool@5 mm + 3 mm", r"the distance '5 mm \+ 3 mm' holds a sum or a difference"),   # was tool@8 mm
+    ("tool.tip:y:theta", r"more than one ':'; expected one DOF suffix"),
+])
+def test_point_names_that_were_computed_or_misread(text, message):
+    with pytest.raises(UnknownPointError, match=message):
+        parse_point(text)
+    assert str(parse_point("tool@1e-3 m")) == "tool@0.001 m"   # an exponent is not a difference
+
+
+def test_a_measured_component_with_labels_that_are_not_points_is_refused_where_it_is_made():
+    """Labels 'a', 'b' were accepted, and the assembly built from it failed on point 'a' without naming the
+    measured component."""
+    y = Tool.end_mill("12 mm", "50 mm").receptance(GRID, ["tip"])
+    with pytest.raises(InvalidValueError, match=r"frf: the label 'a:y' is not a point name with its DOF"):
+        MeasuredComponent("m", FRF(y.frequency, y.data, ("a:y", "a:theta"), ("a:y", "a:theta")))
+    with pytest.raises(InvalidValueError, match=r"frf: the label 'a' is not a point name"):
+        MeasuredComponent("m", FRF(y.frequency, y.data, ("a", "b"), ("a", "b")))
+    assert Assembly("x", components=(MeasuredComponent("m", y),)).receptance("tool.tip:y", frequency=GRID).shape \
+        == (2, 1, 1)
+
+
+def _as(frf, quantity):
+    omega = frf.frequency.omega
+    factor = {"mobility": 1j * omega, "accelerance": -(omega**2)}[quantity]
+    return attrs.evolve(frf, data=frf.data * factor[:, None, None], quantity=quantity)
+
+
+@pytest.mark.parametrize("quantity", ["mobility", "accelerance"])
+def test_a_mass_added_to_a_mobility_or_an_accelerance_is_added_to_what_it_measures(quantity):
+    """The receptance formula ran on the accelerance's values: a 2 g sensor added to a tool tip accelerance gave
+    values 1e5 times too small, still labelled an accelerance."""
+    d = default_assembly()
+    h = d.receptance("tool.tip:y", frequency=GRID)
+    added = add_mass(_as(h, quantity), "tool.tip", "2 g")
+    assert added.quantity == quantity
+    np.testing.assert_allclose(added.to_receptance().data, add_mass(h, "tool.tip", "2 g").data, rtol=1e-12)
+    back = remove_mass(added, "tool.tip", "2 g")
+    np.testing.assert_allclose(back.to_receptance().data, h.data, rtol=1e-9)
+
+
+def test_decoupling_an_accelerance_and_on_the_rotation_alone():
+    """decouple took an accelerance as a receptance; and at an interface of theta alone it took the joint's
+    k_yf for its k_tm (here 0: the tool was not removed at all, 1.4 % off)."""
+    grid = Frequency.from_hz([500.0, 1000.0, 1500.0])
+    joint = Joint("holder-tool", ("holder.tip", "tool.base"), k={"tm": "8e4 N*m/rad"}, c={"tm": "4 N*m*s/rad"})
+    d = default_assembly().with_joint(joint)
+    expected = d.without("tool").frf(["holder.tip:theta"], frequency=grid)
+    removed = d.component("tool").receptance(grid, ["base"]).select(["tool.base:theta"], ["tool.base:theta"])
+    alone = decouple(d.frf(["holder.tip:theta"], frequency=grid), removed, [("holder.tip", "tool.base", joint)])
+    np.testing.assert_allclose(alone.data, expected.data, rtol=1e-9)
+    both = d.frf(["holder.tip"], frequency=grid)
+    alone = decouple(_as(both, "accelerance"), d.component("tool").receptance(grid, ["base"]),
+                     [("holder.tip", "tool.base", joint)])
+    assert alone.quantity == "accelerance"
+    np.testing.assert_allclose(alone.to_receptance().data, d.without("tool").frf(["holder.tip"], frequency=grid).data,
+                               rtol=1e-9)
+
+
+def test_modifications_that_gave_raw_errors_or_refused_a_spaced_point():
+    d = default_assembly()
+    h = d.receptance("tool.tip:y", frequency=GRID)
+    for dz in (5.0, np.ones((1, 1, 7)), lambda f: 3):
+        with pytest.raises(InvalidValueError, match=r"delta_stiffness: got an array of shape .*; expected \(r, r\) or "
+                                                    r"\(r, r, 2\)"):
+            modify(h, "tool.tip:y", dz)
+    with pytest.raises(InvalidValueError, match=r"interface\[0\]: got \('holder.tip', 'tool.base'\); expected"):
+        decouple(h, h, [("holder.tip", "tool.base")])
+    with pytest.raises(InvalidValueError, match=r"frf: got str; expected an FRF"):
+        add_mass("tool.tip", "tool.tip", "2 g")
+    np.testing.assert_array_equal(add_mass(h, "tool.tip :y", "2 g").data, add_mass(h, "tool.tip:y", "2 g").data)
+
+
+def test_a_beams_own_receptance_takes_its_points_as_the_assembly_does():
+    """points='tip' was read letter by letter ('point tool.t'), None gave an AttributeError, a point of another
+    component was read as 'tool.holder.tip', the same place twice said 'positions: expected distinct positions',
+    and position(5) gave an AttributeError."""
+    tool = Tool.end_mill("12 mm", "50 mm", "30 mm")
+    assert tool.receptance(GRID, "tip").outputs == ("tool.tip:y", "tool.tip:theta")
+    assert tool.receptance(GRID, [" tip - 5 mm"]).outputs[0] == "tool.tip-5 mm:y"
+    with pytest.raises(UnknownPointError, match=r"point: got None; expected a point of 'tool'"):
+        tool.receptance(GRID, [None])
+    with pytest.raises(UnknownPointError, match=r"point holder.tip: not on component 'tool'"):
+        tool.receptance(GRID, ["holder.tip"])
+    with pytest.raises(InvalidValueError, match=r"points: 'tip' and '@50 mm' are the same place of 'tool'"):
+        tool.receptance(GRID, ["tip", "@50 mm"])
+    with pytest.raises(UnknownPointError, match=r"point 'tool.tip:y': a DOF suffix is not allowed here"):
+        tool.receptance(GRID, ["tip:y"])
+    with pytest.raises(UnknownPointError, match=r"point: got 5; expected a point of 'tool'"):
+        tool.position(5)
+
+
+def test_a_joint_of_1e300_n_per_m_is_checked_without_overflow():
+    """The passivity check multiplied the entries: a RuntimeWarning (an error under -W error) for k = 1e300."""
+    Joint("j", ("a.tip", "b.base"), k={"yf": "1e300 N/m", "tm": "1e300 N*m/rad"})
+    with pytest.warns(NonPassiveJointWarning, match=r"k_ym\*k_tf = 4e\+12 > k_yf\*k_tm = 1e\+12"):
+        Joint("j", ("a.tip", "b.base"), k={"yf": "1e7 N/m", "ym": "2e6 N", "tf": "2e6 N/rad", "tm": "1e5 N*m/rad"})
+
+
+def test_the_progress_of_a_long_sweep_is_a_line_per_percent_at_most(capsys):
+    """A line per chunk: with one variant per chunk, 300 variants printed 300 lines (a million, a million)."""
+    d = default_assembly().without("spindle", "holder")
+    variants = [d.with_component(Tool.end_mill("12 mm", f"{40 + 0.1 * i:.1f} mm")) for i in range(300)]
+    sweep(variants, "tool.tip:y", frequency=GRID, chunk_lines=1, progress=True)
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) == 101 and lines[0] == "sweep: 1/300 variants" and lines[-1] == "sweep: 300/300 variants"
+
+
+@pytest.mark.parametrize("key, value, message", [
+    ("gap_length", "-2 mm", r"gap_length: got '-2 mm'; expected a length >= 0"),   # was a 72 mm holder for 70 mm
+    ("flange_diameter", "-63 mm", r"flange_diameter: got '-63 mm'; expected a positive length"),   # was 'od: ...'
+    ("nut_length", "0 mm", r"nut_length: got '0 mm'; expected a positive length"),   # was 'length: ...'
+])
+def test_catalogue_lengths_are_checked_under_their_own_names(key, value, message):
+    with pytest.raises(InvalidValueError, match=message):
+        Holder.from_catalog("BT40 ER32", bore="12 mm", gauge_length="70 mm", **{key: value})
+    assert Holder.from_catalog("BT40 ER32", bore="12 mm", gauge_length="70 mm", gap_length="0 mm").length_m \
+        == pytest.approx(0.070)
+
+
+@attrs.frozen
+class _SteppedHolder(Holder):
+    """A holder with a count among its fields, as the shrink-fit holder of docs/extending.md."""
+
+    steps: int = attrs.field(default=4, kw_only=True)
+    nut_kg: float = attrs.field(default=1, kw_only=True)
+
+    def __attrs_post_init__(self):
+        if not isinstance(self.steps, int) or self.steps < 1:
+            raise InvalidValueError(f"steps: got {self.steps!r}; expected a whole number >= 1")
+
+    def receptance_matrix(self, refs, frequency_hz, decay=0.0):
+        return Holder.receptance_matrix(self, refs, frequency_hz, decay)
+
+
+def test_a_count_among_a_components_fields_is_not_a_parameter_to_fit():
+    """steps = 4 was offered to the fits as a number from 0.4 to 40: setting it to 4.37 failed in the middle of a
+    diagnosis (or, without the class's own check, made a holder of 4.37 steps); a text value gave a raw ValueError."""
+    holder = _SteppedHolder("holder", [Segment("50 mm", "40 mm")])
+    assert [p.name for p in own_parameters(holder)] == ["nut_kg"]   # 1, written as an int, is still a value
+    with pytest.raises(UnknownPointError, match=r"no parameter 'steps'; its own parameters: nut_kg"):
+        with_parameter(holder, "steps", 4.37)
+    with pytest.raises(InvalidValueError, match=r"nut_kg: got 'abc'; expected a number"):
+        with_parameter(holder, "nut_kg", "abc")
+    assert with_parameter(holder, "nut_kg", 0.4).nut_kg == 0.4
+
+
+def test_a_sweep_that_moves_a_sensor_between_points_it_computes_anyway_is_refused():
+    """With the sensor at two points that are both outputs, the variants had the same nodes and names and every
+    variant was computed with the sensor where variant 0 has it: variant 1 was 118 % off, silently."""
+    d = default_assembly()
+    variants = [d.attach(Sensor("acc", p, "20 g")) for p in ("tool.tip", "holder.tip")]
+    with pytest.raises(InvalidValueError, match=r"sweep: variant 1 .* has sensor 'acc' at holder.tip, variant 0 at "
+                                                r"tool.tip; a sweep needs each joint, sensor, mass and support at the "
+                                                r"same points"):
+        sweep(variants, ["tool.tip:y", "holder.tip:y"], frequency=GRID)
+    j = d.joint("holder-tool")   # a joint written the other way round couples alike: accepted, and right
+    flipped = d.with_joint(Joint(j.name, j.between[::-1], k=j.k, c=j.c))
+    result = sweep([d, flipped], "tool.tip:y", frequency=GRID)
+    np.testing.assert_allclose(result[1].data, flipped.receptance("tool.tip:y", frequency=GRID).data, rtol=1e-12)
+
+
+@attrs.frozen
+class _Lump:
+    """A lumped body of one's own whose L and N differ: not a linear elastic structure."""
+
+    name: str
+    cross: float = 1e-9
+
+    @property
+    def component_names(self):
+        return frozenset({self.name})
+
+    def node_key(self, ref):
+        return (self.name, ref.where)
+
+    def receptance_matrix(self, refs, frequency_hz):
+        w2 = (2 * np.pi * np.asarray(frequency_hz)) ** 2
+        y = np.zeros((2, 2, w2.size), dtype=complex)
+        y[0, 0], y[1, 1], y[0, 1] = -1 / (0.5 * w2), -1 / (1e-4 * w2), self.cross
+        return y
+
+
+def test_a_component_of_ones_own_that_is_not_reciprocal_is_warned_of():
+    """Its receptances entered the coupling as they were: the tool point FRF was not reciprocal, without a word."""
+    d = default_assembly().without("tool")
+    lumped = d.add(_Lump("nut")).connect("holder.tip", "nut.tip", k={"yf": "1e8 N/m", "tm": "1e6 N*m/rad"})
+    with pytest.warns(NonReciprocalWarning, match=r"component 'nut' \(_Lump\): receptance_matrix gave a matrix that "
+                                                  r"is not symmetric \(nut.tip:y / nut.tip:theta and nut.tip:theta / "
+                                                  r"nut.tip:y differ by"):
+        lumped.receptance("holder.tip:y", frequency=GRID)
+    symmetric = d.add(_Lump("nut", 0.0)).connect("holder.tip", "nut.tip", k={"yf": "1e8 N/m", "tm": "1e6 N*m/rad"})
+    assert np.isfinite(symmetric.receptance("holder.tip:y", frequency=GRID).data).all()   # no warning: an error here
