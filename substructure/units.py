@@ -116,6 +116,42 @@ _DIMENSION_NAMES = {
 
 
 _NUMBER = re.compile(r"^\s*[-+]?(\d|\.\d|inf|nan)", re.IGNORECASE)
+_SIDE_BY_SIDE = re.compile(r"[\w).]\s+\.?\d")  # "1 2 mm", "1 1/2 in", "20 mm 2": pint multiplies them
+
+
+def check_number_text(text: str, field: str, expected: str, error: type[Exception] = UnitError) -> None:
+    """Refuse a value's text that pint reads as another number than the one written.
+
+    pint drops a comma (``"20,5 mm"`` is 205 mm, ``"1,5"`` is 15) and
+    multiplies numbers written side by side (``"1 2 mm"`` is 2 mm, ``"1 1/2
+    in"`` is half an inch): such a text is an error, not a guess.
+    :func:`quantity` and :func:`dimensionless` check every string; readers
+    that hand a string to pint themselves call it first.
+
+    Parameters
+    ----------
+    text : str
+        The value as written.
+    field : str
+        Name of the field, used in error messages.
+    expected : str
+        What the field expects, for the message (``"a length (e.g. '60 mm')"``).
+    error : type, default UnitError
+        The class of the error raised.
+
+    Raises
+    ------
+    UnitError
+        (or ``error``) for a comma or numbers side by side.
+    """
+    _no_comma(text, field, expected, error)
+    m = _SIDE_BY_SIDE.search(text)
+    if m:
+        raise error(
+            f"{field}: got {show_value(text)}: a number written after {text[:m.start() + 1].strip()!r} with "
+            f"only a space between would be multiplied into it; write one number and its unit (e.g. '12 mm'); "
+            f"expected {expected}"
+        )
 
 
 def _describe(dimension: str) -> str:
@@ -252,12 +288,18 @@ def quantity(value: Any, field: str, dimension: str) -> pint.Quantity:
                 f"{field}: cannot read {show_value(value)} as a quantity: it does not start with a number; "
                 f"expected {expected}"
             )
+        check_number_text(value, field, expected)
         try:
             magnitude, units = _parse(value)
         except Exception as exc:  # pint raises several types for bad strings
             raise UnitError(
                 f"{field}: cannot read {show_value(value)} as a quantity ({exc}); expected {expected}"
             ) from None
+        if units is not None and units.dimensionless and dimension != "" and units != ureg.dimensionless:
+            raise UnitError(  # "20 mil" is an angle in pint (angular mil), "2 %" a ratio
+                f"{field}: got {show_value(value)}, whose unit {units} has no dimension (an angle or a ratio); "
+                f"expected {expected}" + (" (a thousandth of an inch is 'thou')" if str(units) == "mil" else "")
+            )
         if units is None or units.dimensionless and dimension != "":
             raise UnitError(
                 f"{field}: got {show_value(value)} without a unit; expected {expected}, with its unit"
@@ -334,7 +376,7 @@ def dimensionless(value: Any, field: str) -> float:
             )
         value = value.m_as("dimensionless")
     elif isinstance(value, str):
-        _no_comma(value, field, "a number", InvalidValueError)
+        check_number_text(value, field, "a number", InvalidValueError)
         try:
             q: Any = ureg.Quantity(value)
         except Exception:

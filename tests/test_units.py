@@ -124,3 +124,37 @@ def test_an_instrument_unit_pint_cannot_read_is_a_value_error(text):
                                         ("", None), ("[]", None)])
 def test_a_unit_cell_loses_only_the_brackets_around_the_whole(cell, unit):
     assert bare_unit(cell) == unit
+
+
+@pytest.mark.parametrize("text, read_by_pint", [
+    ("20,5 mm", "205 mm"),      # a decimal comma: pint drops it
+    ("1,000 mm", "1000 mm"),
+    ("20 , 5 mm", "100 mm"),
+    ("1 2 mm", "2 mm"),         # "12 mm" with a stray space: pint multiplies the numbers
+    ("1 1/2 in", "0.5 in"),     # a mixed fraction
+    ("20 mm 2", "40 mm"),
+])
+def test_a_number_pint_would_read_as_another_is_refused(text, read_by_pint):
+    assert ureg.Quantity(text) == ureg.Quantity(read_by_pint)  # what was read silently before
+    said = r"od: (cannot read|got) '.*'(: a comma|: a number written after).*expected a length"
+    with pytest.raises(UnitError, match=said):
+        quantity(text, "od", "[length]")
+
+
+@pytest.mark.parametrize("text", ["0,002", "1 2"])
+def test_a_dimensionless_number_pint_would_read_as_another_is_refused(text):
+    said = r"loss_factor: (cannot read|got) '.*'(: a comma|: a number written after)"
+    with pytest.raises(InvalidValueError, match=said):
+        dimensionless(text, "loss_factor")
+
+
+@pytest.mark.parametrize("text", ["20 mm", "20mm", "2.5e-3 m", ".5 in", "1/2 in", "20 mm - 5 mm", "5e-8 kg*m**2"])
+def test_numbers_with_operators_and_exponents_still_read(text):
+    quantity(text, "x", str(ureg.Quantity(text).dimensionality))
+
+
+def test_a_dimensionless_unit_where_a_dimension_is_expected_is_named():
+    with pytest.raises(UnitError, match=r"od: got '20 mil', whose unit mil has no dimension .*'thou'"):
+        quantity("20 mil", "od", "[length]")
+    with pytest.raises(UnitError, match=r"od: got '20 %', whose unit percent has no dimension"):
+        quantity("20 %", "od", "[length]")

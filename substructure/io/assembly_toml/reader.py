@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import importlib.resources
 import os
+import re
 
 from .. import read_text
 from ...assembly import Assembly
@@ -23,10 +24,13 @@ from ...frf import Frequency
 from ...joints import Joint, JointProvenance, Mass, Sensor, Support
 from ...materials import CATALOG, Material
 from ...points import parse_point
-from ...units import to_si
+from ...units import check_number_text, to_si
 from ._schema import (_CATALOG_KEYS, _COMPONENT_KEYS, _FLUTES_KEYS, _FREQUENCY_KEYS, _INSERT_KEYS, _JOINT_KEYS,
                       _MASS_KEYS, _MATERIAL_KEYS, _MATRIX_KEYS, _SEGMENT_KEYS, _SENSOR_KEYS, _SUPPORT_KEYS,
                       _TOP_KEYS, MAX_TAPER_STEPS, SIZE_RANGE_M, _extra_fields, _init_fields)
+
+_NUMBER_FIRST = re.compile(r"\s*[-+]?\.?\d")  # a value written as a number (and its unit)
+
 
 class _Reader:
     """Builds an assembly from parsed TOML, naming the key path in every error."""
@@ -117,6 +121,7 @@ class _Reader:
             f for f in extra if f not in _COMPONENT_KEYS)
         self.table(table, parts, allowed, ("name", "type", "segments") if with_segments else ("name", "type"))
         kwargs = {f: table[f] for f in extra if f in table and f not in _COMPONENT_KEYS}
+        self.number_texts(kwargs, parts)
         if not with_segments:
             if "material" in extra and "material" in table:
                 kwargs["material"] = self.material(table["material"], parts + ["material"])
@@ -140,11 +145,22 @@ class _Reader:
         allowed = _CATALOG_KEYS + self.call(parts, catalog_parameters, entry)
         self.table(table, parts, allowed, ("name", "type", "catalog"))
         params = {k: v for k, v in table.items() if k not in _CATALOG_KEYS}
+        self.number_texts(params, parts)
         for key in ("material", "tool_material"):
             if key in params and not (key == "tool_material" and params[key] == "none"):
                 params[key] = self.material(params[key], parts + [key])
         resolved = self.call(parts, design, entry, **params)
         return self.call(parts, resolved.holder, table["name"], cls)
+
+    def number_texts(self, values: dict, parts) -> None:
+        """Refuse a value written as a number that pint would misread (``helix = "3,5 deg"`` is 35 deg to pint).
+
+        The fields of components (a tool's ``helix``, a catalogue holder's
+        angles) may reach pint without :func:`~substructure.units.quantity`.
+        """
+        for key, value in values.items():
+            if isinstance(value, str) and _NUMBER_FIRST.match(value):
+                self.call(parts, check_number_text, value, key, "one number and its unit")
 
     def size(self, value, parts) -> None:
         """Refuse a length outside the range the beam model is made for (a wrong unit, or a typo)."""

@@ -1,0 +1,50 @@
+"""Assembly files written the way people get them wrong: each is an error naming file, line and key, or reads right.
+
+The cases come from trying the reader, the writer and ``substructure frf``
+as a new user would; each failed silently or with an unclear error before.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from substructure.errors import FileFormatError
+from substructure.io.assembly_toml import loads_assembly
+
+DATA = Path(__file__).parent / "data"
+EXAMPLE_TEXT = (DATA / "formats_example.toml").read_text(encoding="utf-8")
+
+
+def edit(old: str, new: str) -> str:
+    assert old in EXAMPLE_TEXT, old
+    return EXAMPLE_TEXT.replace(old, new, 1)
+
+
+SEG_10 = '{ length = "10 mm", od = "40 mm" }'
+
+
+@pytest.mark.parametrize("old, new, key, said", [
+    # pint read these as 205 mm, 2 mm, 1.5 mm, 0.5 in and a loss factor of 2
+    (SEG_10, '{ length = "10 mm", od = "20,5 mm" }', "components[1].segments[1].od", "a comma"),
+    (SEG_10, '{ length = "1 2 mm", od = "40 mm" }', "components[1].segments[1].length", "a number written after '1'"),
+    ('at = "tool.tip"', 'at = "tool@1,5 mm"', "sensors[0].at", "a comma"),
+    (SEG_10, '{ length = "1 1/2 in", od = "40 mm" }', "components[1].segments[1].length", "after '1'"),
+    ("loss_factor = 0.002", 'loss_factor = "0,002"', "materials.steel.loss_factor", "a comma"),
+    # helix reaches pint without the unit checks of the other keys: 35 deg and 30 deg before
+    ('type = "tool"', 'type = "tool"\nhelix = "3,5 deg"', "components[2].helix", "a comma"),
+    ('type = "tool"', 'type = "tool"\nhelix = "1 30 deg"', "components[2].helix", "after '1'"),
+])
+def test_a_number_pint_would_misread_is_an_error_at_its_key(old, new, key, said):
+    with pytest.raises(FileFormatError) as info:
+        loads_assembly(edit(old, new), source="bench.toml")
+    message = str(info.value)
+    assert message.startswith("bench.toml, line "), message
+    assert f": {key}: " in message and said in message, message
+
+
+def test_a_mil_for_a_length_is_named_as_the_angle_pint_reads():
+    with pytest.raises(FileFormatError, match=r"segments\[1\]\.od: got '1575 mil', whose unit mil has no "
+                                              r"dimension .*'thou'"):
+        loads_assembly(edit(SEG_10, '{ length = "10 mm", od = "1575 mil" }'), source="bench.toml")
