@@ -7,13 +7,13 @@ from pathlib import Path
 
 from ._common import (
     UsageError,
+    assembly_point_arg,
     check_outputs,
     check_plot,
     draw_to,
     grid_arg,
     grid_text,
     peak_table,
-    point_arg,
     print_json,
     write_frf,
 )
@@ -27,8 +27,8 @@ def run(args: argparse.Namespace) -> int:
     check_plot(args.plot)
     check_outputs([("--out", args.out), ("--plot", args.plot)], [args.assembly], args.overwrite)
     assembly = load_assembly(args.assembly)
-    at = point_arg(args.at)
-    to = point_arg(args.to) if args.to else at
+    at = assembly_point_arg(assembly, args.at, "--at")
+    to = assembly_point_arg(assembly, args.to, "--to") if args.to else at
     frequency = args.grid or assembly.frequency
     if frequency is None:
         raise UsageError(f"{args.assembly} has no [frequency] table; give the grid with --grid START:STOP:STEP")
