@@ -48,3 +48,12 @@ def test_a_mil_for_a_length_is_named_as_the_angle_pint_reads():
     with pytest.raises(FileFormatError, match=r"segments\[1\]\.od: got '1575 mil', whose unit mil has no "
                                               r"dimension .*'thou'"):
         loads_assembly(edit(SEG_10, '{ length = "10 mm", od = "1575 mil" }'), source="bench.toml")
+
+
+@pytest.mark.parametrize("between", ['["holder.tip", "holder@66 mm"]', '["tool.tip-60 mm", "tool.base"]'])
+def test_a_joint_between_two_names_of_one_point_is_an_error_on_reading(between):
+    # it loaded, and every receptance then failed with "joint 'holder-tool' connects a point to itself"
+    text = edit('between = ["holder.tip", "tool.base"]', f"between = {between}")
+    with pytest.raises(FileFormatError, match=r"^bench\.toml, line 51: joints\[1\]\.between: '.*' and '.*' are the "
+                                              r"same point"):
+        loads_assembly(text, source="bench.toml")

@@ -218,6 +218,9 @@ class _Reader:
         if not isinstance(between, list) or len(between) != 2:
             raise self.error(parts + ["between"], f"got {between!r}; expected two point names")
         points = [self.point(p, parts + ["between", m], base) for m, p in enumerate(between)]
+        if points[0] != points[1] and base.node_key(parse_point(points[0])) == base.node_key(parse_point(points[1])):
+            raise self.error(parts + ["between"], f"{between[0]!r} and {between[1]!r} are the same point; a joint "
+                             "connects two different points")
         if table.get("prior", False) is not False:
             return self.prior_joint(table, parts, base, points)
         stated = {key: table[key] for key in ("provenance", "source", "uncertainty") if key in table}
