@@ -6,6 +6,7 @@ as a new user would; each failed silently or with an unclear error before.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -57,3 +58,15 @@ def test_a_joint_between_two_names_of_one_point_is_an_error_on_reading(between):
     with pytest.raises(FileFormatError, match=r"^bench\.toml, line 51: joints\[1\]\.between: '.*' and '.*' are the "
                                               r"same point"):
         loads_assembly(text, source="bench.toml")
+
+
+@pytest.mark.parametrize("old, new, key", [
+    ('yf = "4.19e7 N/m"', 'yf = "1e300 N/m"', "joints[1].k.yf"),
+    ('k = { yf = "2e8 N/m" }', 'k = { yf = "-1e200 N/m" }', "supports[0].k.yf"),
+])
+def test_a_joint_entry_too_large_to_compute_with_is_refused(old, new, key):
+    # 1e300 N/m gave a numpy overflow warning, then "coupling through joint 'holder-tool' is singular: a rigid joint
+    # that closes a loop of rigid joints", which it is not
+    with pytest.raises(FileFormatError, match=rf"^bench\.toml, line \d+: {re.escape(key)}: got '.*'; expected at most "
+                                              r"1e\+100 N/m in magnitude .*rigid = true"):
+        loads_assembly(edit(old, new), source="bench.toml")
