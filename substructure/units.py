@@ -343,7 +343,10 @@ def to_si(value: Any, field: str, unit: str) -> float:
     float
         The magnitude in ``unit``.
     """
-    return magnitude_in(quantity(value, field, _dimension_of(unit)), unit)
+    out = magnitude_in(quantity(value, field, _dimension_of(unit)), unit)
+    if not math.isfinite(out):  # "1e300 GPa": a finite number whose value in Pa is beyond the floats
+        raise InvalidValueError(f"{field}: got {show_value(value)}, which is {out} in {unit}; expected a finite value")
+    return out
 
 
 @functools.lru_cache(maxsize=256)

@@ -70,3 +70,23 @@ def test_a_joint_entry_too_large_to_compute_with_is_refused(old, new, key):
     with pytest.raises(FileFormatError, match=rf"^bench\.toml, line \d+: {re.escape(key)}: got '.*'; expected at most "
                                               r"1e\+100 N/m in magnitude .*rigid = true"):
         loads_assembly(edit(old, new), source="bench.toml")
+
+
+@pytest.mark.parametrize("old, new, key, said", [
+    # each failed later: a raw ValueError or OverflowError from the beam model, or receptances of rounding noise
+    ('E = "210 GPa"', 'E = "1e300 GPa"', "materials.steel.E", "which is inf in Pa"),
+    ('E = "210 GPa"', 'E = "1e-100 Pa"', "materials.steel.E", "from 1 kPa to 10 TPa"),
+    ('rho = "7850 kg/m^3"', 'rho = "1e300 kg/m^3"', "materials.steel.rho", "from 0.1 to 1e5 kg/m^3"),
+    ("loss_factor = 0.002", "loss_factor = 1e100", "materials.steel.loss_factor", "at most 10"),
+    ('mass = "2 g"', 'mass = "1e60 kg"', "sensors[0].mass", "at most 1e6 kg"),
+    ('inertia = "5e-8 kg*m^2"', 'inertia = "1e300 kg*m^2"', "sensors[0].inertia", "at most 1e6 kg*m^2"),
+])
+def test_a_material_or_body_value_the_models_cannot_compute_with_is_refused(old, new, key, said):
+    with pytest.raises(FileFormatError, match=rf"^bench\.toml, line \d+: {re.escape(key)}: got .*{re.escape(said)}"):
+        loads_assembly(edit(old, new), source="bench.toml")
+
+
+def test_the_ends_of_the_plausible_ranges_read():
+    for old, new in (('E = "210 GPa"', 'E = "10 TPa"'), ('rho = "7850 kg/m^3"', 'rho = "0.1 kg/m^3"'),
+                     ("loss_factor = 0.002", "loss_factor = 10"), ('mass = "2 g"', 'mass = "1000 t"')):
+        loads_assembly(edit(old, new), source="bench.toml")

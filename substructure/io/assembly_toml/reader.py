@@ -24,10 +24,10 @@ from ...frf import Frequency
 from ...joints import Joint, JointProvenance, Mass, Sensor, Support
 from ...materials import CATALOG, Material
 from ...points import parse_point
-from ...units import check_number_text, to_si
+from ...units import check_number_text, dimensionless, to_si
 from ._schema import (_CATALOG_KEYS, _COMPONENT_KEYS, _FLUTES_KEYS, _FREQUENCY_KEYS, _INSERT_KEYS, _JOINT_KEYS,
                       _MASS_KEYS, _MATERIAL_KEYS, _MATRIX_KEYS, _SEGMENT_KEYS, _SENSOR_KEYS, _SUPPORT_KEYS,
-                      _TOP_KEYS, MAX_TAPER_STEPS, SIZE_RANGE_M, _extra_fields, _init_fields)
+                      _TOP_KEYS, MAX_TAPER_STEPS, PLAUSIBLE, SIZE_RANGE_M, _extra_fields, _init_fields)
 
 _NUMBER_FIRST = re.compile(r"\s*[-+]?\.?\d")  # a value written as a number (and its unit)
 
@@ -73,6 +73,7 @@ class _Reader:
         for name, table in materials.items():
             parts = ["materials", name]
             table = self.table(table, parts, _MATERIAL_KEYS, ("E", "nu", "rho"))
+            self.plausible(table, parts)
             custom.append(self.call(parts, Material, name, **table))
             self.materials[name] = custom[-1]
         items = {key: self.array(data.get(key, []), [key], f"[[{key}]] tables")
@@ -161,6 +162,23 @@ class _Reader:
         for key, value in values.items():
             if isinstance(value, str) and _NUMBER_FIRST.match(value):
                 self.call(parts, check_number_text, value, key, "one number and its unit")
+
+    def plausible(self, table: dict, parts) -> None:
+        """Refuse a material's or a body's value outside the range the models compute right (:data:`PLAUSIBLE`).
+
+        ``E = "1e-100 Pa"`` gave a raw OverflowError, ``mass = "1e60 kg"``
+        receptances of rounding noise; a negative value (or 0 where it must
+        be positive) is left to the constructor, which says why.
+        """
+        for key in [k for k in PLAUSIBLE if k in table]:
+            unit, lo, hi, words = PLAUSIBLE[key]
+            value = self.call(parts, to_si, table[key], key, unit) if unit else \
+                self.call(parts, dimensionless, table[key], key)
+            if value < 0 or (value == 0 and lo > 0):
+                continue  # the constructor says what is wrong with it
+            if not lo <= value <= hi:
+                raise self.error(parts + [key], f"got {table[key]!r}; expected {words} (the range the models "
+                                 "compute right): check the value and its unit")
 
     def size(self, value, parts) -> None:
         """Refuse a length outside the range the beam model is made for (a wrong unit, or a typo)."""
@@ -262,6 +280,7 @@ class _Reader:
     def point_mass(self, cls, keys, table, parts, base: Assembly):
         """A sensor or a mass (``cls``) of the table of ``keys``; a mass has no ``always_on``."""
         table = self.table(table, parts, keys, ("name", "at", "mass"))
+        self.plausible(table, parts)
         at = self.point(table["at"], parts + ["at"], base)
         extra = {key: table[key] for key in ("inertia", "always_on") if key in table}
         return self.call(parts, cls, table["name"], at, table["mass"], **extra)
