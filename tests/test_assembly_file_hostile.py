@@ -6,13 +6,14 @@ as a new user would; each failed silently or with an unclear error before.
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 
 import pytest
 
-from substructure.errors import FileFormatError
-from substructure.io.assembly_toml import loads_assembly
+from substructure.errors import FileFormatError, InvalidValueError
+from substructure.io.assembly_toml import load_assembly, loads_assembly, save_assembly
 
 DATA = Path(__file__).parent / "data"
 EXAMPLE_TEXT = (DATA / "formats_example.toml").read_text(encoding="utf-8")
@@ -90,3 +91,23 @@ def test_the_ends_of_the_plausible_ranges_read():
     for old, new in (('E = "210 GPa"', 'E = "10 TPa"'), ('rho = "7850 kg/m^3"', 'rho = "0.1 kg/m^3"'),
                      ("loss_factor = 0.002", "loss_factor = 10"), ('mass = "2 g"', 'mass = "1000 t"')):
         loads_assembly(edit(old, new), source="bench.toml")
+
+
+@pytest.mark.parametrize("path", [None, 3])
+def test_load_and_save_name_what_is_not_a_file_name(path):
+    # raw TypeErrors from os.fspath before
+    with pytest.raises(FileFormatError, match=rf"got {path!r} of type .*; expected the name of an assembly file"):
+        load_assembly(path)
+    with pytest.raises(InvalidValueError, match=rf"path: got {path!r} of type .*; expected the name of the assembly"):
+        save_assembly(loads_assembly('name = "x"'), path)
+
+
+def test_a_bytes_file_name_reads_and_writes(tmp_path):
+    # load_assembly(b"...") failed with "startswith first arg must be str" when the file had an error
+    path = tmp_path / "bench.toml"
+    path.write_text(edit(SEG_10, '{ length = "10 mm", od = "40" }'), encoding="utf-8")
+    where = rf"^{re.escape(str(path))}, line \d+: components\[1\]\.segments\[1\]\.od"
+    with pytest.raises(FileFormatError, match=where):
+        load_assembly(os.fsencode(path))
+    save_assembly(loads_assembly('name = "x"'), os.fsencode(tmp_path / "x.toml"))
+    assert load_assembly(tmp_path / "x.toml").name == "x"

@@ -325,8 +325,11 @@ def load_assembly(path: str | os.PathLike) -> Assembly:
     Assembly
         The assembly; errors name the file and the key.
     """
-    name = os.fspath(path)
-    return loads_assembly(read_text(path, "assembly file"), source=name)
+    try:
+        path = os.fsdecode(path)  # a str, bytes or os.PathLike name, as messages show it
+    except TypeError:
+        pass  # read_text refuses what is not a file name, naming it
+    return loads_assembly(read_text(path, "assembly file"), source=path)
 
 
 def default_assembly() -> Assembly:
