@@ -111,3 +111,24 @@ def test_a_bytes_file_name_reads_and_writes(tmp_path):
         load_assembly(os.fsencode(path))
     save_assembly(loads_assembly('name = "x"'), os.fsencode(tmp_path / "x.toml"))
     assert load_assembly(tmp_path / "x.toml").name == "x"
+
+
+@pytest.mark.parametrize("encoding, said", [
+    ("utf-16-le", "a NUL character"),  # UTF-16 without its byte-order mark: "Expected '=' after a key" before
+    ("utf-32", "a NUL character"),     # "Invalid statement (at line 1, column 1)" before
+])
+def test_text_in_another_encoding_says_so(tmp_path, encoding, said):
+    path = tmp_path / "bench.toml"
+    path.write_bytes(EXAMPLE_TEXT.encode(encoding))
+    with pytest.raises(FileFormatError, match=rf"bench\.toml, line 1: {said} .*save the file as UTF-8"):
+        load_assembly(path)
+
+
+def test_lines_ended_by_a_carriage_return_alone_say_so(tmp_path):
+    # "invalid TOML: Expected newline or end of document after a statement (at line 1, column ...)" before
+    path = tmp_path / "bench.toml"
+    path.write_bytes(EXAMPLE_TEXT.replace("\n", "\r").encode("utf-8"))
+    with pytest.raises(FileFormatError, match=r"bench\.toml: the lines end in a carriage return alone .* LF"):
+        load_assembly(path)
+    path.write_bytes(EXAMPLE_TEXT.replace("\n", "\r\n").encode("utf-8"))  # CRLF reads
+    assert load_assembly(path) == loads_assembly(EXAMPLE_TEXT)
