@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from substructure.errors import FileFormatError, InvalidValueError
-from substructure.io.assembly_toml import load_assembly, loads_assembly, save_assembly
+from substructure.io.assembly_toml import dumps_assembly, load_assembly, loads_assembly, save_assembly
 
 DATA = Path(__file__).parent / "data"
 EXAMPLE_TEXT = (DATA / "formats_example.toml").read_text(encoding="utf-8")
@@ -132,3 +132,41 @@ def test_lines_ended_by_a_carriage_return_alone_say_so(tmp_path):
         load_assembly(path)
     path.write_bytes(EXAMPLE_TEXT.replace("\n", "\r\n").encode("utf-8"))  # CRLF reads
     assert load_assembly(path) == loads_assembly(EXAMPLE_TEXT)
+
+
+CATALOG_FILE = '''name = "catalogue holder, the file's own steel and carbide"
+[materials.steel]
+E = "100 GPa"
+nu = 0.3
+rho = "7000 kg/m^3"
+[materials.carbide]
+E = "300 GPa"
+nu = 0.22
+rho = "14000 kg/m^3"
+[[components]]
+name = "holder"
+type = "holder"
+catalog = "HSK-A63 shrink-fit"
+bore = "12 mm"
+[[components]]
+name = "tool"
+type = "tool"
+segments = [{ length = "40 mm", od = "12 mm" }]
+[[joints]]
+name = "holder-tool"
+between = ["holder.tip", "tool.base"]
+rigid = true
+'''
+
+
+def test_a_catalogue_holder_takes_the_files_steel_and_carbide_as_every_segment_does():
+    # the holder was built of the catalogue's steel (210 GPa) and its shank of the catalogue's carbide while the
+    # tool beside it was of the file's steel; the assembly could then not be saved ("two different materials are
+    # called 'steel'")
+    assembly = loads_assembly(CATALOG_FILE)
+    steel, carbide = assembly.materials
+    holder = assembly.component("holder")
+    assert {s.material for s in holder.segments} == {steel}
+    assert {s.insert.material for s in holder.segments if s.insert is not None} == {carbide}
+    assert assembly.component("tool").segments[0].material == steel
+    assert loads_assembly(dumps_assembly(assembly)) == assembly

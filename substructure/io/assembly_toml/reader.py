@@ -147,6 +147,9 @@ class _Reader:
         self.table(table, parts, allowed, ("name", "type", "catalog"))
         params = {k: v for k, v in table.items() if k not in _CATALOG_KEYS}
         self.number_texts(params, parts)
+        for key, default in (("material", "steel"), ("tool_material", "carbide")):  # the catalogue's defaults
+            if key not in params and self.materials[default] is not CATALOG[default]:
+                params[key] = default  # the file's [materials.steel] counts, as for every segment
         for key in ("material", "tool_material"):
             if key in params and not (key == "tool_material" and params[key] == "none"):
                 params[key] = self.material(params[key], parts + [key])
