@@ -31,3 +31,12 @@ def test_a_wrong_point_names_its_option_and_writes_nothing(capsys, tmp_path, opt
     assert status == 1 and stdout == ""
     assert err.startswith(f"substructure: error: argument {option}: point ") and said in err, err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("grid", ["0:100:5", "0 rpm:100 Hz:5 Hz"])
+def test_a_grid_from_0_hz_is_refused_as_the_files_frequency_table_is(capsys, tmp_path, grid):
+    # it was read, the file loaded, and the receptance failed with "frequency: component 'tool' is free-free"
+    out = tmp_path / "h.csv"
+    status, stdout, err = run(capsys, "frf", EXAMPLE, "--at", "tool.tip", "--grid", grid, "--out", out)
+    assert status == 2 and stdout == "" and not out.exists()
+    assert err.startswith("substructure: error: argument --grid: START is 0 Hz; expected a frequency > 0 Hz"), err

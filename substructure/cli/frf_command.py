@@ -22,6 +22,9 @@ from ._common import (
 def run(args: argparse.Namespace) -> int:
     from ..io.assembly_toml import load_assembly
 
+    if args.grid is not None and args.grid.hz[0] <= 0:  # the rule of [frequency], checked before any work
+        raise UsageError(f"argument --grid: START is {args.grid.hz[0]:g} Hz; expected a frequency > 0 Hz, as in "
+                         "[frequency] (the components of an assembly are free-free: no static receptance)")
     if args.out and Path(args.out).suffix.lower() not in (".csv", ".uff", ".unv"):
         raise UsageError(f"argument --out: {args.out!r}: expected a .csv or .uff file")
     check_plot(args.plot)
