@@ -170,3 +170,12 @@ def test_a_catalogue_holder_takes_the_files_steel_and_carbide_as_every_segment_d
     assert {s.insert.material for s in holder.segments if s.insert is not None} == {carbide}
     assert assembly.component("tool").segments[0].material == steel
     assert loads_assembly(dumps_assembly(assembly)) == assembly
+
+
+def test_an_assembly_built_in_python_refuses_a_joint_between_two_names_of_one_point():
+    from substructure import Assembly, Holder, Segment, Tool
+    from substructure.errors import AssemblyError
+
+    parts = [Holder("holder", [Segment("30 mm", "40 mm")]), Tool("tool", [Segment("30 mm", "12 mm")])]
+    with pytest.raises(AssemblyError, match=r"joint 'joint-1': tool\.tip and tool@30 mm are the same point"):
+        Assembly("a", parts).connect("tool.tip", "tool@30 mm", rigid=True)
