@@ -179,3 +179,13 @@ def test_an_assembly_built_in_python_refuses_a_joint_between_two_names_of_one_po
     parts = [Holder("holder", [Segment("30 mm", "40 mm")]), Tool("tool", [Segment("30 mm", "12 mm")])]
     with pytest.raises(AssemblyError, match=r"joint 'joint-1': tool\.tip and tool@30 mm are the same point"):
         Assembly("a", parts).connect("tool.tip", "tool@30 mm", rigid=True)
+
+
+def test_a_warning_about_a_value_of_the_file_names_the_file_and_the_line():
+    # "joint 'holder-tool': the joint matrix is not symmetric ..." did not say which file
+    from substructure.errors import NonReciprocalWarning
+
+    text = edit('tf = "1.0e6 N/rad"', 'tf = "2.0e6 N/rad"')
+    with pytest.warns(NonReciprocalWarning, match=r"^bench\.toml, line \d+: joints\[1\]: joint 'holder-tool': the "
+                                                  r"joint matrix is not symmetric"):
+        loads_assembly(text, source="bench.toml")

@@ -13,13 +13,14 @@ from __future__ import annotations
 import importlib.resources
 import os
 import re
+import warnings
 
 from .. import read_text
 from ...assembly import Assembly
 from ...beams import Flutes, Insert, Segment
 from ...components import COMPONENT_TYPES, Beam
 from ..._toml import TomlDocument, key_path, loads_toml
-from ...errors import SubstructureError
+from ...errors import SubstructureError, SubstructureWarning
 from ...frf import Frequency
 from ...joints import Joint, JointProvenance, Mass, Sensor, Support
 from ...materials import CATALOG, Material
@@ -40,10 +41,19 @@ class _Reader:
         self.materials: dict[str, Material] = dict(CATALOG)
 
     def call(self, parts, factory, *args, **kwargs):
-        try:
-            return factory(*args, **kwargs)
-        except SubstructureError as exc:  # the constructor's field merged into the key path
-            raise self.doc.wrap(parts, str(exc)) from None
+        """``factory(*args, **kwargs)``, its errors and the package's warnings at the file, line and key path."""
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", SubstructureWarning)
+            try:
+                result = factory(*args, **kwargs)
+            except SubstructureError as exc:  # the constructor's field merged into the key path
+                raise self.doc.wrap(parts, str(exc)) from None
+        for w in caught:  # "joint 'holder-tool': not positive semi-definite" said where in which file
+            message = w.message
+            if isinstance(message, SubstructureWarning):
+                message = type(message)(str(self.doc.wrap(parts, str(message))))
+            warnings.warn(message, stacklevel=3)
+        return result
 
     def array(self, value, parts, what: str) -> list:
         if not isinstance(value, list):
