@@ -1,6 +1,7 @@
 """Unit checks at the boundary: one registry, bare numbers and wrong dimensions rejected."""
 
 import math
+import re
 
 import numpy as np
 import pint
@@ -158,3 +159,25 @@ def test_a_dimensionless_unit_where_a_dimension_is_expected_is_named():
         quantity("20 mil", "od", "[length]")
     with pytest.raises(UnitError, match=r"od: got '20 %', whose unit percent has no dimension"):
         quantity("20 %", "od", "[length]")
+
+
+@pytest.mark.parametrize("text, read_by_pint, char", [
+    ("12 \u2212 3 mm", "36 mm", "\u2212"),  # a Unicode minus sign, as word processors write it
+    ("12 \u2013 3 mm", "36 mm", "\u2013"),  # an en dash
+    ("12 # 3 mm", "12", "#"),               # the rest read as a comment
+    ("2' 3 mm", "6 mm", "'"),
+    ("12\u200bmm", "12 mm", "\u200b"),      # a zero-width space pasted from a web page
+])
+def test_a_character_pint_would_skip_is_refused(text, read_by_pint, char):
+    assert ureg.Quantity(text) == ureg.Quantity(read_by_pint)  # what was read silently before
+    said = rf"od: got .*: the character {re.escape(repr(char))} \(U\+{ord(char):04X}\) is neither"
+    with pytest.raises(UnitError, match=said):
+        quantity(text, "od", "[length]")
+
+
+def test_a_unicode_minus_at_the_start_says_so_and_unit_symbols_still_read():
+    with pytest.raises(UnitError, match="write '-' for a minus sign"):
+        quantity("\u22125 mm", "od", "[length]")
+    assert quantity("5e-8 kg\u00b7m\u00b2", "J", "[mass] * [length] ** 2") == Q_(5e-8, "kg*m^2")
+    assert quantity("3 \u00c5", "x", "[length]") == Q_(3, "angstrom")
+    assert quantity("9.81 m\u00b7s\u207b\u00b2", "a", "[length] / [time] ** 2") == Q_(9.81, "m/s^2")
