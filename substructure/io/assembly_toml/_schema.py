@@ -39,6 +39,9 @@ PLAUSIBLE = {
     "mass": ("kg", 0.0, 1e6, "at most 1e6 kg"),
     "inertia": ("kg*m^2", 0.0, 1e6, "at most 1e6 kg*m^2"),
 }
+MAX_JOINT_ENTRY = 1e100
+"""The largest magnitude of a joint's or support's k or c entry in SI units: beyond it the coupling's products
+of entries overflow (a joint without flexibility is ``rigid = true``)."""
 
 
 def _init_fields(cls) -> tuple[str, ...]:

@@ -22,13 +22,14 @@ from ...components import COMPONENT_TYPES, Beam
 from ..._toml import TomlDocument, key_path, loads_toml
 from ...errors import SubstructureError, SubstructureWarning
 from ...frf import Frequency
-from ...joints import Joint, JointProvenance, Mass, Sensor, Support
+from ...joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint, JointProvenance, Mass, Sensor, Support
 from ...materials import CATALOG, Material
 from ...points import parse_point
 from ...units import check_number_text, dimensionless, to_si
 from ._schema import (_CATALOG_KEYS, _COMPONENT_KEYS, _FLUTES_KEYS, _FREQUENCY_KEYS, _INSERT_KEYS, _JOINT_KEYS,
                       _MASS_KEYS, _MATERIAL_KEYS, _MATRIX_KEYS, _SEGMENT_KEYS, _SENSOR_KEYS, _SUPPORT_KEYS,
-                      _TOP_KEYS, MAX_TAPER_STEPS, PLAUSIBLE, SIZE_RANGE_M, _extra_fields, _init_fields)
+                      _TOP_KEYS, MAX_JOINT_ENTRY, MAX_TAPER_STEPS, PLAUSIBLE, SIZE_RANGE_M, _extra_fields,
+                      _init_fields)
 
 _NUMBER_FIRST = re.compile(r"\s*[-+]?\.?\d")  # a value written as a number (and its unit)
 
@@ -240,8 +241,27 @@ class _Reader:
         return str(ref)
 
     def matrices(self, table, parts) -> dict:
-        return {key: self.table(table[key], parts + [key], _MATRIX_KEYS)
-                for key in ("k", "c") if key in table}
+        """The ``k`` and ``c`` tables, each entry at most :data:`MAX_JOINT_ENTRY` in SI units.
+
+        ``yf = "1e300 N/m"`` gave a numpy overflow in the coupling and then
+        "coupling through joint ... is singular: a rigid joint that closes a
+        loop", which it is not.
+        """
+        out = {}
+        for key, units in (("k", STIFFNESS_UNITS), ("c", DAMPING_UNITS)):
+            if key not in table:
+                continue
+            out[key] = self.table(table[key], parts + [key], _MATRIX_KEYS)
+            for entry, value in out[key].items():
+                try:
+                    si = to_si(value, entry, units[entry])
+                except SubstructureError:
+                    continue  # the joint says what is wrong with it
+                if abs(si) > MAX_JOINT_ENTRY:
+                    raise self.error(parts + [key, entry], f"got {value!r}; expected at most {MAX_JOINT_ENTRY:g} "
+                                     f"{units[entry]} in magnitude (beyond, the coupling's products of entries "
+                                     "overflow; a joint without flexibility is rigid = true)")
+        return out
 
     def joint(self, table, parts, base: Assembly) -> Joint:
         table = self.table(table, parts, _JOINT_KEYS, ("name", "between"))
