@@ -170,21 +170,32 @@ def decode_text(data: bytes, name: str) -> str:
     ------
     FileFormatError
         Naming the file and the byte, for bytes that are not UTF-8 (nor UTF-16
-        after a UTF-16 byte-order mark).
+        after a UTF-16 byte-order mark), and for a NUL character (UTF-16
+        text without its byte-order mark, UTF-32).
     """
     if data[:2] in (b"\xff\xfe", b"\xfe\xff"):  # UTF-16 with its byte-order mark (Excel's "Unicode text")
         try:
-            return data.decode("utf-16")
+            text = data.decode("utf-16")
         except UnicodeDecodeError as exc:
             raise FileFormatError(f"{name}: starts with a UTF-16 byte-order mark but is not UTF-16 text "
                                   f"(byte {exc.start}); save the file as UTF-8") from None
-    try:
-        return data.decode("utf-8-sig")  # a BOM (Windows editors write one) is not part of the text
-    except UnicodeDecodeError as exc:
+    else:
+        try:
+            text = data.decode("utf-8-sig")  # a BOM (Windows editors write one) is not part of the text
+        except UnicodeDecodeError as exc:
+            raise FileFormatError(
+                f"{name}: not UTF-8 text (byte {exc.start}: {data[exc.start:exc.start + 1]!r}); "
+                "save the file as UTF-8"
+            ) from None
+    nul = text.find("\x00")
+    if nul >= 0:  # valid UTF-8 to the decoder, but no text file of the package holds one
+        line = text.count("\n", 0, nul) + 1
+        column = nul - (text.rfind("\n", 0, nul) + 1) + 1
         raise FileFormatError(
-            f"{name}: not UTF-8 text (byte {exc.start}: {data[exc.start:exc.start + 1]!r}); "
-            "save the file as UTF-8"
-        ) from None
+            f"{name}, line {line}: a NUL character (column {column}): the file is not UTF-8 text (UTF-16 without "
+            "its byte-order mark, UTF-32, or no text at all); save the file as UTF-8"
+        )
+    return text
 
 
 def parse_toml(text: str, source: str) -> dict:

@@ -253,6 +253,9 @@ def loads_toml(text: Any, source: str = "<string>", what: str | None = None) -> 
     if what is not None and not text.strip():
         article = "an" if what[:1] in "aeiou" else "a"
         raise FileFormatError(f"{source}: the file is empty; expected {article} {what} (docs/file-formats.md)")
+    if "\r" in text.rstrip("\r") and "\n" not in text:  # TOML ends a line with LF or CRLF, never CR alone
+        raise FileFormatError(f"{source}: the lines end in a carriage return alone (CR, as old Mac OS wrote "
+                              "them); TOML needs LF or CRLF line ends: save the file with LF line ends")
     return TomlDocument(source, text, parse_toml(text, source))
 
 

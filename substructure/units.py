@@ -116,6 +116,54 @@ _DIMENSION_NAMES = {
 
 
 _NUMBER = re.compile(r"^\s*[-+]?(\d|\.\d|inf|nan)", re.IGNORECASE)
+_SIDE_BY_SIDE = re.compile(r"[\w).]\s+\.?\d")  # "1 2 mm", "1 1/2 in", "20 mm 2": pint multiplies them
+_OPERATORS = set(".+-*/^()%_\u00b7\u00d7\u00b0\u00b2\u00b3\u00b9\u2070\u2074\u2075\u2076\u2077\u2078\u2079\u207b")
+# besides letters, digits and spaces, what a number and a unit are written with (·, ×, °, superscripts); pint skips
+# any other character without a word: "12 − 3 mm" (a Unicode minus) is 36 mm to it, "12 # 3" is 12
+
+
+def check_number_text(text: str, field: str, expected: str, error: type[Exception] = UnitError) -> None:
+    """Refuse a value's text that pint reads as another number than the one written.
+
+    pint drops a comma (``"20,5 mm"`` is 205 mm, ``"1,5"`` is 15) and any
+    character it does not know (``"12 \u2212 3 mm"``, a Unicode minus, is
+    36 mm), and multiplies numbers written side by side (``"1 2 mm"`` is
+    2 mm, ``"1 1/2 in"`` is half an inch): such a text is an error, not a
+    guess.
+    :func:`quantity` and :func:`dimensionless` check every string; readers
+    that hand a string to pint themselves call it first.
+
+    Parameters
+    ----------
+    text : str
+        The value as written.
+    field : str
+        Name of the field, used in error messages.
+    expected : str
+        What the field expects, for the message (``"a length (e.g. '60 mm')"``).
+    error : type, default UnitError
+        The class of the error raised.
+
+    Raises
+    ------
+    UnitError
+        (or ``error``) for a comma or numbers side by side.
+    """
+    odd = next((c for c in text if not (c.isalnum() or c.isspace() or c in _OPERATORS or c == ",")), None)
+    if odd is not None:
+        hint = "; write '-' for a minus sign" if odd in "\u2212\u2010\u2011\u2012\u2013\u2014" else ""
+        raise error(
+            f"{field}: got {show_value(text)}: the character {odd!r} (U+{ord(odd):04X}) is neither part of a number "
+            f"nor of a unit, and pint would skip it without a word{hint}; expected {expected}"
+        )
+    _no_comma(text, field, expected, error)
+    m = _SIDE_BY_SIDE.search(text)
+    if m:
+        raise error(
+            f"{field}: got {show_value(text)}: a number written after {text[:m.start() + 1].strip()!r} with "
+            f"only a space between would be multiplied into it; write one number and its unit (e.g. '12 mm'); "
+            f"expected {expected}"
+        )
 
 
 def _describe(dimension: str) -> str:
@@ -246,7 +294,7 @@ def quantity(value: Any, field: str, dimension: str) -> pint.Quantity:
             f"{field}: got the bare number {show_value(value)}; expected {expected}, with its unit"
         )
     if isinstance(value, str):
-        _no_comma(value, field, expected)
+        check_number_text(value, field, expected)
         if not _NUMBER.match(value):  # pint reads "mm" as 1 mm and "a" as 1 year
             raise UnitError(
                 f"{field}: cannot read {show_value(value)} as a quantity: it does not start with a number; "
@@ -258,6 +306,11 @@ def quantity(value: Any, field: str, dimension: str) -> pint.Quantity:
             raise UnitError(
                 f"{field}: cannot read {show_value(value)} as a quantity ({exc}); expected {expected}"
             ) from None
+        if units is not None and units.dimensionless and dimension != "" and units != ureg.dimensionless:
+            raise UnitError(  # "20 mil" is an angle in pint (angular mil), "2 %" a ratio
+                f"{field}: got {show_value(value)}, whose unit {units} has no dimension (an angle or a ratio); "
+                f"expected {expected}" + (" (a thousandth of an inch is 'thou')" if str(units) == "mil" else "")
+            )
         if units is None or units.dimensionless and dimension != "":
             raise UnitError(
                 f"{field}: got {show_value(value)} without a unit; expected {expected}, with its unit"
@@ -301,7 +354,10 @@ def to_si(value: Any, field: str, unit: str) -> float:
     float
         The magnitude in ``unit``.
     """
-    return magnitude_in(quantity(value, field, _dimension_of(unit)), unit)
+    out = magnitude_in(quantity(value, field, _dimension_of(unit)), unit)
+    if not math.isfinite(out):  # "1e300 GPa": a finite number whose value in Pa is beyond the floats
+        raise InvalidValueError(f"{field}: got {show_value(value)}, which is {out} in {unit}; expected a finite value")
+    return out
 
 
 @functools.lru_cache(maxsize=256)
@@ -334,7 +390,7 @@ def dimensionless(value: Any, field: str) -> float:
             )
         value = value.m_as("dimensionless")
     elif isinstance(value, str):
-        _no_comma(value, field, "a number", InvalidValueError)
+        check_number_text(value, field, "a number", InvalidValueError)
         try:
             q: Any = ureg.Quantity(value)
         except Exception:

@@ -113,3 +113,14 @@ def test_an_unexplained_diagnosis_writes_no_partial_model_unless_asked(files, ca
     assert _run(files, *args, "--save-partial", "--json") == 0
     assert json.loads(capsys.readouterr().out)["saved_model"] == str(model_out)
     assert load_assembly(model_out).name
+
+
+@pytest.mark.parametrize("name", ["improved.csv", "improved", "improved.toml.bak"])
+def test_save_model_is_a_toml_file_checked_before_the_diagnosis(files, capsys, tmp_path, name):
+    # an assembly file was written under any name, e.g. over a CSV that is no input with --overwrite
+    target = tmp_path / name
+    target.write_text("frequency_hz,real,imag\n")
+    assert _run(files, "--save-model", str(target), "--overwrite") == 2
+    err = capsys.readouterr().err
+    assert "argument --save-model" in err and "expected a .toml file" in err, err
+    assert target.read_text() == "frequency_hz,real,imag\n"

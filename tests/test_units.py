@@ -1,6 +1,7 @@
 """Unit checks at the boundary: one registry, bare numbers and wrong dimensions rejected."""
 
 import math
+import re
 
 import numpy as np
 import pint
@@ -124,3 +125,59 @@ def test_an_instrument_unit_pint_cannot_read_is_a_value_error(text):
                                         ("", None), ("[]", None)])
 def test_a_unit_cell_loses_only_the_brackets_around_the_whole(cell, unit):
     assert bare_unit(cell) == unit
+
+
+@pytest.mark.parametrize("text, read_by_pint", [
+    ("20,5 mm", "205 mm"),      # a decimal comma: pint drops it
+    ("1,000 mm", "1000 mm"),
+    ("20 , 5 mm", "100 mm"),
+    ("1 2 mm", "2 mm"),         # "12 mm" with a stray space: pint multiplies the numbers
+    ("1 1/2 in", "0.5 in"),     # a mixed fraction
+    ("20 mm 2", "40 mm"),
+])
+def test_a_number_pint_would_read_as_another_is_refused(text, read_by_pint):
+    assert ureg.Quantity(text) == ureg.Quantity(read_by_pint)  # what was read silently before
+    said = r"od: (cannot read|got) '.*'(: a comma|: a number written after).*expected a length"
+    with pytest.raises(UnitError, match=said):
+        quantity(text, "od", "[length]")
+
+
+@pytest.mark.parametrize("text", ["0,002", "1 2"])
+def test_a_dimensionless_number_pint_would_read_as_another_is_refused(text):
+    said = r"loss_factor: (cannot read|got) '.*'(: a comma|: a number written after)"
+    with pytest.raises(InvalidValueError, match=said):
+        dimensionless(text, "loss_factor")
+
+
+@pytest.mark.parametrize("text", ["20 mm", "20mm", "2.5e-3 m", ".5 in", "1/2 in", "20 mm - 5 mm", "5e-8 kg*m**2"])
+def test_numbers_with_operators_and_exponents_still_read(text):
+    quantity(text, "x", str(ureg.Quantity(text).dimensionality))
+
+
+def test_a_dimensionless_unit_where_a_dimension_is_expected_is_named():
+    with pytest.raises(UnitError, match=r"od: got '20 mil', whose unit mil has no dimension .*'thou'"):
+        quantity("20 mil", "od", "[length]")
+    with pytest.raises(UnitError, match=r"od: got '20 %', whose unit percent has no dimension"):
+        quantity("20 %", "od", "[length]")
+
+
+@pytest.mark.parametrize("text, read_by_pint, char", [
+    ("12 \u2212 3 mm", "36 mm", "\u2212"),  # a Unicode minus sign, as word processors write it
+    ("12 \u2013 3 mm", "36 mm", "\u2013"),  # an en dash
+    ("12 # 3 mm", "12", "#"),               # the rest read as a comment
+    ("2' 3 mm", "6 mm", "'"),
+    ("12\u200bmm", "12 mm", "\u200b"),      # a zero-width space pasted from a web page
+])
+def test_a_character_pint_would_skip_is_refused(text, read_by_pint, char):
+    assert ureg.Quantity(text) == ureg.Quantity(read_by_pint)  # what was read silently before
+    said = rf"od: got .*: the character {re.escape(repr(char))} \(U\+{ord(char):04X}\) is neither"
+    with pytest.raises(UnitError, match=said):
+        quantity(text, "od", "[length]")
+
+
+def test_a_unicode_minus_at_the_start_says_so_and_unit_symbols_still_read():
+    with pytest.raises(UnitError, match="write '-' for a minus sign"):
+        quantity("\u22125 mm", "od", "[length]")
+    assert quantity("5e-8 kg\u00b7m\u00b2", "J", "[mass] * [length] ** 2") == Q_(5e-8, "kg*m^2")
+    assert quantity("3 \u00c5", "x", "[length]") == Q_(3, "angstrom")
+    assert quantity("9.81 m\u00b7s\u207b\u00b2", "a", "[length] / [time] ** 2") == Q_(9.81, "m/s^2")

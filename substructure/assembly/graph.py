@@ -86,8 +86,10 @@ class Assembly:
             if dup:
                 raise AssemblyError(f"{kind} names used twice: {', '.join(sorted(dup))}")
         for j in self.joints:
-            for p in j.between:
-                self._resolve(p, f"joint {j.name!r}")
+            ka, kb = (self._resolve(p, f"joint {j.name!r}")[2] for p in j.between)
+            if ka == kb:  # "tool.tip" and "tool@30 mm" on a 30 mm tool: refused here, not at the first receptance
+                raise AssemblyError(f"joint {j.name!r}: {j.between[0]} and {j.between[1]} are the same point; a "
+                                    "joint connects two different points")
         for sensor in self.sensors:
             self._resolve(sensor.at, f"sensor {sensor.name!r}")
         for support in self.supports:

@@ -125,6 +125,23 @@ def point_arg(text: str) -> str:
     return str(attrs.evolve(ref, dof=ref.dof or "y"))
 
 
+def assembly_point_arg(assembly, text: str, option: str) -> str:
+    """A point of ``assembly`` given with ``option`` (``"--at"``), its DOF ``y`` when none is given.
+
+    The point is checked to exist before any computation; an error names the
+    option and what was given (``argument --at: point tool.tip-500 mm: lies
+    outside 'tool', ...``).
+    """
+    from ..points import parse_point
+
+    try:
+        point = point_arg(text)
+        assembly.node_key(parse_point(point).point)
+    except SubstructureError as exc:
+        raise type(exc)(f"argument {option}: {one_line(str(exc))}") from None
+    return point
+
+
 def peak_table(frf: FRF) -> list[tuple[float, float]]:
     """``(frequency in Hz, |FRF|)`` of the peaks of a one-entry FRF, ascending."""
     import numpy as np

@@ -42,6 +42,9 @@ def run(args: argparse.Namespace) -> int:
     figures_out = [("--plot", Path(args.plot) / name) for name in FIGURES] if into_dir else []
     check_outputs([("--save-model", args.save_model), *figures_out],
                   [args.assembly, *measurement_inputs(args.measurements)], args.overwrite)
+    if args.save_model and Path(args.save_model).suffix.lower() != ".toml":  # an assembly file, whatever the name
+        raise UsageError(f"argument --save-model: {args.save_model!r}: expected a .toml file (the model is written "
+                         "as an assembly file)")
     assembly = load_assembly(args.assembly)
     measurements = load_measurements(args.measurements)
     progress = None if args.quiet else (lambda text: print(f"{PROG}: {text}", file=sys.stderr, flush=True))

@@ -7,13 +7,13 @@ from pathlib import Path
 
 from ._common import (
     UsageError,
+    assembly_point_arg,
     check_outputs,
     check_plot,
     draw_to,
     grid_arg,
     grid_text,
     peak_table,
-    point_arg,
     print_json,
     write_frf,
 )
@@ -22,13 +22,16 @@ from ._common import (
 def run(args: argparse.Namespace) -> int:
     from ..io.assembly_toml import load_assembly
 
+    if args.grid is not None and args.grid.hz[0] <= 0:  # the rule of [frequency], checked before any work
+        raise UsageError(f"argument --grid: START is {args.grid.hz[0]:g} Hz; expected a frequency > 0 Hz, as in "
+                         "[frequency] (the components of an assembly are free-free: no static receptance)")
     if args.out and Path(args.out).suffix.lower() not in (".csv", ".uff", ".unv"):
         raise UsageError(f"argument --out: {args.out!r}: expected a .csv or .uff file")
     check_plot(args.plot)
     check_outputs([("--out", args.out), ("--plot", args.plot)], [args.assembly], args.overwrite)
     assembly = load_assembly(args.assembly)
-    at = point_arg(args.at)
-    to = point_arg(args.to) if args.to else at
+    at = assembly_point_arg(assembly, args.at, "--at")
+    to = assembly_point_arg(assembly, args.to, "--to") if args.to else at
     frequency = args.grid or assembly.frequency
     if frequency is None:
         raise UsageError(f"{args.assembly} has no [frequency] table; give the grid with --grid START:STOP:STEP")

@@ -19,7 +19,7 @@ import numpy as np
 import pint
 
 from ..errors import InvalidValueError, UnitError
-from ..units import ureg
+from ..units import check_number_text, ureg
 
 __all__ = ["PARAMETER_UNITS"]
 
@@ -145,6 +145,7 @@ def _to_unit(value: Any, unit: str, field: str) -> float:
     if isinstance(value, bool) or isinstance(value, (int, float, np.number)):
         raise UnitError(f"{field}: got the bare number {value!r}; expected a value with a unit like {unit!r}")
     if isinstance(value, str):
+        check_number_text(value, field, f"a value with a unit like {unit!r}")  # pint reads "12,5 mm" as 125 mm
         try:
             q = ureg.Quantity(value)
         except Exception:

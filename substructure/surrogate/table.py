@@ -183,6 +183,10 @@ class JointTable:
         line_of = [k for k, _ in numbered]
         reader = csv.reader([ln for _, ln in numbered])
         header = next(reader)
+        if len(header) == 1 and (";" in header[0] or "\t" in header[0]):
+            raise FileFormatError(
+                f"{where}, line {line_of[0]}: the header {header[0]!r} has no comma; the columns of a joint table "
+                "are separated by commas, with '.' for the decimal point (docs/file-formats.md)")
         names, units = [], []
         for col in header:
             m = _HEADER.match(col)
@@ -199,6 +203,9 @@ class JointTable:
         par_units, feat_units = {}, {}
         for n, u in zip(names, units):
             if n.endswith("_std") and n[:-4] in pset:
+                if u is None:  # a std in another unit than its parameter is allowed: never guess which
+                    raise FileFormatError(f"{where}, line {line_of[0]}: standard deviation column {n!r} has no "
+                                          f"unit (write '{n} [unit]', a unit of {n[:-4]})")
                 continue
             try:
                 if n in pset:

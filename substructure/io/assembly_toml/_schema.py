@@ -30,6 +30,19 @@ _MASS_KEYS = ("name", "at", "mass", "inertia")
 _MATRIX_KEYS = ("yf", "ym", "tf", "tm")
 _STANDARD_FIELDS = ("name", "segments", "description")
 
+# The values the beam and coupling models compute right (beyond them, results turn to NaN, overflow or noise):
+# a value outside is a wrong unit or a typo.  key -> (SI unit, lowest, highest, the range in words)
+PLAUSIBLE = {
+    "E": ("Pa", 1e3, 1e13, "from 1 kPa to 10 TPa"),
+    "rho": ("kg/m^3", 0.1, 1e5, "from 0.1 to 1e5 kg/m^3"),
+    "loss_factor": ("", 0.0, 10.0, "at most 10"),
+    "mass": ("kg", 0.0, 1e6, "at most 1e6 kg"),
+    "inertia": ("kg*m^2", 0.0, 1e6, "at most 1e6 kg*m^2"),
+}
+MAX_JOINT_ENTRY = 1e100
+"""The largest magnitude of a joint's or support's k or c entry in SI units: beyond it the coupling's products
+of entries overflow (a joint without flexibility is ``rigid = true``)."""
+
 
 def _init_fields(cls) -> tuple[str, ...]:
     return tuple(f.name for f in attrs.fields(cls) if f.init) if attrs.has(cls) else _STANDARD_FIELDS

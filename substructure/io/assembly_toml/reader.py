@@ -12,21 +12,27 @@ from __future__ import annotations
 
 import importlib.resources
 import os
+import re
+import warnings
 
 from .. import read_text
 from ...assembly import Assembly
 from ...beams import Flutes, Insert, Segment
 from ...components import COMPONENT_TYPES, Beam
 from ..._toml import TomlDocument, key_path, loads_toml
-from ...errors import SubstructureError
+from ...errors import SubstructureError, SubstructureWarning
 from ...frf import Frequency
-from ...joints import Joint, JointProvenance, Mass, Sensor, Support
+from ...joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint, JointProvenance, Mass, Sensor, Support
 from ...materials import CATALOG, Material
 from ...points import parse_point
-from ...units import to_si
+from ...units import check_number_text, dimensionless, to_si
 from ._schema import (_CATALOG_KEYS, _COMPONENT_KEYS, _FLUTES_KEYS, _FREQUENCY_KEYS, _INSERT_KEYS, _JOINT_KEYS,
                       _MASS_KEYS, _MATERIAL_KEYS, _MATRIX_KEYS, _SEGMENT_KEYS, _SENSOR_KEYS, _SUPPORT_KEYS,
-                      _TOP_KEYS, MAX_TAPER_STEPS, SIZE_RANGE_M, _extra_fields, _init_fields)
+                      _TOP_KEYS, MAX_JOINT_ENTRY, MAX_TAPER_STEPS, PLAUSIBLE, SIZE_RANGE_M, _extra_fields,
+                      _init_fields)
+
+_NUMBER_FIRST = re.compile(r"\s*[-+]?\.?\d")  # a value written as a number (and its unit)
+
 
 class _Reader:
     """Builds an assembly from parsed TOML, naming the key path in every error."""
@@ -36,10 +42,19 @@ class _Reader:
         self.materials: dict[str, Material] = dict(CATALOG)
 
     def call(self, parts, factory, *args, **kwargs):
-        try:
-            return factory(*args, **kwargs)
-        except SubstructureError as exc:  # the constructor's field merged into the key path
-            raise self.doc.wrap(parts, str(exc)) from None
+        """``factory(*args, **kwargs)``, its errors and the package's warnings at the file, line and key path."""
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", SubstructureWarning)
+            try:
+                result = factory(*args, **kwargs)
+            except SubstructureError as exc:  # the constructor's field merged into the key path
+                raise self.doc.wrap(parts, str(exc)) from None
+        for w in caught:  # "joint 'holder-tool': not positive semi-definite" said where in which file
+            message = w.message
+            if isinstance(message, SubstructureWarning):
+                message = type(message)(str(self.doc.wrap(parts, str(message))))
+            warnings.warn(message, stacklevel=3)
+        return result
 
     def array(self, value, parts, what: str) -> list:
         if not isinstance(value, list):
@@ -69,6 +84,7 @@ class _Reader:
         for name, table in materials.items():
             parts = ["materials", name]
             table = self.table(table, parts, _MATERIAL_KEYS, ("E", "nu", "rho"))
+            self.plausible(table, parts)
             custom.append(self.call(parts, Material, name, **table))
             self.materials[name] = custom[-1]
         items = {key: self.array(data.get(key, []), [key], f"[[{key}]] tables")
@@ -117,6 +133,7 @@ class _Reader:
             f for f in extra if f not in _COMPONENT_KEYS)
         self.table(table, parts, allowed, ("name", "type", "segments") if with_segments else ("name", "type"))
         kwargs = {f: table[f] for f in extra if f in table and f not in _COMPONENT_KEYS}
+        self.number_texts(kwargs, parts)
         if not with_segments:
             if "material" in extra and "material" in table:
                 kwargs["material"] = self.material(table["material"], parts + ["material"])
@@ -140,11 +157,42 @@ class _Reader:
         allowed = _CATALOG_KEYS + self.call(parts, catalog_parameters, entry)
         self.table(table, parts, allowed, ("name", "type", "catalog"))
         params = {k: v for k, v in table.items() if k not in _CATALOG_KEYS}
+        self.number_texts(params, parts)
+        for key, default in (("material", "steel"), ("tool_material", "carbide")):  # the catalogue's defaults
+            if key not in params and self.materials[default] is not CATALOG[default]:
+                params[key] = default  # the file's [materials.steel] counts, as for every segment
         for key in ("material", "tool_material"):
             if key in params and not (key == "tool_material" and params[key] == "none"):
                 params[key] = self.material(params[key], parts + [key])
         resolved = self.call(parts, design, entry, **params)
         return self.call(parts, resolved.holder, table["name"], cls)
+
+    def number_texts(self, values: dict, parts) -> None:
+        """Refuse a value written as a number that pint would misread (``helix = "3,5 deg"`` is 35 deg to pint).
+
+        The fields of components (a tool's ``helix``, a catalogue holder's
+        angles) may reach pint without :func:`~substructure.units.quantity`.
+        """
+        for key, value in values.items():
+            if isinstance(value, str) and _NUMBER_FIRST.match(value):
+                self.call(parts, check_number_text, value, key, "one number and its unit")
+
+    def plausible(self, table: dict, parts) -> None:
+        """Refuse a material's or a body's value outside the range the models compute right (:data:`PLAUSIBLE`).
+
+        ``E = "1e-100 Pa"`` gave a raw OverflowError, ``mass = "1e60 kg"``
+        receptances of rounding noise; a negative value (or 0 where it must
+        be positive) is left to the constructor, which says why.
+        """
+        for key in [k for k in PLAUSIBLE if k in table]:
+            unit, lo, hi, words = PLAUSIBLE[key]
+            value = self.call(parts, to_si, table[key], key, unit) if unit else \
+                self.call(parts, dimensionless, table[key], key)
+            if value < 0 or (value == 0 and lo > 0):
+                continue  # the constructor says what is wrong with it
+            if not lo <= value <= hi:
+                raise self.error(parts + [key], f"got {table[key]!r}; expected {words} (the range the models "
+                                 "compute right): check the value and its unit")
 
     def size(self, value, parts) -> None:
         """Refuse a length outside the range the beam model is made for (a wrong unit, or a typo)."""
@@ -193,8 +241,27 @@ class _Reader:
         return str(ref)
 
     def matrices(self, table, parts) -> dict:
-        return {key: self.table(table[key], parts + [key], _MATRIX_KEYS)
-                for key in ("k", "c") if key in table}
+        """The ``k`` and ``c`` tables, each entry at most :data:`MAX_JOINT_ENTRY` in SI units.
+
+        ``yf = "1e300 N/m"`` gave a numpy overflow in the coupling and then
+        "coupling through joint ... is singular: a rigid joint that closes a
+        loop", which it is not.
+        """
+        out = {}
+        for key, units in (("k", STIFFNESS_UNITS), ("c", DAMPING_UNITS)):
+            if key not in table:
+                continue
+            out[key] = self.table(table[key], parts + [key], _MATRIX_KEYS)
+            for entry, value in out[key].items():
+                try:
+                    si = to_si(value, entry, units[entry])
+                except SubstructureError:
+                    continue  # the joint says what is wrong with it
+                if abs(si) > MAX_JOINT_ENTRY:
+                    raise self.error(parts + [key, entry], f"got {value!r}; expected at most {MAX_JOINT_ENTRY:g} "
+                                     f"{units[entry]} in magnitude (beyond, the coupling's products of entries "
+                                     "overflow; a joint without flexibility is rigid = true)")
+        return out
 
     def joint(self, table, parts, base: Assembly) -> Joint:
         table = self.table(table, parts, _JOINT_KEYS, ("name", "between"))
@@ -202,6 +269,9 @@ class _Reader:
         if not isinstance(between, list) or len(between) != 2:
             raise self.error(parts + ["between"], f"got {between!r}; expected two point names")
         points = [self.point(p, parts + ["between", m], base) for m, p in enumerate(between)]
+        if points[0] != points[1] and base.node_key(parse_point(points[0])) == base.node_key(parse_point(points[1])):
+            raise self.error(parts + ["between"], f"{between[0]!r} and {between[1]!r} are the same point; a joint "
+                             "connects two different points")
         if table.get("prior", False) is not False:
             return self.prior_joint(table, parts, base, points)
         stated = {key: table[key] for key in ("provenance", "source", "uncertainty") if key in table}
@@ -243,6 +313,7 @@ class _Reader:
     def point_mass(self, cls, keys, table, parts, base: Assembly):
         """A sensor or a mass (``cls``) of the table of ``keys``; a mass has no ``always_on``."""
         table = self.table(table, parts, keys, ("name", "at", "mass"))
+        self.plausible(table, parts)
         at = self.point(table["at"], parts + ["at"], base)
         extra = {key: table[key] for key in ("inertia", "always_on") if key in table}
         return self.call(parts, cls, table["name"], at, table["mass"], **extra)
@@ -287,8 +358,11 @@ def load_assembly(path: str | os.PathLike) -> Assembly:
     Assembly
         The assembly; errors name the file and the key.
     """
-    name = os.fspath(path)
-    return loads_assembly(read_text(path, "assembly file"), source=name)
+    try:
+        path = os.fsdecode(path)  # a str, bytes or os.PathLike name, as messages show it
+    except TypeError:
+        pass  # read_text refuses what is not a file name, naming it
+    return loads_assembly(read_text(path, "assembly file"), source=path)
 
 
 def default_assembly() -> Assembly:

@@ -381,4 +381,9 @@ def save_assembly(assembly: Assembly, path: str | os.PathLike, overwrite: bool =
     InvalidValueError
         For what the file cannot hold (:func:`dumps_assembly`).
     """
-    write_text(path, dumps_assembly(assembly), overwrite=overwrite)
+    try:
+        name = os.fsdecode(path)  # a str, bytes or os.PathLike name
+    except TypeError:
+        raise InvalidValueError(f"path: got {path!r} of type {type(path).__name__}; expected the name of the "
+                                "assembly file (a str or os.PathLike)") from None
+    write_text(name, dumps_assembly(assembly), overwrite=overwrite)
