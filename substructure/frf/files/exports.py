@@ -195,10 +195,10 @@ def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None
         # a row of units under the names (an empty cell: no unit), as acquisition programs export them
         units = cells[1] + [""] * (len(columns) - len(cells[1]))
         for (_, unit), u, cell in zip(columns, units, cells[0]):
-            below = bare_unit(u)
-            if unit is not None and below is not None and not _same_unit(unit, below):
+            row_unit = bare_unit(u)
+            if unit is not None and row_unit is not None and not _same_unit(unit, row_unit):
                 raise FileFormatError(f"{name}, line {rows[1][0]}: column {_shown(cell)}: the units row says "
-                                      f"{_shown(below)} but the header {_shown(unit)}; give the unit once, "
+                                      f"{_shown(row_unit)} but the header {_shown(unit)}; give the unit once, "
                                       "or correct the one that is wrong")
         columns = [(kind, unit if unit is not None else bare_unit(u)) for (kind, unit), u in zip(columns, units)]
         cells, rows = [cells[0]] + cells[2:], [rows[0]] + rows[2:]
