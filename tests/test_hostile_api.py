@@ -319,3 +319,16 @@ def test_a_component_of_ones_own_that_is_not_reciprocal_is_warned_of():
         lumped.receptance("holder.tip:y", frequency=GRID)
     symmetric = d.add(_Lump("nut", 0.0)).connect("holder.tip", "nut.tip", k={"yf": "1e8 N/m", "tm": "1e6 N*m/rad"})
     assert np.isfinite(symmetric.receptance("holder.tip:y", frequency=GRID).data).all()   # no warning: an error here
+
+
+def test_an_angle_with_a_comma_is_refused_in_python_too():
+    """A tool's helix and a shrink-fit holder's nose angle as texts with a comma were read by pint as ten times the
+    angle ("3,5 deg" as 35 deg) in the Python API (the file reader refused them); they are refused by name."""
+    from substructure import Holder, InvalidValueError, Tool, UnitError
+
+    with pytest.raises(UnitError, match="helix.*comma"):
+        Tool.end_mill("12 mm", "50 mm", "30 mm", helix="3,5 deg")
+    assert Tool.end_mill("12 mm", "50 mm", "30 mm", helix="3.5 deg") is not None
+    with pytest.raises(InvalidValueError, match="nose_angle.*comma"):
+        Holder.from_catalog("BT40 shrink-fit", bore="12 mm", nose_angle="4,5 deg")
+    assert Holder.from_catalog("BT40 shrink-fit", bore="12 mm", nose_angle="4.5 deg") is not None

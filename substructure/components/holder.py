@@ -49,7 +49,7 @@ from .._toml import loads_toml
 from ..beams import Segment
 from ..errors import InvalidValueError
 from ..sections import Insert, _material
-from ..units import Q_, quantity, show_value
+from ..units import Q_, check_number_text, quantity, show_value
 from .beam import Beam
 from .protocol import register_component
 
@@ -252,6 +252,8 @@ def _catalog_length(value: Any, key: str) -> pint.Quantity:
 
 def _angle(value: Any) -> pint.Quantity:
     """An angle with its unit (``"4.5 deg"``); a bare number is refused."""
+    if isinstance(value, str):  # "4,5 deg" is 45 deg to pint: refused, as every value's text
+        check_number_text(value, "nose_angle", "an angle with its unit, e.g. '4.5 deg'", InvalidValueError)
     try:
         q = value if isinstance(value, pint.Quantity) else Q_(value) if isinstance(value, str) else None
     except pint.PintError:

@@ -14,7 +14,7 @@ import pint
 
 from ..beams import Flutes, Segment
 from ..errors import InvalidValueError, UnitError
-from ..units import Q_, quantity, show_value, ureg
+from ..units import Q_, check_number_text, quantity, show_value, ureg
 from .beam import Beam
 from .protocol import register_component
 
@@ -33,6 +33,8 @@ def _tool_teeth(value):
 def _tool_helix(value):
     if value is None:
         return None
+    if isinstance(value, str):  # "3,5 deg" is 35 deg to pint: refused, as every value's text
+        check_number_text(value, "helix", "the helix angle with its unit, e.g. '30 deg'")
     try:
         q = Q_(value) if isinstance(value, str) else value
     except Exception:
