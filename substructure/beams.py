@@ -60,6 +60,7 @@ __all__ = [
     "stepped_beam_receptance",
     "stepped_beam_receptance_batch",
     "stepped_beam_receptance_si",
+    "stepped_beam_receptances_si",
 ]
 
 def _optional_length(field: str, *, allow_zero: bool = False):
