@@ -37,7 +37,8 @@ from .errors import InvalidValueError
 from .frf import FRF, Frequency
 from .joints import dynamic_stiffness
 
-__all__ = ["SweepResult", "sweep"]  # MAX_SWEEP_VALUES below: module-level, as the module shares the function's name in the API pages
+# MAX_SWEEP_VALUES is not listed: the module shares the sweep function's name in the API pages
+__all__ = ["SweepResult", "sweep"]
 
 MAX_SWEEP_VALUES = 100_000_000
 """The most receptance values a sweep returns (1.6 GB of complex numbers), checked before any work."""
