@@ -7,6 +7,7 @@ gigabytes of memory before it was checked where it enters.
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 import attrs
 import numpy as np
@@ -332,3 +333,31 @@ def test_an_angle_with_a_comma_is_refused_in_python_too():
     with pytest.raises(InvalidValueError, match="nose_angle.*comma"):
         Holder.from_catalog("BT40 shrink-fit", bore="12 mm", nose_angle="4,5 deg")
     assert Holder.from_catalog("BT40 shrink-fit", bore="12 mm", nose_angle="4.5 deg") is not None
+
+
+def test_a_name_given_for_the_object_and_component_names_as_a_text_are_named():
+    """with_component("tool") and with_joint("x") raised AttributeErrors; a component of one's own whose
+    component_names is a text (not a set of names) failed later with a KeyError of one letter's name."""
+    from substructure import default_assembly
+    from substructure.errors import InvalidValueError as Invalid
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from custom_components import NutChuck
+
+    model = default_assembly()
+    with pytest.raises(Invalid, match=r"with_component: got 'tool'.*assembly.component\('tool'\)"):
+        model.with_component("tool")
+    with pytest.raises(Invalid, match=r"with_joint: got 'x', which is not a joint"):
+        model.with_joint("x")
+    with pytest.raises(Invalid, match="with_component: got None"):
+        model.with_component(None)
+
+    class TextNames(NutChuck):
+        @property
+        def component_names(self):
+            return "holder"
+
+    holder = model.component("holder")
+    with pytest.raises(Invalid, match="component_names is 'holder'; expected a set"):
+        model.with_component(TextNames("holder", holder.segments, nut_mass="150 g"))
+    assert model.with_component(NutChuck("holder", holder.segments, nut_mass="150 g")) is not None

@@ -53,4 +53,18 @@ def _component_check(items) -> tuple:
                     f"components: {c!r} is not a component (it has no {attr!r}); see "
                     "substructure.components for the protocol"
                 )
+        names = c.component_names
+        if isinstance(names, (str, bytes)) or not all(isinstance(n, str) for n in _items(names)):
+            raise InvalidValueError(
+                f"components: {getattr(c, 'name', c)!r}: component_names is {names!r}; expected a set of the names "
+                f"of the pieces it holds, e.g. {{{getattr(c, 'name', 'holder')!r}}} (a text is not a set of names)"
+            )
     return items
+
+
+def _items(value) -> tuple:
+    """The items of a collection, or (None,) when it is none (then refused as not a name)."""
+    try:
+        return tuple(value)
+    except TypeError:
+        return (None,)

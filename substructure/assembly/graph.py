@@ -354,6 +354,7 @@ class Assembly:
         Assembly
             A new assembly; this one is unchanged.
         """
+        _check_member(joint, "joint", ("name", "between", "rigid", "dynamic_stiffness"), "with_joint")
         self.joint(joint.name)
         return attrs.evolve(self, joints=tuple(joint if j.name == joint.name else j for j in self.joints))
 
@@ -370,6 +371,8 @@ class Assembly:
         Assembly
             A new assembly; this one is unchanged.
         """
+        _check_member(component, "component", ("name", "component_names", "node_key", "receptance_matrix"),
+                      "with_component")
         if not any(c.name == component.name for c in self.components):
             raise UnknownPointError(f"no component {component.name!r} in assembly {self.name!r}")
         return attrs.evolve(
@@ -589,3 +592,12 @@ class Assembly:
         for m in self.masses:
             lines.append(f"  mass {m.name} at {m.at}: {m.mass:~P}")
         return "\n".join(lines)
+
+
+def _check_member(item, kind: str, attributes: tuple, method: str) -> None:
+    """Refuse, naming the method, what is not a joint or a component (a name given for the object, None)."""
+    missing = [a for a in attributes if not hasattr(item, a)]
+    if missing:
+        hint = (f" (a name: give the {kind} itself, e.g. assembly.{kind}({item!r}) changed)"
+                if isinstance(item, str) else "")
+        raise InvalidValueError(f"{method}: got {item!r}, which is not a {kind} (it has no {missing[0]!r}){hint}")
