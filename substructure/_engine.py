@@ -304,6 +304,14 @@ def couple_substructures(blocks, links: Sequence[Link], outputs: Sequence[object
         idx = np.array([i for _, i in kept], dtype=np.int64)
         out, finite = _kernels.couple_link(ya, yb, a[0], a[1], b[0], b[1], src, idx, stiffness, rigid, rows, cols)
         if not finite:
+            if not rigid:  # an elastic link: its stiffness is beyond what floating point holds beside the rest
+                with np.errstate(invalid="ignore", over="ignore"):
+                    largest = float(np.nanmax(np.abs(stiffness)))
+                raise AssemblyError(
+                    f"coupling through {link.label or 'a connection'} is singular in floating point: its dynamic "
+                    f"stiffness reaches {largest:.3g} (SI); a joint that stiff is rigid: give it as rigid "
+                    "(Joint(..., rigid=True))"
+                )
             raise AssemblyError(
                 f"coupling through {link.label or 'a connection'} is singular: a rigid joint that "
                 "closes a loop of rigid joints (redundant), or a connection to a point with no "

@@ -361,3 +361,18 @@ def test_a_name_given_for_the_object_and_component_names_as_a_text_are_named():
     with pytest.raises(Invalid, match="component_names is 'holder'; expected a set"):
         model.with_component(TextNames("holder", holder.segments, nut_mass="150 g"))
     assert model.with_component(NutChuck("holder", holder.segments, nut_mass="150 g")) is not None
+
+
+def test_a_joint_too_stiff_for_floating_point_says_to_make_it_rigid():
+    """A joint of 1e200 N/m made the coupling singular and was reported as 'a rigid joint that closes a loop of rigid
+    joints', which it is not: the error now names its stiffness and says to give it as rigid."""
+    from substructure import AssemblyError
+
+    model = default_assembly()
+    joint = model.joints[1]
+    stiff = model.with_joint(Joint(joint.name, joint.between, k={"yf": "1e200 N/m", "tm": "1e200 N*m/rad"}))
+    with pytest.raises(AssemblyError, match=r"singular in floating point: its dynamic stiffness reaches 1e\+200.*"
+                                            r"rigid=True"):
+        stiff.frf("tool.tip", frequency=Frequency.from_hz([100.0, 1000.0]))
+    rigid = model.with_joint(Joint(joint.name, joint.between, rigid=True))
+    assert np.isfinite(rigid.frf("tool.tip", frequency=Frequency.from_hz([100.0, 1000.0])).data).all()
