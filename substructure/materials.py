@@ -16,13 +16,27 @@ import pint
 from .errors import InvalidValueError
 from .units import dimensionless, quantity
 
-__all__ = ["Material", "CATALOG", "get_material", "steel", "carbide", "aluminium"]
+__all__ = ["Material", "CATALOG", "get_material", "steel", "carbide", "aluminium", "E_RANGE", "RHO_RANGE",
+           "LOSS_FACTOR_MAX"]
 
 
-def _positive(value, field: str, dimension: str, what: str) -> pint.Quantity:
+E_RANGE = (1e3, 1e13)
+"""Young's moduli the beam model computes right [Pa] (1 kPa to 10 TPa): beyond them its products overflow or
+vanish in floating point."""
+RHO_RANGE = (0.1, 1e5)
+"""Densities the beam model computes right [kg/m^3]."""
+LOSS_FACTOR_MAX = 10.0
+"""The largest structural loss factor taken (a material's ``eta``; 0.5 is already a very lossy polymer)."""
+
+
+def _positive(value, field: str, dimension: str, what: str, si: str = "", within: tuple = (0.0, float("inf")),
+              shown: str = "") -> pint.Quantity:
     q = quantity(value, field, dimension)
     if q.magnitude <= 0:
         raise InvalidValueError(f"{field}: got {value!r}; expected a positive {what}")
+    if si and not within[0] <= q.m_as(si) <= within[1]:
+        raise InvalidValueError(f"{field}: got {value!r}; expected a {what} {shown} (beyond, the beam model's "
+                                "numbers overflow or vanish)")
     return q
 
 
@@ -39,6 +53,8 @@ def _loss(value) -> float:
         raise InvalidValueError(
             f"loss_factor: got {value!r}; expected a loss factor >= 0 (a negative one adds energy)"
         )
+    if not eta <= LOSS_FACTOR_MAX:
+        raise InvalidValueError(f"loss_factor: got {value!r}; expected a loss factor of at most {LOSS_FACTOR_MAX:g}")
     return eta
 
 
@@ -57,20 +73,25 @@ class Material:
     name : str
         Name used in files and messages.
     E : quantity or str
-        Young's modulus, e.g. ``"210 GPa"``.
+        Young's modulus, e.g. ``"210 GPa"``; from 1 kPa to 10 TPa (``E_RANGE``).
     nu : float
         Poisson ratio, in (-1, 0.5).
     rho : quantity or str
-        Density, e.g. ``"7850 kg/m^3"``.
+        Density, e.g. ``"7850 kg/m^3"``; from 0.1 to 1e5 kg/m^3 (``RHO_RANGE``).
     loss_factor : float, default 0
-        Structural (hysteretic) loss factor ``eta >= 0``.
+        Structural (hysteretic) loss factor, ``0 <= eta <= 10`` (``LOSS_FACTOR_MAX``).
+
+    Values outside these ranges are refused: the beam model's numbers overflow
+    or vanish there, and such a value is a wrong unit or a typo.
     """
 
     name: str = attrs.field(converter=_name)
     E: pint.Quantity = attrs.field(
-        converter=lambda v: _positive(v, "E", "[mass] / [length] / [time] ** 2", "Young's modulus"))
+        converter=lambda v: _positive(v, "E", "[mass] / [length] / [time] ** 2", "Young's modulus", "Pa", E_RANGE,
+                                      "from 1 kPa to 10 TPa"))
     nu: float = attrs.field(converter=_poisson)
-    rho: pint.Quantity = attrs.field(converter=lambda v: _positive(v, "rho", "[mass] / [length] ** 3", "density"))
+    rho: pint.Quantity = attrs.field(converter=lambda v: _positive(v, "rho", "[mass] / [length] ** 3", "density",
+                                                                   "kg/m^3", RHO_RANGE, "from 0.1 to 1e5 kg/m^3"))
     loss_factor: float = attrs.field(default=0.0, converter=_loss)
     # SI values, derived once (every section of every beam variant needs them)
     _si: tuple = attrs.field(init=False, eq=False, repr=False)

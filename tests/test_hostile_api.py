@@ -376,3 +376,14 @@ def test_a_joint_too_stiff_for_floating_point_says_to_make_it_rigid():
         stiff.frf("tool.tip", frequency=Frequency.from_hz([100.0, 1000.0]))
     rigid = model.with_joint(Joint(joint.name, joint.between, rigid=True))
     assert np.isfinite(rigid.frf("tool.tip", frequency=Frequency.from_hz([100.0, 1000.0])).data).all()
+
+
+@pytest.mark.parametrize("field, value", [("E", "1e-100 Pa"), ("E", "1e300 GPa"), ("rho", "1e300 kg/m^3"),
+                                          ("rho", "1e-3 kg/m^3"), ("loss_factor", 1e300)])
+def test_a_material_the_beam_model_cannot_compute_is_refused_where_it_is_made(field, value):
+    """In Python these were accepted and failed later in the beam model with a raw OverflowError or 'cannot convert
+    float NaN to integer' (the assembly file's reader already refused them at their key)."""
+    args = {"name": "odd", "E": "200 GPa", "nu": 0.3, "rho": "7800 kg/m^3", field: value}
+    with pytest.raises(InvalidValueError, match=f"^{field}: got "):
+        Material(**args)
+    Material("light", "1 GPa", 0.3, "1 kg/m^3", 9.0)  # within the ranges

@@ -12,6 +12,7 @@ from __future__ import annotations
 import attrs
 
 from ...beams import MAX_TAPER_STEPS  # noqa: F401 (the limits of the beam model, named in the reader's errors)
+from ...materials import E_RANGE, LOSS_FACTOR_MAX, RHO_RANGE
 from ...sections import SIZE_RANGE_M  # noqa: F401
 
 _TOP_KEYS = ("name", "frequency", "materials", "components", "joints", "supports", "sensors", "masses")
@@ -32,10 +33,10 @@ _STANDARD_FIELDS = ("name", "segments", "description")
 
 # The values the beam and coupling models compute right (beyond them, results turn to NaN, overflow or noise):
 # a value outside is a wrong unit or a typo.  key -> (SI unit, lowest, highest, the range in words)
-PLAUSIBLE = {
-    "E": ("Pa", 1e3, 1e13, "from 1 kPa to 10 TPa"),
-    "rho": ("kg/m^3", 0.1, 1e5, "from 0.1 to 1e5 kg/m^3"),
-    "loss_factor": ("", 0.0, 10.0, "at most 10"),
+PLAUSIBLE = {  # a material's as Material checks them, said at the file's key and line
+    "E": ("Pa", *E_RANGE, "from 1 kPa to 10 TPa"),
+    "rho": ("kg/m^3", *RHO_RANGE, "from 0.1 to 1e5 kg/m^3"),
+    "loss_factor": ("", 0.0, LOSS_FACTOR_MAX, f"at most {LOSS_FACTOR_MAX:g}"),
     "mass": ("kg", 0.0, 1e6, "at most 1e6 kg"),
     "inertia": ("kg*m^2", 0.0, 1e6, "at most 1e6 kg*m^2"),
 }
