@@ -81,6 +81,8 @@ class Material:
     loss_factor : float, default 0
         Structural (hysteretic) loss factor, ``0 <= eta <= 10`` (``LOSS_FACTOR_MAX``).
 
+    Notes
+    -----
     Values outside these ranges are refused: the beam model's numbers overflow
     or vanish there, and such a value is a wrong unit or a typo.
     """
