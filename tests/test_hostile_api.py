@@ -387,3 +387,28 @@ def test_a_material_the_beam_model_cannot_compute_is_refused_where_it_is_made(fi
     with pytest.raises(InvalidValueError, match=f"^{field}: got "):
         Material(**args)
     Material("light", "1 GPa", 0.3, "1 kg/m^3", 9.0)  # within the ranges
+
+
+def test_the_plot_note_says_what_the_entries_drawn_are():
+    """The note under an FRF plot said 'H = displacement / force' also for a rotation's or a moment's entries."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from substructure.plot import plot_frf
+
+    model = default_assembly()
+    grid = Frequency.from_hz(np.linspace(100.0, 2000.0, 50))
+    frf = model.frf(["tool.tip:y", "tool.tip:theta"], ["tool.tip:y", "tool.tip:theta"], frequency=grid)
+
+    def note(entries) -> str:
+        fig = plot_frf(frf, entries=entries)
+        text = next(t.get_text() for t in fig.axes[-1].texts if t.get_gid() == "substructure-note")
+        plt.close(fig)
+        return text
+
+    assert note([("tool.tip:y", "tool.tip:y")]).startswith("H = displacement / force")
+    assert note([("tool.tip:theta", "tool.tip:theta")]).startswith("H = rotation / moment")
+    assert note([("tool.tip:theta", "tool.tip:y"), ("tool.tip:y", "tool.tip:y")]).startswith(
+        "H = displacement or rotation / force")

@@ -30,11 +30,24 @@ KINDS = {"bode": ("magnitude", "phase"), "real-imag": ("real", "imag"), "nyquist
 FRF_UNITS = {"m/N": 1.0, "mm/N": 1e3, "um/N": 1e6, "µm/N": 1e6, "nm/N": 1e9}
 """Display units of translational FRFs (displacement per force) and their factors from m/N."""
 _LENGTH = {"m/N": "m", "mm/N": "mm", "um/N": "µm", "µm/N": "µm", "nm/N": "nm"}
-_NAMES = {  # plain name, symbol, definition (for the note)
-    "receptance": ("receptance", "H", "displacement / force"),
-    "mobility": ("mobility", "Y", "velocity / force"),
-    "accelerance": ("accelerance", "A", "acceleration / force"),
-}
+_NAMES = {"receptance": ("receptance", "H"), "mobility": ("mobility", "Y"), "accelerance": ("accelerance", "A")}
+"""Plain name and symbol of each quantity (the note's definition follows the DOFs drawn: :func:`_definition`)."""
+_MOTIONS = {"receptance": ("displacement", "rotation"), "mobility": ("velocity", "angular velocity"),
+            "accelerance": ("acceleration", "angular acceleration")}
+
+
+def _definition(quantity: str, entries: Sequence[tuple[str, str]]) -> str:
+    """What the entries drawn are, per their DOFs: ``displacement / force``, ``rotation / moment``, or both words
+    where the entries mix them (a label without ``:theta`` is a translation)."""
+    def words(labels, pair) -> str:
+        kinds = sorted({pair[1] if str(label).endswith(":theta") else pair[0] for label in labels},
+                       key=pair.index)
+        return " or ".join(kinds) if kinds else pair[0]
+
+    return (f"{words([o for o, _ in entries], _MOTIONS[quantity])} / "
+            f"{words([i for _, i in entries], ('force', 'moment'))}")
+
+
 _RIGID_GID = "substructure-rigid-body-region"
 _NOTE_GID = "substructure-note"
 
@@ -240,7 +253,7 @@ def draw_frf(
             else:
                 (line,) = axis.plot(hz, re if part == "real" else im, label=text, **line_kw)
             _mark(line, hz, cutoff)
-    plain, symbol, definition = _NAMES[frf.quantity]
+    plain, symbol = _NAMES[frf.quantity]
     ylabels = {
         "magnitude": f"{plain} |{symbol}| ({shown})",
         "phase": "phase (deg)",
@@ -275,7 +288,8 @@ def draw_frf(
                                       if isinstance(plt.rcParams["figure.titlesize"], (int, float)) else 12.0)))
     if note:
         earlier = [t for t in axes[-1].texts if t.get_gid() == _NOTE_GID]
-        text = f"{symbol} = {definition} ({frf.quantity}), time convention x(t) = X exp(i omega t)"
+        text = (f"{symbol} = {_definition(frf.quantity, entries)} ({frf.quantity}), time convention "
+                "x(t) = X exp(i omega t)")
         if len(entries) == 1 and not earlier:
             text += f"; response {entries[0][0]}, excitation {entries[0][1]}"
         found = [c for a in axes for ln in a.lines if (c := _cutoff(ln)) is not None]
