@@ -103,3 +103,35 @@ def test_predict_json_flags_extrapolation(table_csv, capsys):
     assert main(["predict", table_csv, "--features", "tool_diameter=14 mm,gauge_length=90 mm", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["extrapolation"] == [] and out["parameters"]["k_yf"]["extrapolation"] == []
+
+
+def test_json_numbers_are_si_whatever_unit_the_table_gives(tmp_path, capsys):
+    """A table in N/mm gave its prediction's and its cross-validation's numbers in N/mm in the JSON, whose numbers
+    are SI by the command's contract; they are in N/m now, the table's unit named beside."""
+    import json
+
+    from substructure.cli import main
+    from substructure.surrogate import thesis_table_4_2
+
+    si = tmp_path / "si.csv"
+    thesis_table_4_2().to_csv(si)
+    lines = si.read_text().splitlines()
+    assert lines[0].startswith("tool_diameter [mm],gauge_length [mm],k_yf [N/m]")
+    in_mm = tmp_path / "mm.csv"
+    rows = [lines[0].replace("[N/m]", "[N/mm]")]
+    for line in lines[1:]:
+        cells = line.split(",")
+        cells[2] = repr(float(cells[2]) / 1000.0)
+        rows.append(",".join(cells))
+    in_mm.write_text("\n".join(rows) + "\n")
+    got = {}
+    for name, path in (("si", si), ("mm", in_mm)):
+        assert main(["predict", str(path), "--features", "tool_diameter=14 mm,gauge_length=80 mm", "--json"]) == 0
+        got[name] = json.loads(capsys.readouterr().out)["parameters"]["k_yf"]
+        assert main(["predict", str(path), "--cross-validate", "loo", "--json"]) == 0
+        got[name + "_cv"] = json.loads(capsys.readouterr().out)
+    assert got["mm"]["unit"] == "N/m" and got["mm"]["table_unit"] == "N/mm" and got["si"]["table_unit"] == "N/m"
+    assert got["mm"]["value"] == pytest.approx(got["si"]["value"], rel=1e-6)
+    assert got["mm"]["interval_95"] == pytest.approx(got["si"]["interval_95"], rel=1e-6)
+    assert got["mm_cv"]["unit"] == "N/m" and got["mm_cv"]["table_unit"] == "N/mm"
+    assert got["mm_cv"]["folds"][0]["true"] == pytest.approx(got["si_cv"]["folds"][0]["true"], rel=1e-9)

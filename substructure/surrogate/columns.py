@@ -29,6 +29,15 @@ PARAMETER_UNITS = {
 }
 """The SI unit of each joint parameter (conventions.md, Joints)."""
 
+def in_si(name: str, unit: str) -> tuple[float, str]:
+    """``(factor, unit)``: a joint parameter's values in ``unit`` times ``factor`` are in its SI unit
+    (``PARAMETER_UNITS``); a parameter of another name stays in its unit (factor 1)."""
+    si = PARAMETER_UNITS.get(name)
+    if si is None or unit == si:
+        return 1.0, unit
+    return float(ureg.Quantity(1.0, unit).m_as(si)), si
+
+
 _HEADER = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:\[(.*)\])?\s*$")
 
 _DIRECT = ("k_yf", "k_tm", "c_yf", "c_tm")

@@ -35,6 +35,7 @@ from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
 from sklearn.neural_network import MLPRegressor
 
 from ..errors import InvalidValueError, SubstructureWarning
+from .columns import in_si
 from .table import JointTable
 
 __all__ = ["ExtrapolationWarning", "Prediction", "JointSurrogate", "MLPSurrogate", "GPSurrogate", "make_surrogate"]
@@ -195,14 +196,17 @@ class Prediction:
         Returns
         -------
         dict
-            Values in ``unit``; plain floats, ready for JSON.
+            Values in SI units (``unit``, the joint parameters' of ``PARAMETER_UNITS`` whatever unit the table
+            gave, ``table_unit``); plain floats, ready for JSON.
         """
         out = {}
         for p in self.log_mean:
             lo, hi = self.interval(p, 0.95)
-            out[p] = {"value": float(self.value(p)[index]), "unit": self.units[p],
-                      "std": float(self.std(p)[index]), "interval_95": [float(lo[index]), float(hi[index])],
-                      "extrapolation": self.outside(index)}
+            factor, unit = in_si(p, self.units[p])
+            out[p] = {"value": factor * float(self.value(p)[index]), "unit": unit,
+                      "std": factor * float(self.std(p)[index]),
+                      "interval_95": [factor * float(lo[index]), factor * float(hi[index])],
+                      "table_unit": self.units[p], "extrapolation": self.outside(index)}
         return out
 
 

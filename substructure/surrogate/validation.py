@@ -18,6 +18,7 @@ from sklearn.base import clone
 from .._text import plain_text
 from ..errors import InvalidValueError
 from .models import JointSurrogate
+from .columns import in_si
 from .table import JointTable
 
 __all__ = ["CrossValidation", "cross_validate"]
@@ -92,11 +93,13 @@ class CrossValidation:
         Returns
         -------
         dict
-            The folds (values in ``unit``), the errors in % and the coverages.
+            The folds (values in SI units, ``unit``; the table's was ``table_unit``), the errors in % and the
+            coverages.
         """
+        factor, unit = in_si(self.target, self.unit)
         return {
-            "model": self.model, "target": self.target, "unit": self.unit, "scheme": self.scheme,
-            "folds": [{k: [int(i) for i in f[k]] if k == "held_out" else [float(x) for x in f[k]]
+            "model": self.model, "target": self.target, "unit": unit, "table_unit": self.unit, "scheme": self.scheme,
+            "folds": [{k: [int(i) for i in f[k]] if k == "held_out" else [factor * float(x) for x in f[k]]
                        for k in ("held_out", "true", "predicted", "std")} for f in self.folds],
             "mean_abs_percent_error": self.mean_abs_percent_error,
             "max_abs_percent_error": self.max_abs_percent_error,
