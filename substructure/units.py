@@ -330,8 +330,14 @@ def quantity(value: Any, field: str, dimension: str) -> pint.Quantity:
         )
     if np.iscomplexobj(q.magnitude):
         raise InvalidValueError(f"{field}: got {show_value(value)}; expected a real value")
-    if not math.isfinite(float(q.magnitude)):
+    try:
+        magnitude = float(q.magnitude)
+    except (TypeError, ValueError):
+        raise InvalidValueError(f"{field}: got {show_value(value)}; expected a real number with its unit") from None
+    if not math.isfinite(magnitude):
         raise InvalidValueError(f"{field}: got {show_value(value)}; expected a finite value")
+    if not isinstance(q.magnitude, (int, float, np.integer, np.floating)):  # a Fraction, a Decimal: as a float
+        q = ureg.Quantity(magnitude, q.units)
     return q
 
 

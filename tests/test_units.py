@@ -181,3 +181,17 @@ def test_a_unicode_minus_at_the_start_says_so_and_unit_symbols_still_read():
     assert quantity("5e-8 kg\u00b7m\u00b2", "J", "[mass] * [length] ** 2") == Q_(5e-8, "kg*m^2")
     assert quantity("3 \u00c5", "x", "[length]") == Q_(3, "angstrom")
     assert quantity("9.81 m\u00b7s\u207b\u00b2", "a", "[length] / [time] ** 2") == Q_(9.81, "m/s^2")
+
+
+def test_a_fraction_or_a_decimal_magnitude_is_taken_as_a_float():
+    """Q_(Fraction(1, 3), "mm") or a Decimal magnitude passed the checks and failed later in numpy with a raw
+    TypeError ('ufunc isfinite not supported'); such a magnitude is taken as the float it is."""
+    from decimal import Decimal
+    from fractions import Fraction
+
+    from substructure import Segment
+    from substructure.units import Q_, quantity
+
+    assert Segment(Q_(Fraction(1, 3), "mm"), "12 mm").length_m == pytest.approx(1e-3 / 3, rel=1e-15)
+    q = quantity(Q_(Decimal("12.5"), "mm"), "od", "[length]")
+    assert isinstance(q.magnitude, float) and q.magnitude == 12.5
