@@ -554,8 +554,9 @@ def stepped_beam_receptances_si(
     -------
     list of ndarray or None
         ``(2p, 2p, n_freq)`` per beam; None when a beam is long enough at the
-        highest line that its chain must be cut (then call
-        :func:`stepped_beam_receptance_si` for each).
+        highest line that its chain must be cut, or a section is not a number
+        (then call :func:`stepped_beam_receptance_si` for each, which cuts the
+        chain or raises as for that beam alone).
     """
     from . import _kernels
 
@@ -569,7 +570,8 @@ def stepped_beam_receptances_si(
     _, k_max = _kernels.segment_coefficients(ei.T, kga.T, rhoa.T, rhoi.T,
                                              float(np.max(np.abs(omega))) if omega.size else 0.0)
     phases = k_max[:, seg] * widths[:, 0]
-    if phases.max() > _CHUNK_KL or np.cumsum(phases, axis=1)[:, -1].max() > _CHUNK_KL:
+    # a chain to cut, or a section that is not a number (refused by the single call): each beam alone
+    if not np.isfinite(phases).all() or phases.max() > _CHUNK_KL or np.cumsum(phases, axis=1)[:, -1].max() > _CHUNK_KL:
         return None
     ei, kga, rhoa, rhoi = (np.ascontiguousarray(v[seg]) for v in (ei, kga, rhoa, rhoi))
     shared = ((ei == ei[:, :1]).all(axis=1) & (kga == kga[:, :1]).all(axis=1)

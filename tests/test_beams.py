@@ -199,6 +199,9 @@ def test_si_beams_of_one_layout_together_are_each_the_beam_alone():
     long_bar = beam.evolve(length=beam.length * 40.0)
     f = np.linspace(20.0, 20000.0, 50)
     assert stepped_beam_receptances_si([long_bar.sections()] * 2, long_bar.length, [0.0], f) is None
+    # a section that is not a number raises alone: left to the single call, not coupled as NaN
+    not_a_number = beam.evolve(od=beam.od * np.where(np.arange(beam.od.size) == 0, np.nan, 1.0))
+    assert stepped_beam_receptances_si([beam.sections(), not_a_number.sections()], beam.length, [0.0], f) is None
 
 
 def test_composite_and_fluted_sections():
