@@ -453,7 +453,16 @@ def _intervals(lengths: np.ndarray, positions) -> tuple:
     found = _INTERVALS.get(key)
     if found is not None:
         return found
-    pos = np.asarray(positions, dtype=float)
+    # checked here, once per layout kept: a length or a position the beam does not have gave numbers silently
+    if lengths.ndim != 1 or lengths.size == 0 or not (np.isfinite(lengths).all() and (lengths > 0).all()):
+        raise InvalidValueError(f"lengths: got {lengths.tolist()!r}; expected the segment lengths in m, each finite "
+                                "and > 0")
+    pos = np.asarray(positions, dtype=float).reshape(-1)
+    total = float(lengths.sum())
+    outside = ~np.isfinite(pos) | (pos < 0.0) | (pos > total * (1.0 + 1e-12))
+    if pos.size == 0 or outside.any():
+        raise InvalidValueError(f"positions: got {pos.tolist()!r}; expected at least one position in m from the base, "
+                                f"each within the beam (0 to {total!r} m)")
     order = np.argsort(pos)
     sorted_pos = pos[order]
     if np.any(np.diff(sorted_pos) <= 0):
@@ -472,6 +481,29 @@ def _intervals(lengths: np.ndarray, positions) -> tuple:
     return found
 
 
+def _checked_si(ei, kga, rhoa, rhoi, n_seg: int, frequency_hz, finite: bool = True) -> None:
+    """The SI arrays of :func:`stepped_beam_receptance_si` (shape ``(n_seg, 1)``) and of
+    :func:`stepped_beam_receptances_si` (``(n_seg, beams)``) checked: one value per segment, sections a beam has
+    (``EI`` and ``kappa G A`` of positive real part, ``rho A`` > 0, ``rho I`` >= 0, finite; with ``finite``
+    False a value that is not a number passes, for the batch to fall back on single calls), lines above 0 Hz (a
+    free-free beam has no static receptance: 0 Hz gave infinite values)."""
+    for name, v in (("ei", ei), ("kga", kga), ("rhoa", rhoa), ("rhoi", rhoi)):
+        if v.shape[0] != n_seg:
+            raise InvalidValueError(f"{name}: got {v.shape[0]} values for {n_seg} segments; expected one per segment")
+    bad = (ei.real <= 0) | (kga.real <= 0) | (rhoa <= 0) | (rhoi < 0)
+    if finite:
+        bad |= ~(np.isfinite(ei) & np.isfinite(kga) & np.isfinite(rhoa) & np.isfinite(rhoi))
+    if bad.any():
+        k, b = (int(i) for i in np.argwhere(bad)[0])
+        raise InvalidValueError(f"segment {k}: got EI = {complex(ei[k, b])!r}, kGA = {complex(kga[k, b])!r}, "
+                                f"rhoA = {float(rhoa[k, b])!r}, rhoI = {float(rhoi[k, b])!r}; expected EI and kGA of "
+                                "positive real part, rhoA > 0 and rhoI >= 0, each finite (SI)")
+    f = np.asarray(frequency_hz, dtype=float)
+    if f.size and not (f.min() > 0 and f.max() < np.inf):
+        raise InvalidValueError("frequency_hz: expected lines above 0 Hz, each finite (a free-free beam has no "
+                                "static receptance)")
+
+
 def stepped_beam_receptance_si(
     ei: np.ndarray, kga: np.ndarray, rhoa: np.ndarray, rhoi: np.ndarray, lengths: np.ndarray,
     positions: Sequence[float], frequency_hz: np.ndarray, decay: float = 0.0,
@@ -486,9 +518,9 @@ def stepped_beam_receptance_si(
     ----------
     ei, kga : ndarray of complex, shape (n_seg,)
         Bending stiffness [N m^2] and shear stiffness ``kappa G A`` [N] of each
-        segment, base to tip (complex with a loss factor).
+        segment, base to tip (complex with a loss factor; real parts > 0).
     rhoa, rhoi : ndarray of float, shape (n_seg,)
-        Mass per length [kg/m] and rotary inertia per length [kg m].
+        Mass per length [kg/m] (> 0) and rotary inertia per length [kg m] (>= 0).
     lengths : ndarray of float, shape (n_seg,)
         Segment lengths [m], all > 0.
     positions : sequence of float
@@ -503,14 +535,22 @@ def stepped_beam_receptance_si(
     ndarray, shape (2p, 2p, n_freq)
         Frequency-last receptances; DOFs ``(y, theta)`` per position in the
         order given.
+
+    Raises
+    ------
+    InvalidValueError
+        For arrays not of one value per segment, a section, a length or a
+        line outside those ranges (or not a number), or a position off the
+        beam: they gave numbers without a word.
     """
     lengths = np.asarray(lengths, dtype=float)
-    order, widths, seg, nodes = _intervals(lengths, positions)
-    omega = angular_lines(frequency_hz, decay)
     from . import _kernels
 
     ei, kga = (_kernels.c_array(np.asarray(v, complex).reshape(-1, 1), complex) for v in (ei, kga))
     rhoa, rhoi = (_kernels.c_array(np.asarray(v, float).reshape(-1, 1), float) for v in (rhoa, rhoi))
+    _checked_si(ei, kga, rhoa, rhoi, lengths.size, frequency_hz)
+    order, widths, seg, nodes = _intervals(lengths, positions)
+    omega = angular_lines(frequency_hz, decay)
     _, k_max = _kernels.segment_coefficients(  # every segment's largest wavenumber, in one call
         ei.reshape(1, -1), kga.reshape(1, -1), rhoa.reshape(1, -1), rhoi.reshape(1, -1),
         float(np.max(np.abs(omega))) if omega.size else 0.0)
@@ -557,16 +597,29 @@ def stepped_beam_receptances_si(
         highest line that its chain must be cut, or a section is not a number
         (then call :func:`stepped_beam_receptance_si` for each, which cuts the
         chain or raises as for that beam alone).
+
+    Raises
+    ------
+    InvalidValueError
+        As :func:`stepped_beam_receptance_si` (but for a section that is not
+        a number), and for no beams or beams of other numbers of segments.
     """
     from . import _kernels
 
     lengths = np.asarray(lengths, dtype=float)
-    order, widths, seg, nodes = _intervals(lengths, positions)
+    if len(sections) == 0:
+        raise InvalidValueError("sections: got none; expected the section arrays of at least one beam")
     omega = angular_lines(frequency_hz, decay)
-    ei, kga = (np.ascontiguousarray(np.stack([np.asarray(s[k], complex) for s in sections], axis=1))
-               for k in (0, 1))
-    rhoa, rhoi = (np.ascontiguousarray(np.stack([np.asarray(s[k], float) for s in sections], axis=1))
-                  for k in (2, 3))
+    try:
+        ei, kga = (np.ascontiguousarray(np.stack([np.asarray(s[k], complex).reshape(-1) for s in sections], axis=1))
+                   for k in (0, 1))
+        rhoa, rhoi = (np.ascontiguousarray(np.stack([np.asarray(s[k], float).reshape(-1) for s in sections], axis=1))
+                      for k in (2, 3))
+    except ValueError as exc:  # beams of other numbers of segments
+        raise InvalidValueError(f"sections: {exc}; expected (ei, kga, rhoa, rhoi) of {lengths.size} values each, "
+                                "for every beam") from None
+    _checked_si(ei, kga, rhoa, rhoi, lengths.size, frequency_hz, finite=False)
+    order, widths, seg, nodes = _intervals(lengths, positions)
     _, k_max = _kernels.segment_coefficients(ei.T, kga.T, rhoa.T, rhoi.T,
                                              float(np.max(np.abs(omega))) if omega.size else 0.0)
     phases = k_max[:, seg] * widths[:, 0]

@@ -204,6 +204,80 @@ def test_si_beams_of_one_layout_together_are_each_the_beam_alone():
     assert stepped_beam_receptances_si([beam.sections(), not_a_number.sections()], beam.length, [0.0], f) is None
 
 
+def _si_tool():
+    from substructure import default_assembly
+    from substructure.updating.structure import Structure
+
+    beam = Structure.from_assembly(default_assembly()).beams["tool"]
+    return beam.sections(), beam.length
+
+
+@pytest.mark.parametrize("case, message", [
+    ("fewer lengths", "ei: got 2 values for 1 segments"),
+    ("negative length", "lengths: got [-0.046, -0.03]"),
+    ("position past the tip", "positions: got [0.0, 0.5]; expected at least one position in m from the base, "
+                              "each within the beam (0 to 0.076 m)"),
+    ("position before the base", "positions: got [-0.001, 0.076]"),
+    ("no position", "positions: got []"),
+    ("a line at 0 Hz", "frequency_hz: expected lines above 0 Hz"),
+    ("a line not a number", "frequency_hz: expected lines above 0 Hz"),
+    ("negative EI", "segment 1: got EI = (-"),
+    ("massless segment", "segment 0: got EI = (590"),
+    ("EI not a number", "segment 0: got EI = (nan+nanj)"),
+])
+def test_si_beam_receptances_refuse_what_a_beam_cannot_be(case, message):
+    """The SI fast paths took these and gave numbers: positions off the beam (extrapolated), infinite values at
+    0 Hz or for a massless segment, receptances of a negative stiffness or length; arrays of another number of
+    segments than lengths were cut silently to the lengths. Each is now refused naming the argument, in the single
+    call and in the batch (where a section that is not a number is still left to the single call, None)."""
+    from substructure.beams import stepped_beam_receptance_si, stepped_beam_receptances_si
+
+    (ei, kga, rhoa, rhoi), length = _si_tool()
+    f, xs = np.linspace(20.0, 5000.0, 20), [0.0, 0.076]
+    if case == "fewer lengths":
+        length = length[:1]
+    elif case == "negative length":
+        length = -length
+    elif case == "position past the tip":
+        xs = [0.0, 0.5]
+    elif case == "position before the base":
+        xs = [-0.001, 0.076]
+    elif case == "no position":
+        xs = []
+    elif case == "a line at 0 Hz":
+        f = np.array([0.0, 100.0])
+    elif case == "a line not a number":
+        f = np.array([np.nan, 100.0])
+    elif case == "negative EI":
+        ei = ei * np.array([1.0, -1.0])
+    elif case == "massless segment":
+        rhoa = rhoa * np.array([0.0, 1.0])
+    elif case == "EI not a number":
+        ei = ei * np.array([np.nan, 1.0])
+    with pytest.raises(InvalidValueError) as single:
+        stepped_beam_receptance_si(ei, kga, rhoa, rhoi, length, xs, f)
+    assert message in str(single.value)
+    good = tuple(np.array(v) for v in _si_tool()[0])
+    if case == "EI not a number":
+        assert stepped_beam_receptances_si([good, (ei, kga, rhoa, rhoi)], length, xs, f) is None
+        return
+    with pytest.raises(InvalidValueError) as batch:
+        stepped_beam_receptances_si([good, (ei, kga, rhoa, rhoi)] if case != "fewer lengths" else [good], length,
+                                    xs, f)
+    assert message in str(batch.value)
+
+
+def test_si_beams_together_refuse_no_beams_and_beams_of_other_segment_counts():
+    from substructure.beams import stepped_beam_receptances_si
+
+    (ei, kga, rhoa, rhoi), length = _si_tool()
+    f = np.linspace(20.0, 5000.0, 20)
+    with pytest.raises(InvalidValueError, match="sections: got none"):
+        stepped_beam_receptances_si([], length, [0.0], f)
+    with pytest.raises(InvalidValueError, match="expected \\(ei, kga, rhoa, rhoi\\) of 2 values each"):
+        stepped_beam_receptances_si([(ei, kga, rhoa, rhoi), (ei[:1], kga[:1], rhoa[:1], rhoi[:1])], length, [0.0], f)
+
+
 def test_composite_and_fluted_sections():
     steel, carbide = Material.from_catalog("steel"), Material.from_catalog("carbide")
     seg = Segment("40 mm", "40 mm", "12 mm", insert=Insert("12 mm", "carbide"))
