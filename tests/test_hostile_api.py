@@ -412,3 +412,38 @@ def test_the_plot_note_says_what_the_entries_drawn_are():
     assert note([("tool.tip:theta", "tool.tip:theta")]).startswith("H = rotation / moment")
     assert note([("tool.tip:theta", "tool.tip:y"), ("tool.tip:y", "tool.tip:y")]).startswith(
         "H = displacement or rotation / force")
+
+
+# -- the SI form's evaluator, a public class of the model-updating core -----------------------------------------
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"frequency_hz": [np.nan, 100.0]}, "lines above 0 Hz, each finite"),
+    ({"frequency_hz": [np.inf, 100.0]}, "lines above 0 Hz, each finite"),
+    ({"frequency_hz": np.linspace(20.0, 500.0, 30).reshape(5, 6)}, "shape (5, 6); expected one line after another"),
+    ({"frequency_hz": ["100", "200"]}, "expected numbers in Hz, not texts"),
+    ({"frequency_hz": [True, 200.0]}, "expected numbers in Hz, not texts or booleans"),
+    ({"outputs": "tool.tip"}, "outputs: got 'tool.tip'; expected a sequence of DOF labels"),
+    ({"inputs": []}, "inputs: got []; expected a sequence of DOF labels"),
+    ({"cache": -1}, "cache: got -1; expected a whole number >= 0"),
+    ({"memo_bytes": 2.5}, "memo_bytes: got 2.5"),
+])
+def test_the_evaluator_refuses_what_it_cannot_evaluate_where_it_is_made(kwargs, message):
+    """A NaN line reached the beam kernel, a 2-D array of lines was flattened, texts were read as numbers, a text
+    of outputs was taken letter by letter ("point 't'"), and a negative cache emptied itself at every call."""
+    from substructure.updating import Evaluator
+
+    args = {"outputs": ["tool.tip"], "inputs": ["tool.tip"], "frequency_hz": [100.0, 200.0], **kwargs}
+    with pytest.raises(InvalidValueError) as caught:
+        Evaluator(**args)
+    assert message in str(caught.value)
+
+
+def test_the_evaluator_given_an_assembly_says_to_make_its_structure():
+    from substructure.updating import Evaluator, Structure
+
+    evaluator = Evaluator(["tool.tip"], ["tool.tip"], [100.0, 200.0])
+    for call in (lambda: evaluator(default_assembly()), lambda: evaluator.many([default_assembly()])):
+        with pytest.raises(InvalidValueError, match=r"got Assembly; expected a Structure \(Structure.from_assembly"):
+            call()
+    assert evaluator(Structure.from_assembly(default_assembly())).shape == (2, 1, 1)

@@ -39,6 +39,12 @@ def _link_token(link: "LinkSI"):
     return (link.rigid, link.K.tobytes(), link.C.tobytes(), link.M.tobytes())
 
 
+def _check_structure(structure) -> None:
+    if not isinstance(structure, Structure):
+        raise InvalidValueError(f"structure: got {type(structure).__name__}; expected a Structure "
+                                "(Structure.from_assembly(assembly))")
+
+
 class Evaluator:
     """Receptances between fixed points on fixed lines, for structures of one assembly.
 
@@ -63,17 +69,41 @@ class Evaluator:
         lines).  Every component and joint model of the structures must
         then take ``decay`` (:meth:`Structure.not_at_complex_frequency
         <substructure.updating.structure.Structure.not_at_complex_frequency>` names those that do not).
+
+    Raises
+    ------
+    InvalidValueError
+        Where it is made: outputs or inputs that are not a non-empty
+        sequence of labels, lines that are not finite numbers above 0 Hz in
+        a 1-D array (texts and booleans refused), a negative ``cache`` or
+        ``memo_bytes``; when called: anything but a :class:`Structure`.
     """
 
     def __init__(self, outputs: Sequence[str], inputs: Sequence[str], frequency_hz: np.ndarray, cache: int = 12,
                  memo_bytes: int = 32 * 2**20, decay: float = 0.0):
+        for name, labels in (("outputs", outputs), ("inputs", inputs)):
+            if isinstance(labels, str) or not all(isinstance(x, str) for x in labels) or not len(labels):
+                raise InvalidValueError(f"{name}: got {labels!r}; expected a sequence of DOF labels such as "
+                                        "['tool.tip:y']")
         self.outputs = tuple(outputs)
         self.inputs = tuple(inputs)
-        self.f = np.asarray(frequency_hz, dtype=float)
+        raw = np.asarray(frequency_hz)
+        listed = raw.dtype.kind == "O" or not isinstance(frequency_hz, np.ndarray)  # numpy reads True as 1.0
+        if raw.dtype.kind in "USb" or (listed and any(isinstance(x, (str, bytes, bool, np.bool_))
+                                                      for x in np.ravel(np.asarray(frequency_hz, dtype=object)))):
+            raise InvalidValueError(f"frequency_hz: got {frequency_hz!r}; expected numbers in Hz, not texts or "
+                                    "booleans")
+        self.f = np.asarray(raw, dtype=float)
         self.decay = float(decay)
-        if self.f.size == 0 or np.any(self.f <= 0):
-            raise InvalidValueError("frequency: a model evaluation needs lines above 0 Hz (free-free components "
-                                    "have no static receptance); crop the data, e.g. from 1 Hz")
+        if self.f.ndim != 1:
+            raise InvalidValueError(f"frequency_hz: got an array of shape {self.f.shape}; expected one line after "
+                                    "another (1-D)")
+        if self.f.size == 0 or not np.all(self.f > 0) or not np.all(np.isfinite(self.f)):
+            raise InvalidValueError("frequency: a model evaluation needs lines above 0 Hz, each finite (free-free "
+                                    "components have no static receptance); crop the data, e.g. from 1 Hz")
+        for name, value in (("cache", cache), ("memo_bytes", memo_bytes)):
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+                raise InvalidValueError(f"{name}: got {value!r}; expected a whole number >= 0")
         refs = [_parse(p) for p in self.outputs + self.inputs]
         self._points = list(dict.fromkeys(str(r.point) for r in refs))
         self._dofs = [(self._points.index(str(r.point)), DOFS.index(r.dof or "y")) for r in refs]
@@ -133,6 +163,7 @@ class Evaluator:
 
     def __call__(self, structure: Structure) -> np.ndarray:
         """The receptances ``(n_freq, n_out, n_in)`` of ``structure``."""
+        _check_structure(structure)
         blocks, coupling, out_keys, tokens = self._prepare(structure)
         return self._pick(couple_substructures(blocks, coupling, out_keys, self._memo, tokens, pick=self._wanted))
 
@@ -154,6 +185,8 @@ class Evaluator:
         list of ndarray
             ``(n_freq, n_out, n_in)`` per structure, in order.
         """
+        for s in structures:
+            _check_structure(s)
         layouts = [self._layout(s) for s in structures]
         ready = self._beams_together(structures, layouts)
         prepared = [self._prepare(s, layout, ready) for s, layout in zip(structures, layouts)]
