@@ -6,6 +6,7 @@ gigabytes of memory before it was checked where it enters.
 
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 
@@ -447,3 +448,102 @@ def test_the_evaluator_given_an_assembly_says_to_make_its_structure():
         with pytest.raises(InvalidValueError, match=r"got Assembly; expected a Structure \(Structure.from_assembly"):
             call()
     assert evaluator(Structure.from_assembly(default_assembly())).shape == (2, 1, 1)
+
+
+# -- the model-updating core's public functions ---------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def core():
+    from substructure.synthetic import simulate
+    from substructure.updating import Likelihood, measured_frfs
+
+    model = default_assembly()
+    data = [m.frf for m in simulate(model, ["tool.tip", "holder.tip"], frequency=np.linspace(20.0, 5000.0, 120),
+                                    noise=0.01, seed=0)]
+    measured, _ = measured_frfs(data)
+    return model, data, measured, Likelihood(model, measured)
+
+
+@pytest.mark.parametrize("lines, message", [
+    ([-1, 3], "expected increasing, distinct indices from 0 to 119"),  # counted from the end
+    ([3, 3, 4], "expected increasing, distinct indices"),               # a line weighed twice
+    ([0, 500], "expected increasing, distinct indices from 0 to 119"),   # a raw IndexError
+    ([0.5, 3.2], "expected a 1-D array of line indices (whole numbers)"),
+    (np.ones(120, bool), "expected a 1-D array of line indices (whole numbers)"),  # lines 0 and 1
+    ([], "expected a 1-D array of line indices"),
+])
+def test_a_likelihood_refuses_lines_the_data_do_not_have_once_each(core, lines, message):
+    from substructure.updating import Likelihood
+
+    model, _, measured, _ = core
+    with pytest.raises(InvalidValueError, match="lines: got") as caught:
+        Likelihood(model, measured, np.asarray(lines))
+    assert message in str(caught.value)
+
+
+def test_a_likelihood_refuses_no_data_and_a_subsample_step_below_one(core):
+    from substructure.updating import Likelihood, measured_frfs
+
+    model, data, _, lik = core
+    with pytest.raises(InvalidValueError, match="measured: got \\[\\]; expected at least one Measured"):
+        Likelihood(model, [])
+    for step in (0, -3, 2.5, True):
+        with pytest.raises(InvalidValueError, match=f"step: got {step!r}; expected a whole number >= 1"):
+            lik.subsample(step)
+    assert lik.subsample(2).lines.tolist() == list(range(0, 120, 2))
+    with pytest.raises(InvalidValueError, match="band: got '100-2000'; expected \\(lo, hi\\) in Hz"):
+        measured_frfs(data, band="100-2000")
+
+
+def test_the_tests_of_the_core_refuse_numbers_they_cannot_judge(core):
+    """A NaN chi^2 gave a verdict of 'not significant' without a word, n = 0 a raw math domain error, a negative
+    misfit scale or number of parameters an answer."""
+    from substructure.updating import consistency, indifferent, significance
+
+    *_, lik = core
+    with pytest.raises(InvalidValueError, match="significance: chi\\^2 of nan"):
+        significance(float("nan"), 90.0, 1, 1000, 1)
+    with pytest.raises(InvalidValueError, match="significance: chi\\^2 of -1.0"):
+        significance(-1.0, -2.0, 1, 1000, 1)
+    with pytest.raises(InvalidValueError, match="significance: k: got 1.5"):
+        significance(100.0, 90.0, 1.5, 1000, 1)
+    assert not significance(100.0, math.inf, 1, 1000, 1).significant  # a model that cannot be held
+    with pytest.raises(InvalidValueError, match="indifferent: n: got 0"):
+        indifferent(10.0, 1, 12.0, 1, 0)
+    with pytest.raises(InvalidValueError, match="indifferent: s2: got -1.0"):
+        indifferent(10.0, 1, 12.0, 1, 100, -1.0)
+    with pytest.raises(InvalidValueError, match="consistency: p: got -1"):
+        consistency(lik, lik.log_ratios([]), -1)
+
+
+@pytest.mark.parametrize("path, value, message", [
+    ("components.tool.segments.0.od", float("nan"), "the value makes a size that is not a finite number"),
+    ("materials.carbide.E", float("nan"), "makes E nan Pa"),
+    ("components.tool.segments.0.od", "12 mm", "got '12 mm'; expected a finite number"),
+    ("joints.holder-tool.k.yf", float("inf"), "got inf; expected a finite number"),
+    ("materials.carbide.E", 0.0, "makes E 0 Pa; expected E in [1000, 1e+13] Pa"),
+    ("materials.carbide.rho", -5.0, "makes rho -5 kg/m^3"),
+    ("materials.carbide.nu", 0.6, "makes nu 0.6; expected nu in (-1, 0.5)"),
+    ("materials.carbide.loss_factor", -0.1, "makes loss_factor -0.1; expected loss_factor in [0, 10]"),
+    ("components.tool.E", 1e-20, "makes E 5.8e-09 Pa"),
+])
+def test_the_si_form_refuses_the_values_set_parameters_refuses(path, value, message):
+    """apply_path_si (the fits' setter) took these and gave a structure of a material the beam model cannot
+    compute; set_parameters, which shares its parser, refused each through the objects."""
+    from substructure.updating import Structure, apply_path_si, set_parameters
+
+    model = default_assembly()
+    with pytest.raises(InvalidValueError) as caught:
+        apply_path_si(Structure.from_assembly(model), path, value)
+    assert f"parameter {path!r}" in str(caught.value) and message in str(caught.value)
+    with pytest.raises(InvalidValueError, match=f"parameter {path!r}"):
+        set_parameters(model, {path: value})
+
+
+def test_a_noise_window_of_zero_lines_is_refused_not_taken_for_the_default(core):
+    from substructure.updating import estimate_noise
+
+    _, data, _, _ = core
+    with pytest.raises(InvalidValueError, match="window: got 0; expected an odd number of lines"):
+        estimate_noise(data[0], 0)

@@ -114,8 +114,12 @@ def measured_frfs(measurements, band=None) -> tuple[list[Measured], tuple[float,
         raise InvalidValueError("measurements: got none")
     f0 = items[0][1].frequency
     full = (float(f0.hz[0]), float(f0.hz[-1]))
-    lo, hi = full if band is None else band
     try:
+        if isinstance(band, (str, bytes)):  # '100-200' unpacked to its characters, or a raw error
+            raise TypeError
+        lo, hi = full if band is None else band
+        if any(isinstance(x, (str, bytes, bool, np.bool_)) for x in (lo, hi)):
+            raise TypeError
         lo, hi = float(lo), float(hi)
     except (TypeError, ValueError):
         raise InvalidValueError(f"band: got {band!r}; expected (lo, hi) in Hz") from None
@@ -244,6 +248,22 @@ class _Group:
         return [[y[:, i, j] for i, j in self.entries] for y in ys]
 
 
+def _line_indices(lines, n: int) -> np.ndarray:
+    """``lines`` checked as indices of distinct lines of the data, increasing (a negative index counted from the
+    end, a line twice weighed twice, a boolean mask read as the lines 0 and 1: each silently wrong)."""
+    idx = np.asarray(lines)
+    if idx.ndim != 1 or idx.size == 0 or idx.dtype.kind not in "iu":
+        raise InvalidValueError(f"lines: got {_short(lines)}; expected a 1-D array of line indices (whole numbers)")
+    if idx.min() < 0 or idx.max() >= n or np.any(np.diff(idx) <= 0):
+        raise InvalidValueError(f"lines: got {_short(lines)}; expected increasing, distinct indices from 0 to {n - 1}")
+    return idx
+
+
+def _short(values) -> str:
+    text = " ".join(repr(values).split())
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
 class Likelihood:
     """``chi^2`` of models (the assembly with changes) against measured FRFs.
 
@@ -267,8 +287,11 @@ class Likelihood:
     def __init__(self, assembly, measured: Sequence[Measured], lines: np.ndarray | None = None):
         self.assembly = assembly
         self.measured = list(measured)
+        if not self.measured or not all(isinstance(m, Measured) for m in self.measured):
+            raise InvalidValueError(f"measured: got {measured!r}; expected at least one Measured (from "
+                                    "measured_frfs)")
         n = self.measured[0].frf.frequency.n
-        self.lines = np.arange(n) if lines is None else np.asarray(lines)
+        self.lines = np.arange(n) if lines is None else _line_indices(lines, n)
         groups: dict[tuple, list] = {}
         for i, m in enumerate(self.measured):
             groups.setdefault((m.configuration, getattr(m.measurement, "window_tau", None)), []).append((i, m))
@@ -368,7 +391,9 @@ class Likelihood:
         Likelihood
             The subsampled likelihood (the same noise per line).
         """
-        lines = self.lines[:: max(1, int(step))]
+        if isinstance(step, (bool, np.bool_)) or not isinstance(step, (int, np.integer)) or step < 1:
+            raise InvalidValueError(f"step: got {step!r}; expected a whole number >= 1")
+        lines = self.lines[:: int(step)]
         if keep is not None and len(keep):
             keep = np.asarray(keep, dtype=int)
             lines = np.union1d(lines, self.lines[keep[(keep >= 0) & (keep < self.lines.size)]])

@@ -469,6 +469,10 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     coh = _coherence_regressor(coherence, averages, n, label)
     clean = measured if usable.all() else FRF(measured.frequency, np.where(usable, h, 0.0)[:, None, None],
                                              measured.outputs, measured.inputs)
+    if window is not None and (isinstance(window, (bool, np.bool_)) or not isinstance(window, (int, np.integer))
+                               or window < 1):
+        raise InvalidValueError(f"window: got {window!r}; expected an odd number of lines (e.g. 11), or None to "
+                                "choose it from the sharpest resonance")
     w = window or _window(clean, polyorder)
     s = smooth(clean, window=w, polyorder=polyorder).data[:, 0, 0]
     if window_tau is not None:

@@ -23,13 +23,32 @@ import numpy as np
 
 from ..errors import InvalidValueError, NonPassiveJointWarning, UnknownPointError
 from ..joints import DAMPING_UNITS, STIFFNESS_UNITS
-from ..materials import Material
+from ..materials import E_RANGE, LOSS_FACTOR_MAX, RHO_RANGE, Material
 from ..units import Q_, format_quantity
 
 __all__ = ["apply_path_si", "set_parameters", "check_path"]
 
 
 _MAT_COLUMN = {"E": 0, "nu": 1, "rho": 2, "loss_factor": 3}
+
+
+_MAT_LIMITS = (("E", "Pa", *E_RANGE), ("nu", "", -1.0, 0.5), ("rho", "kg/m^3", *RHO_RANGE),
+               ("loss_factor", "", 0.0, LOSS_FACTOR_MAX))
+"""Per column of the SI material arrays: the name, the unit and the range :class:`Material` takes (nu open)."""
+
+
+def _materials_checked(path: str, value: float, *arrays) -> None:
+    """The SI form's material rows (``E, nu, rho, loss factor``; an insert's from its third column) in the ranges
+    :class:`Material` takes, as :func:`set_parameters` refuses them through the objects."""
+    for rows in arrays:
+        for column, (name, unit, lo, hi) in enumerate(_MAT_LIMITS):
+            v = rows[:, column]
+            inside = (v > lo) & (v < hi) if name == "nu" else (v >= lo) & (v <= hi)
+            if not inside.all():
+                got, unit = float(v[~inside][0]), " " + unit if unit else ""
+                left, right = ("(", ")") if name == "nu" else ("[", "]")
+                raise InvalidValueError(f"parameter {path!r} = {value!r}: makes {name} {got:g}{unit}; expected {name} "
+                                        f"in {left}{lo:g}, {hi:g}{right}{unit}")
 
 
 def _arrays_of(component):
@@ -522,6 +541,7 @@ def _component_si(structure, path: str, name: str, rest: tuple, value: float):
     if rest[0] in _COMPONENT_KEYS:  # its material: E, rho, loss_factor as factors, material.X as values
         mat, column = beam.material.copy(), _MAT_COLUMN[rest[-1]]
         mat[:, column] = mat[:, column] * value if len(rest) == 1 else value
+        _materials_checked(path, value, mat)
         return structure.with_beam(beam.evolve(material=mat))
     source = structure.sources.get(name)  # a number the component's type adds
     if source is None:
@@ -555,6 +575,7 @@ def _material_si(structure, path: str, name: str, prop: str, value: float):
             mat, ins = beam.material.copy(), beam.insert.copy()
             mat[hit, column] = value
             ins[ins_hit, 2 + column] = value
+            _materials_checked(path, value, mat[hit], ins[ins_hit, 2:])
             out = out.with_beam(beam.evolve(material=mat, insert=ins))
     return out
 
@@ -655,8 +676,19 @@ def apply_path_si(structure, path: str, value: float):
     ------
     UnknownPointError
         When the path names nothing in the configuration.
+    InvalidValueError
+        For a value that is not a finite number, or one that makes what the
+        objects refuse (a size under 1 um, a material outside the ranges of
+        :class:`~substructure.materials.Material`), as :func:`set_parameters`
+        refuses it.
     """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise InvalidValueError(f"parameter {path!r}: got {value!r}; expected a finite number (SI, or a factor for a "
+                                "linked parameter)")
     kind, *what = _target_of(structure.assembly, path)
+    if kind == "link" and not np.isfinite(value):  # a component's sizes and materials are checked as they are made
+        raise InvalidValueError(f"parameter {path!r}: got {value!r}; expected a finite number (SI, or a factor for a "
+                                "linked parameter)")
     return _SETTERS[kind][1](structure, path, *what, value)
 
 

@@ -57,6 +57,8 @@ import numpy as np
 from scipy.stats import chi2 as chi2_dist
 from scipy.stats import gamma as gamma_dist
 
+from ..errors import InvalidValueError
+
 __all__ = ["Consistency", "consistency", "ErrorCheck", "error_check", "Significance", "significance", "indifferent",
            "bic", "INDIFFERENCE", "CONSISTENCY_ALPHA", "outlying_runs", "OUTLYING_RUN"]
 
@@ -218,6 +220,9 @@ def consistency(likelihood, ratios: Sequence[np.ndarray], p: int) -> Consistency
     Consistency
         The verdict and where the residual is too large.
     """
+    if isinstance(p, (bool, np.bool_)) or not isinstance(p, (int, np.integer)) or p < 0:
+        raise InvalidValueError(f"consistency: p: got {p!r}; expected the number of fitted parameters, a whole "
+                                "number >= 0")
     alive = likelihood.alive
     scored = _scores(likelihood, ratios)
     z2, dofs = [z for z, _ in scored], [d for _, d in scored]
@@ -436,6 +441,7 @@ def significance(chi2_0: float, chi2_1: float, k: int, n: int, p1: int, candidat
     Significance
         The statistic, the threshold and the verdict.
     """
+    _checked("significance", chi2=(chi2_0, chi2_1), counts=(("k", k), ("p1", p1), ("candidates", candidates)), n=n)
     s2 = max(1.0, chi2_1 / max(n - p1, 1))
     stat = (chi2_0 - chi2_1) / s2
     threshold = max(k * math.log(n), float(chi2_dist.isf(SIGNIFICANCE_ALPHA / max(candidates, 1), max(k, 1))))
@@ -487,4 +493,19 @@ def indifferent(chi2_a: float, k_a: int, chi2_b: float, k_b: int, n: int, s2: fl
     bool
         Whether they are inside the indifference region.
     """
+    _checked("indifferent", chi2=(chi2_a, chi2_b), counts=(("k_a", k_a), ("k_b", k_b)), n=n)
+    if not (isinstance(s2, (int, float, np.integer, np.floating)) and s2 > 0 and math.isfinite(s2)):
+        raise InvalidValueError(f"indifferent: s2: got {s2!r}; expected a finite misfit scale > 0")
     return abs(bic(chi2_b, k_b, n, s2) - bic(chi2_a, k_a, n, s2)) <= INDIFFERENCE
+
+
+def _checked(what: str, chi2: tuple, counts: tuple, n) -> None:
+    """The numbers of a test checked where they enter: ``chi^2`` values that are numbers >= 0 (inf, a model that
+    cannot be held, allowed), counts that are whole numbers >= 0, ``n`` >= 1 (a NaN gave a verdict of False
+    without a word, n = 0 a raw math domain error)."""
+    for x in chi2:
+        if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, float, np.integer, np.floating)) or not x >= 0:
+            raise InvalidValueError(f"{what}: chi^2 of {x!r}; expected a number >= 0")
+    for name, value in counts + (("n", n),):
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < (name == "n"):
+            raise InvalidValueError(f"{what}: {name}: got {value!r}; expected a whole number >= {int(name == 'n')}")
