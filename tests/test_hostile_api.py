@@ -7,6 +7,7 @@ gigabytes of memory before it was checked where it enters.
 from __future__ import annotations
 
 import math
+import re
 import sys
 from pathlib import Path
 
@@ -547,3 +548,51 @@ def test_a_noise_window_of_zero_lines_is_refused_not_taken_for_the_default(core)
     _, data, _, _ = core
     with pytest.raises(InvalidValueError, match="window: got 0; expected an odd number of lines"):
         estimate_noise(data[0], 0)
+
+
+@pytest.mark.parametrize("args, message", [
+    (("tool", -0.076, 0.1), "length: got -0.076; expected a finite number > 0"),
+    (("tool", "76 mm", 0.1), "length: got '76 mm'"),
+    (("tool", 0.076, 0.0), "mass_max: got 0.0"),
+    (("tool", 0.076, 0.1, (0.05, 0.2)), "position: got (0.05, 0.2); expected (lo, hi) with 0 <= lo <= hi <= length"),
+    ((None, 0.076, 0.1), "component: got None; expected a component's name"),
+])
+def test_a_body_at_a_fitted_place_refuses_bounds_it_cannot_have(args, message):
+    """A negative length or a range past the component's end gave bounds a fit then searched outside the beam."""
+    from substructure.updating import AddedMass
+
+    with pytest.raises(InvalidValueError) as caught:
+        AddedMass(*args)
+    assert message in str(caught.value)
+
+
+def test_diagnose_takes_one_frf_as_one_measurement_and_refuses_a_name_for_the_model(core):
+    """One FRF was iterated (FRF[0]: 'index: got 0; expected a pair'); a name for the model gave an AttributeError."""
+    from substructure.diagnose import diagnose
+
+    model, data, _, _ = core
+    one = diagnose(model, data[0], budget=50)
+    assert one.explained and not one.effects
+    with pytest.raises(InvalidValueError, match="assembly: got str; expected an Assembly"):
+        diagnose("default", data)
+
+
+def test_a_fit_refuses_changes_values_and_options_it_cannot_use(core):
+    """A free list of another length was cut to the changes, max_nfev = 0 became the default, a value of NaN, a
+    text or a name the change does not have reached scipy or numpy as raw errors."""
+    from substructure.updating import ParameterChange, fit, model_parameters
+
+    model, _, _, lik = core
+    change = ParameterChange(model_parameters(model)[0])
+    for kwargs, message in (({"free": [True, False]}, "free: got [True, False]; expected one True or False per "
+                                                        "change (1)"),
+                            ({"max_nfev": 0}, "max_nfev: got 0; expected a whole number >= 1")):
+        with pytest.raises(InvalidValueError, match=re.escape(message)):
+            fit(lik, [(change, {})], **kwargs)
+    for values, message in (({"banana": 1.0}, "has no parameter 'banana'; expected some of value"),
+                            ({"value": float("nan")}, "value = nan; expected a finite number"),
+                            ({"value": "3"}, "value = '3'; expected a finite number")):
+        with pytest.raises(InvalidValueError, match=re.escape(message)):
+            fit(lik, [(change, values)])
+    with pytest.raises(InvalidValueError, match=re.escape("changes[0]: got ('x', {}); expected a pair")):
+        fit(lik, [("x", {})])

@@ -205,6 +205,11 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     """
     from .report import Explanation, level_signature, separation, unexplained_report, values_text
 
+    if not isinstance(assembly, Assembly):
+        raise InvalidValueError(f"assembly: got {type(assembly).__name__}; expected an Assembly (load_assembly(path) "
+                                "for a file, default_assembly() for the built-in one)")
+    if isinstance(measurements, FRF):  # one FRF is one measurement (iterated, it was read as FRF[0])
+        measurements = [measurements]
     if settings is None:
         settings = DEFAULT_SETTINGS
     elif not isinstance(settings, DiagnoseSettings):

@@ -19,9 +19,11 @@ range of it, shared with the diagnosis catalogue's fluted section.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from ..errors import UnknownPointError
+from ..errors import InvalidValueError, UnknownPointError
 from ..joints import Mass, Support
 from ..units import Q_, format_quantity
 from .parameters import Change, ParamSpec
@@ -132,11 +134,20 @@ def unique_name(taken, base: str) -> str:
     return name
 
 
+def _positive(name: str, value) -> float:
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not (math.isfinite(value) and value > 0):
+        raise InvalidValueError(f"{name}: got {value!r}; expected a finite number > 0 (SI)")
+    return float(value)
+
+
 class _OnComponent(Change):
     def __init__(self, component: str, length: float):
+        if not isinstance(component, str) or not component:
+            raise InvalidValueError(f"component: got {component!r}; expected a component's name")
         self.component = component
         self.where = component
-        self.length = float(length)
+        self.length = _positive("length", length)
 
     def place(self, values) -> str:
         return f"{self.component}@{_mm(values['position'])}"
@@ -174,7 +185,14 @@ class AddedMass(_OnComponent):
                  inertia_max: float = 1e-3, where: str | None = None):
         super().__init__(component, length)
         self.where = where or component
+        if _positive("mass_max", mass_max) <= 1e-4:
+            raise InvalidValueError(f"mass_max: got {mass_max!r}; expected more than the least mass fitted, 1e-4 kg")
+        _positive("inertia_max", inertia_max)
         lo, hi = position if position is not None else (0.0, self.length)
+        slack = 1e-12 * self.length
+        if not -slack <= lo <= hi <= self.length + slack:
+            raise InvalidValueError(f"position: got {position!r}; expected (lo, hi) with 0 <= lo <= hi <= length "
+                                    f"({self.length!r} m)")
         self.specs = (
             ParamSpec("mass", "kg", 1e-4, float(mass_max), min(0.01, float(mass_max))),
             ParamSpec("inertia", "kg*m^2", 1e-10, max(float(inertia_max), 1e-9), 1e-8),

@@ -18,7 +18,8 @@ follow by the delta method: ``std(v) = v std(u)`` on the log scale.
 
 from __future__ import annotations
 
-from typing import Callable, Sequence
+import math
+from typing import Callable, Mapping, Sequence
 
 import attrs
 import numpy as np
@@ -141,6 +142,27 @@ class Fit:
         return self.chi2 / self.dof
 
 
+def _checked_changes(changes) -> list:
+    """``(Change, values)`` pairs checked and copied: values by the change's parameter names, finite numbers."""
+    out = []
+    for k, item in enumerate(changes):
+        if not (isinstance(item, (tuple, list)) and len(item) == 2 and hasattr(item[0], "specs")
+                and isinstance(item[1], Mapping)):
+            raise InvalidValueError(f"changes[{k}]: got {item!r}; expected a pair (Change, dict of its values)")
+        change, values = item
+        names = [spec.name for spec in change.specs]
+        for name, value in values.items():
+            if name not in names:
+                raise InvalidValueError(f"changes[{k}]: {change.effect} has no parameter {name!r}; expected some of "
+                                        f"{', '.join(names)}")
+            real = isinstance(value, (int, float, np.integer, np.floating))
+            if isinstance(value, (bool, np.bool_, str, bytes)) or (real and not math.isfinite(value)):
+                raise InvalidValueError(f"changes[{k}]: {change.effect} {name} = {value!r}; expected a finite "
+                                        "number (SI)")
+        out.append((change, dict(values)))
+    return out
+
+
 def fit(likelihood, changes: Sequence[tuple], free: Sequence[bool] | None = None, max_nfev: int | None = None,
         progress: Callable[[str], None] | None = None) -> Fit:
     """Fit the parameters of changes to the data of a likelihood.
@@ -164,8 +186,13 @@ def fit(likelihood, changes: Sequence[tuple], free: Sequence[bool] | None = None
     Fit
         Values, standard deviations (inflated by the misfit), correlations.
     """
-    changes = [(c, dict(v)) for c, v in changes]
+    changes = _checked_changes(changes)
     free = [True] * len(changes) if free is None else list(free)
+    if len(free) != len(changes) or not all(isinstance(x, (bool, np.bool_)) for x in free):
+        raise InvalidValueError(f"free: got {free!r}; expected one True or False per change ({len(changes)})")
+    if max_nfev is not None and (isinstance(max_nfev, bool) or not isinstance(max_nfev, (int, np.integer))
+                                 or max_nfev < 1):
+        raise InvalidValueError(f"max_nfev: got {max_nfev!r}; expected a whole number >= 1, or None for the default")
     slots = []  # (change index, spec)
     for i, ((change, values), is_free) in enumerate(zip(changes, free)):
         for spec in change.specs:

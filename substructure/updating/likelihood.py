@@ -100,6 +100,8 @@ def measured_frfs(measurements, band=None) -> tuple[list[Measured], tuple[float,
         For FRFs on different frequency lines in the band (taps of different
         lengths or sample rates), naming two of them.
     """
+    if isinstance(measurements, FRF):  # one FRF is one measurement (iterated, it was read as FRF[0])
+        measurements = [measurements]
     items = []
     for m in measurements:
         # an H2 with its coherence is compared as the H1 of the same taps (Measurement.h1_frf)
