@@ -596,3 +596,22 @@ def test_a_fit_refuses_changes_values_and_options_it_cannot_use(core):
             fit(lik, [(change, values)])
     with pytest.raises(InvalidValueError, match=re.escape("changes[0]: got ('x', {}); expected a pair")):
         fit(lik, [("x", {})])
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"bootstrap": -1}, "bootstrap: got -1; expected an integer >= 0"),     # numpy warnings, then a raw TypeError
+    ({"bootstrap": 2.5}, "bootstrap: got 2.5; expected an integer >= 0"),   # a raw TypeError of range
+    ({"bootstrap": True}, "bootstrap: got True; expected an integer >= 0"),  # one refit
+    ({"bootstrap": 2, "random_state": "x"}, "random_state: got 'x'; expected a seed"),
+])
+def test_identify_joint_checks_its_bootstrap_with_the_automatic_parameters(kwargs, message):
+    """The check of bootstrap ran only when parameters were named; with the default 'auto' it was skipped."""
+    from substructure.identify import identify_joint
+    from substructure.synthetic import simulate
+
+    model = default_assembly()
+    taps = simulate(model, ["tool.tip", "tool.tip-20 mm"], frequency=np.linspace(20.0, 5000.0, 50), seed=0)
+    with pytest.raises(InvalidValueError, match=re.escape(message)):
+        identify_joint(model, taps, "holder-tool", **kwargs)
+    with pytest.raises(InvalidValueError, match="assembly: got str; expected an Assembly"):
+        identify_joint("default", taps, "holder-tool")

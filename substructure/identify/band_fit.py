@@ -201,6 +201,13 @@ class JointIdentifier:
         self.initial = dict(initial or {})
 
     def _check(self) -> None:
+        # checked whatever the parameters (with 'auto' they were not: -1 failed in numpy, 2.5 in range, True was 1)
+        if isinstance(self.bootstrap, (bool, np.bool_)) or not isinstance(self.bootstrap, (int, np.integer)) \
+                or self.bootstrap < 0:
+            raise InvalidValueError(f"bootstrap: got {self.bootstrap!r}; expected an integer >= 0")
+        if isinstance(self.random_state, (bool, np.bool_)) or not isinstance(self.random_state, (int, np.integer)) \
+                or self.random_state < 0:
+            raise InvalidValueError(f"random_state: got {self.random_state!r}; expected a seed, an integer >= 0")
         if isinstance(self.parameters, str):
             if self.parameters != "auto":
                 raise InvalidValueError(f"parameters: got {self.parameters!r}; expected 'auto' or some of "
@@ -215,8 +222,6 @@ class JointIdentifier:
         if twice:
             raise InvalidValueError(f"parameters: {', '.join(twice)} named twice in {list(self.parameters)}; "
                                     "name each parameter once")
-        if not (isinstance(self.bootstrap, int) and self.bootstrap >= 0):
-            raise InvalidValueError(f"bootstrap: got {self.bootstrap!r}; expected an integer >= 0")
 
     def _joint(self, template: Joint, values: Mapping[str, float]) -> Joint:
         k, c = (template.k.as_dict(), template.c.as_dict()) if not template.rigid else ({}, {})

@@ -238,6 +238,9 @@ def identify_joint(assembly: Assembly, measurements, joint: str, band="auto",
         The fitted values with standard deviations (SI), the closed form, the FRFs before and
         after.
     """
+    if not isinstance(assembly, Assembly):
+        raise InvalidValueError(f"assembly: got {type(assembly).__name__}; expected an Assembly (load_assembly(path) "
+                                "for a file, default_assembly() for the built-in one)")
     if hasattr(measurements, "validate"):
         measurements.validate(assembly)
     for i, m in enumerate(measurements):
