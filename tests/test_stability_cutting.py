@@ -167,3 +167,17 @@ def test_speeds_in_hz_or_bare_are_refused():
 
 def test_tooth_passing_frequency_is_teeth_times_revolutions_per_second():
     assert tooth_passing_hz(12000, 4) == pytest.approx(800.0)  # not 800 * 2 * pi
+
+
+@pytest.mark.parametrize("speed, teeth, message", [
+    (12000, 0, "teeth: got 0; expected a whole number of teeth >= 1"),  # 0 Hz
+    (12000, 2.5, "teeth: got 2.5"),
+    ("12000", 4, "speed_rpm: got '12000'; expected spindle speeds in rpm, plain numbers >= 0"),
+    ([-100.0, 2000.0], 4, "speed_rpm: got [-100.0, 2000.0]"),
+])
+def test_tooth_passing_refuses_no_teeth_and_speeds_that_are_not_speeds(speed, teeth, message):
+    from substructure import InvalidValueError
+
+    with pytest.raises(InvalidValueError) as caught:
+        tooth_passing_hz(speed, teeth)
+    assert message in str(caught.value)

@@ -185,6 +185,17 @@ def tooth_passing_hz(speed_rpm: Any, teeth: int) -> np.ndarray:
     -------
     ndarray
         Tooth-passing frequencies in Hz.
+
+    Raises
+    ------
+    InvalidValueError
+        For teeth that are not a whole number >= 1, or speeds that are not
+        finite numbers >= 0 (0 teeth gave 0 Hz; texts were read as numbers).
     """
-    return np.asarray(speed_rpm, dtype=float) * teeth / 60.0
+    if isinstance(teeth, (bool, np.bool_)) or not isinstance(teeth, (int, np.integer)) or teeth < 1:
+        raise InvalidValueError(f"teeth: got {teeth!r}; expected a whole number of teeth >= 1")
+    raw = np.asarray(speed_rpm)
+    if raw.dtype.kind not in "iuf" or not (np.isfinite(raw).all() and (raw >= 0).all()):
+        raise InvalidValueError(f"speed_rpm: got {speed_rpm!r}; expected spindle speeds in rpm, plain numbers >= 0")
+    return raw.astype(float) * teeth / 60.0
 
