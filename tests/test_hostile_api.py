@@ -615,3 +615,18 @@ def test_identify_joint_checks_its_bootstrap_with_the_automatic_parameters(kwarg
         identify_joint(model, taps, "holder-tool", **kwargs)
     with pytest.raises(InvalidValueError, match="assembly: got str; expected an Assembly"):
         identify_joint("default", taps, "holder-tool")
+
+
+def test_the_parameter_functions_say_what_a_model_and_values_are():
+    """A name given for the model, or a list of pairs for the values, gave AttributeErrors deep inside."""
+    from substructure.updating import (ParameterChange, Structure, get_parameter, model_parameters,
+                                       set_parameters)
+
+    for call in (lambda: get_parameter("default", "joints.holder-tool.k.yf"), lambda: model_parameters("default"),
+                 lambda: Structure.from_assembly("default"), lambda: set_parameters("default", {})):
+        with pytest.raises(InvalidValueError, match="assembly: got str; expected an Assembly"):
+            call()
+    with pytest.raises(InvalidValueError, match="values: got list; expected a mapping of parameter paths"):
+        set_parameters(default_assembly(), [("joints.holder-tool.k.yf", 2e7)])
+    with pytest.raises(InvalidValueError, match="parameter: got 'joints.holder-tool.k.yf'; expected a ModelParameter"):
+        ParameterChange("joints.holder-tool.k.yf")

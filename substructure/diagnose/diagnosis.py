@@ -38,6 +38,7 @@ from ..assembly import Assembly
 from ..errors import InvalidValueError
 from ..frf import FRF
 from ..updating.likelihood import Likelihood, measured_frfs
+from ..updating.structure import assembly_checked
 from ..updating.selection import INDIFFERENCE, consistency, error_check, outlying_runs
 from .compare import METRIC, Comparison, _pairs, frac, error_bands
 from .effects import Effect, registry
@@ -205,9 +206,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     """
     from .report import Explanation, level_signature, separation, unexplained_report, values_text
 
-    if not isinstance(assembly, Assembly):
-        raise InvalidValueError(f"assembly: got {type(assembly).__name__}; expected an Assembly (load_assembly(path) "
-                                "for a file, default_assembly() for the built-in one)")
+    assembly_checked(assembly)
     if isinstance(measurements, FRF):  # one FRF is one measurement (iterated, it was read as FRF[0])
         measurements = [measurements]
     if settings is None:

@@ -24,6 +24,7 @@ from ..frf import FRF
 from ..points import parse_point
 from ..rdof import estimate_rotational, positions_from
 from ..updating import Evaluator, Structure
+from ..updating.structure import assembly_checked
 from .band_fit import _UNITS, JointIdentifier, model_of_measurement
 from .closed_form import ClosedFormResult, closed_form, joint_sides
 
@@ -238,9 +239,7 @@ def identify_joint(assembly: Assembly, measurements, joint: str, band="auto",
         The fitted values with standard deviations (SI), the closed form, the FRFs before and
         after.
     """
-    if not isinstance(assembly, Assembly):
-        raise InvalidValueError(f"assembly: got {type(assembly).__name__}; expected an Assembly (load_assembly(path) "
-                                "for a file, default_assembly() for the built-in one)")
+    assembly_checked(assembly)
     if hasattr(measurements, "validate"):
         measurements.validate(assembly)
     for i, m in enumerate(measurements):

@@ -61,6 +61,7 @@ from ..errors import InvalidValueError
 from ..joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint
 from ..materials import Material
 from .changes import Change, ParamSpec
+from .structure import assembly_checked
 from .paths import (
     _on_beam,
     _overhang_segment,
@@ -234,6 +235,7 @@ def model_parameters(assembly) -> list[ModelParameter]:
     list of ModelParameter
         Components first, then materials, joints, supports, sensors, masses.
     """
+    assembly_checked(assembly)
     out: list[ModelParameter] = []
     materials: dict[str, Material] = {}
     for comp in assembly.components:
@@ -449,6 +451,7 @@ def get_parameter(assembly, path: str) -> float:
     UnknownPointError
         When the path names nothing in the assembly.
     """
+    assembly_checked(assembly)
     for p in model_parameters(assembly):
         if p.path == path:
             return p.nominal
@@ -506,6 +509,9 @@ class ParameterChange(ParameterSet):
     explanation = "a number of the model is off: the fit corrects it"
 
     def __init__(self, parameter: ModelParameter):
+        if not isinstance(parameter, ModelParameter):
+            raise InvalidValueError(f"parameter: got {parameter!r}; expected a ModelParameter (from "
+                                    "model_parameters(assembly))")
         super().__init__("model-parameter", parameter.path, {"value": parameter.path}, (parameter.spec(),))
         self.parameter = parameter
 

@@ -25,6 +25,7 @@ from ..errors import InvalidValueError, NonPassiveJointWarning, UnknownPointErro
 from ..joints import DAMPING_UNITS, STIFFNESS_UNITS
 from ..materials import E_RANGE, LOSS_FACTOR_MAX, RHO_RANGE, Material
 from ..units import Q_, format_quantity
+from .structure import assembly_checked
 
 __all__ = ["apply_path_si", "set_parameters", "check_path"]
 
@@ -714,6 +715,10 @@ def set_parameters(assembly, values: Mapping[str, float]):
     UnknownPointError
         When a path names nothing in the assembly.
     """
+    assembly_checked(assembly)
+    if not isinstance(values, Mapping):
+        raise InvalidValueError(f"values: got {type(values).__name__}; expected a mapping of parameter paths to "
+                                "numbers, e.g. {'joints.holder-tool.k.yf': 2e7}")
     for path, value in values.items():
         if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
             raise InvalidValueError(f"parameter {path!r}: got {value!r}; expected a number (SI, or a factor for a "

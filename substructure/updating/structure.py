@@ -23,10 +23,11 @@ import attrs
 import numpy as np
 
 from .._blocks import angular_lines, takes_decay
+from ..assembly import Assembly
 from ..assembly.plan import check_connected
 from ..beams import Flutes, Insert, Segment, shear_coefficient, stepped_beam_receptance_si
 from ..components import Beam, is_plain_beam
-from ..errors import UnknownPointError
+from ..errors import InvalidValueError, UnknownPointError
 from ..joints import Joint, dynamic_stiffness
 from ..materials import Material
 from ..points import parse_point
@@ -35,6 +36,15 @@ from ..units import Q_
 __all__ = ["BeamArrays", "LinkSI", "Structure", "si_beam"]
 
 _TOKENS = itertools.count(1)
+
+
+def assembly_checked(assembly, where: str = "assembly"):
+    """``assembly`` when it is an :class:`~substructure.assembly.Assembly`; else a clear error (a name or a path
+    for the model gave an AttributeError deep inside)."""
+    if not isinstance(assembly, Assembly):
+        raise InvalidValueError(f"{where}: got {type(assembly).__name__}; expected an Assembly (load_assembly(path) "
+                                "for a file, default_assembly() for the built-in one)")
+    return assembly
 
 
 @functools.lru_cache(maxsize=4096)
@@ -424,7 +434,7 @@ class Structure:
         Structure
             The SI form.
         """
-        check_connected(assembly)
+        check_connected(assembly_checked(assembly))
         beams, opaque, order, sources = {}, {}, [], {}
         for comp in assembly.components:
             order.append(comp.name)
