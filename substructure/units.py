@@ -35,6 +35,7 @@ __all__ = [
     "quantity",
     "to_si",
     "dimensionless",
+    "whole_number",
     "format_quantity",
     "rpm_to_hz",
     "hz_to_rpm",
@@ -369,6 +370,38 @@ def to_si(value: Any, field: str, unit: str) -> float:
 @functools.lru_cache(maxsize=256)
 def _dimension_of(unit: str) -> str:
     return str(ureg.Quantity(1.0, unit).dimensionality)
+
+
+def whole_number(value: Any, field: str, minimum: int = 0, meaning: str = "a whole number") -> int:
+    """Check a count (a number of lines, steps, teeth, refits): an ``int`` or numpy integer, ``>= minimum``.
+
+    A boolean, a float (even 2.0) or a text is refused: ``True`` passed as 1 and ``2.5`` was cut or failed
+    later with a raw ``TypeError``.
+
+    Parameters
+    ----------
+    value : object
+        The value.
+    field : str
+        Its name in the message (``"bootstrap"``, ``"significance: k"``).
+    minimum : int
+        The least value allowed.
+    meaning : str
+        What it is, for the message (``"a whole number of teeth"``).
+
+    Returns
+    -------
+    int
+        The value.
+
+    Raises
+    ------
+    InvalidValueError
+        ``"{field}: got {value!r}; expected {meaning} >= {minimum}"``.
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < minimum:
+        raise InvalidValueError(f"{field}: got {value!r}; expected {meaning} >= {minimum}")
+    return int(value)
 
 
 def dimensionless(value: Any, field: str) -> float:

@@ -195,3 +195,16 @@ def test_a_fraction_or_a_decimal_magnitude_is_taken_as_a_float():
     assert Segment(Q_(Fraction(1, 3), "mm"), "12 mm").length_m == pytest.approx(1e-3 / 3, rel=1e-15)
     q = quantity(Q_(Decimal("12.5"), "mm"), "od", "[length]")
     assert isinstance(q.magnitude, float) and q.magnitude == 12.5
+
+
+def test_whole_number_takes_integers_only_and_names_the_field():
+    import numpy as np
+    import pytest
+
+    from substructure.errors import InvalidValueError
+    from substructure.units import whole_number
+
+    assert whole_number(np.int64(3), "steps", 1) == 3 and type(whole_number(np.int64(3), "steps", 1)) is int
+    for value in (True, 2.0, "3", 0, None):
+        with pytest.raises(InvalidValueError, match=f"steps: got {value!r}; expected a whole number of steps >= 1"):
+            whole_number(value, "steps", 1, "a whole number of steps")

@@ -31,6 +31,7 @@ from ..frf import FRF
 from ..joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint, JointProvenance
 from ..measurements import model_of_measurement
 from ..points import parse_point
+from ..units import whole_number
 from ..updating.fit import fit
 from ..updating.likelihood import Likelihood, measured_frfs
 from ..updating.parameters import ParameterSet, ParamSpec
@@ -202,12 +203,8 @@ class JointIdentifier:
 
     def _check(self) -> None:
         # checked whatever the parameters (with 'auto' they were not: -1 failed in numpy, 2.5 in range, True was 1)
-        if isinstance(self.bootstrap, (bool, np.bool_)) or not isinstance(self.bootstrap, (int, np.integer)) \
-                or self.bootstrap < 0:
-            raise InvalidValueError(f"bootstrap: got {self.bootstrap!r}; expected an integer >= 0")
-        if isinstance(self.random_state, (bool, np.bool_)) or not isinstance(self.random_state, (int, np.integer)) \
-                or self.random_state < 0:
-            raise InvalidValueError(f"random_state: got {self.random_state!r}; expected a seed, an integer >= 0")
+        whole_number(self.bootstrap, "bootstrap", 0, "an integer")
+        whole_number(self.random_state, "random_state", 0, "a seed, an integer")
         if isinstance(self.parameters, str):
             if self.parameters != "auto":
                 raise InvalidValueError(f"parameters: got {self.parameters!r}; expected 'auto' or some of "

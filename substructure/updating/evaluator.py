@@ -24,6 +24,7 @@ from ..components import receptances
 from ..coupling import Link, couple_substructures
 from ..errors import AssemblyError, InvalidValueError
 from ..points import DOFS
+from ..units import whole_number
 from .structure import LinkSI, Structure, _at, _parse
 
 __all__ = ["Evaluator"]
@@ -101,9 +102,8 @@ class Evaluator:
         if self.f.size == 0 or not np.all(self.f > 0) or not np.all(np.isfinite(self.f)):
             raise InvalidValueError("frequency: a model evaluation needs lines above 0 Hz, each finite (free-free "
                                     "components have no static receptance); crop the data, e.g. from 1 Hz")
-        for name, value in (("cache", cache), ("memo_bytes", memo_bytes)):
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-                raise InvalidValueError(f"{name}: got {value!r}; expected a whole number >= 0")
+        whole_number(cache, "cache")
+        whole_number(memo_bytes, "memo_bytes")
         refs = [_parse(p) for p in self.outputs + self.inputs]
         self._points = list(dict.fromkeys(str(r.point) for r in refs))
         self._dofs = [(self._points.index(str(r.point)), DOFS.index(r.dof or "y")) for r in refs]

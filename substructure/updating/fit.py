@@ -26,6 +26,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..errors import InvalidValueError, SubstructureError
+from ..units import whole_number
 from .parameters import Change, ParamSpec
 
 __all__ = ["Fit", "fit", "scan", "FTOL", "XTOL", "INFEASIBLE"]
@@ -190,9 +191,8 @@ def fit(likelihood, changes: Sequence[tuple], free: Sequence[bool] | None = None
     free = [True] * len(changes) if free is None else list(free)
     if len(free) != len(changes) or not all(isinstance(x, (bool, np.bool_)) for x in free):
         raise InvalidValueError(f"free: got {free!r}; expected one True or False per change ({len(changes)})")
-    if max_nfev is not None and (isinstance(max_nfev, bool) or not isinstance(max_nfev, (int, np.integer))
-                                 or max_nfev < 1):
-        raise InvalidValueError(f"max_nfev: got {max_nfev!r}; expected a whole number >= 1, or None for the default")
+    if max_nfev is not None:
+        whole_number(max_nfev, "max_nfev", 1)  # None: the default
     slots = []  # (change index, spec)
     for i, ((change, values), is_free) in enumerate(zip(changes, free)):
         for spec in change.specs:

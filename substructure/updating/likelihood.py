@@ -30,6 +30,7 @@ from ..errors import FrequencyAxisMismatchError, InvalidValueError, UnknownPoint
 from .._memo import Same
 from ..frf import FRF, REVERSED_SHARE, reversed_share
 from ..measurements import model_of_measurement
+from ..units import whole_number
 from .noise import NoiseModel, estimate_noise
 from .parameters import Change
 from .evaluator import Evaluator
@@ -393,9 +394,7 @@ class Likelihood:
         Likelihood
             The subsampled likelihood (the same noise per line).
         """
-        if isinstance(step, (bool, np.bool_)) or not isinstance(step, (int, np.integer)) or step < 1:
-            raise InvalidValueError(f"step: got {step!r}; expected a whole number >= 1")
-        lines = self.lines[:: int(step)]
+        lines = self.lines[:: whole_number(step, "step", 1)]
         if keep is not None and len(keep):
             keep = np.asarray(keep, dtype=int)
             lines = np.union1d(lines, self.lines[keep[(keep >= 0) & (keep < self.lines.size)]])

@@ -58,6 +58,7 @@ from scipy.stats import chi2 as chi2_dist
 from scipy.stats import gamma as gamma_dist
 
 from ..errors import InvalidValueError
+from ..units import whole_number
 
 __all__ = ["Consistency", "consistency", "ErrorCheck", "error_check", "Significance", "significance", "indifferent",
            "bic", "INDIFFERENCE", "CONSISTENCY_ALPHA", "outlying_runs", "OUTLYING_RUN"]
@@ -220,9 +221,7 @@ def consistency(likelihood, ratios: Sequence[np.ndarray], p: int) -> Consistency
     Consistency
         The verdict and where the residual is too large.
     """
-    if isinstance(p, (bool, np.bool_)) or not isinstance(p, (int, np.integer)) or p < 0:
-        raise InvalidValueError(f"consistency: p: got {p!r}; expected the number of fitted parameters, a whole "
-                                "number >= 0")
+    whole_number(p, "consistency: p", 0, "the number of fitted parameters, a whole number")
     alive = likelihood.alive
     scored = _scores(likelihood, ratios)
     z2, dofs = [z for z, _ in scored], [d for _, d in scored]
@@ -507,5 +506,4 @@ def _checked(what: str, chi2: tuple, counts: tuple, n) -> None:
         if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, float, np.integer, np.floating)) or not x >= 0:
             raise InvalidValueError(f"{what}: chi^2 of {x!r}; expected a number >= 0")
     for name, value in counts + (("n", n),):
-        if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < (name == "n"):
-            raise InvalidValueError(f"{what}: {name}: got {value!r}; expected a whole number >= {int(name == 'n')}")
+        whole_number(value, f"{what}: {name}", int(name == "n"))
