@@ -29,7 +29,7 @@ frequency line.  Static compliances and natural frequencies are then within
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Sequence
+from typing import TYPE_CHECKING, NamedTuple, Sequence
 
 import attrs
 import numpy as np
@@ -43,7 +43,8 @@ if TYPE_CHECKING:  # beams imports this module (Segment delegates its tapers to 
     from .beams import Segment
 
 __all__ = ["TAPER_STEP_RATIO", "TAPER_STEP_PHASE", "TAPER_ERROR_BOUND", "check_taper", "step_count",
-           "piece_sections", "section_at", "split", "mass", "piecewise_sections", "tapered_column"]
+           "piece_sections", "section_at", "split", "mass", "piecewise_sections", "tapered_column", "TaperSI",
+           "taper_si", "pieces", "mass_si"]
 
 TAPER_STEP_RATIO = 0.3
 """Largest relative change of a section property over one step of a tapered segment (default steps)."""
@@ -69,37 +70,92 @@ def _steps(value) -> int | None:
     return int(value)
 
 
-def _taper_arrays(seg: Segment, t: np.ndarray, part: tuple[float, float] = (0.0, 1.0)):
+class TaperSI(NamedTuple):
+    """A tapered segment as the SI numbers its sections along it follow from (a :class:`Segment`'s, or a row of
+    the fits' arrays, :class:`~substructure.updating.structure.BeamArrays`).
+
+    Parameters
+    ----------
+    length : float
+        Its length [m].
+    ends : tuple of float
+        ``(od, od_tip, id, id_tip)`` [m].
+    ratio : float
+        The flutes' diameter ratio (1: no flutes).
+    E, G : complex
+        Young's and shear moduli with the loss factor, ``E (1 + i eta)`` [Pa].
+    nu : float
+        Poisson's ratio.
+    rho : float
+        Density [kg/m^3].
+    insert : tuple or None
+        ``(EI, kGA, rhoA, rhoI)`` of an insert in its (uniform) bore.
+    steps : int or None
+        ``taper_steps``; None for the count of the error bound.
+    """
+
+    length: float
+    ends: tuple
+    ratio: float
+    E: complex
+    G: complex
+    nu: float
+    rho: float
+    insert: tuple | None
+    steps: int | None
+
+
+def taper_si(seg: Segment) -> TaperSI:
+    """The SI numbers of a tapered :class:`Segment`.
+
+    Parameters
+    ----------
+    seg : Segment
+        A tapered segment.
+
+    Returns
+    -------
+    TaperSI
+        Its numbers.
+    """
+    mat, ins = seg.material, None
+    if seg.insert is not None:
+        s = Section.ring(seg.insert.od.m_as("m"), seg.insert.id.m_as("m"), seg.insert.material)
+        ins = (s.EI, s.kGA, s.rhoA, s.rhoI)
+    assert seg._taper is not None  # called for tapered segments only
+    return TaperSI(seg.length_m, seg._taper, 1.0 if seg.flutes is None else seg.flutes.diameter_ratio, mat.E_si,
+                   mat.G_si, mat.nu, mat.rho_si, ins, seg.taper_steps)
+
+
+def _taper_arrays(tp: TaperSI, t: np.ndarray, part: tuple[float, float] = (0.0, 1.0)):
     """``EI, kGA, rhoA, rhoI`` arrays of a tapered segment at fractions ``t`` of its length (SI), or of the
     part of it between the fractions ``part`` (as :func:`split` cuts it, without building the parts)."""
-    assert seg._taper is not None  # called for tapered segments only
-    od0, od1, id0, id1 = seg._taper
+    od0, od1, id0, id1 = tp.ends
     if part != (0.0, 1.0):
         t = part[0] + (part[1] - part[0]) * t
     od = od0 + (od1 - od0) * t
     idd = id0 + (id1 - id0) * t
-    if seg.flutes is not None:
-        od = od * seg.flutes.diameter_ratio
-    mat = seg.material
+    if tp.ratio != 1.0:
+        od = od * tp.ratio
     area = math.pi / 4.0 * (od**2 - idd**2)
     inertia = math.pi / 64.0 * (od**4 - idd**4)
-    kappa = shear_coefficient(mat.nu, idd / od)
-    ei = mat.E_si * inertia
-    kga = kappa * mat.G_si * area
-    rhoa = mat.rho_si * area
-    rhoi = mat.rho_si * inertia
-    if seg.insert is not None:
-        ins = Section.ring(seg.insert.od.m_as("m"), seg.insert.id.m_as("m"), seg.insert.material)
-        ei, kga, rhoa, rhoi = ei + ins.EI, kga + ins.kGA, rhoa + ins.rhoA, rhoi + ins.rhoI
-    return (np.broadcast_to(np.asarray(ei, dtype=complex), t.shape),
-            np.broadcast_to(np.asarray(kga, dtype=complex), t.shape),
-            np.broadcast_to(np.asarray(rhoa, dtype=float), t.shape),
-            np.broadcast_to(np.asarray(rhoi, dtype=float), t.shape))
+    kappa = shear_coefficient(tp.nu, idd / od)
+    ei = tp.E * inertia
+    kga = kappa * tp.G * area
+    rhoa = tp.rho * area
+    rhoi = tp.rho * inertia
+    if tp.insert is not None:
+        ei, kga, rhoa, rhoi = ei + tp.insert[0], kga + tp.insert[1], rhoa + tp.insert[2], rhoi + tp.insert[3]
+    out = (np.asarray(ei, dtype=complex), np.asarray(kga, dtype=complex), np.asarray(rhoa, dtype=float),
+           np.asarray(rhoi, dtype=float))
+    if out[0].shape != t.shape:  # a scalar t
+        return tuple(np.broadcast_to(a, t.shape) for a in out)
+    return out
 
 
 def _taper_sections(seg: Segment, t: np.ndarray) -> list[Section]:
     """Sections of a tapered segment at fractions ``t`` of its length."""
-    ei, kga, rhoa, rhoi = _taper_arrays(seg, np.asarray(t, dtype=float))
+    ei, kga, rhoa, rhoi = _taper_arrays(taper_si(seg), np.asarray(t, dtype=float))
     return [Section(complex(a), complex(b), float(c), float(d)) for a, b, c, d in zip(ei, kga, rhoa, rhoi)]
 
 
@@ -107,8 +163,9 @@ _GAUSS = math.sqrt(3.0) / 6.0          # Gauss points of a step at its middle -+
 _CF = (0.5 + math.sqrt(3.0) / 3.0, 0.5 - math.sqrt(3.0) / 3.0)  # commutator-free Magnus weights
 
 
-def _magnus_sections(seg: Segment, n: int, part: tuple[float, float] = (0.0, 1.0)) -> list[Section]:
-    """The ``2 n`` uniform half-steps of the fourth-order commutator-free Magnus scheme.
+def _magnus_arrays(tp: TaperSI, n: int, part: tuple[float, float] = (0.0, 1.0)) -> tuple[np.ndarray, ...]:
+    """The ``2 n`` uniform half-steps of the fourth-order commutator-free Magnus scheme, as arrays
+    ``(EI, kGA, rhoA, rhoI)``.
 
     Over a step of length ``h`` with the section ``S1`` at its base-side
     Gauss point and ``S2`` at its tip-side one, the transfer matrix is
@@ -122,19 +179,27 @@ def _magnus_sections(seg: Segment, n: int, part: tuple[float, float] = (0.0, 1.0
     """
     middle = (np.arange(n) + 0.5) / n
     t = np.column_stack([middle - _GAUSS / n, middle + _GAUSS / n]).ravel()
-    ei, kga, rhoa, rhoi = _taper_arrays(seg, t, part)
+    c1, c2 = _CF
     out = []
-    for k in range(n):
-        i, j = 2 * k, 2 * k + 1
-        for a, b in (_CF, _CF[::-1]):
-            out.append(Section(
-                EI=1.0 / (a / ei[i] + b / ei[j]), kGA=1.0 / (a / kga[i] + b / kga[j]),
-                rhoA=float(a * rhoa[i] + b * rhoa[j]), rhoI=float(a * rhoi[i] + b * rhoi[j]),
-            ))
-    return out
+    for k, x in enumerate(_taper_arrays(tp, t, part)):
+        first, second = x[0::2], x[1::2]
+        halves = np.empty(2 * n, dtype=x.dtype)
+        if k < 2:  # EI, kGA: harmonic
+            halves[0::2] = 1.0 / (c1 / first + c2 / second)
+            halves[1::2] = 1.0 / (c2 / first + c1 / second)
+        else:
+            halves[0::2] = c1 * first + c2 * second
+            halves[1::2] = c2 * first + c1 * second
+        out.append(halves)
+    return tuple(out)
 
 
-def _auto_steps(seg: Segment, omega_max: float = 0.0, part: tuple[float, float] = (0.0, 1.0)) -> int:
+def _magnus_sections(seg: Segment, n: int, part: tuple[float, float] = (0.0, 1.0)) -> list[Section]:
+    """:func:`_magnus_arrays` of a segment, as sections."""
+    return [Section(*row) for row in zip(*_magnus_arrays(taper_si(seg), n, part))]
+
+
+def _auto_steps(tp: TaperSI, omega_max: float = 0.0, part: tuple[float, float] = (0.0, 1.0)) -> int:
     """Steps such that no section property changes by more than TAPER_STEP_RATIO over one
     step and, at ``omega_max``, no step is longer than TAPER_STEP_PHASE over the bending wavenumber.
 
@@ -144,11 +209,12 @@ def _auto_steps(seg: Segment, omega_max: float = 0.0, part: tuple[float, float] 
     part between these fractions of the segment.
     """
     t = np.linspace(0.0, 1.0, 257)
-    slopes = [np.max(np.abs(np.diff(np.log(np.abs(p))))) * (t.size - 1) for p in _taper_arrays(seg, t, part)]
-    n = math.ceil(max(slopes) / TAPER_STEP_RATIO - 1e-9)
+    # the four properties' largest slope at once (the largest of the four largest)
+    slope = np.max(np.abs(np.diff(np.log(np.abs(np.stack(_taper_arrays(tp, t, part)))), axis=1))) * (t.size - 1)
+    n = math.ceil(slope / TAPER_STEP_RATIO - 1e-9)
     if omega_max > 0.0:
-        ends = Section(*_taper_arrays(seg, np.array([0.0, 1.0]), part))  # both ends in one kernel call
-        n = max(n, math.ceil(_phase(ends, seg.length_m * (part[1] - part[0]), omega_max) / TAPER_STEP_PHASE - 1e-9))
+        ends = Section(*_taper_arrays(tp, np.array([0.0, 1.0]), part))  # both ends in one kernel call
+        n = max(n, math.ceil(_phase(ends, tp.length * (part[1] - part[0]), omega_max) / TAPER_STEP_PHASE - 1e-9))
     return max(1, n)
 
 
@@ -215,7 +281,7 @@ def step_count(seg: Segment, omega_max: float) -> int:
     """
     if not seg.is_tapered:
         return 1
-    return seg.taper_steps if seg.taper_steps is not None else _auto_steps(seg, omega_max)
+    return seg.taper_steps if seg.taper_steps is not None else _auto_steps(taper_si(seg), omega_max)
 
 
 def piece_sections(seg: Segment, steps: int | None, omega_max: float) -> list[Section]:
@@ -257,8 +323,24 @@ def mass(seg: Segment) -> float:
     float
         Mass in kg, insert included.
     """
-    ends = _taper_sections(seg, np.array([0.0, 0.5, 1.0]))
-    return float(seg.length_m * (ends[0].rhoA + 4.0 * ends[1].rhoA + ends[2].rhoA) / 6.0)
+    return mass_si(taper_si(seg))
+
+
+def mass_si(tp: TaperSI) -> float:
+    """:func:`mass` of a tapered segment given by its SI numbers.
+
+    Parameters
+    ----------
+    tp : TaperSI
+        The segment.
+
+    Returns
+    -------
+    float
+        Mass in kg, insert included.
+    """
+    rhoa = _taper_arrays(tp, np.array([0.0, 0.5, 1.0]))[2]
+    return float(tp.length * (float(rhoa[0]) + 4.0 * float(rhoa[1]) + float(rhoa[2])) / 6.0)
 
 
 def section_at(seg: Segment, x) -> Section:
@@ -348,35 +430,64 @@ def piecewise_sections(segments: Sequence[Segment], omega_max: float = 0.0,
     bounds : ndarray
         Their ``len(sections) + 1`` boundaries from the base, in metres.
     """
+    ends = np.concatenate([[0.0], np.cumsum([s.length_m for s in segments])])
     sections: list[Section] = []
     bounds = [0.0]
-    ends = np.concatenate([[0.0], np.cumsum([s.length_m for s in segments])])
-    for seg, x0, x1 in zip(segments, ends[:-1], ends[1:]):
-        if not seg.is_tapered:
-            sections.append(seg.section())
-            bounds.append(x1)
+    for seg, (arrays, cuts) in zip(segments, pieces([taper_si(s) if s.is_tapered else None for s in segments],
+                                                    ends, omega_max, positions)):
+        sections.extend([seg.section()] if arrays is None else [Section(*row) for row in zip(*arrays)])
+        bounds.extend(cuts)
+    return sections, np.array(bounds)
+
+
+def pieces(tapers: Sequence[TaperSI | None], ends: np.ndarray, omega_max: float, positions=()) -> list[tuple]:
+    """The uniform pieces of a stepped beam's segments (:func:`piecewise_sections`, from SI numbers).
+
+    Parameters
+    ----------
+    tapers : sequence of TaperSI or None
+        Per segment, base to tip: its numbers when it is tapered, None when it is uniform.
+    ends : ndarray
+        The segments' ends from the base [m] (``len(tapers) + 1``, from 0).
+    omega_max : float
+        Highest angular frequency of the computation [rad/s].
+    positions : sequence of float
+        Requested points [m from the base]: a tapered segment is cut there.
+
+    Returns
+    -------
+    list of (tuple or None, list of float)
+        Per segment: the arrays ``(EI, kGA, rhoA, rhoI)`` of its pieces (None for a uniform segment, one
+        piece) and the pieces' ends from the base.
+    """
+    positions = sorted(float(p) for p in positions)
+    out: list[tuple] = []
+    for tp, x0, x1 in zip(tapers, ends[:-1], ends[1:]):
+        if tp is None:
+            out.append((None, [float(x1)]))
             continue
         tol = 1e-12 * max(x1, 1e-300)
-        inner = [float(p) for p in positions if x0 + tol < p < x1 - tol]
+        inner = [p for p in positions if x0 + tol < p < x1 - tol]
         # the parts between the points, as split() cuts them (its share of the steps given, too), as fractions of
         # the segment: their sections without building the parts
         stops = [*inner, x1]
         steps: list = [None] * len(stops)
-        if seg.taper_steps is not None:
-            rest = seg.taper_steps
+        if tp.steps is not None:
+            rest = tp.steps
             for k, (a, b) in enumerate(zip([x0, *inner], inner)):
                 steps[k] = max(1, round(rest * (b - a) / (x1 - a)))
                 rest = max(1, rest - steps[k])
             steps[-1] = rest
         length = x1 - x0
+        arrays, cuts = [], []
         for a, b, n in zip([x0, *inner], stops, steps):
             part = ((a - x0) / length, (b - x0) / length)
-            pieces = _magnus_sections(seg, n if n is not None else _auto_steps(seg, omega_max, part), part)
-            sections.extend(pieces)
-            n = len(pieces)
-            bounds.extend(a + (b - a) * np.arange(1, n) / n)
-            bounds.append(b)
-    return sections, np.array(bounds)
+            arrays.append(_magnus_arrays(tp, n if n is not None else _auto_steps(tp, omega_max, part), part))
+            m = arrays[-1][0].size
+            cuts.extend(a + (b - a) * np.arange(1, m) / m)
+            cuts.append(b)
+        out.append((tuple(np.concatenate(column) for column in zip(*arrays)), cuts))
+    return out
 
 
 def tapered_column(column: Sequence[Segment], omega_max: float) -> list[tuple[Section, object]]:

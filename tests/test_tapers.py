@@ -9,6 +9,7 @@ section at Gauss points.
 """
 
 import math
+import re
 
 import attrs
 import numpy as np
@@ -21,10 +22,12 @@ from substructure.beams import segment_transfer_matrix, stepped_beam_receptance,
 from substructure.tapers import TAPER_ERROR_BOUND
 from substructure.errors import InvalidValueError
 from test_fe_reference import taper_compliance
+from substructure.updating.evaluator import Evaluator
 
 STEEL0 = Material("steel0", E="210 GPa", nu=0.29, rho="7850 kg/m^3")
 CARBIDE0 = Material("carbide0", E="580 GPa", nu=0.22, rho="14500 kg/m^3")
 FE_STEEL = fe.Material(210e9, 0.29, 7850.0)
+F_HZ = np.linspace(20.0, 5000.0, 300)
 FE_CARBIDE = fe.Material(580e9, 0.22, 14500.0)
 # damped materials (quality factor ~ 1/eta = 100) for receptance comparisons: near an
 # undamped pole a tiny frequency error is an unbounded receptance error
@@ -147,7 +150,10 @@ def test_tapered_holder_in_an_assembly_matches_fe_receptances(decay):
         from substructure.updating.structure import Structure
 
         structure = Structure.from_assembly(asm)
-        assert set(structure.opaque) == {"spindle", "holder", "tool"} and structure.not_at_complex_frequency() == []
+        # the tapers held in the SI arrays (the fits' fast path), evaluated at the complex frequency
+        assert set(structure.beams) == {"spindle", "holder", "tool"} and not structure.opaque
+        assert all(structure.beam(n).tapered.any() for n in structure.beams)
+        assert structure.not_at_complex_frequency() == []
         labels = ["tool.tip:y", "tool.tip:theta", "holder.tip:y", "holder.tip:theta"]
         ours = Evaluator(labels, labels, grid.hz, decay=decay)(structure)
     else:
@@ -319,3 +325,61 @@ def test_assembly_file_round_trip_and_errors():
         loads_assembly(bad, "m.toml")
     with pytest.raises(FileFormatError, match=r"segments\[2\]\.taper_steps: got 0"):
         loads_assembly(text.replace("taper_steps = 5", "taper_steps = 0"), "m.toml")
+
+
+@pytest.mark.parametrize("decay", [0.0, 30.0])
+def test_the_fits_arrays_hold_tapers_as_the_segments_do(decay):
+    """The SI arrays of a beam with tapers (flutes, an insert in a uniform bore, a tapered bore, a given step
+    count, a point inside a taper) give the segments' receptances, mass and segments back."""
+    from substructure.updating.structure import BeamArrays
+
+    segs = [Segment("20 mm", "40 mm", "12 mm", insert=Insert("12 mm", "carbide"), od_tip="34 mm"),
+            Segment("25 mm", "30 mm", "8 mm", od_tip="26 mm", id_tip="5 mm"),
+            Segment("10 mm", "25 mm"),
+            Segment("30 mm", "20 mm", material="carbide", flutes=Flutes(0.8), od_tip="16 mm", taper_steps=3),
+            Segment("5 mm", "16 mm", material="carbide", id_tip="2 mm")]
+    beam = Holder("h", segs)
+    arrays = BeamArrays.from_beam(beam)
+    assert arrays.tapered.tolist() == [True, True, False, True, True] and arrays.has_taper
+    f = np.linspace(50.0, 8000.0, 120)
+    for xs in ([0.0, 0.09], [0.0, 0.01, 0.03, 0.07, 0.09], [0.08, 0.0, 0.062]):  # inside tapers, in any order
+        ref = stepped_beam_receptance(segs, xs, f, decay)
+        np.testing.assert_allclose(arrays.receptance(xs, f, decay), ref, rtol=1e-11, atol=1e-13 * np.abs(ref).max())
+    assert arrays.mass() == pytest.approx(beam.mass(), rel=1e-13)
+    back = BeamArrays.from_beam(arrays.as_component(beam))  # tips and step counts kept
+    for name in ("length", "od", "id", "od_tip", "id_tip", "steps", "tapered"):
+        np.testing.assert_allclose(getattr(back, name), getattr(arrays, name), rtol=1e-15, err_msg=name)
+    assert [s.taper_steps for s in arrays.as_component(beam).segments] == [None, None, None, 3, None]
+    uniform = BeamArrays.from_beam(Holder("u", [Segment("20 mm", "40 mm"), Segment("20 mm", "30 mm", od_tip="30 mm")]))
+    assert uniform.tapered.tolist() == [False, False] and not uniform.has_taper and not uniform.no_tips
+
+
+def test_the_fits_arrays_refuse_a_taper_the_segment_refuses():
+    """A tip diameter set in the SI form that a Segment refuses (a bore as wide as the tip, an insert in a
+    tapered bore) is refused with the path, as set_parameters refuses it."""
+    from substructure import default_assembly
+    from substructure.updating.parameters import apply_path_si, set_parameters
+    from substructure.updating.structure import Structure
+
+    model = default_assembly()
+    tool = model.component("tool")
+    model = model.with_component(attrs.evolve(tool, segments=[*tool.segments[:-1], attrs.evolve(
+        tool.segments[-1], id="4 mm")]))
+    structure = Structure.from_assembly(model)
+    last = len(tool.segments) - 1
+    holder_insert = next(i for i, s in enumerate(model.component("holder").segments) if s.insert is not None)
+    for path, value in ((f"components.tool.segments.{last}.od_tip", 0.004),
+                        (f"components.tool.segments.{last}.id_tip", 0.0125),
+                        (f"components.holder.segments.{holder_insert}.id_tip", 0.0135)):
+        with pytest.raises(InvalidValueError, match=re.escape(repr(path))):
+            apply_path_si(structure, path, value)
+        with pytest.raises(InvalidValueError):
+            set_parameters(model, {path: value})
+    # a material changed by name leaves the tapered parts as the objects do (each part's own material path
+    # changes it)
+    tapered = set_parameters(model, {f"components.tool.segments.{last}.od_tip": 0.01})
+    for path, value in (("materials.carbide.E", 5.5e11), ("components.tool.E", 0.9)):
+        ref = set_parameters(tapered, {path: value}).frf(["tool.tip:y"], ["tool.tip:y"], frequency=F_HZ).data
+        got = Evaluator(["tool.tip:y"], ["tool.tip:y"], F_HZ)(apply_path_si(Structure.from_assembly(tapered), path,
+                                                                              value))
+        np.testing.assert_allclose(got, ref, rtol=1e-10)

@@ -310,7 +310,7 @@ def test_significance_and_indifference_follow_their_definitions():
 
 
 def test_a_tapered_tool_takes_part_as_it_is():
-    """A component the SI form cannot hold as arrays (a tapered segment) is evaluated by its own methods."""
+    """A tapered tool is held in the SI arrays (its segments' tip diameters), evaluated as the objects are."""
     from substructure import Segment, Tool
 
     model = default_assembly()
@@ -318,10 +318,11 @@ def test_a_tapered_tool_takes_part_as_it_is():
                           Segment("30 mm", "12 mm", material="carbide", od_tip="10 mm")])
     tapered = model.with_component(taper)
     structure = Structure.from_assembly(tapered)
-    assert "tool" in structure.opaque and "tool" not in structure.beams
+    assert "tool" in structure.beams and "tool" not in structure.opaque
+    assert structure.beam("tool").tapered.tolist() == [False, True]
     ref = tapered.frf(OUT, IN, F).data
     np.testing.assert_allclose(Evaluator(OUT, IN, F)(structure), ref, rtol=1e-10)
-    # its numbers are candidates too, set on the component itself in the SI form (evaluated by its own methods)
+    # its numbers are candidates too, set in the SI arrays
     params = {p.path: p for p in model_parameters(tapered) if p.path.startswith("components.tool.")}
     tip = params["components.tool.segments.1.od_tip"]
     assert tip.nominal == pytest.approx(0.010) and tip.lower < 0.010 < tip.upper
@@ -332,7 +333,7 @@ def test_a_tapered_tool_takes_part_as_it_is():
                                                      Segment("30 mm", "12 mm", material="carbide", od_tip="9 mm")]))
     expected = lik_model.frf(OUT, IN, F).data
     changed = change.apply_si(structure, {"value": 0.009})
-    assert "tool" in changed.opaque and changed.opaque["tool"] == lik_model.component("tool")
+    assert "tool" in changed.beams and changed.component("tool") == lik_model.component("tool")
     evaluator = Evaluator(OUT, IN, F)
     np.testing.assert_allclose(evaluator(structure), ref, rtol=1e-10)
     np.testing.assert_allclose(evaluator(changed), expected, rtol=1e-10)
@@ -347,9 +348,8 @@ def test_a_tapered_tool_takes_part_as_it_is():
                                     {"components.tool.segments.1.flutes.diameter_ratio": 0.75}],
                          ids=["alone", "after-its-od", "after-material-and-insert", "after-flutes"])
 def test_a_taper_set_on_a_uniform_segment_is_the_assemblys_taper_in_the_si_form(before):
-    """``od_tip`` and ``id_tip`` of a uniform segment make it tapered on the assembly; the SI form's arrays of
-    uniform segments cannot hold that: the component, with the changes its arrays carry, is evaluated by its
-    own methods (they once set the flutes' ratio instead, 350 times off)."""
+    """``od_tip`` and ``id_tip`` of a uniform segment make it tapered on the assembly, and in the SI form's
+    arrays, with the changes they carry (they once set the flutes' ratio instead, 350 times off)."""
     model = _rich_model()
     evaluate = Evaluator(OUT, IN, F)
     for path, value in (("components.tool.segments.0.od_tip", 0.0105), ("components.tool.segments.1.od_tip", 0.011),
@@ -366,7 +366,7 @@ def test_a_taper_set_on_a_uniform_segment_is_the_assemblys_taper_in_the_si_form(
         structure = Structure.from_assembly(model)
         for p, v in values.items():
             structure = apply_path_si(structure, p, v)
-        assert name in structure.opaque and name not in structure.beams
+        assert name in structure.beams and structure.beam(name).tapered.any() and not structure.opaque
         got = evaluate(structure)
         assert np.abs(got - ref).max() <= 1e-10 * np.abs(ref).max(), path
         assert np.abs(ref - evaluate(Structure.from_assembly(set_parameters(model, before)))).max() \

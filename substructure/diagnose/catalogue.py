@@ -434,7 +434,21 @@ class TaperedTool(Effect):
         return assembly.with_component(taper_tool(assembly.component(self.where), self.values["tip_ratio"]))
 
     def apply_si(self, structure):
-        return structure.with_opaque(taper_tool(structure.component(self.where), self.values["tip_ratio"]))
+        if self.where in structure.opaque:  # a tool of a type of one's own
+            return structure.with_opaque(taper_tool(structure.component(self.where), self.values["tip_ratio"]))
+        beam = structure.beam(self.where)
+        od1, _ = beam.tips
+        # the arrays as taper_tool makes the segments (the same numbers)
+        shrink = 1.0 - self.values["tip_ratio"]
+        ends = np.concatenate([[0.0], np.cumsum(beam.length)])
+        total = beam.total_length
+        base, tip = (beam.od * (1.0 - shrink * x / total) for x in (ends[:-1], ends[1:]))
+        bored = beam.id > 0  # the bore stays inside the section as it narrows
+        base = np.where(bored, np.maximum(base, 1.0001 * beam.id), base)
+        tip = np.where(bored, np.maximum(tip, 1.0001 * beam.id), tip)
+        changed = (beam.ratio == 1.0) & ~(beam.insert[:, 0] > 0) & ~beam.tapered
+        return structure.with_beam(beam.evolve(od=np.where(changed, base, beam.od),
+                                               od_tip=np.where(changed, tip, beam.od_tip)))
 
 
 def taper_tool(tool: Beam, tip_ratio: float) -> Beam:

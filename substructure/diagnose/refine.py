@@ -314,21 +314,32 @@ def _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
     return kept, kept_chi2, rivals
 
 
-def _named_firsts(lik, first, first_scored, firsts, passive, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> list:
+def _named_firsts(lik, first, first_scored, firsts, passive, settings: DiagnoseSettings = DEFAULT_SETTINGS,
+                  cands=()) -> list:
     """Where the path's first change is an element at a fitted place (a section change, the generic stand-in),
-    the catalogue's effects on the same component that improved the model in the first step (best first, at
-    most ``settings.confirm_named``, those not among ``firsts``), each fitted on all lines from its screened
-    values: the other firsts of the confirming step besides.
+    the catalogue's effects on the same component (those that improved the model in the first step best first
+    from their screened values, then the others of ``cands`` from their starts; at most
+    ``settings.confirm_named``, those not among ``firsts``), each fitted on all lines: the other firsts of the
+    confirming step besides.
 
     A tapered tool with a 3 g sensor came back as a section change over most of the tool and a 0.9 mm bore:
     the taper alone screened too far behind the section change to be fitted in the first step, so no pair
-    started from it; with it, the taper and the sensor describe the data better with fewer parameters.
+    started from it; with it, the taper and the sensor describe the data better with fewer parameters.  Under
+    three times the real noise the taper alone screened no better than the model at all (the sensor hides it),
+    so an effect that did not improve the model alone starts the step too.
     """
     if preference(first) < ELEMENT or not settings.confirm_named:
         return []
     taken = {s.change.key for s in firsts} | {first.key}
-    named = [s for s in first_scored if isinstance(s.change, EffectChange) and s.change.where == first.where
-             and s.change.key not in taken][:settings.confirm_named]
+
+    def same(change) -> bool:
+        return isinstance(change, EffectChange) and change.where == first.where and change.key not in taken
+
+    named = [s for s in first_scored if same(s.change)]
+    screened = {s.change.key for s in named}
+    named += [Scored(c, {spec.name: spec.start for spec in c.specs}, np.inf) for c in cands
+              if same(c) and c.key not in screened]
+    named = named[:settings.confirm_named]
     return [s for s in full_fits(lik, [], named) if physical(s.change, s.values) and passive(s.fit.changes)]
 
 
@@ -545,7 +556,7 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
 
     # a single element at a fitted place that reached the noise (a section change) may stand in for a named effect
     # of its component with a change it hides (a taper with a sensor): the pairs from those, cheaply screened
-    named = _named_firsts(lik, current[0][0], first_scored, [], passive, settings) if len(current) == 1 else []
+    named = _named_firsts(lik, current[0][0], first_scored, [], passive, settings, cands) if len(current) == 1 else []
     if named:
         more = confirming(named)
         before = [c.key for c, _ in current]
@@ -569,7 +580,7 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
         if failed:
             more = other_paths(lik, screen_lik, lik0, firsts, cands, passive, say, settings) if firsts else []
         else:  # the named effects of a first change that is an element too (even with confirm_firsts 0)
-            firsts += _named_firsts(lik, path[0][1], first_scored, firsts, passive, settings)
+            firsts += _named_firsts(lik, path[0][1], first_scored, firsts, passive, settings, cands)
             more = confirming(firsts) if firsts else []
         current, chi2_now, rivals = _parsimony(lik, screen_lik, current, chi2_now, first_fitted, passive, say,
                                                settings, more)

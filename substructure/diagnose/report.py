@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..updating.structure import si_beam
+from ..updating.structure import uniform_beam
 from ..errors import SubstructureError
 from ..measurements import model_of_measurement
 from ..updating.parameters import set_parameters
@@ -44,7 +44,7 @@ __all__ = ["unexplained_report", "separation", "signature", "level_signature", "
 
 
 def _plain_beams(assembly):
-    return [c for c in assembly.components if si_beam(c)]
+    return [c for c in assembly.components if uniform_beam(c)]
 
 
 def _peak(f: np.ndarray, h: np.ndarray, near: float, width: float = 0.15) -> float | None:

@@ -41,7 +41,7 @@ from ..errors import SubstructureError
 from ..updating.elements import AddedMass, GroundSpring, SectionChange, body_bounds, rear_bounds
 from ..updating.fit import Fit, fit, from_u, to_u
 from ..updating.parameters import Change, ParameterChange, material_changes, model_parameters, parameter_change
-from ..updating.structure import si_beam
+from ..updating.structure import uniform_beam
 from ..updating.selection import INDIFFERENCE, bic, significance
 from .effects import EffectChange, effect_change
 from .scan import finer
@@ -172,7 +172,7 @@ def candidates(assembly, measured_points: Sequence[str], effects: dict, open_wor
             if rear is not None:  # a spindle's rear end: a pulley, a rotary union
                 out.append(AddedMass(comp.name, comp.length_m, mass_max, rear, inertia_max, f"{comp.name} rear end"))
             out.append(GroundSpring(comp.name, comp.length_m))
-            if si_beam(comp):  # a section changed in the arrays of a plain beam
+            if uniform_beam(comp):  # a section changed in the arrays of a plain beam
                 out.append(SectionChange(comp.name, comp.length_m))
     for name, cls in effects.items():
         try:

@@ -305,10 +305,11 @@ class DiagnoseSettings:
     confirm_named : int
         Where that path's first change is an element at a fitted place (a
         section change: the generic stand-in), the catalogue's effects on the
-        same component that improved the model in the first step (best
-        first, at most this many) are fitted on all lines and start that
-        second step too: a tapered tool with a sensor otherwise came back as
-        a section change and a bore (default 2; 0: not tried).
+        same component (those that improved the model in the first step
+        best first, then the others from their starts; at most this many)
+        are fitted on all lines and start that second step too: a tapered
+        tool with a sensor otherwise came back as a section change and a
+        bore (default 2; 0: not tried).
     other_starts : int
         Starts per placed change from which other values of the same change are
         fitted (default 2).

@@ -270,6 +270,8 @@ def split_beam(beam, start: float, stop: float, od_factor: float = 1.0, flutes: 
     BeamArrays
         The changed beam.
     """
+    if beam.has_taper:
+        raise UnknownPointError(f"{beam.name!r} has a tapered segment: a range of it is not cut in the arrays")
     ends = np.concatenate([[0.0], np.cumsum(beam.length)])
     total = ends[-1]
     start, stop = max(0.0, float(start)), min(total, float(stop))
@@ -286,7 +288,8 @@ def split_beam(beam, start: float, stop: float, od_factor: float = 1.0, flutes: 
     od = np.maximum(od, bore * 1.0001 / ratio)
     return beam.evolve(length=np.diff(cuts), od=od, id=bore, ratio=ratio, material=beam.material[idx],
                        material_names=[beam.material_names[i] for i in idx], insert=beam.insert[idx],
-                       insert_names=[beam.insert_names[i] for i in idx])
+                       insert_names=[beam.insert_names[i] for i in idx], od_tip=beam.od_tip[idx],
+                       id_tip=beam.id_tip[idx], steps=beam.steps[idx])
 
 
 _SLIVER = 1e-6  # m: the shortest segment a model holds (sections.py refuses shorter lengths)

@@ -294,7 +294,7 @@ class Evaluator:
         for structure, (nodes, _, _) in zip(structures, layouts):
             for comp, items in nodes.items():
                 beam = structure.beams.get(comp)
-                if beam is None:
+                if beam is None or beam.has_taper:  # a taper's pieces follow the nodes: one by one
                     continue
                 xs = tuple(x for _, (x, _) in items)
                 key = (beam.token, xs)

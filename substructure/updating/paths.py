@@ -86,7 +86,9 @@ def _geometry(beam, path: str, rest: list[str], value: float):
         return beam.evolve(length=length)
     i = _index(path, rest[1], beam.length.size, f"segment index of {beam.name!r}")
     what = ".".join(rest[2:])
-    if what in ("length", "od", "id"):
+    if what in ("length", "od", "id", "od_tip", "id_tip"):
+        if what == "id_tip" and value < 1e-6:  # a bore under a micrometre is no bore, as on the objects
+            value = 0.0
         arr = getattr(beam, what).copy()
         arr[i] = value
         return beam.evolve(**{what: arr})
@@ -109,12 +111,20 @@ def _problems(beam) -> tuple:
     """``(what, mask)`` of every check of :class:`~substructure.beams.Segment` on the beam's arrays."""
     insert_od, insert_id = beam.insert[:, 0], beam.insert[:, 1]
     sizes = np.concatenate([beam.length, beam.od, beam.id, beam.ratio, insert_od, insert_id])
+    thin, wide = beam.od < 1e-6, beam.id >= beam.od * beam.ratio
+    tapered_bore = np.zeros(thin.shape, dtype=bool)
+    if not beam.no_tips:  # the tip ends' sizes too (Segment's checks of a taper)
+        od1, id1 = beam.tips
+        sizes = np.concatenate([sizes, od1, id1])
+        thin, wide = thin | (od1 < 1e-6), wide | (id1 >= od1 * beam.ratio)
+        tapered_bore = (insert_od > 0) & ~np.isclose(id1, beam.id, rtol=1e-12, atol=0.0)
     return (("a size that is not a finite number", ~np.isfinite(sizes)),
             ("a segment shorter than 1 um", beam.length < 1e-6),
-            ("an outer diameter under 1 um", beam.od < 1e-6),
-            ("a bore as wide as the section", beam.id >= beam.od * beam.ratio),
+            ("an outer diameter under 1 um", thin),
+            ("a bore as wide as the section", wide),
             ("an insert wider than its bore", (insert_od > 0) & (insert_od > beam.id)),
-            ("an insert's bore as wide as the insert", (insert_od > 0) & (insert_id >= insert_od)))
+            ("an insert's bore as wide as the insert", (insert_od > 0) & (insert_id >= insert_od)),
+            ("an insert in a tapered bore", tapered_bore))
 
 
 def _section_checked(path: str, beam, before=None):
@@ -126,7 +136,7 @@ def _section_checked(path: str, beam, before=None):
     not refuse every later value on the beam."""
     old = _problems(before) if before is not None and before.length.size == beam.length.size else None
     for k, (what, bad) in enumerate(_problems(beam)):
-        if old is not None:
+        if old is not None and old[k][1].shape == bad.shape:  # (the sizes of a beam given tips just now: more)
             bad = bad & ~old[k][1]
         if np.any(bad):
             raise InvalidValueError(f"parameter {path!r}: the value makes {what} in {beam.name!r}")
@@ -155,9 +165,10 @@ def _si(value: float, unit: str) -> str:
 
 
 def _plain(component) -> bool:
-    from .structure import si_beam
+    """A plain beam of uniform segments: the parts whose materials ``materials.NAME.X`` changes."""
+    from .structure import uniform_beam
 
-    return si_beam(component)
+    return uniform_beam(component)
 
 
 def _segmented(component) -> bool:
@@ -520,10 +531,6 @@ def _component_obj(assembly, path: str, name: str, rest: tuple, value: float):
 
 
 def _component_si(structure, path: str, name: str, rest: tuple, value: float):
-    if rest[0] == "segments" and rest[-1] in ("od_tip", "id_tip") and name in structure.beams:
-        # a taper, which the arrays of uniform segments cannot hold: the component, with every change the arrays
-        # carry, is evaluated by its own methods from here on (as the assembly's tapered one is)
-        return structure.with_opaque(_set_component(structure.component(name), path, list(rest), value))
     if name in structure.opaque:  # a component evaluated by its own methods: changed as an object
         comp = _set_component(structure.opaque[name], path, list(rest), value)
         out = structure.with_opaque(comp)
@@ -570,6 +577,8 @@ def _material_obj(assembly, path: str, name: str, prop: str, value: float):
 def _material_si(structure, path: str, name: str, prop: str, value: float):
     out, column = structure, _MAT_COLUMN[prop]
     for beam in structure.beams.values():
+        if beam.has_taper:  # as on the objects: materials.NAME.X changes the parts of uniform segments
+            continue
         hit = np.array([n == name for n in beam.material_names])
         ins_hit = np.array([n == name for n in beam.insert_names])
         if hit.any() or ins_hit.any():

@@ -26,6 +26,7 @@ from .._blocks import angular_lines, takes_decay
 from ..assembly import Assembly
 from ..assembly.plan import check_connected
 from ..beams import Flutes, Insert, Segment, shear_coefficient, stepped_beam_receptance_si
+from ..tapers import TaperSI, mass_si, pieces
 from ..components import Beam, is_plain_beam
 from ..errors import InvalidValueError, UnknownPointError
 from ..joints import Joint, dynamic_stiffness
@@ -33,7 +34,7 @@ from ..materials import Material
 from ..points import parse_point
 from ..units import Q_
 
-__all__ = ["BeamArrays", "LinkSI", "Structure", "si_beam"]
+__all__ = ["BeamArrays", "LinkSI", "Structure", "si_beam", "uniform_beam"]
 
 _TOKENS = itertools.count(1)
 
@@ -113,15 +114,23 @@ class BeamArrays:
         segment's insert (``od = 0``: none).
     insert_names : tuple of str or None
         The inserts' material names.
+    od_tip, id_tip : ndarray, shape (n_seg,)
+        Outer and inner diameters at the segments' tip ends [m]; NaN where
+        none is given (the segment's ``od``, ``id``: uniform).  A segment
+        whose ends differ is tapered (:mod:`substructure.tapers`).
+    steps : ndarray of int, shape (n_seg,)
+        A tapered segment's ``taper_steps``; 0 for the error bound's count.
     token : int
         Identifies the arrays: a changed beam gets a new token, so that the
         evaluator recomputes only what changed.
     """
 
     __slots__ = ("name", "length", "od", "id", "ratio", "material", "material_names", "insert", "insert_names",
-                 "token", "_sections", "_total", "_component", "_parent")
+                 "od_tip", "id_tip", "steps", "token", "_sections", "_total", "_component", "_parent", "_tapered",
+                 "_no_tips")
 
-    def __init__(self, name, length, od, id, ratio, material, material_names, insert, insert_names):
+    def __init__(self, name, length, od, id, ratio, material, material_names, insert, insert_names, od_tip=None,
+                 id_tip=None, steps=None):
         self.name = name
         self.length = np.asarray(length, dtype=float)
         self.od = np.asarray(od, dtype=float)
@@ -131,6 +140,12 @@ class BeamArrays:
         self.material_names = tuple(material_names)
         self.insert = np.asarray(insert, dtype=float)
         self.insert_names = tuple(insert_names)
+        none = np.full(self.length.shape, np.nan)
+        self.od_tip = none if od_tip is None else np.asarray(od_tip, dtype=float)
+        self.id_tip = none if id_tip is None else np.asarray(id_tip, dtype=float)
+        self.steps = np.zeros(self.length.shape, dtype=int) if steps is None else np.asarray(steps, dtype=int)
+        self._tapered: np.ndarray | None = None
+        self._no_tips: bool | None = None  # no tip diameter given: every segment uniform, whatever its sizes
         self.token = next(_TOKENS)
         self._sections = None
         self._total = None
@@ -166,14 +181,14 @@ class BeamArrays:
         return cls(beam.name, [s.length_m for s in segs], [s.od.m_as("m") for s in segs],
                    [s.id.m_as("m") for s in segs],
                    [1.0 if s.flutes is None else s.flutes.diameter_ratio for s in segs],
-                   mat, [s.material.name for s in segs], ins, ins_names)
+                   mat, [s.material.name for s in segs], ins, ins_names,
+                   [np.nan if s.od_tip is None else s.od_tip.m_as("m") for s in segs],
+                   [np.nan if s.id_tip is None else s.id_tip.m_as("m") for s in segs],
+                   [s.taper_steps or 0 for s in segs])
 
     def as_component(self, template: Beam) -> Beam:
         """The component whose segments these arrays hold, with every change they carry (sizes, materials,
         inserts, flutes, segments split by an added element); its type and other numbers are ``template``'s.
-
-        For a change the arrays of uniform segments cannot hold (a taper): the component is then evaluated by
-        its own methods (:meth:`~substructure.updating.structure.Structure.with_opaque`).
 
         Parameters
         ----------
@@ -198,9 +213,12 @@ class BeamArrays:
             insert = None if not od_in > 0 else Insert(Q_(od_in, "m"), material(self.insert_names[i],
                                                                                  self.insert[i, 2:]), Q_(id_in, "m"))
             ratio = float(self.ratio[i])
+            tips = {k: Q_(float(v[i]), "m") for k, v in (("od_tip", self.od_tip), ("id_tip", self.id_tip))
+                    if not np.isnan(v[i])}
             segs.append(Segment(Q_(float(self.length[i]), "m"), Q_(float(self.od[i]), "m"),
                                 Q_(float(self.id[i]), "m"), material(self.material_names[i], self.material[i]), insert,
-                                None if ratio == 1.0 else Flutes(ratio)))
+                                None if ratio == 1.0 else Flutes(ratio), taper_steps=int(self.steps[i]) or None,
+                                **tips))
         self._component = (template, attrs.evolve(template, segments=segs))
         return self._component[1]
 
@@ -218,9 +236,11 @@ class BeamArrays:
             The changed beam.
         """
         fields = {k: getattr(self, k) for k in ("name", "length", "od", "id", "ratio", "material", "material_names",
-                                               "insert", "insert_names")}
+                                               "insert", "insert_names", "od_tip", "id_tip", "steps")}
         fields.update(changes)
         beam = BeamArrays(**fields)
+        if "od_tip" not in changes and "id_tip" not in changes:
+            beam._no_tips = self._no_tips
         if self._sections is not None:  # the sections of the segments that did not change are taken from here
             beam._parent = self
         return beam
@@ -232,8 +252,52 @@ class BeamArrays:
             self._total = float(self.length.sum())
         return self._total
 
+    @property
+    def tips(self) -> tuple[np.ndarray, np.ndarray]:
+        """The outer and inner diameters at the segments' tip ends [m] (their ``od``, ``id`` where none is given)."""
+        return (np.where(np.isnan(self.od_tip), self.od, self.od_tip),
+                np.where(np.isnan(self.id_tip), self.id, self.id_tip))
+
+    @property
+    def no_tips(self) -> bool:
+        """True when no segment has a tip diameter given: none is tapered (the usual beam; quick to tell)."""
+        if self._no_tips is None:
+            self._no_tips = bool(np.isnan(self.od_tip).all() and np.isnan(self.id_tip).all())
+        return self._no_tips
+
+    @property
+    def has_taper(self) -> bool:
+        """True when a segment is tapered."""
+        return not self.no_tips and bool(self.tapered.any())
+
+    @property
+    def tapered(self) -> np.ndarray:
+        """Which segments are tapered: their ends' diameters differ (as :func:`substructure.tapers.check_taper`
+        tells)."""
+        if self._tapered is None and self.no_tips:
+            self._tapered = np.zeros(self.length.shape, dtype=bool)
+        if self._tapered is None:
+            od1, id1 = self.tips
+            self._tapered = ~(np.isclose(od1, self.od, rtol=1e-12, atol=0.0)
+                              & np.isclose(id1, self.id, rtol=1e-12, atol=1e-18))
+        return self._tapered
+
+    def _taper(self, k: int) -> TaperSI:
+        """Segment ``k``'s numbers, for :mod:`substructure.tapers`."""
+        od1, id1 = self.tips
+        E, nu, rho, eta = (float(v) for v in self.material[k])
+        insert = None
+        if self.insert[k, 0] > 0:
+            io, ii, iE, inu, irho, ieta = (np.array([v]) for v in self.insert[k])
+            insert = tuple(complex(v[0]) if j < 2 else float(v[0])
+                           for j, v in enumerate(_ring(io, ii, iE, inu, irho, ieta)))
+        damp = 1.0 + 1j * eta
+        return TaperSI(float(self.length[k]), (float(self.od[k]), float(od1[k]), float(self.id[k]), float(id1[k])),
+                       float(self.ratio[k]), E * damp, E / (2.0 * (1.0 + nu)) * damp, nu, rho, insert,
+                       int(self.steps[k]) or None)
+
     def sections(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """``(EI, kGA, rhoA, rhoI)`` per segment, layers (inserts) summed.
+        """``(EI, kGA, rhoA, rhoI)`` per segment, layers (inserts) summed (of a tapered segment: at its base).
 
         Returns
         -------
@@ -267,7 +331,10 @@ class BeamArrays:
         float
             [kg].
         """
-        return float(np.sum(self.sections()[2] * self.length))
+        rhoa = self.sections()[2] * self.length
+        for k in np.flatnonzero(self.tapered) if self.has_taper else ():
+            rhoa[k] = mass_si(self._taper(k))
+        return float(np.sum(rhoa))
 
     def receptance(self, positions: Sequence[float], frequency_hz: np.ndarray, decay: float = 0.0) -> np.ndarray:
         """Free-free receptances between positions.
@@ -287,7 +354,21 @@ class BeamArrays:
             Frequency-last receptances, DOFs ``(y, theta)`` per position.
         """
         ei, kga, rhoa, rhoi = self.sections()
-        return stepped_beam_receptance_si(ei, kga, rhoa, rhoi, self.length, positions, frequency_hz, decay)
+        if not self.has_taper:
+            return stepped_beam_receptance_si(ei, kga, rhoa, rhoi, self.length, positions, frequency_hz, decay)
+        # the tapered segments as their uniform pieces (cut at the positions within them), as the objects do
+        omega = angular_lines(np.asarray(frequency_hz, dtype=float), decay)
+        ends = np.concatenate([[0.0], np.cumsum(self.length)])
+        columns: list[list] = [[], [], [], []]
+        bounds = [0.0]
+        parts = pieces([self._taper(k) if t else None for k, t in enumerate(self.tapered)], ends,
+                       float(np.abs(omega).max()) if omega.size else 0.0, positions)
+        for k, (arrays, cuts) in enumerate(parts):
+            for column, whole, part in zip(columns, (ei, kga, rhoa, rhoi), arrays or (None,) * 4):
+                column.append(whole[k:k + 1] if part is None else part)
+            bounds.extend(cuts)
+        return stepped_beam_receptance_si(*(np.concatenate(c) for c in columns), np.diff(bounds), positions,
+                                          frequency_hz, decay)
 
 
 class LinkSI:
@@ -365,7 +446,7 @@ def _along(component) -> float | None:
 
 
 def si_beam(component) -> bool:
-    """Whether a component can be held as SI arrays: a plain beam of uniform segments.
+    """Whether a component can be held as SI arrays: a plain beam of segments (tapered ones too).
 
     Parameters
     ----------
@@ -376,11 +457,28 @@ def si_beam(component) -> bool:
     -------
     bool
         True for a component whose receptances are those of its segments
-        (:func:`substructure.components.is_plain_beam`) when no segment is
-        tapered; other components take part through their own methods.
+        (:func:`substructure.components.is_plain_beam`); other components
+        take part through their own methods.
     """
     return (is_plain_beam(component) and isinstance(component, Beam)
-            and all(type(s) is Segment and not s.is_tapered for s in component.segments))
+            and all(type(s) is Segment for s in component.segments))
+
+
+def uniform_beam(component) -> bool:
+    """Whether a component is a plain beam of uniform segments: one whose materials the ``materials.NAME.X``
+    paths change (:func:`si_beam`, no segment tapered).
+
+    Parameters
+    ----------
+    component : object
+        Any component.
+
+    Returns
+    -------
+    bool
+        :func:`si_beam` without tapers.
+    """
+    return si_beam(component) and not any(s.is_tapered for s in component.segments)
 
 
 class Structure:
