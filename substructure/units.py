@@ -325,6 +325,7 @@ def quantity(value: Any, field: str, dimension: str) -> pint.Quantity:
         )
     if np.ndim(q.magnitude) != 0:
         raise UnitError(f"{field}: got an array {show_value(value)}; expected a single value")
+    _check_angles(q, value, field, dimension, expected)
     if not _has_dimension(q.units, dimension):
         raise UnitError(
             f"{field}: got {show_value(value)} with dimension {q.dimensionality}; expected {expected}"
@@ -340,6 +341,24 @@ def quantity(value: Any, field: str, dimension: str) -> pint.Quantity:
     if not isinstance(q.magnitude, (int, float, np.integer, np.floating)):  # a Fraction, a Decimal: as a float
         q = ureg.Quantity(magnitude, q.units)
     return q
+
+
+def _check_angles(q: pint.Quantity, value: Any, field: str, dimension: str, expected: str) -> None:
+    """Refuse angle units (and other units without a dimension: a percent) that only scale the number: one over
+    another (``"12 mm*rad/deg"`` is 687.5 mm), or any in a length (``"12 mm*rad"``); ``"N*m/deg"`` for a
+    rotational stiffness is a value, and stays."""
+    bare = {name: power for name, power in q.units._units.items() if not ureg.get_dimensionality(name)}
+    if not bare or q.units.dimensionless:  # a unit without a dimension alone is judged by the caller
+        return
+    mixed = any(p > 0 for p in bare.values()) and any(p < 0 for p in bare.values())
+    if mixed or dimension == "[length]":
+        kept = q.units
+        for name, power in bare.items():
+            kept = kept / ureg.Unit(name) ** power
+        names = " and ".join(sorted(bare))
+        its = f"its units {names} have" if len(bare) > 1 else f"its unit {names} has"
+        raise UnitError(f"{field}: got {show_value(value)}; {its} no dimension and only scales the number (it is "
+                        f"{q.to(kept):~P}); expected {expected}")
 
 
 def to_si(value: Any, field: str, unit: str) -> float:

@@ -208,3 +208,23 @@ def test_whole_number_takes_integers_only_and_names_the_field():
     for value in (True, 2.0, "3", 0, None):
         with pytest.raises(InvalidValueError, match=f"steps: got {value!r}; expected a whole number of steps >= 1"):
             whole_number(value, "steps", 1, "a whole number of steps")
+
+
+@pytest.mark.parametrize("text, dimension, value", [
+    ("12 mm*rad/deg", "[length]", "687.5"),  # read as 687.5 mm without a word
+    ("12 mm*rad", "[length]", "12 mm"),
+    ("3 mm*%", "[length]", "3 mm"),
+    ("8e4 N*m*rad/deg", "[mass] * [length] ** 2 / [time] ** 2", "4583662"),
+])
+def test_units_without_a_dimension_that_only_scale_the_number_are_refused(text, dimension, value):
+    with pytest.raises(UnitError, match=rf"od: got '{re.escape(text)}'; its units? .* no dimension .*{value}"):
+        quantity(text, "od", dimension)
+
+
+def test_an_angle_unit_that_carries_meaning_stays():
+    from substructure import Joint
+
+    joint = Joint("j", ["a.tip", "b.base"], k={"yf": "1e7 N/m", "tm": "8e4 N*m/deg"})
+    assert joint.k.values[1, 1] == pytest.approx(8e4 * 180.0 / math.pi, rel=1e-12)  # per degree: 57.3 per rad
+    with pytest.raises(UnitError, match="only scales the number"):
+        Segment("12 mm*rad/deg", "10 mm")
