@@ -22,7 +22,7 @@ import numbers
 import os
 import re
 import shutil
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import pint
@@ -347,7 +347,7 @@ def _check_angles(q: pint.Quantity, value: Any, field: str, dimension: str, expe
     """Refuse angle units (and other units without a dimension: a percent) that only scale the number: one over
     another (``"12 mm*rad/deg"`` is 687.5 mm), or any in a length (``"12 mm*rad"``); ``"N*m/deg"`` for a
     rotational stiffness is a value, and stays."""
-    bare = {name: float(power) for name, power in q.units._units.items() if not ureg.get_dimensionality(name)}
+    bare = {name: cast(float, power) for name, power in q.units._units.items() if not ureg.get_dimensionality(name)}
     if not bare or q.units.dimensionless:  # a unit without a dimension alone is judged by the caller
         return
     mixed = any(p > 0 for p in bare.values()) and any(p < 0 for p in bare.values())
