@@ -630,3 +630,32 @@ def test_the_parameter_functions_say_what_a_model_and_values_are():
         set_parameters(default_assembly(), [("joints.holder-tool.k.yf", 2e7)])
     with pytest.raises(InvalidValueError, match="parameter: got 'joints.holder-tool.k.yf'; expected a ModelParameter"):
         ParameterChange("joints.holder-tool.k.yf")
+
+
+def test_one_record_given_as_two_measurements_is_refused():
+    """A file copied under another name gives two measurements with the same numbers on every line: weighed
+    twice and fitted at two places, it was taken without a word.  A reciprocal pair may be equal (an exact
+    simulation) and stays."""
+    import numpy as np
+
+    from substructure import FRF, Frequency, default_assembly
+    from substructure.diagnose import diagnose
+    from substructure.measurements import Measurement
+    from substructure.synthetic import simulate
+    from substructure.updating.likelihood import measured_frfs
+
+    model = default_assembly()
+    grid = Frequency.from_hz(np.linspace(20.0, 5000.0, 300))
+    tip, holder = (m.frf for m in simulate(model, ["tool.tip", "holder.tip"], frequency=grid, noise=0.01, seed=4))
+    copy = Measurement.from_frf(tip, "tool.tip-20 mm", "tool.tip", file="b.uff")
+    first = Measurement.from_frf(tip, "tool.tip", "tool.tip", file="a.uff")
+    for data in ([first, copy], [tip, holder, FRF(tip.frequency, tip.data, ("tool.tip-20 mm:y",), tip.inputs)]):
+        with pytest.raises(InvalidValueError, match=r"hold the same numbers on every line: one record given twice"):
+            measured_frfs(data)
+    with pytest.raises(InvalidValueError, match=r"tool\.tip:y / tool\.tip:y \(a\.uff\) and .*\(b\.uff\)"):
+        diagnose(model, [first, copy], progress=False)
+    exact = model.frf(["tool.tip:y", "holder.tip:y"], frequency=grid)
+    hab = exact.select(["tool.tip:y"], ["holder.tip:y"])
+    pair = [hab, FRF(hab.frequency, hab.data, hab.inputs, hab.outputs)]  # H_ba given as H_ab (reciprocity)
+    assert len(measured_frfs(pair)[0]) == 2  # a reciprocal pair with the same numbers: both kept
+    assert len(measured_frfs([tip, holder])[0]) == 2

@@ -20,6 +20,8 @@ there, others (registered effects without one) on the assembly.
 
 from __future__ import annotations
 
+import hashlib
+
 from collections import OrderedDict
 from typing import Sequence
 
@@ -76,6 +78,25 @@ class Measured:
                 tuple(sorted(getattr(self.measurement, "removed", ()) or ())))
 
 
+def _no_copies(items: list) -> None:
+    """Refuse one record given as two measurements (a file copied under another name): the same numbers on every
+    line, which two taps never give, would be weighed twice and fitted at two places.  A reciprocal pair of an
+    exact simulation (``H_ab`` and ``H_ba``) may be equal and stays."""
+    seen: dict[bytes, tuple] = {}
+    for m, frf in items:
+        digest = hashlib.sha256(np.ascontiguousarray(frf.data).tobytes()).digest()
+        if digest in seen and seen[digest][0] is not m:
+            first, other = seen[digest]
+            if (other.outputs, other.inputs) != (frf.inputs, frf.outputs):
+                def name(x, f):
+                    return x.describe() if hasattr(x, "describe") else f"{f.outputs[0]} / {f.inputs[0]}"
+                raise InvalidValueError(
+                    f"measurements: {name(first, other)} and {name(m, frf)} hold the same numbers on every line: one "
+                    "record given twice (a file copied under another name?); two taps never give the same record "
+                    "to the last digit: keep the right one")
+        seen.setdefault(digest, (m, frf))
+
+
 def measured_frfs(measurements, band=None) -> tuple[list[Measured], tuple[float, float]]:
     """Measured FRFs (one entry each) cropped to a band, with their noise estimated on the whole record.
 
@@ -115,6 +136,7 @@ def measured_frfs(measurements, band=None) -> tuple[list[Measured], tuple[float,
                 items.append((m, frf.select([out], [inp]) if frf.shape[1:] != (1, 1) else frf))
     if not items:
         raise InvalidValueError("measurements: got none")
+    _no_copies(items)
     f0 = items[0][1].frequency
     full = (float(f0.hz[0]), float(f0.hz[-1]))
     try:
