@@ -123,3 +123,19 @@ def test_a_coherence_in_percent_holding_fractions_is_refused(tmp_path):
     path.write_text("Frequency [Hz];Real [m/N];Imag [m/N];Coherence [%]\n"
                     + rows(HZ, H.real, H.imag, np.array([95.0, 99.0, 98.0, 0.5])), encoding="utf-8")
     np.testing.assert_allclose(read_csv_with_coherence(path)[1], [0.95, 0.99, 0.98, 0.005])
+
+
+@pytest.mark.parametrize("sep", [";", "\t"])
+def test_a_thousands_separator_beside_decimal_commas_is_named_as_written(tmp_path, sep):
+    """'1.234,5e-9' with decimal commas: the message showed '1.234.5e-9' (the cell after the commas were turned
+    into points), which is not what the file says; now the cell as written and why."""
+    path = tmp_path / "h.csv"
+    path.write_text(sep.join(["frequency_hz", "re", "im"]) + "\n"
+                    + "".join(sep.join(row) + "\n" for row in (("100", "1,5e-6", "-2,0e-7"),
+                                                                ("102", "1.234,5e-9", "-2,0e-7"),
+                                                                ("104", "1,6e-6", "-2,1e-7"))))
+    with pytest.raises(FileFormatError, match=r"h\.csv, line 3: 're' is '1\.234,5e-9'; expected a number \(with "
+                                              r"decimal commas, a point is a thousands separator"):
+        read_csv(path)
+    path.write_text(path.read_text().replace("1.234,5e-9", "1234,5e-9"))
+    assert read_csv(path).data[1, 0, 0] == pytest.approx(1234.5e-9 - 2.0e-7j)

@@ -254,13 +254,15 @@ def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None
     try:
         table = np.array(text, dtype=np.float64).reshape(-1, width)
     except ValueError:
-        for n, row in zip(lines, text):
-            for column, cell in zip(cells[0], row):
+        for n, row, written in zip(lines, text, data):
+            for column, cell, given in zip(cells[0], row, written):
                 try:
                     float(cell)
                 except ValueError:
-                    raise FileFormatError(f"{name}, line {n}: {_shown(column)} is {_shown(cell)}; "
-                                          "expected a number") from None
+                    hint = (" (with decimal commas, a point is a thousands separator: write the number without it)"
+                            if delimiter != "," and "," in given and "." in given else "")
+                    raise FileFormatError(f"{name}, line {n}: {_shown(column)} is {_shown(given)}; "
+                                          f"expected a number{hint}") from None
         raise  # pragma: no cover - numpy and float() disagree on a cell
     if angle == 1.0 and (np.abs(table[:, 2]) > 2 * np.pi + 1e-9).any():
         k = int(np.argmax(np.abs(table[:, 2]) > 2 * np.pi + 1e-9))
