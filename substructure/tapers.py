@@ -43,8 +43,9 @@ if TYPE_CHECKING:  # beams imports this module (Segment delegates its tapers to 
     from .beams import Segment
 
 __all__ = ["TAPER_STEP_RATIO", "TAPER_STEP_PHASE", "TAPER_ERROR_BOUND", "check_taper", "step_count",
-           "piece_sections", "section_at", "split", "mass", "piecewise_sections", "tapered_column", "TaperSI",
-           "taper_si", "pieces", "mass_si"]
+           "piece_sections", "section_at", "split", "mass", "piecewise_sections", "tapered_column"]
+# TaperSI, taper_si, pieces and mass_si serve this module's functions and the fits' SI arrays
+# (updating.structure.BeamArrays), which check what they are given: not for users
 
 TAPER_STEP_RATIO = 0.3
 """Largest relative change of a section property over one step of a tapered segment (default steps)."""
