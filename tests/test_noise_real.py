@@ -315,3 +315,31 @@ def test_a_misfit_on_a_few_neighbouring_lines_is_said_where_the_tests_do_not_jud
     assert len(notes) == 1 and f"{lo:.4g}-{hi:.4g} Hz" in notes[0] and "--band" in notes[0], d.report
     if d.explained:
         assert any("on the lines the tests judge" in line for line in words.summary(d, "rig", 1))
+
+
+@pytest.mark.parametrize("grams, offset", [(120.0, 23000), (180.0, 2500)])
+def test_a_heavy_body_on_a_measured_point_is_a_body_of_the_structure_not_a_sensor(grams, offset):
+    """A nut of 80 to 200 g on the holder's tip, a tapped point, came back as a forgotten sensor of that mass
+    (sensors were allowed up to 200 g): the physics is the same, the name was not what a machinist looks for.
+    A sensor with its mounting weighs tens of grams at most (``SENSOR_MASS_MAX``): the body is an added mass at
+    the holder's tip, its mass right; a 30 g body there is still read as a sensor."""
+    from substructure import Mass, default_assembly
+    from substructure.diagnose.catalogue import SENSOR_MASS_MAX
+    from substructure.synthetic import simulate
+
+    assert SENSOR_MASS_MAX == 0.05
+    grid = Frequency.from_hz(np.linspace(20.0, 5000.0, 2500))
+    model = default_assembly()
+    holder = model.component("holder").length_m
+    for kg, name in ((grams / 1e3, "added-mass"), (0.03, "sensor-mass")):
+        truth = model.attach(Mass("nut", "holder.tip", f"{kg * 1e3} g"))
+        exact = [m.frf for m in simulate(truth, ["tool.tip", "tool.tip-20 mm", "holder.tip"], frequency=grid,
+                                         noise=0.0, seed=2)]
+        d = diagnose(model, real_noise.with_real_noise(exact, offset, 2.0), progress=False)
+        assert d.explained and [e.name for e in d.effects] == [name], [repr(e) for e in d.effects]
+        (found,) = d.effects
+        assert found.values["mass"] == pytest.approx(kg, rel=0.03)
+        if name == "added-mass":
+            assert found.where.startswith("holder@") and found.values["position"] == pytest.approx(holder, abs=1e-3)
+        else:
+            assert found.where == "holder.tip"

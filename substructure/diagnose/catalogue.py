@@ -43,6 +43,11 @@ def _si(value: float, unit: str) -> str:
     return format_quantity(ureg.Quantity(float(value), unit))
 
 
+SENSOR_MASS_MAX = 0.05
+"""The heaviest body ``sensor-mass`` fits [kg]: a tap test's accelerometer with its mounting (tens of grams at
+most); a heavier body on a measured point is a body of the structure (a nut, a ring), ``added-mass``."""
+
+
 @register_effect
 class SensorMass(Effect):
     """A body on a measured point (an accelerometer, a magnet) that the model lacks: ``mass``, ``inertia``.
@@ -54,7 +59,7 @@ class SensorMass(Effect):
     name = "sensor-mass"
     test_only: ClassVar[bool] = True  # a sensor is on the tested points only (see Change.test_only)
     parameters = (
-        Parameter("mass", "kg", 1e-4, 0.2, 2e-3),
+        Parameter("mass", "kg", 1e-4, SENSOR_MASS_MAX, 2e-3),
         Parameter("inertia", "kg*m^2", 1e-10, 1e-4, 1e-8),
     )
     explanation = (
@@ -78,7 +83,7 @@ class SensorMass(Effect):
         except (AttributeError, UnknownPointError):
             return out
         if shift > 0:  # f_model / f_measured - 1 = sqrt(1 + dm / m_eff) - 1
-            out["mass"] = float(np.clip(m_eff * ((1 + shift) ** 2 - 1), 1e-4, 0.2))
+            out["mass"] = float(np.clip(m_eff * ((1 + shift) ** 2 - 1), 1e-4, SENSOR_MASS_MAX))
         return out
 
     def apply(self, assembly):
