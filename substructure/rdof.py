@@ -39,7 +39,7 @@ import pint
 from .errors import InvalidValueError, UnitError, UnknownPointError
 from .frf import FRF
 from .points import PointRef, parse_point
-from .units import Q_, to_si
+from .units import Q_, to_si, whole_number
 
 __all__ = [
     "fd_weights",
@@ -126,8 +126,7 @@ def fd_weights(positions: Sequence[Any], at: Any, derivative: int = 1) -> np.nda
     >>> fd_weights([-1.0, 0.0, 1.0], 0.0)    # central
     array([-0.5,  0. ,  0.5])
     """
-    if isinstance(derivative, bool) or not isinstance(derivative, (int, np.integer)) or derivative < 0:
-        raise InvalidValueError(f"derivative: got {derivative!r}; expected an integer >= 0")
+    whole_number(derivative, "derivative", 0, "an integer")
     x, x0 = _coordinates(positions, at)
     _check_distinct(x)
     n = x.size

@@ -25,6 +25,7 @@ from scipy.signal import find_peaks, savgol_coeffs, savgol_filter
 
 from .errors import InvalidValueError, SubstructureWarning
 from .frf import FRF
+from .units import whole_number
 
 __all__ = ["smooth", "choose_window", "PEAK_BIAS", "CoarseDataWarning"]
 
@@ -55,9 +56,7 @@ def _check_frf(frf: FRF) -> None:
 
 
 def _check_polyorder(polyorder: object) -> int:
-    if isinstance(polyorder, bool) or not isinstance(polyorder, (int, np.integer)) or polyorder < 0:
-        raise InvalidValueError(f"polyorder: got {polyorder!r}; expected an integer >= 0")
-    return int(polyorder)
+    return whole_number(polyorder, "polyorder", 0, "an integer")
 
 
 def _floor(polyorder: int) -> int:

@@ -36,6 +36,7 @@ from .coupling import Link, couple_substructures
 from .errors import InvalidValueError
 from .frf import FRF, Frequency
 from .joints import dynamic_stiffness
+from .units import whole_number
 
 # MAX_SWEEP_VALUES is not listed: the module shares the sweep function's name in the API pages
 __all__ = ["SweepResult", "sweep"]
@@ -156,8 +157,7 @@ def sweep(
     for i, a in enumerate(assemblies):
         if not isinstance(a, Assembly):
             raise InvalidValueError(f"sweep: variant {i} is {_show(a)}; expected an Assembly")
-    if isinstance(chunk_lines, bool) or not isinstance(chunk_lines, (int, np.integer)) or chunk_lines < 1:
-        raise InvalidValueError(f"chunk_lines: got {chunk_lines!r}; expected a whole number of lines >= 1")
+    whole_number(chunk_lines, "chunk_lines", 1, "a whole number of lines")
     freq = assemblies[0]._frequency(frequency)
     f = freq.hz
     n_f = f.size

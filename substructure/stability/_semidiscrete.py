@@ -24,6 +24,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..errors import InvalidValueError
+from ..units import whole_number
 from .modal import ModalModel
 
 __all__ = ["expm_batch", "ARNOLDI_ORDER"]  # the rest is private to substructure.stability.sdm
@@ -66,8 +67,7 @@ class _Grid:
     """The discretised delay period of a cut: interval angles, cutting flags, mean force matrices."""
 
     def __init__(self, cut: Any, intervals: int) -> None:
-        if not isinstance(intervals, (int, np.integer)) or isinstance(intervals, bool) or intervals < 1:
-            raise InvalidValueError(f"intervals: got {intervals!r}; expected a whole number >= 1")
+        whole_number(intervals, "intervals", 1)
         arcs = cut.period_arcs()
         cutting_length = sum(b - a for a, b, c in arcs if c)
         edges, flags = [arcs[0][0]], []
@@ -208,9 +208,8 @@ class _Plan:
     def __init__(self, model: ModalModel, cut: Any, intervals: int | None, min_intervals: int,
                  max_phase_step: float) -> None:
         for name, value in (("intervals", intervals), ("min_intervals", min_intervals)):
-            if value is not None and (isinstance(value, bool) or not isinstance(value, (int, np.integer))
-                                      or value < 1):
-                raise InvalidValueError(f"{name}: got {value!r}; expected a whole number >= 1")
+            if value is not None:
+                whole_number(value, name, 1)
         if not max_phase_step > 0:
             raise InvalidValueError(f"max_phase_step: got {max_phase_step!r}; expected a positive angle in rad")
         self.cut, self.fixed, self.min_intervals, self.max_phase_step = cut, intervals, min_intervals, max_phase_step

@@ -35,6 +35,7 @@ from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
 from sklearn.neural_network import MLPRegressor
 
 from ..errors import InvalidValueError, SubstructureWarning
+from ..units import whole_number
 from .columns import in_si
 from .table import JointTable
 
@@ -172,8 +173,7 @@ class Prediction:
         dict
             ``{parameter: ndarray of n values}``, in ``units[parameter]``.
         """
-        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
-            raise InvalidValueError(f"n: got {n!r}; expected a whole number of samples >= 1")
+        whole_number(n, "n", 1, "a whole number of samples")
         rng = np.random.default_rng(rng)
         p = (np.arange(n) + 0.5) / n
         out = {}
