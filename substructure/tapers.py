@@ -45,7 +45,7 @@ if TYPE_CHECKING:  # beams imports this module (Segment delegates its tapers to 
 __all__ = ["TAPER_STEP_RATIO", "TAPER_STEP_PHASE", "TAPER_ERROR_BOUND", "check_taper", "step_count",
            "piece_sections", "section_at", "split", "mass", "piecewise_sections", "tapered_column"]
 # TaperSI, taper_si, pieces and mass_si serve this module's functions and the fits' SI arrays
-# (updating.structure.BeamArrays), which check what they are given: not for users
+# (updating.beam_arrays.BeamArrays), which check what they are given: not for users
 
 TAPER_STEP_RATIO = 0.3
 """Largest relative change of a section property over one step of a tapered segment (default steps)."""
@@ -147,11 +147,8 @@ def _taper_arrays(tp: TaperSI, t: np.ndarray, part: tuple[float, float] = (0.0, 
     rhoi = tp.rho * inertia
     if tp.insert is not None:
         ei, kga, rhoa, rhoi = ei + tp.insert[0], kga + tp.insert[1], rhoa + tp.insert[2], rhoi + tp.insert[3]
-    out = (np.asarray(ei, dtype=complex), np.asarray(kga, dtype=complex), np.asarray(rhoa, dtype=float),
-           np.asarray(rhoi, dtype=float))
-    if out[0].shape != t.shape:  # a scalar t
-        return tuple(np.broadcast_to(a, t.shape) for a in out)
-    return out
+    return (np.asarray(ei, dtype=complex), np.asarray(kga, dtype=complex), np.asarray(rhoa, dtype=float),
+            np.asarray(rhoi, dtype=float))
 
 
 def _taper_sections(seg: Segment, t: np.ndarray) -> list[Section]:

@@ -442,18 +442,22 @@ class TaperedTool(Effect):
         if self.where in structure.opaque:  # a tool of a type of one's own
             return structure.with_opaque(taper_tool(structure.component(self.where), self.values["tip_ratio"]))
         beam = structure.beam(self.where)
-        od1, _ = beam.tips
-        # the arrays as taper_tool makes the segments (the same numbers)
-        shrink = 1.0 - self.values["tip_ratio"]
-        ends = np.concatenate([[0.0], np.cumsum(beam.length)])
-        total = beam.total_length
-        base, tip = (beam.od * (1.0 - shrink * x / total) for x in (ends[:-1], ends[1:]))
-        bored = beam.id > 0  # the bore stays inside the section as it narrows
-        base = np.where(bored, np.maximum(base, 1.0001 * beam.id), base)
-        tip = np.where(bored, np.maximum(tip, 1.0001 * beam.id), tip)
+        base, tip = _tapered_diameters(beam.length, beam.od, beam.id, self.values["tip_ratio"])
         changed = (beam.ratio == 1.0) & ~(beam.insert[:, 0] > 0) & ~beam.tapered
         return structure.with_beam(beam.evolve(od=np.where(changed, base, beam.od),
                                                od_tip=np.where(changed, tip, beam.od_tip)))
+
+
+def _tapered_diameters(length, od, bore, tip_ratio: float) -> tuple[np.ndarray, np.ndarray]:
+    """The outer diameters at the base and tip ends of each segment [m] of a tool tapered to ``tip_ratio``
+    (:func:`taper_tool`'s rule, for the objects and the arrays alike): ``od (1 - (1 - tip_ratio) x / L)`` at a
+    distance ``x`` from the tool's base, kept above the bore."""
+    length, od, bore = (np.asarray(v, dtype=float) for v in (length, od, bore))
+    ends = np.concatenate([[0.0], np.cumsum(length)])
+    base, tip = (od * (1.0 - (1.0 - tip_ratio) * x / float(length.sum())) for x in (ends[:-1], ends[1:]))
+    bored = bore > 0  # the bore stays inside the section as it narrows
+    return (np.where(bored, np.maximum(base, 1.0001 * bore), base),
+            np.where(bored, np.maximum(tip, 1.0001 * bore), tip))
 
 
 def taper_tool(tool: Beam, tip_ratio: float) -> Beam:
@@ -477,17 +481,10 @@ def taper_tool(tool: Beam, tip_ratio: float) -> Beam:
     Beam
         A new tool.
     """
-    total = tool.length_m
-    segs, start = [], 0.0
-    for seg in tool.segments:
-        stop = start + seg.length_m
+    segs = list(tool.segments)
+    bases, tips = _tapered_diameters([s.length_m for s in segs], [s.od.m_as("m") for s in segs],
+                                     [s.id.m_as("m") for s in segs], tip_ratio)
+    for i, (seg, base, tip) in enumerate(zip(segs, bases.tolist(), tips.tolist())):
         if seg.flutes is None and seg.insert is None and not seg.is_tapered:
-            od = seg.od.m_as("m")
-            base, tip = (od * (1.0 - (1.0 - tip_ratio) * x / total) for x in (start, stop))
-            bore = seg.id.m_as("m")
-            if bore > 0:  # the bore stays inside the section as it narrows
-                base, tip = max(base, 1.0001 * bore), max(tip, 1.0001 * bore)
-            seg = attrs.evolve(seg, od=seg.od if base == od else Q_(base, "m"), od_tip=Q_(tip, "m"))
-        segs.append(seg)
-        start = stop
+            segs[i] = attrs.evolve(seg, od=seg.od if base == seg.od.m_as("m") else Q_(base, "m"), od_tip=Q_(tip, "m"))
     return attrs.evolve(tool, segments=segs)
