@@ -369,3 +369,98 @@ def test_a_file_of_spectra_and_an_frf_read_whole_names_the_frfs_index(tmp_path):
         load_measurements(measurement_set(tmp_path, "test.uff"))
     frf, _ = read_set(measurement_set(tmp_path, "test.uff", record=1))
     assert_receptance(frf.frf)
+
+
+def _roving_hammer_file(tmp_path, pairs):
+    """One file of several records, response node and reference node each (direction +Z), as a roving-hammer
+    test exports them; each record's values scaled so that no two are the same."""
+    hz = grid(start=10.0, n=20)
+    accelerance = -((2 * np.pi * hz) ** 2) * receptance(hz)
+    text = "".join(record_58((1 + 0.1 * i) * accelerance, x0=10.0, num=(12, 1, 0, "m/s^2"), rsp=(out, 3),
+                             ref=(ref, 3)) for i, (out, ref) in enumerate(pairs))
+    (tmp_path / "rove.uff").write_text(text, encoding="ascii")
+
+
+def _set_of(tmp_path, rows):
+    lines = ['name = "roving hammer"']
+    for response, excitation, record in rows:
+        lines += ["[[frf]]", f'response = "{response}"', f'excitation = "{excitation}"', 'file = "rove.uff"',
+                  f"record = {record}"]
+    path = tmp_path / "measurements.toml"
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        measurements = load_measurements(path)
+    return measurements, [str(w.message) for w in caught if issubclass(w.category, SubstructureWarning)]
+
+
+ROVING = [("tool.tip", "tool.tip", 0), ("tool.tip", "tool.tip-20 mm", 1), ("tool.tip", "holder.tip", 2)]
+
+
+def test_records_whose_nodes_agree_with_the_tables_are_read_without_a_word(tmp_path):
+    _roving_hammer_file(tmp_path, [(1, 1), (1, 2), (1, 3)])
+    measurements, said = _set_of(tmp_path, ROVING)
+    assert said == [] and len(measurements) == 3
+
+
+def test_a_driving_point_read_from_a_cross_record_is_named(tmp_path):
+    """Record indices counted from 1: the driving point's record 1 is the cross FRF node 1 / node 2.  The nodes
+    said so, but the set read the cross FRF as the tool tip's driving point without a word."""
+    _roving_hammer_file(tmp_path, [(1, 1), (1, 2), (1, 3)])
+    _, said = _set_of(tmp_path, [("tool.tip", "tool.tip", 1), ("tool.tip", "tool.tip-20 mm", 2)])
+    assert any("frf[0]: rove.uff, type-58 record 1 has its response at node 1 (direction 3) and its reference at "
+               "node 2 (direction 3), but this table measures the driving point tool.tip:y; check the record index "
+               "(0-based)" in s for s in said), said
+
+
+def test_a_cross_frf_read_from_a_driving_point_record_is_named(tmp_path):
+    _roving_hammer_file(tmp_path, [(9, 9), (1, 1), (1, 2), (1, 3)])
+    _, said = _set_of(tmp_path, ROVING)
+    assert any("frf[1]: rove.uff, type-58 record 1: its excitation is node 1, read as tool.tip-20 mm, but its "
+               "response is that node too, read as tool.tip" in s for s in said), said
+
+
+def test_one_node_read_as_two_points_is_named(tmp_path):
+    """Records off by one among cross FRFs: node 2 read as the point 20 mm back in one table and as the holder's
+    tip in another."""
+    _roving_hammer_file(tmp_path, [(1, 1), (1, 2), (1, 3), (2, 2)])
+    _, said = _set_of(tmp_path, [("tool.tip", "tool.tip", 0), ("tool.tip", "holder.tip", 1),
+                                 ("tool.tip-20 mm", "tool.tip-20 mm", 3)])
+    assert len(said) == 2, said  # node 2 as two points, as the response and as the reference
+    for role, text in zip(("response", "excitation"), said):
+        assert (f"frf[2]: rove.uff, type-58 record 3: its {role} is node 2, read as tool.tip-20 mm, but frf[1] "
+                "reads node 2 of this file as holder.tip; a node is one point") in text
+
+
+def test_one_point_read_from_two_nodes_is_named(tmp_path):
+    _roving_hammer_file(tmp_path, [(1, 1), (1, 2), (1, 3)])
+    _, said = _set_of(tmp_path, [("tool.tip", "tool.tip", 0), ("tool.tip", "holder.tip", 1),
+                                 ("holder.tip", "tool.tip", 2)])
+    assert any("frf[2]: rove.uff, type-58 record 2: its excitation tool.tip is node 3, but in frf[0] tool.tip is "
+               "node 1 of this file" in s for s in said), said
+
+
+def test_nodes_of_another_configuration_are_not_compared(tmp_path):
+    """Node 2 is the holder's tip with the tool on and a point of the tool in a test without it: another test,
+    numbered anew (here in one file)."""
+    _roving_hammer_file(tmp_path, [(1, 1), (1, 2), (2, 2)])
+    lines = ['name = "two tests"', "[[frf]]", 'response = "tool.tip"', 'excitation = "tool.tip"',
+             'file = "rove.uff"', "record = 0", "[[frf]]", 'response = "tool.tip"', 'excitation = "holder.tip"',
+             'file = "rove.uff"', "record = 1", "[[frf]]", 'response = "holder.tip-5 mm"',
+             'excitation = "holder.tip-5 mm"', 'file = "rove.uff"', "record = 2", 'removed = ["tool"]']
+    path = tmp_path / "measurements.toml"
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert len(load_measurements(path)) == 3
+
+
+def test_a_driving_point_from_a_record_of_two_directions_is_named(tmp_path):
+    """Node 1 in Z over node 1 in X: a cross-axis FRF, not a driving point (-Z over +Z is one, its sign turned)."""
+    hz = grid(start=10.0, n=20)
+    accelerance = -((2 * np.pi * hz) ** 2) * receptance(hz)
+    for ref, words in (((1, 1), ["reference at node 1 (direction 1)"]), ((1, -3), [])):
+        (tmp_path / "d.uff").write_text(record_58(accelerance, x0=10.0, num=(12, 1, 0, "m/s^2"), rsp=(1, 3),
+                                                  ref=ref), encoding="ascii")
+        _, said = read_set(measurement_set(tmp_path, "d.uff"))
+        assert [w for w in words if any(w in s for s in said)] == words and len(said) == len(words), said

@@ -35,7 +35,11 @@ accelerance divided by ``2 pi f`` once or twice first), and data files on
 different frequency grids (never reconciled silently).  A CSV data file
 with a fourth column ``coherence`` (written by ``substructure tap``) gives
 the measurement its coherence, cropped with the FRF when a 0 Hz line is
-dropped.
+dropped.  Records of other programs, whose points are node numbers, are
+compared with the tables: a driving point read from a record of two nodes,
+or a node read as two points (one point from two nodes) in one file and
+configuration, is warned of (a ``SubstructureWarning`` naming the table and
+the record; a record index counted from 1, most often).
 """
 
 from __future__ import annotations

@@ -77,6 +77,7 @@ class _LocatedError(FileFormatError):
 class _Reader:
     def __init__(self, doc: TomlDocument, base_dir: Path):
         self.base_dir, self.source, self.doc = base_dir, doc.source, doc
+        self.nodes: dict[int, tuple[tuple[int, int], tuple[int, int]]] = {}  # frf index: (node, direction) x 2
 
     @staticmethod
     def parts(index: int | None, key: str | None) -> list:
@@ -218,6 +219,11 @@ class _Reader:
                 stored.append(dof_label(label))
             except SubstructureError:  # labels of another program: their nodes are not the set's points
                 self.check_directions(index, path, record, frf, response, excitation)
+                found = [_FOREIGN_LABEL.match(label) for label in (frf.outputs[0], frf.inputs[0])]
+                if found[0] and found[1]:
+                    self.nodes[index] = tuple(  # type: ignore[assignment]
+                        (int(m["node"]), 2 if m["dof"] == "y" else 6 if m["dof"] == "theta" else int(m["code"]))
+                        for m in found)
                 return frf.with_labels((response,), (excitation,))
         if stored != [response, excitation]:
             raise self.error(
@@ -359,6 +365,45 @@ class _Reader:
                     "each [[frf]] table is a measurement of its own: check the file name and the record index",
                 )
             sources[source] = i
+        self.check_nodes(measurements)
+
+    def check_nodes(self, measurements: list[Measurement]) -> None:
+        """Records of another program name their points by node number: warn where the tables and the nodes
+        disagree (a record index off by one, most often), not refuse, since a laboratory may number a point's
+        hammer side and sensor side apart.  A driving point's record has one node in one direction; within one
+        file and configuration a node is one point of the tables and a point one node."""
+        points: dict[tuple, tuple[str, int]] = {}
+        numbers: dict[tuple, tuple[int, int]] = {}
+        for i, m in enumerate(measurements):
+            if i not in self.nodes:
+                continue
+            found = os.stat(self.base_dir / m.file)
+            where = f"{m.file}, type-58 record {m.record or 0}"
+            (out_node, out_dir), (in_node, in_dir) = self.nodes[i]
+            turned = 0 not in (out_dir, in_dir) and out_dir != in_dir  # direction 0, a scalar, says nothing
+            if m.response == m.excitation and (out_node != in_node or turned):
+                self.warn(i, f"{where} has its response at node {out_node} (direction {out_dir}) and its "
+                             f"reference at node {in_node} (direction {in_dir}), but this table measures the driving "
+                             f"point {m.response}; check the record index (0-based)")
+            for role, label, node in (("response", m.response, out_node), ("excitation", m.excitation, in_node)):
+                point = label.rsplit(":", 1)[0]
+                key = (found.st_dev, found.st_ino, m.configuration)
+                other, j = points.setdefault(key + (node,), (point, i))
+                if other != point:
+                    there = ("its response is that node too, read as" if j == i else
+                             f"frf[{j}] reads node {node} of this file as")
+                    self.warn(i, f"{where}: its {role} is node {node}, read as {point}, but {there} {other}; a node "
+                                 "is one point: check the record indices (0-based), and write one point the same "
+                                 "way in every table")
+                    continue
+                number, j = numbers.setdefault(key + (point,), (node, i))
+                if number != node:
+                    self.warn(i, f"{where}: its {role} {point} is node {node}, but in frf[{j}] {point} is node "
+                                 f"{number} of this file; check the record indices (0-based)")
+
+    def warn(self, index: int, message: str) -> None:
+        warnings.warn(f"{self.doc.where(self.parts(index, 'record'))}: frf[{index}]: {message}", SubstructureWarning,
+                      stacklevel=2)
 
 
 def reads_measurements(cls: Any, text: str, base_dir: str | os.PathLike = ".", source: str = "<string>") -> Any:
