@@ -42,7 +42,7 @@ from ..updating.structure import assembly_checked
 from ..updating.selection import INDIFFERENCE, consistency, error_check, outlying_runs
 from .compare import METRIC, Comparison, _pairs, frac, error_bands
 from .effects import Effect, registry
-from .refine import refine as refine_model
+from .refine import refine as refine_model, trim_partial
 from . import words
 from .result import Alternatives, Candidate, Changes, Diagnosis, Found, Measures, Step, Verdict, _finite, strict
 from .search import Budget, candidates
@@ -279,6 +279,14 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     final_error = lik.rms(final_ratios)
     check = error_check(lik, final_ratios, settings.explained_error_factor)
     explained = bool(cons.consistent and check.passed)
+    left: list = []
+    if not explained and len(current) > 1:  # a partial explanation without the changes worth little error
+        current, final_fit, left = trim_partial(lik, current, final_fit, floor, settings.partial_gain)
+        if left:
+            p_now = sum(len(c.specs) for c, _ in current)
+            final_ratios = lik.log_ratios(current)
+            cons, final_error = consistency(lik, final_ratios, p_now), lik.rms(final_ratios)
+            check = error_check(lik, final_ratios, settings.explained_error_factor)
     hits = bound_hits(current, final_fit)
     final_effects = tuple(Found(c, v, {k: x for k, x in (final_fit.std[i] if final_fit else {}).items()
                                        if (i, k) not in {(h[0], h[1]) for h in hits}})
@@ -314,6 +322,9 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     final = _comparisons(lik, final_ratios, floors, settings)
     report = unexplained_report(lik, assembly, current, baseline, cons, final_error, floor, explained, say,
                                 settings, check) if not explained else ()
+    if left:
+        report = list(report) + [words.left_out([(c.effect, c.place(v), w) for c, v, w in left],
+                                                settings.partial_gain, floor)]
     if explained and len(current) > settings.most_changes:  # a composite that only just reaches the noise
         explained = False
         report = [words.too_many_changes(settings.most_changes, [f"{c.effect} at {c.place(v)}" for c, v in current]),

@@ -131,6 +131,26 @@ def _prune(lik, current, chi2_now, say, refits: dict | None = None):
     return current, chi2_now, dropped
 
 
+def trim_partial(lik, current: list, final: Fit | None, floor: float, gain: float) -> tuple[list, Fit | None, list]:
+    """An unexplained model's changes, less those worth under ``gain`` noise floors of error (``partial_gain``).
+
+    The least worth first, each judged refitted without it, until every change left is worth more (or one is left).
+    Returns the changes kept, their joint fit and ``[(change, values, error it was worth), ...]`` left out.
+    """
+    left: list = []
+    error = lik.rms(lik.log_ratios(current))
+    while len(current) > 1:
+        refits = [fit(lik, current[:i] + current[i + 1:]) for i in range(len(current))]
+        worth = [lik.rms(lik.log_ratios(r.changes)) - error for r in refits]
+        i = int(np.argmin(worth))
+        if worth[i] >= gain * floor:
+            break
+        left.append((current[i][0], dict(current[i][1]), worth[i]))
+        current, final = [(c, dict(v)) for c, v in refits[i].changes], refits[i]
+        error += worth[i]
+    return current, final, left
+
+
 def _review(lik, current, chi2_now, steps_fitted, steps_inside, dropped, passive, say,
             settings: DiagnoseSettings = DEFAULT_SETTINGS, cands=()):
     """Alternatives of each kept change; preferred ones replace it (see the module docstring)."""

@@ -327,6 +327,13 @@ class DiagnoseSettings:
         each line as the noise model scores it (capped as in the band test),
         and within what the noise allows when that is more (the floor living
         on a few lines).
+    partial_gain : float
+        An unexplained verdict's partial explanation keeps a change only when
+        the error, refitted without it, is higher by at least this share of
+        the noise floor (default 0.05): against a misfit that no candidate
+        explains, every flexible change wins a little, significantly against
+        the noise alone; such corrections are named as left out, not
+        stacked.
     signature_step : float
         The factor of the finite differences of the signature (default 1.05: 5 %).
     signature_window : float
@@ -427,6 +434,7 @@ class DiagnoseSettings:
     other_apart_std: float = attrs.field(default=3.0, validator=_number(0.0, lo_open=False))
     rivals_checked: int = attrs.field(default=3, validator=_count(0))
     explained_error_factor: float = attrs.field(default=1.5, validator=_number(1.0, lo_open=False))
+    partial_gain: float = attrs.field(default=0.05, validator=_number(0.0, lo_open=False))
     signature_step: float = attrs.field(default=1.05, validator=_number(1.0, 2.0))
     signature_window: float = attrs.field(default=0.15, validator=_number(0.0, 1.0, hi_open=True))
     signature_share: float = attrs.field(default=0.5, validator=_number(0.0, 1.0, lo_open=False, hi_open=True))

@@ -16,7 +16,7 @@ import math
 from typing import Iterable, Sequence
 
 __all__ = [
-    "UNEXPLAINED", "values_text", "bound_text", "partial", "too_many_changes", "bounded", "on_bound",
+    "UNEXPLAINED", "values_text", "left_out", "bound_text", "partial", "too_many_changes", "bounded", "on_bound",
     "not_unique", "tell_apart", "budget_cut", "windowed", "outlying", "unexplained", "error_lives", "error_spread",
     "best_partial", "nothing_improves", "mode_line", "signature_line", "level_line", "separation_text",
     "parameter_values", "summary",
@@ -184,6 +184,29 @@ def tell_apart(text: str) -> str:
         One line.
     """
     return f"to tell them apart: {text}"
+
+
+def left_out(parts: Sequence[tuple[str, str, float]], gain: float, floor: float) -> str:
+    """The changes an unexplained verdict's partial explanation leaves out (``partial_gain``).
+
+    Parameters
+    ----------
+    parts : sequence of (str, str, float)
+        Each change's effect, place and the error it was worth.
+    gain : float
+        The share of the noise floor a change must be worth.
+    floor : float
+        The noise floor.
+
+    Returns
+    -------
+    str
+        One line of the report.
+    """
+    listed = "; ".join(f"{e} at {p} ({w:.2g})" for e, p, w in parts)
+    return (f"left out of the partial explanation, each worth less than {gain:g} times the noise floor "
+            f"({gain * floor:.2g}) in error: {listed}; a misfit no candidate explains lets any change win a "
+            "little of it")
 
 
 def held_back(effect: str, where: str, chi2_with: float, chi2_without: float) -> str:
