@@ -24,7 +24,7 @@ FIGURES = ("where_it_fails.png", "error_fall.png", "after_refinement.png")
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..diagnose import diagnose
+    from ..diagnose import DiagnoseSettings, diagnose
     from ..io.assembly_toml import load_assembly, save_assembly
     from ..io.measurements import load_measurements
 
@@ -35,6 +35,9 @@ def run(args: argparse.Namespace) -> int:
                                                                                "seconds")):
         if value is not None and not (math.isfinite(value) and value > 0):
             raise UsageError(f"argument {option}: got {value:g}; expected a positive number of {what}")
+    if args.calibration is not None and not (math.isfinite(args.calibration) and 0 < args.calibration < 1):
+        raise UsageError(f"argument --calibration: got {args.calibration:g}; expected the relative uncertainty of "
+                         "the FRFs' scale, a number between 0 and 1 (0.05 for 5 %)")
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise UsageError(f"argument --plot: {args.plot} is a file; expected a directory for the figures")
     # figures go into DIR (created if missing): the ones there already are checked like any output
@@ -48,8 +51,9 @@ def run(args: argparse.Namespace) -> int:
     assembly = load_assembly(args.assembly)
     measurements = load_measurements(args.measurements)
     progress = None if args.quiet else (lambda text: print(f"{PROG}: {text}", file=sys.stderr, flush=True))
+    settings = None if args.calibration is None else DiagnoseSettings(calibration=args.calibration)
     result = diagnose(assembly, measurements, effects=args.effects, band=args.band, progress=progress or False,
-                      max_steps=args.max_steps, open_world=not args.catalogue_only,
+                      max_steps=args.max_steps, open_world=not args.catalogue_only, settings=settings,
                       time_limit=args.time_limit, **({} if args.budget is None else {"budget": args.budget}))
     written = []
     if args.plot:
@@ -104,6 +108,9 @@ def add_parser(commands) -> None:
                            "search stops adding changes and says so")
     diag.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
                       help="a limit in wall-clock seconds as well (default none)")
+    diag.add_argument("--calibration", type=float, default=None, metavar="FRACTION",
+                      help="relative uncertainty of the FRFs' scale (the hammer's and the sensors' sensitivities), "
+                           "e.g. 0.05: compare at the common level that fits best within it (default: exact)")
     diag.add_argument("--band", type=band_range_arg, metavar="LO:HI", help="frequency band in Hz (default: all data)")
     diag.add_argument("--plot", metavar="DIR", help="write the figures (where it fails, error fall) to DIR")
     diag.add_argument("--save-model", metavar="FILE.toml", help="write the model with the changes found")

@@ -98,8 +98,8 @@ def _refitted(likelihood, changes: list, masks: Sequence[np.ndarray]) -> np.ndar
     out = []
     for held in masks:
         per_line = held[:n_lines]
-        kept = Likelihood(likelihood.assembly, likelihood.measured, lines=likelihood.lines[~per_line])
-        back = Likelihood(likelihood.assembly, likelihood.measured, lines=likelihood.lines[per_line])
+        kept = Likelihood(likelihood.assembly, likelihood.measured, likelihood.lines[~per_line], likelihood.calibration)
+        back = Likelihood(likelihood.assembly, likelihood.measured, likelihood.lines[per_line], likelihood.calibration)
         try:
             values = fit(kept, changes).changes
         except (SubstructureError, ValueError, FloatingPointError):

@@ -232,7 +232,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         measurements.validate(assembly)
     _refuse_rotations(measurements)
     measured, band = measured_frfs(measurements, band)
-    lik = Likelihood(assembly, measured)
+    lik = Likelihood(assembly, measured, calibration=settings.calibration)
     floor, floors = lik.floors()
     base_ratios = lik.log_ratios([])
     e0 = lik.rms(base_ratios)
@@ -249,7 +249,8 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     lacking = _peak_lines(baseline, settings)
     screen_lik = lik.subsample(max(1, lik.lines.size // settings.screen_lines), keep=lacking)
     limit = 0 if cons.consistent else (max_steps if refine else 1)
-    if limit and level_signature(baseline, floor, settings)[0]:
+    scaled = bool(limit) and bool(level_signature(baseline, floor, settings)[0])
+    if scaled:
         # every FRF a constant factor times the model with every mode in place: a calibration or unit error, which
         # no change of the structure makes (changes fitted to it would only be stacked on the wrong level)
         limit = 0
@@ -322,6 +323,11 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     final = _comparisons(lik, final_ratios, floors, settings)
     report = unexplained_report(lik, assembly, current, baseline, cons, final_error, floor, explained, say,
                                 settings, check) if not explained else ()
+    level = lik.level(current)
+    if settings.calibration is not None:
+        report = list(report) + [words.calibrated(level, settings.calibration)]
+    elif not explained and not scaled and min(settings.calibration_hint) <= abs(level - 1.0) <= max(settings.calibration_hint):
+        report = list(report) + [words.level_hint(level)]
     if left:
         report = list(report) + [words.left_out([(c.effect, c.place(v), w) for c, v, w in left],
                                                 settings.partial_gain, floor)]
@@ -382,7 +388,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
                         missing_where=None if missing is None else missing.where),
         measures=Measures(metric=METRIC, band=band, noise_floor=floor, baseline_error=e0, final_error=final_error,
                           consistency=cons, correlation=correlation, baseline=baseline, final=final,
-                          error_check=check),
+                          error_check=check, level=level if settings.calibration is not None else None),
         changes=Changes(final_effects=final_effects, refined_assembly=refined, candidates=tuple(first),
                         refinement=tuple(steps)),
         alternatives=Alternatives(ambiguous=tuple(ambiguous), ambiguous_with=names,

@@ -477,7 +477,7 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     n = lik.n
     search = {"candidates": len(cands), "steps_screened": 0, "full_fits": 0, "cut": False, "cut_at": None,
               "held_back": []}
-    lik0 = Likelihood(lik.assembly, lik.measured[:1])
+    lik0 = Likelihood(lik.assembly, lik.measured[:1], calibration=lik.calibration)
     if budget is not None:
         budget.watch(lik, screen_lik, lik0)
 

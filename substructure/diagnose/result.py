@@ -259,6 +259,10 @@ class Measures:
         The plain check of the verdict: the final error in noise floors with
         each line as the noise model scores it, and what the noise allows
         (:func:`~substructure.updating.error_check`).
+    level : float or None
+        With ``settings.calibration``: the measured FRFs' common scale over
+        the final model's, profiled out of every comparison
+        (:meth:`~substructure.updating.Likelihood.level`); None without.
     """
 
     metric: str
@@ -271,6 +275,7 @@ class Measures:
     baseline: tuple[Comparison, ...] = attrs.field(default=(), eq=False)
     final: tuple[Comparison, ...] = attrs.field(default=(), eq=False)
     error_check: ErrorCheck | None = attrs.field(default=None, eq=False)
+    level: float | None = None
 
 
 @attrs.frozen
@@ -396,6 +401,7 @@ class Diagnosis:
     baseline = _read("measures", "baseline")
     final = _read("measures", "final")
     error_check = _read("measures", "error_check")
+    level = _read("measures", "level")
     final_effects = _read("changes", "final_effects")
     refined_assembly = _read("changes", "refined_assembly")
     candidates = _read("changes", "candidates")
@@ -440,6 +446,7 @@ class Diagnosis:
             "error_check": None if self.error_check is None else {
                 "ratio": _finite(self.error_check.ratio), "allowed": _finite(self.error_check.allowed)},
             "final_effects": [_effect_json(e) for e in self.final_effects],
+            "calibration_factor": None if self.level is None else _finite(self.level),
             "correlation": self.correlation,
             "consistency": None if cons is None else {
                 "chi2_reduced": _finite(cons.chi2_reduced), "threshold": _finite(cons.threshold),

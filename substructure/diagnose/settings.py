@@ -327,6 +327,19 @@ class DiagnoseSettings:
         each line as the noise model scores it (capped as in the band test),
         and within what the noise allows when that is more (the floor living
         on a few lines).
+    calibration : float or None
+        The relative uncertainty of the measured FRFs' common scale, the
+        hammer's and the sensors' sensitivities (e.g. 0.05; default None: the
+        scale taken as exact).  With it every model is compared with the data
+        after the common level that fits best, within ``1 + calibration``
+        either way (:class:`~substructure.updating.Likelihood`), and the
+        report gives that level: a test 3 % off in scale, normal for a real
+        one, is not a change of the structure.
+    calibration_hint : tuple of float
+        Without ``calibration``, an unexplained verdict whose final model the
+        data match in level only within this range of shares (default
+        (0.01, 0.25): 1 % to 25 % above or below throughout) suggests giving
+        it: a real test's scale is rarely better than a few per cent.
     partial_gain : float
         An unexplained verdict's partial explanation keeps a change only when
         the error, refitted without it, is higher by at least this share of
@@ -434,6 +447,9 @@ class DiagnoseSettings:
     other_apart_std: float = attrs.field(default=3.0, validator=_number(0.0, lo_open=False))
     rivals_checked: int = attrs.field(default=3, validator=_count(0))
     explained_error_factor: float = attrs.field(default=1.5, validator=_number(1.0, lo_open=False))
+    calibration: float | None = attrs.field(default=None, validator=_number(0.0, 1.0, hi_open=True, optional=True))
+    calibration_hint: tuple[float, ...] = attrs.field(default=(0.01, 0.25), converter=_tuple,
+                                                      validator=_numbers(0.0, 1.0, hi_open=True))
     partial_gain: float = attrs.field(default=0.05, validator=_number(0.0, lo_open=False))
     signature_step: float = attrs.field(default=1.05, validator=_number(1.0, 2.0))
     signature_window: float = attrs.field(default=0.15, validator=_number(0.0, 1.0, hi_open=True))

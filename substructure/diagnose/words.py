@@ -16,7 +16,8 @@ import math
 from typing import Iterable, Sequence
 
 __all__ = [
-    "UNEXPLAINED", "values_text", "left_out", "bound_text", "partial", "too_many_changes", "bounded", "on_bound",
+    "UNEXPLAINED", "values_text", "left_out", "calibrated", "level_hint",
+    "bound_text", "partial", "too_many_changes", "bounded", "on_bound",
     "not_unique", "tell_apart", "budget_cut", "windowed", "outlying", "unexplained", "error_lives", "error_spread",
     "best_partial", "nothing_improves", "mode_line", "signature_line", "level_line", "separation_text",
     "parameter_values", "summary",
@@ -184,6 +185,50 @@ def tell_apart(text: str) -> str:
         One line.
     """
     return f"to tell them apart: {text}"
+
+
+def calibrated(level: float, calibration: float) -> str:
+    """The common level of the data over the model, fitted within the calibration uncertainty given.
+
+    Parameters
+    ----------
+    level : float
+        The measured FRFs' scale over the final model's.
+    calibration : float
+        The relative uncertainty given (``DiagnoseSettings.calibration``).
+
+    Returns
+    -------
+    str
+        One line of the report.
+    """
+    text = (f"level: the measured FRFs read {level:.4g} times the final model's throughout, fitted within the "
+            f"calibration uncertainty given ({calibration:.3g}, a factor {1 / (1 + calibration):.4g} to "
+            f"{1 + calibration:.4g}); every comparison is made at that level")
+    if abs(math.log(level)) >= math.log1p(calibration) * (1 - 1e-9):
+        text += ("; it is at the bound: the data's scale differs by more than the uncertainty given (check the "
+                 "hammer's and the sensors' sensitivities and units)")
+    return text
+
+
+def level_hint(level: float) -> str:
+    """The suggestion to give the calibration uncertainty, for data that differ from the final model in level.
+
+    Parameters
+    ----------
+    level : float
+        The measured FRFs' scale over the final model's (:meth:`Likelihood.level`).
+
+    Returns
+    -------
+    str
+        One line of the report.
+    """
+    return (f"level: the measured FRFs read {level:.4g} times the final model's throughout, a common factor that "
+            "no change of the structure gives; a real test's scale (the hammer's and the sensors' sensitivities) is "
+            "rarely better than a few per cent: if yours is uncertain by that much, give it "
+            "(DiagnoseSettings(calibration=0.05), diagnose --calibration 0.05) and the comparison is made at the "
+            "level that fits")
 
 
 def left_out(parts: Sequence[tuple[str, str, float]], gain: float, floor: float) -> str:

@@ -301,6 +301,14 @@ class Likelihood:
         The data (:func:`measured_frfs`).
     lines : ndarray of int, optional
         Indices of the lines to use (default all): a subsample for screening.
+    calibration : float, optional
+        The relative uncertainty of the measured FRFs' common scale (the
+        hammer's and the sensors' sensitivities), e.g. 0.05.  With it every
+        model's log ratios are compared after the common level that fits them
+        best (the mean of ``ln |model / measured|`` weighed by the noise),
+        within ``ln(1 + calibration)`` either way: one more fitted number,
+        profiled out of every evaluation (:meth:`level`).  None (default): the
+        data's scale is taken as exact.
 
     Attributes
     ----------
@@ -309,7 +317,13 @@ class Likelihood:
         zero, finite).  The others are left out of every comparison.
     """
 
-    def __init__(self, assembly, measured: Sequence[Measured], lines: np.ndarray | None = None):
+    def __init__(self, assembly, measured: Sequence[Measured], lines: np.ndarray | None = None,
+                 calibration: float | None = None):
+        if calibration is not None and not (isinstance(calibration, (int, float)) and not isinstance(
+                calibration, bool) and 0.0 < calibration < 1.0):
+            raise InvalidValueError(f"calibration: got {calibration!r}; expected the relative uncertainty of the "
+                                    "FRFs' scale, a number in (0, 1), e.g. 0.05, or None")
+        self.calibration = None if calibration is None else float(calibration)
         self.assembly = assembly
         self.measured = list(measured)
         if not self.measured or not all(isinstance(m, Measured) for m in self.measured):
@@ -420,7 +434,7 @@ class Likelihood:
         if keep is not None and len(keep):
             keep = np.asarray(keep, dtype=int)
             lines = np.union1d(lines, self.lines[keep[(keep >= 0) & (keep < self.lines.size)]])
-        return Likelihood(self.assembly, self.measured, lines)
+        return Likelihood(self.assembly, self.measured, lines, self.calibration)
 
     def predict(self, changes: Sequence[tuple] = ()) -> list[np.ndarray]:
         """Model values per measured FRF on the lines used.
@@ -492,15 +506,45 @@ class Likelihood:
     def _ratios(self, predicted: list) -> list[np.ndarray]:
         return list(self._log_ratio_array(np.array(predicted)))
 
-    def _log_ratio_array(self, predicted: np.ndarray) -> np.ndarray:
+    def level(self, changes: Sequence[tuple] = ()) -> float:
+        """The measured FRFs' common scale over the model's that fits best: ``exp(-c)``, ``c`` the mean of
+        ``ln |model / measured|`` over the lines the data hold, each weighed by its inverse variance.
+
+        With ``calibration`` it is the factor profiled out of every comparison (within ``1 + calibration``
+        either way); without, what it would be (1 for data and a model that agree in level).
+
+        Parameters
+        ----------
+        changes : sequence of (Change, dict)
+            The changes with their values (SI), applied in order.
+
+        Returns
+        -------
+        float
+            E.g. 1.03: the data read 3 % above the model throughout.
+        """
+        raw = self._log_ratio_array(np.array(self.predict(changes)), calibrated=False)
+        return float(np.exp(-self._offset(raw, self.calibration)))
+
+    def _offset(self, r: np.ndarray, bound: float | None) -> np.ndarray:
+        """The weighted mean of ``Re r`` per model (``r``: ``(..., FRF, line)``), within ``ln(1 + bound)``."""
+        w = self._w[:, 0, :] ** 2
+        ok = np.isfinite(r.real) & (w > 0)
+        c = np.sum(np.where(ok, r.real, 0.0) * w, axis=(-2, -1)) / np.maximum(np.sum(np.where(ok, w, 0.0),
+                                                                                   axis=(-2, -1)), 1e-300)
+        return c if bound is None else np.clip(c, -np.log1p(bound), np.log1p(bound))
+
+    def _log_ratio_array(self, predicted: np.ndarray, calibrated: bool = True) -> np.ndarray:
         """Log ratios of model values ``(..., FRF, line)`` (several models at once: the same numbers, element by
-        element, as each alone)."""
+        element, as each alone); with ``calibration``, less each model's common level (:meth:`level`)."""
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             q = predicted / self._data
             # ln|q| + i arg q: the complex logarithm's value (to rounding), several times faster than np.log
             r = np.empty_like(q)
             r.real = np.log(np.abs(q))
             r.imag = np.arctan2(q.imag, q.real)
+        if calibrated and self.calibration is not None:
+            r.real -= self._offset(r, self.calibration)[..., None, None]
         bad = ~np.isfinite(r)
         if bad.any():
             r = np.where(bad, LOG_RATIO_PENALTY * (1 + 1j), r)
