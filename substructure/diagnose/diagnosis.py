@@ -326,7 +326,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     level = lik.level(current)
     if settings.calibration is not None:
         report = list(report) + [words.calibrated(level, settings.calibration)]
-    elif not explained and not scaled and min(settings.calibration_hint) <= abs(level - 1.0) <= max(settings.calibration_hint):
+    elif not (explained or scaled) and min(hint := settings.calibration_hint) <= abs(level - 1) <= max(hint):
         report = list(report) + [words.level_hint(level)]
     if left:
         report = list(report) + [words.left_out([(c.effect, c.place(v), w) for c, v, w in left],
