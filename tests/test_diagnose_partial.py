@@ -15,7 +15,7 @@ import pytest
 
 import hidden_data as hd
 from real_noise import free_free_residual, with_real_noise
-from substructure.diagnose import DiagnoseSettings, diagnose
+from substructure.diagnose import diagnose
 from substructure.updating import Likelihood, fit, measured_frfs
 
 POINTS = ("tool.tip", "tool.tip-20 mm", "holder.tip")
@@ -59,8 +59,9 @@ def test_a_hysteretic_joint_is_partly_the_joints_damping_and_nothing_stacked_on_
     assert [(e.name, e.where) for e in d.effects] == [("joint-damping", "holder-tool")], [repr(e) for e in d.effects]
     line = _left_out(d)
     assert "joint-cross-coupling at holder-tool" in line and "0.05 times the noise floor" in line
-    # the search's steps stay on record
-    assert [s.added.name for s in d.refinement[1:]][:1] == ["joint-damping"] and len(d.refinement) >= 3
+    # the search's steps stay on record: it had stacked more than it keeps
+    assert [s.added.name for s in d.refinement[1:]][:1] == ["joint-damping"]
+    assert len(d.refinement) - 1 > len(d.effects)
 
 
 def test_a_drawbar_is_partly_a_stiffer_spindle_and_nothing_stacked_on_it(drawbar):
@@ -71,22 +72,19 @@ def test_a_drawbar_is_partly_a_stiffer_spindle_and_nothing_stacked_on_it(drawbar
     assert "left out of the partial explanation" in _left_out(d)
 
 
-@pytest.mark.parametrize("case", ["hysteretic", "drawbar"])
-def test_every_change_kept_is_worth_the_share_and_every_one_left_out_is_not(case, request):
-    taps, d = request.getfixturevalue(case)
+def _rule_holds(taps, d) -> None:
     gain = d.settings.partial_gain * d.noise_floor
     assert all(w >= gain for w in _worth(taps, d))
     worths = [float(part.rsplit("(", 1)[1].rstrip(")")) for part in _left_out(d).split(": ", 1)[1].split("; ")[:-1]]
     assert worths and all(0.0 <= w < gain for w in worths), worths
 
 
-def test_without_the_rule_the_corrections_were_stacked(hysteretic):
-    """``partial_gain = 0``: every significant step stays, as before the rule."""
-    taps, d = hysteretic
-    stacked = diagnose(hd.nominal_model(), taps, progress=False, settings=DiagnoseSettings(partial_gain=0.0))
-    assert not stacked.explained and len(stacked.effects) >= 2 > len(d.effects)
-    assert not [x for x in stacked.report if x.startswith("left out")]
-    assert stacked.final_error < d.final_error < stacked.final_error + 0.05 * d.noise_floor * len(stacked.effects)
+def test_every_change_kept_is_worth_the_share_and_every_one_left_out_is_not(hysteretic):
+    _rule_holds(*hysteretic)
+
+
+def test_so_too_for_the_drawbar(drawbar):
+    _rule_holds(*drawbar)
 
 
 def test_under_another_real_tests_noise_the_hysteretic_joint_is_its_damping_too():

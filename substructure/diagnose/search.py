@@ -36,9 +36,10 @@ import attrs
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from ..components import Beam
+from ..components import Beam, is_plain_beam
 from ..errors import SubstructureError
-from ..updating.elements import AddedMass, GroundSpring, SectionChange, body_bounds, rear_bounds
+from ..points import parse_point
+from ..updating.elements import AddedMass, GroundSpring, PointPosition, SectionChange, body_bounds, rear_bounds
 from ..updating.fit import Fit, fit, from_u, to_u
 from ..updating.parameters import Change, ParameterChange, material_changes, model_parameters, parameter_change
 from ..updating.structure import uniform_beam
@@ -174,6 +175,7 @@ def candidates(assembly, measured_points: Sequence[str], effects: dict, open_wor
             out.append(GroundSpring(comp.name, comp.length_m))
             if uniform_beam(comp):  # a section changed in the arrays of a plain beam
                 out.append(SectionChange(comp.name, comp.length_m))
+        out += _point_positions(assembly, measured_points, settings.point_reach)
     for name, cls in effects.items():
         try:
             places = cls.places(assembly, list(measured_points))
@@ -192,6 +194,21 @@ def candidates(assembly, measured_points: Sequence[str], effects: dict, open_wor
         if progress:
             progress(f"  skipped {c.effect} at {c.where}: a parameter's search range is empty")
     return [c for c in out if c not in empty]
+
+
+def _point_positions(assembly, measured_points: Sequence[str], reach: float) -> list[Change]:
+    """A measured point given at a distance along a beam (``tool.tip-20 mm``, ``holder@30 mm``: measured with a
+    ruler) may be a few millimetres off: its position, a candidate (the ends are where they are)."""
+    out: list[Change] = []
+    for label in dict.fromkeys(measured_points):
+        try:
+            ref = parse_point(label)
+            comp = assembly.component(ref.component)
+        except SubstructureError:
+            continue
+        if reach > 0 and ref.where in ("at", "from_tip") and isinstance(comp, Beam) and is_plain_beam(comp):
+            out.append(PointPosition(str(ref.point), comp.name, comp.position(ref.point), comp.length_m, reach))
+    return list({c.where: c for c in out}.values())
 
 
 @attrs.frozen

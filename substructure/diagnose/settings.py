@@ -327,6 +327,13 @@ class DiagnoseSettings:
         each line as the noise model scores it (capped as in the band test),
         and within what the noise allows when that is more (the floor living
         on a few lines).
+    point_reach : float
+        A measured point given at a distance along a beam (``tool.tip-20
+        mm``, ``holder@30 mm``: placed with a ruler) is a candidate,
+        ``point-position``: its position fitted within this many metres of
+        the one its name says (default 0.005; 0: not a candidate).  A sensor
+        2 mm from where the record puts it otherwise came back as three
+        invented changes of the structure.
     calibration : float or None
         The relative uncertainty of the measured FRFs' common scale, the
         hammer's and the sensors' sensitivities (e.g. 0.05; default None: the
@@ -447,6 +454,7 @@ class DiagnoseSettings:
     other_apart_std: float = attrs.field(default=3.0, validator=_number(0.0, lo_open=False))
     rivals_checked: int = attrs.field(default=3, validator=_count(0))
     explained_error_factor: float = attrs.field(default=1.5, validator=_number(1.0, lo_open=False))
+    point_reach: float = attrs.field(default=0.005, validator=_number(0.0, 0.1, lo_open=False))
     calibration: float | None = attrs.field(default=None, validator=_number(0.0, 1.0, hi_open=True, optional=True))
     calibration_hint: tuple[float, ...] = attrs.field(default=(0.01, 0.25), converter=_tuple,
                                                       validator=_numbers(0.0, 1.0, hi_open=True))

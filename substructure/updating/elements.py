@@ -1,4 +1,5 @@
-"""Elements a model may lack, at fitted places: bodies, springs to the ground, changes of section.
+"""Elements a model may lack, at fitted places: bodies, springs to the ground, changes of section; and where a
+measured point was.
 
 Each is a :class:`~substructure.updating.parameters.Change` on one beam
 component with its position fitted along it:
@@ -12,6 +13,9 @@ component with its position fitted along it:
 * :class:`SectionChange` (``section-change``): the outer diameter scaled
   over a fitted length at a fitted position: a neck, a groove, a collar.
   Written back as the component's segments split where it begins and ends.
+* :class:`PointPosition` (``point-position``): where a measured point given at
+  a distance really was, a few millimetres from its name's place: a change of
+  the test, not of the structure (nothing written back).
 
 The helper :func:`split_beam` cuts a beam's arrays at positions and scales a
 range of it, shared with the diagnosis catalogue's fluted section.
@@ -29,8 +33,8 @@ from ..units import Q_, format_quantity
 from .parameters import Change, ParamSpec
 from .structure import LinkSI
 
-__all__ = ["AddedMass", "GroundSpring", "SectionChange", "split_beam", "split_segments", "unique_name", "body_bounds",
-           "rear_bounds", "STEEL_DENSITY"]
+__all__ = ["AddedMass", "GroundSpring", "SectionChange", "PointPosition", "split_beam", "split_segments", "unique_name",
+           "body_bounds", "rear_bounds", "STEEL_DENSITY"]
 
 
 def _si(value: float, unit: str) -> str:
@@ -249,6 +253,47 @@ class GroundSpring(_OnComponent):
         name = unique_name([s.name for s in assembly.supports if s.name], f"diagnosed-{self.component}-spring")
         return assembly.support(Support(f"{self.component}@{_si(values['position'], 'm')}",
                                         k={"yf": _si(values["k_yf"], "N/m")}, name=name))
+
+
+class PointPosition(Change):
+    """Where a measured point really was: its position along its component fitted within ``reach`` of the one
+    its name says (``shift``, towards the tip positive).  A test-only change: the model is not changed.
+
+    Parameters
+    ----------
+    point : str
+        The point's name as the measurements give it, e.g. ``"tool.tip-20 mm"``.
+    component : str
+        Its component, a beam.
+    x : float
+        Where its name puts it [m from the component's base].
+    length : float
+        The component's length [m].
+    reach : float
+        How far from ``x`` it may be [m] (within the component).
+    """
+
+    effect = "point-position"
+    explanation = ("a sensor or a hit a few millimetres from where the record puts it changes that FRF alone: its "
+                   "modes stay where they are, its levels and antiresonances move")
+    test_only = True
+
+    def __init__(self, point: str, component: str, x: float, length: float, reach: float):
+        self.where, self.component, self.x, self.length = point, component, float(x), float(length)
+        self.specs = (ParamSpec("shift", "m", max(0.0, x - reach) - x, min(length, x + reach) - x, 0.0, log=False),)
+
+    def place(self, values) -> str:
+        """Where the point was, written as its name is (``tool.tip-22 mm`` for ``tool.tip-20 mm``)."""
+        x = self.x + float(values["shift"])
+        if ".tip-" in self.where:
+            return f"{self.component}.tip-{_mm(self.length - x)}"
+        return f"{self.component}@{_mm(x)}"
+
+    def apply_si(self, structure, values):
+        return structure.with_point(self.where, self.x + float(values["shift"]))
+
+    def apply(self, assembly, values):
+        return assembly  # the model is as it was: the test was taken elsewhere
 
 
 def split_beam(beam, start: float, stop: float, od_factor: float = 1.0, flutes: float | None = None):

@@ -241,7 +241,7 @@ class Evaluator:
         opaque = tuple(structure.opaque.values())
         key = (tuple((link.a, link.b) for link in structure.links),
                tuple((name, beam.total_length) for name, beam in structure.beams.items()),
-               tuple(id(c) for c in opaque))
+               tuple(id(c) for c in opaque), tuple(structure.moved.items()))
         found = self._layouts.get(key)
         if found is not None and all(a is b for a, b in zip(found[0], opaque)):  # kept with it: ids not reused
             self._layouts.move_to_end(key)

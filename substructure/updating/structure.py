@@ -175,8 +175,8 @@ def uniform_beam(component) -> bool:
 class Structure:
     """An assembly as SI arrays (one test configuration), changed without rebuilding objects.
 
-    Build it with :meth:`from_assembly`; :meth:`with_beam`, :meth:`with_link`
-    and :meth:`add_link` return changed copies.
+    Build it with :meth:`from_assembly`; :meth:`with_beam`, :meth:`with_link`,
+    :meth:`add_link` and :meth:`with_point` return changed copies.
 
     Parameters
     ----------
@@ -192,18 +192,28 @@ class Structure:
         The components' names in the assembly's order.
     sources : dict of str to object, optional
         The component objects the beams were made from (to share arrays).
+    moved : dict of str to (str, float), optional
+        Points placed elsewhere than their names say, ``(component, x)``
+        (:meth:`with_point`: where a measured point really was).
     """
 
-    __slots__ = ("assembly", "beams", "opaque", "links", "order", "sources", "_positions")
+    __slots__ = ("assembly", "beams", "opaque", "links", "order", "sources", "moved", "_positions")
 
-    def __init__(self, assembly, beams: dict, opaque: dict, links: tuple, order: tuple, sources: dict | None = None):
+    def __init__(self, assembly, beams: dict, opaque: dict, links: tuple, order: tuple, sources: dict | None = None,
+                 moved: dict | None = None):
         self.assembly = assembly
         self.beams = beams
         self.opaque = opaque
         self.links = links
         self.order = order
         self.sources = sources or {}
+        self.moved = moved or {}  # point name -> (component, x): a measured point where a fit placed it
         self._positions: dict = {}  # point name -> (component, x): a structure is never changed in place
+
+    def _copy(self, **fields) -> "Structure":
+        kept = {"assembly": self.assembly, "beams": self.beams, "opaque": self.opaque, "links": self.links,
+                "order": self.order, "sources": self.sources, "moved": self.moved}
+        return Structure(**{**kept, **fields})
 
     @classmethod
     def from_assembly(cls, assembly, like: "Structure | None" = None) -> "Structure":
@@ -372,7 +382,7 @@ class Structure:
         """
         self.beam(beam.name)
         sources = {k: v for k, v in self.sources.items() if k != beam.name}
-        return Structure(self.assembly, {**self.beams, beam.name: beam}, self.opaque, self.links, self.order, sources)
+        return self._copy(beams={**self.beams, beam.name: beam}, sources=sources)
 
     def with_opaque(self, component) -> "Structure":
         """The structure with one component evaluated by its own methods replaced (by name).
@@ -392,11 +402,10 @@ class Structure:
         if name in self.beams:  # a beam that takes a change its arrays cannot hold (a taper)
             beams = {k: v for k, v in self.beams.items() if k != name}
             sources = {k: v for k, v in self.sources.items() if k != name}
-            return Structure(self.assembly, beams, {**self.opaque, name: component}, self.links, self.order, sources)
+            return self._copy(beams=beams, opaque={**self.opaque, name: component}, sources=sources)
         if name not in self.opaque:
             raise UnknownPointError(f"no component {name!r} evaluated by its own methods here")
-        return Structure(self.assembly, self.beams, {**self.opaque, name: component}, self.links,
-                         self.order, self.sources)
+        return self._copy(opaque={**self.opaque, name: component})
 
     def with_link(self, index: int, link: LinkSI) -> "Structure":
         """The structure with one link replaced.
@@ -415,7 +424,7 @@ class Structure:
         """
         links = list(self.links)
         links[index] = link
-        return Structure(self.assembly, self.beams, self.opaque, tuple(links), self.order, self.sources)
+        return self._copy(links=tuple(links))
 
     def add_link(self, link: LinkSI) -> "Structure":
         """The structure with one more link (applied after the others).
@@ -431,7 +440,27 @@ class Structure:
             A new structure.
         """
         self.position(link.a)
-        return Structure(self.assembly, self.beams, self.opaque, self.links + (link,), self.order, self.sources)
+        return self._copy(links=self.links + (link,))
+
+    def with_point(self, point: str, x: float) -> "Structure":
+        """The structure with a point (a measured one) placed at ``x`` along its component instead.
+
+        Parameters
+        ----------
+        point : str
+            The point's name, e.g. ``"tool.tip-20 mm"``, on a beam.
+        x : float
+            Where it is [m from the component's base], on the component.
+
+        Returns
+        -------
+        Structure
+            A new structure: the point's outputs, and the sensors and bodies on it, sit at ``x``.
+        """
+        comp, at = self.position(point)
+        if at is None:
+            raise UnknownPointError(f"point {point}: {comp!r} has no length to place a point along")
+        return self._copy(moved={**self.moved, str(_parse(point).point): self.position((comp, float(x)))})
 
     def position(self, point) -> tuple[str, float | None]:
         """``(component, x)`` of a point: ``x`` in metres from the base on a plain beam, else None.
@@ -467,6 +496,8 @@ class Structure:
     def _named_position(self, point: str) -> tuple[str, float | None]:
         """:meth:`position` of a point name (kept by :meth:`position`)."""
         ref = _parse(point)
+        if self.moved and str(ref.point) in self.moved:
+            return self.moved[str(ref.point)]
         if ref.component in self.beams:
             beam = self.beams[ref.component]
             total = beam.total_length
