@@ -122,5 +122,7 @@ def test_the_command_takes_the_uncertainty(tmp_path, capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["explained"] and out["calibration_factor"] == pytest.approx(1.03, abs=0.005)
     assert out["settings"]["calibration"] == 0.05
+    assert main(args + ["--calibration", "0.05"]) == 0
+    assert "level: the measured FRFs read 1.03 times the final model's" in capsys.readouterr().out
     assert main(args + ["--calibration", "5"]) == 2  # a usage error
     assert "argument --calibration: got 5; expected the relative uncertainty" in capsys.readouterr().err

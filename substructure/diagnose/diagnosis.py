@@ -323,11 +323,6 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     final = _comparisons(lik, final_ratios, floors, settings)
     report = unexplained_report(lik, assembly, current, baseline, cons, final_error, floor, explained, say,
                                 settings, check) if not explained else ()
-    level = lik.level(current)
-    if settings.calibration is not None:
-        report = list(report) + [words.calibrated(level, settings.calibration)]
-    elif not (explained or scaled) and min(hint := settings.calibration_hint) <= abs(level - 1) <= max(hint):
-        report = list(report) + [words.level_hint(level)]
     if left:
         report = list(report) + [words.left_out([(c.effect, c.place(v), w) for c, v, w in left],
                                                 settings.partial_gain, floor)]
@@ -362,6 +357,11 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     if search["cut"] and not explained:
         report = list(report) + [words.budget_cut(search["cut_at"])]
     # facts of the data, whatever the verdict
+    level = lik.level(current)
+    if settings.calibration is not None:
+        report = list(report) + [words.calibrated(level, settings.calibration)]
+    elif not (explained or scaled) and min(hint := settings.calibration_hint) <= abs(level - 1) <= max(hint):
+        report = list(report) + [words.level_hint(level)]
     runs = outlying_runs(lik, final_ratios) if cons.consistent else []  # else the failing bands say where
     for item, (m, alive, (_, lacking)) in enumerate(zip(lik.measured, lik.alive, lik.windows())):
         which, hz = getattr(m.measurement, "describe", lambda: m.label)(), m.frf.frequency.hz

@@ -662,6 +662,9 @@ def summary(result, model_name: str, measured: int) -> list[str]:
     lines.append(f"model {model_name!r} against {measured} measured FRF(s), "
                  f"{result.band[0]:.0f}-{result.band[1]:.0f} Hz")
     lines.append(f"error ({result.metric}): {result.baseline_error:.4f}; noise floor of the data: {floor:.4f}")
+    if result.explained and result.level is not None:  # else the report above said it
+        lines.append(f"level: the measured FRFs read {result.level:.4g} times the final model's (calibration "
+                     "uncertainty given)")
     base = result.baseline[0]
     for m in [m for m in base.modes if m.model_hz is not None][:12]:
         lines.append(f"  mode at {m.measured_hz:7.0f} Hz measured, {m.model_hz:7.0f} Hz in the model "
