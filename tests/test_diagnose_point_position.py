@@ -78,3 +78,21 @@ def test_beside_a_change_of_the_structure():
 def test_a_point_where_its_label_says_is_not_moved():
     d = diagnose(hd.nominal_model(), _taps(20), progress=False)
     assert d.explained and d.effects == []
+
+
+def test_the_shift_holds_beside_a_shorter_tool():
+    """A tool reground 4 mm shorter with the second sensor 1 mm further back than its label, under another real
+    test's noise: the shift is from where the label puts the point on the shorter tool (it was fixed on the tool as
+    given, and came back at its 5 mm bound, unexplained)."""
+    from real_noise import free_free_residual
+
+    real = ("tool.tip", "tool.tip-21 mm", "holder.tip")
+    exact = hd.measure(points=real, noise=0.0, phase_deg=0.0, floor=0.0, tool_length=0.072)
+    taps = [FRF(f.frequency, f.data, (f"{label}:y",), ("tool.tip:y",))
+            for f, label in zip(with_real_noise(exact, 11, 1.0, free_free_residual()), LABELS)]
+    d = diagnose(hd.nominal_model(), taps, progress=False)
+    assert d.explained, d.report
+    found = {e.name: e for e in d.effects}
+    assert sorted(found) == ["model-parameter", "point-position"], [repr(e) for e in d.effects]
+    assert found["model-parameter"].values["value"] == pytest.approx(0.072, abs=2e-4)
+    assert found["point-position"].where == "tool.tip-21 mm"

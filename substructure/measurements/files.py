@@ -378,6 +378,7 @@ class _Reader:
             if i not in self.nodes:
                 continue
             found = os.stat(self.base_dir / m.file)
+            key = (found.st_dev, found.st_ino, m.configuration)  # one file's nodes, in one configuration
             where = f"{m.file}, type-58 record {m.record or 0}"
             (out_node, out_dir), (in_node, in_dir) = self.nodes[i]
             turned = 0 not in (out_dir, in_dir) and out_dir != in_dir  # direction 0, a scalar, says nothing
@@ -387,7 +388,6 @@ class _Reader:
                              f"point {m.response}; check the record index (0-based)")
             for role, label, node in (("response", m.response, out_node), ("excitation", m.excitation, in_node)):
                 point = label.rsplit(":", 1)[0]
-                key = (found.st_dev, found.st_ino, m.configuration)
                 other, j = points.setdefault(key + (node,), (point, i))
                 if other != point:
                     there = ("its response is that node too, read as" if j == i else

@@ -256,8 +256,11 @@ class GroundSpring(_OnComponent):
 
 
 class PointPosition(Change):
-    """Where a measured point really was: its position along its component fitted within ``reach`` of the one
-    its name says (``shift``, towards the tip positive).  A test-only change: the model is not changed.
+    """Where a measured point really was: ``shift`` [m] along its component (towards the tip positive) from where
+    its name puts it, within ``reach``.  A test-only change: the model is not changed.
+
+    The shift is from where the name puts the point in the structure fitted, so that it holds beside a change of
+    the component's length (``tool.tip-20 mm`` of a shorter tool is nearer its base).
 
     Parameters
     ----------
@@ -266,11 +269,11 @@ class PointPosition(Change):
     component : str
         Its component, a beam.
     x : float
-        Where its name puts it [m from the component's base].
+        Where its name puts it on the model as given [m from the component's base].
     length : float
-        The component's length [m].
+        The component's length on the model as given [m].
     reach : float
-        How far from ``x`` it may be [m] (within the component).
+        How far from there it may be [m] (within the component).
     """
 
     effect = "point-position"
@@ -279,18 +282,21 @@ class PointPosition(Change):
     test_only = True
 
     def __init__(self, point: str, component: str, x: float, length: float, reach: float):
-        self.where, self.component, self.x, self.length = point, component, float(x), float(length)
+        self.where, self.component = point, component
+        self.from_tip = ".tip-" in point  # the name's distance: from the tip, else from the base
+        self.distance = float(length - x if self.from_tip else x)
         self.specs = (ParamSpec("shift", "m", max(0.0, x - reach) - x, min(length, x + reach) - x, 0.0, log=False),)
 
     def place(self, values) -> str:
         """Where the point was, written as its name is (``tool.tip-22 mm`` for ``tool.tip-20 mm``)."""
-        x = self.x + float(values["shift"])
-        if ".tip-" in self.where:
-            return f"{self.component}.tip-{_mm(self.length - x)}"
-        return f"{self.component}@{_mm(x)}"
+        shift = float(values["shift"])
+        if self.from_tip:
+            return f"{self.component}.tip-{_mm(self.distance - shift)}"
+        return f"{self.component}@{_mm(self.distance + shift)}"
 
     def apply_si(self, structure, values):
-        return structure.with_point(self.where, self.x + float(values["shift"]))
+        _, x = structure.position(self.where)
+        return structure.with_point(self.where, x + float(values["shift"]))
 
     def apply(self, assembly, values):
         return assembly  # the model is as it was: the test was taken elsewhere
