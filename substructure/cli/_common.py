@@ -71,6 +71,18 @@ def positive_arg(option: str, value: float | None, zero: bool = False) -> float 
     return value
 
 
+def calibration_arg(value: float | None) -> float | None:
+    """``--calibration``: the relative uncertainty of the FRFs' scale, in (0, 1), or None."""
+    if value is not None and not (math.isfinite(value) and 0 < value < 1):
+        raise UsageError(f"argument --calibration: got {value:g}; expected the relative uncertainty of "
+                         "the FRFs' scale, a number between 0 and 1 (0.05 for 5 %)")
+    return value
+
+
+CALIBRATION_HELP = ("relative uncertainty of the FRFs' scale (the hammer's and the sensors' sensitivities), "
+                    "e.g. 0.05: compare at the common level that fits best within it (default: exact)")
+
+
 def one_line(text: str) -> str:
     """The text on one line, runs of white space made one space."""
     return " ".join(str(text).split())

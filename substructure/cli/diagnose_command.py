@@ -8,9 +8,11 @@ import sys
 from pathlib import Path
 
 from ._common import (
+    CALIBRATION_HELP,
     PROG,
     UsageError,
     band_range_arg,
+    calibration_arg,
     check_outputs,
     count_arg,
     figures,
@@ -35,9 +37,7 @@ def run(args: argparse.Namespace) -> int:
                                                                                "seconds")):
         if value is not None and not (math.isfinite(value) and value > 0):
             raise UsageError(f"argument {option}: got {value:g}; expected a positive number of {what}")
-    if args.calibration is not None and not (math.isfinite(args.calibration) and 0 < args.calibration < 1):
-        raise UsageError(f"argument --calibration: got {args.calibration:g}; expected the relative uncertainty of "
-                         "the FRFs' scale, a number between 0 and 1 (0.05 for 5 %)")
+    calibration_arg(args.calibration)
     if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
         raise UsageError(f"argument --plot: {args.plot} is a file; expected a directory for the figures")
     # figures go into DIR (created if missing): the ones there already are checked like any output
@@ -108,9 +108,7 @@ def add_parser(commands) -> None:
                            "search stops adding changes and says so")
     diag.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
                       help="a limit in wall-clock seconds as well (default none)")
-    diag.add_argument("--calibration", type=float, default=None, metavar="FRACTION",
-                      help="relative uncertainty of the FRFs' scale (the hammer's and the sensors' sensitivities), "
-                           "e.g. 0.05: compare at the common level that fits best within it (default: exact)")
+    diag.add_argument("--calibration", type=float, default=None, metavar="FRACTION", help=CALIBRATION_HELP)
     diag.add_argument("--band", type=band_range_arg, metavar="LO:HI", help="frequency band in Hz (default: all data)")
     diag.add_argument("--plot", metavar="DIR", help="write the figures (where it fails, error fall) to DIR")
     diag.add_argument("--save-model", metavar="FILE.toml", help="write the model with the changes found")

@@ -5,8 +5,10 @@ from __future__ import annotations
 import argparse
 
 from ._common import (
+    CALIBRATION_HELP,
     UsageError,
     band_arg,
+    calibration_arg,
     check_outputs,
     check_plot,
     count_arg,
@@ -23,6 +25,7 @@ def run(args: argparse.Namespace) -> int:
 
     check_plot(args.plot)
     count_arg("--bootstrap", args.bootstrap)
+    calibration_arg(args.calibration)
     check_outputs([("--plot", args.plot)], [args.assembly, *measurement_inputs(args.measurements)], args.overwrite)
     assembly = load_assembly(args.assembly)
     measurements = load_measurements(args.measurements)
@@ -35,7 +38,7 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"argument --parameters: {', '.join(twice)} named twice in {args.parameters!r}; "
                          "name each parameter once")
     report = identify_joint(assembly, measurements, args.joint, band=args.band, parameters=parameters,
-                            bootstrap=args.bootstrap)
+                            bootstrap=args.bootstrap, calibration=args.calibration)
     if args.plot:
         draw_to(args.plot, args.overwrite, report.plot)
     if args.json:
@@ -47,6 +50,9 @@ def run(args: argparse.Namespace) -> int:
               "below are uncertain (run `substructure diagnose` to find what is missing)")
     print(f"band {lo:.0f}-{hi:.0f} Hz, {len(measurements)} measured FRFs, relative residual {report.residual_rms:.3f}, "
           f"chi^2/nu {report.chi2_reduced:.3g}; joint model: {report.model}")
+    if report.level is not None:
+        print(f"level: the measured FRFs read {report.level:.4g} times the fitted model's throughout (calibration "
+              f"uncertainty {report.calibration:.3g}); the joint was fitted at that level")
     units = {"k": ("N/m", "N", "N/rad", "N*m/rad"), "c": ("N*s/m", "N*s", "N*s/rad", "N*m*s/rad")}
     for kind, values, stds in (("k", report.k, report.k_std), ("c", report.c, report.c_std)):
         for (entry, value), unit in zip(values.items(), units[kind]):
@@ -79,6 +85,7 @@ def add_parser(commands) -> None:
                             "default auto: the diagonal joint, with the cross terms when they are significant")
     ident.add_argument("--bootstrap", type=int, default=0, metavar="N",
                        help="bootstrap refits for the standard deviations (default 0: from the Jacobian)")
+    ident.add_argument("--calibration", type=float, default=None, metavar="FRACTION", help=CALIBRATION_HELP)
     ident.add_argument("--plot", metavar="FILE.png", help="plot the closed form, the band, the fit and the FRFs")
     ident.add_argument("--overwrite", action="store_true", help="let --plot replace an existing file")
     ident.add_argument("--json", action="store_true", help="print one JSON object instead of the summary")

@@ -33,7 +33,7 @@ from ..measurements import model_of_measurement
 from ..points import parse_point
 from ..units import whole_number
 from ..updating.fit import fit
-from ..updating.likelihood import Likelihood, measured_frfs
+from ..updating.likelihood import Likelihood, calibration_checked, measured_frfs
 from ..updating.parameters import ParameterSet, ParamSpec
 from ..updating.selection import consistency, significance
 from .closed_form import PARAMETERS
@@ -44,6 +44,10 @@ DIAGONAL = ("k_yf", "k_tm", "c_yf", "c_tm")
 """The diagonal joint of thesis eq. 2.4."""
 CROSS = ("k_ym", "c_ym")
 """The cross terms of eq. 2.5 (``k_ym = k_tf``, ``c_ym = c_tf``)."""
+
+CALIBRATION_HINT = (0.01, 0.25)
+"""Without a calibration uncertainty: a refit with one of the upper number suggests giving one when it finds the
+data's level off by at least the lower number (and lowers ``chi^2`` significantly)."""
 
 _UNITS = {name: (STIFFNESS_UNITS if name[0] == "k" else DAMPING_UNITS)[name[2:]] for name in PARAMETERS}
 
@@ -152,6 +156,15 @@ class JointIdentifier:
     initial : mapping, optional
         Starting values (SI), overriding the assembly's joint (needed where it
         gives 0 or a rigid joint).
+    calibration : float, optional
+        The relative uncertainty of the measured FRFs' common scale (the
+        hammer's and the sensors' sensitivities), e.g. 0.05: the joint is
+        fitted at the common level that fits best within it (profiled out
+        of every comparison, as in
+        :class:`~substructure.updating.likelihood.Likelihood`), so that a test
+        read a few per cent high or low does not bend the joint's values.
+        None (default): the scale is taken as exact, and a note says when the
+        data differ from the fitted model by a common factor.
 
     Attributes
     ----------
@@ -190,11 +203,17 @@ class JointIdentifier:
         Misfit, passivity and reciprocity findings, and the values on a bound.
     n_lines_ : int
         Number of frequency lines (over all FRFs) in the fit.
+    level_ : float
+        The measured FRFs' common scale over the fitted model's (the
+        noise-weighted mean of ``ln |measured / model|``, exponentiated): with
+        ``calibration``, the level the joint was fitted at; without, what it
+        would be (about 1 when the scale is right).
     """
 
     def __init__(self, joint: str, parameters: str | Sequence[str] = "auto", band="auto", bootstrap: int = 0,
-                 random_state: int = 0, initial: Mapping | None = None):
+                 random_state: int = 0, initial: Mapping | None = None, calibration: float | None = None):
         self.joint = joint
+        self.calibration = calibration
         self.parameters = parameters if isinstance(parameters, str) else tuple(parameters)
         self.band = band
         self.bootstrap = bootstrap
@@ -205,6 +224,7 @@ class JointIdentifier:
         # checked whatever the parameters (with 'auto' they were not: -1 failed in numpy, 2.5 in range, True was 1)
         whole_number(self.bootstrap, "bootstrap", 0, "an integer")
         whole_number(self.random_state, "random_state", 0, "a seed, an integer")
+        calibration_checked(self.calibration)
         if isinstance(self.parameters, str):
             if self.parameters != "auto":
                 raise InvalidValueError(f"parameters: got {self.parameters!r}; expected 'auto' or some of "
@@ -364,12 +384,16 @@ class JointIdentifier:
         self.residual_rms_ = float(np.sqrt(np.mean(np.concatenate([np.abs(r) ** 2 for r in ratios]))))
         self.warnings_ = notes + _passivity(self.joint_)
         self.n_lines_ = int(sum(m.frf.frequency.n for m in lik.measured))
+        self.level_ = lik.level(result.changes)
+        note = _level_note(lik, result, self.level_)
+        if note:
+            self.warnings_.append(note)
         return self
 
     def _likelihood(self, model, cases, band, n_par):
         self._enough(cases, band, n_par)
         measured, _ = measured_frfs(cases, band)
-        return Likelihood(model, measured)
+        return Likelihood(model, measured, calibration=self.calibration)
 
     @staticmethod
     def _enough(cases, band, n_par) -> None:
@@ -396,7 +420,8 @@ class JointIdentifier:
                 data = m.frf.data.copy()
                 data[lik.lines, 0, 0] = y / np.exp(pick)
                 boot.append(attrs.evolve(m, frf=FRF(m.frf.frequency, data, m.frf.outputs, m.frf.inputs)))
-            refit = fit(Likelihood(lik.assembly, boot, lik.lines), [(change, best)], max_nfev=50 * len(best))
+            refit = fit(Likelihood(lik.assembly, boot, lik.lines, lik.calibration), [(change, best)],
+                        max_nfev=50 * len(best))
             samples.append([refit.changes[0][1][p] for p in best])
         spread = np.std(np.array(samples), axis=0, ddof=1)
         return {p: float(max(result.std[0][p], s)) for p, s in zip(best, spread)}
@@ -421,6 +446,33 @@ class JointIdentifier:
             The receptances with the fitted joint (m/N, ...).
         """
         return assembly.with_joint(self.joint_).frf(outputs, inputs, frequency)
+
+
+def _level_note(lik, result, level: float) -> str | None:
+    """What the data's common level says of the values: at the calibration's bound, or (without a calibration
+    uncertainty) a level that a refit with one finds significant and that leaves a residual consistent with the
+    noise (a level that does not account for the misfit is no hint: the model misses something else)."""
+    if lik.calibration is not None:
+        if abs(np.log(level)) < np.log1p(lik.calibration) * (1 - 1e-9):
+            return None
+        return (f"the measured FRFs read {level:.4g} times the fitted model's throughout, on the bound of the "
+                f"calibration uncertainty given ({lik.calibration:.3g}): the data differ from the model by more than "
+                "it, and the values absorb the rest; check the hammer's and the sensors' sensitivities and units, "
+                "and what the model may miss")
+    lo, hi = CALIBRATION_HINT
+    wide = Likelihood(lik.assembly, lik.measured, lik.lines, hi)
+    change, values = result.changes[0]
+    refit = fit(wide, [(change, values)])
+    level = wide.level(refit.changes)
+    if not lo <= abs(level - 1.0) or not significance(result.chi2, refit.chi2, 1, lik.n, refit.p + 1).significant:
+        return None
+    if not consistency(wide, wide.log_ratios(refit.changes), refit.p + 1).consistent:
+        return None  # the level does not account for the misfit: the model misses something else
+    return (f"the measured FRFs read {level:.4g} times the model's throughout, a common factor the joint cannot "
+            "give: the values above (and the joint model chosen) absorb it, fitted at the scale as given; a real "
+            "test's scale (the hammer's and the sensors' sensitivities) is rarely better than a few per cent: if "
+            "yours is uncertain by that much, give it (calibration=0.05, identify --calibration 0.05) and the joint "
+            "is fitted at the level that fits")
 
 
 def _bound_note(name: str, value: float, side: str, search: tuple[float, float], log: bool) -> str:

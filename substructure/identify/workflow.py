@@ -21,6 +21,7 @@ from ..assembly import Assembly
 from ..coupling import remove_mass
 from ..errors import InvalidValueError, SubstructureError
 from ..frf import FRF
+from ..measurements import MeasurementSet
 from ..points import parse_point
 from ..rdof import estimate_rotational, positions_from
 from ..updating import Evaluator, Structure
@@ -85,6 +86,13 @@ class IdentificationReport:
         ``warnings`` says what to do).  Empty when every value lies inside.
     search : dict
         The search range ``(lower, upper)`` of each fitted parameter (SI).
+    calibration : float or None
+        The relative uncertainty of the data's scale the joint was fitted
+        with (None: the scale taken as exact).
+    level : float or None
+        With ``calibration``: the measured FRFs' common scale over the fitted
+        model's, the level the joint was fitted at (e.g. 1.03: the data read
+        3 % high).  None without.
     """
 
     joint: str
@@ -106,6 +114,8 @@ class IdentificationReport:
     correlation: tuple = ()
     at_bound: dict = attrs.field(factory=dict)
     search: dict = attrs.field(factory=dict)
+    calibration: float | None = None
+    level: float | None = None
 
     def to_json(self) -> dict:
         """The JSON object of docs/file-formats.md (SI units, Hz; strict JSON), plus a few added keys.
@@ -116,7 +126,8 @@ class IdentificationReport:
             ``joint``, ``band_hz``, ``k``, ``c``, ``k_std``, ``c_std``, ``warnings``, ``fitted``,
             ``residual_rms``, ``model``, ``consistent``, ``chi2_reduced``, ``parameters`` (each with
             ``at_bound``: null, ``"lower"`` or ``"upper"``, and ``search``: ``[lower, upper]``), ``correlation``,
-            ``at_bound`` (the names of the parameters on a bound of their search).
+            ``at_bound`` (the names of the parameters on a bound of their search), ``calibration`` and
+            ``calibration_factor`` (the data's level with a calibration uncertainty; null without).
         """
         return {
             "joint": self.joint,
@@ -137,6 +148,8 @@ class IdentificationReport:
                            for name in self.fitted},
             "correlation": [[_finite(x) for x in row] for row in self.correlation],
             "at_bound": [name for name in self.fitted if name in self.at_bound],
+            "calibration": self.calibration,
+            "calibration_factor": None if self.level is None else _finite(self.level),
         }
 
     def _value(self, name: str) -> float:
@@ -213,7 +226,7 @@ def _points_on(measurements, assembly: Assembly, components: set, removed=()) ->
 
 def identify_joint(assembly: Assembly, measurements, joint: str, band="auto",
                    parameters: str | Sequence[str] = "auto", bootstrap: int = 0,
-                   random_state: int = 0) -> IdentificationReport:
+                   random_state: int = 0, calibration: float | None = None) -> IdentificationReport:
     """Identify a joint from a measurement set (see the module docstring).
 
     Parameters
@@ -232,6 +245,11 @@ def identify_joint(assembly: Assembly, measurements, joint: str, band="auto",
         Bootstrap refits for the standard deviations (0: from the Jacobian).
     random_state : int
         Seed of the bootstrap.
+    calibration : float, optional
+        The relative uncertainty of the data's scale (the hammer's and the
+        sensors' sensitivities), e.g. 0.05: the joint is fitted at the common
+        level that fits best within it (:class:`JointIdentifier`); default
+        None, the scale taken as exact.
 
     Returns
     -------
@@ -248,8 +266,10 @@ def identify_joint(assembly: Assembly, measurements, joint: str, band="auto",
                 f"measurements[{i}]: got {type(m).__name__}; expected a measurement (what was measured where, with "
                 "which sensors on: Measurement.from_frf(frf, response, excitation), or a MeasurementSet); "
                 "JointIdentifier fits plain FRFs")
+    if not isinstance(measurements, MeasurementSet):  # a plain sequence: its configurations as a set's
+        measurements = MeasurementSet("measurements", tuple(measurements))
     ident = JointIdentifier(joint, parameters=parameters, band=band, bootstrap=bootstrap,
-                            random_state=random_state).fit(assembly, list(measurements))
+                            random_state=random_state, calibration=calibration).fit(assembly, list(measurements))
     notes = list(ident.warnings_)
     first = next(m for m in measurements if not set(m.removed) & _sides_components(assembly, joint))
     model = model_of_measurement(assembly, first)
@@ -283,7 +303,8 @@ def identify_joint(assembly: Assembly, measurements, joint: str, band="auto",
         warnings=tuple(notes), measured=first.frf, initial=initial, predicted=predicted,
         residual_rms=ident.residual_rms_, closed_form=result, model=ident.model_, consistent=ident.consistent_,
         chi2_reduced=ident.chi2_reduced_, correlation=tuple(tuple(float(x) for x in row) for row in ident.correlation_),
-        at_bound=dict(ident.at_bound_), search=dict(ident.search_),
+        at_bound=dict(ident.at_bound_), search=dict(ident.search_), calibration=ident.calibration,
+        level=None if ident.calibration is None else ident.level_,
     )
 
 

@@ -38,7 +38,7 @@ from .parameters import Change
 from .evaluator import Evaluator
 from .structure import Structure
 
-__all__ = ["Measured", "Likelihood", "measured_frfs", "LOG_RATIO_PENALTY"]
+__all__ = ["Measured", "Likelihood", "measured_frfs", "calibration_checked", "LOG_RATIO_PENALTY"]
 
 SIGN_ERROR_FACTOR = 4.0
 """How many times smaller a driving point's phase error must be negated or conjugated to call it so."""
@@ -289,6 +289,26 @@ def _short(values) -> str:
     return text if len(text) <= 80 else text[:77] + "..."
 
 
+def calibration_checked(calibration) -> float | None:
+    """``calibration`` as a float, or None; refused unless a relative uncertainty in (0, 1).
+
+    Parameters
+    ----------
+    calibration : float or None
+        The relative uncertainty of the measured FRFs' common scale (see :class:`Likelihood`).
+
+    Returns
+    -------
+    float or None
+        The uncertainty.
+    """
+    if calibration is not None and not (isinstance(calibration, (int, float)) and not isinstance(
+            calibration, bool) and 0.0 < calibration < 1.0):
+        raise InvalidValueError(f"calibration: got {calibration!r}; expected the relative uncertainty of the "
+                                "FRFs' scale, a number in (0, 1), e.g. 0.05, or None")
+    return None if calibration is None else float(calibration)
+
+
 class Likelihood:
     """``chi^2`` of models (the assembly with changes) against measured FRFs.
 
@@ -319,11 +339,7 @@ class Likelihood:
 
     def __init__(self, assembly, measured: Sequence[Measured], lines: np.ndarray | None = None,
                  calibration: float | None = None):
-        if calibration is not None and not (isinstance(calibration, (int, float)) and not isinstance(
-                calibration, bool) and 0.0 < calibration < 1.0):
-            raise InvalidValueError(f"calibration: got {calibration!r}; expected the relative uncertainty of the "
-                                    "FRFs' scale, a number in (0, 1), e.g. 0.05, or None")
-        self.calibration = None if calibration is None else float(calibration)
+        self.calibration = calibration_checked(calibration)
         self.assembly = assembly
         self.measured = list(measured)
         if not self.measured or not all(isinstance(m, Measured) for m in self.measured):
