@@ -17,6 +17,11 @@ test record forgot is on the tool tip, and the test reads 3 % high:
     sensor is found at its mass, the verdict is "explained", and the report
     gives the level, 1.03.
 
+(c) a scale is not the only thing a file can get wrong: an FRF exported
+    as a mobility without its units is read as a receptance, ``i omega``
+    times the structure; no change of the structure does that, and the
+    diagnosis refuses it naming the quantity the data hold.
+
 The "measured" data are made with the library's model plus the sensor and
 1.5 % noise (fixed seed), scaled by 1.03, so that we know the answer
 (docs/diagnose.md, section 6). A sensor's mass lowers the tool mode as the
@@ -32,8 +37,11 @@ Figures are written to $SUBSTRUCTURE_EXAMPLES_OUT (default: out/examples).
 import os
 from pathlib import Path
 
+import numpy as np
+
 from substructure import FRF, Sensor, default_assembly
 from substructure.diagnose import DiagnoseSettings, diagnose
+from substructure.errors import InvalidValueError
 from substructure.synthetic import simulate
 
 out = Path(os.environ.get("SUBSTRUCTURE_EXAMPLES_OUT", "out/examples"))
@@ -79,3 +87,19 @@ assert calibrated.explained and abs(sensor.values["mass"] - 0.002) < 1e-4 and ab
 fig = calibrated.plot_history()
 fig.savefig(out / "calibration_error_fall.png", dpi=110)
 print(f"    wrote {out / 'calibration_error_fall.png'}")
+
+# %%
+# (c) Another quantity: a mobility read as a receptance
+# -----------------------------------------------------
+# Each measured FRF is fitted as A (i 2 pi f)^n times the model as given,
+# n from -2 to 2; when an n other than 0 fits ten times better, the data are
+# refused with what they hold (docs/diagnose.md, section 6, "Another
+# quantity").
+mobility = [FRF(f.frequency, f.data * (2j * np.pi * f.frequency.hz)[:, None, None], f.outputs, f.inputs)
+            for f in (m.frf for m in taps)]
+try:
+    diagnose(model, mobility)
+except InvalidValueError as exc:
+    print(f"4. (c) a mobility read as a receptance: refused\n    | {exc}")
+else:
+    raise AssertionError("a mobility read as a receptance was diagnosed")

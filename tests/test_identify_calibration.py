@@ -134,3 +134,13 @@ def test_the_bootstrap_refits_at_the_level_too():
     truth = _truth(0.7, 1.5)
     for name, value in ident.values_.items():
         assert abs(value - truth[name]) < 3 * ident.std_[name] + 0.005 * truth[name], name
+
+
+@pytest.mark.parametrize("scale", [1e-3, 0.7, 9.81])
+def test_a_level_beyond_any_calibration_is_named_a_unit_error(scale):
+    """mm/N read as m/N, 30 % off (a sensitivity in another unit), g read as m/s^2: the joint cannot give it."""
+    ident = JointIdentifier("holder-tool").fit(hd.nominal_model(), _taps(scale, 0.7, 1.0, 11))
+    (note,) = _level_notes(ident)
+    assert "more than a joint or a sensor's calibration gives: a unit error" in note
+    said = float(note.split("read ")[1].split(" times")[0])
+    assert said == pytest.approx(scale, rel=0.01) if scale == 0.7 else abs(np.log(said / scale)) < abs(np.log(scale))

@@ -175,8 +175,10 @@ def level_signature(baseline, floor: float, settings: DiagnoseSettings = DEFAULT
     has the sign of ``m`` and lies between ``1 / settings.level_spread`` and
     ``settings.level_spread`` (half and twice) times it, and every paired
     mode is within ``settings.level_in_place`` (1 %, or
-    ``settings.in_place_lines`` lines) of the model's, the FRFs differ from
-    the model by a scale: what a
+    ``settings.in_place_lines`` lines) of the model's (or, the factor taken
+    out, the FRF's error is within ``settings.explained_error_factor`` of
+    its noise floor: a peak picked on noisy lines near a node moves more
+    than the modes do), the FRFs differ from the model by a scale: what a
     calibration or unit error does (the hammer's or the sensor's
     sensitivity, g taken for m/s^2), and what a change of the structure
     does only by scaling every mass and stiffness alike.
@@ -200,17 +202,20 @@ def level_signature(baseline, floor: float, settings: DiagnoseSettings = DEFAULT
     for c in baseline:
         f = c.measured.frequency.hz
         with np.errstate(divide="ignore", invalid="ignore"):
-            r = np.log(np.abs(c.measured.data[:, 0, 0]) / np.abs(c.model.data[:, 0, 0]))
-        ok = np.isfinite(r)
+            full = np.log(c.measured.data[:, 0, 0] / c.model.data[:, 0, 0])
+        ok = np.isfinite(full)
         if ok.sum() < 4 * settings.level_bands:  # at least four lines a band
             return [], {}
-        r = r[ok]
+        r = full.real[ok]
         m = float(np.median(r))
         bands = np.array([np.median(b) for b in np.array_split(r, settings.level_bands)])
         step = float(f[1] - f[0]) if f.size > 1 else 1.0
         # a peak picked on noisy lines moves by a few lines: "in place" is within 1 % (or two lines)
         in_place = all(p.model_hz is not None and abs(p.model_hz - p.measured_hz)
                        <= max(settings.in_place_lines * step, settings.level_in_place * p.model_hz) for p in c.modes)
+        # or the factor taken out, the FRF as good as the data (a peak picked off by noise near a node moves)
+        in_place = in_place or (float(np.sqrt(np.mean(np.abs(full[ok] - m) ** 2)))
+                                <= settings.explained_error_factor * c.noise_floor)
         spread = settings.level_spread
         if not (in_place and c.modes and abs(m) > settings.level_floors * floor and np.all(bands / m > 1.0 / spread)
                 and np.all(bands / m < spread)):

@@ -49,6 +49,10 @@ CALIBRATION_HINT = (0.01, 0.25)
 """Without a calibration uncertainty: a refit with one of the upper number suggests giving one when it finds the
 data's level off by at least the lower number (and lowers ``chi^2`` significantly)."""
 
+LEVEL_REFIT = 0.99
+"""The refit behind that suggestion takes the level within a factor ``1 + LEVEL_REFIT`` either way; a level found
+beyond ``1 + CALIBRATION_HINT[1]`` (and one of the fit itself beyond it) is named a unit error instead."""
+
 _UNITS = {name: (STIFFNESS_UNITS if name[0] == "k" else DAMPING_UNITS)[name[2:]] for name in PARAMETERS}
 
 
@@ -332,6 +336,8 @@ class JointIdentifier:
             if not lo < hi:
                 raise InvalidValueError(f"band: got {self.band!r}; expected lo < hi")
             band = (lo, hi)
+        self._enough(cases, band, len(names))
+        Likelihood(model, measured_frfs(cases)[0])  # the data as a whole against the model: quantity and sign
         for attempt in range(2 if auto else 1):
             lik = self._likelihood(model, cases, band, len(names))
             result = self._fit(lik, start_joint, names, nominal)
@@ -449,9 +455,10 @@ class JointIdentifier:
 
 
 def _level_note(lik, result, level: float) -> str | None:
-    """What the data's common level says of the values: at the calibration's bound, or (without a calibration
-    uncertainty) a level that a refit with one finds significant and that leaves a residual consistent with the
-    noise (a level that does not account for the misfit is no hint: the model misses something else)."""
+    """What the data's common level says of the values: at the calibration's bound, beyond any calibration (a unit
+    error), or (without a calibration uncertainty) a level that a refit with one finds significant and that leaves
+    a residual consistent with the noise (a level that does not account for the misfit is no hint: the model misses
+    something else)."""
     if lik.calibration is not None:
         if abs(np.log(level)) < np.log1p(lik.calibration) * (1 - 1e-9):
             return None
@@ -460,7 +467,12 @@ def _level_note(lik, result, level: float) -> str | None:
                 "it, and the values absorb the rest; check the hammer's and the sensors' sensitivities and units, "
                 "and what the model may miss")
     lo, hi = CALIBRATION_HINT
-    wide = Likelihood(lik.assembly, lik.measured, lik.lines, hi)
+    unit = ("the measured FRFs read {:.4g} times the {} model's throughout, more than a joint or a sensor's "
+            "calibration gives: a unit error (mm/N read as m/N, g as m/s^2, a sensitivity in another unit)? The "
+            "values above are fitted to it; check the units of the data")
+    if abs(np.log(level)) > np.log1p(hi):
+        return unit.format(level, "fitted")
+    wide = Likelihood(lik.assembly, lik.measured, lik.lines, LEVEL_REFIT)
     change, values = result.changes[0]
     refit = fit(wide, [(change, values)])
     level = wide.level(refit.changes)
@@ -468,6 +480,8 @@ def _level_note(lik, result, level: float) -> str | None:
         return None
     if not consistency(wide, wide.log_ratios(refit.changes), refit.p + 1).consistent:
         return None  # the level does not account for the misfit: the model misses something else
+    if abs(np.log(level)) > np.log1p(hi):
+        return unit.format(level, "refitted")
     return (f"the measured FRFs read {level:.4g} times the model's throughout, a common factor the joint cannot "
             "give: the values above (and the joint model chosen) absorb it, fitted at the scale as given; a real "
             "test's scale (the hammer's and the sensors' sensitivities) is rarely better than a few per cent: if "

@@ -35,6 +35,7 @@ from ..measurements import model_of_measurement
 from ..units import whole_number
 from .noise import NoiseModel, estimate_noise
 from .parameters import Change
+from .quantity import quantity_error, quantity_signature
 from .evaluator import Evaluator
 from .structure import Structure
 
@@ -368,8 +369,21 @@ class Likelihood:
         self._all_alive = bool(self._alive.all())
         self._w = np.stack([np.array(self.w_re), np.array(self.w_im)], axis=1)  # (FRF, part, line)
         self.evaluations = 0
+        if lines is None:  # the data as given (a subsample of them was checked when they were)
+            self._check_quantities()
         self._check_signs()
-        self.evaluations = 0  # the check's evaluation is not the caller's
+        self.evaluations = 0  # the checks' evaluation is not the caller's
+
+    def _check_quantities(self) -> None:
+        """Refuse an FRF that holds another quantity than the one it was read as (:mod:`.quantity`): the model times
+        ``(i omega)^n`` over the whole band, an accelerance or a mobility exported without its units."""
+        predicted = self.predict()
+        for m, y, data, w_re, w_im in zip(self.measured, predicted, self.data, self.w_re, self.w_im):
+            fit = quantity_signature(data, y, m.frf.frequency.hz[self.lines], w_re, w_im)
+            where = getattr(m.measurement, "describe", lambda m=m: m.label)()
+            message = quantity_error(fit, where, getattr(m.measurement, "quantity", "receptance"))
+            if message:
+                raise InvalidValueError(message)
 
     def _check_signs(self) -> None:
         """Refuse a driving point whose sign is reversed or conjugated: by passivity, and against the model.

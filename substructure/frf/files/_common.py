@@ -64,8 +64,10 @@ def _beyond_physical(hz: np.ndarray, values: np.ndarray, quantity: str) -> tuple
     if not np.isfinite(magnitude[k]):
         return k, "its magnitude overflows (is not a finite number)"
     what = "" if not power else f" as a receptance ({magnitude[k]:.3g} / (2 pi f){'^2' if power == 2 else ''})"
+    unit = ("a wrong unit (an accelerance or a mobility without its units is read as a receptance: give them, "
+            "e.g. `real [m/(N s^2)]`)" if not power else "a wrong unit")
     return k, (f"|H| is {receptance[k]:.3g}{what} in SI units (m/N), more than {RECEPTANCE_LIMIT:g} m/N: no "
-               "structure moves that much; a wrong unit or a broken export?")
+               f"structure moves that much; {unit} or a broken export?")
 
 
 def _shown(text: str, limit: int = 60) -> str:
