@@ -131,3 +131,35 @@ def test_an_accelerance_file_without_units_is_refused_as_it_is_read(tmp_path):
     with pytest.raises(Exception, match=r"more than 1 m/N: no structure moves that much; a wrong unit \(an "
                                         r"accelerance or a mobility without its units is read as a receptance"):
         load_measurements(tmp_path / "measurements.toml")
+
+
+# --- without a model: a driving point's passivity (substructure lobes --frf) ------------------------------------
+
+@pytest.mark.parametrize("hidden", [dict(), dict(nut=(0.3, 1e-4, 0.03)), dict(springs=(1e5, 0.05, 0.25))],
+                         ids=["rig", "nut", "free-free"])
+def test_a_driving_point_reads_as_its_quantity_by_passivity(hidden):
+    from substructure.frf.passivity import driving_point_quantity
+
+    tip = _taps(**hidden)[0]
+    hz, h = tip.frequency.hz, tip.data[:, 0, 0]
+    w = 2 * np.pi * hz
+    assert driving_point_quantity(h, hz) is None
+    assert driving_point_quantity(1j * w * h, hz)[0] == "mobility"
+    kind, slope = driving_point_quantity(-(w**2) * h, hz)
+    assert kind == "accelerance" and slope > 1
+    kind, slope = driving_point_quantity(-h, hz)
+    assert kind == "reversed" and slope == pytest.approx(driving_point_quantity(-(w**2) * h, hz)[1] - 2)
+
+
+def test_lobes_refuse_a_mobility_and_name_an_accelerance(tmp_path, capsys):
+    tip = _taps()[0]
+    w = 2 * np.pi * tip.frequency.hz
+    cut = ["--teeth", "4", "--diameter", "12 mm", "--radial-depth", "6 mm", "--kt", "625 MPa", "--kn", "100 MPa"]
+    for name, factor in (("mobility", 1j * w), ("accelerance", -(w**2)), ("receptance", np.ones(w.size))):
+        FRF(tip.frequency, tip.data * factor[:, None, None], tip.outputs, tip.inputs).to_csv(tmp_path / f"{name}.csv")
+    assert main(["lobes", "--frf", str(tmp_path / "mobility.csv"), *cut]) == 1
+    assert "the pattern of a driving-point mobility (Re Y >= 0" in capsys.readouterr().err
+    assert main(["lobes", "--frf", str(tmp_path / "accelerance.csv"), *cut]) == 1
+    err = capsys.readouterr().err
+    assert "|H| grows as f^" in err and "over the band: an accelerance whose units the file left out" in err
+    assert main(["lobes", "--frf", str(tmp_path / "receptance.csv"), *cut]) == 0

@@ -42,20 +42,35 @@ def _window(args: argparse.Namespace) -> dict | None:
 
 
 def _check_sign(path, frf) -> None:
-    """Refuse a driving-point receptance whose imaginary part is positive where most of ``|Im H|`` lies."""
+    """Refuse a driving point that reads as no receptance by its passivity: an imaginary part positive where most
+    of ``|Im H|`` lies (a reversed sign, the other convention, or an accelerance), or a real part positive where
+    most of ``|Re H|`` lies with an imaginary part of both signs (a mobility)."""
     import numpy as np
 
-    from ..frf import REVERSED_SHARE, reversed_share
+    from ..frf.passivity import driving_point_quantity, reversed_share
 
     h = frf.data[:, 0, 0]
-    share = reversed_share(h)
-    if share > REVERSED_SHARE:
-        lines = float(np.mean(np.imag(h[np.isfinite(h)]) > 0))
+    found = driving_point_quantity(h, frf.frequency.hz)
+    if found is None:
+        return
+    kind, value = found
+    if kind == "mobility":
         raise SubstructureError(
-            f"{path}: Im(H) > 0 on {lines:.0%} of the lines, holding {share:.0%} of |Im H| (a tool point's "
-            "receptance has Im(H) <= 0, but for noise near its antiresonances): its sign is reversed (a channel's "
-            "polarity: negate the data) or the data follow the other convention, exp(-i omega t) (take their "
-            "conjugate); as they are, the lobes would be many times too deep")
+            f"{path}: Re(H) > 0 on lines holding {value:.0%} of |Re H|, and Im(H) of both signs: the pattern of a "
+            "driving-point mobility (Re Y >= 0 on a passive structure), not of a receptance (Im H <= 0): a mobility "
+            "whose units the file left out? give them in its header (`real [m/(N s)]`, `imag [m/(N s)]`); as read, "
+            "the lobes would be wrong by a factor of 2 pi f")
+    lines = float(np.mean(np.imag(h[np.isfinite(h)]) > 0))
+    accelerance = ("an accelerance whose units the file left out (Im A >= 0 on a passive structure; give them in "
+                   "its header: `real [m/(N s^2)]`, `imag [m/(N s^2)]`)")
+    reversed_ = ("its sign is reversed (a channel's polarity: negate the data) or the data follow the other "
+                 "convention, exp(-i omega t) (take their conjugate)")
+    causes = (f"|H| grows as f^{value:.2g} over the band: {accelerance}; or {reversed_}" if kind == "accelerance"
+              else f"{reversed_}; or {accelerance}")
+    raise SubstructureError(
+        f"{path}: Im(H) > 0 on {lines:.0%} of the lines, holding {reversed_share(h):.0%} of |Im H| (a tool point's "
+        f"receptance has Im(H) <= 0, but for noise near its antiresonances): {causes}; as they are, the lobes "
+        "would be many times too deep")
 
 
 def _lobes_structure(args: argparse.Namespace):

@@ -416,7 +416,8 @@ class Likelihood:
             m = self.measured[i]
             where = getattr(m.measurement, "describe", lambda: m.label)()
             fix = ("one channel's sign is reversed (the hammer's or the sensor's polarity, or a sensor facing the "
-                   "other way): negate the FRF (substructure tap --reverse-polarity)" if negated <= conjugated else
+                   "other way; unless it is an accelerance whose units the file left out, with Im > 0 too: then give "
+                   "them): negate the FRF (substructure tap --reverse-polarity)" if negated <= conjugated else
                    "the data follow the convention exp(-i omega t), not exp(+i omega t): take their complex "
                    "conjugate")
             raise InvalidValueError(
