@@ -126,7 +126,8 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
     wanted = {"spindle": [], "holder": [], "tool": []}
     for p in list(points) + [excitation]:
         comp, x = _offset(p, lengths[p.split(".")[0].split("@")[0]])
-        wanted[comp].append(x)
+        if x not in wanted[comp]:  # a point measured and hit: one node (two would make an element of no length)
+            wanted[comp].append(x)
     places = list(BEARINGS)
     if bearing_moved:
         places[bearing_moved[0]] = bearing_moved[1]

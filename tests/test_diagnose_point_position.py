@@ -96,3 +96,16 @@ def test_the_shift_holds_beside_a_shorter_tool():
     assert sorted(found) == ["model-parameter", "point-position"], [repr(e) for e in d.effects]
     assert found["model-parameter"].values["value"] == pytest.approx(0.072, abs=2e-4)
     assert found["point-position"].where == "tool.tip-21 mm"
+
+
+def test_an_alternative_beyond_a_shorter_tool_is_skipped_not_raised():
+    """The tool's tip hit and measured 1 mm below it, labelled ``tool.tip`` (a free tip is no candidate): the search
+    shortened the tool, and an alternative of another step placed beyond the shorter tip ended the diagnosis with
+    an UnknownPointError.  Such an alternative has no place beside the other changes and is skipped."""
+    real = "tool.tip-1 mm"
+    exact = hd.measure(points=(real, "tool.tip-20 mm", "holder.tip"), excitation=real, noise=0.0, phase_deg=0.0,
+                       floor=0.0)
+    taps = [FRF(f.frequency, f.data, (f"{label}:y",), ("tool.tip:y",))
+            for f, label in zip(with_real_noise(exact, 11, 1.0), LABELS)]
+    d = diagnose(hd.nominal_model(), taps, progress=False)
+    assert d.effects and (d.explained or d.report)  # a diagnosis, whatever its verdict

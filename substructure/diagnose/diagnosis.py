@@ -35,7 +35,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ..assembly import Assembly
-from ..errors import InvalidValueError
+from ..errors import InvalidValueError, SubstructureError
 from ..frf import FRF
 from ..updating.likelihood import Likelihood, measured_frfs
 from ..updating.structure import assembly_checked
@@ -297,8 +297,14 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         refined = c.apply(refined, v)
     missing = steps[1].added if len(steps) > 1 else None
     def instead(change) -> list:  # a kept change's alternatives of its step, each with the error in its place
-        return [(Found(c, v), lik.rms(lik.log_ratios([(c, v) if x is change else (x, y) for x, y in current])))
-                for c, v, _ in outcome.alternatives.get(change.key, [])]
+        out = []
+        for c, v, _ in outcome.alternatives.get(change.key, []):
+            try:
+                error = lik.rms(lik.log_ratios([(c, v) if x is change else (x, y) for x, y in current]))
+            except SubstructureError:  # no place beside the other changes (a point beyond a tool they shortened)
+                continue
+            out.append((Found(c, v), error))
+        return out
 
     ambiguous = instead(missing.change) if missing is not None else []
     # the other kept changes' alternatives inside the indifference region (the first's are ``ambiguous``)
@@ -319,7 +325,10 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         if (i, found.change.key) not in {(j, a.change.key) for j, a, _ in equivalents} and not (
                 missing is not None and final_effects[i].change.key == missing.change.key
                 and found.change.key in {a.change.key for a, _ in ambiguous}):
-            equivalents.append((i, found, lik.rms(lik.log_ratios([(f.change, f.values) for f in rival]))))
+            try:
+                equivalents.append((i, found, lik.rms(lik.log_ratios([(f.change, f.values) for f in rival]))))
+            except SubstructureError:  # no place beside the other changes
+                continue
     final = _comparisons(lik, final_ratios, floors, settings)
     report = unexplained_report(lik, assembly, current, baseline, cons, final_error, floor, explained, say,
                                 settings, check) if not explained else ()
