@@ -22,6 +22,7 @@ from typing import Any, Callable
 import attrs
 
 from ..errors import InvalidValueError
+from ..updating.likelihood import CALIBRATION_HINT
 
 __all__ = ["DiagnoseSettings", "DEFAULT_SETTINGS", "FROM_SETTINGS"]
 
@@ -456,7 +457,7 @@ class DiagnoseSettings:
     explained_error_factor: float = attrs.field(default=1.5, validator=_number(1.0, lo_open=False))
     point_reach: float = attrs.field(default=0.005, validator=_number(0.0, 0.1, lo_open=False))
     calibration: float | None = attrs.field(default=None, validator=_number(0.0, 1.0, hi_open=True, optional=True))
-    calibration_hint: tuple[float, ...] = attrs.field(default=(0.01, 0.25), converter=_tuple,
+    calibration_hint: tuple[float, ...] = attrs.field(default=CALIBRATION_HINT, converter=_tuple,
                                                       validator=_numbers(0.0, 1.0, hi_open=True))
     partial_gain: float = attrs.field(default=0.05, validator=_number(0.0, lo_open=False))
     signature_step: float = attrs.field(default=1.05, validator=_number(1.0, 2.0))

@@ -33,7 +33,7 @@ from ..measurements import model_of_measurement
 from ..points import parse_point
 from ..units import whole_number
 from ..updating.fit import fit
-from ..updating.likelihood import Likelihood, calibration_checked, measured_frfs
+from ..updating.likelihood import CALIBRATION_HINT, Likelihood, calibration_checked, measured_frfs
 from ..updating.parameters import ParameterSet, ParamSpec
 from ..updating.selection import consistency, significance
 from .closed_form import PARAMETERS
@@ -45,13 +45,10 @@ DIAGONAL = ("k_yf", "k_tm", "c_yf", "c_tm")
 CROSS = ("k_ym", "c_ym")
 """The cross terms of eq. 2.5 (``k_ym = k_tf``, ``c_ym = c_tf``)."""
 
-CALIBRATION_HINT = (0.01, 0.25)
-"""Without a calibration uncertainty: a refit with one of the upper number suggests giving one when it finds the
-data's level off by at least the lower number (and lowers ``chi^2`` significantly)."""
-
 LEVEL_REFIT = 0.99
-"""The refit behind that suggestion takes the level within a factor ``1 + LEVEL_REFIT`` either way; a level found
-beyond ``1 + CALIBRATION_HINT[1]`` (and one of the fit itself beyond it) is named a unit error instead."""
+"""Without a calibration uncertainty, the refit that suggests one (a level off by ``CALIBRATION_HINT`` of the
+updating core, lowering ``chi^2`` significantly) takes the level within a factor ``1 + LEVEL_REFIT`` either way; a
+level found beyond ``1 + CALIBRATION_HINT[1]`` (and one of the fit itself beyond it) is named a unit error."""
 
 _UNITS = {name: (STIFFNESS_UNITS if name[0] == "k" else DAMPING_UNITS)[name[2:]] for name in PARAMETERS}
 

@@ -39,7 +39,7 @@ from .quantity import quantity_error, quantity_signature
 from .evaluator import Evaluator
 from .structure import Structure
 
-__all__ = ["Measured", "Likelihood", "measured_frfs", "calibration_checked", "LOG_RATIO_PENALTY"]
+__all__ = ["Measured", "Likelihood", "measured_frfs", "calibration_checked", "CALIBRATION_HINT", "LOG_RATIO_PENALTY"]
 
 SIGN_ERROR_FACTOR = 4.0
 """How many times smaller a driving point's phase error must be negated or conjugated to call it so."""
@@ -288,6 +288,13 @@ def _line_indices(lines, n: int) -> np.ndarray:
 def _short(values) -> str:
     text = " ".join(repr(values).split())
     return text if len(text) <= 80 else text[:77] + "..."
+
+
+CALIBRATION_HINT = (0.01, 0.25)
+"""The data's level off by this much (the lower number to the upper, relatively) is worth the calibration
+uncertainty: a diagnosis or an identification made without one then suggests giving it
+(``DiagnoseSettings.calibration_hint``, :class:`~substructure.identify.JointIdentifier`'s note); beyond the upper
+number it is no calibration but a unit error."""
 
 
 def calibration_checked(calibration) -> float | None:
