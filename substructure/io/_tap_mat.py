@@ -8,7 +8,11 @@ sample rate in a scalar ``fs``, ``sample_rate``, ``sampling_rate``,
 ``sampling_frequency`` (Hz) or the step in ``dt`` (s).  A force or response
 vector without its unit is refused: nothing says whether it is in N or kN,
 m/s^2 or g.  A force and a response matrix of one shape hold several taps, one a
-column.  Version 7.3 files are HDF5 and refused with how to re-save them.
+column.  Structs are opened: their fields are variables of dotted names
+(``tap.force``), a struct array of taps a matrix, and the signal structures
+of Simcenter Testlab exports channels with their own units and clocks
+(``_tap_mat_structs``).  Version 7.3 files are HDF5 and refused with how to
+re-save them.
 """
 
 from __future__ import annotations
@@ -24,6 +28,7 @@ from ..errors import FileFormatError
 from ..tap.records import TapRecord, unit_of
 from ._tap_build import build_record, option_rate, time_axis, units_of_columns
 from ._tap_columns import Columns, choose
+from ._tap_mat_structs import Signal, text_value, flatten
 
 _TIME = re.compile(r"^(time|t|zeit|time_s)$", re.I)
 _RATE = re.compile(r"^(fs|sample_?rate|sampling_?rate|sampling_?frequency|samplerate)$", re.I)
@@ -31,13 +36,9 @@ _STEP = re.compile(r"^(dt|delta_?t|delta_?x|increment|sample_?interval)$", re.I)
 _UNIT_SUFFIX = re.compile(r"^(.+?)_(unit|units|unit_label)$", re.I)
 
 
-def _text(value: Any) -> str | None:
-    if isinstance(value, str):
-        return value.strip()
-    array = np.asarray(value)
-    if array.dtype.kind == "U" and array.size == 1:
-        return str(array.item()).strip()
-    return None
+def _leaf(key: str) -> str:
+    """The last name of a dotted variable (``tap.fs``: ``fs``)."""
+    return key.rsplit(".", 1)[-1]
 
 
 def mat_record(path: str | os.PathLike, data: bytes, sensitivity: Any, hammer_sensitivity: Any,
@@ -53,15 +54,15 @@ def mat_record(path: str | os.PathLike, data: bytes, sensitivity: Any, hammer_se
         raise FileFormatError(f"{name}: a MATLAB 7.3 file (HDF5), which is not read; save it again as version 7 "
                               "(in MATLAB: save(file, '-v7'); in Python: scipy.io.savemat)")
     try:
-        content = sio.loadmat(io.BytesIO(data), squeeze_me=True, chars_as_strings=True)
+        content = sio.loadmat(io.BytesIO(data), simplify_cells=True, chars_as_strings=True)
     except Exception as exc:  # scipy raises several kinds for files that are not MATLAB files
         raise FileFormatError(f"{name}: cannot read the MATLAB file ({exc}); expected a .mat file of version 4 "
                               "to 7") from None
-    variables = {k: v for k, v in content.items() if not k.startswith("__")}
+    variables, signals, skipped = flatten(content, name)
     units: dict[str, str] = {}
     for key, value in variables.items():
         match = _UNIT_SUFFIX.match(key)
-        text = _text(value)
+        text = text_value(value)
         if match and text is not None:
             units[match.group(1).lower()] = text
     vectors: dict[str, np.ndarray] = {}
@@ -78,15 +79,24 @@ def mat_record(path: str | os.PathLike, data: bytes, sensitivity: Any, hammer_se
             vectors[key] = taps[key][:, 0]
         elif array.ndim == 0:
             scalars[key] = float(array)
+    clocked: dict[str, Signal] = {}  # the columns of signal structures, each with its clock
+    for key, signal in signals.items():
+        if key in vectors:
+            key = f"{signal.where.split('.')[0]}:{key}"
+        vectors[key], clocked[key] = signal.values, signal
+        if signal.unit is not None:
+            units[key.lower()] = signal.unit
     if not vectors:
+        passed = f"; passed over: {'; '.join(skipped)}" if skipped else ""
         raise FileFormatError(f"{name}: no vector or matrix of real numbers among the variables "
-                              f"({', '.join(variables) or 'none'}); expected time, force and response vectors")
+                              f"({', '.join(variables) or 'none'}){passed}; expected time, force and response "
+                              "vectors, or signal structures of a time record")
     names = list(vectors)
-    columns = Columns(names, [units.get(n.lower()) or ("s" if _TIME.match(n) else None) for n in names], None)
+    columns = Columns(names, [units.get(n.lower()) or ("s" if _TIME.match(_leaf(n)) else None) for n in names], None)
     stated = None
     for key, value in scalars.items():
         for pattern, default, to_hz in ((_RATE, "Hz", lambda q: q.m_as("Hz")), (_STEP, "s", lambda q: 1 / q.m_as("s"))):
-            if pattern.match(key):
+            if pattern.match(_leaf(key)):
                 unit = unit_of(units.get(key.lower(), default), f"{name}: variable {key!r}")
                 try:
                     hz = float(to_hz(value * unit))
@@ -106,13 +116,26 @@ def mat_record(path: str | os.PathLike, data: bytes, sensitivity: Any, hammer_se
                                   f"{hz:.10g} Hz; leave the option out or fix the file")
         stated = (hz, "--sample-rate")
     parsed, dims, errors = units_of_columns(columns, name)
-    t_col, f_col, r_col = choose(columns, parsed, dims, name, force_column, response_column, stated is not None,
-                                 "a scalar variable fs (Hz) or dt (s)")
+    t_col, f_col, r_col = choose(columns, parsed, dims, name, force_column, response_column,
+                                 stated is not None or bool(clocked), "a scalar variable fs (Hz) or dt (s)")
     labels = columns.labels
+    for signal in (clocked.get(names[k]) for k in (f_col, r_col)):
+        if signal is None:
+            continue
+        hz = 1.0 / signal.step_s
+        if stated is not None and abs(stated[0] - hz) > 1e-6 * hz:
+            fix = ("leave the option out or fix the file" if stated[1] == "--sample-rate" else
+                   "the force and the response must be sampled at one rate" if stated[1].endswith(".increment")
+                   else "the file contradicts itself")
+            raise FileFormatError(f"{name}: {signal.where} says {hz:.10g} Hz, {stated[1]} {stated[0]:.10g} Hz; {fix}")
+        stated = (hz, signal.where)
     for k in (t_col, f_col, r_col):
         if k is None:
             continue
         if columns.units[k] is None:
+            if names[k] in clocked:
+                raise FileFormatError(f"{name}: the signal {names[k]!r} has no unit (its y_values.quantity.label is "
+                                      "empty); export it with its unit")
             raise FileFormatError(f"{name}: variable {names[k]!r} has no unit; add a text variable "
                                   f"{names[k]}_unit (e.g. 'N', 'g', 'm/s^2', 'mV') to the file")
         if errors[k]:

@@ -18,6 +18,10 @@ when a file holds more; :func:`read_tap_uff` and :func:`read_taps_uff`, in
 TDMS (NI's acquisition): channels found by their ``unit_string`` as columns
 are, the time step from ``wf_increment``; :func:`read_tap_tdms`, in
 ``_tap_tdms``.
+
+MATLAB: vectors with ``<name>_unit`` texts, structs and struct arrays of
+taps, Simcenter Testlab signal structures; :func:`read_tap_mat` and
+:func:`read_taps_mat`, in ``_tap_mat`` and ``_tap_mat_structs``.
 """
 
 from __future__ import annotations
@@ -320,7 +324,10 @@ def read_tap_mat(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
         response vector with its unit in a text variable ``<name>_unit``
         (``force_unit = 'N'``, ``acc_unit = 'g'``, ``'mV'`` with a
         sensitivity); without a time vector, a scalar ``fs`` or
-        ``sample_rate`` (Hz) or ``dt`` (s).
+        ``sample_rate`` (Hz) or ``dt`` (s).  Struct fields are variables
+        of dotted names (``tap.force``, ``tap.force_unit``); Simcenter
+        Testlab signal structures (``x_values``, ``y_values``,
+        ``function_record``) are channels with their own unit and clock.
     sensitivity, hammer_sensitivity : str or pint.Quantity, optional
         As for :func:`read_tap_csv` (``"10.2 mV/g"``, ``"2.25 mV/N"``).
     quantity : {"acceleration", "velocity", "displacement"}, optional
@@ -360,7 +367,8 @@ def read_taps_mat(path: str | os.PathLike, sensitivity: Any = None, hammer_sensi
 
     A force and a response that are matrices of one shape hold a tap a
     column (samples along the longer side, as MATLAB's acquisition
-    functions return them), sharing the time vector or sample rate.
+    functions return them), sharing the time vector or sample rate; so
+    does a struct array of taps (``tap(k).force``, ``tap(k).acc``).
 
     Parameters
     ----------

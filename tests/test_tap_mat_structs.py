@@ -1,0 +1,170 @@
+"""MATLAB structures of tap records: the signal structures of Simcenter Testlab exports, nested structs and
+struct arrays of taps, read to the same records as the project's real taps written as plain vectors."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from scipy.io import savemat
+
+from substructure.cli import main
+from substructure.datasets import impact_records
+from substructure.errors import FileFormatError
+from substructure.io.tap_files import read_tap_mat, read_taps_mat
+
+G = 9.80665
+
+
+def signal(values, label, name, fs, factor=1.0, offset=0.0, x_label="s", increment=None, count=None):
+    """A signal structure as Testlab exports it: the values times ``factor`` plus ``offset`` are in ``label``."""
+    values = np.asarray(values)
+    return {"x_values": {"start_value": 0.0, "increment": 1 / fs if increment is None else increment,
+                         "number_of_values": values.shape[0] if count is None else count,
+                         "quantity": {"label": x_label, "unit_transformation": {"factor": 1.0, "offset": 0.0}}},
+            "y_values": {"values": values,
+                         "quantity": {"label": label, "unit_transformation": {"factor": factor, "offset": offset,
+                                                                              "log_reference": 1e-6}}},
+            "function_record": {"name": name, "type": "Signal", "creation_time": "2026/11/28 12:00:00"}}
+
+
+@pytest.fixture
+def tap():
+    return impact_records()[0]
+
+
+def same(got, r):
+    assert got.sample_rate == r.sample_rate and got.time.size == r.time.size
+    assert np.allclose(got.force, r.force, rtol=1e-12, atol=0)
+    assert np.allclose(got.response, r.response, rtol=1e-12, atol=0)
+
+
+def test_testlab_signals_in_si_with_the_factor_to_their_label_read_as_the_real_tap(tmp_path, tap):
+    """Testlab stores SI values and the factor to the label's unit (1/9.80665 for g): read as the tap itself.
+    Values stored in the label's unit (factor 1) are read in that unit: the same tap from values in g."""
+    fs = tap.sample_rate
+    path = tmp_path / "testlab.mat"
+    savemat(path, {"Signal_0": signal(tap.force, "N", "Force", fs),
+                   "Signal_1": signal(tap.response, "g", "Point1:+Z", fs, factor=1 / G)})
+    got = read_tap_mat(path)
+    same(got, tap)
+    assert (got.force_column, got.response_column) == ("Force [N]", "Point1:+Z [g]")
+    savemat(path, {"Signal_0": signal(tap.force, "N", "Force", fs),
+                   "Signal_1": signal(tap.response / G, "g", "Point1:+Z", fs)})
+    same(read_tap_mat(path), tap)
+    # the channel names of the record, or the variables' names when the record names none
+    savemat(path, {"hammer": signal(tap.force * 1e-3, "kN", "", fs), "acc": signal(tap.response, "m/s^2", "", fs)})
+    got = read_tap_mat(path)
+    same(got, tap)
+    assert got.force_column.startswith("hammer")
+
+
+def test_a_group_of_channels_in_one_structure_and_spectra_passed_over(tmp_path, tap):
+    """Channels exported as a group: one matrix a channel a column, a cell of names, a quantity a channel; an
+    FRF and an autopower spectrum in the same file (complex values, an axis in Hz) are no channels."""
+    fs = tap.sample_rate
+    group = signal(np.column_stack([tap.force, tap.response]), "N", np.array(["Force", "Tip Z"], dtype=object), fs)
+    group["y_values"]["quantity"] = np.array([{"label": "N"}, {"label": "m/s^2"}], dtype=object)
+    frf = signal(np.fft.rfft(tap.response)[:100] / np.fft.rfft(tap.force)[:100], "g/N", "H1 Tip Z/Force", fs,
+                 x_label="Hz", increment=1.0)
+    power = signal(np.abs(np.fft.rfft(tap.force)[:100]) ** 2, "N^2", "Force APS", fs, x_label="Hz", increment=1.0)
+    path = tmp_path / "group.mat"
+    savemat(path, {"Group": group, "FRF": frf, "APS": power})
+    got = read_tap_mat(path)
+    same(got, tap)
+    assert (got.force_column, got.response_column) == ("Force [N]", "Tip Z [m/s^2]")
+    savemat(path, {"FRF": frf, "APS": power})
+    with pytest.raises(FileFormatError, match=r"group.mat: no vector .* passed over: FRF \(complex values: a "
+                                              r"spectrum or an FRF, not a time record\); APS \(its axis is in 'Hz'"):
+        read_tap_mat(path)
+    # a channel a row: read by its number of values
+    group["y_values"]["values"] = np.vstack([tap.force, tap.response])
+    savemat(path, {"Group": group})
+    same(read_tap_mat(path), tap)
+
+
+def test_testlab_signals_that_contradict_themselves_or_lack_a_unit_are_refused(tmp_path, tap):
+    fs = tap.sample_rate
+    path = tmp_path / "bad.mat"
+    force = signal(tap.force, "N", "Force", fs)
+    savemat(path, {"F": force, "A": signal(tap.response, "m/s^2", "Acc", fs / 2)})
+    with pytest.raises(FileFormatError, match=r"bad.mat: A.x_values.increment says 12800 Hz, F.x_values.increment "
+                                              r"25600 Hz; the force and the response must be sampled at one rate"):
+        read_tap_mat(path)
+    savemat(path, {"F": force, "A": signal(tap.response, "", "Acc", fs)})
+    with pytest.raises(FileFormatError, match=r"bad.mat: the signal 'Acc' has no unit \(its y_values.quantity.label "
+                                              r"is empty\)"):
+        read_tap_mat(path, response_column="Acc")
+    savemat(path, {"F": force, "A": signal(tap.response, "m/s^2", "Acc", fs, count=tap.time.size + 1)})
+    with pytest.raises(FileFormatError, match=r"A.y_values.values holds 25600 samples a channel, "
+                                              r"A.x_values.number_of_values says 25601"):
+        read_tap_mat(path)
+    savemat(path, {"F": force, "A": signal(tap.response, "m/s^2", "Acc", fs, increment=-1 / fs)})
+    with pytest.raises(FileFormatError, match=r"A.x_values.increment is -3.9\S+ s; expected a positive time step"):
+        read_tap_mat(path)
+    savemat(path, {"F": force, "A": signal(tap.response, "m/s^2", "Acc", fs)})
+    with pytest.raises(FileFormatError, match=r"F.x_values.increment says 25600 Hz, --sample-rate 1000 Hz; leave the "
+                                              r"option out or fix the file"):
+        read_tap_mat(path, sample_rate="1 kHz")
+    savemat(path, {"F": force, "A": signal(tap.response, "m/s^2", "Acc", fs), "fs": fs / 2})
+    with pytest.raises(FileFormatError, match=r"F.x_values.increment says 25600 Hz, fs 12800 Hz; the file "
+                                              r"contradicts itself"):
+        read_tap_mat(path)
+    savemat(path, {"F": force, "A": signal(tap.response, "m/s^2", "Acc", fs), "fs": fs})
+    same(read_tap_mat(path, sample_rate=fs), tap)
+    # a time axis in milliseconds is a time axis
+    savemat(path, {"F": signal(tap.force, "N", "Force", fs, x_label="ms", increment=1e3 / fs),
+                   "A": signal(tap.response, "m/s^2", "Acc", fs, x_label="ms", increment=1e3 / fs)})
+    same(read_tap_mat(path), tap)
+
+
+def test_nested_structs_and_struct_arrays_of_taps(tmp_path):
+    """A struct's fields are variables of dotted names; a struct array of taps is a matrix of a tap a column:
+    the same records as the plain vectors."""
+    taps = impact_records()[:3]
+    fs = taps[0].sample_rate
+    path = tmp_path / "s.mat"
+    savemat(path, {"test": {"tap": {"force": taps[0].force, "force_unit": "N", "acc": taps[0].response / G,
+                                    "acc_unit": "g"}, "fs": fs, "operator": "A. Smith"}})
+    got = read_tap_mat(path)
+    same(got, taps[0])
+    assert got.force_column == "test.tap.force [N]"
+    elements = np.empty(3, dtype=object)
+    for k, r in enumerate(taps):
+        elements[k] = {"force": r.force, "force_unit": "N", "acc": r.response, "acc_unit": "m/s^2", "fs": fs}
+    savemat(path, {"taps": elements})
+    got = read_taps_mat(path)
+    assert len(got) == 3
+    for g, r in zip(got, taps):
+        same(g, r)
+    elements[1] = dict(elements[1], acc_unit="g")
+    savemat(path, {"taps": elements})
+    with pytest.raises(FileFormatError, match=r"taps\(k\).acc_unit differs between the taps \('m/s\^2', 'g', "):
+        read_taps_mat(path)
+    elements[1] = dict(elements[1], acc_unit="m/s^2", acc=taps[1].response[:-10])
+    savemat(path, {"taps": elements})
+    with pytest.raises(FileFormatError, match=r"taps\(k\).acc holds vectors of 25590 to 25600 samples"):
+        read_taps_mat(path)
+
+
+def test_the_command_gives_the_testlab_export_the_frf_of_the_same_taps_as_vectors(tmp_path, capsys):
+    taps = impact_records()[:2]
+    fs = taps[0].sample_rate
+    plain, testlab = [], []
+    for k, r in enumerate(taps):
+        plain.append(tmp_path / f"v{k}.mat")
+        savemat(plain[-1], {"fs": fs, "force": r.force, "force_unit": "N", "acc": r.response, "acc_unit": "m/s^2"})
+        testlab.append(tmp_path / f"Run {k + 1}.mat")
+        savemat(testlab[-1], {"Signal_0": signal(r.force, "N", "Force", fs),
+                              "Signal_1": signal(r.response, "g", "Point1:+Z", fs, factor=1 / G)})
+    results = []
+    for files in (plain, testlab):
+        code = main(["tap", *map(str, files), "--json"])
+        out = capsys.readouterr()
+        assert code == 0, out.err
+        results.append(json.loads(out.out))
+    assert results[1]["frequency_hz"] == results[0]["frequency_hz"] and results[1]["averages"] == 2
+    scale = np.max(np.abs(results[0]["real"]))
+    assert np.allclose(results[1]["real"], results[0]["real"], rtol=0, atol=1e-12 * scale)
+    assert np.allclose(results[1]["imag"], results[0]["imag"], rtol=0, atol=1e-12 * scale)
