@@ -11,13 +11,12 @@ m/s^2 or g.  A force and a response matrix of one shape hold several taps, one a
 column.  Structs are opened: their fields are variables of dotted names
 (``tap.force``), a struct array of taps a matrix, and the signal structures
 of Simcenter Testlab exports channels with their own units and clocks
-(``_tap_mat_structs``).  Version 7.3 files are HDF5 and refused with how to
+(``substructure._matlab``).  Version 7.3 files are HDF5 and refused with how to
 re-save them.
 """
 
 from __future__ import annotations
 
-import io
 import os
 import re
 from typing import Any
@@ -28,7 +27,7 @@ from ..errors import FileFormatError
 from ..tap.records import TapRecord, unit_of
 from ._tap_build import build_record, option_rate, time_axis, units_of_columns
 from ._tap_columns import Columns, choose
-from ._tap_mat_structs import Signal, text_value, flatten
+from .._matlab import Signal, flatten, load, text_value
 
 _TIME = re.compile(r"^(time|t|zeit|time_s)$", re.I)
 _RATE = re.compile(r"^(fs|sample_?rate|sampling_?rate|sampling_?frequency|samplerate)$", re.I)
@@ -47,18 +46,14 @@ def mat_record(path: str | os.PathLike, data: bytes, sensitivity: Any, hammer_se
 
     A force and a response that are matrices of the same shape hold a tap a column (samples along the longer
     side, as MATLAB's acquisition functions return them): a record each."""
-    from scipy import io as sio
-
     name = os.fspath(path)
-    if b"MATLAB 7.3 MAT-file" in data[:128] or data[512:520] == b"\x89HDF\r\n\x1a\n":
-        raise FileFormatError(f"{name}: a MATLAB 7.3 file (HDF5), which is not read; save it again as version 7 "
-                              "(in MATLAB: save(file, '-v7'); in Python: scipy.io.savemat)")
-    try:
-        content = sio.loadmat(io.BytesIO(data), simplify_cells=True, chars_as_strings=True)
-    except Exception as exc:  # scipy raises several kinds for files that are not MATLAB files
-        raise FileFormatError(f"{name}: cannot read the MATLAB file ({exc}); expected a .mat file of version 4 "
-                              "to 7") from None
+    content = load(data, name)
     variables, signals, skipped = flatten(content, name)
+    for key, signal in list(signals.items()):  # spectra and FRFs beside the time records: no channels
+        if signal.axis != "time" or np.iscomplexobj(signal.values):
+            what = "complex values" if np.iscomplexobj(signal.values) else f"an axis in {signal.axis}"
+            skipped.append(f"{signal.where} ({what}: a spectrum or an FRF, not a time record)")
+            del signals[key]
     units: dict[str, str] = {}
     for key, value in variables.items():
         match = _UNIT_SUFFIX.match(key)
@@ -82,7 +77,7 @@ def mat_record(path: str | os.PathLike, data: bytes, sensitivity: Any, hammer_se
     clocked: dict[str, Signal] = {}  # the columns of signal structures, each with its clock
     for key, signal in signals.items():
         if key in vectors:
-            key = f"{signal.where.split('.')[0]}:{key}"
+            key = f"{signal.where}:{key}"
         vectors[key], clocked[key] = signal.values, signal
         if signal.unit is not None:
             units[key.lower()] = signal.unit
@@ -122,13 +117,13 @@ def mat_record(path: str | os.PathLike, data: bytes, sensitivity: Any, hammer_se
     for signal in (clocked.get(names[k]) for k in (f_col, r_col)):
         if signal is None:
             continue
-        hz = 1.0 / signal.step_s
+        hz, where = 1.0 / signal.step, f"{signal.where}.x_values.increment"
         if stated is not None and abs(stated[0] - hz) > 1e-6 * hz:
             fix = ("leave the option out or fix the file" if stated[1] == "--sample-rate" else
                    "the force and the response must be sampled at one rate" if stated[1].endswith(".increment")
                    else "the file contradicts itself")
-            raise FileFormatError(f"{name}: {signal.where} says {hz:.10g} Hz, {stated[1]} {stated[0]:.10g} Hz; {fix}")
-        stated = (hz, signal.where)
+            raise FileFormatError(f"{name}: {where} says {hz:.10g} Hz, {stated[1]} {stated[0]:.10g} Hz; {fix}")
+        stated = (hz, where)
     for k in (t_col, f_col, r_col):
         if k is None:
             continue

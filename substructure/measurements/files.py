@@ -26,6 +26,7 @@ from ..frf.axis import ROUNDED_STEP_SHARE, rounded_uniform
 from ..frf.files._common import _beyond_physical
 from ..frf.files._common import QuantityContradiction
 from ..frf.files.csv_files import _read_csv
+from ..frf.files.mat_reader import read_mat, read_mat_coherence
 from ..frf.files.uff_reader import read_uff, read_uff_coherence
 from ..points import check_name
 from ..tap import ESTIMATORS
@@ -40,6 +41,7 @@ _REQUIRED = ("response", "excitation", "file")
 _CSV = (".csv",)
 _FOREIGN_LABEL = re.compile(r"^node(?P<node>-?\d+):(?:(?P<dof>y|theta)|dir(?P<code>\d+))$")  # uff_units._label
 _UFF = (".uff", ".unv")
+_MAT = (".mat",)  # MATLAB files of signal structures (Simcenter Testlab exports)
 
 
 def _uniform_grid(hz: np.ndarray) -> tuple[np.ndarray | None, tuple[int, str] | None]:
@@ -146,17 +148,21 @@ class _Reader:
              response: str, excitation: str) -> tuple[FRF, dict[str, Any], float | None]:
         path = self.base_dir / file
         suffix = path.suffix.lower()
-        if suffix not in _CSV + _UFF:
-            raise self.error(index, "file", f"{file!r}: unknown kind of file; expected .csv, .uff or .unv")
+        if suffix not in _CSV + _UFF + _MAT:
+            raise self.error(index, "file", f"{file!r}: unknown kind of file; expected .csv, .uff, .unv or .mat")
         if not path.exists():
             raise self.error(index, "file", f"{path}: no such file (paths are relative to the measurement file)")
         try:
             check_readable_file(path, "data file", MAX_DATA_BYTES)
             if suffix in _CSV:
                 if record is not None:
-                    raise self.error(index, "record", f"a CSV file ({file}) holds one FRF; record is for UFF files")
+                    raise self.error(index, "record", f"a CSV file ({file}) holds one FRF; record is for UFF and "
+                                                      "MATLAB files")
                 frf, lines_of, columns, window = _read_csv(path, output=response, input=excitation,
                                                            quantity=quantity)
+            elif suffix in _MAT:
+                frf = read_mat(path, record=record, quantity=quantity, output=response, input=excitation)
+                lines_of, columns, window = None, {}, None
             else:
                 frf = self.uff(index, path, record, quantity, response, excitation)
                 lines_of, columns, window = None, {}, None
@@ -164,7 +170,8 @@ class _Reader:
             if beyond is not None:
                 k, what = beyond
                 where = (f"line {lines_of[k]}" if lines_of is not None else
-                         f"type-58 record {record or 0}, value {k + 1} of {frf.frequency.n}")
+                         f"{'channel' if suffix in _MAT else 'type-58 record'} {record or 0}, value {k + 1} of "
+                         f"{frf.frequency.n}")
                 raise FileFormatError(f"{path}, {where}: at {frf.frequency.hz[k]:g} Hz: {what}")
             grid, irregular = _uniform_grid(frf.frequency.hz)
             if grid is not None and not np.array_equal(grid, frf.frequency.hz):
@@ -172,7 +179,8 @@ class _Reader:
             if irregular is not None:
                 k, what = irregular
                 where = (f"line {lines_of[k]}" if lines_of is not None else
-                         f"type-58 record {record or 0}, value {k + 1} of {frf.frequency.n}")
+                         f"{'channel' if suffix in _MAT else 'type-58 record'} {record or 0}, value {k + 1} of "
+                         f"{frf.frequency.n}")
                 raise FileFormatError(f"{path}, {where}: at {frf.frequency.hz[k]:g} Hz: {what}")
             return frf, columns, window
         except _LocatedError:
@@ -187,16 +195,18 @@ class _Reader:
 
     def uff_coherence(self, index: int, file: str, record: int, frf: FRF) -> Any:
         path = self.base_dir / file
-        if path.suffix.lower() not in _UFF:
+        if path.suffix.lower() not in _UFF + _MAT:
             raise self.error(index, "coherence_record", f"a CSV file ({file}) has no records; its coherence is its "
                                                         "fourth column")
         try:
-            hz, values = read_uff_coherence(path, record)
+            read = read_mat_coherence if path.suffix.lower() in _MAT else read_uff_coherence
+            hz, values = read(path, record)
         except FileFormatError as exc:
             raise self.error(index, "coherence_record", str(exc)) from None
         if hz.size != frf.frequency.n or not np.allclose(hz, frf.frequency.hz, rtol=1e-6, atol=0.0):
             raise self.error(index, "coherence_record",
-                             f"{path}, type-58 record {record}: the coherence's {hz.size} lines from {hz[0]:g} to "
+                             f"{path}, {'channel' if path.suffix.lower() in _MAT else 'type-58 record'} {record}: "
+                             f"the coherence's {hz.size} lines from {hz[0]:g} to "
                              f"{hz[-1]:g} Hz are not the FRF's {frf.frequency!r}")
         return values
 
@@ -286,7 +296,8 @@ class _Reader:
         response, excitation = self.point(table, index, "response"), self.point(table, index, "excitation")
         file = self.string(table, index, "file")
         quantity = self.choice(table, index, "quantity", QUANTITIES)
-        record = self.integer(table, index, "record", 0, "the 0-based index of a type-58 record")
+        record = self.integer(table, index, "record", 0, "the 0-based index of a type-58 record (of a channel "
+                              "on a frequency axis in a .mat file)")
         sensors, removed = self.names(table, index, "sensors"), self.names(table, index, "removed")
         averages = self.integer(table, index, "averages", 1, "the number of averages (an integer >= 1)")
         tau = self.seconds(table, index, "window_tau_s", _optional_tau, "the exponential window's time constant in s")

@@ -25,7 +25,8 @@ The code is in ``substructure.frf.files``, one format per module: ``csv_files`` 
 :func:`read_csv_with_coherence`, :func:`read_csv_window`, :func:`write_csv`; ``exports`` for other
 programs' CSV exports),
 ``uff_writer`` (:func:`write_uff`), ``uff_reader`` (:func:`read_uff`,
-:func:`read_uff_coherence`) and ``uff_units`` (what a
+:func:`read_uff_coherence`), ``mat_reader`` (:func:`read_mat`, :func:`read_mat_coherence`: the signal
+structures of Simcenter Testlab's MATLAB exports) and ``uff_units`` (what a
 type-58 record holds: its labels, quantity, units and abscissa), with ``_common`` for the checks
 and codes they share.  It sits in the ``frf`` layer so that ``FRF.to_csv``, ``FRF.from_uff`` and
 the other methods read and write without importing ``io``; every name is imported from here
@@ -41,8 +42,9 @@ from ...frf.files.csv_files import (  # noqa: F401 (CSV_HEADER: its old place)
     read_csv_with_coherence,
     write_csv,
 )
+from ...frf.files.mat_reader import read_mat, read_mat_coherence
 from ...frf.files.uff_reader import read_uff, read_uff_coherence
 from ...frf.files.uff_writer import write_uff
 
 __all__ = ["write_csv", "read_csv", "read_csv_with_coherence", "read_csv_window", "write_uff", "read_uff",
-           "read_uff_coherence"]
+           "read_uff_coherence", "read_mat", "read_mat_coherence"]

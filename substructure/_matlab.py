@@ -1,19 +1,24 @@
-"""MATLAB structures of tap records: what ``scipy.io.loadmat(..., simplify_cells=True)`` gives, as named channels.
+"""MATLAB files (``.mat``, versions 4 to 7): loaded once, their structures opened into named channels.
 
-Two kinds of structure are read:
+:func:`load` reads the bytes (``scipy.io.loadmat``; a version 7.3 file, HDF5,
+is refused with how to save it again) and :func:`flatten` gives what they
+hold.  Two kinds of structure are read:
 
 - **Signal structures** as Simcenter Testlab (LMS) and tools that copy its
   layout export them: a struct with ``x_values`` (``start_value``,
-  ``increment``, ``number_of_values``, ``quantity.label``: the time axis)
+  ``increment``, ``number_of_values``, ``quantity.label``: the axis, in a
+  unit of time for a time record, of frequency for a spectrum or an FRF)
   and ``y_values`` (``values``: the samples, a column a channel when the
   export groups channels; ``quantity.label``: the unit;
   ``quantity.unit_transformation``: ``factor`` and ``offset`` that turn the
   stored values into the label's unit), ``function_record.name`` naming the
-  channel(s).  Each channel becomes a :class:`Signal`, its own clock with it.
-  Spectra and FRFs (complex values, an axis in Hz) are passed over.
+  channel(s).  Each channel becomes a :class:`Signal` with its axis.
 - **Any other struct**: its fields read as variables of dotted names
   (``tap.force``, ``tap.force_unit``, ``tap.fs``), and a struct array of
   taps (``tap(k).force``) as matrices of a tap a column.
+
+The tap records (``io._tap_mat``) and the measured FRFs
+(``frf.files.mat_reader``) read through it.
 """
 
 from __future__ import annotations
@@ -23,8 +28,7 @@ from typing import Any
 import attrs
 import numpy as np
 
-from ..errors import FileFormatError, SubstructureError
-from ..tap.records import unit_of
+from .errors import FileFormatError
 
 MAX_DEPTH = 6
 """How deep structs are opened (a struct in a struct in ...)."""
@@ -32,13 +36,32 @@ MAX_DEPTH = 6
 
 @attrs.frozen
 class Signal:
-    """One channel of a signal structure: samples in ``unit`` (None when its label is empty), sampled every
-    ``step_s`` seconds, as ``where`` states."""
+    """One channel of a signal structure: ``values`` in ``unit`` (the label; None when it is empty), on an axis
+    of ``axis`` (``"time"`` in s or ``"frequency"`` in Hz) starting at ``start`` and stepping by ``step``;
+    ``where`` is the struct's variable."""
 
     values: np.ndarray
     unit: str | None
-    step_s: float
+    axis: str
+    start: float
+    step: float
     where: str
+
+
+def load(data: bytes, name: str) -> dict:
+    """The variables of the bytes of a MATLAB file (structs as dicts, cells as lists), or a FileFormatError."""
+    import io
+
+    from scipy import io as sio
+
+    if b"MATLAB 7.3 MAT-file" in data[:128] or data[512:520] == b"\x89HDF\r\n\x1a\n":
+        raise FileFormatError(f"{name}: a MATLAB 7.3 file (HDF5), which is not read; save it again as version 7 "
+                              "(in MATLAB: save(file, '-v7'); in Python: scipy.io.savemat)")
+    try:
+        return sio.loadmat(io.BytesIO(data), simplify_cells=True, chars_as_strings=True)
+    except Exception as exc:  # scipy raises several kinds for files that are not MATLAB files
+        raise FileFormatError(f"{name}: cannot read the MATLAB file ({exc}); expected a .mat file of version 4 "
+                              "to 7") from None
 
 
 def text_value(value: Any) -> str | None:
@@ -76,7 +99,8 @@ def _is_signal(value: Any) -> bool:
 
 def flatten(content: dict, name: str) -> tuple[dict[str, Any], dict[str, Signal], list[str]]:
     """The variables of a loaded MATLAB file by dotted name, the channels of its signal structures by name,
-    and what was passed over (signal structures that are no time record), said in words."""
+    and what was passed over (signal structures of no numbers, or whose axis is neither time nor frequency),
+    said in words."""
     variables: dict[str, Any] = {}
     signals: dict[str, Signal] = {}
     skipped: list[str] = []
@@ -156,37 +180,46 @@ def _names(record: Any, count: int) -> list[str | None]:
     return names if len(names) == count else [None] * count
 
 
+def _axis(label: str | None) -> tuple[str, float] | None:
+    """``(axis, factor to s or Hz)`` of an axis label (no label: s), None for another unit."""
+    from .units import ureg
+
+    try:
+        unit = ureg.Quantity(1.0, (label or "s").strip())
+    except Exception:  # pint raises its own errors
+        return None
+    for axis, si in (("time", "s"), ("frequency", "Hz")):
+        if unit.is_compatible_with(si):
+            return axis, float(unit.m_as(si))
+    return None
+
+
 def _signal(key: str, value: dict, name: str, signals: dict[str, Signal], skipped: list[str]) -> None:
     """The channels of one signal structure (see the module's docstring)."""
     x, y = value["x_values"], value["y_values"]
     values = np.asarray(y.get("values"))
-    if values.dtype.kind == "c":
-        skipped.append(f"{key} (complex values: a spectrum or an FRF, not a time record)")
+    if values.dtype.kind not in "iufc" or values.size < 2 or values.ndim > 2:
+        skipped.append(f"{key} (its y_values.values are not a vector or a matrix of numbers)")
         return
-    if values.dtype.kind not in "iuf" or values.size < 2 or values.ndim > 2:
-        skipped.append(f"{key} (its y_values.values are not a vector or a matrix of real numbers)")
-        return
-    x_label = _label(x.get("quantity")) or "s"
-    try:
-        x_unit = unit_of(x_label, f"{name}: {key}.x_values.quantity.label")
-    except SubstructureError:
-        skipped.append(f"{key} (its axis is in {x_label!r}, not in a unit of time)")
-        return
-    if not x_unit.is_compatible_with("s"):
-        skipped.append(f"{key} (its axis is in {x_label!r}, not in a unit of time: not a time record)")
+    x_label = _label(x.get("quantity"))
+    axis = _axis(x_label)
+    if axis is None:
+        skipped.append(f"{key} (its axis is in {x_label!r}, neither time nor frequency)")
         return
     if "increment" not in x:
-        raise FileFormatError(f"{name}: {key}.x_values has no increment; expected the time step of the samples")
-    step = _number(x["increment"], f"{key}.x_values.increment", name) * (1.0 * x_unit).m_as("s")
+        raise FileFormatError(f"{name}: {key}.x_values has no increment; expected the step of its axis")
+    step = _number(x["increment"], f"{key}.x_values.increment", name) * axis[1]
+    start = _number(x.get("start_value", 0.0), f"{key}.x_values.start_value", name) * axis[1]
     if step <= 0:
-        raise FileFormatError(f"{name}: {key}.x_values.increment is {step!r} s; expected a positive time step")
+        unit = "s" if axis[0] == "time" else "Hz"
+        raise FileFormatError(f"{name}: {key}.x_values.increment is {step!r} {unit}; expected a positive step")
     samples = values.reshape(-1, 1) if values.ndim == 1 else values
     count = x.get("number_of_values")
     n = None if count is None else int(_number(count, f"{key}.x_values.number_of_values", name))
     if n is not None and samples.shape[0] != n and samples.shape[1] == n:
         samples = samples.T  # a channel a row
     if n is not None and samples.shape[0] != n:
-        raise FileFormatError(f"{name}: {key}.y_values.values holds {samples.shape[0]} samples a channel, "
+        raise FileFormatError(f"{name}: {key}.y_values.values holds {samples.shape[0]} values a channel, "
                               f"{key}.x_values.number_of_values says {n}; the file contradicts itself")
     quantity = y.get("quantity")
     per_channel = _structs(quantity)
@@ -206,5 +239,6 @@ def _signal(key: str, value: dict, name: str, signals: dict[str, Signal], skippe
                 raise FileFormatError(f"{name}: {where}.factor is 0; expected the factor to the label's unit")
         channel = names[j] if names[j] and names[j] not in signals else \
             (key if samples.shape[1] == 1 else f"{key}[{j + 1}]")
-        signals[channel] = Signal(samples[:, j].astype(np.float64) * factor + offset, _label(q) or None, step,
-                                  f"{key}.x_values.increment")
+        column = samples[:, j]
+        column = column.astype(np.complex128 if column.dtype.kind == "c" else np.float64) * factor + offset
+        signals[channel] = Signal(column, _label(q) or None, axis[0], start, step, key)

@@ -1,0 +1,106 @@
+"""Measured FRFs in MATLAB files of signal structures (Simcenter Testlab exports): read into a measurement set with
+their quantity from the unit, their coherence beside them, checked against the closed form of a one-mode
+receptance."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.io import savemat
+
+from substructure.errors import FileFormatError
+from substructure.frf.files.mat_reader import read_mat, read_mat_coherence
+from substructure.io.measurements import load_measurements
+
+G = 9.80665
+HZ = 100.0 + 2.0 * np.arange(200)
+W = 2 * np.pi * HZ
+H = 1.0 / (1e7 - 0.5 * W**2 + 1j * 300.0 * W)  # a receptance (m/N), closed form
+GAMMA = np.clip(0.6 + 0.4 * np.cos(HZ / 60.0) ** 2, 0.0, 1.0)
+
+
+def struct(values, label, name, factor=1.0, x_label="Hz", start=HZ[0], step=2.0, kind="FRF"):
+    """A signal structure as Testlab exports it: the values times ``factor`` are in ``label``."""
+    return {"x_values": {"start_value": start, "increment": step, "number_of_values": np.shape(values)[0],
+                         "quantity": {"label": x_label}},
+            "y_values": {"values": values, "quantity": {"label": label,
+                                                        "unit_transformation": {"factor": factor, "offset": 0.0}}},
+            "function_record": {"name": name, "type": kind}}
+
+
+def measurement_set(tmp_path, extra, file="test.mat"):
+    text = (f'[[frf]]\nresponse = "tool.tip"\nexcitation = "tool.tip"\nfile = "{file}"\naverages = 5\n' + extra)
+    (tmp_path / "set.toml").write_text(text, encoding="utf-8")
+    return tmp_path / "set.toml"
+
+
+@pytest.mark.parametrize("values, label, factor", [
+    (-W**2 * H, "g/N", 1 / G),  # as Testlab stores it: SI values, the factor to the unit shown
+    (-W**2 * H / G, "g/N", 1.0),  # values in the label's unit
+    (1j * W * H * 1e3, "mm/s/N", 1.0),  # a mobility in mm/s per N
+    (H, "m/N", 1.0),
+])
+def test_an_frf_reads_in_si_with_the_quantity_of_its_unit(tmp_path, values, label, factor):
+    path = tmp_path / "test.mat"
+    savemat(path, {"FRF": struct(values, label, "Tip:+Y/Tip:+Y", factor=factor),
+                   "Coh": struct(GAMMA, "", "Coherence Tip:+Y", kind="Coherence")})
+    frf = read_mat(path, record=0)
+    assert frf.quantity == {"g/N": "accelerance", "mm/s/N": "mobility", "m/N": "receptance"}[label]
+    np.testing.assert_allclose(frf.frequency.hz, HZ, rtol=1e-12)
+    np.testing.assert_allclose(frf.to_receptance().data[:, 0, 0], H, rtol=1e-12)
+    (m,) = load_measurements(measurement_set(tmp_path, "coherence_record = 1\n")).measurements
+    np.testing.assert_allclose(m.frf.to_receptance().data[:, 0, 0], H, rtol=1e-12)
+    np.testing.assert_allclose(m.coherence, GAMMA, rtol=1e-12)
+    assert m.frf.outputs == m.frf.inputs == ("tool.tip:y",) and m.averages == 5
+
+
+def test_a_group_of_frfs_needs_its_record_and_what_is_not_an_frf_is_said(tmp_path):
+    path = tmp_path / "test.mat"
+    group = struct(np.column_stack([H, 2 * H]), "m/N", np.array(["H11", "H21"], dtype=object))
+    savemat(path, {"Group": group, "Coh": struct(GAMMA, "", "Coherence", kind="Coherence")})
+    with pytest.raises(FileFormatError, match=r"test.mat: 2 complex channels on a frequency axis \(0: H11 \(complex, "
+                                              r"m/N\); 1: H21 \(complex, m/N\); 2: Coherence \(real, no unit\)\); "
+                                              r"give the 0-based index"):
+        read_mat(path)
+    np.testing.assert_allclose(read_mat(path, record=1).data[:, 0, 0], 2 * H, rtol=1e-12)
+    with pytest.raises(FileFormatError, match=r"channel 2 \(Coherence\): real values; an FRF needs complex values"):
+        read_mat(path, record=2)
+    with pytest.raises(FileFormatError, match=r"channel 0 \(H11\): complex values; expected a coherence"):
+        read_mat_coherence(path, 0)
+    with pytest.raises(FileFormatError, match=r"test.mat: coherence record 7; the file has 3 channel\(s\)"):
+        read_mat_coherence(path, 7)
+    # in the measurement set: the key and the file named
+    with pytest.raises(FileFormatError, match=r"frf\[0\]\.file: .*2 complex channels"):
+        load_measurements(measurement_set(tmp_path, ""))
+    assert load_measurements(measurement_set(tmp_path, "record = 1\n")).measurements[0].frf.frequency.n == HZ.size
+
+
+@pytest.mark.parametrize("content, message", [
+    ({"FRF": struct(H, "dB", "H")}, r"the unit 'dB' is in decibels"),
+    ({"FRF": struct(H, "N/m", "H")}, r"the unit 'N/m' is not a displacement, velocity or acceleration per force"),
+    ({"FRF": struct(H, "", "H")}, r"no unit \(y_values.quantity.label is empty\); give the quantity"),
+    ({"FRF": struct(0 * H, "m/N", "H")}, r"every value is 0, a dead channel"),
+    ({"FRF": struct(H * 1e9, "m/N", "H")}, r"more than 1 m/N"),
+    ({"FRF": struct(H, "m/N", "H", step=-2.0)}, r"FRF.x_values.increment is -2.0 Hz; expected a positive step"),
+    ({"Signal": struct(H.real, "N", "Force", x_label="s", step=1e-4)}, r"no signal structure on a frequency axis "
+                                                                       r"\(an FRF\); the file holds time records "
+                                                                       r"\(Force\): make the FRF from them"),
+    ({"x": np.arange(3.0)}, r"the file holds no signal structure"),
+])
+def test_files_that_hold_no_usable_frf_are_refused_by_name(tmp_path, content, message):
+    path = tmp_path / "test.mat"
+    savemat(path, content)
+    with pytest.raises(FileFormatError, match=message):
+        load_measurements(measurement_set(tmp_path, ""))
+
+
+def test_a_quantity_given_agrees_with_the_unit_or_stands_for_a_missing_one(tmp_path):
+    path = tmp_path / "test.mat"
+    savemat(path, {"FRF": struct(-W**2 * H, "(m/s^2)/N", "H")})
+    assert read_mat(path, quantity="accelerance").quantity == "accelerance"
+    with pytest.raises(FileFormatError, match=r"the quantity given is receptance, but its unit '\(m/s\^2\)/N' is that "
+                                              r"of an accelerance"):
+        read_mat(path, quantity="receptance")
+    savemat(path, {"FRF": struct(-W**2 * H, "", "H")})
+    frf = read_mat(path, quantity="accelerance")
+    np.testing.assert_allclose(frf.to_receptance().data[:, 0, 0], H, rtol=1e-12)
