@@ -168,3 +168,33 @@ def test_the_command_gives_the_testlab_export_the_frf_of_the_same_taps_as_vector
     scale = np.max(np.abs(results[0]["real"]))
     assert np.allclose(results[1]["real"], results[0]["real"], rtol=0, atol=1e-12 * scale)
     assert np.allclose(results[1]["imag"], results[0]["imag"], rtol=0, atol=1e-12 * scale)
+
+
+@pytest.mark.parametrize("rate", ["25600", "25600,000000", "2.56E+04 Hz", "25.6 kHz"])
+def test_a_bk_pulse_export_reads_with_its_channel_headers(tmp_path, tap, rate):
+    """B&K PULSE's MATLAB export: a File_Header of texts (the sample frequency as the program writes it, decimal
+    comma and unit included) and a Channel_k_Header with each Channel_k_Data's unit."""
+    path = tmp_path / "pulse.mat"
+    header = {"NumberOfChannels": "2", "SampleFrequency": rate, "NumberOfSamplesPerChannel": str(tap.time.size),
+              "Date": "28-Nov-2026 12:00:00", "Comment": "tap 1"}
+    savemat(path, {"File_Header": header,
+                   "Channel_1_Header": {"SignalName": "Hammer", "Unit": "N", "MaxLevel": "500 N"},
+                   "Channel_1_Data": tap.force,
+                   "Channel_2_Header": {"SignalName": "Tip", "Unit": "m/s²", "MaxLevel": "5000 m/s²"},
+                   "Channel_2_Data": tap.response})
+    got = read_tap_mat(path)
+    same(got, tap)
+    assert (got.force_column, got.response_column) == ("Channel_1_Data [N]", "Channel_2_Data [m/s²]")
+    header["SampleFrequency"] = "fast"
+    savemat(path, {"File_Header": header, "Channel_1_Header": {"Unit": "N"}, "Channel_1_Data": tap.force,
+                   "Channel_2_Header": {"Unit": "g"}, "Channel_2_Data": tap.response})
+    with pytest.raises(FileFormatError, match=r"pulse.mat: variable 'File_Header.SampleFrequency' is 'fast'; "
+                                              r"expected a number"):
+        read_tap_mat(path)
+    header["SampleFrequency"] = "25,600"  # 25.6 Hz, or 25600 Hz with a thousands separator: not guessed
+    savemat(path, {"File_Header": header, "Channel_1_Header": {"Unit": "N"}, "Channel_1_Data": tap.force,
+                   "Channel_2_Header": {"Unit": "g"}, "Channel_2_Data": tap.response})
+    with pytest.raises(FileFormatError, match=r"a decimal comma or a thousands separator\? Give the rate with "
+                                              r"--sample-rate"):
+        read_tap_mat(path)
+    assert read_tap_mat(path, sample_rate="25.6 kHz").sample_rate == tap.sample_rate

@@ -11,8 +11,10 @@ m/s^2 or g.  A force and a response matrix of one shape hold several taps, one a
 column.  Structs are opened: their fields are variables of dotted names
 (``tap.force``), a struct array of taps a matrix, and the signal structures
 of Simcenter Testlab exports channels with their own units and clocks
-(``substructure._matlab``).  Version 7.3 files are HDF5 and refused with how to
-re-save them.
+(``substructure._matlab``).  B&K PULSE exports: ``Channel_k_Header.Unit`` is
+the unit of ``Channel_k_Data``, and a rate written as text
+(``File_Header.SampleFrequency = '25600'``) is read as a number.  Version
+7.3 files are HDF5 and refused with how to re-save them.
 """
 
 from __future__ import annotations
@@ -30,9 +32,11 @@ from ._tap_columns import Columns, choose
 from .._matlab import Signal, flatten, load, text_value
 
 _TIME = re.compile(r"^(time|t|zeit|time_s)$", re.I)
-_RATE = re.compile(r"^(fs|sample_?rate|sampling_?rate|sampling_?frequency|samplerate)$", re.I)
+_RATE = re.compile(r"^(fs|sample_?rate|sampling_?rate|sampling_?frequency|sample_?frequency)$", re.I)
 _STEP = re.compile(r"^(dt|delta_?t|delta_?x|increment|sample_?interval)$", re.I)
 _UNIT_SUFFIX = re.compile(r"^(.+?)_(unit|units|unit_label)$", re.I)
+_HEADER_UNIT = re.compile(r"^(.+)_header\.unit$", re.I)  # B&K PULSE: Channel_1_Header.Unit of Channel_1_Data
+_TEXT_NUMBER = re.compile(r"^\s*([-+]?(?:\d+(?:[.,]\d*)?|[.,]\d+)(?:[eE][-+]?\d+)?)\s*(\S.*)?$")
 
 
 def _leaf(key: str) -> str:
@@ -60,11 +64,28 @@ def mat_record(path: str | os.PathLike, data: bytes, sensitivity: Any, hammer_se
         text = text_value(value)
         if match and text is not None:
             units[match.group(1).lower()] = text
+        header = _HEADER_UNIT.match(key)
+        if header and text:
+            units.setdefault(f"{header.group(1)}_data".lower(), text)
     vectors: dict[str, np.ndarray] = {}
     scalars: dict[str, float] = {}
     taps: dict[str, np.ndarray] = {}  # matrices of one channel, a tap a column (samples along the longer side)
     for key, value in variables.items():
         array = np.asarray(value)
+        text = text_value(value)
+        if text is not None and (_RATE.match(_leaf(key)) or _STEP.match(_leaf(key))):  # '25600', '2,56E+04 Hz'
+            number = _TEXT_NUMBER.match(text)
+            if number is None:
+                raise FileFormatError(f"{name}: variable {key!r} is {text!r}; expected a number")
+            if re.fullmatch(r"[-+]?\d{1,3},\d{3}", number.group(1)):  # 25,600: a thousands separator or a decimal?
+                if sample_rate is not None:
+                    continue  # the option says it
+                raise FileFormatError(f"{name}: variable {key!r} is {text!r}: a decimal comma or a thousands "
+                                      "separator? Give the rate with --sample-rate")
+            scalars[key] = float(number.group(1).replace(",", "."))
+            if number.group(2):
+                units.setdefault(key.lower(), number.group(2))
+            continue
         if array.dtype.kind not in "iuf":
             continue
         if array.ndim == 1 and array.size >= 2:

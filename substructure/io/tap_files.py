@@ -327,7 +327,10 @@ def read_tap_mat(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
         ``sample_rate`` (Hz) or ``dt`` (s).  Struct fields are variables
         of dotted names (``tap.force``, ``tap.force_unit``); Simcenter
         Testlab signal structures (``x_values``, ``y_values``,
-        ``function_record``) are channels with their own unit and clock.
+        ``function_record``) are channels with their own unit and clock;
+        B&K PULSE's ``Channel_k_Data`` take their unit from
+        ``Channel_k_Header.Unit`` and the rate from the text
+        ``File_Header.SampleFrequency``.
     sensitivity, hammer_sensitivity : str or pint.Quantity, optional
         As for :func:`read_tap_csv` (``"10.2 mV/g"``, ``"2.25 mV/N"``).
     quantity : {"acceleration", "velocity", "displacement"}, optional
