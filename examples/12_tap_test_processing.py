@@ -23,7 +23,9 @@ package: 25.6 kHz, 1 s each) through ``substructure.tap``:
     an H2 as the H1 of its taps;
 (g) the same taps cut short while their modes still ring: the error the
     end of a tap leaves, which the coherence does not see, estimated from
-    the taps and counted.
+    the taps and counted;
+(h) the same taps as Simcenter Testlab exports them to MATLAB: a signal
+    structure per channel, SI values with the factor to the unit shown.
 
 Figures are written to $SUBSTRUCTURE_EXAMPLES_OUT (default: out/examples).
 """
@@ -37,11 +39,12 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 import pyuff
+from scipy.io import savemat
 
 from substructure.datasets import impact_records
 from substructure.io.frf_files import write_csv
 from substructure.io.measurements import load_measurements
-from substructure.io.tap_files import read_taps_uff
+from substructure.io.tap_files import read_tap_mat, read_taps_uff
 from substructure.measurements import Measurement
 from substructure.plot import plot_taps
 from substructure.tap import TapRecord, process_taps
@@ -230,3 +233,30 @@ ax.legend(fontsize=8)
 ax.set_title("taps cut at 0.25 s: an error the coherence does not see")
 fig.tight_layout()
 save(fig, "12_truncation.png")
+
+
+# %%
+# (h) A Simcenter Testlab export to MATLAB
+# ----------------------------------------
+# Testlab writes each channel as a struct: ``x_values`` (the time step in
+# ``increment``), ``y_values`` (the samples, stored in SI, and
+# ``quantity.label`` with the ``unit_transformation`` factor to the unit
+# shown: 1/9.80665 for g) and ``function_record.name``.  ``read_tap_mat``
+# (and ``substructure tap FILE.mat``) takes the unit and the clock from
+# them; nothing else needs saying.
+def testlab_signal(values, label, factor, channel, fs):
+    return {"x_values": {"start_value": 0.0, "increment": 1.0 / fs, "number_of_values": values.size,
+                         "quantity": {"label": "s"}},
+            "y_values": {"values": values, "quantity": {"label": label,
+                                                        "unit_transformation": {"factor": factor, "offset": 0.0}}},
+            "function_record": {"name": channel, "type": "Signal"}}
+
+
+first = records[0]
+mat_path = out / "12_testlab_tap1.mat"
+savemat(mat_path, {"Signal_0": testlab_signal(first.force, "N", 1.0, "Hammer", first.sample_rate),
+                   "Signal_1": testlab_signal(first.response, "g", 1 / 9.80665, "Tip:+Y", first.sample_rate)})
+read_back = read_tap_mat(mat_path)
+print(f"{mat_path.name}: force {read_back.force_column}, response {read_back.response_column}, "
+      f"{read_back.sample_rate:g} Hz; the samples are the record's: "
+      f"{np.allclose(read_back.response, first.response, rtol=1e-12, atol=0)}")
