@@ -25,7 +25,8 @@ package: 25.6 kHz, 1 s each) through ``substructure.tap``:
     end of a tap leaves, which the coherence does not see, estimated from
     the taps and counted;
 (h) the same taps as Simcenter Testlab exports them to MATLAB: a signal
-    structure per channel, SI values with the factor to the unit shown.
+    structure per channel, SI values with the factor to the unit shown;
+    and the FRF as Testlab exports it, read into a measurement set.
 
 Figures are written to $SUBSTRUCTURE_EXAMPLES_OUT (default: out/examples).
 """
@@ -260,3 +261,26 @@ read_back = read_tap_mat(mat_path)
 print(f"{mat_path.name}: force {read_back.force_column}, response {read_back.response_column}, "
       f"{read_back.sample_rate:g} Hz; the samples are the record's: "
       f"{np.allclose(read_back.response, first.response, rtol=1e-12, atol=0)}")
+
+# %%
+# Testlab exports its FRFs the same way: complex values on an axis in Hz,
+# here an accelerance stored in SI with the factor to g/N, and a coherence
+# beside it.  A measurement set names the file; the unit says the quantity,
+# and ``record`` / ``coherence_record`` count its channels on a frequency
+# axis from 0.
+hz = result.frf.frequency.hz
+keep = hz > 0
+accelerance = -(2 * np.pi * hz[keep]) ** 2 * result.frf.data[keep, 0, 0]
+frf_struct = testlab_signal(accelerance, "g/N", 1 / 9.80665, "H1 Tip:+Y/Hammer", first.sample_rate)
+frf_struct["x_values"].update(start_value=hz[keep][0], increment=hz[1] - hz[0], quantity={"label": "Hz"})
+coherence_struct = testlab_signal(result.coherence[keep], "", 1.0, "Coherence Tip:+Y", first.sample_rate)
+coherence_struct["x_values"] = frf_struct["x_values"]
+savemat(out / "12_testlab_frf.mat", {"FRF": frf_struct, "Coherence": coherence_struct})
+(out / "12_tests_testlab.toml").write_text(
+    'name = "pyFRF impact records, Testlab export"\n\n[[frf]]\nresponse = "tool.tip"\nexcitation = "tool.tip"\n'
+    f'file = "12_testlab_frf.mat"\nrecord = 0\ncoherence_record = 1\naverages = {result.averages}\n'
+)
+from_testlab = load_measurements(out / "12_tests_testlab.toml").measurements[0]
+receptance = from_testlab.frf.to_receptance().data[:, 0, 0]
+print(f"read back: {from_testlab.describe()}, read from g/N and held as a {from_testlab.frf.quantity}; it equals "
+      f"the CSV's: {np.allclose(receptance, result.frf.data[keep, 0, 0], rtol=1e-9)}")
