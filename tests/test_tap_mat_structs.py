@@ -198,3 +198,53 @@ def test_a_bk_pulse_export_reads_with_its_channel_headers(tmp_path, tap, rate):
                                               r"--sample-rate"):
         read_tap_mat(path)
     assert read_tap_mat(path, sample_rate="25.6 kHz").sample_rate == tap.sample_rate
+
+
+@pytest.mark.robustness
+def test_random_structures_give_a_record_or_a_file_format_error(tmp_path):
+    """Structures of every shape, signal structures with wrong fields among them: the readers of tap records and
+    of FRFs give a result or an error of the package naming the file, never another exception (none of these
+    is a whole tap or FRF: the errors are the point)."""
+    import io
+
+    from substructure.errors import SubstructureError
+    from substructure.frf.files.mat_reader import read_mat, read_mat_coherence
+
+    rng = np.random.default_rng(3)
+
+    def pick(options):
+        return options[int(rng.integers(len(options)))]
+
+    def leaf():
+        n = int(rng.integers(2, 40))
+        return pick([rng.normal(size=n), rng.normal(size=(2, n)), float(rng.normal()), rng.normal(size=n) + 1j,
+                     pick(["N", "g", "m/s^2", "Hz", "", "dB", "mV", "25,600", "1e3 Hz", "g/N"]),
+                     np.array([np.nan, 1.0, np.inf]), np.arange(n, dtype=np.int16), 0.0])
+
+    def signal():
+        n = int(rng.integers(2, 40))
+        x = {"increment": pick([1e-4, -1.0, 0.0, "x", np.nan, 1.0]), "number_of_values": pick([n, n + 1, -3]),
+             "start_value": pick([0.0, np.nan]), "quantity": {"label": pick(["s", "Hz", "ms", "rpm", "", "m"])}}
+        values = pick([rng.normal(size=n), rng.normal(size=(n, 2)), rng.normal(size=(2, n)), rng.normal(size=n) + 1j,
+                       "text", rng.normal(size=(n, 3, 2))])
+        quantity = pick([{"label": pick(["N", "g", "m/s^2", "g/N", "", "dB"]),
+                          "unit_transformation": {"factor": pick([1.0, 0.0, np.nan, 0.1]), "offset": 0.0}}, "bad"])
+        return {"x_values": x, "y_values": {"values": values, "quantity": quantity},
+                "function_record": {"name": pick(["F", "", np.array(["a", "b"], dtype=object)])}}
+
+    path = tmp_path / "random.mat"
+    for _ in range(200):
+        content = {}
+        for k in range(int(rng.integers(1, 5))):
+            key = pick(["force", "acc", "fs", "Signal_0", "tap", "t", "force_unit", "acc_unit", "FRF",
+                        "File_Header", "Channel_1_Data", "Channel_1_Header"]) + pick(["", str(k)])
+            content[key] = signal() if rng.random() < 0.4 else \
+                {"force": leaf(), "force_unit": leaf(), "fs": leaf()} if rng.random() < 0.2 else leaf()
+        buffer = io.BytesIO()
+        savemat(buffer, content)
+        path.write_bytes(buffer.getvalue())
+        for reader in (read_taps_mat, read_mat, lambda p: read_mat(p, record=0), lambda p: read_mat_coherence(p, 0)):
+            try:
+                reader(path)
+            except SubstructureError as exc:
+                assert "random.mat" in str(exc), exc
