@@ -104,3 +104,40 @@ def test_a_quantity_given_agrees_with_the_unit_or_stands_for_a_missing_one(tmp_p
     savemat(path, {"FRF": struct(-W**2 * H, "", "H")})
     frf = read_mat(path, quantity="accelerance")
     np.testing.assert_allclose(frf.to_receptance().data[:, 0, 0], H, rtol=1e-12)
+
+
+def test_lobes_read_an_accelerance_in_every_file_that_says_so_as_its_receptance(tmp_path, capsys):
+    """A tool point accelerance whose file states its units (a CSV header in m/(N s^2), a universal file of data
+    type 12, a Testlab export in g/N) gives the lobes of its receptance; it was refused as a reversed sign."""
+    import json
+
+    import pyuff
+
+    from substructure import FRF, Frequency
+    from substructure.cli import main
+
+    hz = np.arange(1.0, 4001.0)
+    w = 2 * np.pi * hz
+    h = 1.0 / (2e7 - 0.4 * w**2 + 1j * 300 * w) + 1.0 / (5e7 - 0.1 * w**2 + 1j * 200 * w)
+    a = -(w**2) * h
+    FRF.single(Frequency.from_hz(hz), h).to_csv(tmp_path / "receptance.csv")
+    lines = "".join(f"{float(f)!r},{float(v.real)!r},{float(v.imag)!r}\n" for f, v in zip(hz, a))
+    (tmp_path / "accelerance.csv").write_text("frequency [Hz],real [m/(N s^2)],imag [m/(N s^2)]\n" + lines)
+    pyuff.UFF(str(tmp_path / "accelerance.uff")).write_sets([pyuff.prepare_58(
+        func_type=4, rsp_node=1, rsp_dir=2, ref_node=1, ref_dir=2, data=a, x=hz, abscissa_spacing=1,
+        abscissa_min=1.0, abscissa_inc=1.0, abscissa_spec_data_type=18, ordinate_spec_data_type=12,
+        orddenom_spec_data_type=13, ordinate_axis_units_lab="m/s^2", orddenom_axis_units_lab="N", id1="tip")])
+    savemat(tmp_path / "accelerance.mat", {"FRF": struct(a, "g/N", "H1", factor=1 / G, start=1.0, step=1.0)})
+    cut = ["--teeth", "2", "--diameter", "12 mm", "--radial-depth", "6 mm", "--kt", "625 MPa", "--kn", "100 MPa",
+           "--speeds", "2000:20000", "--json"]
+    results = {}
+    for name in ("receptance.csv", "accelerance.csv", "accelerance.uff", "accelerance.mat"):
+        code = main(["lobes", "--frf", str(tmp_path / name), *cut])
+        out = capsys.readouterr()
+        assert code == 0, out.err
+        results[name] = json.loads(out.out)
+    expected = results.pop("receptance.csv")
+    for name, got in results.items():
+        assert got["spindle_speed_rpm"] == expected["spindle_speed_rpm"], name
+        np.testing.assert_allclose(got["depth_limit_m"], expected["depth_limit_m"], rtol=1e-6, err_msg=name)
+        assert got["absolute_limit_m"] == pytest.approx(expected["absolute_limit_m"], rel=1e-6)

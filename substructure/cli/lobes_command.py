@@ -41,6 +41,22 @@ def _window(args: argparse.Namespace) -> dict | None:
     return taus if any(t is not None for t in taus.values()) else None
 
 
+def _read_frf(path):
+    """A measured tool point FRF by its suffix: CSV, a universal file of one type-58 record, or a MATLAB file of
+    signal structures (a Testlab export) of one FRF."""
+    from pathlib import Path
+
+    from ..frf import FRF
+    from ..frf.files.mat_reader import read_mat
+
+    suffix = Path(path).suffix.lower()
+    if suffix in (".uff", ".unv"):
+        return FRF.from_uff(path)
+    if suffix == ".mat":
+        return read_mat(path)
+    return FRF.from_csv(path)
+
+
 def _check_sign(path, frf) -> None:
     """Refuse a driving point that reads as no receptance by its passivity: an imaginary part positive where most
     of ``|Im H|`` lies (a reversed sign, the other convention, or an accelerance), or a real part positive where
@@ -112,11 +128,11 @@ def _lobes_structure(args: argparse.Namespace):
     else:
         with warnings.catch_warnings():  # the window a file declares is taken out below
             warnings.simplefilter("ignore", WindowedFRFWarning)
-            x = FRF.from_csv(args.frf)
-            y = FRF.from_csv(args.frf_y) if args.frf_y else None
+            x = _read_frf(args.frf)
+            y = _read_frf(args.frf_y) if args.frf_y else None
         for path, one in ((args.frf, x), (args.frf_y, y)):
-            if one is not None:
-                _check_sign(path, one)
+            if one is not None:  # checked as the receptance it is read as (an accelerance whose units say so too)
+                _check_sign(path, one.to_receptance())
         frf = xy_frf(x, y)
         what = f"FRF from {args.frf}" + (f" (x) and {args.frf_y} (y)" if args.frf_y else ", y = x (a symmetric tool)")
     frf, band = choose_band(frf, band)
@@ -300,8 +316,9 @@ def add_parser(commands) -> None:
     where = lobes.add_argument_group("structure (one of)")
     where.add_argument("--assembly", metavar="A.toml", help="assembly file; the tool point FRF at --at")
     where.add_argument("--at", metavar="POINT", help="the tool point of --assembly, e.g. tool.tip")
-    where.add_argument("--frf", metavar="X.csv", help="tool point receptance in the feed direction x (CSV)")
-    where.add_argument("--frf-y", metavar="Y.csv", help="receptance in y (default: equal to x, a symmetric tool)")
+    where.add_argument("--frf", metavar="X.csv", help="tool point FRF in the feed direction x (CSV; a universal file "
+                       "of one record or a MATLAB file of one FRF, a Testlab export, with their units)")
+    where.add_argument("--frf-y", metavar="Y.csv", help="FRF in y, likewise (default: equal to x, a symmetric tool)")
     where.add_argument("--modes", metavar="MODES.csv",
                        help="modal parameters, header direction,frequency_hz,damping_ratio,stiffness_n_per_m")
     where.add_argument("--window-tau", type=float, metavar="SECONDS",
