@@ -91,7 +91,6 @@ def _check_sign(path, frf) -> None:
 
 def _lobes_structure(args: argparse.Namespace):
     """The structure, a line describing it, the band chosen, the tool and the window removed (or None)."""
-    from ..frf import FRF
     from ..io.assembly_toml import load_assembly
     from ..stability import ModalModel, assembly_structure, choose_band, window_removed, xy_frf
 
