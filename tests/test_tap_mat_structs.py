@@ -76,7 +76,9 @@ def test_a_group_of_channels_in_one_structure_and_spectra_passed_over(tmp_path, 
     assert (got.force_column, got.response_column) == ("Force [N]", "Tip Z [m/s^2]")
     savemat(path, {"FRF": frf, "APS": power})
     with pytest.raises(FileFormatError, match=r"group.mat: no vector .* passed over: FRF \(complex values: a "
-                                              r"spectrum or an FRF, not a time record\); APS \(an axis in frequency: "):
+                                              r"spectrum or an FRF, not a time record\); APS \(an axis in "
+                                              r"frequency: .*time record \(the FRF 'FRF' is read by a measurement "
+                                              r"set: file = \"group.mat\"\)"):
         read_tap_mat(path)
     # a channel a row: read by its number of values
     group["y_values"]["values"] = np.vstack([tap.force, tap.response])

@@ -53,6 +53,7 @@ def mat_record(path: str | os.PathLike, data: bytes, sensitivity: Any, hammer_se
     name = os.fspath(path)
     content = load(data, name)
     variables, signals, skipped = flatten(content, name)
+    frfs = [s.where for s in signals.values() if s.axis == "frequency" and np.iscomplexobj(s.values)]
     for key, signal in list(signals.items()):  # spectra and FRFs beside the time records: no channels
         if signal.axis != "time" or np.iscomplexobj(signal.values):
             what = "complex values" if np.iscomplexobj(signal.values) else f"an axis in {signal.axis}"
@@ -104,9 +105,11 @@ def mat_record(path: str | os.PathLike, data: bytes, sensitivity: Any, hammer_se
             units[key.lower()] = signal.unit
     if not vectors:
         passed = f"; passed over: {'; '.join(skipped)}" if skipped else ""
+        hint = (f" (the FRF {frfs[0]!r} is read by a measurement set: file = \"{os.path.basename(name)}\")"
+                if frfs else "")
         raise FileFormatError(f"{name}: no vector or matrix of real numbers among the variables "
                               f"({', '.join(variables) or 'none'}){passed}; expected time, force and response "
-                              "vectors, or signal structures of a time record")
+                              f"vectors, or signal structures of a time record{hint}")
     names = list(vectors)
     columns = Columns(names, [units.get(n.lower()) or ("s" if _TIME.match(_leaf(n)) else None) for n in names], None)
     stated = None
