@@ -45,7 +45,7 @@ from .effects import Effect, registry
 from .refine import refine as refine_model, trim_partial
 from . import words
 from .result import Alternatives, Candidate, Changes, Diagnosis, Found, Measures, Step, Verdict, _finite, strict
-from .search import Budget, candidates
+from .search import Budget, candidates, free_tips
 from .settings import DEFAULT_SETTINGS, FROM_SETTINGS, DiagnoseSettings, _FromSettings, _real
 
 __all__ = ["Found", "Candidate", "Step", "Diagnosis", "diagnose", "strict", "sites"]
@@ -129,6 +129,50 @@ def _main_shift(comparison: Comparison, share: float) -> float:
     strong = [m for m in pairs if m.measured_amplitude >= share * top] or pairs
     best = max(strong, key=lambda m: abs(m.model_hz / m.measured_hz - 1))
     return float(best.model_hz / best.measured_hz - 1)
+
+
+def _explains(lik: Likelihood, outcome, settings: DiagnoseSettings) -> bool:
+    """The outcome's changes could be claimed: within the noise (consistent, the error within the explained
+    factor), at most ``settings.most_changes`` of them, none on the bound of its search."""
+    current = outcome.current
+    if not current or len(current) > settings.most_changes or bound_hits(current, outcome.fit):
+        return False
+    ratios = lik.log_ratios(current)
+    p = sum(len(c.specs) for c, _ in current)
+    return bool(consistency(lik, ratios, p).consistent
+                and error_check(lik, ratios, settings.explained_error_factor).passed)
+
+
+def _tip_alone(lik: Likelihood, screen_lik: Likelihood, assembly: Assembly, points: list, outcome, say,
+               settings: DiagnoseSettings, floor: float) -> tuple:
+    """``(outcome, note)``: where the search explained nothing, a measured free tip taken where the test could have
+    been (towards the base, within ``settings.point_reach``) when that alone explains the data, else ``outcome``;
+    the note of the report when it would, but for the end of its reach (else None).
+
+    A sensor cannot sit on a tool's very edge, nor a hammer strike it: a test labelled ``tool.tip`` was taken a
+    few millimetres below it.  That moves no mode; tried among the search's candidates it took places on the
+    shortlist from the changes a search needs, so it is tried on its own, after the search."""
+    import attrs
+
+    tips = free_tips(assembly, points, settings.point_reach)
+    if not tips:
+        return outcome, None
+    alone = refine_model(lik, screen_lik, tips, 1, lambda changes: _passive(lik, changes), None, None,
+                         settings=settings)
+    if not alone.current:
+        return outcome, None
+    change, values = alone.current[0]
+    if not _explains(lik, alone, settings):
+        bounded = attrs.evolve(alone, fit=None)  # the same changes, their bounds not looked at
+        if bound_hits(alone.current, alone.fit) and _explains(lik, bounded, settings):
+            error = lik.rms(lik.log_ratios(alone.current))
+            return outcome, words.tip_beyond_reach(change.where, change.place(values), error, floor)
+        return outcome, None
+    if say:
+        say(f"the search explained nothing; {change.where} taken at {change.place(values)} alone explains the data")
+    return attrs.evolve(alone, first_scored=alone.first_scored + outcome.first_scored,
+                        first_fitted=alone.first_fitted + outcome.first_fitted,
+                        search=dict(outcome.search, tip_alone=change.where)), None
 
 
 def _refuse_rotations(measurements) -> None:
@@ -259,6 +303,9 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
                 "or unit error; no change of the structure is fitted")
     outcome = refine_model(lik, screen_lik, cands, limit, lambda changes: _passive(lik, changes), say, meter,
                            lacking=bool(len(lacking)), settings=settings)
+    tip_note = None
+    if limit and not _explains(lik, outcome, settings):
+        outcome, tip_note = _tip_alone(lik, screen_lik, assembly, points, outcome, say, settings, floor)
     current = outcome.current
     p_now = sum(len(c.specs) for c, _ in current)
     steps = [Step(0, None, e0, chi2_now / n)]
@@ -363,6 +410,8 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     if not explained:  # the changes the cross-validation dropped, said where the verdict is read
         report = list(report) + [words.held_back(r["effect"], r["where"], r["chi2_with"], r["chi2_without"])
                                  for r in search.get("held_back", []) if not r["predicts"]]
+        if tip_note is not None:
+            report.append(tip_note)
     if search["cut"] and not explained:
         report = list(report) + [words.budget_cut(search["cut_at"])]
     # facts of the data, whatever the verdict

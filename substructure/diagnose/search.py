@@ -211,6 +211,24 @@ def _point_positions(assembly, measured_points: Sequence[str], reach: float) -> 
     return list({c.where: c for c in out}.values())
 
 
+def free_tips(assembly, measured_points: Sequence[str], reach: float) -> list[Change]:
+    """A measured free tip (``tool.tip``, nothing joined or supported there): a sensor cannot sit on the very edge,
+    nor a hammer strike it, so where the test was taken, up to ``reach`` towards the base, is a candidate.  Not one
+    of the search's: :func:`~substructure.diagnose.diagnose` tries these alone when the search explains nothing."""
+    held = {p for j in assembly.joints for p in j.between} | {s.at for s in assembly.supports}
+    out: list[Change] = []
+    for label in dict.fromkeys(measured_points):
+        try:
+            ref = parse_point(label)
+            comp = assembly.component(ref.component)
+        except SubstructureError:
+            continue
+        if reach > 0 and ref.where == "tip" and str(ref.point) not in held and isinstance(comp, Beam) \
+                and is_plain_beam(comp):
+            out.append(PointPosition(str(ref.point), comp.name, comp.length_m, comp.length_m, reach))
+    return list({c.where: c for c in out}.values())
+
+
 @attrs.frozen
 class Scored:
     """A candidate after screening (and possibly a full fit).
@@ -695,4 +713,4 @@ def physical(change: Change, values: dict) -> bool:
     return True
 
 
-__all__ += ["shortlist", "rank", "physical", "preference", "choose", "MEASURED", "ELEMENT"]
+__all__ += ["shortlist", "rank", "physical", "preference", "choose", "free_tips", "MEASURED", "ELEMENT"]

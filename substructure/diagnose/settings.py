@@ -334,7 +334,9 @@ class DiagnoseSettings:
         ``point-position``: its position fitted within this many metres of
         the one its name says (default 0.005; 0: not a candidate).  A sensor
         2 mm from where the record puts it otherwise came back as three
-        invented changes of the structure.
+        invented changes of the structure.  A measured free tip
+        (``tool.tip``) is tried alone, within this many metres towards its
+        base, after a search that explained nothing.
     calibration : float or None
         The relative uncertainty of the measured FRFs' common scale, the
         hammer's and the sensors' sensitivities (e.g. 0.05; default None: the

@@ -273,6 +273,28 @@ def held_back(effect: str, where: str, chi2_with: float, chi2_without: float) ->
             f"{chi2_without:.1f} without)")
 
 
+def tip_beyond_reach(point: str, place: str, error: float, floor: float) -> str:
+    """A measured free tip that, taken as far towards its base as the search goes, nearly explains the data.
+
+    Parameters
+    ----------
+    point : str
+        The tip as the measurements name it (``tool.tip``).
+    place : str
+        Where the search's reach ends (``tool.tip-5 mm``).
+    error, floor : float
+        The error with the tip there, and the noise floor.
+
+    Returns
+    -------
+    str
+        One line of the report.
+    """
+    return (f"{point} taken at {place}, as far as the search reaches (DiagnoseSettings.point_reach), brings the "
+            f"error to {error:.4g} ({error / floor:.2f} x the noise floor): was the test taken further from the "
+            f"edge? Give the point as measured ({point}-N mm) in the measurement set")
+
+
 def budget_cut(where: str) -> str:
     """The note that the search's budget cut it short.
 

@@ -284,12 +284,16 @@ class PointPosition(Change):
     def __init__(self, point: str, component: str, x: float, length: float, reach: float):
         self.where, self.component = point, component
         self.from_tip = ".tip-" in point  # the name's distance: from the tip, else from the base
+        self.tip = point == f"{component}.tip"  # the free tip itself: where the test was, said from the tip
         self.distance = float(length - x if self.from_tip else x)
         self.specs = (ParamSpec("shift", "m", max(0.0, x - reach) - x, min(length, x + reach) - x, 0.0, log=False),)
 
     def place(self, values) -> str:
-        """Where the point was, written as its name is (``tool.tip-22 mm`` for ``tool.tip-20 mm``)."""
+        """Where the point was, written as its name is (``tool.tip-22 mm`` for ``tool.tip-20 mm``; ``tool.tip-2 mm``
+        for a free tip)."""
         shift = float(values["shift"])
+        if self.tip:
+            return f"{self.component}.tip-{_mm(-shift)}"
         if self.from_tip:
             return f"{self.component}.tip-{_mm(self.distance - shift)}"
         return f"{self.component}@{_mm(self.distance + shift)}"
