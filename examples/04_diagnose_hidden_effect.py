@@ -18,7 +18,9 @@ only when it is statistically significant; (c) add the effect found to the
 model and save it as a TOML file; (d) the refinement: watch the error fall;
 (e) two hidden effects at once (flutes the model lacks, and a forgotten 2 g
 accelerometer); (f) an effect of your own, registered without touching the
-library (a heavy clamping nut on the holder).
+library (a heavy clamping nut on the holder); (g) a tip tested a few
+millimetres below its edge, as every real tap test is, but recorded as
+``tool.tip``.
 
 Figures are written to $SUBSTRUCTURE_EXAMPLES_OUT (default: out/examples).
 """
@@ -213,3 +215,21 @@ show_candidates(d4, n=3)
 print(f"    missing effect: {d4.missing_effect} at {d4.missing_where}; why: {d4.candidates[0].effect.explanation}")
 show_refinement(d4)
 save_history(d4, "04f_error_fall_clamping_nut.png")
+
+# %%
+# (g) A tip tested below its edge
+# -------------------------------
+# A sensor cannot sit on the tool's cutting edge, nor a hammer strike it: the
+# test was taken 2 mm below the tip (``tool.tip-2 mm``), the record says
+# ``tool.tip``.  That moves no mode; a search of the model's changes finds
+# nothing that explains it, so the diagnosis then tries the free tip alone,
+# towards its base: where it alone reaches the noise, that is the answer, and
+# the fix is to name the point where it was.
+print("8. (g) A tip tested 2 mm below its edge, recorded as tool.tip")
+below = simulate(model, ["tool.tip-2 mm"], frequency=model.frequency, noise=0.015, seed=8)
+relabelled = MeasurementSet(below.name, tuple(
+    attrs.evolve(m, response="tool.tip:y", excitation="tool.tip:y",
+                 frf=m.frf.with_labels(("tool.tip:y",), ("tool.tip:y",))) for m in below))
+d5 = diagnose(model, relabelled)
+print(f"    explained: {d5.explained}; missing effect: {d5.missing_effect} at {d5.missing_where}")
+print(f"    the search explained nothing, the tip alone did: {d5.search.get('tip_alone')}")
