@@ -196,18 +196,23 @@ def candidates(assembly, measured_points: Sequence[str], effects: dict, open_wor
     return [c for c in out if c not in empty]
 
 
-def _point_positions(assembly, measured_points: Sequence[str], reach: float) -> list[Change]:
-    """A measured point given at a distance along a beam (``tool.tip-20 mm``, ``holder@30 mm``: measured with a
-    ruler) may be a few millimetres off: its position, a candidate (the ends are where they are)."""
-    out: list[Change] = []
+def _measured_beams(assembly, measured_points: Sequence[str]):
+    """``(point, component)`` of each measured point on a plain beam, once each."""
     for label in dict.fromkeys(measured_points):
         try:
             ref = parse_point(label)
             comp = assembly.component(ref.component)
         except SubstructureError:
             continue
-        if reach > 0 and ref.where in ("at", "from_tip") and isinstance(comp, Beam) and is_plain_beam(comp):
-            out.append(PointPosition(str(ref.point), comp.name, comp.position(ref.point), comp.length_m, reach))
+        if isinstance(comp, Beam) and is_plain_beam(comp):
+            yield ref, comp
+
+
+def _point_positions(assembly, measured_points: Sequence[str], reach: float) -> list[Change]:
+    """A measured point given at a distance along a beam (``tool.tip-20 mm``, ``holder@30 mm``: measured with a
+    ruler) may be a few millimetres off: its position, a candidate (the ends are where they are)."""
+    out = [PointPosition(str(ref.point), comp.name, comp.position(ref.point), comp.length_m, reach)
+           for ref, comp in _measured_beams(assembly, measured_points) if reach > 0 and ref.where in ("at", "from_tip")]
     return list({c.where: c for c in out}.values())
 
 
@@ -216,16 +221,9 @@ def free_tips(assembly, measured_points: Sequence[str], reach: float) -> list[Ch
     nor a hammer strike it, so where the test was taken, up to ``reach`` towards the base, is a candidate.  Not one
     of the search's: :func:`~substructure.diagnose.diagnose` tries these alone when the search explains nothing."""
     held = {p for j in assembly.joints for p in j.between} | {s.at for s in assembly.supports}
-    out: list[Change] = []
-    for label in dict.fromkeys(measured_points):
-        try:
-            ref = parse_point(label)
-            comp = assembly.component(ref.component)
-        except SubstructureError:
-            continue
-        if reach > 0 and ref.where == "tip" and str(ref.point) not in held and isinstance(comp, Beam) \
-                and is_plain_beam(comp):
-            out.append(PointPosition(str(ref.point), comp.name, comp.length_m, comp.length_m, reach))
+    out = [PointPosition(str(ref.point), comp.name, comp.length_m, comp.length_m, reach)
+           for ref, comp in _measured_beams(assembly, measured_points)
+           if reach > 0 and ref.where == "tip" and str(ref.point) not in held]
     return list({c.where: c for c in out}.values())
 
 
