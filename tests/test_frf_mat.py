@@ -141,3 +141,15 @@ def test_lobes_read_an_accelerance_in_every_file_that_says_so_as_its_receptance(
         assert got["spindle_speed_rpm"] == expected["spindle_speed_rpm"], name
         np.testing.assert_allclose(got["depth_limit_m"], expected["depth_limit_m"], rtol=1e-6, err_msg=name)
         assert got["absolute_limit_m"] == pytest.approx(expected["absolute_limit_m"], rel=1e-6)
+    # files of two FRFs: --frf takes one, and says so
+    savemat(tmp_path / "two.mat", {"A": struct(a, "g/N", "H11", factor=1 / G, start=1.0, step=1.0),
+                                   "B": struct(2 * a, "g/N", "H21", factor=1 / G, start=1.0, step=1.0)})
+    pyuff.UFF(str(tmp_path / "accelerance.uff")).write_sets([pyuff.prepare_58(
+        func_type=4, rsp_node=2, rsp_dir=2, ref_node=1, ref_dir=2, data=2 * a, x=hz, abscissa_spacing=1,
+        abscissa_min=1.0, abscissa_inc=1.0, abscissa_spec_data_type=18, ordinate_spec_data_type=12,
+        orddenom_spec_data_type=13, ordinate_axis_units_lab="m/s^2", orddenom_axis_units_lab="N", id1="other")],
+        mode="add")
+    for name, message in (("two.mat", "2 FRF channels (H11, H21); --frf takes a file of one tool point FRF"),
+                          ("accelerance.uff", "2 FRF records (node1:y, node2:y / node1:y); --frf takes a file of one")):
+        assert main(["lobes", "--frf", str(tmp_path / name), *cut]) == 1
+        assert message in capsys.readouterr().err

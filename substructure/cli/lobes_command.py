@@ -50,11 +50,25 @@ def _read_frf(path):
     from ..frf.files.mat_reader import read_mat
 
     suffix = Path(path).suffix.lower()
-    if suffix in (".uff", ".unv"):
-        return FRF.from_uff(path)
-    if suffix == ".mat":
-        return read_mat(path)
+    if suffix in (".uff", ".unv", ".mat"):
+        frf = FRF.from_uff(path) if suffix != ".mat" else read_mat(path, record=_one_frf_channel(path))
+        if frf.shape[1:] != (1, 1):
+            raise SubstructureError(f"{path}: {frf.shape[1] * frf.shape[2]} FRF records ({', '.join(frf.outputs)} / "
+                                    f"{', '.join(frf.inputs)}); --frf takes a file of one tool point FRF: export "
+                                    "that record alone")
+        return frf
     return FRF.from_csv(path)
+
+
+def _one_frf_channel(path) -> int:
+    """The index of a MATLAB file's one FRF channel, or an error naming them for ``--frf``."""
+    from ..frf.files.mat_reader import frf_channels
+
+    found = frf_channels(path)
+    if len(found) != 1:
+        raise SubstructureError(f"{path}: {len(found)} FRF channels ({', '.join(n for _, n in found) or 'none'}); "
+                                "--frf takes a file of one tool point FRF: export that channel alone")
+    return found[0][0]
 
 
 def _check_sign(path, frf) -> None:

@@ -24,7 +24,7 @@ from ..axis import Frequency
 from ._common import frf_class
 from .uff_units import _TIME_EXPONENT, DecibelLabel, _a, _exponents, _unit_of_label
 
-__all__ = ["read_mat", "read_mat_coherence"]
+__all__ = ["read_mat", "read_mat_coherence", "frf_channels"]
 
 
 def _channels(path: str | os.PathLike) -> tuple[str, list[tuple[str, Signal]]]:
@@ -89,6 +89,13 @@ def _quantity(signal: Signal, where: str, given: str | None) -> tuple[str, float
                               f"{_a(by_label)}")
     force, length, time = exps  # type: ignore[misc]
     return by_label, float(unit.m_as(f"meter ** {length} / newton * second ** {time}"))
+
+
+def frf_channels(path: str | os.PathLike) -> list[tuple[int, str]]:
+    """``(record, name)`` of each FRF (a complex channel on a frequency axis) of a MATLAB file of signal
+    structures; a FileFormatError for a file with no channel on a frequency axis."""
+    _, found = _channels(path)
+    return [(k, key) for k, (key, s) in enumerate(found) if np.iscomplexobj(s.values)]
 
 
 def read_mat(path: str | os.PathLike, record: int | None = None, quantity: str | None = None,
