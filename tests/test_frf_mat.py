@@ -73,6 +73,9 @@ def test_a_group_of_frfs_needs_its_record_and_what_is_not_an_frf_is_said(tmp_pat
     with pytest.raises(FileFormatError, match=r"frf\[0\]\.file: .*2 complex channels"):
         load_measurements(measurement_set(tmp_path, ""))
     assert load_measurements(measurement_set(tmp_path, "record = 1\n")).measurements[0].frf.frequency.n == HZ.size
+    with pytest.raises(FileFormatError, match=r"frf\[0\]\.record: .*test.mat: got 5; .*test.mat has 3 channel\(s\) "
+                                              r"on a frequency axis, indices 0..2"):
+        load_measurements(measurement_set(tmp_path, "record = 5\n"))
 
 
 @pytest.mark.parametrize("content, message", [

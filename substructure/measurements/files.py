@@ -161,7 +161,12 @@ class _Reader:
                 frf, lines_of, columns, window = _read_csv(path, output=response, input=excitation,
                                                            quantity=quantity)
             elif suffix in _MAT:
-                frf = read_mat(path, record=record, quantity=quantity, output=response, input=excitation)
+                try:
+                    frf = read_mat(path, record=record, quantity=quantity, output=response, input=excitation)
+                except InvalidValueError as exc:  # an index beyond the file's channels
+                    if not str(exc).startswith("record:"):
+                        raise
+                    raise self.error(index, "record", f"{path}: {str(exc)[len('record: '):]}") from None
                 lines_of, columns, window = None, {}, None
             else:
                 frf = self.uff(index, path, record, quantity, response, excitation)

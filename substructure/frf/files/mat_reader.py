@@ -50,8 +50,10 @@ def _listing(found: list[tuple[str, Signal]]) -> str:
 
 def _chosen(name: str, found: list[tuple[str, Signal]], record, what: str) -> tuple[str, Signal, str]:
     if isinstance(record, bool) or not isinstance(record, (int, np.integer)) or not 0 <= record < len(found):
-        raise FileFormatError(f"{name}: {what} {record!r}; the file has {len(found)} channel(s) on a frequency "
-                              f"axis, indices 0..{len(found) - 1} ({_listing(found)})")
+        has = f"{len(found)} channel(s) on a frequency axis, indices 0..{len(found) - 1} ({_listing(found)})"
+        if what == "record":  # as read_uff says of a record index: the caller's argument, not the file, is wrong
+            raise InvalidValueError(f"record: got {record!r}; {name} has {has}")
+        raise FileFormatError(f"{name}: {what} {record!r}; the file has {has}")
     key, signal = found[int(record)]
     return key, signal, f"{name}, channel {int(record)} ({key})"
 
