@@ -130,6 +130,10 @@ def read_mat(path: str | os.PathLike, record: int | None = None, quantity: str |
         dB or one that is no response per force, a quantity that contradicts
         the unit, frequencies that do not increase, values that are not
         finite or all 0.
+    InvalidValueError
+        For a quantity that is none of the three, or a ``record`` beyond
+        the file's channels on a frequency axis (the message starts
+        ``record:``).
     """
     if quantity is not None and quantity not in QUANTITIES:
         raise InvalidValueError(f"quantity: got {quantity!r}; expected one of {', '.join(QUANTITIES)}")
