@@ -147,7 +147,7 @@ def _tip_alone(lik: Likelihood, screen_lik: Likelihood, assembly: Assembly, poin
                settings: DiagnoseSettings, floor: float) -> tuple:
     """``(outcome, note)``: where the search explained nothing, a measured free tip taken where the test could have
     been (towards the base, within ``settings.point_reach``) when that alone explains the data, else ``outcome``;
-    the note of the report when it would, but for the end of its reach (else None).
+    the note of the report when it alone removes at least ``settings.tip_share`` of the misfit (else None).
 
     A sensor cannot sit on a tool's very edge, nor a hammer strike it: a test labelled ``tool.tip`` was taken a
     few millimetres below it.  That moves no mode; tried among the search's candidates it took places on the
@@ -163,11 +163,14 @@ def _tip_alone(lik: Likelihood, screen_lik: Likelihood, assembly: Assembly, poin
         return outcome, None
     change, values = alone.current[0]
     if not _explains(lik, alone, settings):
-        bounded = attrs.evolve(alone, fit=None)  # the same changes, their bounds not looked at
-        if bound_hits(alone.current, alone.fit) and _explains(lik, bounded, settings):
-            error = lik.rms(lik.log_ratios(alone.current))
-            return outcome, words.tip_beyond_reach(change.where, change.place(values), error, floor)
-        return outcome, None
+        chi2_0 = lik.chi2([])
+        excess = chi2_0 - lik.n  # the misfit above what the noise makes
+        share = (chi2_0 - lik.chi2(alone.current)) / excess if excess > 0 else 0.0
+        if share < settings.tip_share:
+            return outcome, None
+        error = lik.rms(lik.log_ratios(alone.current))
+        return outcome, words.tip_nearly(change.where, change.place(values), share, error, floor,
+                                         bool(bound_hits(alone.current, alone.fit)))
     if say:
         say(f"the search explained nothing; {change.where} taken at {change.place(values)} alone explains the data")
     return attrs.evolve(alone, first_scored=alone.first_scored + outcome.first_scored,

@@ -273,26 +273,32 @@ def held_back(effect: str, where: str, chi2_with: float, chi2_without: float) ->
             f"{chi2_without:.1f} without)")
 
 
-def tip_beyond_reach(point: str, place: str, error: float, floor: float) -> str:
-    """A measured free tip that, taken as far towards its base as the search goes, nearly explains the data.
+def tip_nearly(point: str, place: str, share: float, error: float, floor: float, at_reach: bool) -> str:
+    """A measured free tip that, taken alone towards its base, nearly explains the data.
 
     Parameters
     ----------
     point : str
         The tip as the measurements name it (``tool.tip``).
     place : str
-        Where the search's reach ends (``tool.tip-5 mm``).
+        Where it was taken (``tool.tip-2 mm``).
+    share : float
+        The share of the misfit above the noise it removes.
     error, floor : float
         The error with the tip there, and the noise floor.
+    at_reach : bool
+        The place is as far as the search reaches (``DiagnoseSettings.point_reach``).
 
     Returns
     -------
     str
         One line of the report.
     """
-    return (f"{point} taken at {place}, as far as the search reaches (DiagnoseSettings.point_reach), brings the "
-            f"error to {error:.4g} ({error / floor:.2f} x the noise floor): was the test taken further from the "
-            f"edge? Give the point as measured ({point}-N mm) in the measurement set")
+    where = (f"{place}, as far as the search reaches (DiagnoseSettings.point_reach)" if at_reach else place)
+    return (f"{point} taken at {where} removes {share:.0%} of the misfit alone (error {error:.4g}, "
+            f"{error / floor:.2f} x the noise floor), not all of it: were the sensor and the hammer at different "
+            f"heights{', or further from the edge' if at_reach else ''}? Give each point as measured "
+            f"({point}-N mm) in the measurement set")
 
 
 def budget_cut(where: str) -> str:
