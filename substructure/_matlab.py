@@ -65,6 +65,7 @@ def load(data: bytes, name: str) -> dict:
 
 
 def text_value(value: Any) -> str | None:
+    """A MATLAB text (a char array, or a cell of one) stripped, else None."""
     if isinstance(value, str):
         return value.strip()
     array = np.asarray(value)
@@ -116,7 +117,7 @@ def flatten(content: dict, name: str) -> tuple[dict[str, Any], dict[str, Signal]
             if depth >= MAX_DEPTH:
                 skipped.append(f"{key} (structs nested deeper than {MAX_DEPTH})")
                 return
-            fields = value if isinstance(value, dict) else _stacked(key, elements, name)
+            fields = value if isinstance(value, dict) else _stacked(key, elements or [], name)
             for field, inner in fields.items():
                 visit(f"{key}.{field}", inner, depth + 1)
         else:
@@ -237,8 +238,8 @@ def _signal(key: str, value: dict, name: str, signals: dict[str, Signal], skippe
             offset = _number(transform.get("offset", 0.0), f"{where}.offset", name)
             if factor == 0:
                 raise FileFormatError(f"{name}: {where}.factor is 0; expected the factor to the label's unit")
-        channel = names[j] if names[j] and names[j] not in signals else \
-            (key if samples.shape[1] == 1 else f"{key}[{j + 1}]")
+        given = names[j]
+        channel = given if given and given not in signals else (key if samples.shape[1] == 1 else f"{key}[{j + 1}]")
         column = samples[:, j]
         column = column.astype(np.complex128 if column.dtype.kind == "c" else np.float64) * factor + offset
         signals[channel] = Signal(column, _label(q) or None, axis[0], start, step, key)
