@@ -111,7 +111,8 @@ def test_a_quantity_given_agrees_with_the_unit_or_stands_for_a_missing_one(tmp_p
 
 def test_lobes_read_an_accelerance_in_every_file_that_says_so_as_its_receptance(tmp_path, capsys):
     """A tool point accelerance whose file states its units (a CSV header in m/(N s^2), a universal file of data
-    type 12, a Testlab export in g/N) gives the lobes of its receptance; it was refused as a reversed sign."""
+    type 12, a Testlab export in g/N to MATLAB, a spreadsheet export in g/N with decimal commas) gives the lobes of
+    its receptance; it was refused as a reversed sign."""
     import json
 
     import pyuff
@@ -131,10 +132,12 @@ def test_lobes_read_an_accelerance_in_every_file_that_says_so_as_its_receptance(
         abscissa_min=1.0, abscissa_inc=1.0, abscissa_spec_data_type=18, ordinate_spec_data_type=12,
         orddenom_spec_data_type=13, ordinate_axis_units_lab="m/s^2", orddenom_axis_units_lab="N", id1="tip")])
     savemat(tmp_path / "accelerance.mat", {"FRF": struct(a, "g/N", "H1", factor=1 / G, start=1.0, step=1.0)})
+    export = "".join(f"{f:.1f};{v.real:.12e};{v.imag:.12e}\n".replace(".", ",") for f, v in zip(hz, a / G))
+    (tmp_path / "export.csv").write_text("Frequency (Hz);Real (g/N);Imaginary (g/N)\n" + export)
     cut = ["--teeth", "2", "--diameter", "12 mm", "--radial-depth", "6 mm", "--kt", "625 MPa", "--kn", "100 MPa",
            "--speeds", "2000:20000", "--json"]
     results = {}
-    for name in ("receptance.csv", "accelerance.csv", "accelerance.uff", "accelerance.mat"):
+    for name in ("receptance.csv", "accelerance.csv", "accelerance.uff", "accelerance.mat", "export.csv"):
         code = main(["lobes", "--frf", str(tmp_path / name), *cut])
         out = capsys.readouterr()
         assert code == 0, out.err
