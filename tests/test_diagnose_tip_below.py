@@ -42,6 +42,9 @@ def test_a_tip_tested_1_mm_below_it_is_found_where_it_was():
     assert found.values["shift"] == pytest.approx(-0.001, abs=5e-5)
     assert found.change.place(found.values) == "tool.tip-1 mm"
     assert result.search["tip_alone"] == "tool.tip"
+    # the search's own counts are kept; what was held back is that of the answer, not of the search's path
+    assert result.search["candidates"] > 1
+    assert [r["effect"] for r in result.search["held_back"]] in ([], ["point-position"])
 
 
 @pytest.mark.parametrize("mm", [2.0, 3.0])

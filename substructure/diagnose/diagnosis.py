@@ -175,7 +175,8 @@ def _tip_alone(lik: Likelihood, screen_lik: Likelihood, assembly: Assembly, poin
         say(f"the search explained nothing; {change.where} taken at {change.place(values)} alone explains the data")
     return attrs.evolve(alone, first_scored=alone.first_scored + outcome.first_scored,
                         first_fitted=alone.first_fitted + outcome.first_fitted,
-                        search=dict(outcome.search, tip_alone=change.where)), None
+                        search={**outcome.search, "held_back": alone.search.get("held_back", []),
+                                "tip_alone": change.where}), None
 
 
 def _refuse_rotations(measurements) -> None:
