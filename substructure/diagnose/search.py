@@ -210,7 +210,8 @@ def _measured_beams(assembly, measured_points: Sequence[str]):
 
 def _point_positions(assembly, measured_points: Sequence[str], reach: float) -> list[Change]:
     """A measured point given at a distance along a beam (``tool.tip-20 mm``, ``holder@30 mm``: measured with a
-    ruler) may be a few millimetres off: its position, a candidate (the ends are where they are)."""
+    ruler) may be a few millimetres off: its position, a candidate (a free tip is tried alone after the search:
+    :func:`free_tips`)."""
     out = [PointPosition(str(ref.point), comp.name, comp.position(ref.point), comp.length_m, reach)
            for ref, comp in _measured_beams(assembly, measured_points) if reach > 0 and ref.where in ("at", "from_tip")]
     return list({c.where: c for c in out}.values())

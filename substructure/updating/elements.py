@@ -14,8 +14,9 @@ component with its position fitted along it:
   over a fitted length at a fitted position: a neck, a groove, a collar.
   Written back as the component's segments split where it begins and ends.
 * :class:`PointPosition` (``point-position``): where a measured point given at
-  a distance really was, a few millimetres from its name's place: a change of
-  the test, not of the structure (nothing written back).
+  a distance really was, a few millimetres from its name's place, or where a
+  free tip was tested (``tool.tip-2 mm``): a change of the test, not of the
+  structure (nothing written back).
 
 The helper :func:`split_beam` cuts a beam's arrays at positions and scales a
 range of it, shared with the diagnosis catalogue's fluted section.
