@@ -35,7 +35,7 @@ from ...errors import FileFormatError, InvalidValueError, WindowedFRFWarning
 from .._fields import window_tau as _window_tau
 from ..axis import MAX_GRID_LINES, Frequency
 from ._common import _contradiction, _refuse_all_zero, _require_frf, _shown, frf_class
-from .uff_units import _TIME_EXPONENT, _exponents, _unit_of_label
+from .uff_units import _unit_of_label, frf_quantity
 
 if TYPE_CHECKING:  # the annotations only (frf.response imports this module)
     from ..response import FRF
@@ -61,13 +61,11 @@ def _quantity_of_unit(unit: str, cell: str, name: str, line: int) -> tuple[str, 
         q = _unit_of_label(unit)
     except ValueError:
         q = None
-    exps = _exponents(q) if q is not None else None
-    kind = _TIME_EXPONENT.get(exps[2]) if exps is not None and exps[0] == -1 and exps[1] in (1, 0, -1) else None
-    if kind is None:
+    found = frf_quantity(q)
+    if found is None:
         raise FileFormatError(f"{name}, line {line}: column {_shown(cell)}: the unit {_shown(unit)} is not that of a "
                               "receptance, mobility or accelerance (e.g. m/N, m/(N s), m/(N s^2), 1/N, 1/(N m))")
-    assert q is not None and exps is not None  # kind is found only for a unit read
-    return kind, float(q.m_as(f"meter ** {exps[1]} / newton * second ** {exps[2]}"))
+    return found
 
 
 def _units_header(header: str, name: str, line: int) -> tuple[str, str, float] | None:

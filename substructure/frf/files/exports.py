@@ -25,7 +25,7 @@ import numpy as np
 from ...errors import FileFormatError
 from ...units import bare_unit
 from ._common import _contradiction, _shown
-from .uff_units import _TIME_EXPONENT, _exponents, _frequency_unit, _unit_of_label
+from .uff_units import _frequency_unit, _unit_of_label, frf_quantity
 
 __all__ = ["parse_export"]
 
@@ -101,13 +101,11 @@ def _value_unit(unit: str | None, cell: str, name: str, line: int):
         q = _unit_of_label(unit)
     except ValueError:
         q = None
-    exps = _exponents(q) if q is not None else None
-    kind = _TIME_EXPONENT.get(exps[2]) if exps is not None and exps[:2] == (-1, 1) else None
-    if kind is None:
+    found = frf_quantity(q, lengths=(1,))
+    if found is None:
         raise FileFormatError(f"{name}, line {line}: column {_shown(cell)}: the unit {_shown(unit)} is not that of a "
                               "receptance, mobility or accelerance (e.g. m/N, mm/N, um/N, (m/s^2)/N, g/N)")
-    assert q is not None and exps is not None  # kind is found only for a unit read
-    return kind, float(q.m_as(f"meter / newton * second ** {exps[2]}"))
+    return found
 
 
 def _header_below(rows: list[tuple[int, str]], name: str) -> tuple[int, str] | None:

@@ -22,7 +22,7 @@ from ...errors import FileFormatError, InvalidValueError
 from .._fields import QUANTITIES
 from ..axis import Frequency
 from ._common import frf_class
-from .uff_units import _TIME_EXPONENT, DecibelLabel, _a, _exponents, _unit_of_label
+from .uff_units import DecibelLabel, _a, _unit_of_label, frf_quantity
 
 __all__ = ["read_mat", "read_mat_coherence", "frf_channels"]
 
@@ -81,16 +81,14 @@ def _quantity(signal: Signal, where: str, given: str | None) -> tuple[str, float
             raise FileFormatError(f"{where}: no unit (y_values.quantity.label is empty); give the quantity "
                                   "(quantity = \"...\" in the measurement set); values are then taken in SI units")
         return given, 1.0
-    exps = _exponents(unit)
-    by_label = None if exps is None or exps[0] != -1 or exps[1] not in (0, 1) else _TIME_EXPONENT.get(exps[2])
-    if by_label is None:
+    found = frf_quantity(unit, lengths=(1, 0))
+    if found is None:
         raise FileFormatError(f"{where}: the unit {signal.unit!r} is not a displacement, velocity or acceleration "
                               "per force: not a receptance, mobility or accelerance")
-    if given is not None and given != by_label:
+    if given is not None and given != found[0]:
         raise FileFormatError(f"{where}: the quantity given is {given}, but its unit {signal.unit!r} is that of "
-                              f"{_a(by_label)}")
-    force, length, time = exps  # type: ignore[misc]
-    return by_label, float(unit.m_as(f"meter ** {length} / newton * second ** {time}"))
+                              f"{_a(found[0])}")
+    return found
 
 
 def frf_channels(path: str | os.PathLike) -> list[tuple[int, str]]:

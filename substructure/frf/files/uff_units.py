@@ -103,6 +103,17 @@ def _exponents(q) -> tuple[int, int, int] | None:
     return m, n - m, t + 2 * m  # M^m L^n T^t = F^m L^(n-m) T^(t+2m)
 
 
+def frf_quantity(unit, lengths: tuple[int, ...] = (1, 0, -1)) -> tuple[str, float] | None:
+    """``(quantity, factor to SI)`` of an FRF's unit (a pint Quantity of 1, as :func:`_unit_of_label` gives):
+    a response per force whose length exponent is one of ``lengths`` (1: ``m/N``; 0: ``1/N``, a rotation per
+    force or a displacement per moment; -1: ``1/(N m)``), its time exponent saying the quantity
+    (:data:`_TIME_EXPONENT`); None for another unit or None."""
+    exps = _exponents(unit) if unit is not None else None
+    if exps is None or exps[0] != -1 or exps[1] not in lengths or exps[2] not in _TIME_EXPONENT:
+        return None
+    return _TIME_EXPONENT[exps[2]], float(unit.m_as(f"meter ** {exps[1]} / newton * second ** {exps[2]}"))
+
+
 class DecibelRecord(FileFormatError):
     """A record whose ordinate is labelled in decibels: refused even when the quantity is given."""
 
