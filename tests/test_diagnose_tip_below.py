@@ -100,3 +100,22 @@ def test_the_tip_alone_explains_no_other_effect(hidden):
     # nor is it named as nearly the answer: it removes far less of the misfit than tip_share
     chi2_0 = lik.chi2([])
     assert (chi2_0 - lik.chi2(outcome.current)) / (chi2_0 - lik.n) < 0.5 < DEFAULT_SETTINGS.tip_share
+
+
+@pytest.mark.parametrize("mm", [1.0, 3.0])
+def test_the_tip_found_on_the_driving_point_predicts_the_cross_frfs(mm):
+    """The tip's position fitted on the driving point alone predicts, within the noise, the FRFs it was not fitted
+    to: the responses 20 mm back and on the holder to a hammer at the tip depend on where the hammer struck."""
+    measured, _ = measured_frfs(_tested_below(mm))
+    driving = [m for m in measured if m.frf.outputs[0] == "tool.tip:y"]
+    others = [m for m in measured if m.frf.outputs[0] != "tool.tip:y"]
+    model = hd.nominal_model()
+    lik = Likelihood(model, driving)
+    tips = free_tips(model, ["tool.tip:y"], DEFAULT_SETTINGS.point_reach)
+    screen = lik.subsample(max(1, lik.lines.size // DEFAULT_SETTINGS.screen_lines))
+    (found,) = refine(lik, screen, tips, 1, lambda changes: True).current
+    assert found[0].place(found[1]) == f"tool.tip-{mm:g} mm"
+    held = Likelihood(model, others)
+    before = consistency(held, held.log_ratios([]), 0).consistent
+    after = consistency(held, held.log_ratios([found]), 0).consistent
+    assert after and not before
