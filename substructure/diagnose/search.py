@@ -425,8 +425,9 @@ def _refined(s: Scored, chi2_of, current, thorough: bool, settings: DiagnoseSett
             best_c, best_u = min(down)
             bracket = (lo, u0) if best_u < u0 else (u0, hi)
     if bracket is not None and bracket[1] > bracket[0]:
-        r = minimize_scalar(cost, bounds=bracket, method="bounded",
-                            options={"maxiter": settings.brent_evaluations, "xatol": settings.brent_tolerance})
+        with np.errstate(invalid="ignore", over="ignore"):  # a model refused inside the bracket costs inf
+            r = minimize_scalar(cost, bounds=bracket, method="bounded",
+                                options={"maxiter": settings.brent_evaluations, "xatol": settings.brent_tolerance})
         if np.isfinite(r.fun) and r.fun < best_c:
             best_u, best_c = float(r.x), float(r.fun)
     if np.isfinite(best_c) and best_c < s.chi2:
