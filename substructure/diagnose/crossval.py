@@ -40,7 +40,6 @@ import numpy as np
 
 from ..errors import SubstructureError
 from ..updating.fit import fit, from_u, to_u
-from ..updating.likelihood import Likelihood
 
 __all__ = ["CV_FOLDS", "CV_BLOCKS", "fold_masks", "held_back_chi2", "cross_validate"]
 
@@ -98,8 +97,8 @@ def _refitted(likelihood, changes: list, masks: Sequence[np.ndarray]) -> np.ndar
     out = []
     for held in masks:
         per_line = held[:n_lines]
-        kept = Likelihood(likelihood.assembly, likelihood.measured, likelihood.lines[~per_line], likelihood.calibration)
-        back = Likelihood(likelihood.assembly, likelihood.measured, likelihood.lines[per_line], likelihood.calibration)
+        kept = likelihood.same(lines=likelihood.lines[~per_line])
+        back = likelihood.same(lines=likelihood.lines[per_line])
         try:
             values = fit(kept, changes).changes
         except (SubstructureError, ValueError, FloatingPointError):

@@ -44,8 +44,10 @@ from .compare import METRIC, Comparison, _pairs, frac, error_bands
 from .effects import Effect, registry
 from .refine import refine as refine_model, trim_partial
 from . import words
+from .claims import bound_hits, bound_text, explains, passive
 from .result import Alternatives, Candidate, Changes, Diagnosis, Found, Measures, Step, Verdict, _finite, strict
-from .search import Budget, candidates, free_tips
+from .search import Budget, candidates
+from .tip import tip_fallback
 from .settings import DEFAULT_SETTINGS, FROM_SETTINGS, DiagnoseSettings, _FromSettings, _real
 
 __all__ = ["Found", "Candidate", "Step", "Diagnosis", "diagnose", "strict", "sites"]
@@ -106,21 +108,6 @@ def _peak_lines(baseline, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> np.n
     return np.unique(np.array(keep, dtype=int))
 
 
-def _passive(lik: Likelihood, changes) -> bool:
-    """Every joint, support and body of the changed model is passive (PSD matrices, masses >= 0)."""
-    for g in lik.groups:
-        s = g.structure_with(changes)
-        for link in s.links:
-            if link.rigid or link.custom is not None:
-                continue
-            for m in (link.K, link.C, link.M):
-                sym = 0.5 * (m + m.T)
-                scale = max(abs(sym).max(), 1e-300)
-                if np.linalg.eigvalsh(sym).min() < -1e-9 * scale:
-                    return False
-    return True
-
-
 def _main_shift(comparison: Comparison, share: float) -> float:
     pairs = [m for m in comparison.modes if m.model_hz is not None]
     if not pairs:
@@ -129,54 +116,6 @@ def _main_shift(comparison: Comparison, share: float) -> float:
     strong = [m for m in pairs if m.measured_amplitude >= share * top] or pairs
     best = max(strong, key=lambda m: abs(m.model_hz / m.measured_hz - 1))
     return float(best.model_hz / best.measured_hz - 1)
-
-
-def _explains(lik: Likelihood, outcome, settings: DiagnoseSettings) -> bool:
-    """The outcome's changes could be claimed: within the noise (consistent, the error within the explained
-    factor), at most ``settings.most_changes`` of them, none on the bound of its search."""
-    current = outcome.current
-    if not current or len(current) > settings.most_changes or bound_hits(current, outcome.fit):
-        return False
-    ratios = lik.log_ratios(current)
-    p = sum(len(c.specs) for c, _ in current)
-    return bool(consistency(lik, ratios, p).consistent
-                and error_check(lik, ratios, settings.explained_error_factor).passed)
-
-
-def _tip_alone(lik: Likelihood, screen_lik: Likelihood, assembly: Assembly, points: list, outcome, say,
-               settings: DiagnoseSettings, floor: float) -> tuple:
-    """``(outcome, note)``: where the search explained nothing, a measured free tip taken where the test could have
-    been (towards the base, within ``settings.point_reach``) when that alone explains the data, else ``outcome``;
-    the note of the report when it alone removes at least ``settings.tip_share`` of the misfit (else None).
-
-    A sensor cannot sit on a tool's very edge, nor a hammer strike it: a test labelled ``tool.tip`` was taken a
-    few millimetres below it.  That moves no mode; tried among the search's candidates it took places on the
-    shortlist from the changes a search needs, so it is tried on its own, after the search."""
-    import attrs
-
-    tips = free_tips(assembly, points, settings.point_reach)
-    if not tips:
-        return outcome, None
-    alone = refine_model(lik, screen_lik, tips, 1, lambda changes: _passive(lik, changes), None, None,
-                         settings=settings)
-    if not alone.current:
-        return outcome, None
-    change, values = alone.current[0]
-    if not _explains(lik, alone, settings):
-        chi2_0 = lik.chi2([])
-        excess = chi2_0 - lik.n  # the misfit above what the noise makes
-        share = (chi2_0 - lik.chi2(alone.current)) / excess if excess > 0 else 0.0
-        if share < settings.tip_share:
-            return outcome, None
-        error = lik.rms(lik.log_ratios(alone.current))
-        return outcome, words.tip_nearly(change.where, change.place(values), share, error, floor,
-                                         bool(bound_hits(alone.current, alone.fit)))
-    if say:
-        say(f"the search explained nothing; {change.where} taken at {change.place(values)} alone explains the data")
-    return attrs.evolve(alone, first_scored=alone.first_scored + outcome.first_scored,
-                        first_fitted=alone.first_fitted + outcome.first_fitted,
-                        search={**outcome.search, "held_back": alone.search.get("held_back", []),
-                                "tip_alone": change.where}), None
 
 
 def _refuse_rotations(measurements) -> None:
@@ -305,11 +244,11 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         if say:
             say("every measured FRF is a constant factor times the model with every mode in place: a calibration "
                 "or unit error; no change of the structure is fitted")
-    outcome = refine_model(lik, screen_lik, cands, limit, lambda changes: _passive(lik, changes), say, meter,
+    outcome = refine_model(lik, screen_lik, cands, limit, lambda changes: passive(lik, changes), say, meter,
                            lacking=bool(len(lacking)), settings=settings)
     tip_note = None
-    if limit and not _explains(lik, outcome, settings):
-        outcome, tip_note = _tip_alone(lik, screen_lik, assembly, points, outcome, say, settings, floor)
+    if limit and not explains(lik, outcome, settings):
+        outcome, tip_note = tip_fallback(lik, screen_lik, assembly, points, outcome, say, settings, floor)
     current = outcome.current
     p_now = sum(len(c.specs) for c, _ in current)
     steps = [Step(0, None, e0, chi2_now / n)]
@@ -591,65 +530,6 @@ def _same_part_replacements(assembly, final_effects, outcome, settings: Diagnose
         if same_parts and len(new) == 1 and len(gone) == 1:
             out.append((gone[0], new[0], founds))
     return out
-
-
-PHYSICAL_ENDS = ("position", "start", "inset", "inset_tip", "length", "end")
-"""Parameters whose bounds are the ends of a component (a body at the tip, a section over the whole tool):
-places, not limits of a search, so that a value on them is a finding."""
-
-
-def bound_hits(current, fit) -> list[tuple[int, str, float, float, str]]:
-    """The fitted parameters of the kept changes that ended on a bound of their search.
-
-    Parameters
-    ----------
-    current : sequence of (Change, dict)
-        The kept changes with their values.
-    fit : Fit or None
-        Their joint fit (``at_bound`` per fitted parameter).
-
-    Returns
-    -------
-    list of (change index, parameter name, value, bound, "lower" or "upper")
-        One entry per parameter on a bound.
-    """
-    if fit is None:
-        return []
-    out = []
-    for (i, name), on in zip(fit.names, fit.at_bound):
-        if not on or i >= len(current):
-            continue
-        change, values = current[i]
-        spec = next((sp for sp in change.specs if sp.name == name), None)
-        if spec is None or name not in values or name in PHYSICAL_ENDS:
-            continue
-        value = float(values[name])
-        side = "lower" if abs(value - spec.lower) <= abs(value - spec.upper) else "upper"
-        if side == "lower" and spec.log and spec is not change.specs[0]:
-            continue  # a secondary size at its floor: none detectable (a sensor's rotary inertia), not a limit
-        out.append((i, name, value, float(spec.lower if side == "lower" else spec.upper), side))
-    return out
-
-
-def bound_text(current, hit) -> str:
-    """One bound hit in words: the change, the parameter, its value and the bound.
-
-    Parameters
-    ----------
-    current : sequence of (Change, dict)
-        The kept changes.
-    hit : tuple
-        An entry of :func:`bound_hits`.
-
-    Returns
-    -------
-    str
-        E.g. ``"joint-damping at holder-tool: c_yf = 240 N*s/m, the upper bound of its search"``.
-    """
-    i, name, value, bound, side = hit
-    change = current[i][0]
-    unit = next((sp.unit for sp in change.specs if sp.name == name), "")
-    return words.bound_text(change.effect, change.where, name, value, unit, side, bound)
 
 
 def _std_of(result, change) -> dict:

@@ -59,7 +59,6 @@ import numpy as np
 from ..errors import SubstructureError
 from ..updating.fit import Fit, fit, to_u
 from ..updating.selection import INDIFFERENCE, bic, consistency, significance
-from ..updating.likelihood import Likelihood
 from .crossval import cross_validate
 from .effects import EffectChange
 from .modes import mode_starts
@@ -477,7 +476,7 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
     n = lik.n
     search = {"candidates": len(cands), "steps_screened": 0, "full_fits": 0, "cut": False, "cut_at": None,
               "held_back": []}
-    lik0 = Likelihood(lik.assembly, lik.measured[:1], calibration=lik.calibration)
+    lik0 = lik.same(measured=lik.measured[:1])
     if budget is not None:
         budget.watch(lik, screen_lik, lik0)
 

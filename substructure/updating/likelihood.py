@@ -472,7 +472,24 @@ class Likelihood:
         if keep is not None and len(keep):
             keep = np.asarray(keep, dtype=int)
             lines = np.union1d(lines, self.lines[keep[(keep >= 0) & (keep < self.lines.size)]])
-        return Likelihood(self.assembly, self.measured, lines, self.calibration)
+        return self.same(lines=lines)
+
+    def same(self, measured: Sequence[Measured] | None = None, lines: np.ndarray | None = None) -> "Likelihood":
+        """The same model and calibration on other data or lines.
+
+        Parameters
+        ----------
+        measured : sequence of Measured, optional
+            The data (default: these).
+        lines : ndarray of int, optional
+            Indices of the lines to use (default: all of the data's).
+
+        Returns
+        -------
+        Likelihood
+            The new likelihood.
+        """
+        return Likelihood(self.assembly, self.measured if measured is None else measured, lines, self.calibration)
 
     def predict(self, changes: Sequence[tuple] = ()) -> list[np.ndarray]:
         """Model values per measured FRF on the lines used.
