@@ -159,3 +159,19 @@ def test_lobes_read_an_accelerance_in_every_file_that_says_so_as_its_receptance(
                           ("accelerance.uff", "2 FRF records (node1:y, node2:y / node1:y); --frf takes a file of one")):
         assert main(["lobes", "--frf", str(tmp_path / name), *cut]) == 1
         assert message in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("values, unit, shown", [(np.where(HZ > 300, 1.2, GAMMA), "", "1.2"),
+                                                 (np.where(HZ > 300, np.nan, GAMMA), "", "nan"),
+                                                 (GAMMA * 100 + 5, "%", r"1\.0\d+;")])
+def test_a_coherence_outside_0_to_1_is_refused_at_its_first_bad_line(tmp_path, values, unit, shown):
+    """In a fraction or in %: the channel, the line and the value named (a rounding just above 1 is clipped)."""
+    path = tmp_path / "test.mat"
+    savemat(path, {"FRF": struct(H, "m/N", "H11"), "Coh": struct(values, unit, "Coherence", kind="Coherence")})
+    scaled = values * (0.01 if unit else 1.0)
+    k = int(np.argmax(~(np.isfinite(scaled) & (scaled <= 1.0 + 1e-6))))
+    with pytest.raises(FileFormatError, match=rf"channel 1 \(Coherence\): value {k + 1} is {shown}"):
+        read_mat_coherence(path, 1)
+    savemat(path, {"FRF": struct(H, "m/N", "H11"), "Coh": struct(np.where(HZ > 300, 1 + 5e-7, GAMMA), "",
+                                                                 "Coherence", kind="Coherence")})
+    assert read_mat_coherence(path, 1)[1].max() == 1.0

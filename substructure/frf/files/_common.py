@@ -82,6 +82,17 @@ def _require_frf(frf: Any, function: str) -> Any:
     return frf
 
 
+def coherence_checked(values: np.ndarray, where: str, shown: np.ndarray | None = None) -> np.ndarray:
+    """A coherence read from a file: each value finite and in [0, 1] (rounding above 1 clipped), else a
+    ``FileFormatError`` naming ``where`` and the first bad value (as ``shown`` holds it, default ``values``)."""
+    bad = ~(np.isfinite(values) & (values >= 0.0) & (values <= 1.0 + 1e-6))
+    if bad.any():
+        k = int(np.argmax(bad))
+        value = np.asarray(values if shown is None else shown)[k].item()  # a Python number: 1.2, not np.float64(1.2)
+        raise FileFormatError(f"{where}: value {k + 1} is {value!r}; expected a coherence in [0, 1]")
+    return np.minimum(values, 1.0)
+
+
 def _refuse_all_zero(frf: Any, name: str) -> None:
     """Readers take an FRF that is 0 at every line for a dead channel: such a file is not written."""
     dead = ~np.any(frf.data, axis=0)

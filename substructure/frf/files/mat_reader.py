@@ -21,7 +21,7 @@ from ..._matlab import Signal, flatten, load
 from ...errors import FileFormatError, InvalidValueError
 from .._fields import QUANTITIES
 from ..axis import Frequency
-from ._common import frf_class
+from ._common import coherence_checked, frf_class
 from .uff_units import DecibelLabel, _a, _unit_of_label, frf_quantity
 
 __all__ = ["read_mat", "read_mat_coherence", "frf_channels"]
@@ -184,9 +184,5 @@ def read_mat_coherence(path: str | os.PathLike, record: int) -> tuple[np.ndarray
     if np.iscomplexobj(signal.values) or unit not in ("", "-", "1", "%"):
         raise FileFormatError(f"{where}: {'complex values' if np.iscomplexobj(signal.values) else repr(unit)}; "
                               "expected a coherence (real values in [0, 1], no unit)")
-    values = signal.values * (0.01 if unit == "%" else 1.0)
-    bad = ~(np.isfinite(values) & (values >= 0.0) & (values <= 1.0 + 1e-6))
-    if bad.any():
-        k = int(np.argmax(bad))
-        raise FileFormatError(f"{where}: value {k + 1} is {values[k]!r}; expected a coherence in [0, 1]")
-    return _grid(signal, where).hz, np.minimum(values, 1.0)
+    values = coherence_checked(signal.values * (0.01 if unit == "%" else 1.0), where)
+    return _grid(signal, where).hz, values

@@ -17,7 +17,7 @@ import numpy as np
 from ...errors import FileFormatError, InvalidValueError
 from .._fields import QUANTITIES
 from ..axis import Frequency
-from ._common import _GRID_LINE, frf_class
+from ._common import _GRID_LINE, coherence_checked, frf_class
 
 if TYPE_CHECKING:  # the annotations only (frf.response imports this module)
     from ..response import FRF
@@ -370,10 +370,6 @@ def read_uff_coherence(path: str | os.PathLike, record: int) -> tuple[np.ndarray
         kind = _FUNCTION_TYPES.get(function, f"function type {function}")
         raise FileFormatError(f"{where}: {_a(kind)} (function type {function}), not a coherence (type 6)")
     data = np.asarray(dset["data"])
-    values = np.real(data).astype(np.float64)
-    bad = ~(np.isfinite(values) & (values >= 0.0) & (values <= 1.0 + 1e-6)) | (np.abs(np.imag(data)) > 1e-9)
-    if bad.any():
-        k = int(np.argmax(bad))
-        raise FileFormatError(f"{where}: value {k + 1} is {data[k]!r}; expected a coherence in [0, 1]")
-    return _abscissa_hz(dset, where), np.minimum(values, 1.0)
+    values = np.where(np.abs(np.imag(data)) > 1e-9, np.nan, np.real(data)).astype(np.float64)
+    return _abscissa_hz(dset, where), coherence_checked(values, where, shown=data)
 
