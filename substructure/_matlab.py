@@ -78,7 +78,8 @@ def _number(value: Any, where: str, name: str) -> float:
     try:
         number = float(np.asarray(value, dtype=float).reshape(-1)[0])
     except (TypeError, ValueError, IndexError):
-        raise FileFormatError(f"{name}: {where} is {value!r}; expected a number") from None
+        shown = "empty" if np.size(value) == 0 else f"{value!r}"
+        raise FileFormatError(f"{name}: {where} is {shown}; expected a number") from None
     if not np.isfinite(number):
         raise FileFormatError(f"{name}: {where} is {number!r}; expected a finite number")
     return number
@@ -241,5 +242,6 @@ def _signal(key: str, value: dict, name: str, signals: dict[str, Signal], skippe
         given = names[j]
         channel = given if given and given not in signals else (key if samples.shape[1] == 1 else f"{key}[{j + 1}]")
         column = samples[:, j]
-        column = column.astype(np.complex128 if column.dtype.kind == "c" else np.float64) * factor + offset
+        with np.errstate(invalid="ignore", over="ignore"):  # a value not finite: its reader refuses it by place
+            column = column.astype(np.complex128 if column.dtype.kind == "c" else np.float64) * factor + offset
         signals[channel] = Signal(column, _label(q) or None, axis[0], start, step, key)

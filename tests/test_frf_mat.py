@@ -4,6 +4,8 @@ receptance."""
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 from scipy.io import savemat
@@ -175,3 +177,19 @@ def test_a_coherence_outside_0_to_1_is_refused_at_its_first_bad_line(tmp_path, v
     savemat(path, {"FRF": struct(H, "m/N", "H11"), "Coh": struct(np.where(HZ > 300, 1 + 5e-7, GAMMA), "",
                                                                  "Coherence", kind="Coherence")})
     assert read_mat_coherence(path, 1)[1].max() == 1.0
+
+
+def test_a_value_not_finite_or_an_empty_number_is_refused_by_name_without_a_warning(tmp_path):
+    path = tmp_path / "test.mat"
+    values = H.copy()
+    values[5] = np.inf
+    savemat(path, {"FRF": struct(values, "g/N", "H11", factor=1 / G)})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # inf times the factor: refused as a value, not warned about
+        with pytest.raises(FileFormatError, match=r"channel 0 \(H11\): value 6 is \(inf\+nanj\); expected finite"):
+            read_mat(path)
+    frf = struct(H, "m/N", "H11")
+    frf["x_values"]["start_value"] = np.array([])
+    savemat(path, {"FRF": frf})
+    with pytest.raises(FileFormatError, match=r"FRF\.x_values\.start_value is empty; expected a number"):
+        read_mat(path)
