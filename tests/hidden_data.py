@@ -100,7 +100,7 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
             tool_nu: float = 0.22, ht_loss: float = 0.0,
             drawbar: bool = False, taper: float | None = None, taper_pieces: int = 8, insert_length: float = 0.040,
             tool_bore: float = 0.0, bearing_moved: tuple[int, float] | None = None,
-            spindle_body: tuple[float, float, float] | None = None, seed: int = 0,
+            spindle_body: tuple[float, float, float] | None = None, sensor_below: float = 0.0, seed: int = 0,
             points=("tool.tip",), excitation: str = "tool.tip", noise: float = 0.015, phase_deg: float = 0.5,
             floor: float = 1e-3) -> list[FRF]:
     """FRFs of the rig with the hidden effects, noisy (response at each point, hammer at ``excitation``).
@@ -118,7 +118,8 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
     stays 66 mm, its 40 mm collar longer by as much as the insert is shorter); tool_bore, a coolant bore
     through the whole tool [m] (the shank in the holder too); bearing_moved, (index, position m) of one
     bearing placed elsewhere than the model says (with ``bearings``); spindle_body, (mass kg, rotary inertia
-    kg m^2, x m) of a body on the spindle (a pulley, a rotary union at its rear end).
+    kg m^2, x m) of a body on the spindle (a pulley, a rotary union at its rear end); sensor_below, how far below the
+    tool's tip the sensor of ``sensor_kg`` sits [m] (a sensor cannot sit on the cutting edge).
     """
     cb = fe.Material(tool_E, tool_nu, tool_rho, 0.002)
     m = fe.Model()
@@ -154,7 +155,9 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
         pieces = [(cuts[1], fe.section(0.012, tool_bore, cb))]
     if flutes:
         pieces.append((fl_len, fe.fluted(0.012, fl_ratio, cb)))
-    t = m.add_beam([pc for pc in pieces if pc[0] > 0], points=wanted["tool"])
+    sensor_x = tool_length - sensor_below
+    t = m.add_beam([pc for pc in pieces if pc[0] > 0],
+                   points=wanted["tool"] + ([sensor_x] if sensor_below and sensor_x not in wanted["tool"] else []))
     k_sh, c_sh = (np.array(x, dtype=float) for x in NOMINAL["sh"])
     k_sh[1, 1] *= sh_ktm_scale
     k_sh[0, 1] = k_sh[1, 0] = sh_cross
@@ -165,7 +168,7 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
     c_ht *= ht_damping
     m.add_joint((h, 0.066), (t, 0.0), k_ht * (1 + 1j * ht_loss), c_ht)
     if sensor_kg:
-        m.add_mass((t, tool_length), sensor_kg, 0.0)
+        m.add_mass((t, sensor_x), sensor_kg, 0.0)
     if nut:
         m.add_mass((h, nut[2]), nut[0], nut[1])
     if spindle_body:

@@ -22,13 +22,13 @@ from substructure.updating import Likelihood, measured_frfs
 from substructure.updating.selection import consistency
 
 
-def _tested_below(mm: float, **hidden) -> MeasurementSet:
+def _tested_below(mm: float, offset: int = 11, **hidden) -> MeasurementSet:
     """The rig's tip FRFs taken ``mm`` below the tip (hit and sensor), labelled ``tool.tip``, with real noise."""
     where = f"tool.tip-{mm:g} mm" if mm else "tool.tip"
     exact = hd.measure(points=(where, "tool.tip-20 mm", "holder.tip"), excitation=where, noise=0.0, phase_deg=0.0,
                        floor=0.0, **hidden)
     out = []
-    for frf in with_real_noise(exact, 11, 1.0):
+    for frf in with_real_noise(exact, offset, 1.0):
         response = "tool.tip:y" if frf.outputs[0] == f"{where}:y" else frf.outputs[0]
         out.append(Measurement(response, "tool.tip:y", frf.with_labels((response,), ("tool.tip:y",)), averages=5))
     return MeasurementSet("tip below", out)
@@ -79,6 +79,30 @@ def test_a_sensor_and_a_hammer_at_different_heights_are_named_not_claimed():
     assert not result.verdict.explained
     (note,) = [line for line in result.verdict.report if line.startswith("tool.tip taken at tool.tip-1.")]
     assert "of the misfit alone" in note and "were the sensor and the hammer at different heights?" in note
+
+
+def test_a_sensor_below_the_tip_is_found_where_it_sat_and_predicts_the_cross_frfs():
+    """The usual tap test: the model lacks the sensor, which sat 2 mm below the edge (1 g, where the hammer struck).
+    The search alone explains nothing, nor does the tip's position alone (the sensor lowers the modes); the tip
+    fitted together with the sensor on it explains the driving point, and the two predict, within the noise, the
+    cross FRFs they were not fitted to (20 mm back and on the holder)."""
+    measured, _ = measured_frfs(_tested_below(2.0, offset=1500, sensor_kg=0.001, sensor_below=0.002))
+    driving = [m for m in measured if m.frf.outputs[0] == "tool.tip:y"]
+    model = hd.nominal_model()
+    result = diagnose(model, driving, progress=False)
+    assert result.verdict.explained, result.verdict.report
+    found = {e.change.effect: e for e in result.changes.final_effects}
+    assert set(found) == {"point-position", "sensor-mass"} and result.search["tip_alone"] == "tool.tip"
+    tip, sensor = found["point-position"], found["sensor-mass"]
+    assert tip.change.place(tip.values) == "tool.tip-2 mm" and sensor.change.where == "tool.tip"
+    assert sensor.values["mass"] == pytest.approx(0.001, rel=0.05)
+    held = Likelihood(model, [m for m in measured if m.frf.outputs[0] != "tool.tip:y"])
+    kept = [(e.change, dict(e.values)) for e in result.changes.final_effects]
+    assert consistency(held, held.log_ratios(kept), 0).consistent
+    assert not consistency(held, held.log_ratios([]), 0).consistent
+    # neither alone: the tip without the sensor, nor the sensor at the edge, predicts them
+    for one in kept:
+        assert not consistency(held, held.log_ratios([one]), 0).consistent, one[0].effect
 
 
 @pytest.mark.parametrize("hidden", [dict(sensor_kg=0.003), dict(sensor_kg=0.0005), dict(ht_scale=0.8),

@@ -248,7 +248,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
                            lacking=bool(len(lacking)), settings=settings)
     tip_note = None
     if limit and not explains(lik, outcome, settings):
-        outcome, tip_note = tip_fallback(lik, screen_lik, assembly, points, outcome, say, settings, floor)
+        outcome, tip_note = tip_fallback(lik, screen_lik, assembly, points, cands, outcome, say, settings, floor)
     current = outcome.current
     p_now = sum(len(c.specs) for c, _ in current)
     steps = [Step(0, None, e0, chi2_now / n)]

@@ -7,8 +7,12 @@ candidates it took places on the shortlist from the changes a search needs.
 So where the search explained nothing and a measured point is a free tip
 (:func:`~substructure.diagnose.search.free_tips`), :func:`tip_fallback` fits
 the tip's position alone: where that alone explains the data, it is the
-answer; where it removes at least ``settings.tip_share`` of the misfit, the
-report says so without claiming it.
+answer.  Else the tip's position is fitted together with what the test put
+at that point (the search's test-only candidates there: a sensor the model
+lacks, for the sensor sat where the test was, not on the edge): where the two
+explain the data, they are the answer.  Else, where the tip alone removes at
+least ``settings.tip_share`` of the misfit, the report says so without
+claiming it.
 """
 
 from __future__ import annotations
@@ -25,8 +29,8 @@ from .settings import DiagnoseSettings
 __all__ = ["tip_fallback"]
 
 
-def tip_fallback(lik: Likelihood, screen_lik: Likelihood, assembly, points: list, outcome: Outcome, say,
-                 settings: DiagnoseSettings, floor: float) -> tuple[Outcome, str | None]:
+def tip_fallback(lik: Likelihood, screen_lik: Likelihood, assembly, points: list, cands: list, outcome: Outcome,
+                 say, settings: DiagnoseSettings, floor: float) -> tuple[Outcome, str | None]:
     """``(outcome, note)`` after a search that explained nothing (see the module docstring).
 
     Parameters
@@ -37,6 +41,8 @@ def tip_fallback(lik: Likelihood, screen_lik: Likelihood, assembly, points: list
         The model.
     points : list of str
         The measured points (``component.point:dof``).
+    cands : list of Change
+        The search's candidates (the test-only ones at the tip are fitted with it).
     outcome : Outcome
         What the search gave.
     say : callable or None
@@ -61,11 +67,20 @@ def tip_fallback(lik: Likelihood, screen_lik: Likelihood, assembly, points: list
     change, values = alone.current[0]
     firsts = {"first_scored": alone.first_scored + outcome.first_scored,
               "first_fitted": alone.first_fitted + outcome.first_fitted}
-    if explains(lik, alone, settings):
+    found = alone if explains(lik, alone, settings) else None
+    at_tip = [c for c in cands if c.test_only and c.where == change.where and c.effect != change.effect]
+    if found is None and at_tip:
+        both = refine(lik, screen_lik, [change, *at_tip], 2, lambda changes: passive(lik, changes), None, None,
+                      settings=settings)
+        if any(c is change for c, _ in both.current) and explains(lik, both, settings):
+            found = both
+    if found is not None:
         if say:
-            say(f"the search explained nothing; {change.where} taken at {change.place(values)} alone explains "
-                "the data")
-        return attrs.evolve(alone, **firsts, search={**outcome.search, "held_back": alone.search.get("held_back", []),
+            at = next(v for c, v in found.current if c is change)
+            kept = " and ".join(f"{c.effect} at {c.where}" for c, _ in found.current if c is not change)
+            say(f"the search explained nothing; {change.where} taken at {change.place(at)}"
+                f"{' with ' + kept if kept else ' alone'} explains the data")
+        return attrs.evolve(found, **firsts, search={**outcome.search, "held_back": found.search.get("held_back", []),
                                                      "tip_alone": change.where}), None
     chi2_0 = lik.chi2([])
     excess = chi2_0 - lik.n  # the misfit above what the noise makes
