@@ -20,7 +20,8 @@ model and save it as a TOML file; (d) the refinement: watch the error fall;
 accelerometer); (f) an effect of your own, registered without touching the
 library (a heavy clamping nut on the holder); (g) a tip tested a few
 millimetres below its edge, as every real tap test is, but recorded as
-``tool.tip``.
+``tool.tip``; (h) the usual tap test: the accelerometer the record forgot,
+sitting 2 mm below the edge where the test was.
 
 Figures are written to $SUBSTRUCTURE_EXAMPLES_OUT (default: out/examples).
 """
@@ -233,3 +234,26 @@ relabelled = MeasurementSet(below.name, tuple(
 d5 = diagnose(model, relabelled)
 print(f"    explained: {d5.explained}; missing effect: {d5.missing_effect} at {d5.missing_where}")
 print(f"    the search explained nothing, the tip alone did: {d5.search.get('tip_alone')}")
+
+# %%
+# (h) The usual tap test: a sensor the record forgot, below the edge
+# ------------------------------------------------------------------
+# What a real test of a model without its accelerometer looks like: the
+# 2 g sensor sat 2 mm below the edge, where the hammer struck too, and the
+# record says ``tool.tip`` without the sensor.  The sensor lowers the modes,
+# which the tip's position alone cannot do, and the search, without the
+# tip, ends elsewhere.  So the tip is fitted together with what a test puts
+# at that point (a sensor on it, which then sits at the tip's fitted place):
+# the two are the answer, the sensor's mass and where the test was.
+print("9. (h) A 2 g sensor 2 mm below the edge, forgotten by the record, which says tool.tip")
+rig_below = model.attach(Sensor("accelerometer", "tool.tip-2 mm", "2 g"))
+below = simulate(rig_below, ["tool.tip-2 mm"], frequency=model.frequency, noise=0.015, seed=9,
+                 sensors=["accelerometer"])
+relabelled = MeasurementSet(below.name, tuple(
+    attrs.evolve(m, response="tool.tip:y", excitation="tool.tip:y", sensors=(),
+                 frf=m.frf.with_labels(("tool.tip:y",), ("tool.tip:y",))) for m in below))
+d6 = diagnose(model, relabelled)
+print(f"    explained: {d6.explained}; the search explained nothing, the tip with the sensor did: "
+      f"{d6.search.get('tip_alone')}")
+for e in d6.effects:
+    print(f"    {e.name} at {e.where}: {values(e)}")
