@@ -103,6 +103,15 @@ def test_a_sensor_below_the_tip_is_found_where_it_sat_and_predicts_the_cross_frf
     # neither alone: the tip without the sensor, nor the sensor at the edge, predicts them
     for one in kept:
         assert not consistency(held, held.log_ratios([one]), 0).consistent, one[0].effect
+    # written back, the sensor sits where the test was: with the point named as measured the model is consistent
+    (sensor,) = result.changes.refined_assembly.sensors
+    assert sensor.at == "tool.tip-2 mm" and sensor.always_on
+    assert sensor.mass.m_as("kg") == pytest.approx(0.001, rel=0.05)
+    as_measured = [Measurement("tool.tip-2 mm:y", "tool.tip-2 mm:y", m.frf.with_labels(
+        ("tool.tip-2 mm:y",), ("tool.tip-2 mm:y",)), averages=5) for m in _tested_below(
+            2.0, offset=1500, sensor_kg=0.001, sensor_below=0.002) if m.response == "tool.tip:y"]
+    lik = Likelihood(result.changes.refined_assembly, measured_frfs(as_measured)[0])
+    assert consistency(lik, lik.log_ratios([]), 0).consistent
 
 
 @pytest.mark.parametrize("hidden", [dict(sensor_kg=0.003), dict(sensor_kg=0.0005), dict(ht_scale=0.8),
