@@ -55,7 +55,8 @@ def model() -> Assembly:
 def measure(points=("tool.tip",), sensor_kg: float = 0.0, flutes: tuple[float, float] = FLUTES,
             nut: tuple[float, float, float] | None = None, ht_scale: float = 1.0,
             tool_E: float = 580e9, tool_rho: float = 14500.0, tool_nu: float = 0.22,
-            bearings: tuple[float, float] = (1.0, 1.0), shank_taper: float | None = None) -> list[FRF]:
+            bearings: tuple[float, float] = (1.0, 1.0), shank_taper: float | None = None,
+            below: float = 0.0) -> list[FRF]:
     """Exact FRFs of the rig with hidden effects (response at each point, the hammer at the tool's tip).
 
     points: ``tool.tip``, ``tool.tip-X mm`` or ``holder.tip``; flutes: the tool's real fluted tip (length m,
@@ -63,7 +64,8 @@ def measure(points=("tool.tip",), sensor_kg: float = 0.0, flutes: tuple[float, f
     joint's k_yf times this; tool_E, tool_rho, tool_nu: the tool's material; bearings: (rear, front) factors on
     the stiffness of the bearing pairs; shank_taper: the tool's plain length tapering linearly (16 uniform
     pieces) as if from 20 mm at its base to this diameter [m] at its tip, its fluted tip left at 20 mm (not the
-    library's tapered tool, which tapers the flutes too).
+    library's tapered tool, which tapers the flutes too); below: the test taken this far below the tip [m] (the
+    hammer, the sensor of ``sensor_kg`` and the point labelled ``tool.tip``: a sensor cannot sit on the edge).
     """
     m = fe.Model()
     lengths = {"holder": sum(h[0] for h in HOLDER), "tool": TOOL_LENGTH}
@@ -71,12 +73,14 @@ def measure(points=("tool.tip",), sensor_kg: float = 0.0, flutes: tuple[float, f
     def place(point: str) -> tuple[str, float]:
         comp, _, rest = point.partition(".")
         back = float(rest[4:].replace("mm", "")) / 1e3 if rest.startswith("tip-") else 0.0
+        back = below if point == "tool.tip" else back
         return comp, lengths[comp] - back
 
     wanted: dict[str, list[float]] = {"holder": [], "tool": []}
-    for p in points:
+    for p in list(points) + (["tool.tip"] if below else []):  # the hammer's place too
         comp, x = place(p)
-        wanted[comp].append(x)
+        if x not in wanted[comp]:
+            wanted[comp].append(x)
     s = m.add_beam([(length, fe.section(od, bore, STEEL)) for length, od, bore in SPINDLE], points=list(BEARINGS))
     *plain, (length, od, bore) = HOLDER
     h = m.add_beam([(a, fe.section(b, c, STEEL)) for a, b, c in plain]
@@ -97,10 +101,10 @@ def measure(points=("tool.tip",), sensor_kg: float = 0.0, flutes: tuple[float, f
         factor = bearings[0] if i < 2 else bearings[1]
         m.add_support((s, x), [[BEARING_K * factor, 0], [0, 0]], [[BEARING_C, 0], [0, 0]])
     if sensor_kg:
-        m.add_mass((t, TOOL_LENGTH), sensor_kg, 0.0)
+        m.add_mass((t, TOOL_LENGTH - below), sensor_kg, 0.0)
     if nut:
         m.add_mass((h, nut[2]), nut[0], nut[1])
     beams = {"holder": h, "tool": t}
     outputs = [(beams[place(p)[0]], place(p)[1], "y") for p in points]
-    receptance = m.receptance(GRID.hz, outputs, [(t, TOOL_LENGTH, "y")])
+    receptance = m.receptance(GRID.hz, outputs, [(t, TOOL_LENGTH - below, "y")])
     return [FRF(GRID, receptance[:, i:i + 1, :], (f"{p}:y",), ("tool.tip:y",)) for i, p in enumerate(points)]

@@ -87,3 +87,16 @@ def test_a_sensor_the_data_cannot_tell_from_thicker_flutes_is_said_beside_them()
     assert error <= 1.05 * d.final_error
     assert any(line.startswith("  as well (the data cannot tell them apart): sensor-mass at tool.tip")
                for line in summary(d, "m", 1))
+
+
+def test_a_sensor_below_the_tip_is_found_where_it_sat():
+    """The second rig tested 1.5 mm below its tip with a 2 g sensor there that the model lacks, with two cross FRFs:
+    the tip fitted with the sensor on it (tests/test_diagnose_tip_below.py, built on the other rig) is the answer."""
+    taps = real_noise.with_real_noise(hl.measure(points=("tool.tip", "tool.tip-30 mm", "holder.tip"), below=0.0015,
+                                                 sensor_kg=0.002), 1200)
+    d = diagnose(hl.model(), taps, progress=False)
+    assert d.explained, d.report
+    found = {e.name: e for e in d.effects}
+    assert set(found) == {"point-position", "sensor-mass"}, _summary(d)
+    assert found["point-position"].values["shift"] == pytest.approx(-0.0015, abs=5e-5)
+    assert found["sensor-mass"].values["mass"] == pytest.approx(0.002, rel=0.05)
