@@ -15,6 +15,7 @@ import hidden_data as hd
 from real_noise import with_real_noise
 from substructure.diagnose import diagnose
 from substructure.diagnose.refine import refine
+from substructure.diagnose.report import Explanation
 from substructure.diagnose.search import free_tips
 from substructure.diagnose.settings import DEFAULT_SETTINGS
 from substructure.measurements import Measurement, MeasurementSet
@@ -106,6 +107,7 @@ def test_a_sensor_below_the_tip_is_found_where_it_sat_and_predicts_the_cross_frf
     # written back, the sensor sits where the test was: with the point named as measured the model is consistent
     (sensor,) = result.changes.refined_assembly.sensors
     assert sensor.at == "tool.tip-2 mm" and sensor.always_on
+    assert [s.at for s in Explanation(result.changes.final_effects).apply(model).sensors] == ["tool.tip-2 mm"]
     assert sensor.mass.m_as("kg") == pytest.approx(0.001, rel=0.05)
     as_measured = [Measurement("tool.tip-2 mm:y", "tool.tip-2 mm:y", m.frf.with_labels(
         ("tool.tip-2 mm:y",), ("tool.tip-2 mm:y",)), averages=5) for m in _tested_below(

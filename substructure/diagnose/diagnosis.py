@@ -41,7 +41,7 @@ from ..updating.likelihood import Likelihood, measured_frfs
 from ..updating.structure import assembly_checked
 from ..updating.selection import INDIFFERENCE, consistency, error_check, outlying_runs
 from .compare import METRIC, Comparison, _pairs, frac, error_bands
-from .effects import Effect, EffectChange, registry
+from .effects import Effect, registry, written_back
 from .refine import refine as refine_model, trim_partial
 from . import words
 from .claims import bound_hits, bound_text, explains, passive
@@ -282,13 +282,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     final_effects = tuple(Found(c, v, {k: x for k, x in (final_fit.std[i] if final_fit else {}).items()
                                        if (i, k) not in {(h[0], h[1]) for h in hits}})
                           for i, (c, v) in enumerate(current))
-    refined = assembly
-    moved = {c.where: c.place(v) for c, v in current if c.effect == "point-position"}
-    for c, v in current:
-        if c.test_only and c.effect != "point-position" and c.where in moved and isinstance(c, EffectChange):
-            refined = c.cls(moved[c.where], **v).apply(refined)  # a sensor sat where the test was taken
-        else:
-            refined = c.apply(refined, v)
+    refined = written_back(assembly, current)
     missing = steps[1].added if len(steps) > 1 else None
     def instead(change) -> list:  # a kept change's alternatives of its step, each with the error in its place
         out = []

@@ -43,10 +43,11 @@ import numpy as np
 from ..assembly import Assembly
 from ..errors import InvalidValueError
 from ..units import ureg
+from ..updating.elements import PointPosition
 from ..updating.parameters import Change, ParamSpec
 
 __all__ = ["Parameter", "Effect", "EFFECTS", "register_effect", "get_effect", "EffectChange", "registry",
-           "registered"]
+           "registered", "written_back"]
 
 EFFECTS: dict[str, type] = {}
 """Registered effects by name."""
@@ -371,9 +372,9 @@ class EffectChange(Change):
         self.specs = tuple(specs)
         self.trials = _scan_starts(cls, where, assembly, {spec.name: (spec.lower, spec.upper) for spec in specs})
 
-    def instance(self, values) -> Effect:
-        """The effect at this change's place with these values (SI)."""
-        return self.cls(self.where, **{k: float(v) for k, v in values.items()})
+    def instance(self, values, where: str | None = None) -> Effect:
+        """The effect at this change's place (or at ``where``) with these values (SI)."""
+        return self.cls(where or self.where, **{k: float(v) for k, v in values.items()})
 
     def apply(self, assembly, values):
         """The assembly with the effect applied (:meth:`Change.apply`)."""
@@ -422,3 +423,29 @@ class _AssemblyOnlyEffect(EffectChange):
     """An effect without an SI form: fits apply it to the assembly (slower)."""
 
     apply_si = Change.apply_si
+
+
+def written_back(assembly, current: list):
+    """The assembly with the kept changes applied; a test-only effect at a point whose position was fitted (a
+    sensor on a tip tested below its edge) is written where the test was taken (``tool.tip-2 mm``), so that the
+    point named as measured finds it there.
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model as given.
+    current : list of (Change, dict)
+        The kept changes with their values.
+
+    Returns
+    -------
+    Assembly
+        The model with the changes.
+    """
+    moved = {c.where: c.place(v) for c, v in current if isinstance(c, PointPosition)}
+    for c, v in current:
+        if isinstance(c, EffectChange) and c.test_only and c.where in moved:
+            assembly = c.instance(v, moved[c.where]).apply(assembly)
+        else:
+            assembly = c.apply(assembly, v)
+    return assembly

@@ -37,6 +37,7 @@ from ..measurements import model_of_measurement
 from ..updating.parameters import set_parameters
 from ..updating.selection import INDIFFERENCE
 from . import words
+from .effects import written_back
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 from .words import values_text
 
@@ -322,10 +323,8 @@ class Explanation:
         self.change = self
 
     def apply(self, assembly):
-        """The assembly with every change applied (as :meth:`Found.apply`)."""
-        for f in self.founds:
-            assembly = f.apply(assembly)
-        return assembly
+        """The assembly with every change applied (:func:`~substructure.diagnose.effects.written_back`)."""
+        return written_back(assembly, [(f.change, f.values) for f in self.founds])
 
 
 def _applied(explanation, config, non_contact: bool):
