@@ -34,6 +34,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from .._kernels import one_blas_thread
 from ..assembly import Assembly
 from ..errors import InvalidValueError, SubstructureError
 from ..frf import FRF
@@ -244,8 +245,9 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         if say:
             say("every measured FRF is a constant factor times the model with every mode in place: a calibration "
                 "or unit error; no change of the structure is fitted")
-    outcome = refine_model(lik, screen_lik, cands, limit, lambda changes: passive(lik, changes), say, meter,
-                           lacking=bool(len(lacking)), settings=settings)
+    with one_blas_thread():  # small, narrow linear algebra throughout the search (``_kernels.one_blas_thread``)
+        outcome = refine_model(lik, screen_lik, cands, limit, lambda changes: passive(lik, changes), say, meter,
+                               lacking=bool(len(lacking)), settings=settings)
     tip_note = None
     if limit and not explains(lik, outcome, settings):
         outcome, tip_note = tip_fallback(lik, screen_lik, assembly, points, cands, outcome, say, settings, floor)

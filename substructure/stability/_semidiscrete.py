@@ -21,8 +21,8 @@ from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
+from .._kernels import one_blas_thread
 from ..errors import InvalidValueError
 from ..units import whole_number
 from .modal import ModalModel
@@ -322,7 +322,7 @@ def _critical(model: ModalModel, plan: _Plan, speed_rpm: np.ndarray, depth_m: np
         grid, part = task
         mu[part] = _largest(_monodromy(model, grid, speed_rpm[part], depth_m[part]))[0]
 
-    with threadpool_limits(limits=1, user_api="blas"):
+    with one_blas_thread():
         if len(tasks) == 1 or _workers() == 1:
             for task in tasks:
                 run(task)
@@ -352,7 +352,7 @@ def _chatter(model: ModalModel, plan: _Plan, speed_rpm: np.ndarray, depth_m: np.
     f_top = 1.5 * model.arrays()["frequency_hz"].max()
     for grid, idx in _chunks(model, plan, speed_rpm):
         phi, r0, r1, select, free = _steps(model, grid, speed_rpm[idx], depth_m[idx])
-        with threadpool_limits(limits=1, user_api="blas"):
+        with one_blas_thread():
             mu, vec = _largest(_assemble(grid, phi, r0, r1, select), vectors=True)
         assert vec is not None
         period = 60.0 / (plan.teeth * speed_rpm[idx])
