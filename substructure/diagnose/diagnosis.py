@@ -38,6 +38,7 @@ from .._kernels import one_blas_thread
 from ..assembly import Assembly
 from ..errors import InvalidValueError, SubstructureError
 from ..frf import FRF
+from ..updating.elements import PointPosition
 from ..updating.likelihood import Likelihood, measured_frfs
 from ..updating.structure import assembly_checked
 from ..updating.selection import INDIFFERENCE, consistency, error_check, outlying_runs
@@ -48,7 +49,7 @@ from . import words
 from .claims import bound_hits, bound_text, explains, passive
 from .result import Alternatives, Candidate, Changes, Diagnosis, Found, Measures, Step, Verdict, _finite, strict
 from .search import Budget, candidates
-from .tip import tip_fallback
+from .tip import tip_fallback, tip_rival
 from .settings import DEFAULT_SETTINGS, FROM_SETTINGS, DiagnoseSettings, _FromSettings, _real
 
 __all__ = ["Found", "Candidate", "Step", "Diagnosis", "diagnose", "strict", "sites"]
@@ -310,6 +311,8 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         labels = [f"{current[i][0].effect}@{current[i][0].where}:{name}" for i, name in final_fit.names]
         correlation = {"parameters": labels, "matrix": [[_finite(x) for x in row] for row in final_fit.correlation]}
     rivals = _distinct_rivals(assembly, measured, final_effects, outcome, say, settings) if explained else []
+    if explained and limit and not rivals:
+        rivals = _tip_rival(lik, screen_lik, assembly, measured, points, cands, outcome, final_effects, say, settings)
     # a same-part rival's replacement of one kept change, not listed yet
     for i, found, rival in _same_part_replacements(assembly, final_effects, outcome, settings):
         if (i, found.change.key) not in {(j, a.change.key) for j, a, _ in equivalents} and not (
@@ -511,6 +514,26 @@ def _distinct_rivals(assembly, measured, final_effects, outcome, say,
                 say(f"rival explanation {rival.name} at {rival.where}: {sep['text']}")
             out.append((rival, sep))
     return out
+
+
+def _tip_rival(lik, screen_lik, assembly, measured, points, cands, outcome, final_effects, say,
+               settings: DiagnoseSettings) -> list:
+    """The test taken below a free tip as a rival of an explanation that changed the structure there
+    (:func:`~substructure.diagnose.tip.tip_rival`), with the measurement that tells the two apart."""
+    from .report import Explanation, separation
+
+    found = tip_rival(lik, screen_lik, assembly, points, cands, outcome, settings)
+    if found is None:
+        return []
+    rival = Explanation(tuple(Found(c, v, sd) for c, v, sd in found))
+    sep = separation(assembly, measured, Explanation(final_effects), rival, say, contact_only=True, settings=settings)
+    if sep is None or sep["chi2"] <= INDIFFERENCE:  # alike at the ends, quarter points and middles: a ruler tells
+        tip = next(f for f in rival.founds if isinstance(f.change, PointPosition))
+        sep = {**(sep or {"response": None, "excitation": None, "non_contact": False, "chi2": None}),
+               "text": words.taken_below(tip.change.where, tip.change.place(tip.values))}
+    if say:
+        say(f"rival explanation {rival.name} at {rival.where}: {sep['text']}")
+    return [(rival, sep)]
 
 
 def _same_part_replacements(assembly, final_effects, outcome, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> list:

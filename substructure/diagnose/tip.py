@@ -26,7 +26,7 @@ from .refine import Outcome, refine
 from .search import free_tips
 from .settings import DiagnoseSettings
 
-__all__ = ["tip_fallback"]
+__all__ = ["tip_fallback", "tip_rival"]
 
 
 def tip_fallback(lik: Likelihood, screen_lik: Likelihood, assembly, points: list, cands: list, outcome: Outcome,
@@ -90,3 +90,38 @@ def tip_fallback(lik: Likelihood, screen_lik: Likelihood, assembly, points: list
     error = lik.rms(lik.log_ratios(alone.current))
     return outcome, words.tip_nearly(change.where, change.place(values), share, error, floor,
                                      bool(bound_hits(alone.current, alone.fit)))
+
+
+def tip_rival(lik: Likelihood, screen_lik: Likelihood, assembly, points: list, cands: list, outcome: Outcome,
+              settings: DiagnoseSettings) -> list | None:
+    """Another explanation of an explained outcome: its test-only changes at a free tip, the tip taken below it.
+
+    On a tool tested a few millimetres below its tip with a sensor the model lacks, a tool that much shorter with
+    a heavier sensor (the stub beyond the sensor added to it) is nearly the same structure on a driving point:
+    the search may explain the data that way.  Where the outcome holds a test-only change at a measured free tip
+    beside a change of the structure, and not the tip's position, the tip's position is fitted with the same
+    test-only candidates at that point alone (as :func:`tip_fallback` does); where they explain the data too,
+    their changes are returned (the diagnosis weighs them as a rival explanation), else None.
+
+    Parameters
+    ----------
+    lik, screen_lik, assembly, points, cands, outcome, settings
+        As for :func:`tip_fallback`; ``outcome`` explains the data.
+
+    Returns
+    -------
+    list of (Change, dict, dict) or None
+        The rival's changes with their values and standard deviations.
+    """
+    kept = [c for c, _ in outcome.current]
+    for tip in free_tips(assembly, points, settings.point_reach):
+        if any(c.key == tip.key for c in kept) or all(c.test_only for c in kept):
+            continue
+        if not any(c.test_only and c.where == tip.where for c in kept):
+            continue
+        at_tip = [c for c in cands if c.test_only and c.where == tip.where and c.effect != tip.effect]
+        both = refine(lik, screen_lik, [tip, *at_tip], 2, lambda changes: passive(lik, changes), None, None,
+                      settings=settings)
+        if any(c is tip for c, _ in both.current) and explains(lik, both, settings) and both.fit is not None:
+            return [(c, dict(v), dict(sd)) for (c, v), sd in zip(both.current, both.fit.std)]
+    return None

@@ -187,6 +187,26 @@ def tell_apart(text: str) -> str:
     return f"to tell them apart: {text}"
 
 
+def taken_below(point: str, place: str) -> str:
+    """How to tell a test taken below a free tip from a change of the structure there that fits as well.
+
+    Parameters
+    ----------
+    point : str
+        The tip as the measurements name it (``tool.tip``).
+    place : str
+        Where the rival explanation says the test was taken (``tool.tip-1.2 mm``).
+
+    Returns
+    -------
+    str
+        The measurement, for :func:`tell_apart`.
+    """
+    return (f"measure how far below the edge the sensor and the hammer sat (the rival says {point} was taken at "
+            f"{place}) and the tool's overhang, or a cross FRF at a point named from the tip ({point}-20 mm): "
+            "a point measured from the tool's base or holder does not tell them apart")
+
+
 def calibrated(level: float, calibration: float) -> str:
     """The common level of the data over the model, fitted within the calibration uncertainty given.
 
