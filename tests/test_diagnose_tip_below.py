@@ -167,13 +167,17 @@ def _driving_point_below(mm: float, grams: float, offset: int, level: float) -> 
         ("tool.tip:y",), ("tool.tip:y",)), averages=5)])
 
 
+def _rms_log(h, truth) -> float:
+    return float(np.sqrt(np.mean(np.abs(np.log(h.data.ravel() / truth.data.ravel())) ** 2)))
+
+
 def test_a_shorter_tool_with_a_heavier_sensor_is_not_claimed_beside_the_tip_tested_below_it():
     """On the driving point alone a 5.3 g sensor 1.2 mm below the tip is nearly a tool 1.2 mm shorter with the stub
     beyond the sensor added to it (7.3 g): the search found that form (a random case of 16, the seed of the data
-    fixed here).  The tip taken below with the sensor explains the data too, so neither is claimed; the report
-    says what tells them apart.  Checked against the FE rig: both predict a cross FRF at a point measured from the
-    tool's base, with the hammer where the test was, within a tenth of a per cent, so the separating measurement
-    named is not such a point."""
+    fixed here).  The tip taken below with the sensor explains the data too, so neither is claimed, and the report
+    names what tells them apart.  Checked against the FE rig: the cross FRF it names, at a point a quarter of the
+    tool from the tip, is the rival's and far from the shorter tool's; a point measured from the tool's base would
+    not have told them (both within a tenth of a per cent)."""
     measured = _driving_point_below(1.2, 5.3, 7410, 1.0)
     model = hd.nominal_model()
     result = diagnose(model, measured)
@@ -183,12 +187,16 @@ def test_a_shorter_tool_with_a_heavier_sensor_is_not_claimed_beside_the_tip_test
     tip = next(f for f in rival.founds if f.change.effect == "point-position")
     sensor = next(f for f in rival.founds if f.change.effect == "sensor-mass")
     assert tip.change.place(tip.values) == "tool.tip-1.2 mm" and sensor.values["mass"] == pytest.approx(5.3e-3, 0.03)
-    assert any(line.startswith("to tell them apart: measure how far below the edge") for line in result.verdict.report)
-    # the FE rig at a point measured from the tool's base, the hammer 1.2 mm below the tip
-    truth = hd.measure(points=("tool@38 mm",), excitation="tool.tip-1.2 mm", noise=0.0, phase_deg=0.0, floor=0.0,
-                       sensor_kg=5.3e-3, sensor_below=1.2e-3)[0]
-    hz = truth.frequency.hz
-    kept = Explanation(result.changes.final_effects).apply(model).receptance("tool@38 mm:y", "tool.tip:y", hz)
-    taken = Explanation(rival.founds).apply(model).receptance("tool@38 mm:y", "tool.tip-1.2 mm:y", hz)
-    for h in (kept, taken):
-        assert np.sqrt(np.mean(np.abs(np.log(h.data.ravel() / truth.data.ravel())) ** 2)) < 2e-3
+    assert (sep["response"], sep["excitation"]) == ("tool.tip-19 mm:y", "tool.tip:y") and sep["chi2"] > 1e3
+    assert "how far below the edge the sensor and the hammer sat" in sep["text"]
+    assert any(line.startswith("to tell them apart: measure the cross FRF tool.tip-19 mm / tool.tip")
+               for line in result.verdict.report)
+    kept, taken = Explanation(result.changes.final_effects).apply(model), Explanation(rival.founds).apply(model)
+    # the FE rig, the hammer where the test was: each explanation read where it says the test was taken
+    truth = hd.measure(points=("tool.tip-19 mm", "tool@38 mm"), excitation="tool.tip-1.2 mm", noise=0.0,
+                       phase_deg=0.0, floor=0.0, sensor_kg=5.3e-3, sensor_below=1.2e-3)
+    hz = truth[0].frequency.hz
+    assert _rms_log(taken.receptance("tool.tip-19 mm:y", "tool.tip-1.2 mm:y", hz), truth[0]) < 1e-3
+    assert _rms_log(kept.receptance("tool.tip-19 mm:y", "tool.tip:y", hz), truth[0]) > 0.05
+    assert _rms_log(taken.receptance("tool@38 mm:y", "tool.tip-1.2 mm:y", hz), truth[1]) < 2e-3
+    assert _rms_log(kept.receptance("tool@38 mm:y", "tool.tip:y", hz), truth[1]) < 2e-3

@@ -527,10 +527,12 @@ def _tip_rival(lik, screen_lik, assembly, measured, points, cands, outcome, fina
         return []
     rival = Explanation(tuple(Found(c, v, sd) for c, v, sd in found))
     sep = separation(assembly, measured, Explanation(final_effects), rival, say, contact_only=True, settings=settings)
-    if sep is None or sep["chi2"] <= INDIFFERENCE:  # alike at the ends, quarter points and middles: a ruler tells
-        tip = next(f for f in rival.founds if isinstance(f.change, PointPosition))
-        sep = {**(sep or {"response": None, "excitation": None, "non_contact": False, "chi2": None}),
-               "text": words.taken_below(tip.change.where, tip.change.place(tip.values))}
+    tip = next(f for f in rival.founds if isinstance(f.change, PointPosition))
+    ruler = words.taken_below(tip.change.where, tip.change.place(tip.values))  # what tells them apart without a test
+    if sep is None or sep["chi2"] <= INDIFFERENCE:  # no FRF with the test's sensors on does
+        sep = {**(sep or {"response": None, "excitation": None, "non_contact": False, "chi2": None}), "text": ruler}
+    else:
+        sep = {**sep, "text": f"{sep['text']}; or {ruler}"}
     if say:
         say(f"rival explanation {rival.name} at {rival.where}: {sep['text']}")
     return [(rival, sep)]

@@ -373,9 +373,13 @@ def separation(assembly, measured, a, b, say=None, contact_only: bool = False,
     excitation = str(first.frf.inputs[0]).split(":")[0]
     done = {(str(m.frf.outputs[0]).split(":")[0], str(m.frf.inputs[0]).split(":")[0]) for m in measured}
     points = list(dict.fromkeys(_measurement_points(config) + [p for pair in done for p in pair]))
-    # a point an explanation says the test took elsewhere (a tip tested below its edge) is read there in its model
+    # a point an explanation says the test took elsewhere (a tip tested below its edge) is read there in its model;
+    # a point a quarter of the component from it (named from it, as a sensor is placed) is a measurement too
     moved = [{f.change.where: f.change.place(f.values) for f in getattr(e, "founds", (e,))
               if isinstance(f.change, PointPosition)} for e in (a, b)]
+    beams = {comp.name: comp.length_m for comp in _plain_beams(config)}
+    points += [f"{w}-{beams[w.split('.')[0]] * 250:.3g} mm" for w in dict.fromkeys(k for m in moved for k in m)
+               if w.split(".")[0] in beams and w.endswith(".tip")]
     variants = [False] + ([True] if (a.change.test_only or b.change.test_only) and not contact_only else [])
     best = None
     for non_contact in variants:

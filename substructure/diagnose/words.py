@@ -188,7 +188,7 @@ def tell_apart(text: str) -> str:
 
 
 def taken_below(point: str, place: str) -> str:
-    """How to tell a test taken below a free tip from a change of the structure there that fits as well.
+    """How to tell a test taken below a free tip from a change of the structure there that fits as well, with a ruler.
 
     Parameters
     ----------
@@ -203,8 +203,7 @@ def taken_below(point: str, place: str) -> str:
         The measurement, for :func:`tell_apart`.
     """
     return (f"measure how far below the edge the sensor and the hammer sat (the rival says {point} was taken at "
-            f"{place}) and the tool's overhang, or a cross FRF at a point named from the tip ({point}-20 mm): "
-            "a point measured from the tool's base or holder does not tell them apart")
+            f"{place}) and the tool's overhang")
 
 
 def calibrated(level: float, calibration: float) -> str:
