@@ -166,3 +166,20 @@ def test_the_engine_picks_the_same_numbers_with_its_memo_with_copies_and_with_un
     apart = couple_substructures(blocks + [(["u0"], a[:2, :2])], links, outputs + ["u0"], pick=([0, 6], [6, 0]))
     full = couple_substructures(blocks + [(["u0"], a[:2, :2])], links, outputs + ["u0"])
     assert np.array_equal(apart, full[np.ix_([0, 6], [6, 0])]) and not apart[0, 0].any()
+
+
+def test_one_blas_thread_limits_every_blas_and_restores_it():
+    """The fits' and the diagnosis's limit (``_kernels.one_blas_thread``): numpy's and scipy's BLAS on one thread
+    inside, as they were after (read through threadpoolctl, the library that sets it)."""
+    import scipy.linalg  # noqa: F401  (its BLAS loaded, as in a fit)
+    from threadpoolctl import threadpool_info
+
+    def blas():
+        return sorted((i["filepath"], i["num_threads"]) for i in threadpool_info() if i["user_api"] == "blas")
+
+    before = blas()
+    assert before
+    with kernels.one_blas_thread():
+        inside = blas()
+    assert [n for _, n in inside] == [1] * len(before) and [p for p, _ in inside] == [p for p, _ in before]
+    assert blas() == before

@@ -38,12 +38,11 @@ from .._kernels import one_blas_thread
 from ..assembly import Assembly
 from ..errors import InvalidValueError, SubstructureError
 from ..frf import FRF
-from ..updating.elements import PointPosition
 from ..updating.likelihood import Likelihood, measured_frfs
 from ..updating.structure import assembly_checked
 from ..updating.selection import INDIFFERENCE, consistency, error_check, outlying_runs
 from .compare import METRIC, Comparison, _pairs, frac, error_bands
-from .effects import Effect, registry, written_back
+from .effects import Effect, registry, tested_at, written_back
 from .refine import refine as refine_model, trim_partial
 from . import words
 from .claims import bound_hits, bound_text, explains, passive
@@ -527,8 +526,8 @@ def _tip_rival(lik, screen_lik, assembly, measured, points, cands, outcome, fina
         return []
     rival = Explanation(tuple(Found(c, v, sd) for c, v, sd in found))
     sep = separation(assembly, measured, Explanation(final_effects), rival, say, contact_only=True, settings=settings)
-    tip = next(f for f in rival.founds if isinstance(f.change, PointPosition))
-    ruler = words.taken_below(tip.change.where, tip.change.place(tip.values))  # what tells them apart without a test
+    ((point, place),) = tested_at((c, v) for c, v, _ in found).items()
+    ruler = words.taken_below(point, place)  # what tells them apart without a test
     if sep is None or sep["chi2"] <= INDIFFERENCE:  # no FRF with the test's sensors on does
         sep = {**(sep or {"response": None, "excitation": None, "non_contact": False, "chi2": None}), "text": ruler}
     else:

@@ -47,7 +47,7 @@ from ..updating.elements import PointPosition
 from ..updating.parameters import Change, ParamSpec
 
 __all__ = ["Parameter", "Effect", "EFFECTS", "register_effect", "get_effect", "EffectChange", "registry",
-           "registered", "written_back"]
+           "registered", "written_back", "tested_at"]
 
 EFFECTS: dict[str, type] = {}
 """Registered effects by name."""
@@ -442,10 +442,26 @@ def written_back(assembly, current: list):
     Assembly
         The model with the changes.
     """
-    moved = {c.where: c.place(v) for c, v in current if isinstance(c, PointPosition)}
+    moved = tested_at(current)
     for c, v in current:
         if isinstance(c, EffectChange) and c.test_only and c.where in moved:
             assembly = c.instance(v, moved[c.where]).apply(assembly)
         else:
             assembly = c.apply(assembly, v)
     return assembly
+
+
+def tested_at(current) -> dict[str, str]:
+    """Where kept point positions say the test was taken: ``{"tool.tip": "tool.tip-2 mm"}``.
+
+    Parameters
+    ----------
+    current : iterable of (Change, dict)
+        Kept changes with their values.
+
+    Returns
+    -------
+    dict of str to str
+        The point as the measurements name it, and its place on the model.
+    """
+    return {c.where: c.place(v) for c, v in current if isinstance(c, PointPosition)}

@@ -13,6 +13,12 @@ lacks, for the sensor sat where the test was, not on the edge): where the two
 explain the data, they are the answer.  Else, where the tip alone removes at
 least ``settings.tip_share`` of the misfit, the report says so without
 claiming it.
+
+The same pair is a rival of an explanation the search did find
+(:func:`tip_rival`): a sensor on the tip beside a change of the structure
+there (a tool that much shorter carrying the stub beyond the sensor) is
+nearly the test taken below the tip with that sensor; where the pair
+explains the data too, the diagnosis claims neither.
 """
 
 from __future__ import annotations
@@ -67,13 +73,7 @@ def tip_fallback(lik: Likelihood, screen_lik: Likelihood, assembly, points: list
     change, values = alone.current[0]
     firsts = {"first_scored": alone.first_scored + outcome.first_scored,
               "first_fitted": alone.first_fitted + outcome.first_fitted}
-    found = alone if explains(lik, alone, settings) else None
-    at_tip = [c for c in cands if c.test_only and c.where == change.where and c.effect != change.effect]
-    if found is None and at_tip:
-        both = refine(lik, screen_lik, [change, *at_tip], 2, lambda changes: passive(lik, changes), None, None,
-                      settings=settings)
-        if any(c is change for c, _ in both.current) and explains(lik, both, settings):
-            found = both
+    found = alone if explains(lik, alone, settings) else _with_test_only(lik, screen_lik, change, cands, settings)
     if found is not None:
         if say:
             at = next(v for c, v in found.current if c is change)
@@ -119,9 +119,19 @@ def tip_rival(lik: Likelihood, screen_lik: Likelihood, assembly, points: list, c
             continue
         if not any(c.test_only and c.where == tip.where for c in kept):
             continue
-        at_tip = [c for c in cands if c.test_only and c.where == tip.where and c.effect != tip.effect]
-        both = refine(lik, screen_lik, [tip, *at_tip], 2, lambda changes: passive(lik, changes), None, None,
-                      settings=settings)
-        if any(c is tip for c, _ in both.current) and explains(lik, both, settings) and both.fit is not None:
+        both = _with_test_only(lik, screen_lik, tip, cands, settings)
+        if both is not None and both.fit is not None:
             return [(c, dict(v), dict(sd)) for (c, v), sd in zip(both.current, both.fit.std)]
     return None
+
+
+def _with_test_only(lik: Likelihood, screen_lik: Likelihood, tip, cands: list,
+                    settings: DiagnoseSettings) -> Outcome | None:
+    """The tip's position searched with the test-only candidates at its point (a sensor there), at most two
+    changes; the outcome where it keeps the tip and explains the data, else None."""
+    at_tip = [c for c in cands if c.test_only and c.where == tip.where and c.effect != tip.effect]
+    if not at_tip:
+        return None
+    both = refine(lik, screen_lik, [tip, *at_tip], 2, lambda changes: passive(lik, changes), None, None,
+                  settings=settings)
+    return both if any(c is tip for c, _ in both.current) and explains(lik, both, settings) else None
