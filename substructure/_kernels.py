@@ -30,9 +30,11 @@ is stable: model-updating code may call :func:`chain_receptance` and
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import itertools
 import os
+import threading
 
 import numpy as np
 
@@ -135,8 +137,10 @@ def threads() -> int:
 
 
 _blas_state: dict = {}
+_blas_lock = threading.Lock()
 
 
+@contextlib.contextmanager
 def one_blas_thread():
     """A context in which the BLAS libraries numpy and scipy load run on one thread.
 
@@ -146,22 +150,45 @@ def one_blas_thread():
     thread costs more in synchronisation than it computes, and on a machine
     whose cores are busy (other fits, the kernels' threads, other processes)
     it is several times slower.  Measured: a diagnosis of the FE rig took 14 s
-    with one BLAS thread and 20 s with two, on two cores.  The limit is set
-    on entry and the previous one restored on exit; the libraries are looked
-    up once per process (the first call, after numpy and scipy are loaded).
+    with one BLAS thread and 20 s with two, on two cores.  The libraries are
+    looked up once per process (the first call, after numpy and scipy are
+    loaded).
+
+    The limit is the process's (BLAS has one thread count) and one thread
+    holds it at a time (threadpoolctl, which sets it, lets one thread set
+    limits so that threads do not fight over them): a context entered while
+    another thread's holds the limit runs under that limit and neither sets
+    nor restores it.  So threads that enter and leave in any order (fits in
+    a study's worker threads) leave the process as it was; a thread still
+    inside when the holder leaves finishes under the process's own setting.
+    Nested contexts in one thread hold it until the outermost leaves.
 
     Returns
     -------
     context manager
     """
-    pid = os.getpid()
-    if _blas_state.get("pid") != pid:
-        import scipy.linalg  # noqa: F401  (its BLAS too, loaded before the lookup)
-        from threadpoolctl import ThreadpoolController  # only where linear algebra runs: keeps start-up light
+    me = threading.get_ident()
+    with _blas_lock:
+        pid = os.getpid()
+        if _blas_state.get("pid") != pid:  # first call, or a forked child (the parent's holder is not its own)
+            import scipy.linalg  # noqa: F401  (its BLAS too, loaded before the lookup)
+            from threadpoolctl import ThreadpoolController  # only where linear algebra runs: light start-up
 
-        _blas_state["controller"] = ThreadpoolController()
-        _blas_state["pid"] = pid
-    return _blas_state["controller"].limit(limits=1, user_api="blas")
+            _blas_state.update(controller=ThreadpoolController(), pid=pid, holder=None, depth=0, limiter=None)
+        mine = _blas_state["holder"] in (None, me)
+        if _blas_state["holder"] is None:
+            _blas_state["limiter"] = _blas_state["controller"].limit(limits=1, user_api="blas").__enter__()
+            _blas_state["holder"] = me
+        _blas_state["depth"] += mine
+    try:
+        yield
+    finally:
+        if mine:
+            with _blas_lock:
+                _blas_state["depth"] -= 1
+                if _blas_state["depth"] == 0:
+                    _blas_state["limiter"].__exit__(None, None, None)
+                    _blas_state.update(limiter=None, holder=None)
 
 
 def _pool():

@@ -183,3 +183,54 @@ def test_one_blas_thread_limits_every_blas_and_restores_it():
         inside = blas()
     assert [n for _, n in inside] == [1] * len(before) and [p for p, _ in inside] == [p for p, _ in before]
     assert blas() == before
+
+
+def test_one_blas_thread_in_threads_that_enter_and_leave_in_turn_leaves_the_process_as_it_was():
+    """The limit is the process's and one thread holds it: threads entering and leaving in turn (A in, B in,
+    A out, B out) run on one BLAS thread while A holds it and leave the process as it was (before, B restored
+    the limit it had found, A's, and left the process on one thread)."""
+    import threading
+
+    import scipy.linalg  # noqa: F401  (its BLAS loaded, as in a fit)
+    from threadpoolctl import ThreadpoolController, threadpool_info
+
+    def blas():
+        return [i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"]
+
+    def set_in_a_thread(n):  # set from a thread that then ends: no thread keeps threadpoolctl's control
+        t = threading.Thread(target=lambda: ThreadpoolController().limit(limits=n, user_api="blas"))
+        t.start()
+        t.join()
+
+    original = blas()
+    set_in_a_thread(2)  # two threads before, whatever the machine's default
+    a_in, b_in, a_out = threading.Event(), threading.Event(), threading.Event()
+    seen = {}
+
+    def first():
+        with kernels.one_blas_thread():
+            a_in.set()
+            b_in.wait(10)
+            seen["both inside"] = blas()
+        a_out.set()
+
+    def second():
+        a_in.wait(10)
+        with kernels.one_blas_thread():
+            b_in.set()
+            a_out.wait(10)
+
+    try:
+        before = blas()
+        threads = [threading.Thread(target=first), threading.Thread(target=second)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join(30)
+        after = blas()
+    finally:
+        for n in sorted(set(original)):
+            set_in_a_thread(n)
+    assert before == [2] * len(before)
+    assert seen["both inside"] == [1] * len(before)
+    assert after == before
