@@ -21,7 +21,8 @@ accelerometer); (f) an effect of your own, registered without touching the
 library (a heavy clamping nut on the holder); (g) a tip tested a few
 millimetres below its edge, as every real tap test is, but recorded as
 ``tool.tip``; (h) the usual tap test: the accelerometer the record forgot,
-sitting 2 mm below the edge where the test was.
+sitting 2 mm below the edge where the test was; (i) the sensor and the hammer
+at different heights below the edge, with a cross FRF of the same hit.
 
 Figures are written to $SUBSTRUCTURE_EXAMPLES_OUT (default: out/examples).
 """
@@ -256,4 +257,25 @@ d6 = diagnose(model, relabelled)
 print(f"    explained: {d6.explained}; the search explained nothing, the tip with the sensor did: "
       f"{d6.search.get('tip_alone')}")
 for e in d6.effects:
+    print(f"    {e.name} at {e.where}: {values(e)}")
+
+# %%
+# (i) The sensor and the hammer at different heights
+# ---------------------------------------------------
+# The sensor sits on one side of the tool 3 mm below the edge, the hammer
+# strikes the other side 1 mm below it; both are recorded as ``tool.tip``,
+# with the response on the holder face to the same hit.  On the driving
+# point alone the two places are one (reciprocity); the cross FRF depends on
+# where the hammer hit alone, so the tip's place and the hammer's
+# (``hit-position``) are fitted apart.
+print("10. (i) The sensor 3 mm and the hammer 1 mm below the edge, both recorded as tool.tip, and the holder face")
+apart = simulate(model, ["tool.tip-3 mm", "holder.tip"], "tool.tip-1 mm", frequency=model.frequency,
+                 noise=0.015, seed=10)
+named = {"tool.tip-3 mm:y": "tool.tip:y", "holder.tip:y": "holder.tip:y"}
+relabelled = MeasurementSet(apart.name, tuple(
+    attrs.evolve(m, response=named[m.response], excitation="tool.tip:y",
+                 frf=m.frf.with_labels((named[m.response],), ("tool.tip:y",))) for m in apart))
+d7 = diagnose(model, relabelled)
+print(f"    explained: {d7.explained}")
+for e in d7.effects:
     print(f"    {e.name} at {e.where}: {values(e)}")

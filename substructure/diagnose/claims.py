@@ -3,8 +3,9 @@
 A changed model must stay passive (:func:`passive`); a fitted value on the
 bound of its search is not a measurement (:func:`bound_hits`); and changes
 explain the data when they reach the noise with at most
-``DiagnoseSettings.most_changes`` of them and none on a bound
-(:func:`explains`).
+``DiagnoseSettings.most_changes`` of them (:func:`counted`: where the test
+was taken and where its hammer hit, at one point, are one fact) and none on
+a bound (:func:`explains`).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from ..updating.selection import consistency, error_check
 from . import words
 from .settings import DiagnoseSettings
 
-__all__ = ["PHYSICAL_ENDS", "passive", "bound_hits", "bound_text", "explains"]
+__all__ = ["PHYSICAL_ENDS", "passive", "bound_hits", "bound_text", "explains", "counted"]
 
 
 def passive(lik: Likelihood, changes) -> bool:
@@ -106,9 +107,27 @@ def bound_text(current, hit) -> str:
     return words.bound_text(change.effect, change.where, name, value, unit, side, bound)
 
 
+def counted(current) -> int:
+    """How many changes an explanation holds, against ``most_changes``: a point's ``point-position`` and its
+    ``hit-position`` together count once (where the sensor sat and where the hammer hit beside it: how one test
+    was taken, not two things found).
+
+    Parameters
+    ----------
+    current : sequence of (Change, dict)
+        The changes with their values.
+
+    Returns
+    -------
+    int
+    """
+    placed = {c.where for c, _ in current if c.effect == "point-position"}
+    return len(current) - sum(1 for c, _ in current if c.effect == "hit-position" and c.where in placed)
+
+
 def explains(lik: Likelihood, outcome, settings: DiagnoseSettings) -> bool:
     """The outcome's changes could be claimed: within the noise (consistent, the error within the explained
-    factor), at most ``settings.most_changes`` of them, none on the bound of its search.
+    factor), at most ``settings.most_changes`` of them (:func:`counted`), none on the bound of its search.
 
     Parameters
     ----------
@@ -125,7 +144,7 @@ def explains(lik: Likelihood, outcome, settings: DiagnoseSettings) -> bool:
         Whether the changes explain the data.
     """
     current = outcome.current
-    if not current or len(current) > settings.most_changes or bound_hits(current, outcome.fit):
+    if not current or counted(current) > settings.most_changes or bound_hits(current, outcome.fit):
         return False
     ratios = lik.log_ratios(current)
     p = sum(len(c.specs) for c, _ in current)

@@ -42,12 +42,12 @@ from ..updating.likelihood import Likelihood, measured_frfs
 from ..updating.structure import assembly_checked
 from ..updating.selection import INDIFFERENCE, consistency, error_check, outlying_runs
 from .compare import METRIC, Comparison, _pairs, frac, error_bands
-from .effects import Effect, registry, tested_at, written_back
+from .effects import Effect, hit_at, registry, tested_at, written_back
 from .refine import refine as refine_model, trim_partial
 from . import words
-from .claims import bound_hits, bound_text, explains, passive
+from .claims import bound_hits, bound_text, counted, explains, passive
 from .result import Alternatives, Candidate, Changes, Diagnosis, Found, Measures, Step, Verdict, _finite, strict
-from .search import Budget, candidates
+from .search import Budget, candidates, free_tip_hits
 from .tip import tip_fallback, tip_rival
 from .settings import DEFAULT_SETTINGS, FROM_SETTINGS, DiagnoseSettings, _FromSettings, _real
 
@@ -234,6 +234,9 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     points = [lbl for m in measured for lbl in (m.frf.outputs[0], m.frf.inputs[0])]
     cands = candidates(assembly, points, catalogue, open_world, _main_shift(baseline[0], settings.main_mode_share),
                        say, settings)
+    # where the hammer hit a free tip apart from the sensor: tried with the tip's position, not in the search
+    tip_cands = cands + free_tip_hits(assembly, [(m.frf.outputs[0], m.frf.inputs[0]) for m in measured],
+                                      settings.point_reach)
     lacking = _peak_lines(baseline, settings)
     screen_lik = lik.subsample(max(1, lik.lines.size // settings.screen_lines), keep=lacking)
     limit = 0 if cons.consistent else (max_steps if refine else 1)
@@ -250,7 +253,8 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
                                lacking=bool(len(lacking)), settings=settings)
     tip_note = None
     if limit and not explains(lik, outcome, settings):
-        outcome, tip_note = tip_fallback(lik, screen_lik, assembly, points, cands, outcome, say, settings, floor)
+        outcome, tip_note = tip_fallback(lik, screen_lik, assembly, points, tip_cands, outcome, say, settings,
+                                         floor)
     current = outcome.current
     p_now = sum(len(c.specs) for c, _ in current)
     steps = [Step(0, None, e0, chi2_now / n)]
@@ -311,7 +315,8 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         correlation = {"parameters": labels, "matrix": [[_finite(x) for x in row] for row in final_fit.correlation]}
     rivals = _distinct_rivals(assembly, measured, final_effects, outcome, say, settings) if explained else []
     if explained and limit and not rivals:
-        rivals = _tip_rival(lik, screen_lik, assembly, measured, points, cands, outcome, final_effects, say, settings)
+        rivals = _tip_rival(lik, screen_lik, assembly, measured, points, tip_cands, outcome, final_effects, say,
+                            settings)
     # a same-part rival's replacement of one kept change, not listed yet
     for i, found, rival in _same_part_replacements(assembly, final_effects, outcome, settings):
         if (i, found.change.key) not in {(j, a.change.key) for j, a, _ in equivalents} and not (
@@ -327,7 +332,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     if left:
         report = list(report) + [words.left_out([(c.effect, c.place(v), w) for c, v, w in left],
                                                 settings.partial_gain, floor)]
-    if explained and len(current) > settings.most_changes:  # a composite that only just reaches the noise
+    if explained and counted(current) > settings.most_changes:  # a composite that only just reaches the noise
         explained = False
         report = [words.too_many_changes(settings.most_changes, [f"{c.effect} at {c.place(v)}" for c, v in current]),
                   words.partial("composite", final_effects)]
@@ -385,6 +390,8 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         if getattr(m.measurement, "estimator", None) == "H2":
             corrected = getattr(m.measurement, "coherence", None) is not None
             report = list(report) + [words.estimated_as_h2(which, corrected)]
+    if missing is not None:  # where it acts as kept (a point's place at its final value, not its first step's)
+        missing = next((f for f in final_effects if f.change.key == missing.change.key), missing)
     return Diagnosis(
         verdict=Verdict(explained=explained, report=tuple(report),
                         missing_effect=None if missing is None else missing.name,
@@ -526,7 +533,8 @@ def _tip_rival(lik, screen_lik, assembly, measured, points, cands, outcome, fina
         return []
     rival = Explanation(tuple(Found(c, v, sd) for c, v, sd in found))
     sep = separation(assembly, measured, Explanation(final_effects), rival, say, contact_only=True, settings=settings)
-    ((point, place),) = tested_at((c, v) for c, v, _ in found).items()
+    kept = [(c, v) for c, v, _ in found]
+    (point, place), *_ = (tested_at(kept) or hit_at(kept)).items()  # the sensor's place, else the hit's (on the edge)
     ruler = words.taken_below(point, place)  # what tells them apart without a test
     if sep is None or sep["chi2"] <= INDIFFERENCE:  # no FRF with the test's sensors on does
         sep = {**(sep or {"response": None, "excitation": None, "non_contact": False, "chi2": None}), "text": ruler}

@@ -43,11 +43,11 @@ import numpy as np
 from ..assembly import Assembly
 from ..errors import InvalidValueError
 from ..units import ureg
-from ..updating.elements import PointPosition
+from ..updating.elements import HitPosition, PointPosition
 from ..updating.parameters import Change, ParamSpec
 
 __all__ = ["Parameter", "Effect", "EFFECTS", "register_effect", "get_effect", "EffectChange", "registry",
-           "registered", "written_back", "tested_at"]
+           "registered", "written_back", "tested_at", "hit_at"]
 
 EFFECTS: dict[str, type] = {}
 """Registered effects by name."""
@@ -464,4 +464,20 @@ def tested_at(current) -> dict[str, str]:
     dict of str to str
         The point as the measurements name it, and its place on the model.
     """
-    return {c.where: c.place(v) for c, v in current if isinstance(c, PointPosition)}
+    return {c.where: c.place(v) for c, v in current if isinstance(c, PointPosition) and not isinstance(c, HitPosition)}
+
+
+def hit_at(current) -> dict[str, str]:
+    """Where kept hit positions say the hammer hit, apart from the sensor: ``{"tool.tip": "tool.tip-1 mm"}``.
+
+    Parameters
+    ----------
+    current : iterable of (Change, dict)
+        Kept changes with their values.
+
+    Returns
+    -------
+    dict of str to str
+        The point as the measurements name the excitation, and where it was hit on the model.
+    """
+    return {c.where: c.place(v) for c, v in current if isinstance(c, HitPosition)}

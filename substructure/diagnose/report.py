@@ -37,7 +37,7 @@ from ..measurements import model_of_measurement
 from ..updating.parameters import set_parameters
 from ..updating.selection import INDIFFERENCE
 from . import words
-from .effects import tested_at, written_back
+from .effects import hit_at, tested_at, written_back
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 from .words import values_text
 
@@ -374,18 +374,21 @@ def separation(assembly, measured, a, b, say=None, contact_only: bool = False,
     points = list(dict.fromkeys(_measurement_points(config) + [p for pair in done for p in pair]))
     # a point an explanation says the test took elsewhere (a tip tested below its edge) is read there in its model;
     # a point a quarter of the component from it (named from it, as a sensor is placed) is a measurement too
-    moved = [tested_at((f.change, f.values) for f in getattr(e, "founds", (e,))) for e in (a, b)]
+    pairs = [[(f.change, f.values) for f in getattr(e, "founds", (e,))] for e in (a, b)]
+    moved = [tested_at(p) for p in pairs]
     length_m = {comp.name: comp.length_m for comp in _plain_beams(config)}
     tips = [w for w in dict.fromkeys(w for place in moved for w in place)
             if w.endswith(".tip") and w.split(".")[0] in length_m]
     points += [f"{w}-{0.25 * length_m[w.split('.')[0]] * 1e3:.3g} mm" for w in tips]
     labels = [[f"{place.get(p, p)}:y" for p in points] for place in moved]
+    # and its hits where it says the hammer hit, apart from the sensor
+    hit_labels = [[f"{hit.get(p, place.get(p, p))}:y" for p in points] for place, hit in zip(moved, map(hit_at, pairs))]
     variants = [False] + ([True] if (a.change.test_only or b.change.test_only) and not contact_only else [])
     best = None
     for non_contact in variants:
         models = [_applied(e, config, non_contact) for e in (a, b)]
         try:
-            ha, hb = (m.frf(at, at, sub).data for m, at in zip(models, labels))
+            ha, hb = (m.frf(at, hit, sub).data for m, at, hit in zip(models, labels, hit_labels))
         except (SubstructureError, ValueError) as exc:
             if say:
                 say(f"separating measurement skipped: {exc}")

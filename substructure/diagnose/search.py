@@ -39,7 +39,8 @@ from scipy.optimize import minimize_scalar
 from ..components import Beam, is_plain_beam
 from ..errors import SubstructureError
 from ..points import parse_point
-from ..updating.elements import AddedMass, GroundSpring, PointPosition, SectionChange, body_bounds, rear_bounds
+from ..updating.elements import (AddedMass, GroundSpring, HitPosition, PointPosition, SectionChange, body_bounds,
+                                 rear_bounds)
 from ..updating.fit import Fit, fit, from_u, to_u
 from ..updating.parameters import Change, ParameterChange, material_changes, model_parameters, parameter_change
 from ..updating.structure import uniform_beam
@@ -226,6 +227,29 @@ def free_tips(assembly, measured_points: Sequence[str], reach: float) -> list[Ch
            for ref, comp in _measured_beams(assembly, measured_points)
            if reach > 0 and ref.where == "tip" and str(ref.point) not in held]
     return list({c.where: c for c in out}.values())
+
+
+def free_tip_hits(assembly, pairs: Sequence[tuple[str, str]], reach: float) -> list[Change]:
+    """Where the hammer hit a measured free tip apart from the sensor there (at another height beside it): a
+    candidate where the tip is hit and takes part in an FRF with another point too, as the hit (a roving sensor)
+    or as the response (a roving hammer): on the driving point alone the hit's place and the sensor's are one
+    (reciprocity).  Like the free tip's position, not one of the search's: tried with it
+    (:mod:`~substructure.diagnose.tip`).
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The model.
+    pairs : sequence of (str, str)
+        ``(response, excitation)`` labels of the measurements.
+    reach : float
+        How far from the tip [m] (``point_reach``).
+    """
+    ends = [(parse_point(r).point, parse_point(e).point) for r, e in pairs]
+    crossed = {p for r, e in ends if r != e for p in (r, e)}
+    tips = free_tips(assembly, [e for _, e in pairs], reach)
+    return [HitPosition(t.where, t.component, t.distance, t.distance, reach) for t in tips
+            if parse_point(t.where).point in crossed]
 
 
 @attrs.frozen
@@ -713,4 +737,5 @@ def physical(change: Change, values: dict) -> bool:
     return True
 
 
-__all__ += ["shortlist", "rank", "physical", "preference", "choose", "free_tips", "MEASURED", "ELEMENT"]
+__all__ += ["shortlist", "rank", "physical", "preference", "choose", "free_tips", "free_tip_hits", "MEASURED",
+            "ELEMENT"]

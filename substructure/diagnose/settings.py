@@ -336,14 +336,17 @@ class DiagnoseSettings:
         2 mm from where the record puts it otherwise came back as three
         invented changes of the structure.  A measured free tip
         (``tool.tip``) is tried alone, within this many metres towards its
-        base, after a search that explained nothing.
+        base, after a search that explained nothing; where it is hit and
+        takes part in a cross FRF, the hammer's place apart from the
+        sensor's (``hit-position``) within as many.
     tip_share : float
         A measured free tip tried alone that does not reach the noise but
         removes at least this share of the misfit above it (``chi^2 - n``;
-        default 0.9) is named in the report as nearly the answer (the
-        sensor and the hammer at different heights, or further from the
-        edge than ``point_reach``).  Tested 1 to 4 mm below the tip it
-        removes 97 % or more; for effects of the structure at most 41 %.
+        default 0.9) is named in the report as nearly the answer (further
+        from the edge than ``point_reach``, or the sensor and the hammer at
+        different heights where no cross FRF tells them apart).  Tested 1
+        to 4 mm below the tip it removes 97 % or more; for effects of the
+        structure at most 41 %.
     calibration : float or None
         The relative uncertainty of the measured FRFs' common scale, the
         hammer's and the sensors' sensitivities (e.g. 0.05; default None: the

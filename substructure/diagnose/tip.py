@@ -76,10 +76,10 @@ def tip_fallback(lik: Likelihood, screen_lik: Likelihood, assembly, points: list
     found = alone if explains(lik, alone, settings) else _with_test_only(lik, screen_lik, change, cands, settings)
     if found is not None:
         if say:
-            at = next(v for c, v in found.current if c is change)
-            kept = " and ".join(f"{c.effect} at {c.where}" for c, _ in found.current if c is not change)
-            say(f"the search explained nothing; {change.where} taken at {change.place(at)}"
-                f"{' with ' + kept if kept else ' alone'} explains the data")
+            kept = " and ".join(f"{change.where} taken at {c.place(v)}" if c is change else
+                                f"{c.effect} at {c.where}" + (f" ({c.place(v)})" if c.effect == "hit-position" else "")
+                                for c, v in found.current)
+            say(f"the search explained nothing; {kept} explains the data")
         return attrs.evolve(found, **firsts, search={**outcome.search, "held_back": found.search.get("held_back", []),
                                                      "tip_alone": change.where}), None
     chi2_0 = lik.chi2([])
@@ -127,11 +127,14 @@ def tip_rival(lik: Likelihood, screen_lik: Likelihood, assembly, points: list, c
 
 def _with_test_only(lik: Likelihood, screen_lik: Likelihood, tip, cands: list,
                     settings: DiagnoseSettings) -> Outcome | None:
-    """The tip's position searched with the test-only candidates at its point (a sensor there), at most two
-    changes; the outcome where it keeps the tip and explains the data, else None."""
+    """The tip's position searched with the test-only candidates at its point (a sensor there; the hammer's place
+    apart from the sensor's where a cross FRF of that hit was measured), at most one change each; the outcome
+    where it keeps the tip and explains the data, else None."""
     at_tip = [c for c in cands if c.test_only and c.where == tip.where and c.effect != tip.effect]
     if not at_tip:
         return None
-    both = refine(lik, screen_lik, [tip, *at_tip], 2, lambda changes: passive(lik, changes), None, None,
-                  settings=settings)
-    return both if any(c is tip for c, _ in both.current) and explains(lik, both, settings) else None
+    both = refine(lik, screen_lik, [tip, *at_tip], 1 + len({c.effect for c in at_tip}),
+                  lambda changes: passive(lik, changes), None, None, settings=settings)
+    # the tip's test: where it was taken, or where it was hit apart from the sensor (the sensor on the very edge)
+    kept = any(c is tip or c.effect == "hit-position" for c, _ in both.current)
+    return both if kept and explains(lik, both, settings) else None

@@ -17,6 +17,9 @@ component with its position fitted along it:
   a distance really was, a few millimetres from its name's place, or where a
   free tip was tested (``tool.tip-2 mm``): a change of the test, not of the
   structure (nothing written back).
+* :class:`HitPosition` (``hit-position``): where the hammer hit a measured
+  point, apart from where the sensor sat (at another height beside it): the
+  point's inputs move, its outputs stay; a change of the test too.
 
 The helper :func:`split_beam` cuts a beam's arrays at positions and scales a
 range of it, shared with the diagnosis catalogue's fluted section.
@@ -34,8 +37,8 @@ from ..units import Q_, format_quantity
 from .parameters import Change, ParamSpec
 from .structure import LinkSI
 
-__all__ = ["AddedMass", "GroundSpring", "SectionChange", "PointPosition", "split_beam", "split_segments", "unique_name",
-           "body_bounds", "rear_bounds", "STEEL_DENSITY"]
+__all__ = ["AddedMass", "GroundSpring", "SectionChange", "PointPosition", "HitPosition", "split_beam", "split_segments",
+           "unique_name", "body_bounds", "rear_bounds", "STEEL_DENSITY"]
 
 
 def _si(value: float, unit: str) -> str:
@@ -305,6 +308,25 @@ class PointPosition(Change):
 
     def apply(self, assembly, values):
         return assembly  # the model is as it was: the test was taken elsewhere
+
+
+class HitPosition(PointPosition):
+    """Where the hammer hit a measured point, apart from where the sensor sat: ``shift`` [m] along its component
+    (towards the tip positive) from where its name puts it, within ``reach``.  A test-only change.
+
+    The point's inputs move (every FRF of that hit: its cross FRFs too); its outputs, and a sensor on it, stay
+    where the name or a kept ``point-position`` puts them.  The hammer and the sensor on either side of a tool a
+    few millimetres apart in height: the driving point alone cannot tell which of the two moved (reciprocity),
+    a cross FRF of the same hit can.  Parameters as :class:`PointPosition`.
+    """
+
+    effect = "hit-position"
+    explanation = ("a hit a few millimetres above or below the sensor changes every FRF of that hit, the cross FRFs "
+                   "as much as the driving point's: its modes stay where they are, its levels and antiresonances move")
+
+    def apply_si(self, structure, values):
+        _, x = structure.named_position(self.where)
+        return structure.with_hit(self.where, x + float(values["shift"]))
 
 
 def split_beam(beam, start: float, stop: float, od_factor: float = 1.0, flutes: float | None = None):

@@ -105,8 +105,14 @@ class Evaluator:
         whole_number(cache, "cache")
         whole_number(memo_bytes, "memo_bytes")
         refs = [_parse(p) for p in self.outputs + self.inputs]
-        self._points = list(dict.fromkeys(str(r.point) for r in refs))
-        self._dofs = [(self._points.index(str(r.point)), DOFS.index(r.dof or "y")) for r in refs]
+        # the outputs' points, then the inputs' (a point both measured and hit is twice: the hammer may have hit
+        # it elsewhere than the sensor sat, Structure.with_hit; where it did not, both are one node)
+        out_points = list(dict.fromkeys(str(r.point) for r in refs[: len(self.outputs)]))
+        in_points = list(dict.fromkeys(str(r.point) for r in refs[len(self.outputs):]))
+        self._points = [(p, False) for p in out_points] + [(p, True) for p in in_points]
+        self._dofs = [(out_points.index(str(r.point)) if i < len(self.outputs)
+                       else len(out_points) + in_points.index(str(r.point)), DOFS.index(r.dof or "y"))
+                      for i, r in enumerate(refs)]
         self._n_out = len(self.outputs)
         # the engine's rows and columns of the outputs and inputs (DOF indices over the points)
         self._wanted = ([2 * p + d for p, d in self._dofs[: self._n_out]],
@@ -241,7 +247,7 @@ class Evaluator:
         opaque = tuple(structure.opaque.values())
         key = (tuple((link.a, link.b) for link in structure.links),
                tuple((name, beam.total_length) for name, beam in structure.beams.items()),
-               tuple(id(c) for c in opaque), tuple(structure.moved.items()))
+               tuple(id(c) for c in opaque), tuple(structure.moved.items()), tuple(structure.hits.items()))
         found = self._layouts.get(key)
         if found is not None and all(a is b for a, b in zip(found[0], opaque)):  # kept with it: ids not reused
             self._layouts.move_to_end(key)
@@ -258,10 +264,10 @@ class Evaluator:
         nodes: dict[str, dict] = {}
         keys = {}
 
-        def node(point):
-            if not isinstance(point, tuple) and point in keys:
-                return keys[point]
-            comp, x = structure.position(point)
+        def node(point, hit=False):
+            if not isinstance(point, tuple) and (point, hit) in keys:
+                return keys[(point, hit)]
+            comp, x = structure.hit_position(point) if hit else structure.position(point)
             if x is None:
                 ref = _parse(point).point
                 owner = structure.opaque[comp]
@@ -271,10 +277,10 @@ class Evaluator:
                 k = (comp, round(x, 12))
                 nodes.setdefault(comp, {}).setdefault(k, (x, None))
             if not isinstance(point, tuple):
-                keys[point] = k
+                keys[(point, hit)] = k
             return k
 
-        out_keys = [node(p) for p in self._points]
+        out_keys = [node(p, hit) for p, hit in self._points]
         pairs = []
         for link in structure.links:
             ka = node(link.a)

@@ -195,12 +195,16 @@ class Structure:
     moved : dict of str to (str, float), optional
         Points placed elsewhere than their names say, ``(component, x)``
         (:meth:`with_point`: where a measured point really was).
+    hits : dict of str to (str, float), optional
+        Points hit elsewhere than where they are measured, ``(component,
+        x)`` (:meth:`with_hit`: the hammer beside the sensor, at another
+        height); they place the inputs of that name only.
     """
 
-    __slots__ = ("assembly", "beams", "opaque", "links", "order", "sources", "moved", "_positions")
+    __slots__ = ("assembly", "beams", "opaque", "links", "order", "sources", "moved", "hits", "_positions")
 
     def __init__(self, assembly, beams: dict, opaque: dict, links: tuple, order: tuple, sources: dict | None = None,
-                 moved: dict | None = None):
+                 moved: dict | None = None, hits: dict | None = None):
         self.assembly = assembly
         self.beams = beams
         self.opaque = opaque
@@ -208,11 +212,13 @@ class Structure:
         self.order = order
         self.sources = sources or {}
         self.moved = moved or {}  # point name -> (component, x): a measured point where a fit placed it
+        self.hits = hits or {}  # point name -> (component, x): where the hammer hit it, apart from the sensor
         self._positions: dict = {}  # point name -> (component, x): a structure is never changed in place
 
     def _copy(self, **fields) -> "Structure":
         kept = {"assembly": self.assembly, "beams": self.beams, "opaque": self.opaque, "links": self.links,
-                "order": self.order, "sources": self.sources, "moved": self.moved}
+                "order": self.order, "sources": self.sources, "moved": self.moved,
+                "hits": self.hits}
         return Structure(**{**kept, **fields})
 
     @classmethod
@@ -461,6 +467,61 @@ class Structure:
         if at is None:
             raise UnknownPointError(f"point {point}: {comp!r} has no length to place a point along")
         return self._copy(moved={**self.moved, str(_parse(point).point): self.position((comp, float(x)))})
+
+    def with_hit(self, point: str, x: float) -> "Structure":
+        """The structure with a point hit at ``x`` along its component: its inputs there, its outputs kept.
+
+        Parameters
+        ----------
+        point : str
+            The point's name as the measurements give the excitation, e.g. ``"tool.tip"``, on a beam.
+        x : float
+            Where the hammer hit [m from the component's base], on the component.
+
+        Returns
+        -------
+        Structure
+            A new structure: the point's inputs sit at ``x``; its outputs, and the sensors and bodies on it, stay
+            where :meth:`position` puts them.
+        """
+        comp, at = self.position(point)
+        if at is None:
+            raise UnknownPointError(f"point {point}: {comp!r} has no length to place a hit along")
+        return self._copy(hits={**self.hits, str(_parse(point).point): self.position((comp, float(x)))})
+
+    def named_position(self, point: str) -> tuple[str, float | None]:
+        """``(component, x)`` where a point's name puts it, whatever :meth:`with_point` moved (a hit's reference).
+
+        Parameters
+        ----------
+        point : str
+            A point name.
+
+        Returns
+        -------
+        (str, float or None)
+            The component's name and the position.
+        """
+        return self._copy(moved={}).position(point) if self.moved else self.position(point)
+
+    def hit_position(self, point: str) -> tuple[str, float | None]:
+        """``(component, x)`` of a point as an input: where :meth:`with_hit` put it, else :meth:`position`.
+
+        Parameters
+        ----------
+        point : str
+            A point name.
+
+        Returns
+        -------
+        (str, float or None)
+            The component's name and the position.
+        """
+        if self.hits:
+            found = self.hits.get(str(_parse(point).point))
+            if found is not None:
+                return found
+        return self.position(point)
 
     def position(self, point) -> tuple[str, float | None]:
         """``(component, x)`` of a point: ``x`` in metres from the base on a plain beam, else None.
