@@ -56,7 +56,7 @@ def measure(points=("tool.tip",), sensor_kg: float = 0.0, flutes: tuple[float, f
             nut: tuple[float, float, float] | None = None, ht_scale: float = 1.0,
             tool_E: float = 580e9, tool_rho: float = 14500.0, tool_nu: float = 0.22,
             bearings: tuple[float, float] = (1.0, 1.0), shank_taper: float | None = None,
-            below: float = 0.0) -> list[FRF]:
+            below: float = 0.0, hammer_below: float | None = None) -> list[FRF]:
     """Exact FRFs of the rig with hidden effects (response at each point, the hammer at the tool's tip).
 
     points: ``tool.tip``, ``tool.tip-X mm`` or ``holder.tip``; flutes: the tool's real fluted tip (length m,
@@ -65,8 +65,10 @@ def measure(points=("tool.tip",), sensor_kg: float = 0.0, flutes: tuple[float, f
     the stiffness of the bearing pairs; shank_taper: the tool's plain length tapering linearly (16 uniform
     pieces) as if from 20 mm at its base to this diameter [m] at its tip, its fluted tip left at 20 mm (not the
     library's tapered tool, which tapers the flutes too); below: the test taken this far below the tip [m] (the
-    hammer, the sensor of ``sensor_kg`` and the point labelled ``tool.tip``: a sensor cannot sit on the edge).
+    hammer, the sensor of ``sensor_kg`` and the point labelled ``tool.tip``: a sensor cannot sit on the edge);
+    hammer_below: the hammer this far below the tip instead [m] (the sensor and the hammer at different heights).
     """
+    hammer_x = TOOL_LENGTH - (below if hammer_below is None else hammer_below)
     m = fe.Model()
     lengths = {"holder": sum(h[0] for h in HOLDER), "tool": TOOL_LENGTH}
 
@@ -77,10 +79,12 @@ def measure(points=("tool.tip",), sensor_kg: float = 0.0, flutes: tuple[float, f
         return comp, lengths[comp] - back
 
     wanted: dict[str, list[float]] = {"holder": [], "tool": []}
-    for p in list(points) + (["tool.tip"] if below else []):  # the hammer's place too
+    for p in list(points):
         comp, x = place(p)
         if x not in wanted[comp]:
             wanted[comp].append(x)
+    if hammer_x not in wanted["tool"]:  # the hammer's place too
+        wanted["tool"].append(hammer_x)
     s = m.add_beam([(length, fe.section(od, bore, STEEL)) for length, od, bore in SPINDLE], points=list(BEARINGS))
     *plain, (length, od, bore) = HOLDER
     h = m.add_beam([(a, fe.section(b, c, STEEL)) for a, b, c in plain]
@@ -106,5 +110,5 @@ def measure(points=("tool.tip",), sensor_kg: float = 0.0, flutes: tuple[float, f
         m.add_mass((h, nut[2]), nut[0], nut[1])
     beams = {"holder": h, "tool": t}
     outputs = [(beams[place(p)[0]], place(p)[1], "y") for p in points]
-    receptance = m.receptance(GRID.hz, outputs, [(t, TOOL_LENGTH - below, "y")])
+    receptance = m.receptance(GRID.hz, outputs, [(t, hammer_x, "y")])
     return [FRF(GRID, receptance[:, i:i + 1, :], (f"{p}:y",), ("tool.tip:y",)) for i, p in enumerate(points)]

@@ -100,3 +100,33 @@ def test_a_sensor_below_the_tip_is_found_where_it_sat():
     assert set(found) == {"point-position", "sensor-mass"}, _summary(d)
     assert found["point-position"].values["shift"] == pytest.approx(-0.0015, abs=5e-5)
     assert found["sensor-mass"].values["mass"] == pytest.approx(0.002, rel=0.05)
+
+
+def test_changes_of_the_structure_standing_in_for_the_tip_tested_below_it_are_not_claimed():
+    """The sensor and the hammer 1 mm below the tip, no sensor mass, the driving point and the holder's response at
+    twice a real test's noise: the search explains the data as flutes 1.5 mm longer and an overhang 0.8 mm shorter
+    (claimed before).  The tip's place alone explains them too, so neither is claimed, and the report names what
+    tells them apart; the rival's place is the truth's, and at the point it names the FE rig is the rival's."""
+    data = real_noise.with_real_noise(hl.measure(points=("tool.tip", "holder.tip"), below=0.001), 1800, 2.0)
+    model = hl.model()
+    d = diagnose(model, data, progress=False)
+    assert not d.verdict.explained
+    assert d.verdict.report[0].startswith("unexplained: no candidate explains the data uniquely")
+    assert {e.name for e in d.effects} & {"fluted-section", "model-parameter"}  # the search's changes, partial
+    ((rival, sep),) = d.alternatives.rivals
+    (tip,) = rival.founds
+    assert tip.change.effect == "point-position" and tip.values["shift"] == pytest.approx(-0.001, abs=5e-5)
+    assert "how far below the edge the sensor and the hammer sat" in sep["text"] and sep["chi2"] > 100
+    # the FRF named, from the FE rig: the rival reads tool.tip where it says the test was taken, 1 mm below
+    response, excitation = (sep[k].removesuffix(":y") for k in ("response", "excitation"))
+    hammer_mm = 1.0 if excitation == "tool.tip" else float(excitation.removeprefix("tool.tip-").removesuffix(" mm"))
+    (truth,) = hl.measure(points=(response,), below=0.001, hammer_below=hammer_mm / 1e3)
+    place = {"tool.tip": "tool.tip-1 mm"}
+    hz = truth.frequency.hz
+    taken = model.receptance(f"{place.get(response, response)}:y", f"{place.get(excitation, excitation)}:y", hz)
+    kept = d.changes.refined_assembly.receptance(f"{response}:y", f"{excitation}:y", hz)
+
+    def rms_log(h):
+        return float(np.sqrt(np.mean(np.abs(np.log(h.data.ravel() / truth.data.ravel())) ** 2)))
+
+    assert rms_log(taken) < 0.01 < rms_log(kept)

@@ -18,7 +18,8 @@ The same pair is a rival of an explanation the search did find
 (:func:`tip_rival`): a sensor on the tip beside a change of the structure
 there (a tool that much shorter carrying the stub beyond the sensor) is
 nearly the test taken below the tip with that sensor; where the pair
-explains the data too, the diagnosis claims neither.
+explains the data too, the diagnosis claims neither.  Without a sensor
+there, the tip's position alone is the rival of changes of the structure.
 """
 
 from __future__ import annotations
@@ -101,7 +102,9 @@ def tip_rival(lik: Likelihood, screen_lik: Likelihood, assembly, points: list, c
     the search may explain the data that way.  Where the outcome holds a test-only change at a measured free tip
     beside a change of the structure, and not the tip's position, the tip's position is fitted with the same
     test-only candidates at that point alone (as :func:`tip_fallback` does); where they explain the data too,
-    their changes are returned (the diagnosis weighs them as a rival explanation), else None.
+    their changes are returned (the diagnosis weighs them as a rival explanation), else None.  Where the outcome
+    changes the structure without a test-only change at the tip (a little less overhang and a little more flute
+    standing in for the test taken below it), the tip's position alone is the rival where it explains the data.
 
     Parameters
     ----------
@@ -118,6 +121,12 @@ def tip_rival(lik: Likelihood, screen_lik: Likelihood, assembly, points: list, c
         if any(c.key == tip.key for c in kept) or all(c.test_only for c in kept):
             continue
         if not any(c.test_only and c.where == tip.where for c in kept):
+            # no sensor there: changes of the structure that only stand in for the test taken below the tip (a
+            # few millimetres' less overhang and a little more flute) are rivalled by the tip's place alone
+            alone = refine(lik, screen_lik, [tip], 1, lambda changes: passive(lik, changes), None, None,
+                           settings=settings)
+            if alone.current and alone.fit is not None and explains(lik, alone, settings):
+                return [(c, dict(v), dict(sd)) for (c, v), sd in zip(alone.current, alone.fit.std)]
             continue
         both = _with_test_only(lik, screen_lik, tip, cands, settings)
         if both is not None and both.fit is not None:
