@@ -155,3 +155,21 @@ def test_the_sensor_on_the_edge_and_the_hammer_below_it():
     result = diagnose(hd.nominal_model(), _roving_sensor(0.0, 2.0), budget=150)
     assert result.verdict.explained, result.verdict.report
     assert _found(result) == _mm(hit_position=2.0)
+
+
+@pytest.mark.parametrize(("sensor_mm", "hammer_mm", "level", "offset"), [(3.3, 1.9, 1.26, 6832), (1.3, 0.6, 2.03, 2294),
+                                                                         (1.0, 1.0, 2.0, 333)])
+def test_where_one_place_for_both_reaches_the_noise_the_hit_apart_is_kept_when_significant(sensor_mm, hammer_mm,
+                                                                                            level, offset):
+    """At more noise one place for both reaches it (2.385 mm for 3.3 and 1.9 mm, their compromise, before); the
+    hammer's place apart is then added where it is significant, fitted from that place, and the two are found; at
+    one height it is not significant and one place stays."""
+    data = _roving_sensor(sensor_mm, hammer_mm, offset=offset, level=level)
+    result = diagnose(hd.nominal_model(), data, budget=150)
+    assert result.verdict.explained, result.verdict.report
+    if sensor_mm == hammer_mm:
+        assert _found(result) == _mm(point_position=sensor_mm)
+    else:
+        assert _found(result) == _mm(point_position=sensor_mm, hit_position=hammer_mm)
+        steps = [s.added.name for s in result.refinement[1:]]
+        assert steps == ["point-position", "hit-position"]  # the error falls at each

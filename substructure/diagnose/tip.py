@@ -7,7 +7,9 @@ candidates it took places on the shortlist from the changes a search needs.
 So where the search explained nothing and a measured point is a free tip
 (:func:`~substructure.diagnose.search.free_tips`), :func:`tip_fallback` fits
 the tip's position alone: where that alone explains the data, it is the
-answer.  Else the tip's position is fitted together with what the test put
+answer (with the hammer's place apart from it, ``hit-position``, where a
+cross FRF lets it be fitted and it is significant: one place for both is
+then their compromise).  Else the tip's position is fitted together with what the test put
 at that point (the search's test-only candidates there: a sensor the model
 lacks, for the sensor sat where the test was, not on the edge): where the two
 explain the data, they are the answer.  Else, where the tip alone removes at
@@ -26,7 +28,9 @@ from __future__ import annotations
 
 import attrs
 
+from ..updating.fit import fit
 from ..updating.likelihood import Likelihood
+from ..updating.selection import significance
 from . import words
 from .claims import bound_hits, explains, passive
 from .refine import Outcome, refine
@@ -74,7 +78,8 @@ def tip_fallback(lik: Likelihood, screen_lik: Likelihood, assembly, points: list
     change, values = alone.current[0]
     firsts = {"first_scored": alone.first_scored + outcome.first_scored,
               "first_fitted": alone.first_fitted + outcome.first_fitted}
-    found = alone if explains(lik, alone, settings) else _with_test_only(lik, screen_lik, change, cands, settings)
+    found = (_apart(lik, screen_lik, alone, cands, settings) if explains(lik, alone, settings)
+             else _with_test_only(lik, screen_lik, change, cands, settings))
     if found is not None:
         if say:
             kept = " and ".join(f"{change.where} taken at {c.place(v)}" if c is change else
@@ -132,6 +137,29 @@ def tip_rival(lik: Likelihood, screen_lik: Likelihood, assembly, points: list, c
         if both is not None and both.fit is not None:
             return [(c, dict(v), dict(sd)) for (c, v), sd in zip(both.current, both.fit.std)]
     return None
+
+
+def _apart(lik: Likelihood, screen_lik: Likelihood, alone: Outcome, cands: list,
+           settings: DiagnoseSettings) -> Outcome:
+    """The tip alone explains the data: the sensor's place and the hammer's apart, fitted from the tip alone's place,
+    where the hammer's is significant (one place for both is then their compromise), else the tip alone."""
+    (tip, _), = alone.current
+    hits = [c for c in cands if c.effect == "hit-position" and c.where == tip.where]
+    if not hits:
+        return alone
+    (hit,) = hits
+    try:
+        # from where the tip alone is (both at one place): the joint fit starts at the tip alone's optimum
+        both = fit(lik, [alone.current[0], (hit, dict(alone.current[0][1]))])
+    except (ValueError, ArithmeticError):
+        return alone
+    sig = significance(alone.fit.chi2, both.chi2, len(hit.specs), lik.n, len(tip.specs) + len(hit.specs))
+    if not sig.significant:
+        return alone
+    added = both.changes[1][0]
+    apart = attrs.evolve(alone, current=[(c, dict(v)) for c, v in both.changes], fit=both,
+                         history=[*alone.history, (both, added, sig.statistic, sig.threshold)])
+    return apart if passive(lik, apart.current) and explains(lik, apart, settings) else alone
 
 
 def _with_test_only(lik: Likelihood, screen_lik: Likelihood, tip, cands: list,
