@@ -42,7 +42,7 @@ from ..updating.likelihood import Likelihood, measured_frfs
 from ..updating.structure import assembly_checked
 from ..updating.selection import INDIFFERENCE, consistency, error_check, outlying_runs
 from .compare import METRIC, Comparison, _pairs, frac, error_bands
-from .effects import Effect, hit_at, registry, tested_at, written_back
+from .effects import Effect, registry, tested_at, written_back
 from .refine import refine as refine_model, trim_partial
 from . import words
 from .claims import bound_hits, bound_text, counted, explains, passive
@@ -534,7 +534,7 @@ def _tip_rival(lik, screen_lik, assembly, measured, points, cands, outcome, fina
     rival = Explanation(tuple(Found(c, v, sd) for c, v, sd in found))
     sep = separation(assembly, measured, Explanation(final_effects), rival, say, contact_only=True, settings=settings)
     kept = [(c, v) for c, v, _ in found]
-    (point, place), *_ = (tested_at(kept) or hit_at(kept)).items()  # the sensor's place, else the hit's (on the edge)
+    (point, place), *_ = (tested_at(kept) or tested_at(kept, hits=True)).items()  # the sensor's, else the hit's
     ruler = words.taken_below(point, place)  # what tells them apart without a test
     if sep is None or sep["chi2"] <= INDIFFERENCE:  # no FRF with the test's sensors on does
         sep = {**(sep or {"response": None, "excitation": None, "non_contact": False, "chi2": None}), "text": ruler}

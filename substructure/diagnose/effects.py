@@ -47,7 +47,7 @@ from ..updating.elements import HitPosition, PointPosition
 from ..updating.parameters import Change, ParamSpec
 
 __all__ = ["Parameter", "Effect", "EFFECTS", "register_effect", "get_effect", "EffectChange", "registry",
-           "registered", "written_back", "tested_at", "hit_at"]
+           "registered", "written_back", "tested_at"]
 
 EFFECTS: dict[str, type] = {}
 """Registered effects by name."""
@@ -451,33 +451,21 @@ def written_back(assembly, current: list):
     return assembly
 
 
-def tested_at(current) -> dict[str, str]:
-    """Where kept point positions say the test was taken: ``{"tool.tip": "tool.tip-2 mm"}``.
+def tested_at(current, hits: bool = False) -> dict[str, str]:
+    """Where kept point positions say the test was taken: ``{"tool.tip": "tool.tip-2 mm"}``; with ``hits``, where
+    kept hit positions say the hammer hit, apart from the sensor: ``{"tool.tip": "tool.tip-1 mm"}``.
 
     Parameters
     ----------
     current : iterable of (Change, dict)
         Kept changes with their values.
+    hits : bool
+        The hammer's places (``hit-position``) instead of the points' (``point-position``).
 
     Returns
     -------
     dict of str to str
         The point as the measurements name it, and its place on the model.
     """
-    return {c.where: c.place(v) for c, v in current if isinstance(c, PointPosition) and not isinstance(c, HitPosition)}
-
-
-def hit_at(current) -> dict[str, str]:
-    """Where kept hit positions say the hammer hit, apart from the sensor: ``{"tool.tip": "tool.tip-1 mm"}``.
-
-    Parameters
-    ----------
-    current : iterable of (Change, dict)
-        Kept changes with their values.
-
-    Returns
-    -------
-    dict of str to str
-        The point as the measurements name the excitation, and where it was hit on the model.
-    """
-    return {c.where: c.place(v) for c, v in current if isinstance(c, HitPosition)}
+    return {c.where: c.place(v) for c, v in current
+            if isinstance(c, PointPosition) and isinstance(c, HitPosition) == hits}

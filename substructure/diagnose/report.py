@@ -37,7 +37,7 @@ from ..measurements import model_of_measurement
 from ..updating.parameters import set_parameters
 from ..updating.selection import INDIFFERENCE
 from . import words
-from .effects import hit_at, tested_at, written_back
+from .effects import tested_at, written_back
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 from .words import values_text
 
@@ -382,7 +382,8 @@ def separation(assembly, measured, a, b, say=None, contact_only: bool = False,
     points += [f"{w}-{0.25 * length_m[w.split('.')[0]] * 1e3:.3g} mm" for w in tips]
     labels = [[f"{place.get(p, p)}:y" for p in points] for place in moved]
     # and its hits where it says the hammer hit, apart from the sensor
-    hit_labels = [[f"{hit.get(p, place.get(p, p))}:y" for p in points] for place, hit in zip(moved, map(hit_at, pairs))]
+    hit_labels = [[f"{hit.get(p, place.get(p, p))}:y" for p in points]
+                  for place, hit in zip(moved, (tested_at(p, hits=True) for p in pairs))]
     variants = [False] + ([True] if (a.change.test_only or b.change.test_only) and not contact_only else [])
     best = None
     for non_contact in variants:
