@@ -46,8 +46,9 @@ def _roving_sensor(sensor_mm: float, hammer_mm: float, others=OTHERS, offset: in
 
 
 def _found(result) -> dict:
-    """``{effect: mm below the tip}`` of the changes found, to 20 um."""
-    return {e.change.effect: round(-e.values["shift"] * 1e3 / 0.02) * 0.02 for e in result.changes.final_effects}
+    """``{effect: mm below the tip}`` of the places found, to 20 um."""
+    return {e.change.effect: round(-e.values["shift"] * 1e3 / 0.02) * 0.02 for e in result.changes.final_effects
+            if "shift" in e.values}
 
 
 def _mm(**places) -> dict:
@@ -173,3 +174,14 @@ def test_where_one_place_for_both_reaches_the_noise_the_hit_apart_is_kept_when_s
         assert _found(result) == _mm(point_position=sensor_mm, hit_position=hammer_mm)
         steps = [s.added.name for s in result.refinement[1:]]
         assert steps == ["point-position", "hit-position"]  # the error falls at each
+
+
+def test_with_a_sensor_of_its_own_the_place_left_out_is_added_when_significant():
+    """4 and 3.2 mm with a 3 g sensor at twice the noise: the tip with the sensor already reached it at one place
+    (3.5 mm, 2.87 g before); the hammer's place apart is significant and both come back, the sensor's 3 g too."""
+    data = _roving_sensor(4.0, 3.2, offset=6820, level=2.06, sensor_kg=0.003, sensor_below=0.004)
+    result = diagnose(hd.nominal_model(), data, budget=150)
+    assert result.verdict.explained, result.verdict.report
+    found = {e.change.effect: e for e in result.changes.final_effects}
+    assert _found(result) == _mm(point_position=4.0, hit_position=3.2)
+    assert found["sensor-mass"].values["mass"] == pytest.approx(0.003, rel=0.03)

@@ -248,6 +248,7 @@ def free_tip_hits(assembly, pairs: Sequence[tuple[str, str]], reach: float) -> l
     ends = [(parse_point(r).point, parse_point(e).point) for r, e in pairs]
     crossed = {p for r, e in ends if r != e for p in (r, e)}
     tips = free_tips(assembly, [e for _, e in pairs], reach)
+    # a free tip is at its component's end: its place and the component's length are one (t.distance)
     return [HitPosition(t.where, t.component, t.distance, t.distance, reach) for t in tips
             if parse_point(t.where).point in crossed]
 

@@ -9,7 +9,7 @@ So where the search explained nothing and a measured point is a free tip
 the tip's position alone: where that alone explains the data, it is the
 answer (with the hammer's place apart from it, ``hit-position``, where a
 cross FRF lets it be fitted and it is significant: one place for both is
-then their compromise).  Else the tip's position is fitted together with what the test put
+then their compromise; likewise after the tip with a sensor).  Else the tip's position is fitted together with what the test put
 at that point (the search's test-only candidates there: a sensor the model
 lacks, for the sensor sat where the test was, not on the edge): where the two
 explain the data, they are the answer.  Else, where the tip alone removes at
@@ -78,9 +78,9 @@ def tip_fallback(lik: Likelihood, screen_lik: Likelihood, assembly, points: list
     change, values = alone.current[0]
     firsts = {"first_scored": alone.first_scored + outcome.first_scored,
               "first_fitted": alone.first_fitted + outcome.first_fitted}
-    found = (_apart(lik, screen_lik, alone, cands, settings) if explains(lik, alone, settings)
-             else _with_test_only(lik, screen_lik, change, cands, settings))
+    found = alone if explains(lik, alone, settings) else _with_test_only(lik, screen_lik, change, cands, settings)
     if found is not None:
+        found = _apart(lik, change, found, cands, settings)
         if say:
             kept = " and ".join(f"{change.where} taken at {c.place(v)}" if c is change else
                                 f"{c.effect} at {c.where}" + (f" ({c.place(v)})" if c.effect == "hit-position" else "")
@@ -131,35 +131,40 @@ def tip_rival(lik: Likelihood, screen_lik: Likelihood, assembly, points: list, c
             alone = refine(lik, screen_lik, [tip], 1, lambda changes: passive(lik, changes), None, None,
                            settings=settings)
             if alone.current and alone.fit is not None and explains(lik, alone, settings):
+                alone = _apart(lik, tip, alone, cands, settings)  # the hammer's place too, where significant
                 return [(c, dict(v), dict(sd)) for (c, v), sd in zip(alone.current, alone.fit.std)]
             continue
         both = _with_test_only(lik, screen_lik, tip, cands, settings)
+        if both is not None:
+            both = _apart(lik, tip, both, cands, settings)
         if both is not None and both.fit is not None:
             return [(c, dict(v), dict(sd)) for (c, v), sd in zip(both.current, both.fit.std)]
     return None
 
 
-def _apart(lik: Likelihood, screen_lik: Likelihood, alone: Outcome, cands: list,
-           settings: DiagnoseSettings) -> Outcome:
-    """The tip alone explains the data: the sensor's place and the hammer's apart, fitted from the tip alone's place,
-    where the hammer's is significant (one place for both is then their compromise), else the tip alone."""
-    (tip, _), = alone.current
-    hits = [c for c in cands if c.effect == "hit-position" and c.where == tip.where]
-    if not hits:
-        return alone
-    (hit,) = hits
+def _apart(lik: Likelihood, tip, found: Outcome, cands: list, settings: DiagnoseSettings) -> Outcome:
+    """An outcome that explains the data with one of the tip's two places (where the test was, ``tip``, or where
+    the hammer hit, ``hit-position``): the other added, fitted from the kept one's place, where it is significant
+    (one place for both is then their compromise); else the outcome as it was.  The search stops at the noise, so
+    it would not try it."""
+    hit = next((c for c in cands if c.effect == "hit-position" and c.where == tip.where), None)
+    kept = [c for c, _ in found.current]
+    places = [c for c in (tip, hit) if c is not None and c in kept]
+    other = next((c for c in (tip, hit) if c is not None and c not in kept), None)
+    if len(places) != 1 or other is None or found.fit is None:
+        return found
+    start = dict(next(v for c, v in found.current if c is places[0]))  # both at one place: the kept fit's optimum
     try:
-        # from where the tip alone is (both at one place): the joint fit starts at the tip alone's optimum
-        both = fit(lik, [alone.current[0], (hit, dict(alone.current[0][1]))])
+        both = fit(lik, [*found.current, (other, start)])
     except (ValueError, ArithmeticError):
-        return alone
-    sig = significance(alone.fit.chi2, both.chi2, len(hit.specs), lik.n, len(tip.specs) + len(hit.specs))
+        return found
+    p = sum(len(c.specs) for c in kept) + len(other.specs)
+    sig = significance(found.fit.chi2, both.chi2, len(other.specs), lik.n, p)
     if not sig.significant:
-        return alone
-    added = both.changes[1][0]
-    apart = attrs.evolve(alone, current=[(c, dict(v)) for c, v in both.changes], fit=both,
-                         history=[*alone.history, (both, added, sig.statistic, sig.threshold)])
-    return apart if passive(lik, apart.current) and explains(lik, apart, settings) else alone
+        return found
+    apart = attrs.evolve(found, current=[(c, dict(v)) for c, v in both.changes], fit=both,
+                         history=[*found.history, (both, both.changes[-1][0], sig.statistic, sig.threshold)])
+    return apart if passive(lik, apart.current) and explains(lik, apart, settings) else found
 
 
 def _with_test_only(lik: Likelihood, screen_lik: Likelihood, tip, cands: list,
