@@ -10,8 +10,9 @@ the tip's position alone: where that alone explains the data, it is the
 answer (with the hammer's place apart from it, ``hit-position``, where a
 cross FRF lets it be fitted and it is significant: one place for both is
 then their compromise; likewise after the tip with a sensor).  Else the
-tip's position is fitted together with what the test put at that point (the search's test-only candidates there: a sensor the model
-lacks, for the sensor sat where the test was, not on the edge): where the two
+tip's position is fitted together with what the test put at that point
+(the search's test-only candidates there: a sensor the model lacks, for
+the sensor sat where the test was, not on the edge): where the two
 explain the data, they are the answer.  Else, where the tip alone removes at
 least ``settings.tip_share`` of the misfit, the report says so without
 claiming it.
