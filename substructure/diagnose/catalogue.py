@@ -384,6 +384,83 @@ class SupportSprings(Effect):
         return assembly.support(Support(f"{name}@{_si(first, 'm')}", k=k, name=f"diagnosed-{name}-1")).support(
             Support(f"{name}@{_si(second, 'm')}", k=k, name=f"diagnosed-{name}-2"))
 
+    @classmethod
+    def body(cls, where: str) -> str:
+        """The component the springs hold (``where`` checked)."""
+        return cls._ends(where)[0]
+
+    @classmethod
+    def rigid_body_starts(cls, where: str, length: float, body: tuple[float, float, float],
+                          peaks_hz: tuple[float, ...], count: int) -> list[dict]:
+        """Values that put the two modes of the free body on its springs at two measured resonances.
+
+        Below its first flexible mode the body moves as a rigid one: with
+        mass ``m``, rotary inertia ``J`` about its centre of mass and springs
+        ``k`` at distances ``d1``, ``d2`` from that centre, the modes are
+        ``omega^2 = k mu`` with ``mu`` the eigenvalues of
+        ``[[2/m, (d1+d2)/m], [(d1+d2)/J, (d1^2+d2^2)/J]]``.  On a grid of
+        ``count`` values of each inset, the places where the ratio of the two
+        ``mu`` is the ratio of the two resonances' ``omega^2`` (a curve, found
+        by linear interpolation along rows and columns) each give one start,
+        ``k`` from the lower resonance.
+
+        Parameters
+        ----------
+        where : str
+            The place (the component's two ends).
+        length : float
+            The component's length [m].
+        body : (float, float, float)
+            Mass [kg], rotary inertia about the centre of mass [kg m^2] and the
+            centre's distance from the component's base [m].
+        peaks_hz : (float, float)
+            The two resonances [Hz], lower first.
+        count : int
+            Values of each inset.
+
+        Returns
+        -------
+        list of dict
+            Starting values (``k_yf``, ``inset``, ``inset_tip``) within the bounds.
+        """
+        _, base_first = cls._ends(where)
+        mass, inertia, centre = body
+        specs = {p.name: p for p in cls.parameters}
+        u = np.linspace(specs["inset"].lower, specs["inset"].upper, count)
+        a, b = np.meshgrid(u, u, indexing="ij")  # a: inset from the first end named, b: from the second
+        first, second = (a * length, (1.0 - b) * length) if base_first else ((1.0 - a) * length, b * length)
+        d1, d2 = first - centre, second - centre
+        trace = 2.0 / mass + (d1 ** 2 + d2 ** 2) / inertia
+        root = np.sqrt(np.maximum(trace ** 2 - 4.0 * (d1 - d2) ** 2 / (mass * inertia), 0.0))
+        low, high = 0.5 * (trace - root), 0.5 * (trace + root)
+        lam = (2.0 * np.pi * peaks_hz[0]) ** 2
+        k_spec = specs["k_yf"]
+        out = []
+        if len(peaks_hz) == 1:  # the other mode unseen: either mode there, on a coarser grid of places
+            every = slice(None, None, 5)
+            for mu in (low[every, every], high[every, every]):
+                with np.errstate(divide="ignore"):
+                    k = lam / mu
+                keep = (k >= k_spec.lower) & (k <= k_spec.upper)
+                out += [{"k_yf": float(x), "inset": float(y), "inset_tip": float(z)}
+                        for x, y, z in zip(k[keep], a[every, every][keep], b[every, every][keep])]
+            return out
+        with np.errstate(divide="ignore", invalid="ignore"):
+            g = np.log(high / low) - 2.0 * np.log(peaks_hz[1] / peaks_hz[0])
+        for grid_g, grid_low, along in ((g, low, 1), (g.T, low.T, 0)):
+            j = np.nonzero(np.isfinite(grid_g[:, :-1]) & np.isfinite(grid_g[:, 1:])
+                           & (grid_g[:, :-1] * grid_g[:, 1:] <= 0.0) & (grid_g[:, :-1] != grid_g[:, 1:]))
+            t = grid_g[j] / (grid_g[j] - grid_g[j[0], j[1] + 1])
+            mu = grid_low[j] + t * (grid_low[j[0], j[1] + 1] - grid_low[j])
+            moving = u[j[1]] + t * (u[1] - u[0])
+            fixed = u[j[0]]
+            for f, m, value in zip(fixed, moving, mu):
+                k = lam / value if value > 0 else np.inf
+                if k_spec.lower <= k <= k_spec.upper:
+                    inset, inset_tip = (f, m) if along == 1 else (m, f)
+                    out.append({"k_yf": float(k), "inset": float(inset), "inset_tip": float(inset_tip)})
+        return out
+
     @staticmethod
     def _ends(where: str) -> tuple[str, bool]:
         """The component and whether the first end named is its base (``where`` checked)."""

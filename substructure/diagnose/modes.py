@@ -20,20 +20,29 @@ model's, there is nothing to predict from and no extra start is made.  Elements 
 screening place from where they do nothing (a zero mass, a zero spring), with three trials around the
 prediction; a section change's three parameters are left to its scan.  The windows, steps and factors are
 fields of :class:`~substructure.diagnose.settings.DiagnoseSettings`.
+
+Springs to the ground under a free body (suspension bands, a fixture) add resonances the model lacks, with
+nothing to shift: their two rigid-body modes sit in a minimum narrower than any grid of stiffnesses and places.
+Their starts come from the body instead: its mass, rotary inertia and centre read off the model's receptances
+at the component's two ends (:func:`rigid_body`), and the springs that put its two modes at two of the lowest
+resonances the model lacks, or either mode at the lowest.
 """
 
 from __future__ import annotations
+
+import itertools
 
 import numpy as np
 
 from ..errors import SubstructureError
 from ..frf import FRF
 from ..updating.elements import SectionChange
+from ..updating.evaluator import Evaluator
 from ..updating.fit import from_u, to_u
-from .compare import _pairs
+from .compare import _pairs, pair_modes
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
-__all__ = ["mode_starts", "peak_near"]
+__all__ = ["mode_starts", "peak_near", "rigid_starts", "rigid_body"]
 
 
 def peak_near(f: np.ndarray, h: np.ndarray, near: float, width: float = 0.12) -> float | None:
@@ -157,6 +166,126 @@ def mode_starts(lik0, current, changes, places, settings: DiagnoseSettings = DEF
         if trials:
             out[change.key] = trials
     return out
+
+
+def rigid_starts(lik, current, changes, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> dict:
+    """Starts of the changes that hang a free body on springs from the lowest resonances the model lacks, with the
+    body's mass, rotary inertia and centre read off the model's receptances at its two ends (:func:`rigid_body`).
+
+    An effect takes part through two class methods: ``body(where)``, the component its springs hold, and
+    ``rigid_body_starts(where, length, body, peaks_hz, count)``, its values that put the body's modes at the
+    resonances (:class:`~substructure.diagnose.catalogue.SupportSprings`).  The screening searches each start's
+    main parameter near it (:func:`substructure.diagnose.scan.sharpen`).
+
+    Parameters
+    ----------
+    lik : Likelihood
+        Every measured FRF on all its lines.
+    current : list of (Change, dict)
+        The changes already added.
+    changes : sequence of Change
+        The candidates.
+    settings : DiagnoseSettings
+        ``rigid_places`` and the thresholds of a resonance.
+
+    Returns
+    -------
+    dict
+        Per candidate key, groups of trial values: the lowest resonance alone, and each two of them (each group's
+        best are searched further).
+    """
+    hooked = [c for c in changes if hasattr(getattr(c, "cls", None), "rigid_body_starts") and hasattr(c.cls, "body")]
+    if not hooked:
+        return {}
+    try:
+        predicted = lik.predict(current)
+    except SubstructureError:
+        return {}
+    # the resonances the model lacks in every FRF measured (a mode can hardly show at one point and plainly at
+    # another), however low beside the highest (two modes of a body on soft springs can differ by two decades in
+    # height), each located on the measured lines by a parabola through its top (the smoothed data's peak can sit
+    # a line off); one seen in several FRFs within a line is one
+    found = []
+    for m, y in zip(lik.measured, predicted):
+        measured = m.frf
+        f, h = measured.frequency.hz[lik.lines], measured.data[lik.lines, 0, 0]
+        model = FRF(measured.frequency, y[:, None, None], measured.outputs, measured.inputs)
+        found += [peak_near(f, h, p.measured_hz, settings.mode_window) or p.measured_hz
+                  for p in pair_modes(model, measured, 0.0, noise=m.noise.floor, prominence=settings.mode_prominence,
+                                      noise_prominence=settings.mode_prominence_floors,
+                                      pairing=settings.mode_pairing) if p.model_hz is None]
+    step = float(f[1] - f[0]) if f.size > 1 else 0.0
+    clusters: list[list[float]] = []
+    for hz in sorted(found):
+        if clusters and hz - clusters[-1][-1] <= step:
+            clusters[-1].append(hz)
+        else:
+            clusters.append([hz])
+    lacking_hz = [float(np.median(c)) for c in clusters]
+    if not lacking_hz:
+        return {}
+    # every two of the three lowest, the upper one up to a line either way (a peak on noisy lines sits up to a
+    # line off, and the two modes' ratio places the springs), and the lowest alone with either mode there: two
+    # modes close together can show as one
+    sets = [[(lacking_hz[0],)]] + [[(lo, hi + shift * step) for shift in (-1.0, -0.5, 0.0, 0.5, 1.0)
+                                    if hi + shift * step > lo] for lo, hi in itertools.combinations(lacking_hz[:3], 2)]
+    out: dict = {}
+    group = lik.groups[0]
+    for change in hooked:
+        try:
+            name = change.cls.body(change.where)
+            length = group.assembly.component(name).length_m
+            body = rigid_body(group.structure_with(current), name, length, 0.1 * lacking_hz[0])
+            if body is None:
+                continue
+            groups = [[t for peaks in peak_sets
+                       for t in change.cls.rigid_body_starts(change.where, length, body, peaks, settings.rigid_places)]
+                      for peak_sets in sets]
+            if any(groups):
+                out[change.key] = [g for g in groups if g]
+        except (SubstructureError, ValueError, FloatingPointError):
+            continue
+    return out
+
+
+def rigid_body(structure, name: str, length: float, f_hz: float) -> tuple[float, float, float] | None:
+    """A free body's mass [kg], rotary inertia about its centre of mass [kg m^2] and that centre's distance from
+    the component's base [m], from the receptances between the component's two ends at ``f_hz`` and ``2 f_hz``
+    (well below its first flexible mode).
+
+    There ``-omega^2 H_ij = 1/m + d_i d_j / J`` with ``d`` a point's distance from the centre; three receptances
+    give the three numbers.  None where the body is not free (held to the ground, the mass line of ``f_hz`` not
+    that of ``2 f_hz`` within 5 %) or the numbers are not physical.
+
+    Parameters
+    ----------
+    structure : Structure
+        The model (SI form).
+    name : str
+        The component.
+    length : float
+        Its length [m] (from its base to its tip).
+    f_hz : float
+        A frequency below the body's first flexible mode [Hz].
+
+    Returns
+    -------
+    (float, float, float) or None
+    """
+    ends = [f"{name}.base", f"{name}.tip"]
+    hz = np.array([f_hz, 2.0 * f_hz])
+    h = Evaluator(ends, ends, hz)(structure).real
+    a = -(2.0 * np.pi * hz[:, None, None]) ** 2 * h
+    if not np.allclose(a[0], a[1], rtol=0.05, atol=0.0):
+        return None
+    a = a[0]
+    curvature = a[0, 0] + a[1, 1] - 2.0 * a[0, 1]
+    if not curvature > 0:
+        return None
+    inertia = length ** 2 / curvature
+    centre = inertia * (a[0, 0] - a[0, 1]) / length
+    mass = 1.0 / (a[0, 1] + centre * (length - centre) / inertia)
+    return (mass, inertia, centre) if mass > 0 and np.isfinite(mass) else None
 
 
 def _modes(lik0, changes, f, previous, width=0.12):

@@ -61,7 +61,7 @@ from ..updating.fit import Fit, fit, to_u
 from ..updating.selection import INDIFFERENCE, bic, consistency, significance
 from .crossval import cross_validate
 from .effects import EffectChange
-from .modes import mode_starts
+from .modes import mode_starts, rigid_starts
 from .pairs import other_paths
 from .scan import places, trials
 from .search import (ELEMENT, Budget, Scored, _p, choose, full_fits, physical, preference, rank, screen,
@@ -513,8 +513,9 @@ def refine(lik, screen_lik, cands, max_steps: int, passive: Callable, say=None,
         # the current changes refitted on the subsample too: candidates are compared with that
         chi2_s = fit(screen_lik, current).chi2 if current else screen_lik.chi2([])
         extra = mode_starts(lik0, current, remaining, lambda change: places(change, settings), settings)
+        narrow = rigid_starts(lik, current, remaining, settings)
         scored = screen(screen_lik, current, remaining, chi2_s, n, say, extra, cross=lacking and not current,
-                        settings=settings)
+                        settings=settings, narrow=narrow)
         chosen = []
         for s in shortlist(scored, chi2_s, screen_lik.n, n, _p(current), settings):
             # the screened values checked on all lines (noise fitted on the subsample does not carry over)

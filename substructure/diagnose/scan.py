@@ -27,7 +27,7 @@ from ..updating.parameters import Change
 from .effects import EffectChange
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
-__all__ = ["trials", "places", "grid", "finer"]
+__all__ = ["trials", "places", "grid", "finer", "sharpen"]
 
 
 def grid(spec, count: int, settings: DiagnoseSettings = DEFAULT_SETTINGS) -> np.ndarray:
@@ -154,7 +154,51 @@ def finer(change: Change, tried: list[dict], costs: list[float], evaluate: Calla
         return [], []
     starts = [trial for _, trial in best.values()]
     u0 = np.array([to_u(main, t[main.name]) for t in starts])
-    a, b = np.maximum(u0 - step, lo), np.minimum(u0 + step, hi)
+    return _golden(main, starts, np.maximum(u0 - step, lo), np.minimum(u0 + step, hi), evaluate, settings.place_search)
+
+
+def sharpen(change: Change, tried: list[dict], costs: list[float], evaluate: Callable[[list[dict]], list[float]],
+            settings: DiagnoseSettings = DEFAULT_SETTINGS) -> tuple[list[dict], list[float]]:
+    """The main parameter of the best starts searched close to each (starts from a free body's modes).
+
+    The ``settings.rigid_sharpened`` best of ``tried``, each with a
+    golden-section search of ``settings.place_search`` steps within
+    ``settings.rigid_span`` of its main parameter (on its fitted scale), the
+    starts evaluated together.  A start that places the springs right puts
+    the body's modes within a line of the measured ones, and a lightly
+    damped mode's minimum is narrower than that: 1 % off in stiffness,
+    ``chi^2`` 176 becomes 10,789.
+
+    Parameters
+    ----------
+    change : Change
+        The candidate.
+    tried, costs : list
+        The starts and their ``chi^2``.
+    evaluate : callable
+        ``evaluate(trials) -> costs``, for several trials together.
+    settings : DiagnoseSettings
+        ``rigid_sharpened``, ``rigid_span`` and ``place_search``.
+
+    Returns
+    -------
+    (list of dict, list of float)
+        The trials evaluated besides, and their costs.
+    """
+    order = [i for i in np.argsort(costs) if np.isfinite(costs[i])][:settings.rigid_sharpened]
+    if not order or settings.place_search == 0:
+        return [], []
+    main = change.specs[0]
+    lo, hi = sorted((to_u(main, main.lower), to_u(main, main.upper)))
+    starts = [tried[i] for i in order]
+    u0 = np.array([to_u(main, t[main.name]) for t in starts])
+    return _golden(main, starts, np.maximum(u0 - settings.rigid_span, lo), np.minimum(u0 + settings.rigid_span, hi),
+                   evaluate, settings.place_search)
+
+
+def _golden(main, starts: list[dict], a: np.ndarray, b: np.ndarray, evaluate: Callable, steps: int
+            ) -> tuple[list[dict], list[float]]:
+    """A golden-section search of ``main`` in ``[a, b]`` (fitted scale) for each start, evaluated together."""
     out: list[dict] = []
     got: list[float] = []
 
@@ -167,7 +211,7 @@ def finer(change: Change, tried: list[dict], costs: list[float], evaluate: Calla
 
     c, d = b - GOLDEN * (b - a), a + GOLDEN * (b - a)
     fc, fd = at(c), at(d)
-    for _ in range(settings.place_search - 1):
+    for _ in range(steps - 1):
         left = fc <= fd  # the minimum lies in [a, d]: d becomes b, c becomes d
         a, b = np.where(left, a, c), np.where(left, d, b)
         c, d, fc_old, fd_old = (np.where(left, b - GOLDEN * (b - a), d), np.where(left, c, a + GOLDEN * (b - a)),

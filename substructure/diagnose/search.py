@@ -46,7 +46,7 @@ from ..updating.parameters import Change, ParameterChange, material_changes, mod
 from ..updating.structure import uniform_beam
 from ..updating.selection import INDIFFERENCE, bic, significance
 from .effects import EffectChange, effect_change
-from .scan import finer
+from .scan import finer, sharpen
 from .scan import trials as _trials
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
@@ -283,7 +283,7 @@ class Scored:
 
 def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2_now: float, n_full: int,
            progress: Callable | None = None, extra: dict | None = None, cross: bool = False,
-           settings: DiagnoseSettings = DEFAULT_SETTINGS) -> list[Scored]:
+           settings: DiagnoseSettings = DEFAULT_SETTINGS, narrow: dict | None = None) -> list[Scored]:
     """Screen candidates on a subsample: a scan with the changes already added held, then local fits.
 
     Every candidate's main parameter is scanned over its range (at each
@@ -312,6 +312,9 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
         More trials per candidate key (from :func:`substructure.diagnose.modes.mode_starts`).
     cross : bool
         Cross the sizes and positions of springs (:func:`substructure.diagnose.scan.trials`).
+    narrow : dict, optional
+        Groups of more trials per candidate key; each group's best have their main parameter searched close to each
+        (:func:`substructure.diagnose.modes.rigid_starts`, :func:`substructure.diagnose.scan.sharpen`).
     settings : DiagnoseSettings
         The grids, the polish and the shortlist's numbers.
 
@@ -363,6 +366,10 @@ def screen(likelihood, current: Sequence[tuple], changes: Sequence[Change], chi2
             except (SubstructureError, ValueError, FloatingPointError):
                 more, more_costs = [], []  # a size between the grid's that cannot be evaluated: the grid's stand
             tried, costs = tried + more, costs + more_costs
+            for starts in (narrow or {}).get(change.key, ()):
+                start_costs = evaluate(list(starts))
+                sharper, sharper_costs = sharpen(change, list(starts), start_costs, evaluate, settings)
+                tried, costs = tried + list(starts) + sharper, costs + start_costs + sharper_costs
             for trial, chi2 in zip(tried, costs):
                 if chi2 < best_chi2:
                     best_chi2, best = chi2, trial

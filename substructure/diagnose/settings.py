@@ -270,6 +270,20 @@ class DiagnoseSettings:
     mode_start_places : int
         An element with more screening places than this is started from mode
         shifts at every other one (default 5).
+    rigid_places : int
+        Values of each of the two places of springs under a free body on which
+        its two rigid-body modes are matched to the two lowest resonances the
+        model lacks (default 91, half a per cent of the body's length apart):
+        their minimum is narrower than any scan's grid.
+    rigid_sharpened : int
+        Those starts (the best by ``chi^2`` of each group: the lowest resonance
+        alone, each two of them) whose main parameter is searched close to
+        each (default 8).
+    rigid_span : float
+        How far: the half-width of that search on the parameter's fitted
+        scale (default 0.1, 10 % of a stiffness): a start places the modes
+        within a line of the measured ones, and a lightly damped mode's
+        minimum is narrower than a line.
     review_pool : int
         Alternatives the review refits in place of each kept change (default 3).
     review_near_share : float
@@ -451,6 +465,9 @@ class DiagnoseSettings:
     element_factors: tuple[float, ...] = attrs.field(default=(0.6, 1.0, 1.5), converter=_tuple,
                                                      validator=_numbers())
     mode_start_places: int = attrs.field(default=5, validator=_count())
+    rigid_places: int = attrs.field(default=91, validator=_count(2))
+    rigid_sharpened: int = attrs.field(default=8, validator=_count(0))
+    rigid_span: float = attrs.field(default=0.1, validator=_number())
     review_pool: int = attrs.field(default=3, validator=_count(0))
     review_near_share: float = attrs.field(default=0.9, validator=_number(0.0, 1.0))
     pair_pool: int = attrs.field(default=4, validator=_count(0))
