@@ -47,6 +47,7 @@ OUT_OF_RANGE = {
     "mode_locate": -0.1, "in_place_lines": -1, "secant_iterations": -1, "secant_first_step": 0.0,
     "secant_max_step": -1.5, "secant_tolerance": 0.0, "element_probe_linear": 2.0, "element_probe_log": 0.0,
     "element_factors": (), "mode_start_places": 0, "rigid_places": 1, "rigid_sharpened": -1, "rigid_span": 0.0,
+    "rigid_below": 0.6, "rigid_free": 1.0, "rigid_resonances": 1, "rigid_shifts": (), "rigid_places_alone": 1,
     "review_pool": -1, "review_near_share": 1.1,
     "pair_pool": -1,
     "same_direction": 1.01, "pair_screen_evaluations": 0, "pairs_fitted": -1,

@@ -402,7 +402,8 @@ class SupportSprings(Effect):
         ``count`` values of each inset, the places where the ratio of the two
         ``mu`` is the ratio of the two resonances' ``omega^2`` (a curve, found
         by linear interpolation along rows and columns) each give one start,
-        ``k`` from the lower resonance.
+        ``k`` from the lower resonance.  With one resonance alone, every place
+        of the grid gives two starts: either mode there.
 
         Parameters
         ----------
@@ -413,8 +414,8 @@ class SupportSprings(Effect):
         body : (float, float, float)
             Mass [kg], rotary inertia about the centre of mass [kg m^2] and the
             centre's distance from the component's base [m].
-        peaks_hz : (float, float)
-            The two resonances [Hz], lower first.
+        peaks_hz : (float, float) or (float,)
+            The two resonances [Hz], lower first, or one.
         count : int
             Values of each inset.
 
@@ -436,14 +437,13 @@ class SupportSprings(Effect):
         lam = (2.0 * np.pi * peaks_hz[0]) ** 2
         k_spec = specs["k_yf"]
         out = []
-        if len(peaks_hz) == 1:  # the other mode unseen: either mode there, on a coarser grid of places
-            every = slice(None, None, 5)
-            for mu in (low[every, every], high[every, every]):
+        if len(peaks_hz) == 1:  # the other mode unseen: either mode there
+            for mu in (low, high):
                 with np.errstate(divide="ignore"):
                     k = lam / mu
                 keep = (k >= k_spec.lower) & (k <= k_spec.upper)
                 out += [{"k_yf": float(x), "inset": float(y), "inset_tip": float(z)}
-                        for x, y, z in zip(k[keep], a[every, every][keep], b[every, every][keep])]
+                        for x, y, z in zip(k[keep], a[keep], b[keep])]
             return out
         with np.errstate(divide="ignore", invalid="ignore"):
             g = np.log(high / low) - 2.0 * np.log(peaks_hz[1] / peaks_hz[0])

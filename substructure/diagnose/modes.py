@@ -205,6 +205,8 @@ def rigid_starts(lik, current, changes, settings: DiagnoseSettings = DEFAULT_SET
     # another), however low beside the highest (two modes of a body on soft springs can differ by two decades in
     # height), each located on the measured lines by a parabola through its top (the smoothed data's peak can sit
     # a line off); one seen in several FRFs within a line is one
+    hz = lik.measured[0].frf.frequency.hz[lik.lines]
+    step = float(hz[1] - hz[0]) if hz.size > 1 else 0.0
     found = []
     for m, y in zip(lik.measured, predicted):
         measured = m.frf
@@ -214,7 +216,6 @@ def rigid_starts(lik, current, changes, settings: DiagnoseSettings = DEFAULT_SET
                   for p in pair_modes(model, measured, 0.0, noise=m.noise.floor, prominence=settings.mode_prominence,
                                       noise_prominence=settings.mode_prominence_floors,
                                       pairing=settings.mode_pairing) if p.model_hz is None]
-    step = float(f[1] - f[0]) if f.size > 1 else 0.0
     clusters: list[list[float]] = []
     for hz in sorted(found):
         if clusters and hz - clusters[-1][-1] <= step:
@@ -224,22 +225,26 @@ def rigid_starts(lik, current, changes, settings: DiagnoseSettings = DEFAULT_SET
     lacking_hz = [float(np.median(c)) for c in clusters]
     if not lacking_hz:
         return {}
-    # every two of the three lowest, the upper one up to a line either way (a peak on noisy lines sits up to a
-    # line off, and the two modes' ratio places the springs), and the lowest alone with either mode there: two
-    # modes close together can show as one
-    sets = [[(lacking_hz[0],)]] + [[(lo, hi + shift * step) for shift in (-1.0, -0.5, 0.0, 0.5, 1.0)
-                                    if hi + shift * step > lo] for lo, hi in itertools.combinations(lacking_hz[:3], 2)]
+    # every two of the lowest, the upper one a line or so either way (a peak on noisy lines sits up to a line off,
+    # and the two modes' ratio places the springs), and the lowest alone with either mode there (two modes close
+    # together can show as one)
+    pairs = itertools.combinations(lacking_hz[:settings.rigid_resonances], 2)
+    shifted = [[(lo, hi + s * step) for s in settings.rigid_shifts if hi + s * step > lo] for lo, hi in pairs]
+    sets = [[(lacking_hz[0],)]] + [group for group in shifted if group]
     out: dict = {}
     group = lik.groups[0]
     for change in hooked:
         try:
             name = change.cls.body(change.where)
             length = group.assembly.component(name).length_m
-            body = rigid_body(group.structure_with(current), name, length, 0.1 * lacking_hz[0])
+            body = rigid_body(group.structure_with(current), name, length, settings.rigid_below * lacking_hz[0],
+                              settings.rigid_free)
             if body is None:
                 continue
             groups = [[t for peaks in peak_sets
-                       for t in change.cls.rigid_body_starts(change.where, length, body, peaks, settings.rigid_places)]
+                       for t in change.cls.rigid_body_starts(change.where, length, body, peaks,
+                                                             settings.rigid_places_alone if len(peaks) == 1
+                                                             else settings.rigid_places)]
                       for peak_sets in sets]
             if any(groups):
                 out[change.key] = [g for g in groups if g]
@@ -248,14 +253,15 @@ def rigid_starts(lik, current, changes, settings: DiagnoseSettings = DEFAULT_SET
     return out
 
 
-def rigid_body(structure, name: str, length: float, f_hz: float) -> tuple[float, float, float] | None:
+def rigid_body(structure, name: str, length: float, f_hz: float, free: float = 0.05
+               ) -> tuple[float, float, float] | None:
     """A free body's mass [kg], rotary inertia about its centre of mass [kg m^2] and that centre's distance from
     the component's base [m], from the receptances between the component's two ends at ``f_hz`` and ``2 f_hz``
     (well below its first flexible mode).
 
     There ``-omega^2 H_ij = 1/m + d_i d_j / J`` with ``d`` a point's distance from the centre; three receptances
     give the three numbers.  None where the body is not free (held to the ground, the mass line of ``f_hz`` not
-    that of ``2 f_hz`` within 5 %) or the numbers are not physical.
+    that of ``2 f_hz`` within ``free``) or the numbers are not physical.
 
     Parameters
     ----------
@@ -267,6 +273,8 @@ def rigid_body(structure, name: str, length: float, f_hz: float) -> tuple[float,
         Its length [m] (from its base to its tip).
     f_hz : float
         A frequency below the body's first flexible mode [Hz].
+    free : float
+        The relative tolerance of the two mass lines (default 0.05).
 
     Returns
     -------
@@ -276,7 +284,7 @@ def rigid_body(structure, name: str, length: float, f_hz: float) -> tuple[float,
     hz = np.array([f_hz, 2.0 * f_hz])
     h = Evaluator(ends, ends, hz)(structure).real
     a = -(2.0 * np.pi * hz[:, None, None]) ** 2 * h
-    if not np.allclose(a[0], a[1], rtol=0.05, atol=0.0):
+    if not np.allclose(a[0], a[1], rtol=free, atol=0.0):
         return None
     a = a[0]
     curvature = a[0, 0] + a[1, 1] - 2.0 * a[0, 1]

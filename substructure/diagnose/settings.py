@@ -270,11 +270,30 @@ class DiagnoseSettings:
     mode_start_places : int
         An element with more screening places than this is started from mode
         shifts at every other one (default 5).
+    rigid_below : float
+        A free body's mass, inertia and centre are read off the model at this
+        share of the lowest resonance the model lacks, and again at twice it
+        (default 0.1): below the first flexible mode, where the receptances
+        are the rigid body's mass line.
+    rigid_free : float
+        The body is free where those two readings agree within this share
+        (default 0.05); held to the ground, they do not.
+    rigid_resonances : int
+        The lowest resonances the model lacks (in any FRF measured, one seen
+        in several within a line counted once) of which every two are matched
+        by the two modes of the body on its springs (default 3).
+    rigid_shifts : tuple of float
+        The upper of the two also matched this many lines away (default
+        (-1.0, -0.5, 0.0, 0.5, 1.0)): a peak on noisy lines sits up to a line
+        off, and the two modes' ratio places the springs.
     rigid_places : int
         Values of each of the two places of springs under a free body on which
-        its two rigid-body modes are matched to the two lowest resonances the
-        model lacks (default 91, half a per cent of the body's length apart):
-        their minimum is narrower than any scan's grid.
+        its two rigid-body modes are matched to two resonances the model
+        lacks (default 91, half a per cent of the body's length apart): their
+        minimum is narrower than any scan's grid.
+    rigid_places_alone : int
+        Values of each place on which either mode is put at the lowest
+        resonance alone (default 19): two modes close together show as one.
     rigid_sharpened : int
         Those starts (the best by ``chi^2`` of each group: the lowest resonance
         alone, each two of them) whose main parameter is searched close to
@@ -465,7 +484,13 @@ class DiagnoseSettings:
     element_factors: tuple[float, ...] = attrs.field(default=(0.6, 1.0, 1.5), converter=_tuple,
                                                      validator=_numbers())
     mode_start_places: int = attrs.field(default=5, validator=_count())
+    rigid_below: float = attrs.field(default=0.1, validator=_number(0.0, 0.5))
+    rigid_free: float = attrs.field(default=0.05, validator=_number(0.0, 1.0, hi_open=True))
+    rigid_resonances: int = attrs.field(default=3, validator=_count(2))
+    rigid_shifts: tuple[float, ...] = attrs.field(default=(-1.0, -0.5, 0.0, 0.5, 1.0), converter=_tuple,
+                                                  validator=_numbers(-math.inf, math.inf))
     rigid_places: int = attrs.field(default=91, validator=_count(2))
+    rigid_places_alone: int = attrs.field(default=19, validator=_count(2))
     rigid_sharpened: int = attrs.field(default=8, validator=_count(0))
     rigid_span: float = attrs.field(default=0.1, validator=_number())
     review_pool: int = attrs.field(default=3, validator=_count(0))
