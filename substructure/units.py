@@ -336,6 +336,8 @@ def quantity(value: Any, field: str, dimension: str) -> pint.Quantity:
         magnitude = float(q.magnitude)
     except (TypeError, ValueError):
         raise InvalidValueError(f"{field}: got {show_value(value)}; expected a real number with its unit") from None
+    except OverflowError:  # an integer beyond any float
+        magnitude = math.inf
     if not math.isfinite(magnitude):
         raise InvalidValueError(f"{field}: got {show_value(value)}; expected a finite value")
     if not isinstance(q.magnitude, (int, float, np.integer, np.floating)):  # a Fraction, a Decimal: as a float
@@ -423,6 +425,41 @@ def whole_number(value: Any, field: str, minimum: int = 0, meaning: str = "a who
     return int(value)
 
 
+MAX_TEETH = 1000
+"""The most teeth a cutter is taken to have: slitting saws and large face mills have a few hundred; a million
+teeth put the tooth passing frequency in the megahertz and the lobes out of every band, which read as "no limit"."""
+
+
+def teeth_count(value: Any, field: str = "teeth") -> int:
+    """Check a cutter's number of teeth (flutes, inserts): a whole number from 1 to :data:`MAX_TEETH`.
+
+    An ``int``, a numpy integer or a float that is whole (a file's ``4.0``); a boolean or a text is refused.
+
+    Parameters
+    ----------
+    value : object
+        The value.
+    field : str
+        Its name in the message.
+
+    Returns
+    -------
+    int
+        The number of teeth.
+
+    Raises
+    ------
+    InvalidValueError
+        ``"{field}: got {value!r}; expected a whole number of teeth >= 1 and <= 1000"``.
+    """
+    whole = isinstance(value, numbers.Integral) or (
+        isinstance(value, numbers.Real) and math.isfinite(float(value)) and float(value).is_integer())
+    if isinstance(value, (bool, np.bool_)) or not whole or not 1 <= value <= MAX_TEETH:
+        raise InvalidValueError(
+            f"{field}: got {show_value(value)}; expected a whole number of teeth >= 1 and <= {MAX_TEETH}")
+    return int(value)
+
+
 def dimensionless(value: Any, field: str) -> float:
     """Check a dimensionless value (a plain number or a dimensionless quantity).
 
@@ -458,7 +495,10 @@ def dimensionless(value: Any, field: str) -> float:
         raise InvalidValueError(
             f"{field}: got {show_value(value)} of type {type(value).__name__}; expected a number"
         )
-    value = float(value)
+    try:
+        value = float(value)
+    except OverflowError:  # an integer beyond any float
+        raise InvalidValueError(f"{field}: got {show_value(value)}; expected a finite number") from None
     if not math.isfinite(value):
         raise InvalidValueError(f"{field}: got {show_value(value)}; expected a finite number")
     return value

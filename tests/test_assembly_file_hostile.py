@@ -189,3 +189,38 @@ def test_a_warning_about_a_value_of_the_file_names_the_file_and_the_line():
     with pytest.warns(NonReciprocalWarning, match=r"^bench\.toml, line \d+: joints\[1\]: joint 'holder-tool': the "
                                                   r"joint matrix is not symmetric"):
         loads_assembly(text, source="bench.toml")
+
+
+HUGE = "9" * 400  # TOML's integers have no limit; this one is beyond every float
+
+
+@pytest.mark.parametrize("old, new, key", [
+    (SEG_10, f'{{ length = "10 mm", od = "{HUGE} mm" }}', "components[1].segments[1].od"),
+    ("diameter_ratio = 0.8", f"diameter_ratio = {HUGE}", "components[2].segments[1].flutes.diameter_ratio"),
+    ("nu = 0.29", f"nu = {HUGE}", "materials.steel.nu"),
+    ('type = "tool"', f'type = "tool"\nteeth = {HUGE}', "components[2].teeth"),
+])
+def test_an_integer_beyond_every_float_is_an_error_at_its_key(old, new, key):
+    # float() of it raised OverflowError, which the command called an internal error
+    with pytest.raises(FileFormatError) as info:
+        loads_assembly(edit(old, new), source="bench.toml")
+    message = str(info.value)
+    assert message.startswith("bench.toml, line ") and f": {key}: got " in message, message
+    assert "expected" in message, message
+
+
+@pytest.mark.parametrize("teeth", [1001, 10**6, 4.5, 0])
+def test_teeth_beyond_any_cutter_are_refused_in_the_file_the_cut_and_the_tooth_passing(teeth):
+    # a million teeth put the tooth passing frequency in the megahertz: the lobes said "no limit found" and the
+    # recommendation took the largest depth allowed, at a power of two million kilowatts
+    from substructure.stability import MillingCut, tooth_passing_hz
+
+    with pytest.raises(FileFormatError, match=r"components\[2\]\.teeth: got .*; expected a whole number of teeth "
+                                              r">= 1 and <= 1000"):
+        loads_assembly(edit('type = "tool"', f'type = "tool"\nteeth = {teeth}'), source="bench.toml")
+    with pytest.raises(InvalidValueError, match=r"teeth: got .*; expected a whole number of teeth >= 1 and <= 1000"):
+        MillingCut(teeth, "10 mm", "5 mm", kt="6e8 Pa", kn="2e8 Pa")
+    with pytest.raises(InvalidValueError, match=r"teeth: got .*; expected a whole number of teeth >= 1 and <= 1000"):
+        tooth_passing_hz(12000, teeth)
+    assert tooth_passing_hz(60, 1000) == pytest.approx(1000.0)
+    assert loads_assembly(edit('type = "tool"', 'type = "tool"\nteeth = 1000')).component("tool").teeth == 1000

@@ -276,3 +276,15 @@ def test_a_cut_whose_every_row_failed_has_no_best_in_the_summary(tmp_path):
                            "--json", "--quiet", "--scheduler", "serial")
     data = json.loads(stdout)
     assert data["best"] == [] and data["no_ok_row"] == ["alu"]
+
+
+def test_a_tool_value_that_is_not_finite_fails_its_row_and_not_the_study():
+    # the tasks' fingerprint refused infinity as JSON: the whole study stopped with an internal error
+    combos = [Combination("good", tool=TOOL, joint={"k": {"yf": "1.43e7 N/m"}}),
+              Combination("infinite teeth", tool={**TOOL, "teeth": float("inf")}, joint={"k": {"yf": "1.43e7 N/m"}}),
+              Combination("nan overhang", tool={**TOOL, "overhang": float("nan")}, joint={"k": {"yf": "1.43e7 N/m"}})]
+    rows = _rows(_study(combos).run(scheduler="serial", progress=False))
+    assert rows["good"][0] == "ok", rows
+    assert rows["infinite teeth"][0] == "failed" and "teeth: got inf; expected a whole number of teeth" \
+        in rows["infinite teeth"][1], rows
+    assert rows["nan overhang"][0] == "failed" and "overhang" in rows["nan overhang"][1], rows

@@ -14,7 +14,7 @@ import pint
 
 from ..beams import Flutes, Segment
 from ..errors import InvalidValueError, UnitError
-from ..units import Q_, check_number_text, quantity, show_value, ureg
+from ..units import Q_, check_number_text, quantity, show_value, teeth_count, ureg
 from .beam import Beam
 from .protocol import register_component
 
@@ -22,12 +22,7 @@ __all__ = ["Tool"]
 
 
 def _tool_teeth(value):
-    if value is None:
-        return None
-    if isinstance(value, bool) or not (isinstance(value, (int, np.integer)) or (
-            isinstance(value, float) and value.is_integer())) or value < 1:
-        raise InvalidValueError(f"teeth: got {value!r}; expected a whole number of teeth (flutes) >= 1")
-    return int(value)
+    return None if value is None else teeth_count(value)
 
 
 def _tool_helix(value):

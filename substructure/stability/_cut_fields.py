@@ -13,7 +13,7 @@ from typing import Any
 import pint
 
 from ..errors import InvalidValueError, UnitError
-from ..units import quantity, show_value
+from ..units import quantity, show_value, teeth_count
 
 MILLING_MODES = ("up", "down")
 MILLING_ALIASES = {"up": "up", "conventional": "up", "down": "down", "climb": "down"}
@@ -21,10 +21,7 @@ MILLING_ALIASES = {"up": "up", "conventional": "up", "down": "down", "climb": "d
 
 
 def _teeth(value: Any) -> int:
-    whole = isinstance(value, numbers.Integral) or (isinstance(value, numbers.Real) and float(value).is_integer())
-    if isinstance(value, bool) or not whole or value < 1:
-        raise InvalidValueError(f"teeth: got {show_value(value)}; expected a whole number of teeth >= 1")
-    return int(value)
+    return teeth_count(value)
 
 
 def _length(field: str):

@@ -16,7 +16,7 @@ import numpy as np
 import pint
 
 from ..errors import InvalidValueError, UnitError
-from ..units import Q_, show_value, ureg, whole_number
+from ..units import Q_, show_value, teeth_count, ureg
 
 __all__ = ["spindle_speeds", "as_speed_rpm", "tooth_passing_hz", "MAX_SPEEDS"]
 
@@ -192,7 +192,7 @@ def tooth_passing_hz(speed_rpm: Any, teeth: int) -> np.ndarray:
         For teeth that are not a whole number >= 1, or speeds that are not
         finite numbers >= 0 (0 teeth gave 0 Hz; texts were read as numbers).
     """
-    whole_number(teeth, "teeth", 1, "a whole number of teeth")
+    teeth = teeth_count(teeth)
     raw = np.asarray(speed_rpm)
     if raw.dtype.kind not in "iuf" or not (np.isfinite(raw).all() and (raw >= 0).all()):
         raise InvalidValueError(f"speed_rpm: got {speed_rpm!r}; expected spindle speeds in rpm, plain numbers >= 0")

@@ -298,7 +298,7 @@ class Study:
                 "cuts": [cuts[n] for n in (combo.cuts if combo.cuts is not None else cuts)],
                 "compute": compute, "grid": grid, "plugins": list(self.plugins),
             }
-            text = json.dumps(task, sort_keys=True, allow_nan=False) + f"\x00substructure {__version__}"
+            text = json.dumps(task, sort_keys=True) + f"\x00substructure {__version__}"  # inf as a bad value says it
             task["fingerprint"] = hashlib.sha256(text.encode()).hexdigest()
             tasks.append(task)
         return tasks
