@@ -607,3 +607,29 @@ def test_the_offset_is_read_before_the_force_window_not_from_what_rings_ahead_of
     leak = np.mean(ring[cut][:p]) * np.fft.rfft(w)[np.searchsorted(np.fft.rfftfreq(w.size, 1.0 / FS), hz)] / \
         np.fft.rfft(f[cut] * w)[np.searchsorted(np.fft.rfftfreq(w.size, 1.0 / FS), hz)]
     assert np.abs(leak[band] / expected[band]).max() > 0.02
+
+
+@pytest.mark.parametrize("scale", [1e3, 1e-3])
+def test_a_time_axis_in_other_units_than_read_is_refused_by_the_hammer_s_pulse(scale):
+    # times in ms read as s gave an FRF up to 7 Hz with modes below 1 Hz, said "kept", without a word of doubt
+    r = tap()
+    wrong = TapRecord(r.time * scale, r.force, r.response, r.quantity, "tap.csv")
+    with pytest.raises(InvalidValueError, match=r"tap.csv: the hammer's pulse lasts (\S+) ms \(median of the 1 kept "
+                                                r"taps\) .* a hammer's lasts about 0\.05 to 10 ms: the time axis is "
+                                                r"not in the unit it was read in") as caught:
+        process_taps([wrong])
+    said = float(str(caught.value).split("lasts ")[1].split(" ms")[0])
+    assert said == pytest.approx(0.6 * scale, rel=0.05)  # the half sine's 0.6 ms above the trigger level
+    # the same pulse read right, and one of 0.05 ms at 100 kHz or 10 ms at 2 kHz, are taps
+    assert process_taps([r]).taps[0].pulse_width_s == pytest.approx(0.6e-3, abs=2 / FS)
+    t, f = half_sine(width=5e-5, n=100_000, fs=1e5)
+    assert process_taps([TapRecord(t, f, simulate(f, fs=1e5))]).taps[0].kept
+    t, f = half_sine(width=1e-2, n=4000, fs=2e3)  # a soft tip on a heavy hammer, on a structure ringing at 40 Hz
+    ring = np.where(t > 0.01, np.exp(-(t - 0.01) / 0.2) * np.sin(2 * np.pi * 40.0 * (t - 0.01)), 0.0)
+    assert process_taps([TapRecord(t, f, ring)]).taps[0].kept
+
+
+def test_a_pulse_of_a_sample_or_two_at_a_low_rate_is_not_judged_short():
+    t, f = half_sine(width=0.2e-3, n=1000, fs=1e3, start=0.1)  # a steel tip sampled at 1 kHz: one sample
+    f[100] = 50.0
+    assert process_taps([TapRecord(t, f, simulate(f, fs=1e3))]).taps[0].kept

@@ -27,7 +27,7 @@ from .records import RESPONSE_QUANTITIES, TapRecord
 from .result import Tap, TapResult
 
 __all__ = ["process_taps", "ESTIMATORS", "EXP_WINDOW_END", "FORCE_WINDOW_EXTRA", "FORCE_WINDOW_BEFORE",
-           "HAMMER_BAND_DB", "SHORT_TAP_SHARE"]
+           "HAMMER_BAND_DB", "SHORT_TAP_SHARE", "PULSE_SHORTEST_S", "PULSE_LONGEST_S"]
 
 ESTIMATORS = ("H1", "H2", "Hv")
 """The FRF estimators: H1 = Gfx/Gff (noise on the response), H2 = Gxx/Gxf (noise on the force), Hv (both)."""
@@ -42,6 +42,15 @@ FORCE_WINDOW_BEFORE = 1.0
 """The force window opens this many pulse widths before the force crosses the trigger level (the pulse's rise
 below that level is kept; the pre-trigger's noise before it is not: left in, it is a smooth random error of H1
 over hundreds of hertz, largest relative to the response's noise at the resonances)."""
+
+PULSE_SHORTEST_S = 5e-6
+"""Taps whose median pulse is shorter (s) are refused: a hammer's pulse lasts from about 0.05 ms (a steel tip on a
+small hammer) to 10 ms (a soft tip on a heavy one); shorter, the time axis is in other units than read (times in
+seconds read as milliseconds make the pulse 1000 times shorter, every frequency 1000 times higher)."""
+
+PULSE_LONGEST_S = 0.05
+"""Taps whose median pulse is longer (s) are refused: times in milliseconds read as seconds make the pulse 1000 times
+longer, and every frequency 1000 times lower."""
 
 SHORT_TAP_SHARE = 0.25
 """Without ``tap_length`` every tap is cut to the shortest; a tap whose record ends sooner after its start than
@@ -106,6 +115,18 @@ def _band_end(power: np.ndarray, hz: np.ndarray, drop_db: float) -> np.ndarray:
     below = power[..., 1:] < reference * 10.0 ** (-drop_db / 10.0)
     first = np.where(below.any(axis=-1), np.argmax(below, axis=-1) + 1, hz.size - 1)
     return hz[first]
+
+
+def _check_pulses(kept: list[Tap], rate: float, record: TapRecord) -> None:
+    """Refuse taps whose pulses no hammer makes: the time axis read in the wrong unit."""
+    width = float(np.median([t.pulse_width_s for t in kept]))
+    if width <= PULSE_LONGEST_S and (width >= PULSE_SHORTEST_S or PULSE_SHORTEST_S * rate < 2):
+        return  # (a pulse of a sample or two is not judged short: the rate would not show a shorter one)
+    raise InvalidValueError(
+        f"{record.source}: the hammer's pulse lasts {width * 1e3:.3g} ms (median of the {len(kept)} kept taps) at "
+        f"{rate:.6g} samples/s, where a hammer's lasts about 0.05 to 10 ms: the time axis is not in the unit it "
+        "was read in (times in ms read as s make the pulse 1000 times longer): check the time column's unit "
+        "(e.g. 'time [ms]') or the sample rate the file or the command gives")
 
 
 def process_taps(
@@ -308,6 +329,7 @@ def process_taps(
     if not kept:
         reasons = "; ".join(f"tap {t.number} ({t.source}): {t.reason}" for t in taps)
         raise InvalidValueError(f"no tap kept: {reasons}")
+    _check_pulses([taps[cuts[r][2]] for r in kept], rate, cuts[0][0])
     rows = np.array(kept)
     f = (force[rows] - baseline[rows, None]) / f_scale
     x = response[rows] / x_scale
