@@ -810,3 +810,25 @@ def test_a_header_in_windows_1252_is_read_with_a_warning_as_the_utf8_one(tmp_pat
     with pytest.warns(UserWarning, match="not UTF-8; read as Windows-1252"):
         (record,) = read_tap_lvm(path)
     assert np.allclose(record.response, a, rtol=1e-12, atol=0) and record.response_column == "Accel [m/s²]"
+
+
+@pytest.mark.parametrize("sep, decimal_comma", [(",", False), (";", True), ("\t", False)])
+def test_numbers_in_quotes_as_some_exports_write_every_cell(tmp_path, monkeypatch, sep, decimal_comma):
+    # every cell quoted: "no row of numbers in the first 2000 lines" before
+    monkeypatch.setattr(_tap_table, "CHUNK_BYTES", 2048)  # pieces by the fast parse, one of them by the slow
+    t, f, a = samples(3000)
+    body = rows([t, f, a], sep=sep, decimal_comma=decimal_comma).splitlines()
+    quoted = [sep.join(f'"{c}"' for c in line.split(sep)) for line in body]
+    quoted[1700] = quoted[1700].replace('"', "", 2)  # one row half quoted
+    quoted.insert(1200, "# range changed")  # a comment: that piece is read line by line
+    names = sep.join(['"time [s]"', '"force [N]"', '"acceleration [m/s^2]"'])
+    path = tmp_path / "quoted.csv"
+    path.write_text(names + "\n" + "\n".join(quoted) + "\n")
+    record = read_tap_csv(path)
+    assert np.array_equal(record.force, f) and np.array_equal(record.response, a)
+    assert np.allclose(record.time, t, rtol=0, atol=1e-12)
+    quoted[2500] = sep.join(['"1"', '"x"', '"3"'])  # line 2502 of the file
+    path.write_text(names + "\n" + "\n".join(quoted) + "\n")
+    with pytest.raises(FileFormatError, match=r"quoted.csv, line 2502: column 'force \[N\]' is '\"x\"'; expected a "
+                                              r"number"):
+        read_tap_csv(path)

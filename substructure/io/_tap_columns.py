@@ -60,9 +60,15 @@ def line_separator(line: str) -> str | None:
     return "\t" if "\t" in line else ";" if ";" in line else "," if "," in line else None
 
 
-def is_number(cell: str, decimal_comma: bool) -> bool:
-    """Whether a cell is one number (``0,5`` too when ``decimal_comma``)."""
+def unquote(cell: str) -> str:
+    """A cell without its blanks and the double quotes around it (``"0.25"``: some exports quote every cell)."""
     cell = cell.strip()
+    return cell[1:-1].strip() if len(cell) >= 2 and cell[0] == cell[-1] == '"' else cell
+
+
+def is_number(cell: str, decimal_comma: bool) -> bool:
+    """Whether a cell is one number (``0,5`` too when ``decimal_comma``), quoted or not."""
+    cell = unquote(cell)
     return bool(_NUMBER.match(cell.replace(",", ".") if decimal_comma else cell))
 
 

@@ -16,6 +16,7 @@ import warnings
 import numpy as np
 
 from ..errors import FileFormatError
+from ._tap_columns import unquote
 
 CHUNK_BYTES = 8 * 2**20
 """Bytes of rows parsed at once (the working arrays stay a few times this size)."""
@@ -41,7 +42,8 @@ def _slow(text: str, first_line: int, ncols: int, sep: str | None, decimal_comma
                                   f"({', '.join(labels)})")
         values = []
         for label, cell in zip(labels, cells):
-            text_cell = cell.replace(",", ".") if decimal_comma else cell
+            text_cell = unquote(cell)
+            text_cell = text_cell.replace(",", ".") if decimal_comma else text_cell
             try:
                 values.append(float(text_cell))
             except ValueError:
@@ -53,6 +55,8 @@ def _slow(text: str, first_line: int, ncols: int, sep: str | None, decimal_comma
 
 def _fast(chunk: bytes, ncols: int, sep: str | None, decimal_comma: bool) -> np.ndarray | None:
     """The rows of ``chunk`` (ending with a newline) by whole-array checks and ``numpy.fromstring``, or None."""
+    if b'"' in chunk:  # every cell quoted, as some exports write them: the quotes go, the checks below still hold
+        chunk = chunk.replace(b'"', b"")
     b = np.frombuffer(chunk, dtype=np.uint8)
     if b.size == 0 or not chunk.isascii():
         return None
