@@ -20,12 +20,12 @@ import contextlib
 import os
 import stat
 import tempfile
-from pathlib import Path
+from pathlib import Path, PureWindowsPath
 from typing import Iterator
 
 from .errors import FileFormatError, OutputExistsError
 
-__all__ = ["MAX_TEXT_BYTES", "MAX_DATA_BYTES", "check_file", "read_bytes", "decode_text",
+__all__ = ["MAX_TEXT_BYTES", "MAX_DATA_BYTES", "relative_path", "check_file", "read_bytes", "decode_text",
            "parse_toml", "read_text", "check_writable", "replacing", "write_text", "write_bytes"]
 
 MAX_TEXT_BYTES = 16 * 2**20
@@ -35,6 +35,33 @@ table, joint table, modal CSV.  Such files are a few kB; a larger one is not wha
 MAX_DATA_BYTES = 128 * 2**20
 """The largest measured FRF file (CSV or universal file) the package reads (128 MiB): a million lines
 (``MAX_GRID_LINES``) of full-precision CSV are about 70 MB."""
+
+
+def relative_path(base, text: str) -> Path:
+    """The file a file names, relative to the folder ``base`` unless absolute.
+
+    A name written on Windows (``data\\tip.csv``) names, here, the file it named there: its backslashes
+    separate folders when no file has the name as written.
+
+    Parameters
+    ----------
+    base : str or os.PathLike
+        The folder of the file that names it.
+    text : str
+        The name as written.
+
+    Returns
+    -------
+    Path
+        The path (which may not exist).
+    """
+    path = Path(base) / text
+    if os.sep == "/" and "\\" in text and not path.exists():
+        windows = PureWindowsPath(text)
+        if not windows.drive:  # C:\\data is another machine's disk: said as written
+            path = Path(base) / windows.as_posix()
+    return path
+
 
 def _name(path, what: str) -> str:
     try:

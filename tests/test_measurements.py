@@ -93,6 +93,20 @@ def test_paths_are_relative_to_the_measurement_file(tmp_path, model):
     assert ms.measurements[0].file == "data/tip.csv"
 
 
+def test_a_set_written_on_windows_names_its_files_with_backslashes(tmp_path, model):
+    # 'data\\tip.csv' was "no such file" on Linux and macOS
+    (tmp_path / "campaign" / "data").mkdir(parents=True)
+    write(model, "tool.tip", "tool.tip", tmp_path / "campaign" / "data" / "tip.csv")
+    path = tmp_path / "campaign" / "set.toml"
+    path.write_text("[[frf]]\nresponse = 'tool.tip'\nexcitation = 'tool.tip'\nfile = 'data\\tip.csv'\n")
+    (m,) = load_measurements(path).measurements
+    assert m.file == "data\\tip.csv"  # kept as written
+    np.testing.assert_array_equal(m.values, model.entry("tool.tip:y", "tool.tip:y"))
+    path.write_text("[[frf]]\nresponse = 'tool.tip'\nexcitation = 'tool.tip'\nfile = 'C:\\data\\tip.csv'\n")
+    with pytest.raises(FileFormatError, match=r"set.toml, line 4: frf\[0\]\.file: .*C:\\data\\tip.csv: no such file"):
+        load_measurements(path)  # another machine's disk is not looked for here
+
+
 @pytest.mark.parametrize("quantity, factor", [("mobility", lambda w: 1j * w), ("accelerance", lambda w: -(w**2))])
 def test_mobility_and_accelerance_are_converted_on_read(tmp_path, model, quantity, factor):
     write(model, "tool.tip", "tool.tip-5 mm", tmp_path / "m.csv", factor=factor(GRID.omega))

@@ -288,3 +288,17 @@ def test_a_tool_value_that_is_not_finite_fails_its_row_and_not_the_study():
     assert rows["infinite teeth"][0] == "failed" and "teeth: got inf; expected a whole number of teeth" \
         in rows["infinite teeth"][1], rows
     assert rows["nan overhang"][0] == "failed" and "overhang" in rows["nan overhang"][1], rows
+
+
+def test_a_study_written_on_windows_names_its_tables_with_backslashes(tmp_path):
+    # 'tables\\tools.csv' was "no such file" on Linux and macOS
+    from study_files import write_study
+
+    path = write_study(tmp_path, n=3)
+    (tmp_path / "tables").mkdir()
+    for name in ("tools.csv", "joints.csv"):
+        (tmp_path / name).rename(tmp_path / "tables" / name)
+    text = path.read_text().replace('"tools.csv"', "'tables\\tools.csv'").replace('"joints.csv"', "'tables\\joints.csv'")
+    path.write_text(text)
+    study = Study.from_file(path)
+    assert [c.name for c in study.combinations][-3:] == ["T00", "T01", "T02"]

@@ -17,7 +17,7 @@ from typing import Any
 import attrs
 import numpy as np
 
-from .._files import MAX_DATA_BYTES, read_text
+from .._files import MAX_DATA_BYTES, read_text, relative_path
 from .._files import check_file as check_readable_file
 from .._toml import TomlDocument, loads_toml
 from ..errors import FileFormatError, InvalidValueError, SubstructureError, SubstructureWarning
@@ -146,7 +146,7 @@ class _Reader:
     # -- data files -----------------------------------------------------------
     def data(self, index: int, file: str, record: int | None, quantity: str | None,
              response: str, excitation: str) -> tuple[FRF, dict[str, Any], float | None]:
-        path = self.base_dir / file
+        path = relative_path(self.base_dir, file)
         suffix = path.suffix.lower()
         if suffix not in _CSV + _UFF + _MAT:
             raise self.error(index, "file", f"{file!r}: unknown kind of file; expected .csv, .uff, .unv or .mat")
@@ -199,7 +199,7 @@ class _Reader:
             raise self.error(index, "file", f"{path}: {exc}") from None
 
     def uff_coherence(self, index: int, file: str, record: int, frf: FRF) -> Any:
-        path = self.base_dir / file
+        path = relative_path(self.base_dir, file)
         if path.suffix.lower() not in _UFF + _MAT:
             raise self.error(index, "coherence_record", f"a CSV file ({file}) has no records; its coherence is its "
                                                         "fourth column")
@@ -326,7 +326,7 @@ class _Reader:
                                                       "1 / force_window_s hertz (the force window's length in s)")
         if raw.frequency.hz[0] == 0.0:
             if raw.frequency.n < 3:
-                raise self.error(index, "file", f"{self.base_dir / file}: {raw.frequency.n} frequency lines, the first "
+                raise self.error(index, "file", f"{relative_path(self.base_dir, file)}: {raw.frequency.n} frequency lines, the first "
                                  "at 0 Hz, which is dropped (no receptance there); an FRF needs at least 2 lines "
                                  "besides it")
             why = ("the model has no receptance at 0 Hz (its free-free components have no static receptance), so "
@@ -342,7 +342,7 @@ class _Reader:
         try:
             receptance = raw.to_receptance(1.0 / tau if tau else 0.0)
         except SubstructureError as exc:
-            raise self.error(index, "file", f"{self.base_dir / file}: {exc}") from None
+            raise self.error(index, "file", f"{relative_path(self.base_dir, file)}: {exc}") from None
         try:
             return Measurement(response, excitation, receptance, raw.quantity, sensors, removed, file, record,
                                columns.get("coherence"), averages, tau, columns.get("force_noise"), force_window,
@@ -371,7 +371,7 @@ class _Reader:
                     "(same sensors and removed components); keep one",
                 )
             seen[key] = i
-            found = os.stat(self.base_dir / m.file)  # the file itself: links, hard links, a name in other case
+            found = os.stat(relative_path(self.base_dir, m.file))  # the file itself: links, hard links, a name in other case
             source = (found.st_dev, found.st_ino, m.record or 0)
             if source in sources:
                 j = sources[source]
@@ -393,7 +393,7 @@ class _Reader:
         for i, m in enumerate(measurements):
             if i not in self.nodes:
                 continue
-            found = os.stat(self.base_dir / m.file)
+            found = os.stat(relative_path(self.base_dir, m.file))
             key = (found.st_dev, found.st_ino, m.configuration)  # one file's nodes, in one configuration
             where = f"{m.file}, type-58 record {m.record or 0}"
             (out_node, out_dir), (in_node, in_dir) = self.nodes[i]

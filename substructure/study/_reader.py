@@ -25,6 +25,7 @@ import re
 from pathlib import Path
 from typing import Any
 
+from .._files import relative_path
 from .._toml import TomlDocument, key_path, loads_toml
 from ..errors import FileFormatError, SubstructureError
 from .settings import Compute, Grid
@@ -66,7 +67,7 @@ class _Reader:
     def file(self, value, parts) -> str:
         if not isinstance(value, str) or not value.strip():
             raise self.error(parts, f"got {value!r}; expected a file name (relative to the study file)")
-        path = value if os.path.isabs(value) else os.path.normpath(self.base / value)
+        path = value if os.path.isabs(value) else os.path.normpath(relative_path(self.base, value))
         if not os.path.isfile(path):
             raise self.error(parts, f"{value!r}: no such file" + (f" ({path})" if path != value else ""))
         self.inputs.append(path)
