@@ -832,3 +832,21 @@ def test_numbers_in_quotes_as_some_exports_write_every_cell(tmp_path, monkeypatc
     with pytest.raises(FileFormatError, match=r"quoted.csv, line 2502: column 'force \[N\]' is '\"x\"'; expected a "
                                               r"number"):
         read_tap_csv(path)
+
+
+def test_matlab_vectors_of_complex_values_are_named_as_passed_over(tmp_path):
+    # they were dropped without a word: "1 columns (time [s]); expected three" left the user guessing
+    from scipy.io import savemat
+
+    from substructure.io.tap_files import read_tap_mat
+
+    t, f, a = samples()
+    path = tmp_path / "tap.mat"
+    savemat(path, {"time": t, "force": f + 0j, "force_unit": "N", "acc": a + 1j, "acc_unit": "m/s^2"})
+    with pytest.raises(FileFormatError, match=r"tap.mat: 1 columns \(time \[s\]\); expected three: .*; passed over: "
+                                              r"force \(complex values: a spectrum or an FRF, not a time record\); "
+                                              r"acc \(complex values"):
+        read_tap_mat(path)
+    savemat(path, {"time": t, "force": f, "force_unit": "N", "acc": a, "acc_unit": "m/s^2", "spectrum": a + 1j})
+    record = read_tap_mat(path)  # a spectrum beside the record: read as before
+    assert np.array_equal(record.force, f) and np.array_equal(record.response, a)

@@ -88,6 +88,8 @@ def mat_record(path: str | os.PathLike, data: bytes, sensitivity: Any, hammer_se
                 units.setdefault(key.lower(), number.group(2))
             continue
         if array.dtype.kind not in "iuf":
+            if array.dtype.kind == "c":
+                skipped.append(f"{key} (complex values: a spectrum or an FRF, not a time record)")
             continue
         if array.ndim == 1 and array.size >= 2:
             vectors[key] = array.astype(np.float64)
@@ -135,8 +137,13 @@ def mat_record(path: str | os.PathLike, data: bytes, sensitivity: Any, hammer_se
                                   f"{hz:.10g} Hz; leave the option out or fix the file")
         stated = (hz, "--sample-rate")
     parsed, dims, errors = units_of_columns(columns, name)
-    t_col, f_col, r_col = choose(columns, parsed, dims, name, force_column, response_column,
-                                 stated is not None or bool(clocked), "a scalar variable fs (Hz) or dt (s)")
+    try:
+        t_col, f_col, r_col = choose(columns, parsed, dims, name, force_column, response_column,
+                                     stated is not None or bool(clocked), "a scalar variable fs (Hz) or dt (s)")
+    except FileFormatError as exc:
+        if not skipped:
+            raise
+        raise FileFormatError(f"{exc}; passed over: {'; '.join(skipped)}") from None
     labels = columns.labels
     for signal in (clocked.get(names[k]) for k in (f_col, r_col)):
         if signal is None:
