@@ -433,3 +433,29 @@ def test_a_recommended_depth_of_many_diameters_with_nothing_to_bound_it_is_warne
     for extra in (["--immersion", "1e-6", "--max-depth", "30 mm"], ["--immersion", "0.5"]):
         status, out, _ = run(capsys, "lobes", "--modes", modes_file, *extra, *cut)
         assert status == 0 and not [n for n in json.loads(out)["notes"] if "times the tool's diameter" in n]
+
+
+def test_an_frf_ending_below_the_tool_mode_gives_lobes_and_no_recommendation(capsys, tmp_path):
+    # a soft tip's band, cropped at 1400 Hz below the tool mode at 1.5 kHz: 69 mm was recommended where the
+    # whole FRF's limit is 1.7 mm
+    path = tmp_path / "soft_tip.csv"
+    grid = Frequency.from_range("20 Hz", "1400 Hz", "2 Hz")
+    default_assembly().receptance("tool.tip:y", frequency=grid).to_csv(path)
+    status, out, err = run(capsys, "lobes", "--frf", path, *THESIS_CUT, "--json")
+    assert status == 0 and "warning: zoa: the FRF (x) rises from" in err, err
+    result = json.loads(out)
+    assert result["recommended"] is None
+    assert result["no_recommendation_reason"].startswith("a mode lies above the FRF's band (x rises to the band's end")
+    assert any(n.startswith("warning: zoa: the FRF (x) rises from") for n in result["notes"])
+    assert result["absolute_limit_m"] is not None  # the lobes of what was measured stand
+
+
+def test_an_assembly_whose_grid_stops_below_the_tool_mode_is_refused(capsys, tmp_path):
+    # the model's [frequency] stopping at 1200 Hz gave a recommendation of 30 mm, the flutes' length
+    path = tmp_path / "low.toml"
+    path.write_text(ASSEMBLY.read_text().replace('stop = "5000 Hz"', 'stop = "1200 Hz"'))
+    status, out, err = run(capsys, "lobes", "--assembly", path, "--at", "tool.tip", "--immersion", "0.5",
+                           "--workpiece", "aluminium-6061")
+    assert status == 1 and out == ""
+    assert "the grid stops at 1200 Hz, below a mode of the model at about 1" in err, err
+    assert "[frequency] stop in the assembly file" in err

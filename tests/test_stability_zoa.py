@@ -255,3 +255,64 @@ def test_low_speed_turning_from_modes_takes_a_graded_grid_within_the_cap(monkeyp
     lowest = float(str(info.value).split("spindle speed to ")[1].split(" rpm")[0])
     assert zoa(benchmark_model(), cut, Q_([np.ceil(lowest), 3000.0], "rpm")).absolute_limit_m == \
         pytest.approx(closed, rel=1e-9)
+
+
+def _two_modes(f):
+    """A driving point of two modes (closed form): 922 Hz, and a more flexible one at 1500 Hz."""
+    r1, r2 = f / FN, f / 1500.0
+    return 1.0 / (K * (1 - r1 ** 2 + 2j * ZETA * r1)) + 1.0 / (0.5 * K * (1 - r2 ** 2 + 2j * 0.01 * r2))
+
+
+@pytest.mark.parametrize("top, warned", [(1400.0, True), (1100.0, True), (2500.0, False), (950.0, False)])
+def test_an_frf_ending_on_the_flank_of_a_mode_above_its_band_warns(top, warned):
+    # a soft hammer tip's band ended below the tool mode: the lobes were drawn from the lesser mode, their
+    # recommendation five to twenty times too deep, without a word
+    f = np.arange(100.0, top, 0.5)
+    frf = FRF.single(Frequency(f), _two_modes(f), output="t:y", input="t:y")
+    cut = benchmark_cut(1.0)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        lobes = zoa(frf, cut, SPEEDS, band="all")
+    said = [str(w.message) for w in caught if "a mode lies above the band" in str(w.message)]
+    assert bool(said) == warned, said
+    if warned:
+        (text,) = said
+        assert text.startswith("zoa: the FRF (x) rises from ") and f"to the band's last line ({f[-1]:g} Hz)" in text
+        full = zoa(FRF.single(Frequency(np.arange(100.0, 3000.0, 0.5)), _two_modes(np.arange(100.0, 3000.0, 0.5)),
+                              output="t:y", input="t:y"), cut, SPEEDS, band="all")
+        assert lobes.absolute_limit_m > 1.5 * full.absolute_limit_m  # what the warning is for
+
+
+def test_a_model_s_grid_that_stops_below_a_mode_as_flexible_as_the_band_s_is_refused():
+    from substructure.stability import assembly_structure
+
+    assembly = default_assembly()  # its tool mode at about 1.5 kHz is the most flexible
+    with pytest.raises(InvalidValueError, match=r"frequency: the grid stops at 1200 Hz, below a mode of the model at "
+                                                r"about 1[45]\d\d Hz .* raise the grid's stop above"):
+        assembly_structure(assembly, "tool.tip:y", Frequency.from_range("20 Hz", "1200 Hz", "2 Hz"))
+    frf, band = assembly_structure(assembly, "tool.tip:y", Frequency.from_range("20 Hz", "5000 Hz", "2 Hz"))
+    assert band.hi_hz == 5000.0  # the modes above 5 kHz are far stiffer at the tool point: accepted
+    frf, band = assembly_structure(assembly, "tool.tip:y", Frequency.from_range("20 Hz", "2500 Hz", "2 Hz"))
+    assert band.model and band.hi_hz == 2500.0  # its mode at 3.8 kHz, under half as flexible: accepted
+
+
+def test_an_frf_gone_to_noise_above_the_hammer_s_band_is_no_mode_above_it():
+    # beyond a hammer's band the force spectrum falls and H1's noise grows: |H| rises to the band's end, roughly
+    assembly = default_assembly()
+    grid = Frequency.from_range("2 Hz", "12800 Hz", "2 Hz")
+    h = assembly.receptance("tool.tip:y", frequency=grid).data[:, 0, 0]
+    rng = np.random.default_rng(7)
+    cut = MillingCut(4, "12 mm", "3 mm", kt="625 MPa", kn="100 MPa")
+    force = 1.0 / (1.0 + (grid.hz / 5000.0) ** 4)
+    for _ in range(5):
+        noisy = h + 1.3e-9 * (rng.normal(size=h.size) + 1j * rng.normal(size=h.size)) / force
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            zoa(FRF.single(grid, noisy, output="t:y", input="t:y"), cut, SPEEDS)
+        assert not [w for w in caught if "a mode lies above" in str(w.message)]
+    # the flank of the tool mode under 2 % of noise is one
+    grid = Frequency.from_range("20 Hz", "1400 Hz", "2 Hz")
+    h = assembly.receptance("tool.tip:y", frequency=grid).data[:, 0, 0]
+    noisy = h * np.exp(0.02 * (rng.normal(size=h.size) + 1j * rng.normal(size=h.size)))
+    with pytest.warns(StabilityWarning, match="a mode lies above the band"):
+        zoa(FRF.single(grid, noisy, output="t:y", input="t:y"), cut, SPEEDS)

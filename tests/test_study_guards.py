@@ -298,7 +298,7 @@ def test_a_study_written_on_windows_names_its_tables_with_backslashes(tmp_path):
     (tmp_path / "tables").mkdir()
     for name in ("tools.csv", "joints.csv"):
         (tmp_path / name).rename(tmp_path / "tables" / name)
-    text = path.read_text().replace('"tools.csv"', "'tables\\tools.csv'").replace('"joints.csv"', "'tables\\joints.csv'")
-    path.write_text(text)
+    text = path.read_text().replace('"tools.csv"', "'tables\\tools.csv'")
+    path.write_text(text.replace('"joints.csv"', "'tables\\joints.csv'"))
     study = Study.from_file(path)
     assert [c.name for c in study.combinations][-3:] == ["T00", "T01", "T02"]

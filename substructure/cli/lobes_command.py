@@ -156,17 +156,18 @@ def _lobes_structure(args: argparse.Namespace):
 
 
 def _zoa_noted(structure, cut, speeds, band, notes: list[str], lobes: bool = True):
-    """``zoa`` of the structure (or, without ``lobes``, only its checks of the band: ``check_band``); its warning
-    that the absolute limit sits on an edge of the band is also a note."""
+    """``zoa`` of the structure (or, without ``lobes``, only its checks of the band: ``check_band``); its warnings
+    that the absolute limit sits on an edge of the band, or that a mode lies above it, are also notes."""
     from ..stability import StabilityWarning, zoa
-    from ..stability.zoa import EDGE_WARNING, check_band
+    from ..stability.zoa import ABOVE_WARNING, EDGE_WARNING, check_band
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         band = band if band is not None else "auto"
         result = zoa(structure, cut, speeds, band=band) if lobes else check_band(structure, cut, band)
     for item in caught:
-        if issubclass(item.category, StabilityWarning) and str(item.message).startswith(EDGE_WARNING.split("{")[0]):
+        if issubclass(item.category, StabilityWarning) and str(item.message).startswith(
+                (EDGE_WARNING.split("{")[0], ABOVE_WARNING.split("{")[0])):
             notes.append(f"warning: {item.message}")
         warnings.warn_explicit(item.message, item.category, item.filename, item.lineno)
     return result
@@ -232,7 +233,14 @@ def run(args: argparse.Namespace) -> int:
                      f"delay period (monodromy matrices of order {n_lo}" + (f" to {n_hi}" if n_hi != n_lo else "")
                      + f"{big}); boundary to {info['depth_rtol']:.1%}")
     best = why = None
-    if limits is not None:
+    from ..stability.zoa import ABOVE_WARNING
+
+    above = [n for n in notes if n.startswith("warning: " + ABOVE_WARNING.split("{")[0])]
+    if above:  # the lobes stand, drawn from what was measured; a depth to cut at would ignore the mode above
+        why = ("a mode lies above the FRF's band (" + above[0].split("(", 1)[1].split(")")[0] + " rises to the "
+               "band's end without a peak): its limit is unknown; measure beyond it")
+        notes.append(f"no recommendation: {why}")
+    elif limits is not None:
         try:
             if args.method == "sdm":
                 progress("the recommendation: the lowest limit within each candidate's speed window, by new runs "

@@ -326,9 +326,9 @@ class _Reader:
                                                       "1 / force_window_s hertz (the force window's length in s)")
         if raw.frequency.hz[0] == 0.0:
             if raw.frequency.n < 3:
-                raise self.error(index, "file", f"{relative_path(self.base_dir, file)}: {raw.frequency.n} frequency lines, the first "
-                                 "at 0 Hz, which is dropped (no receptance there); an FRF needs at least 2 lines "
-                                 "besides it")
+                raise self.error(index, "file", f"{relative_path(self.base_dir, file)}: {raw.frequency.n} "
+                                 "frequency lines, the first at 0 Hz, which is dropped (no receptance there); an FRF "
+                                 "needs at least 2 lines besides it")
             why = ("the model has no receptance at 0 Hz (its free-free components have no static receptance), so "
                    "identify and diagnose cannot compare it" if raw.quantity == "receptance" else
                    f"{'an' if raw.quantity[0] in 'aeiou' else 'a'} {raw.quantity} has no receptance at 0 Hz")
@@ -371,7 +371,8 @@ class _Reader:
                     "(same sensors and removed components); keep one",
                 )
             seen[key] = i
-            found = os.stat(relative_path(self.base_dir, m.file))  # the file itself: links, hard links, a name in other case
+            # the file itself: links, hard links, a name in other case
+            found = os.stat(relative_path(self.base_dir, m.file))
             source = (found.st_dev, found.st_ino, m.record or 0)
             if source in sources:
                 j = sources[source]

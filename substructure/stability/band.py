@@ -57,6 +57,11 @@ MASS_LINE_PHASE_DEG = 30.0
 SUSPENSION_RATIO = 0.1
 """In data, peaks at most this fraction of the next peak's frequency may be suspension modes."""
 
+ABOVE_PROBE, ABOVE_LINES, ABOVE_SHARE = 4.0, 4000, 0.5
+"""A model's grid is probed from its stop to ``ABOVE_PROBE`` times it on ``ABOVE_LINES`` log-spaced lines; a peak
+there above ``ABOVE_SHARE`` of the band's largest is a mode the lobes would miss (its absolute limit within about
+twice the band's), and the grid is refused."""
+
 _PEAK_PROMINENCE = np.log(1.25)  # a peak or valley of |H| stands out by 25 % (in log |H|)
 
 
@@ -84,6 +89,9 @@ class FlexibleBand:
         the tool point "sees" moving rigidly (``None`` without a mass line).
     reason : str
         One sentence for the human output.
+    model : bool
+        Chosen on a model's receptance (:func:`assembly_structure`), whose
+        grid was checked for modes above it.
     """
 
     lo_hz: float
@@ -93,6 +101,7 @@ class FlexibleBand:
     suspension_hz: tuple = attrs.field(default=(), converter=tuple)
     apparent_mass_kg: float | None = None
     reason: str = ""
+    model: bool = False
 
     def crop(self, frf: FRF) -> FRF:
         """``frf`` restricted to ``lo_hz .. hi_hz``.
@@ -346,6 +355,8 @@ def assembly_structure(assembly: Any, at: str, frequency: Any = None) -> tuple[F
     if not assembly.supports:
         band = data_band if data_band.kind != "flexible" else attrs.evolve(
             data_band, kind="free-free", reason="free-free model; its grid starts above the rigid-body mass line")
+        _no_mode_above(assembly, at, band.crop(frf))
+        band = attrs.evolve(band, model=True)
         return band.crop(frf), band
     free = attrs.evolve(assembly, supports=())
     hf = free.receptance(at, frequency=frequency).data[:, 0, 0]
@@ -379,4 +390,24 @@ def assembly_structure(assembly: Any, at: str, frequency: Any = None) -> tuple[F
     if band.kind == "flexible":
         band = attrs.evolve(band, kind="supported",
                             reason="model on its supports: no rigid-body or suspension mode; the whole FRF is used")
+    _no_mode_above(assembly, at, band.crop(frf))
+    band = attrs.evolve(band, model=True)
     return band.crop(frf), band
+
+
+def _no_mode_above(assembly: Any, at: str, frf: FRF) -> None:
+    """Refuse a grid that stops below a mode of the model as flexible at the tool point as those in the band."""
+    from ..frf import Frequency
+
+    top = float(frf.frequency.hz[-1])
+    probe = Frequency.from_hz(np.geomspace(top, ABOVE_PROBE * top, ABOVE_LINES)[1:])
+    above = np.abs(assembly.receptance(at, frequency=probe).data[:, 0, 0])
+    inside = float(np.abs(frf.data[:, 0, 0]).max())
+    k = int(np.argmax(above))
+    if above[k] > ABOVE_SHARE * inside:
+        hz = float(probe.hz[k])
+        raise InvalidValueError(
+            f"frequency: the grid stops at {top:g} Hz, below a mode of the model at about {hz:.4g} Hz whose peak at "
+            f"{at} is {above[k] / inside:.3g} times the largest in the band: the lobes would not see it, and the "
+            f"limit found could be far too deep; raise the grid's stop above {2 * hz:.3g} Hz ([frequency] stop in "
+            "the assembly file, or frequency=)")

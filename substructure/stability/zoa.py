@@ -85,6 +85,51 @@ EDGE_WARNING = ("zoa: the oriented FRF's most negative real part, the absolute l
 band chose above a mass line)."""
 
 
+ABOVE_RISE = 2.0
+"""|H| of a direction rising from its last minimum to the band's last line by this factor or more, without a peak
+between, is the flank of a resonance above the band (a driving-point FRF's poles and zeros alternate)."""
+
+ABOVE_WARNING = ("zoa: the FRF ({direction}) rises from {valley_hz:g} Hz to the band's last line ({hz:g} Hz), "
+                 "{ratio:.3g} times, without a peak: a mode lies above the band, which the lobes do not see, and the "
+                 "limit may be far shallower than found; measure the FRF beyond that mode (a harder hammer tip) and "
+                 "extend the band")
+"""The warning when FRF data end on the rising flank of a resonance above the band."""
+
+
+ABOVE_STRETCH = 0.05
+"""... and when the rise spans at least this share of the band's last frequency (an antiresonance lies well below the
+resonance after it; a rise over the last few lines is noise, or the edge of an anti-aliasing filter)."""
+
+
+ABOVE_SCATTER = 0.1
+"""... and when |H| scatters about its median filter by at most this much in log (RMS) over the rise: the smooth flank
+of a resonance, not an FRF gone to noise above the hammer's band (whose scatter is about 0.5)."""
+
+
+def _rising_end(f: np.ndarray, g: np.ndarray) -> None:
+    """Warn (``ABOVE_WARNING``) when a direction's |H| ends on the flank of a resonance above the band: from its
+    last minimum (after the last peak) it rises ``ABOVE_RISE`` times or more, over at least ``ABOVE_STRETCH`` of the
+    band's top, to its largest value at the last line, smoothly (``ABOVE_SCATTER``; |H| median-filtered over a
+    hundredth of the lines)."""
+    from scipy.ndimage import median_filter
+    from scipy.signal import find_peaks
+
+    for d, direction in enumerate("xy"):
+        mag = np.abs(g[:, d, d])
+        if d == 1 and np.array_equal(mag, np.abs(g[:, 0, 0])):
+            break  # y = x: said once
+        raw = np.log(np.maximum(mag, 1e-300))
+        log = median_filter(raw, size=max(3, mag.size // 100) | 1, mode="nearest")
+        peaks, _ = find_peaks(log, prominence=np.log(1.25))
+        start = int(peaks[-1]) + 1 if peaks.size else 0
+        j = start + int(np.argmin(log[start:]))
+        ratio = float(np.exp(log[-1] - log[j]))
+        smooth = float(np.sqrt(np.mean((raw[j:] - log[j:]) ** 2))) <= ABOVE_SCATTER  # a flank, not noise
+        if ratio >= ABOVE_RISE and f[-1] - f[j] >= ABOVE_STRETCH * f[-1] and log[-1] >= log[j:].max() and smooth:
+            warnings.warn(ABOVE_WARNING.format(direction=direction, valley_hz=f[j], hz=f[-1], ratio=ratio),
+                          StabilityWarning, stacklevel=4)
+
+
 def zoa_eigenvalues(k0: np.ndarray, g: np.ndarray) -> np.ndarray:
     """Eigenvalues of ``K0 @ G`` per line, shape ``(n, 2)``, ordered to follow each branch.
 
@@ -211,9 +256,12 @@ class _ZoaEnvelope:
         return d, at, fc
 
 
-def _lines(structure: Any, frequency: Frequency | None, k0: np.ndarray, teeth: int, lowest_rpm: float):
+def _lines(structure: Any, frequency: Frequency | None, k0: np.ndarray, teeth: int, lowest_rpm: float,
+           used: Any = None):
     """Lines, eigenvalues, where they give a lobe, depths, phases and the last lobe needed down to ``lowest_rpm``."""
     f, g = xy_receptance(structure, frequency)
+    if isinstance(structure, FRF) and not getattr(used, "model", False):  # a model's grid: checked by its band
+        _rising_end(f, g)
     lam = zoa_eigenvalues(k0, g)  # (m, 2)
     with np.errstate(divide="ignore", invalid="ignore"):
         valid = lam.real > 1e-300
@@ -266,11 +314,12 @@ def check_band(structure: Any, cut: Any, band: Any = "auto") -> None:
     Warns
     -----
     StabilityWarning
-        When the absolute limit lies at the first or last line of FRF data (``EDGE_WARNING``).
+        When the absolute limit lies at the first or last line of FRF data (``EDGE_WARNING``), or the data end on
+        the flank of a resonance above the band (``ABOVE_WARNING``).
     """
     structure, used = choose_band(structure, band)
     k0 = cut.mean_force_matrix()
-    f, lam, valid, a, _, _ = _lines(structure, None, k0, cut.regenerations_per_revolution, np.inf)
+    f, lam, valid, a, _, _ = _lines(structure, None, k0, cut.regenerations_per_revolution, np.inf, used)
     _absolute(structure, used, k0, f, a, valid, lam)
 
 
@@ -326,13 +375,14 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
         When the absolute limit lies at the first or last line of FRF data
         (``EDGE_WARNING``): the minimum may lie outside the band; extend
         it.  Not at the first line of a band chosen automatically above a
-        rigid-body mass line.
+        rigid-body mass line.  When FRF data end on the flank of a resonance
+        above the band (``ABOVE_WARNING``): the lobes do not see that mode.
     """
     speeds_rpm = as_speed_rpm(speeds)
     structure, used = choose_band(structure, band)
     k0 = cut.mean_force_matrix()
     teeth = cut.regenerations_per_revolution
-    f, lam, valid, a, theta, k_max = _lines(structure, frequency, k0, teeth, speeds_rpm[0])
+    f, lam, valid, a, theta, k_max = _lines(structure, frequency, k0, teeth, speeds_rpm[0], used)
     points = 2 * (k_max + 1) * f.size
     graded = points > MAX_LOBE_POINTS and frequency is None and isinstance(structure, ModalModel)
     if graded:  # the default grid is fine everywhere: at low speeds too many lines for so many lobes
