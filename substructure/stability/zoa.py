@@ -85,9 +85,13 @@ EDGE_WARNING = ("zoa: the oriented FRF's most negative real part, the absolute l
 band chose above a mass line)."""
 
 
-ABOVE_RISE = 2.0
-"""|H| of a direction rising from its last minimum to the band's last line by this factor or more, without a peak
-between, is the flank of a resonance above the band (a driving-point FRF's poles and zeros alternate)."""
+ABOVE_RISE, ABOVE_STRETCH, ABOVE_SCATTER = 2.0, 0.05, 0.1
+"""FRF data end on the flank of a resonance above the band (a driving-point FRF's resonances and antiresonances
+alternate) when |H| of a direction rises from its last minimum to the band's last line, without a peak between, by
+``ABOVE_RISE`` times or more, over at least ``ABOVE_STRETCH`` of the band's last frequency (a rise over the last few
+lines is noise, or the edge of an anti-aliasing filter), scattering about its median filter by at most
+``ABOVE_SCATTER`` in log, RMS (a smooth flank: an FRF gone to noise above the hammer's band also rises to its end,
+with a scatter near 0.5)."""
 
 ABOVE_WARNING = ("zoa: the FRF ({direction}) rises from {valley_hz:g} Hz to the band's last line ({hz:g} Hz), "
                  "{ratio:.3g} times, without a peak: a mode lies above the band, which the lobes do not see, and the "
@@ -96,21 +100,9 @@ ABOVE_WARNING = ("zoa: the FRF ({direction}) rises from {valley_hz:g} Hz to the 
 """The warning when FRF data end on the rising flank of a resonance above the band."""
 
 
-ABOVE_STRETCH = 0.05
-"""... and when the rise spans at least this share of the band's last frequency (an antiresonance lies well below the
-resonance after it; a rise over the last few lines is noise, or the edge of an anti-aliasing filter)."""
-
-
-ABOVE_SCATTER = 0.1
-"""... and when |H| scatters about its median filter by at most this much in log (RMS) over the rise: the smooth flank
-of a resonance, not an FRF gone to noise above the hammer's band (whose scatter is about 0.5)."""
-
-
 def _rising_end(f: np.ndarray, g: np.ndarray) -> None:
-    """Warn (``ABOVE_WARNING``) when a direction's |H| ends on the flank of a resonance above the band: from its
-    last minimum (after the last peak) it rises ``ABOVE_RISE`` times or more, over at least ``ABOVE_STRETCH`` of the
-    band's top, to its largest value at the last line, smoothly (``ABOVE_SCATTER``; |H| median-filtered over a
-    hundredth of the lines)."""
+    """Warn (``ABOVE_WARNING``) when a direction's |H| ends on the flank of a resonance above the band (the rules of
+    ``ABOVE_RISE``; |H| median-filtered over a hundredth of the lines)."""
     from scipy.ndimage import median_filter
     from scipy.signal import find_peaks
 
