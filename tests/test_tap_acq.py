@@ -850,3 +850,28 @@ def test_matlab_vectors_of_complex_values_are_named_as_passed_over(tmp_path):
     savemat(path, {"time": t, "force": f, "force_unit": "N", "acc": a, "acc_unit": "m/s^2", "spectrum": a + 1j})
     record = read_tap_mat(path)  # a spectrum beside the record: read as before
     assert np.array_equal(record.force, f) and np.array_equal(record.response, a)
+
+
+@pytest.mark.parametrize("header, said", [
+    ("time [s],force [N],acceleration [m/s]", "its name says acceleration and its unit velocity"),
+    ("time [s],force [N],Acc_Z [um]", "its name says acceleration and its unit displacement"),
+    ("time [s],force [N],LDV velocity [m/s^2]", "its name says velocity and its unit acceleration"),
+    ("Zeit [s],Kraft [N],Beschleunigung [m/s]", "its name says acceleration and its unit velocity"),
+])
+def test_a_response_whose_name_and_unit_say_two_quantities_is_refused(tmp_path, header, said):
+    # 'acceleration [m/s]' was read as a velocity: a receptance off by i omega, modes in place, slopes wrong
+    t, f, a = samples()
+    path = tmp_path / "tap.csv"
+    path.write_text(header + "\n" + rows([t, f, a]))
+    with pytest.raises(FileFormatError, match=rf"tap.csv, line 1: column '.*': {said}; correct the one that is wrong"):
+        read_tap_csv(path)
+
+
+@pytest.mark.parametrize("header", ["time [s],force [N],acc1 [g]", "time [s],hammer [N],vel [mm/s]",
+                                    "time [s],force [N],displacement probe [um]", "time [s],force [N],response [g]",
+                                    "time [s],force [N],Accelerometer 352C23 [m/s^2]"])
+def test_names_that_agree_with_their_units_or_say_nothing_read_as_before(tmp_path, header):
+    t, f, a = samples()
+    path = tmp_path / "tap.csv"
+    path.write_text(header + "\n" + rows([t, f, a]))
+    assert np.array_equal(read_tap_csv(path).force, f)

@@ -53,6 +53,11 @@ def unit_label(label: str) -> str | None:
 
 
 _FORCE_NAME = re.compile(r"\b(force|hammer|kraft|impact)", re.I)
+_QUANTITY_NAMES = (("acceleration", re.compile(r"(?<![a-z])(acc|beschl)", re.I)),
+                   ("velocity", re.compile(r"(?<![a-z])(vel|vibrometer|ldv|geschw)", re.I)),
+                   ("displacement", re.compile(r"(?<![a-z])(disp|proximity|weg(?![a-z]))", re.I)))
+"""Words of a response column's name that say its quantity (English and German): a unit of another quantity beside
+them is a mistake of the name or of the unit ('acceleration [m/s]'), refused rather than read as the unit says."""
 
 
 def line_separator(line: str) -> str | None:
@@ -284,6 +289,12 @@ def choose(columns: Columns, parsed: list[Any], dims: list[str | None], name: st
                                       f"neither time nor force ({listing}); choose one with --response-column "
                                       "NAME or INDEX (response_column=)")
             chosen_resp = responses[0]
+    said = [q for q, pattern in _QUANTITY_NAMES if pattern.search(columns.names[chosen_resp])]
+    if len(said) == 1 and dims[chosen_resp] in ("acceleration", "velocity", "displacement") \
+            and said[0] != dims[chosen_resp]:
+        raise FileFormatError(f"{where}: column {labels[chosen_resp]!r}: its name says {said[0]} and its unit "
+                              f"{dims[chosen_resp]}; correct the one that is wrong (e.g. 'acceleration [m/s^2]', "
+                              "'velocity [m/s]')")
     if t_col is None and not has_rate:
         raise no_rate(where, labels, rate_hint)
     return t_col, chosen_force, chosen_resp
