@@ -224,3 +224,26 @@ def test_teeth_beyond_any_cutter_are_refused_in_the_file_the_cut_and_the_tooth_p
         tooth_passing_hz(12000, teeth)
     assert tooth_passing_hz(60, 1000) == pytest.approx(1000.0)
     assert loads_assembly(edit('type = "tool"', 'type = "tool"\nteeth = 1000')).component("tool").teeth == 1000
+
+
+@pytest.mark.parametrize("old, new, key, said", [
+    # the diameters (od, id, the insert's): 12 four times, 40 four times, 63, 70, 90, 110 mm and 40 m: median 40 mm
+    (SEG_10, '{ length = "10 mm", od = "40 m" }', "components[1].segments[1].od", "got '40 m', 1e+03 times the "
+     "median diameter of the file's segments (40 mm) and over 1 m: a unit typo? (m for mm)"),
+    ('{ length = "150 mm", od = "90 mm", id = "40 mm" }', '{ length = "150 m", od = "90 mm", id = "40 mm" }',
+     "components[0].segments[1].length", "got '150 m', 4.29e+03 times the median length"),
+])
+def test_a_segment_in_metres_among_millimetres_is_refused_as_a_unit_typo(old, new, key, said):
+    # both were read: a holder 40 m across, a spindle 150 m long, and their FRFs plotted without a word
+    with pytest.raises(FileFormatError) as info:
+        loads_assembly(edit(old, new), source="bench.toml")
+    assert f": {key}: {said}" in str(info.value), str(info.value)
+
+
+def test_large_parts_that_agree_with_the_rest_are_read():
+    # a boring mill's spindle 1.2 m long among others of its size, and a 10 mm tool among 100 mm parts
+    text = edit('{ length = "120 mm", od = "70 mm", id = "40 mm" }',
+                '{ length = "1200 mm", od = "70 mm", id = "40 mm" }')
+    assert loads_assembly(text).component("spindle").length_m == pytest.approx(1.41)
+    text = edit('{ length = "30 mm", od = "12 mm" },', '{ length = "30 mm", od = "1 mm" },')
+    assert loads_assembly(text).component("tool").segments[0].od.m_as("mm") == pytest.approx(1.0)

@@ -31,6 +31,15 @@ _MASS_KEYS = ("name", "at", "mass", "inertia")
 _MATRIX_KEYS = ("yf", "ym", "tf", "tm")
 _STANDARD_FIELDS = ("name", "segments", "description")
 
+SIZE_OUTLIER = 20.0
+"""A segment's diameter or length this many times the median of the file's, and over ``SIZE_OUTLIER_FLOOR_M`` of its
+kind, is refused as a unit typo (``od = "12 m"`` for 12 mm): the largest parts of a spindle, holder or tool are a
+few times the median, and a spindle is under a metre across."""
+
+SIZE_OUTLIER_FLOOR_M = {"diameter": 1.0, "length": 5.0}
+"""The size [m] below which a segment is never refused as an outlier (micro tools beside a spindle are a hundredth of
+its diameter; many short steps of a taper make the median length small)."""
+
 # The values the beam and coupling models compute right (beyond them, results turn to NaN, overflow or noise):
 # a value outside is a wrong unit or a typo.  key -> (SI unit, lowest, highest, the range in words)
 PLAUSIBLE = {  # a material's as Material checks them, said at the file's key and line

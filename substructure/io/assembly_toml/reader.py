@@ -15,6 +15,8 @@ import os
 import re
 import warnings
 
+import numpy as np
+
 from .. import read_text
 from ...assembly import Assembly
 from ...beams import Flutes, Insert, Segment
@@ -28,8 +30,8 @@ from ...points import parse_point
 from ...units import check_number_text, dimensionless, to_si
 from ._schema import (_CATALOG_KEYS, _COMPONENT_KEYS, _FLUTES_KEYS, _FREQUENCY_KEYS, _INSERT_KEYS, _JOINT_KEYS,
                       _MASS_KEYS, _MATERIAL_KEYS, _MATRIX_KEYS, _SEGMENT_KEYS, _SENSOR_KEYS, _SUPPORT_KEYS,
-                      _TOP_KEYS, MAX_JOINT_ENTRY, MAX_TAPER_STEPS, PLAUSIBLE, SIZE_RANGE_M, _extra_fields,
-                      _init_fields)
+                      _TOP_KEYS, MAX_JOINT_ENTRY, MAX_TAPER_STEPS, PLAUSIBLE, SIZE_OUTLIER, SIZE_OUTLIER_FLOOR_M,
+                      SIZE_RANGE_M, _extra_fields, _init_fields)
 
 _NUMBER_FIRST = re.compile(r"\s*[-+]?\.?\d")  # a value written as a number (and its unit)
 
@@ -40,6 +42,7 @@ class _Reader:
     def __init__(self, doc: TomlDocument):
         self.data, self.doc, self.error, self.table = doc.data, doc, doc.error, doc.table
         self.materials: dict[str, Material] = dict(CATALOG)
+        self.sizes: list[tuple[str, list, object, float]] = []  # (length or diameter, key path, as written, m)
 
     def call(self, parts, factory, *args, **kwargs):
         """``factory(*args, **kwargs)``, its errors and the package's warnings at the file, line and key path."""
@@ -91,6 +94,7 @@ class _Reader:
                  for key in ("components", "joints", "supports", "sensors", "masses")}
         components = self.unique([self.component(c, ["components", i]) for i, c in enumerate(items["components"])],
                                  "components")
+        self.outlying_sizes()
         base = self.call([], Assembly, data["name"], components, frequency=frequency, materials=custom)
         joints = self.unique([self.joint(j, ["joints", i], base) for i, j in enumerate(items["joints"])], "joints")
         supports = [self.support(s, ["supports", i], base) for i, s in enumerate(items["supports"])]
@@ -203,6 +207,20 @@ class _Reader:
         if metres > 0 and not SIZE_RANGE_M[0] <= metres <= SIZE_RANGE_M[1]:
             raise self.error(parts, f"got {value!r}; expected a length from 1 um to 1 km (the range of the "
                              "beam model): check the unit")
+        self.sizes.append(("length" if parts[-1] == "length" else "diameter", parts, value, metres))
+
+    def outlying_sizes(self) -> None:
+        """Refuse a segment's size far beyond the file's others and beyond any machine tool's (:data:`SIZE_OUTLIER`):
+        ``od = "12 m"`` for 12 mm read as a tool 12 metres across."""
+        for kind, floor in SIZE_OUTLIER_FLOOR_M.items():
+            sizes = [(parts, value, m) for k, parts, value, m in self.sizes if k == kind and m > 0]
+            if len(sizes) < 3:
+                continue
+            median = float(np.median([m for _, _, m in sizes]))
+            for parts, value, m in sizes:
+                if m > floor and m > SIZE_OUTLIER * median:
+                    raise self.error(parts, f"got {value!r}, {m / median:.3g} times the median {kind} of the file's "
+                                     f"segments ({median * 1e3:.4g} mm) and over {floor:g} m: a unit typo? (m for mm)")
 
     def segment(self, table, parts, material):
         table = self.table(table, parts, _SEGMENT_KEYS, ("length", "od"), "a segment table {length, od, ...}")
