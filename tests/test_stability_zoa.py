@@ -316,3 +316,24 @@ def test_an_frf_gone_to_noise_above_the_hammer_s_band_is_no_mode_above_it():
     noisy = h * np.exp(0.02 * (rng.normal(size=h.size) + 1j * rng.normal(size=h.size)))
     with pytest.warns(StabilityWarning, match="a mode lies above the band"):
         zoa(FRF.single(grid, noisy, output="t:y", input="t:y"), cut, SPEEDS)
+
+
+def test_a_model_with_a_measured_component_is_judged_as_data_above_its_grid():
+    # a measured spindle-holder (known on its own lines only) cannot be probed above the grid: the probe raised
+    from substructure import Assembly, MeasuredComponent
+    from substructure.stability import assembly_structure
+
+    assembly = default_assembly()
+    cut = MillingCut(4, "12 mm", "3 mm", kt="625 MPa", kn="100 MPa")
+    for stop, warned in (("5000 Hz", False), ("1400 Hz", True)):
+        grid = Frequency.from_range("20 Hz", stop, "2 Hz")
+        measured = MeasuredComponent("spindle-holder", assembly.without("tool").receptance("holder.tip",
+                                                                                          frequency=grid))
+        semi = Assembly("semi", components=(measured, assembly.component("tool")),
+                        joints=(assembly.joint("holder-tool"),), frequency=grid)
+        frf, band = assembly_structure(semi, "tool.tip:y")
+        assert not band.model and band.hi_hz == grid.hz[-1]
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            zoa(frf, cut, SPEEDS, band=band)
+        assert any("a mode lies above the band" in str(w.message) for w in caught) == warned

@@ -90,8 +90,9 @@ class FlexibleBand:
     reason : str
         One sentence for the human output.
     model : bool
-        Chosen on a model's receptance (:func:`assembly_structure`), whose
-        grid was checked for modes above it.
+        Chosen on a model's receptance (:func:`assembly_structure`) whose
+        grid was checked for modes above it (not a model with a measured
+        component, known on its lines only).
     """
 
     lo_hz: float
@@ -355,8 +356,7 @@ def assembly_structure(assembly: Any, at: str, frequency: Any = None) -> tuple[F
     if not assembly.supports:
         band = data_band if data_band.kind != "flexible" else attrs.evolve(
             data_band, kind="free-free", reason="free-free model; its grid starts above the rigid-body mass line")
-        _no_mode_above(assembly, at, band.crop(frf))
-        band = attrs.evolve(band, model=True)
+        band = attrs.evolve(band, model=_no_mode_above(assembly, at, band.crop(frf)))
         return band.crop(frf), band
     free = attrs.evolve(assembly, supports=())
     hf = free.receptance(at, frequency=frequency).data[:, 0, 0]
@@ -390,18 +390,23 @@ def assembly_structure(assembly: Any, at: str, frequency: Any = None) -> tuple[F
     if band.kind == "flexible":
         band = attrs.evolve(band, kind="supported",
                             reason="model on its supports: no rigid-body or suspension mode; the whole FRF is used")
-    _no_mode_above(assembly, at, band.crop(frf))
-    band = attrs.evolve(band, model=True)
+    band = attrs.evolve(band, model=_no_mode_above(assembly, at, band.crop(frf)))
     return band.crop(frf), band
 
 
-def _no_mode_above(assembly: Any, at: str, frf: FRF) -> None:
-    """Refuse a grid that stops below a mode of the model as flexible at the tool point as those in the band."""
+def _no_mode_above(assembly: Any, at: str, frf: FRF) -> bool:
+    """Refuse a grid that stops below a mode of the model as flexible at the tool point as those in the band;
+    False when the model cannot be evaluated above its grid (a measured component: known on its lines only), whose
+    FRF is then judged as data are."""
+    from ..errors import FrequencyAxisMismatchError
     from ..frf import Frequency
 
     top = float(frf.frequency.hz[-1])
     probe = Frequency.from_hz(np.geomspace(top, ABOVE_PROBE * top, ABOVE_LINES)[1:])
-    above = np.abs(assembly.receptance(at, frequency=probe).data[:, 0, 0])
+    try:
+        above = np.abs(assembly.receptance(at, frequency=probe).data[:, 0, 0])
+    except FrequencyAxisMismatchError:
+        return False
     inside = float(np.abs(frf.data[:, 0, 0]).max())
     k = int(np.argmax(above))
     if above[k] > ABOVE_SHARE * inside:
@@ -411,3 +416,4 @@ def _no_mode_above(assembly: Any, at: str, frf: FRF) -> None:
             f"{at} is {above[k] / inside:.3g} times the largest in the band: the lobes would not see it, and the "
             f"limit found could be far too deep; raise the grid's stop above {2 * hz:.3g} Hz ([frequency] stop in "
             "the assembly file, or frequency=)")
+    return True

@@ -268,8 +268,8 @@ def _mode_below_grid(assembly, point: str, frequency, frf) -> tuple[str, float] 
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             probe, _ = assembly_structure(assembly, point, low)
-    except Exception:  # a mass line only (no flexible mode below the grid), or nothing to compute there
-        return None
+    except Exception:  # a mass line only (no flexible mode below the grid), nothing to compute there, or a mode
+        return None      # above these lines as flexible as theirs (assembly_structure refuses them): no finding
     lines = probe.frequency.hz < f0
     h, inside = probe.data[lines, 0, 0], frf.data[:, 0, 0]
     if not h.size or not (h.real.min() < inside.real.min() and np.abs(h).max() > np.abs(inside).max()):
