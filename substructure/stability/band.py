@@ -413,7 +413,7 @@ def _no_mode_above(assembly: Any, at: str, frf: FRF) -> bool:
         hz = float(probe.hz[k])
         raise InvalidValueError(
             f"frequency: the grid stops at {top:g} Hz, below a mode of the model at about {hz:.4g} Hz whose peak at "
-            f"{at} is {above[k] / inside:.3g} times the largest in the band: the lobes would not see it, and the "
-            f"limit found could be far too deep; raise the grid's stop above {2 * hz:.3g} Hz ([frequency] stop in "
-            "the assembly file, or frequency=)")
+            f"{at} is {above[k] / inside:.3g} times the largest in the band: the lobes and the tool mode would miss "
+            f"it, and a limit found could be far too deep; raise the grid's stop above {2 * hz:.3g} Hz ([frequency] "
+            "stop in the assembly file, or frequency=)")
     return True
