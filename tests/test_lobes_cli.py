@@ -442,11 +442,12 @@ def test_an_frf_ending_below_the_tool_mode_gives_lobes_and_no_recommendation(cap
     grid = Frequency.from_range("20 Hz", "1400 Hz", "2 Hz")
     default_assembly().receptance("tool.tip:y", frequency=grid).to_csv(path)
     status, out, err = run(capsys, "lobes", "--frf", path, *THESIS_CUT, "--json")
-    assert status == 0 and "warning: zoa: the FRF (x) rises from" in err, err
+    assert status == 0 and "warning: zoa: a mode lies above the band: the FRF (x) rises from" in err, err
     result = json.loads(out)
     assert result["recommended"] is None
-    assert result["no_recommendation_reason"].startswith("a mode lies above the FRF's band (x rises to the band's end")
-    assert any(n.startswith("warning: zoa: the FRF (x) rises from") for n in result["notes"])
+    assert result["no_recommendation_reason"].startswith("a mode lies above the FRF's band (the FRF (x) rises from")
+    assert any(n.startswith("warning: zoa: a mode lies above the band") for n in result["notes"])
+    assert result["structure_band"]["mode_above"].startswith("the FRF (x) rises from 11")
     assert result["absolute_limit_m"] is not None  # the lobes of what was measured stand
 
 

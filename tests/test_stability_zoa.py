@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from substructure import FRF, Frequency, FrequencyAxisMismatchError, InvalidValueError, UnitError, default_assembly
-from substructure.stability import (MillingCut, ModalModel, Mode, StabilityWarning, TurningCut, spindle_speeds,
-                                    xy_frf, zoa)
+from substructure.stability import (MillingCut, ModalModel, Mode, NoRecommendationError, StabilityWarning,
+                                    TurningCut, recommend, spindle_speeds, xy_frf, zoa)
 from substructure.units import Q_
 
 M, FN, ZETA = 0.03993, 922.0, 0.011
@@ -277,10 +277,15 @@ def test_an_frf_ending_on_the_flank_of_a_mode_above_its_band_warns(top, warned):
     assert bool(said) == warned, said
     if warned:
         (text,) = said
-        assert text.startswith("zoa: the FRF (x) rises from ") and f"to the band's last line ({f[-1]:g} Hz)" in text
+        assert text.startswith("zoa: a mode lies above the band: the FRF (t:y) rises from ")
+        assert f"to the band's last line ({f[-1]:g} Hz)" in text and lobes.band.above in text
+        with pytest.raises(NoRecommendationError, match=r"a mode lies above the FRF's band \(the FRF \(t:y\) rises"):
+            recommend(lobes, cut)  # the lobes stand; a depth to cut at would ignore the mode above
         full = zoa(FRF.single(Frequency(np.arange(100.0, 3000.0, 0.5)), _two_modes(np.arange(100.0, 3000.0, 0.5)),
                               output="t:y", input="t:y"), cut, SPEEDS, band="all")
         assert lobes.absolute_limit_m > 1.5 * full.absolute_limit_m  # what the warning is for
+    else:
+        assert lobes.band.above is None
 
 
 def test_a_model_s_grid_that_stops_below_a_mode_as_flexible_as_the_band_s_is_refused():

@@ -233,14 +233,7 @@ def run(args: argparse.Namespace) -> int:
                      f"delay period (monodromy matrices of order {n_lo}" + (f" to {n_hi}" if n_hi != n_lo else "")
                      + f"{big}); boundary to {info['depth_rtol']:.1%}")
     best = why = None
-    from ..stability.zoa import ABOVE_WARNING
-
-    above = [n for n in notes if n.startswith("warning: " + ABOVE_WARNING.split("{")[0])]
-    if above:  # the lobes stand, drawn from what was measured; a depth to cut at would ignore the mode above
-        why = ("a mode lies above the FRF's band (" + above[0].split("(", 1)[1].split(")")[0] + " rises to the "
-               "band's end without a peak): its limit is unknown; measure beyond it")
-        notes.append(f"no recommendation: {why}")
-    elif limits is not None:
+    if limits is not None:
         try:
             if args.method == "sdm":
                 progress("the recommendation: the lowest limit within each candidate's speed window, by new runs "

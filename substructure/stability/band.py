@@ -48,7 +48,7 @@ import numpy as np
 from ..errors import InvalidValueError
 from ..frf import FRF
 
-__all__ = ["FlexibleBand", "flexible_band", "choose_band", "assembly_structure", "MASS_LINE_PHASE_DEG",
+__all__ = ["FlexibleBand", "flexible_band", "choose_band", "assembly_structure", "mode_above", "MASS_LINE_PHASE_DEG",
            "SUSPENSION_RATIO"]
 
 MASS_LINE_PHASE_DEG = 30.0
@@ -56,6 +56,14 @@ MASS_LINE_PHASE_DEG = 30.0
 
 SUSPENSION_RATIO = 0.1
 """In data, peaks at most this fraction of the next peak's frequency may be suspension modes."""
+
+ABOVE_RISE, ABOVE_STRETCH, ABOVE_SCATTER = 2.0, 0.05, 0.1
+"""FRF data end on the flank of a resonance above the band (a driving-point FRF's resonances and antiresonances
+alternate) when |H| of a direction rises from its last minimum to the band's last line, without a peak between, by
+``ABOVE_RISE`` times or more, over at least ``ABOVE_STRETCH`` of the band's last frequency (a rise over the last few
+lines is noise, or the edge of an anti-aliasing filter), scattering about its median filter by at most
+``ABOVE_SCATTER`` in log, RMS (a smooth flank: an FRF gone to noise above the hammer's band also rises to its end,
+with a scatter near 0.5)."""
 
 ABOVE_PROBE, ABOVE_LINES, ABOVE_SHARE = 4.0, 4000, 0.5
 """A model's grid is probed from its stop to ``ABOVE_PROBE`` times it on ``ABOVE_LINES`` log-spaced lines; a peak
@@ -89,6 +97,11 @@ class FlexibleBand:
         the tool point "sees" moving rigidly (``None`` without a mass line).
     reason : str
         One sentence for the human output.
+    above : str or None
+        FRF data that end on the flank of a resonance above the band
+        (:func:`mode_above`): what rises where; the lobes do not see that
+        mode, :func:`~substructure.stability.zoa` warns and
+        :func:`~substructure.stability.recommend` recommends nothing.
     model : bool
         Chosen on a model's receptance (:func:`assembly_structure`) whose
         grid was checked for modes above it (not a model with a measured
@@ -102,6 +115,7 @@ class FlexibleBand:
     suspension_hz: tuple = attrs.field(default=(), converter=tuple)
     apparent_mass_kg: float | None = None
     reason: str = ""
+    above: str | None = None
     model: bool = False
 
     def crop(self, frf: FRF) -> FRF:
@@ -142,7 +156,7 @@ class FlexibleBand:
         -------
         dict
             ``lo_hz``, ``hi_hz``, ``kind``, ``excluded_hz``, ``suspension_hz``,
-            ``apparent_mass_kg``, ``reason``.
+            ``apparent_mass_kg``, ``reason``, ``mode_above`` (:attr:`above`, or None).
         """
         return {
             "lo_hz": self.lo_hz,
@@ -151,6 +165,7 @@ class FlexibleBand:
             "excluded_hz": None if self.excluded_hz is None else list(self.excluded_hz),
             "suspension_hz": list(self.suspension_hz),
             "apparent_mass_kg": self.apparent_mass_kg,
+            "mode_above": self.above,
             "reason": self.reason,
         }
 
@@ -295,11 +310,11 @@ def choose_band(structure: Any, band: Any = "auto") -> tuple[Any, FlexibleBand |
         return band.crop(structure), band
     if band == "auto":
         found = flexible_band(structure)
-        return found.crop(structure), found
+        return found.crop(structure), _judged(found, found.crop(structure))
     hz = structure.frequency.hz
     if band in ("all", None):
-        return structure, FlexibleBand(float(hz[0]), float(hz[-1]), "all",
-                                       reason="the whole FRF is used (rigid-body detection switched off)")
+        return structure, _judged(FlexibleBand(float(hz[0]), float(hz[-1]), "all", reason="the whole FRF is used "
+                                               "(rigid-body detection switched off)"), structure)
     try:
         lo, hi = (float(v) for v in band)
     except (TypeError, ValueError):
@@ -308,8 +323,55 @@ def choose_band(structure: Any, band: Any = "auto") -> tuple[Any, FlexibleBand |
     cropped = structure.crop(lo, hi)
     f = cropped.frequency.hz
     excluded = (float(hz[0]), float(f[0])) if f[0] > hz[0] else None
-    return cropped, FlexibleBand(float(f[0]), float(f[-1]), "user", excluded,
-                                 reason=f"band {lo:g}..{hi:g} Hz given by the user")
+    return cropped, _judged(FlexibleBand(float(f[0]), float(f[-1]), "user", excluded,
+                                         reason=f"band {lo:g}..{hi:g} Hz given by the user"), cropped)
+
+
+def _judged(band: FlexibleBand, frf: FRF) -> FlexibleBand:
+    """The band with what :func:`mode_above` finds in the FRF data it holds."""
+    return attrs.evolve(band, above=mode_above(frf))
+
+
+def mode_above(frf: FRF) -> str | None:
+    """Whether FRF data end on the flank of a resonance above their band (the rules of ``ABOVE_RISE``).
+
+    |H| of each diagonal entry is median-filtered over a hundredth of the
+    lines; after its last peak it must rise from its minimum to the last
+    line, its largest value there, by ``ABOVE_RISE`` or more, over at least
+    ``ABOVE_STRETCH`` of the last frequency, smoothly (``ABOVE_SCATTER``).
+
+    Parameters
+    ----------
+    frf : FRF
+        Tool point receptances (the diagonal entries are judged).
+
+    Returns
+    -------
+    str or None
+        What rises where (``"the FRF (x) rises from 1178 Hz to the band's last line (1400 Hz), 4.98 times,
+        without a peak"``), or None.
+    """
+    from scipy.ndimage import median_filter
+    from scipy.signal import find_peaks
+
+    f = frf.frequency.hz
+    seen: list[np.ndarray] = []
+    for d in range(min(frf.shape[1], frf.shape[2])):
+        mag = np.abs(frf.data[:, d, d])
+        if any(np.array_equal(mag, m) for m in seen):
+            continue  # y = x: said once
+        seen.append(mag)
+        raw = np.log(np.maximum(mag, 1e-300))
+        log = median_filter(raw, size=max(3, mag.size // 100) | 1, mode="nearest")
+        peaks, _ = find_peaks(log, prominence=_PEAK_PROMINENCE)
+        start = int(peaks[-1]) + 1 if peaks.size else 0
+        j = start + int(np.argmin(log[start:]))
+        ratio = float(np.exp(log[-1] - log[j]))
+        smooth = float(np.sqrt(np.mean((raw[j:] - log[j:]) ** 2))) <= ABOVE_SCATTER  # a flank, not noise
+        if ratio >= ABOVE_RISE and f[-1] - f[j] >= ABOVE_STRETCH * f[-1] and log[-1] >= log[j:].max() and smooth:
+            return (f"the FRF ({frf.outputs[d]}) rises from {f[j]:g} Hz to the band's last line ({f[-1]:g} Hz), "
+                    f"{ratio:.3g} times, without a peak")
+    return None
 
 
 # -- models ----------------------------------------------------------------------------
@@ -356,8 +418,7 @@ def assembly_structure(assembly: Any, at: str, frequency: Any = None) -> tuple[F
     if not assembly.supports:
         band = data_band if data_band.kind != "flexible" else attrs.evolve(
             data_band, kind="free-free", reason="free-free model; its grid starts above the rigid-body mass line")
-        band = attrs.evolve(band, model=_no_mode_above(assembly, at, band.crop(frf)))
-        return band.crop(frf), band
+        return band.crop(frf), _probed(assembly, at, band, band.crop(frf))
     free = attrs.evolve(assembly, supports=())
     hf = free.receptance(at, frequency=frequency).data[:, 0, 0]
     ff = _one_entry(f, hf)
@@ -390,8 +451,13 @@ def assembly_structure(assembly: Any, at: str, frequency: Any = None) -> tuple[F
     if band.kind == "flexible":
         band = attrs.evolve(band, kind="supported",
                             reason="model on its supports: no rigid-body or suspension mode; the whole FRF is used")
-    band = attrs.evolve(band, model=_no_mode_above(assembly, at, band.crop(frf)))
-    return band.crop(frf), band
+    return band.crop(frf), _probed(assembly, at, band, band.crop(frf))
+
+
+def _probed(assembly: Any, at: str, band: FlexibleBand, frf: FRF) -> FlexibleBand:
+    """The model's band, its grid checked for modes above it (:func:`_no_mode_above`), or judged as data are when
+    the model cannot be evaluated there."""
+    return attrs.evolve(band, model=True) if _no_mode_above(assembly, at, frf) else _judged(band, frf)
 
 
 def _no_mode_above(assembly: Any, at: str, frf: FRF) -> bool:

@@ -267,8 +267,9 @@ def recommend(lobes: Any, cut: Any, limits: MachineLimits | None = None, *, marg
     NoRecommendationError
         (an ``InvalidValueError``) When no speed's whole window
         ``n (1 +- x)`` fits the computed range and the machine's speed range,
-        or nothing bounds the depth: the lobes stand, the recommendation is
-        absent, and the message says why.
+        or nothing bounds the depth, or the lobes' FRF data end on the flank
+        of a mode above their band (``FlexibleBand.above``): the lobes stand,
+        the recommendation is absent, and the message says why.
     """
     from .result import Lobes, LobesBand
 
@@ -281,6 +282,10 @@ def recommend(lobes: Any, cut: Any, limits: MachineLimits | None = None, *, marg
     if lobes.cut is not None and hasattr(lobes.cut, "radial_depth") and not _same_cut(lobes.cut, cut):
         raise InvalidValueError("cut: it is not the cut the lobes were computed for (teeth, immersion, milling, "
                                 "Kt or Kn differ)")
+    above = getattr(lobes.band, "above", None)
+    if above:  # the lobes stand, drawn from what was measured; a depth to cut at would ignore the mode above
+        raise NoRecommendationError(f"a mode lies above the FRF's band ({above}): its limit is unknown; measure "
+                                    "the FRF beyond it")
     limits = MachineLimits() if limits is None else limits
     if not isinstance(limits, MachineLimits):
         raise InvalidValueError(f"limits: got {type(limits).__name__}; expected MachineLimits")

@@ -85,41 +85,14 @@ EDGE_WARNING = ("zoa: the oriented FRF's most negative real part, the absolute l
 band chose above a mass line)."""
 
 
-ABOVE_RISE, ABOVE_STRETCH, ABOVE_SCATTER = 2.0, 0.05, 0.1
-"""FRF data end on the flank of a resonance above the band (a driving-point FRF's resonances and antiresonances
-alternate) when |H| of a direction rises from its last minimum to the band's last line, without a peak between, by
-``ABOVE_RISE`` times or more, over at least ``ABOVE_STRETCH`` of the band's last frequency (a rise over the last few
-lines is noise, or the edge of an anti-aliasing filter), scattering about its median filter by at most
-``ABOVE_SCATTER`` in log, RMS (a smooth flank: an FRF gone to noise above the hammer's band also rises to its end,
-with a scatter near 0.5)."""
-
-ABOVE_WARNING = ("zoa: the FRF ({direction}) rises from {valley_hz:g} Hz to the band's last line ({hz:g} Hz), "
-                 "{ratio:.3g} times, without a peak: a mode lies above the band, which the lobes do not see, and the "
-                 "limit may be far shallower than found; measure the FRF beyond that mode (a harder hammer tip) and "
-                 "extend the band")
-"""The warning when FRF data end on the rising flank of a resonance above the band."""
+ABOVE_WARNING = ("zoa: a mode lies above the band: {above}; the lobes do not see it, and the limit may be far "
+                 "shallower than found; measure the FRF beyond that mode (a harder hammer tip) and extend the band")
+"""The warning when FRF data end on the rising flank of a resonance above the band (``FlexibleBand.above``)."""
 
 
-def _rising_end(f: np.ndarray, g: np.ndarray) -> None:
-    """Warn (``ABOVE_WARNING``) when a direction's |H| ends on the flank of a resonance above the band (the rules of
-    ``ABOVE_RISE``; |H| median-filtered over a hundredth of the lines)."""
-    from scipy.ndimage import median_filter
-    from scipy.signal import find_peaks
-
-    for d, direction in enumerate("xy"):
-        mag = np.abs(g[:, d, d])
-        if d == 1 and np.array_equal(mag, np.abs(g[:, 0, 0])):
-            break  # y = x: said once
-        raw = np.log(np.maximum(mag, 1e-300))
-        log = median_filter(raw, size=max(3, mag.size // 100) | 1, mode="nearest")
-        peaks, _ = find_peaks(log, prominence=np.log(1.25))
-        start = int(peaks[-1]) + 1 if peaks.size else 0
-        j = start + int(np.argmin(log[start:]))
-        ratio = float(np.exp(log[-1] - log[j]))
-        smooth = float(np.sqrt(np.mean((raw[j:] - log[j:]) ** 2))) <= ABOVE_SCATTER  # a flank, not noise
-        if ratio >= ABOVE_RISE and f[-1] - f[j] >= ABOVE_STRETCH * f[-1] and log[-1] >= log[j:].max() and smooth:
-            warnings.warn(ABOVE_WARNING.format(direction=direction, valley_hz=f[j], hz=f[-1], ratio=ratio),
-                          StabilityWarning, stacklevel=4)
+def _warn_above(used: Any) -> None:
+    if used is not None and used.above:
+        warnings.warn(ABOVE_WARNING.format(above=used.above), StabilityWarning, stacklevel=3)
 
 
 def zoa_eigenvalues(k0: np.ndarray, g: np.ndarray) -> np.ndarray:
@@ -248,12 +221,9 @@ class _ZoaEnvelope:
         return d, at, fc
 
 
-def _lines(structure: Any, frequency: Frequency | None, k0: np.ndarray, teeth: int, lowest_rpm: float,
-           used: Any = None):
+def _lines(structure: Any, frequency: Frequency | None, k0: np.ndarray, teeth: int, lowest_rpm: float):
     """Lines, eigenvalues, where they give a lobe, depths, phases and the last lobe needed down to ``lowest_rpm``."""
     f, g = xy_receptance(structure, frequency)
-    if isinstance(structure, FRF) and not getattr(used, "model", False):  # a model's grid: checked by its band
-        _rising_end(f, g)
     lam = zoa_eigenvalues(k0, g)  # (m, 2)
     with np.errstate(divide="ignore", invalid="ignore"):
         valid = lam.real > 1e-300
@@ -310,8 +280,9 @@ def check_band(structure: Any, cut: Any, band: Any = "auto") -> None:
         the flank of a resonance above the band (``ABOVE_WARNING``).
     """
     structure, used = choose_band(structure, band)
+    _warn_above(used)
     k0 = cut.mean_force_matrix()
-    f, lam, valid, a, _, _ = _lines(structure, None, k0, cut.regenerations_per_revolution, np.inf, used)
+    f, lam, valid, a, _, _ = _lines(structure, None, k0, cut.regenerations_per_revolution, np.inf)
     _absolute(structure, used, k0, f, a, valid, lam)
 
 
@@ -368,13 +339,15 @@ def zoa(structure: Any, cut: Any, speeds: Any, *, frequency: Frequency | None = 
         (``EDGE_WARNING``): the minimum may lie outside the band; extend
         it.  Not at the first line of a band chosen automatically above a
         rigid-body mass line.  When FRF data end on the flank of a resonance
-        above the band (``ABOVE_WARNING``): the lobes do not see that mode.
+        above the band (``ABOVE_WARNING``, ``FlexibleBand.above``): the lobes
+        do not see that mode, and :func:`recommend` recommends nothing.
     """
     speeds_rpm = as_speed_rpm(speeds)
     structure, used = choose_band(structure, band)
+    _warn_above(used)
     k0 = cut.mean_force_matrix()
     teeth = cut.regenerations_per_revolution
-    f, lam, valid, a, theta, k_max = _lines(structure, frequency, k0, teeth, speeds_rpm[0], used)
+    f, lam, valid, a, theta, k_max = _lines(structure, frequency, k0, teeth, speeds_rpm[0])
     points = 2 * (k_max + 1) * f.size
     graded = points > MAX_LOBE_POINTS and frequency is None and isinstance(structure, ModalModel)
     if graded:  # the default grid is fine everywhere: at low speeds too many lines for so many lobes
