@@ -10,12 +10,13 @@ import warnings
 
 import numpy as np
 import pytest
+from scipy.io import savemat
 
 from substructure.cli import main
 from substructure.datasets import impact_records
 from substructure.errors import FileFormatError, SubstructureWarning
 from substructure.io import _tap_table
-from substructure.io.tap_files import read_tap_csv, read_tap_lvm, read_tap_uff, read_taps_uff
+from substructure.io.tap_files import read_tap_csv, read_tap_lvm, read_tap_mat, read_tap_uff, read_taps_uff
 
 FS = 10240.0
 G = 9.80665
@@ -701,9 +702,6 @@ def test_rows_that_start_with_a_clock_time_are_refused_as_such(tmp_path):
 # -- 6. MATLAB files -------------------------------------------------------------------------------------------------
 
 def test_matlab_vectors_with_their_units(tmp_path):
-    from scipy.io import savemat
-
-    from substructure.io.tap_files import read_tap_mat
 
     t, f, a = samples()
     path = tmp_path / "tap.mat"
@@ -737,9 +735,7 @@ def test_matlab_vectors_with_their_units(tmp_path):
 
 
 def test_matlab_matrices_of_a_tap_a_column(tmp_path, capsys):
-    from scipy.io import savemat
-
-    from substructure.io.tap_files import read_tap_mat, read_taps_mat
+    from substructure.io.tap_files import read_taps_mat
 
     taps = impact_records()[:3]  # the shipped real taps, as a MATLAB acquisition returns them: a tap a column
     fs, n = taps[0].sample_rate, taps[0].time.size
@@ -836,9 +832,6 @@ def test_numbers_in_quotes_as_some_exports_write_every_cell(tmp_path, monkeypatc
 
 def test_matlab_vectors_of_complex_values_are_named_as_passed_over(tmp_path):
     # they were dropped without a word: "1 columns (time [s]); expected three" left the user guessing
-    from scipy.io import savemat
-
-    from substructure.io.tap_files import read_tap_mat
 
     t, f, a = samples()
     path = tmp_path / "tap.mat"
