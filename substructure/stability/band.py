@@ -99,7 +99,7 @@ class FlexibleBand:
         One sentence for the human output.
     above : str or None
         FRF data that end on the flank of a resonance above the band
-        (:func:`mode_above`): what rises where; the lobes do not see that
+        (``mode_above``): what rises where; the lobes do not see that
         mode, :func:`~substructure.stability.zoa` warns and
         :func:`~substructure.stability.recommend` recommends nothing.
     model : bool
@@ -156,7 +156,7 @@ class FlexibleBand:
         -------
         dict
             ``lo_hz``, ``hi_hz``, ``kind``, ``excluded_hz``, ``suspension_hz``,
-            ``apparent_mass_kg``, ``reason``, ``mode_above`` (:attr:`above`, or None).
+            ``apparent_mass_kg``, ``reason``, ``mode_above`` (``above``, or None).
         """
         return {
             "lo_hz": self.lo_hz,
