@@ -139,3 +139,37 @@ def test_a_thousands_separator_beside_decimal_commas_is_named_as_written(tmp_pat
         read_csv(path)
     path.write_text(path.read_text().replace("1.234,5e-9", "1234,5e-9"))
     assert read_csv(path).data[1, 0, 0] == pytest.approx(1234.5e-9 - 2.0e-7j)
+
+
+@pytest.mark.parametrize("head, first", [("", 0), ("index", 0), ('""', 1), ("Unnamed: 0", 0)])
+def test_a_row_number_column_as_pandas_or_r_write_it_is_skipped(tmp_path, head, first):
+    """``DataFrame.to_csv`` writes its index first, under an empty name; R's ``write.csv`` numbers from 1.
+    Such a file was refused ("column ''")."""
+    path = tmp_path / "export.csv"
+    numbers = np.arange(first, first + len(HZ))
+    body = rows(HZ, H.real, H.imag, HZ / 50, sep=",", decimal=".").splitlines()
+    path.write_text(f"{head},frequency_hz,real,imag,coherence\n"
+                    + "".join(f'"{k}",{line}\n' if head == '""' else f"{k},{line}\n" for k, line in zip(numbers, body)),
+                    encoding="utf-8")
+    frf, coherence = read_csv_with_coherence(path)
+    np.testing.assert_array_equal(frf.frequency.hz, HZ)
+    np.testing.assert_allclose(frf.data[:, 0, 0], H, rtol=1e-15)
+    np.testing.assert_allclose(coherence, HZ / 50, rtol=1e-15)
+
+
+@pytest.mark.parametrize("numbers", [[0, 1, 3, 4], [2, 3, 4, 5], [0.5, 1.5, 2.5, 3.5]])
+def test_a_first_column_that_does_not_count_rows_is_not_taken_for_an_index(tmp_path, numbers):
+    path = tmp_path / "export.csv"
+    body = rows(HZ, H.real, H.imag, sep=",", decimal=".").splitlines()
+    path.write_text(",frequency_hz,real,imag\n" + "".join(f"{k},{line}\n" for k, line in zip(numbers, body)),
+                    encoding="utf-8")
+    with pytest.raises(FileFormatError, match=r"line 1: column ''; expected frequency"):
+        read_csv(path)
+
+
+def test_an_index_column_with_a_units_row_is_skipped(tmp_path):
+    path = tmp_path / "export.csv"
+    body = rows(HZ, H.real * 1e3, H.imag * 1e3).splitlines()
+    path.write_text(";Frequency;Real;Imag\n;Hz;mm/N;mm/N\n" + "".join(f"{k};{line}\n" for k, line in enumerate(body)),
+                    encoding="utf-8")
+    np.testing.assert_allclose(read_csv(path).data[:, 0, 0], H, rtol=1e-12)

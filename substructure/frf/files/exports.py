@@ -5,7 +5,7 @@
 header to :func:`parse_export`, which reads what is unambiguous and refuses
 the rest with what to give instead: comment lines (``#``) before the header,
 ``;`` or tab separators (with decimal commas), quoted cells, empty trailing
-columns, units in the header (``Frequency [Hz]``, ``Real [mm/N]``,
+columns, a leading column of row numbers (pandas' index), units in the header (``Frequency [Hz]``, ``Real [mm/N]``,
 ``Magnitude [g/N]``, ``Phase [deg]``) or in a row of their own under the
 names, names of several words one of which says the column (``FRF Real``,
 ``H1 Imag``), real and imaginary parts or magnitude
@@ -108,6 +108,24 @@ def _value_unit(unit: str | None, cell: str, name: str, line: int):
     return found
 
 
+_INDEX_NAMES = {"", "index", "unnamed: 0"}
+
+
+def _without_index(cells: list[list[str]]) -> list[list[str]]:
+    """The table without a leading row-number column, as ``pandas.DataFrame.to_csv`` (an empty or ``index``
+    header cell, rows 0, 1, 2, ...) or R's ``write.csv`` (rows 1, 2, ...) write one; the table as it is
+    otherwise (a units row under the names may leave the column's cell empty)."""
+    if len(cells) < 3 or not cells[0] or cells[0][0].lower() not in _INDEX_NAMES:
+        return cells
+    body = cells[1:]
+    if body[0] and body[0][0] == "" and not any(_is_number(c) for c in body[0][1:]):
+        body = body[1:]  # a units row
+    start = body[0][0] if body and body[0] else ""
+    if start not in ("0", "1") or any(not row or row[0] != str(k + int(start)) for k, row in enumerate(body)):
+        return cells
+    return [row[1:] for row in cells]
+
+
 def _header_below(rows: list[tuple[int, str]], name: str) -> tuple[int, str] | None:
     """The first of ``rows`` that reads as a table's header (a frequency column first, every cell a column's
     name), as when a block of metadata lines without ``#`` comes before the table; None without one."""
@@ -180,6 +198,7 @@ def read_export(numbered: list[tuple[int, str]], name: str, quantity: str | None
     for row in cells:
         while row and row[-1] == "":  # an empty trailing column (a spreadsheet's last separator)
             row.pop()
+    cells = _without_index(cells)
     try:
         columns = [_column(c, name, first) for c in cells[0]]
     except FileFormatError:
