@@ -29,7 +29,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ._schema import MAX_TAPER_STEPS, SIZE_OUTLIER, SIZE_OUTLIER_FLOOR_M, SIZE_RANGE_M  # noqa: F401 (the limits of reading, named in errors)
+from ._schema import MACHINE_SIZE_M, MAX_TAPER_STEPS, SIZE_OUTLIER, SIZE_OUTLIER_FLOOR_M, SIZE_RANGE_M  # noqa: F401 (the limits of reading, named in errors)
 from .reader import default_assembly, load_assembly, loads_assembly
 
 __all__ = ["load_assembly", "loads_assembly", "save_assembly", "dumps_assembly", "default_assembly"]

@@ -40,6 +40,11 @@ SIZE_OUTLIER_FLOOR_M = {"diameter": 1.0, "length": 5.0}
 """The size [m] below which a segment is never refused as an outlier (micro tools beside a spindle are a hundredth of
 its diameter; many short steps of a taper make the median length small)."""
 
+MACHINE_SIZE_M = {"diameter": 2.0, "length": 10.0}
+"""Beyond these [m] (a diameter, a component's length) a file is warned of as written in m for mm, every size
+alike (no size stands out of the others): no spindle, holder or tool is 2 m across or 10 m long, while
+the beam model computes far larger structures right."""
+
 # The values the beam and coupling models compute right (beyond them, results turn to NaN, overflow or noise):
 # a value outside is a wrong unit or a typo.  key -> (SI unit, lowest, highest, the range in words)
 PLAUSIBLE = {  # a material's as Material checks them, said at the file's key and line

@@ -31,7 +31,7 @@ from ...units import check_number_text, dimensionless, to_si
 from ._schema import (_CATALOG_KEYS, _COMPONENT_KEYS, _FLUTES_KEYS, _FREQUENCY_KEYS, _INSERT_KEYS, _JOINT_KEYS,
                       _MASS_KEYS, _MATERIAL_KEYS, _MATRIX_KEYS, _SEGMENT_KEYS, _SENSOR_KEYS, _SUPPORT_KEYS,
                       _TOP_KEYS, MAX_JOINT_ENTRY, MAX_TAPER_STEPS, PLAUSIBLE, SIZE_OUTLIER, SIZE_OUTLIER_FLOOR_M,
-                      SIZE_RANGE_M, _extra_fields, _init_fields)
+                      MACHINE_SIZE_M, SIZE_RANGE_M, _extra_fields, _init_fields)
 
 _NUMBER_FIRST = re.compile(r"\s*[-+]?\.?\d")  # a value written as a number (and its unit)
 
@@ -221,6 +221,19 @@ class _Reader:
                 if m > floor and m > SIZE_OUTLIER * median:
                     raise self.error(parts, f"got {value!r}, {m / median:.3g} times the median {kind} of the file's "
                                      f"segments ({median * 1e3:.4g} mm) and over {floor:g} m: a unit typo? (m for mm)")
+        lengths: dict[tuple, float] = {}  # a component's length, by its key path
+        for kind, parts, _, m in self.sizes:
+            if kind == "length":
+                lengths[tuple(parts[:2])] = lengths.get(tuple(parts[:2]), 0.0) + m
+        large = [(f"{m:.4g} m long", list(at)) for at, m in lengths.items() if m > MACHINE_SIZE_M["length"]]
+        large += [(f"{m:.4g} m across", parts) for kind, parts, _, m in self.sizes
+                  if kind == "diameter" and m > MACHINE_SIZE_M["diameter"]]
+        if large:
+            said, parts = large[0]
+            warnings.warn(SubstructureWarning(str(self.doc.wrap(parts, (
+                f"{said}; no spindle, holder or tool is over {MACHINE_SIZE_M['length']:g} m long or "
+                f"{MACHINE_SIZE_M['diameter']:g} m across: sizes in m written for mm? (read as written)")))),
+                stacklevel=4)
 
     def segment(self, table, parts, material):
         table = self.table(table, parts, _SEGMENT_KEYS, ("length", "od"), "a segment table {length, od, ...}")
