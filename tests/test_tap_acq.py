@@ -14,9 +14,10 @@ from scipy.io import savemat
 
 from substructure.cli import main
 from substructure.datasets import impact_records
-from substructure.errors import FileFormatError, SubstructureWarning
+from substructure.errors import FileFormatError, InvalidValueError, SubstructureWarning
 from substructure.io import _tap_table
 from substructure.io.tap_files import read_tap_csv, read_tap_lvm, read_tap_mat, read_tap_uff, read_taps_uff
+from substructure.tap.records import TapRecord
 
 FS = 10240.0
 G = 9.80665
@@ -672,6 +673,30 @@ def test_times_written_with_few_digits_are_the_uniform_clock_and_a_lost_sample_i
     path.write_text("time [s],force [N],acceleration [g]\n" + rows([lost, f[1:], a[1:]], fmt="{:.6f}"))
     with pytest.raises(FileFormatError, match=r"six.csv: column 'time', sample 2000: step"):
         read_tap_csv(path)
+
+
+@pytest.mark.parametrize("origin", [1.7e9, 86400.0 * 365])
+def test_time_stamps_far_from_their_origin_are_the_uniform_clock_from_the_first_sample(tmp_path, origin):
+    # a logger's Unix time (1.7e9 s) written with every digit: float64 holds such times to 2.4e-7 s, so that
+    # the steps of 1.95e-5 s came out uneven by 1 % and the file was refused as not uniformly sampled
+    t, f, a = samples()
+    whole, frac = divmod(np.arange(t.size) * 390625, 4 * 10 ** 9)  # k / 10240 s = k * 390625 / 4e9 s, exactly
+    stamps = [f"{int(origin) + int(w)}.{int(r) * 25:011d}" for w, r in zip(whole, frac)]
+    path = tmp_path / "logger.csv"
+    path.write_text("time [s],force [N],acceleration [g]\n"
+                    + "".join(f"{s},{float(x)!r},{float(y)!r}\n" for s, x, y in zip(stamps, f, a)))
+    record = read_tap_csv(path)
+    assert record.sample_rate == pytest.approx(FS, rel=1e-9)
+    np.testing.assert_allclose(record.time, t, rtol=0, atol=1e-9)  # counted from the first sample
+    assert np.array_equal(record.force, f)
+
+
+def test_a_record_of_time_stamps_given_in_python_says_why_its_steps_are_uneven():
+    t, f, a = samples()
+    with pytest.raises(InvalidValueError, match=r"expected increasing, uniformly sampled times \(one record per "
+                                                r"sample rate\) \(times near 1\.7e\+09 s, which float64 holds only "
+                                                r"to 2\.4e-07 s: give them from the record's first sample\)"):
+        TapRecord(t + 1.7e9, f, a)
 
 
 def test_blanks_after_separators_quoted_names_and_a_separator_ending_every_line(tmp_path):

@@ -37,9 +37,14 @@ ROUNDED_TIME_TOLERANCE = ROUNDED_STEP_SHARE
 (times written with few digits, e.g. six decimals at 51.2 kHz); farther (a lost or repeated sample) is refused."""
 
 
+_EVEN = 1e-6
+"""The most a fitted time grid's steps may differ, as a share of its step, before it is taken from the first sample."""
+
+
 def regular(time_s: np.ndarray) -> np.ndarray:
     """The uniform grid fitted to the times when every time lies within a quarter step of it
-    (``substructure.frf.axis.rounded_uniform``).
+    (``substructure.frf.axis.rounded_uniform``); counted from the first sample when float64 cannot hold the
+    grid's steps evenly so far from its origin (time stamps).
 
     Times rounded to the digits a file writes (0.000020 for 1.953125e-05 s)
     make uneven steps of a uniform clock; the grid is what was sampled.  A
@@ -47,6 +52,11 @@ def regular(time_s: np.ndarray) -> np.ndarray:
     check to refuse.
     """
     grid = rounded_uniform(time_s)
+    if grid is not None and float(np.ptp(np.diff(grid))) > _EVEN * (grid[-1] - grid[0]) / time_s.size:
+        # a clock far from its origin (time stamps such as 1.7e9 s): float64 holds its times to steps of 1e-7 s
+        # or more, so that even the fitted grid steps unevenly; the grid from the record's first sample does not
+        relative = rounded_uniform(time_s - time_s[0])
+        return time_s if relative is None else relative
     return time_s if grid is None else grid
 
 

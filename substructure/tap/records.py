@@ -252,10 +252,14 @@ class TapRecord:
         mean = (self.time[-1] - self.time[0]) / (n - 1)
         if not mean > 0 or np.any(np.abs(step - mean) > TIME_STEP_TOLERANCE * mean):
             k = int(np.argmax(np.abs(step - mean))) + 1 if mean > 0 else 1
+            far = float(np.max(np.abs(self.time)))
+            held = float(np.spacing(far))
+            hint = (f" (times near {far:.4g} s, which float64 holds only to {held:.2g} s: give them from the "
+                    "record's first sample)" if mean > 0 and abs(float(step[k - 1]) - mean) <= 4 * held else "")
             raise InvalidValueError(
                 f"{where}: column 'time', sample {k}: step {float(step[k - 1])!r} s where the mean step is "
                 f"{float(mean)!r} s; "
-                "expected increasing, uniformly sampled times (one record per sample rate)"
+                f"expected increasing, uniformly sampled times (one record per sample rate){hint}"
             )
 
     @classmethod
