@@ -699,6 +699,17 @@ def test_a_record_of_time_stamps_given_in_python_says_why_its_steps_are_uneven()
         TapRecord(t + 1.7e9, f, a)
 
 
+def test_lines_ended_by_a_carriage_return_alone_are_read(tmp_path):
+    # Excel for Mac's "CSV (Macintosh)": the file read as one header line and no samples
+    t, f, a = samples()
+    path = tmp_path / "mac.csv"
+    path.write_bytes(("Sample rate: 10240 Hz\rtime [s];force [N];acceleration [g]\r"
+                      + rows([t, f, a], sep=";", decimal_comma=True).replace("\n", "\r")).encode())
+    record = read_tap_csv(path)
+    assert np.allclose(record.time, t, rtol=0, atol=1e-15) and np.array_equal(record.force, f)
+    assert np.allclose(record.response, a * G, rtol=1e-12, atol=0)
+
+
 def test_blanks_after_separators_quoted_names_and_a_separator_ending_every_line(tmp_path):
     t, f, a = samples()
     path = tmp_path / "spaced.csv"

@@ -159,11 +159,14 @@ def _comment_header(line: str, sep: str | None, ncols: int) -> list[str] | None:
 
 
 def _text_bytes(path: str | os.PathLike, name: str) -> bytes:
-    """The bytes of a text record: UTF-16 re-encoded as UTF-8, a UTF-8 byte-order mark dropped."""
+    """The bytes of a text record: UTF-16 re-encoded as UTF-8, a UTF-8 byte-order mark dropped, lines ended by a
+    carriage return alone (as Excel for Mac's "CSV (Macintosh)" writes them) ended by a line feed."""
     data = read_bytes(path, "tap record", MAX_RECORD_BYTES)
     if data[:2] in (b"\xff\xfe", b"\xfe\xff"):
-        return decode_text(data, name).encode("utf-8")
-    return data[3:] if data[:3] == b"\xef\xbb\xbf" else data
+        data = decode_text(data, name).encode("utf-8")
+    elif data[:3] == b"\xef\xbb\xbf":
+        data = data[3:]
+    return data.replace(b"\r", b"\n") if b"\r" in data and b"\n" not in data else data
 
 
 def _windows_text(line: bytes, name: str, number: int, pos: int, bad: int) -> str:
