@@ -506,6 +506,8 @@ def dimensionless(value: Any, field: str) -> float:
 
 _GRAVITY = re.compile(r"(?<![A-Za-z_0-9])(?:[gG]|gn|g_n)(?![A-Za-z_0-9])")
 _POUND = re.compile(r"(?<![A-Za-z_0-9])lbs?(?![A-Za-z_0-9])")
+_MIL = re.compile(r"(?<![A-Za-z_0-9])mils?(?![A-Za-z_0-9])")
+_IPS = re.compile(r"(?<![A-Za-z_0-9])ips(?![A-Za-z_0-9])")
 _POWER = re.compile(r"(?<=[A-Za-z])(-?[0-9]+)(?![0-9.])")  # s2, s-2: an exponent written without ^
 _TIMES = re.compile(r"(?<=[A-Za-z0-9])\s*[.\u00b7\u22c5]\s*(?=[A-Za-z])")  # m.s-2, m\u00b7s-2
 _SUPERSCRIPTS = str.maketrans("\u207b\u00b9\u00b2\u00b3\u00b5\u03bc", "-123uu")
@@ -540,7 +542,8 @@ def instrument_unit(text: str) -> pint.Unit:
     """The unit of a channel or axis label as measuring instruments and their programs write it.
 
     ``g``, ``G`` and ``gn`` (``g_n``) are the standard acceleration of
-    gravity (not the gram or the gauss) and ``lb`` is the pound-force (not the pound of mass):
+    gravity (not the gram or the gauss), ``lb`` is the pound-force (not the pound of mass),
+    ``mil`` a thousandth of an inch (not the angle) and ``ips`` inches per second:
     the only meanings they have for a sensor, a hammer or an FRF.
     Exponents may be written without ``^`` (``m/s2``, ``m s-2``), as
     superscripts (``m/s\u00b2``, ``m\u00b7s\u207b\u00b2``) or after ``**``; a product with
@@ -563,6 +566,7 @@ def instrument_unit(text: str) -> pint.Unit:
     """
     cleaned = _TIMES.sub("*", text.strip().translate(_SUPERSCRIPTS)).replace("**", "^")
     cleaned = _POUND.sub("lbf", _GRAVITY.sub("g0", _POWER.sub(r"^\1", cleaned)))
+    cleaned = _IPS.sub("(in/s)", _MIL.sub("thou", cleaned))
     try:
         unit = ureg.Unit(cleaned)
     except Exception:

@@ -108,6 +108,9 @@ def test_catalogue():
     ("\u00b5m", "m", 1e-6), ("\u03bcm", "m", 1e-6), ("um", "m", 1e-6), ("lb", "N", 0.45359237 * 9.80665),
     ("mV/lb", "V/N", 1e-3 / (0.45359237 * 9.80665)), ("mV/g", "V/(m/s^2)", 1e-3 / 9.80665), ("(m/s2)/N", "1/kg", 1.0),
     ("g/N", "1/kg", 9.80665), ("m^2", "m^2", 1.0), ("gn", "m/s^2", 9.80665), ("mV/g_n", "V/(m/s^2)", 1e-3 / 9.80665),
+    # US vibration units: a mil is 0.001 in = 25.4 um (pint's mil is an angle), ips an inch per second
+    ("mil", "m", 25.4e-6), ("mils", "m", 25.4e-6), ("mV/mil", "V/m", 1e-3 / 25.4e-6), ("ips", "m/s", 0.0254),
+    ("mV/ips", "V/(m/s)", 1e-3 / 0.0254), ("in/lbf", "m/N", 0.0254 / (0.45359237 * 9.80665)),
 ])
 def test_instrument_units_read_as_acquisition_programs_write_them(text, si, factor):
     # factors by the definitions: g_n = 9.80665 m/s^2, 1 lb = 0.45359237 kg, so 1 lbf = 0.45359237 g_n newtons
