@@ -659,3 +659,31 @@ def test_one_record_given_as_two_measurements_is_refused():
     pair = [hab, FRF(hab.frequency, hab.data, hab.inputs, hab.outputs)]  # H_ba given as H_ab (reciprocity)
     assert len(measured_frfs(pair)[0]) == 2  # a reciprocal pair with the same numbers: both kept
     assert len(measured_frfs([tip, holder])[0]) == 2
+
+
+@pytest.mark.parametrize("point", [1.0, None, math.nan, 1j, True])
+def test_a_point_that_is_no_name_is_refused_by_name_not_by_iterating_it(point):
+    # 'float' object is not iterable, from the list of points
+    with pytest.raises(UnknownPointError, match=r"point: got .*; expected a name like 'tool\.tip'"):
+        default_assembly().frf(point, frequency=GRID)
+    if point is not None:  # no inputs: the outputs'
+        with pytest.raises(UnknownPointError, match=r"point: got .*; expected a name like 'tool\.tip'"):
+            default_assembly().frf("tool.tip", point, frequency=GRID)
+
+
+def test_a_frequency_beyond_float_range_is_refused_as_too_high():
+    # 1e100 Hz made the wavenumbers NaN and the pieces "cannot convert float NaN to integer"
+    for hz in (1e100, 1e300):
+        with pytest.raises(InvalidValueError, match=r"got a line at 1e\+[0-9]+ Hz, where component '\w+' would be cut "
+                                                    r"into about inf pieces"):
+            default_assembly().frf("tool.tip", frequency=[hz])
+
+
+def test_frequencies_as_a_quantity_are_converted_and_other_units_refused():
+    # numpy's iscomplexobj raised TypeError on any pint quantity
+    from substructure import Q_
+    assert np.array_equal(Frequency(Q_(np.array([1.0, 2.0]), "kHz")).hz, [1000.0, 2000.0])
+    assert np.allclose(Frequency(Q_(np.array([600.0, 1200.0]), "rpm")).hz, [10.0, 20.0], rtol=1e-15)
+    for value in (Q_(np.array([1.0, 2.0]), "s"), Q_(math.nan, "m")):
+        with pytest.raises(UnitError, match=r"hz: got a quantity in (s|m); expected frequencies"):
+            Frequency(value)

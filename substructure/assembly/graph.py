@@ -23,7 +23,7 @@ from ..joints import Joint, Mass, Sensor, Support
 from ..materials import Material
 from ..points import PointRef, parse_point
 from ._fields import _component_check, _joint_check, _tuple
-from .plan import couple, expand_points, plan
+from .plan import couple, expand_points, plan, point_names
 from .prepared import PreparedFRF
 
 __all__ = ["Assembly"]
@@ -524,8 +524,8 @@ class Assembly:
             force in N or moment in N m (H in m/N, L in m/(N m), N in rad/N, P in rad/(N m)).
         """
         freq = self._frequency(frequency)
-        outputs = [outputs] if isinstance(outputs, str) else list(outputs)
-        inputs = outputs if inputs is None else ([inputs] if isinstance(inputs, str) else list(inputs))
+        outputs = point_names(outputs)
+        inputs = outputs if inputs is None else point_names(inputs)
         if not outputs or not inputs:
             raise InvalidValueError("frf: expected at least one output and one input point")
 

@@ -23,7 +23,18 @@ from ..errors import AssemblyError, InvalidValueError, SubstructureWarning
 from ..joints import dynamic_stiffness
 from ..points import DOFS, PointRef, parse_point
 
-__all__ = ["expand_points", "plan", "couple", "check_connected"]
+__all__ = ["point_names", "expand_points", "plan", "couple", "check_connected"]
+
+
+def point_names(points: Any) -> list:
+    """A list of the points given: one name, a sequence of names, or one thing that is no sequence (for
+    :func:`~substructure.points.parse_point` to refuse by name, as it does a wrong item of a sequence)."""
+    if isinstance(points, str):
+        return [points]
+    try:
+        return list(points)
+    except TypeError:  # a number, None, a scalar quantity
+        return [points]
 
 
 def expand_points(points: Sequence[str] | str):
@@ -45,7 +56,7 @@ def expand_points(points: Sequence[str] | str):
     refs : list of PointRef
         The points, in order.
     """
-    points = [points] if isinstance(points, str) else list(points)
+    points = point_names(points)
     if not points:
         raise InvalidValueError("expected at least one point")
     labels, dof_index, refs = [], [], []

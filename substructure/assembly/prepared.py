@@ -16,7 +16,7 @@ from ..coupling import Link, couple_substructures
 from ..errors import InvalidValueError, UnknownPointError
 from ..frf import FRF
 from ..joints import Mass, Sensor, Support, dynamic_stiffness
-from .plan import expand_points
+from .plan import expand_points, point_names
 
 __all__ = ["PreparedFRF"]
 
@@ -44,8 +44,8 @@ class PreparedFRF:
     def __init__(self, assembly, outputs, inputs=None, frequency=None):
         self.assembly = assembly
         self.frequency = assembly._frequency(frequency)
-        outputs = [outputs] if isinstance(outputs, str) else list(outputs)
-        inputs = outputs if inputs is None else ([inputs] if isinstance(inputs, str) else list(inputs))
+        outputs = point_names(outputs)
+        inputs = outputs if inputs is None else point_names(inputs)
         self.outputs, out_idx, out_refs = expand_points(outputs)
         self.inputs, in_idx, in_refs = expand_points(inputs)
         self._groups, self._out_keys, self._links = assembly._plan(out_refs + in_refs)

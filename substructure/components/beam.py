@@ -88,10 +88,11 @@ def check_reach(beam: Any, frequency_hz: np.ndarray) -> None:
     for s, e in zip(beam.segments, ends):
         phase = max(next(phases) for _ in e)
         pieces += phase / (TAPER_STEP_PHASE if s.is_tapered else _CHUNK_KL)
-    if pieces > MAX_BEAM_PIECES:
+    if not pieces <= MAX_BEAM_PIECES:  # beyond float range (1e100 Hz) the wavenumbers are NaN: as many pieces
         raise InvalidValueError(
             f"frequency: got a line at {f_max:g} Hz, where component {beam.name!r} would be cut into about "
-            f"{pieces:.3g} pieces (its bending waves are that short), more than {MAX_BEAM_PIECES} "
+            f"{pieces if np.isfinite(pieces) else np.inf:.3g} pieces (its bending waves are that short), more than "
+            f"{MAX_BEAM_PIECES} "
             "(components.beam.MAX_BEAM_PIECES); the beam model is meant for the vibrations of machine-tool parts, "
             "up to some 100 kHz: check the unit of the frequencies (plain numbers are in Hz)"
         )

@@ -15,8 +15,8 @@ from typing import Any
 import attrs
 import numpy as np
 
-from ..errors import InvalidValueError
-from ..units import frequency_hz
+from ..errors import InvalidValueError, UnitError
+from ..units import cycles_per_second, frequency_hz, ureg
 
 __all__ = ["Frequency", "MAX_GRID_LINES"]
 
@@ -84,6 +84,11 @@ def _readonly(array: np.ndarray) -> np.ndarray:
 
 
 def _hz_array(value: Any) -> np.ndarray:
+    if isinstance(value, ureg.Quantity):  # frequencies with their unit: Hz, kHz, rad/s and rpm converted
+        if not value.check("1 / [time]"):
+            raise UnitError(f"hz: got a quantity in {value.units:~}; expected frequencies (in Hz, or a quantity of "
+                            "a frequency unit)")
+        value = cycles_per_second(value, "hz")
     if np.iscomplexobj(value):
         raise InvalidValueError("hz: got complex values; expected real frequencies in Hz")
     try:
