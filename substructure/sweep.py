@@ -23,7 +23,7 @@ Examples
 from __future__ import annotations
 
 import sys
-from typing import Iterable, Sequence
+from typing import Sequence
 
 import attrs
 import numpy as np
@@ -148,10 +148,14 @@ def sweep(
         The receptances of every variant, shape ``(n_variants, n_freq, n_out, n_in)``
         (m/N, m/(N m), rad/N, rad/(N m)).
     """
-    if isinstance(assemblies, Assembly) or not isinstance(assemblies, Iterable):
+    try:  # (a scalar quantity says it is iterable and is not)
+        items = None if isinstance(assemblies, Assembly) else list(assemblies)
+    except TypeError:
+        items = None
+    if items is None:
         raise InvalidValueError(f"sweep: got {_show(assemblies)}; expected a sequence of assemblies (a list: "
                                 "[assembly] for one)")
-    assemblies = list(assemblies)
+    assemblies = items
     if not assemblies:
         raise InvalidValueError("sweep: got no assemblies")
     for i, a in enumerate(assemblies):

@@ -687,3 +687,57 @@ def test_frequencies_as_a_quantity_are_converted_and_other_units_refused():
     for value in (Q_(np.array([1.0, 2.0]), "s"), Q_(math.nan, "m")):
         with pytest.raises(UnitError, match=r"hz: got a quantity in (s|m); expected frequencies"):
             Frequency(value)
+
+
+def _a_tap():
+    from substructure.tap import TapRecord
+    n, fs = 2048, 10240.0
+    force = np.zeros(n)
+    force[100:104] = [10.0, 30.0, 30.0, 10.0]
+    response = np.convolve(force, np.exp(-np.arange(n) / 200.0) * np.sin(np.arange(n) * 0.5))[:n]
+    return TapRecord(np.arange(n) / fs, force + 1e-3 * np.random.default_rng(0).normal(size=n), response)
+
+
+@pytest.mark.parametrize("settings, message", [
+    (dict(band=1000.0), r"band: got 1000\.0; expected \(lo, hi\) in Hz"),  # cannot unpack non-iterable float
+    (dict(band="abc"), r"band: got 'abc'; expected \(lo, hi\)"),
+    (dict(band=(2000.0, 100.0)), r"band: got \(2000\.0, 100\.0\); expected \(lo, hi\) in Hz, two finite numbers with "
+                                 r"0 <= lo < hi"),
+    (dict(band=(0.0, math.nan)), r"band: got \(0\.0, nan\)"),
+    (dict(pre_trigger=None), r"pre_trigger: got None s; expected a finite number >= 0"),  # float(None)
+    (dict(tau=10 ** 400), r"tau: got 1000\d+ s; expected a finite number > 0"),  # OverflowError
+    (dict(estimator=np.array([])), r"estimator: got array\(\[\], dtype=float64\); expected one of H1"),
+])
+def test_tap_settings_of_the_wrong_kind_are_refused_by_name(settings, message):
+    from substructure.tap import process_taps
+    with pytest.raises(InvalidValueError, match=message):
+        process_taps([_a_tap()], **settings)
+
+
+def test_reading_a_result_with_speeds_beyond_every_float_is_an_error():
+    from substructure.stability import MillingCut, spindle_speeds, zoa
+    frf = default_assembly().frf("tool.tip:y", frequency=np.arange(100.0, 5000.0, 10.0))
+    cut = MillingCut(teeth=4, diameter="12 mm", radial_depth="3 mm", kt="700 MPa", kn="200 MPa")
+    lobes = zoa(frf, cut, spindle_speeds("2000 rpm", "20000 rpm", "100 rpm"))
+    with pytest.raises(InvalidValueError, match=r"expected spindle speeds in rpm"):
+        lobes.limit_at(10 ** 400)  # int too large to convert to float
+
+
+@pytest.mark.parametrize("power, message", [
+    ([1, 2], r"power speeds: got 1; expected quantities with units of one kind"),  # 'int' object is not iterable
+    ([("6000 rpm", "abc"), ("8000 rpm", "1 kW")], r"power values: got \('abc', '1 kW'\)"),  # pint's own error
+    ([("6000 rpm", "1 kW"), ("8000 rpm", "1 m")], r"power values: got \('1 kW', '1 m'\)"),  # DimensionalityError
+])
+def test_a_power_curve_that_is_no_curve_of_quantities_is_refused(power, message):
+    from substructure.stability import MachineLimits
+    with pytest.raises(InvalidValueError, match=message):
+        MachineLimits(power=power)
+
+
+def test_a_label_that_is_no_text_and_a_scalar_quantity_for_a_sweep_are_refused():
+    frf = default_assembly().frf("tool.tip:y", frequency=GRID)
+    with pytest.raises(UnknownPointError, match=r"output array\(\[\], dtype=float64\) is not in this FRF"):
+        frf.select([np.array([])], ["tool.tip:y"])  # the truth value of an empty array is ambiguous
+    from substructure import Q_
+    with pytest.raises(InvalidValueError, match=r"sweep: got .*; expected a sequence of assemblies"):
+        sweep(Q_(1, "s"), "tool.tip:y", frequency=GRID)  # 'int' object is not iterable

@@ -125,7 +125,7 @@ class FRF:
             return list(range(len(have)))
         wanted = list(labels) if isinstance(labels, (list, tuple, np.ndarray)) else [labels]
         for label in wanted:
-            if label not in have:
+            if not isinstance(label, str) or label not in have:
                 available = ", ".join(repr(x) for x in have)
                 raise UnknownPointError(f"{which} {label!r} is not in this FRF; {which}s available: {available}")
         return [have.index(x) for x in wanted]

@@ -124,11 +124,15 @@ def _curve_speeds(q: pint.Quantity, field: str) -> np.ndarray:
 def _stack(values: Any, field: str) -> pint.Quantity:
     if isinstance(values, pint.Quantity):
         return Q_(np.atleast_1d(values.magnitude).astype(float), str(values.units))
-    items = [Q_(v) if isinstance(v, str) else v for v in values]
-    if not items or not all(isinstance(v, pint.Quantity) for v in items):
-        raise InvalidValueError(f"{field}: expected quantities with units, e.g. '15 kW' or '6000 rpm'")
-    unit = str(items[0].units)
-    return Q_(np.array([v.m_as(unit) for v in items], dtype=float), unit)
+    try:
+        items = [Q_(v) if isinstance(v, str) else v for v in values]
+        unit = str(items[0].units) if items and all(isinstance(v, pint.Quantity) for v in items) else None
+        if unit is not None:
+            return Q_(np.array([v.m_as(unit) for v in items], dtype=float), unit)
+    except (TypeError, ValueError, pint.errors.PintError):  # not a sequence; text no unit; units of two kinds
+        pass
+    raise InvalidValueError(f"{field}: got {show_value(values)}; expected quantities with units of one kind, e.g. "
+                            "'15 kW' or '6000 rpm'")
 
 
 @attrs.frozen

@@ -416,7 +416,7 @@ def _plain_numbers(value: Any, field: str) -> np.ndarray:
     """``value`` as a float array, refused naming ``field`` when it is not numbers."""
     try:
         return np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InvalidValueError(f"{field}: got {value!r}; expected speeds in rpm as plain numbers") from None
 
 

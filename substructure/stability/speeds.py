@@ -133,7 +133,7 @@ def rpm_values(value: Any, field: str) -> np.ndarray:
         return _quantity_rpm(value, field)
     try:
         return np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InvalidValueError(
             f"{field}: got {show_value(value)}; expected spindle speeds in rpm: numbers, or a string or "
             "quantity with an angular-speed unit such as '12000 rpm' or Q_(1200, 'rad/s')"

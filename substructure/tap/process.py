@@ -95,18 +95,36 @@ def _records(records: Any) -> tuple[TapRecord, ...]:
     return items
 
 
+_OPTIONAL = ("tap_length", "tau")
+"""The settings that may be None (a record a tap, the window's time constant chosen)."""
+
+
 def _check_settings(**settings: tuple[Any, str, bool]) -> None:
-    """Each ``name=(value, unit, zero_allowed)`` a finite number above 0 (or at 0 where allowed), or None."""
+    """Each ``name=(value, unit, zero_allowed)`` a finite number above 0 (or at 0 where allowed), or None where
+    :data:`_OPTIONAL` allows."""
     for name, (value, unit, zero) in settings.items():
-        if value is None:
+        if value is None and name in _OPTIONAL:
             continue
         try:
             x = float(value)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             x = float("nan")
         if isinstance(value, bool) or not np.isfinite(x) or x < 0 or (x == 0 and not zero):
             expected = "a finite number >= 0" if zero else "a finite number > 0"
             raise InvalidValueError(f"{name}: got {value!r}{' ' + unit if unit else ''}; expected {expected}")
+
+
+def _check_band(band: Any) -> tuple[float, float] | None:
+    """``band`` as ``(lo, hi)`` in Hz, two finite numbers with ``0 <= lo < hi``; None as it is."""
+    if band is None:
+        return None
+    try:
+        lo, hi = (float(v) for v in band)
+    except (TypeError, ValueError, OverflowError):
+        lo = hi = float("nan")
+    if not (np.isfinite(lo) and np.isfinite(hi) and 0.0 <= lo < hi) or isinstance(band, str):
+        raise InvalidValueError(f"band: got {band!r}; expected (lo, hi) in Hz, two finite numbers with 0 <= lo < hi")
+    return lo, hi
 
 
 def _band_end(power: np.ndarray, hz: np.ndarray, drop_db: float) -> np.ndarray:
@@ -208,6 +226,7 @@ def process_taps(
         When a record's force looks like a response (naming file and columns).
     """
     items = _records(records)
+    band = _check_band(band)
     _check_settings(tap_length=(tap_length, "s", False), pre_trigger=(pre_trigger, "s", True),
                     tau=(tau, "s", False), window_end=(window_end, "", False),
                     force_window_extra=(force_window_extra, "pulse widths", True),
@@ -221,7 +240,7 @@ def process_taps(
     exponential = None if exponential is None else bool(exponential)
     if exponential is False and tau is not None:
         raise InvalidValueError(f"tau: got {tau!r} s with exponential=False; a time constant asks for the window")
-    if estimator not in ESTIMATORS:
+    if not isinstance(estimator, str) or estimator not in ESTIMATORS:
         raise InvalidValueError(f"estimator: got {estimator!r}; expected one of {', '.join(ESTIMATORS)}")
     rate = items[0].sample_rate
     dt = 1.0 / rate
