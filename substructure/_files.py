@@ -70,6 +70,12 @@ def _name(path, what: str) -> str:
         raise FileFormatError(f"got {path!r} of type {type(path).__name__}; expected the name of {_a(what)}") from None
 
 
+def file_name(path, what: str = "file") -> str:
+    """``path`` as text, or a :class:`FileFormatError` naming what was expected when it is no file name (a number,
+    None): where a file's name enters, rather than a ``TypeError`` from deep inside."""
+    return os.fsdecode(_name(path, what))
+
+
 def _a(what: str) -> str:
     return f"{'an' if what[:1].lower() in 'aeiou' else 'a'} {what}"
 
@@ -315,7 +321,7 @@ def check_writable(path, overwrite: bool, option: str | None = None) -> Path:
     FileFormatError
         When the path is a directory or its directory does not exist.
     """
-    p = Path(path)
+    p = Path(file_name(path, "file to write"))
     who = f"{option} {p}" if option else str(p)
     if p.is_dir():
         raise FileFormatError(f"{who}: is a directory; expected a file name")

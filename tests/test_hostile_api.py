@@ -741,3 +741,40 @@ def test_a_label_that_is_no_text_and_a_scalar_quantity_for_a_sweep_are_refused()
     from substructure import Q_
     with pytest.raises(InvalidValueError, match=r"sweep: got .*; expected a sequence of assemblies"):
         sweep(Q_(1, "s"), "tool.tip:y", frequency=GRID)  # 'int' object is not iterable
+
+
+def test_the_writers_of_modes_and_joint_tables_keep_an_existing_file_unless_told():
+    # both replaced any file of that name without a word, where every other writer of the package refuses
+    import tempfile
+
+    from substructure import Q_
+    from substructure.errors import OutputExistsError
+    from substructure.stability import ModalModel, Mode
+    from substructure.surrogate import thesis_table_4_2
+    with tempfile.TemporaryDirectory() as folder:
+        for name, write in [("modes.csv", ModalModel([Mode("x", "922 Hz", 0.011, Q_(1e7, "N/m"))]).to_csv),
+                            ("table.csv", thesis_table_4_2().to_csv), ("table.toml", thesis_table_4_2().to_toml)]:
+            path = Path(folder) / name
+            path.write_text("the user's own file\n", encoding="utf-8")
+            with pytest.raises(OutputExistsError, match=re.escape(f"{path}: the file exists; pass overwrite=True")):
+                write(path)
+            assert path.read_text(encoding="utf-8") == "the user's own file\n"
+            write(path, overwrite=True)
+            assert path.read_text(encoding="utf-8") != "the user's own file\n"
+
+
+@pytest.mark.parametrize("path", [1.0, None])
+def test_a_file_name_that_is_no_name_is_refused_by_every_reader_and_writer(path):
+    # TypeError: expected str, bytes or os.PathLike object, from os.fspath or open deep inside
+    from substructure.errors import FileFormatError
+    from substructure.io.frf_files import read_csv, read_mat
+    from substructure.io.measurements import load_measurements
+    from substructure.io.tap_files import read_tap_csv, read_tap_mat
+    from substructure.stability import ModalModel, Mode
+    frf = default_assembly().frf("tool.tip:y", frequency=GRID)
+    modes = ModalModel([Mode("x", "922 Hz", 0.011, "1e7 N/m")])
+    for call in (frf.to_csv, frf.to_uff, modes.to_csv, read_csv, read_mat, read_tap_csv, read_tap_mat,
+                 load_measurements):
+        with pytest.raises(FileFormatError, match=r"got (1\.0 of type float|None of type NoneType); expected the "
+                                                  r"name of an? [\w ()]+"):
+            call(path)

@@ -29,6 +29,7 @@ from ..errors import FileFormatError
 from ..tap.records import TapRecord, unit_of
 from ._tap_build import build_record, option_rate, time_axis, units_of_columns
 from ._tap_columns import Columns, choose
+from .._files import file_name
 from .._matlab import Signal, flatten, load, text_value
 
 _TIME = re.compile(r"^(time|t|zeit|time_s)$", re.I)
@@ -50,7 +51,7 @@ def mat_record(path: str | os.PathLike, data: bytes, sensitivity: Any, hammer_se
 
     A force and a response that are matrices of the same shape hold a tap a column (samples along the longer
     side, as MATLAB's acquisition functions return them): a record each."""
-    name = os.fspath(path)
+    name = file_name(path, "MATLAB file")
     content = load(data, name)
     variables, signals, skipped = flatten(content, name)
     frfs = [s.where for s in signals.values() if s.axis == "frequency" and np.iscomplexobj(s.values)]

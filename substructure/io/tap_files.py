@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from .._files import decode_text
+from .._files import decode_text, file_name
 from ..errors import FileFormatError, SubstructureWarning
 from ..tap.records import TapRecord
 from ..units import bare_unit
@@ -96,7 +96,7 @@ def read_tap_csv(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
         one force and one response, a cell that is not a number, NaN
         samples, a contradiction between the header and the options.
     """
-    name = os.fspath(path)
+    name = file_name(path, "tap record")
     data = _text_bytes(path, name)
     head, start, first_line = _head(data, name)
     row_end = data.find(b"\n", start)
@@ -270,7 +270,7 @@ def read_tap_lvm(path: str | os.PathLike, sensitivity: Any = None, hammer_sensit
     """
     from ._tap_lvm import read_segments
 
-    name = os.fspath(path)
+    name = file_name(path, "tap record")
     data = _text_bytes(path, name)
     segments = read_segments(data, name)
     groups: list[list[Any]] = []

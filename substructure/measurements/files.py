@@ -17,7 +17,7 @@ from typing import Any
 import attrs
 import numpy as np
 
-from .._files import MAX_DATA_BYTES, read_text, relative_path
+from .._files import MAX_DATA_BYTES, file_name, read_text, relative_path
 from .._files import check_file as check_readable_file
 from .._toml import TomlDocument, loads_toml
 from ..errors import FileFormatError, InvalidValueError, SubstructureError, SubstructureWarning
@@ -434,6 +434,6 @@ def reads_measurements(cls: Any, text: str, base_dir: str | os.PathLike = ".", s
 
 def read_measurements(cls: Any, path: str | os.PathLike) -> Any:
     """A measurement set of class ``cls`` from a file (:func:`substructure.io.measurements.load_measurements`)."""
-    name = os.fspath(path)
+    name = file_name(path, "measurement set")
     text = read_text(path, "measurement set file")
     return reads_measurements(cls, text, base_dir=Path(name).parent, source=name)

@@ -260,18 +260,20 @@ class ModalModel:
             raise FileFormatError(f"{name}: no modes after the header")
         return cls(modes)
 
-    def to_csv(self, path: Any) -> None:
+    def to_csv(self, path: Any, overwrite: bool = False) -> None:
         """Write the modes in the format :meth:`from_csv` reads (full precision).
 
         Parameters
         ----------
         path : str or os.PathLike
             The CSV file to write.
+        overwrite : bool, default False
+            Whether an existing file may be replaced (else ``OutputExistsError``, naming it).
         """
-        with open(path, "w", encoding="utf-8", newline="") as fh:
-            fh.write(MODES_CSV_HEADER + "\n")
-            for m in self.modes:
-                fh.write(f"{m.direction},{m.frequency_hz!r},{m.damping_ratio!r},{m.stiffness_n_per_m!r}\n")
+        from .._files import write_text
+
+        rows = [f"{m.direction},{m.frequency_hz!r},{m.damping_ratio!r},{m.stiffness_n_per_m!r}\n" for m in self.modes]
+        write_text(path, MODES_CSV_HEADER + "\n" + "".join(rows), overwrite=overwrite)
 
     # -- arrays for the kernels ---------------------------------------------------
     def arrays(self) -> dict[str, np.ndarray]:

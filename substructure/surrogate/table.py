@@ -483,13 +483,15 @@ class JointTable:
 
     # -- output ------------------------------------------------------------------------------
 
-    def to_csv(self, path: str | Path | None = None) -> str:
+    def to_csv(self, path: str | Path | None = None, overwrite: bool = False) -> str:
         """Write the table as CSV (units in the header); returns the text.
 
         Parameters
         ----------
         path : str or os.PathLike, optional
             Where to write it; None only returns the text.
+        overwrite : bool, default False
+            Whether an existing file may be replaced (else ``OutputExistsError``, naming it).
 
         Returns
         -------
@@ -517,9 +519,9 @@ class JointTable:
                 else:
                     cells.append(repr(float(v)))
             w.writerow(cells)
-        return _written(buf.getvalue(), path)
+        return _written(buf.getvalue(), path, overwrite)
 
-    def to_toml(self, path: str | Path | None = None) -> str:
+    def to_toml(self, path: str | Path | None = None, overwrite: bool = False) -> str:
         """Write the table as TOML: a ``[[joints]]`` table per row, every value with its unit.
 
         :meth:`from_toml` reads it back to an equal table (units and values).
@@ -528,6 +530,8 @@ class JointTable:
         ----------
         path : str or os.PathLike, optional
             Where to write it; None only returns the text.
+        overwrite : bool, default False
+            Whether an existing file may be replaced (else ``OutputExistsError``, naming it).
 
         Returns
         -------
@@ -550,7 +554,7 @@ class JointTable:
             rows.append(row)
         header = {"parameters": dict(self.parameters),
                   "features": {f: (u if u is not None else "categorical") for f, u in self.features.items()}}
-        return _written(tomli_w.dumps({**header, "joints": rows}), path)
+        return _written(tomli_w.dumps({**header, "joints": rows}), path, overwrite)
 
     @classmethod
     def from_toml(cls, path: str | Path) -> "JointTable":
@@ -605,12 +609,12 @@ class JointTable:
         return f"{rows}; parameters {', '.join(self.parameters)}; features {feats}"
 
 
-def _written(text: str, path: str | Path | None) -> str:
-    """``text``, written to ``path`` first unless it is None."""
+def _written(text: str, path: str | Path | None, overwrite: bool) -> str:
+    """``text``, written to ``path`` first unless it is None (an existing file only with ``overwrite``)."""
     if path is not None:
         from ..io import write_text
 
-        write_text(path, text)
+        write_text(path, text, overwrite=overwrite)
     return text
 
 

@@ -139,9 +139,10 @@ def write_csv(frf: FRF, path: str | os.PathLike, overwrite: bool = False, cohere
     OutputExistsError
         When ``path`` exists and ``overwrite`` is false.
     """
-    from ..._files import write_text
+    from ..._files import file_name, write_text
 
     frf = _require_frf(frf, "write_csv")
+    path = file_name(path, "CSV file to write")
     if frf.frequency.n < 2:
         raise InvalidValueError(
             f"frf: cannot write {os.fspath(path)}: an FRF file needs at least 2 frequency lines (readers refuse fewer)"
@@ -322,9 +323,9 @@ def _read_csv(path, output: str, input: str,
     """:func:`read_csv_with_coherence`, with the line of the file each frequency line comes from, the per-line
     columns the file has (``coherence``, ``force_noise``, ``truncation``) by name and the window it declares
     (:func:`read_csv_window`)."""
-    from ..._files import MAX_DATA_BYTES, read_text
+    from ..._files import MAX_DATA_BYTES, file_name, read_text
 
-    name = os.fspath(path)
+    name = file_name(path, "CSV file")
     text = read_text(path, "CSV file", MAX_DATA_BYTES)
     if text.count("\n") > MAX_GRID_LINES + 1000:  # before the lines are split: refused below in any case
         raise FileFormatError(f"{name}: {text.count(chr(10)):,} lines; an FRF has at most {MAX_GRID_LINES:,} "

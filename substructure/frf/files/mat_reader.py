@@ -29,9 +29,9 @@ __all__ = ["read_mat", "read_mat_coherence", "frf_channels"]
 
 def _channels(path: str | os.PathLike) -> tuple[str, list[tuple[str, Signal]]]:
     """The file's name and its channels on a frequency axis, in the file's order."""
-    from ..._files import MAX_DATA_BYTES, read_bytes
+    from ..._files import MAX_DATA_BYTES, file_name, read_bytes
 
-    name = os.fspath(path)
+    name = file_name(path, "MATLAB file")
     data = read_bytes(path, "MATLAB file", MAX_DATA_BYTES)
     _, signals, skipped = flatten(load(data, name), name)
     found = [(key, s) for key, s in signals.items() if s.axis == "frequency"]

@@ -91,8 +91,10 @@ def write_uff(frf: FRF, path: str | os.PathLike, overwrite: bool = False) -> Non
     """
     import pyuff
 
+    from ..._files import file_name
+
     frf = _require_frf(frf, "write_uff")
-    name = os.fspath(path)
+    name = file_name(path, "file to write (UFF)")
     hz = frf.frequency.hz
     if hz.size < 2:
         raise InvalidValueError(f"frf: cannot write {name}: UFF 58 needs at least 2 frequency lines")
