@@ -778,3 +778,26 @@ def test_a_file_name_that_is_no_name_is_refused_by_every_reader_and_writer(path)
         with pytest.raises(FileFormatError, match=r"got (1\.0 of type float|None of type NoneType); expected the "
                                                   r"name of an? [\w ()]+"):
             call(path)
+
+
+def test_what_is_no_frf_measurement_or_name_is_refused_where_it_enters():
+    # each raised AttributeError, TypeError, ValueError or OverflowError from inside
+    from substructure.diagnose import DiagnoseSettings, compare, diagnose, noise_floor
+    from substructure.stability import cutting_data
+    frf = default_assembly().frf("tool.tip:y", frequency=np.arange(100.0, 3000.0, 20.0))
+    with pytest.raises(InvalidValueError, match=r"measurements: got float; expected a MeasurementSet"):
+        diagnose(default_assembly(), 1.0, progress=False)
+    with pytest.raises(InvalidValueError, match=r"model: got float; expected an FRF"):
+        compare(1.0, frf)
+    with pytest.raises(InvalidValueError, match=r"measured: got NoneType; expected an FRF"):
+        noise_floor(None)
+    with pytest.raises(InvalidValueError, match=r"workpiece: got 1\.0; expected a workpiece's name or a Workpiece"):
+        cutting_data(1.0, "carbide")
+    with pytest.raises(UnknownPointError, match=r"component: got \[1, 2\]; expected a component's name"):
+        default_assembly().component([1, 2])
+    with pytest.raises(InvalidValueError, match=r"DiagnoseSettings\.budget: got 1000\d+; expected a number"):
+        DiagnoseSettings(budget=10 ** 400)
+    with pytest.raises(InvalidValueError, match=r"data: cannot read int as complex numbers"):
+        FRF(frf.frequency, 10 ** 400, ["a"], ["b"])
+    with pytest.raises(InvalidValueError, match=r"quantity: got array\(\[\], dtype=float64\); expected one of"):
+        FRF.single(frf.frequency, frf.data[:, 0, 0], quantity=np.array([]))

@@ -144,6 +144,8 @@ class Assembly:
         UnknownPointError
             When there is no such component.
         """
+        if not isinstance(name, str):
+            raise UnknownPointError(f"component: got {name!r}; expected a component's name, e.g. 'tool'")
         for comp in self.components:
             if comp.name == name:
                 return comp

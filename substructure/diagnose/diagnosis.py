@@ -197,6 +197,11 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     assembly_checked(assembly)
     if isinstance(measurements, FRF):  # one FRF is one measurement (iterated, it was read as FRF[0])
         measurements = [measurements]
+    try:
+        iter(measurements)
+    except TypeError:
+        raise InvalidValueError(f"measurements: got {type(measurements).__name__}; expected a MeasurementSet, "
+                                "Measurements or FRFs (one FRF alone is taken as a list of one)") from None
     if settings is None:
         settings = DEFAULT_SETTINGS
     elif not isinstance(settings, DiagnoseSettings):

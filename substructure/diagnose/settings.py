@@ -41,7 +41,10 @@ FROM_SETTINGS = _FromSettings.FROM_SETTINGS
 
 
 def _real(value) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    try:  # (an integer beyond every float: OverflowError)
+        return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    except OverflowError:
+        return False
 
 
 def _fail(attribute, value, expected: str):

@@ -92,7 +92,7 @@ def _complex_array(value: Any) -> np.ndarray:
         return value
     try:
         return _readonly(np.array(value, dtype=np.complex128, copy=True))
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InvalidValueError(
             f"data: cannot read {type(value).__name__} as complex numbers; "
             "expected an array of shape (n_freq, n_out, n_in)"
@@ -100,7 +100,7 @@ def _complex_array(value: Any) -> np.ndarray:
 
 
 def _check_quantity(instance: Any, attribute: Any, value: Any) -> None:
-    if value not in QUANTITIES:
+    if not isinstance(value, str) or value not in QUANTITIES:
         raise InvalidValueError(f"quantity: got {value!r}; expected one of {', '.join(QUANTITIES)}")
 
 

@@ -186,6 +186,8 @@ def cutting_data(workpiece: Any, tool_material: str = "carbide", table: Any = No
     """
     from .workpieces import workpiece as lookup
 
+    if not isinstance(workpiece, str) and not hasattr(workpiece, "name"):
+        raise InvalidValueError(f"workpiece: got {workpiece!r}; expected a workpiece's name or a Workpiece")
     name = (lookup(workpiece) if isinstance(workpiece, str) else workpiece).name
     tool = _tool_material(tool_material)
     rows = (list(load_cutting_data(table)) if table is not None else []) + list(load_cutting_data())
