@@ -73,7 +73,10 @@ def _name(path, what: str) -> str:
 def file_name(path, what: str = "file") -> str:
     """``path`` as text, or a :class:`FileFormatError` naming what was expected when it is no file name (a number,
     None): where a file's name enters, rather than a ``TypeError`` from deep inside."""
-    return os.fsdecode(_name(path, what))
+    name = os.fsdecode(_name(path, what))
+    if "\0" in name:
+        raise FileFormatError(f"got {name!r}; expected the name of {_a(what)} (a file name holds no NUL character)")
+    return name
 
 
 def _a(what: str) -> str:

@@ -801,3 +801,20 @@ def test_what_is_no_frf_measurement_or_name_is_refused_where_it_enters():
         FRF(frf.frequency, 10 ** 400, ["a"], ["b"])
     with pytest.raises(InvalidValueError, match=r"quantity: got array\(\[\], dtype=float64\); expected one of"):
         FRF.single(frf.frequency, frf.data[:, 0, 0], quantity=np.array([]))
+
+
+def test_a_file_name_with_a_nul_character_is_refused_by_writers_and_the_command_line(tmp_path, capsys):
+    # ValueError: embedded null byte, from open and from resolving the command's file names
+    from substructure import save_assembly
+    from substructure.cli import main
+    from substructure.errors import FileFormatError
+    for write in (default_assembly().frf("tool.tip:y", frequency=GRID).to_csv,
+                  lambda p: save_assembly(default_assembly(), p)):
+        with pytest.raises(FileFormatError, match=r"got 'a\\x00b'; expected the name of a .* \(a file name holds no "
+                                                  r"NUL character\)"):
+            write("a\x00b")
+    path = tmp_path / "tip.csv"
+    default_assembly().frf("tool.tip:y", frequency=np.arange(200.0, 5000.0, 10.0)).to_csv(path)
+    code = main(["lobes", "--frf", str(path), "--frf-y", "a\x00b", "--radial-depth", "3 mm", "--teeth", "4",
+                 "--diameter", "12 mm", "--workpiece", "steel-1045"])
+    assert code == 1 and "holds no NUL character" in capsys.readouterr().err

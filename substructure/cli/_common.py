@@ -228,7 +228,9 @@ def check_plot(path: str | None, option: str = "--plot") -> None:
 
 
 def _resolved(path) -> Path:
-    return Path(os.path.abspath(os.path.expanduser(os.fspath(path)))).resolve()
+    from ..io import file_name
+
+    return Path(os.path.abspath(os.path.expanduser(file_name(path)))).resolve()
 
 
 def check_outputs(outputs: Iterable[tuple[str, Any]], inputs: Iterable[Any], overwrite: bool) -> None:

@@ -21,6 +21,7 @@ from .._files import (  # noqa: F401 (in the lowest layer, so that frf's files r
     check_file,
     check_file as check_readable_file,  # the public name, for readers that hand the name to pyuff
     check_writable,
+    file_name,
     parse_toml,
     read_bytes,
     read_text,
