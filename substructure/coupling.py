@@ -268,6 +268,13 @@ def decouple(coupled: FRF, removed: FRF, interface: Sequence[tuple[str, str, Any
     joints with ``-K``; the same engine as coupling.
     """
     given = coupled
+    try:
+        items = None if isinstance(interface, (str, bytes)) else list(interface)
+    except TypeError:  # a number, None (a scalar quantity says it is iterable and is not)
+        items = None
+    if items is None:
+        raise InvalidValueError("interface: expected a sequence of (point_in_coupled, point_in_removed, joint or "
+                                "None)")
     coupled, removed = _receptance(coupled, "coupled"), _receptance(removed, "removed")
     if coupled.frequency != removed.frequency:
         raise FrequencyAxisMismatchError(
@@ -284,7 +291,7 @@ def decouple(coupled: FRF, removed: FRF, interface: Sequence[tuple[str, str, Any
     y[:na, :na] = np.moveaxis(coupled.data, 0, -1)
     y[na:, na:] = -np.moveaxis(removed.data, 0, -1)
     conns = []
-    for i, item in enumerate(interface):
+    for i, item in enumerate(items):
         if not isinstance(item, (tuple, list)) or len(item) != 3:
             raise InvalidValueError(f"interface[{i}]: got {item!r}; expected (point_in_coupled, point_in_removed, "
                                     "joint or None)")

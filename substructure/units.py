@@ -393,7 +393,8 @@ def _dimension_of(unit: str) -> str:
     return str(ureg.Quantity(1.0, unit).dimensionality)
 
 
-def whole_number(value: Any, field: str, minimum: int = 0, meaning: str = "a whole number") -> int:
+def whole_number(value: Any, field: str, minimum: int = 0, meaning: str = "a whole number",
+                 maximum: int | None = None) -> int:
     """Check a count (a number of lines, steps, teeth, refits): an ``int`` or numpy integer, ``>= minimum``.
 
     A boolean, a float (even 2.0) or a text is refused: ``True`` passed as 1 and ``2.5`` was cut or failed
@@ -409,6 +410,8 @@ def whole_number(value: Any, field: str, minimum: int = 0, meaning: str = "a who
         The least value allowed.
     meaning : str
         What it is, for the message (``"a whole number of teeth"``).
+    maximum : int, optional
+        The largest value allowed (a count of refits or samples beyond which the work would never end).
 
     Returns
     -------
@@ -422,8 +425,36 @@ def whole_number(value: Any, field: str, minimum: int = 0, meaning: str = "a who
     """
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < minimum:
         raise InvalidValueError(f"{field}: got {value!r}; expected {meaning} >= {minimum}")
+    if maximum is not None and value > maximum:
+        raise InvalidValueError(f"{field}: got {value!r}; expected {meaning} from {minimum} to {maximum:,}")
     return int(value)
 
+
+def finite_real(value: Any) -> bool:
+    """Whether ``value`` is a finite real number (an int, a float, numpy's, a fraction), not a bool, not NaN or
+    infinite, and not an integer beyond every float (``10**400``, where ``math.isfinite`` raises ``OverflowError``).
+
+    Parameters
+    ----------
+    value : object
+        The value.
+
+    Returns
+    -------
+    bool
+        True for a finite real number.
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        return False
+
+
+MAX_REPEATS = 10_000
+"""The most repetitions of a whole computation (bootstrap refits, samples of a prediction's distribution), in
+Python as on the command line: a count beyond every float ran for ever, or asked for gigabytes first."""
 
 MAX_TEETH = 1000
 """The most teeth a cutter is taken to have: slitting saws and large face mills have a few hundred; a million

@@ -818,3 +818,52 @@ def test_a_file_name_with_a_nul_character_is_refused_by_writers_and_the_command_
     code = main(["lobes", "--frf", str(path), "--frf-y", "a\x00b", "--radial-depth", "3 mm", "--teeth", "4",
                  "--diameter", "12 mm", "--workpiece", "steel-1045"])
     assert code == 1 and "holds no NUL character" in capsys.readouterr().err
+
+
+def test_a_count_of_repetitions_beyond_any_end_is_refused_in_python_as_on_the_command_line():
+    # bootstrap=10**40 refitted for ever; the command line stopped it at --bootstrap 10000, Python did not
+    from substructure.cli._common import MAX_REPEATS as COMMAND_LINE
+    from substructure.identify import JointIdentifier
+    from substructure.units import MAX_REPEATS
+    assert COMMAND_LINE == MAX_REPEATS == 10_000
+    with pytest.raises(InvalidValueError, match=r"bootstrap: got 10{40}; expected an integer from 0 to 10,000"):
+        JointIdentifier("holder-tool", bootstrap=10 ** 40)._check()
+    JointIdentifier("holder-tool", bootstrap=MAX_REPEATS)._check()
+    from substructure.surrogate import make_surrogate, thesis_table_4_2
+    prediction = make_surrogate("gp").fit(thesis_table_4_2()).predict({"tool_diameter": "12 mm",
+                                                                       "gauge_length": "60 mm"})
+    with pytest.raises(InvalidValueError, match=r"n: got 10{12}; expected a whole number of samples from 1 to 10,000"):
+        prediction.sample(10 ** 12)  # 8 GB of quantiles before the first sample
+
+
+def test_identification_measurements_and_decoupling_refuse_what_is_no_name_sequence_or_number():
+    # each raised TypeError, ValueError (an array's truth value) or OverflowError from inside
+    from substructure.identify import JointIdentifier, identify_joint
+    from substructure.measurements import Measurement
+    frf = default_assembly().frf("tool.tip:y", frequency=np.arange(200.0, 3000.0, 20.0))
+    with pytest.raises(InvalidValueError, match=r"joint: got array\(\[\], dtype=float64\); expected a joint's name"):
+        JointIdentifier(np.array([]))._check()
+    with pytest.raises(InvalidValueError, match=r"parameters: got 1\.0; expected 'auto' or some of k_yf"):
+        JointIdentifier("holder-tool", parameters=1.0)._check()
+    with pytest.raises(InvalidValueError, match=r"initial: got 'abc'; expected a mapping of parameter names"):
+        JointIdentifier("holder-tool", initial="abc")
+    with pytest.raises(InvalidValueError, match=r"measurements: got float; expected a MeasurementSet or a list"):
+        identify_joint(default_assembly(), 1.0, "holder-tool")
+    for field in ("coherence", "force_noise", "truncation"):
+        with pytest.raises(InvalidValueError, match=rf"{field}: got int; expected an array of"):
+            Measurement("tool.tip:y", "tool.tip:y", frf, **{field: 10 ** 400})
+    with pytest.raises(InvalidValueError, match=r"window_tau: got 10{400}; expected the exponential window's time"):
+        Measurement("tool.tip:y", "tool.tip:y", frf, window_tau=10 ** 400)
+    with pytest.raises(InvalidValueError, match=r"estimator: got array\(\[\], dtype=float64\); expected one of H1"):
+        Measurement("tool.tip:y", "tool.tip:y", frf, estimator=np.array([]))
+    both = default_assembly().frf("tool.tip", frequency=GRID)
+    with pytest.raises(InvalidValueError, match=r"interface: expected a sequence of \(point_in_coupled"):
+        decouple(both, both, 1.0)
+
+
+def test_finite_real_is_the_one_test_of_a_finite_number():
+    from fractions import Fraction
+
+    from substructure.units import finite_real
+    assert all(finite_real(v) for v in (0, -3, 2.5, np.float32(1.0), np.int64(7), Fraction(1, 3), 10 ** 300))
+    assert not any(finite_real(v) for v in (True, np.bool_(False), math.nan, math.inf, 10 ** 400, "1", None, 1j))

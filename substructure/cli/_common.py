@@ -32,7 +32,9 @@ IMAGE_SUFFIXES = (".png", ".pdf", ".svg", ".svgz", ".eps", ".ps", ".jpg", ".jpeg
 
 
 MAX_REPEATS = 10_000
-"""The most bootstrap refits (``identify --bootstrap``) or samples (``predict --samples``) a command runs."""
+"""The most bootstrap refits (``identify --bootstrap``) or samples (``predict --samples``) a command runs: the
+limit of :data:`substructure.units.MAX_REPEATS`, here again so that the command line starts without pint (a test
+keeps the two equal)."""
 
 
 def count_arg(option: str, value: int, minimum: int = 0) -> int:

@@ -38,6 +38,7 @@ from .._kernels import one_blas_thread
 from ..assembly import Assembly
 from ..errors import InvalidValueError, SubstructureError
 from ..frf import FRF
+from ..measurements.measurement_set import measurements_given
 from ..updating.likelihood import Likelihood, measured_frfs
 from ..updating.structure import assembly_checked
 from ..updating.selection import INDIFFERENCE, consistency, error_check, outlying_runs
@@ -197,11 +198,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     assembly_checked(assembly)
     if isinstance(measurements, FRF):  # one FRF is one measurement (iterated, it was read as FRF[0])
         measurements = [measurements]
-    try:
-        iter(measurements)
-    except TypeError:
-        raise InvalidValueError(f"measurements: got {type(measurements).__name__}; expected a MeasurementSet, "
-                                "Measurements or FRFs (one FRF alone is taken as a list of one)") from None
+    measurements = measurements_given(measurements)
     if settings is None:
         settings = DEFAULT_SETTINGS
     elif not isinstance(settings, DiagnoseSettings):

@@ -22,6 +22,7 @@ from typing import Any, Callable
 import attrs
 
 from ..errors import InvalidValueError
+from ..units import finite_real
 from ..updating.likelihood import CALIBRATION_HINT
 
 __all__ = ["DiagnoseSettings", "DEFAULT_SETTINGS", "FROM_SETTINGS"]
@@ -41,10 +42,7 @@ FROM_SETTINGS = _FromSettings.FROM_SETTINGS
 
 
 def _real(value) -> bool:
-    try:  # (an integer beyond every float: OverflowError)
-        return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-    except OverflowError:
-        return False
+    return finite_real(value)
 
 
 def _fail(attribute, value, expected: str):

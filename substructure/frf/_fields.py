@@ -6,7 +6,6 @@ each names the field and what was expected when it refuses a value.
 
 from __future__ import annotations
 
-import math
 import numbers
 import re
 from typing import Any, cast
@@ -14,6 +13,7 @@ from typing import Any, cast
 import numpy as np
 
 from ..errors import InvalidValueError, SubstructureError
+from ..units import finite_real
 from .axis import Frequency, _readonly
 
 QUANTITIES = ("receptance", "mobility", "accelerance")
@@ -127,7 +127,7 @@ def window_tau(value: Any, field: str = "window_tau") -> float:
     The one check of ``tau`` for every place that takes it (measurements, FRF files, the noise model, the
     window's removal from fitted modes).
     """
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value) or value <= 0:
+    if not finite_real(value) or value <= 0:
         raise InvalidValueError(f"{field}: got {value!r}; expected the exponential window's time constant in s "
                                 "(a finite number > 0)")
     return float(value)

@@ -31,7 +31,7 @@ from ..frf import FRF
 from ..joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint, JointProvenance
 from ..measurements import model_of_measurement
 from ..points import parse_point
-from ..units import whole_number
+from ..units import MAX_REPEATS, whole_number
 from ..updating.fit import fit
 from ..updating.likelihood import CALIBRATION_HINT, Likelihood, calibration_checked, measured_frfs
 from ..updating.parameters import ParameterSet, ParamSpec
@@ -215,15 +215,26 @@ class JointIdentifier:
                  random_state: int = 0, initial: Mapping | None = None, calibration: float | None = None):
         self.joint = joint
         self.calibration = calibration
-        self.parameters = parameters if isinstance(parameters, str) else tuple(parameters)
+        try:
+            self.parameters = parameters if isinstance(parameters, str) else tuple(parameters)
+        except TypeError:  # not a sequence: refused by _check, by name
+            self.parameters = parameters
         self.band = band
         self.bootstrap = bootstrap
         self.random_state = random_state
+        if initial is not None and not isinstance(initial, Mapping):
+            raise InvalidValueError(f"initial: got {initial!r}; expected a mapping of parameter names to start "
+                                    "values (SI units), or None")
         self.initial = dict(initial or {})
 
     def _check(self) -> None:
         # checked whatever the parameters (with 'auto' they were not: -1 failed in numpy, 2.5 in range, True was 1)
-        whole_number(self.bootstrap, "bootstrap", 0, "an integer")
+        if not isinstance(self.joint, str):
+            raise InvalidValueError(f"joint: got {self.joint!r}; expected a joint's name, e.g. 'holder-tool'")
+        if not isinstance(self.parameters, (str, tuple)):
+            raise InvalidValueError(f"parameters: got {self.parameters!r}; expected 'auto' or some of "
+                                    f"{', '.join(PARAMETERS)}")
+        whole_number(self.bootstrap, "bootstrap", 0, "an integer", MAX_REPEATS)
         whole_number(self.random_state, "random_state", 0, "a seed, an integer")
         calibration_checked(self.calibration)
         if isinstance(self.parameters, str):
@@ -322,13 +333,13 @@ class JointIdentifier:
         first = _frf_of(cases[0])
         prepared = model_of_measurement(model, cases[0]).prepare(list(first.outputs), list(first.inputs),
                                                                  first.frequency)
-        auto = self.band == "auto"
+        auto = isinstance(self.band, str) and self.band == "auto"
         if auto:
             band = auto_band(prepared, start_joint)
         else:
             try:
                 lo, hi = (float(x) for x in self.band)
-            except (TypeError, ValueError):
+            except (TypeError, ValueError, OverflowError):
                 raise InvalidValueError(f"band: got {self.band!r}; expected 'auto' or (lo, hi) in Hz") from None
             if not lo < hi:
                 raise InvalidValueError(f"band: got {self.band!r}; expected lo < hi")

@@ -22,6 +22,7 @@ from ..coupling import remove_mass
 from ..errors import InvalidValueError, SubstructureError
 from ..frf import FRF
 from ..measurements import MeasurementSet
+from ..measurements.measurement_set import measurements_given
 from ..points import parse_point
 from ..rdof import estimate_rotational, positions_from
 from ..updating import Evaluator, Structure
@@ -258,6 +259,7 @@ def identify_joint(assembly: Assembly, measurements, joint: str, band="auto",
         after.
     """
     assembly_checked(assembly)
+    measurements = measurements_given(measurements)
     if hasattr(measurements, "validate"):
         measurements.validate(assembly)
     for i, m in enumerate(measurements):

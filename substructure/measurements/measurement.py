@@ -16,6 +16,7 @@ from ..frf import FRF
 from ..frf._fields import _check_quantity, window_tau
 from ..points import check_name, parse_point
 from ..tap import ESTIMATORS
+from ..units import finite_real
 
 __all__ = ["Measurement", "MeasurementSetError", "MissingMeasurementError", "dof_label", "Configuration"]
 
@@ -129,8 +130,7 @@ def _optional_seconds(field: str, expected: str):
     def convert(value: Any) -> float | None:
         if value is None:
             return None
-        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
-                or not np.isfinite(value) or value <= 0:
+        if not finite_real(value) or value <= 0:
             raise InvalidValueError(f"{field}: got {value!r}; expected {expected}")
         return float(value)
 
@@ -157,7 +157,7 @@ def _per_line(name: str, values: str, each: str, bad, top: float | None = None):
             return None
         try:
             array = np.array(value, dtype=np.float64)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise InvalidValueError(f"{name}: got {type(value).__name__}; expected an array of {values}") from None
         if array.ndim != 1:
             raise InvalidValueError(f"{name}: got shape {array.shape}; expected one value per frequency line")
@@ -182,7 +182,7 @@ _truncation = _per_line("truncation", "variances >= 0", "a variance >= 0 (inf wh
 
 
 def _estimator(value: Any) -> str | None:
-    if value is not None and value not in ESTIMATORS:
+    if value is not None and (not isinstance(value, str) or value not in ESTIMATORS):
         raise InvalidValueError(f"estimator: got {value!r}; expected one of {', '.join(ESTIMATORS)}, or None when "
                                 "not known")
     return value

@@ -43,6 +43,17 @@ def _measurements(value: Any) -> tuple[Measurement, ...]:
     return items
 
 
+def measurements_given(value: Any) -> Any:
+    """What a workflow (``identify_joint``, ``diagnose``) was given as its measurements, to go through: a
+    MeasurementSet or a sequence as it is; refused by name when it is no sequence (a number, None)."""
+    try:
+        iter(value)
+    except TypeError:
+        raise InvalidValueError(f"measurements: got {type(value).__name__}; expected a MeasurementSet or a list of "
+                                "measurements") from None
+    return value
+
+
 def _configuration_of(sensors: Any, removed: Any) -> Configuration:
     return tuple(sorted(_names("sensors")(sensors))), tuple(sorted(_names("removed")(removed)))
 

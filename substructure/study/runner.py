@@ -41,6 +41,7 @@ from typing import Any
 
 from .._json import json_text
 from ..errors import InvalidValueError, OutputExistsError, SubstructureWarning
+from ..units import finite_real
 
 __all__ = ["run_study", "Progress", "parse_scheduler", "json_text", "RESULT_FORMAT", "study_identity"]
 
@@ -367,7 +368,6 @@ _NON_NEGATIVE = ("depth_m", "limit_depth_m", "zoa_min_limit_m", "zoa_absolute_li
 
 def _row_problem(row: dict, task: dict, spec: dict | None) -> str:
     """Why one saved row is not one the study could have written (a hand edit), or ``""``."""
-    import math
 
     from .table import COLUMNS
 
@@ -387,7 +387,7 @@ def _row_problem(row: dict, task: dict, spec: dict | None) -> str:
             ok = isinstance(value, int) and not isinstance(value, bool)
             expected = "a whole number"
         else:
-            ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+            ok = isinstance(value, (int, float)) and finite_real(value)
             expected = "a finite number or null"
         if ok and name in _POSITIVE:
             ok, expected = value > 0, "a positive number or null"

@@ -35,7 +35,7 @@ from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
 from sklearn.neural_network import MLPRegressor
 
 from ..errors import InvalidValueError, SubstructureWarning
-from ..units import whole_number
+from ..units import MAX_REPEATS, whole_number
 from .columns import in_si
 from .table import JointTable
 
@@ -173,7 +173,7 @@ class Prediction:
         dict
             ``{parameter: ndarray of n values}``, in ``units[parameter]``.
         """
-        whole_number(n, "n", 1, "a whole number of samples")
+        whole_number(n, "n", 1, "a whole number of samples", MAX_REPEATS)
         rng = np.random.default_rng(rng)
         p = (np.arange(n) + 0.5) / n
         out = {}

@@ -27,13 +27,12 @@ range of it, shared with the diagnosis catalogue's fluted section.
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
 from ..errors import InvalidValueError, UnknownPointError
 from ..joints import Mass, Support
-from ..units import Q_, format_quantity
+from ..units import Q_, finite_real, format_quantity
 from .parameters import Change, ParamSpec
 from .structure import LinkSI
 
@@ -143,8 +142,7 @@ def unique_name(taken, base: str) -> str:
 
 
 def _positive(name: str, value) -> float:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)) \
-            or not (math.isfinite(value) and value > 0):
+    if not (finite_real(value) and value > 0):
         raise InvalidValueError(f"{name}: got {value!r}; expected a finite number > 0 (SI)")
     return float(value)
 

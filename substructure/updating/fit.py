@@ -18,7 +18,6 @@ follow by the delta method: ``std(v) = v std(u)`` on the log scale.
 
 from __future__ import annotations
 
-import math
 from typing import Callable, Mapping, Sequence
 
 import attrs
@@ -27,7 +26,7 @@ from scipy.optimize import least_squares
 
 from .._kernels import one_blas_thread
 from ..errors import InvalidValueError, SubstructureError
-from ..units import whole_number
+from ..units import finite_real, whole_number
 from .parameters import Change, ParamSpec
 
 __all__ = ["Fit", "fit", "scan", "FTOL", "XTOL", "INFEASIBLE"]
@@ -158,7 +157,7 @@ def _checked_changes(changes) -> list:
                 raise InvalidValueError(f"changes[{k}]: {change.effect} has no parameter {name!r}; expected some of "
                                         f"{', '.join(names)}")
             real = isinstance(value, (int, float, np.integer, np.floating))
-            if isinstance(value, (bool, np.bool_, str, bytes)) or (real and not math.isfinite(value)):
+            if isinstance(value, (bool, np.bool_, str, bytes)) or (real and not finite_real(value)):
                 raise InvalidValueError(f"changes[{k}]: {change.effect} {name} = {value!r}; expected a finite "
                                         "number (SI)")
         out.append((change, dict(values)))
