@@ -245,6 +245,19 @@ def test_with_one_change_at_most_two_effects_are_a_missing_effect_not_an_explana
     assert d.to_json()["settings"]["most_changes"] == 1
 
 
+def test_the_verdict_of_too_many_changes_says_how_far_each_step_passed_its_test(reground_one_change):
+    """Two real effects (a reground tool, a forgotten sensor) each pass their step's test many times over: the
+    verdict gives those factors and how to take the changes as one explanation, rather than calling every such
+    composite changes that "each buy a small improvement" (three effects at once were said so)."""
+    d = reground_one_change
+    steps = [s for s in d.changes.refinement if s.statistic is not None]
+    factors = re.search(r"the forward steps passed their tests ([0-9.e+, ]+) times over", d.report[0])
+    assert factors, d.report[0]
+    said = [float(x) for x in factors.group(1).split(", ")]
+    assert said == pytest.approx([s.statistic / s.threshold for s in steps], rel=5e-3) and min(said) > 10
+    assert "DiagnoseSettings(most_changes=2) takes them as one" in d.report[0]
+
+
 # -- the records of a Diagnosis ------------------------------------------------------------------------
 
 

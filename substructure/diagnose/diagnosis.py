@@ -336,7 +336,8 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
                                                 settings.partial_gain, floor)]
     if explained and counted(current) > settings.most_changes:  # a composite that only just reaches the noise
         explained = False
-        report = [words.too_many_changes(settings.most_changes, [f"{c.effect} at {c.place(v)}" for c, v in current]),
+        report = [words.too_many_changes(settings.most_changes, [f"{c.effect} at {c.place(v)}" for c, v in current],
+                                         [s.statistic / s.threshold for s in steps if s.statistic and s.threshold]),
                   words.partial("composite", final_effects)]
     if hits:  # a value on the bound of its search is not a measurement: never an explanation
         texts = [bound_text(current, hit) for hit in hits]

@@ -91,7 +91,7 @@ def partial(kind: str, effects: Iterable) -> str:
     return f"the best ({kind}) explanation is reported as partial: " + ", ".join(repr(e) for e in effects)
 
 
-def too_many_changes(most: int, places: Sequence[str]) -> str:
+def too_many_changes(most: int, places: Sequence[str], strengths: Sequence[float] = ()) -> str:
     """The verdict when the noise is reached only with more changes than an explanation may hold.
 
     Parameters
@@ -100,15 +100,21 @@ def too_many_changes(most: int, places: Sequence[str]) -> str:
         Most changes an explanation may hold (``DiagnoseSettings.most_changes``).
     places : sequence of str
         ``"effect at place"`` of each change.
+    strengths : sequence of float, optional
+        Each forward step's test statistic over its threshold, to tell changes that each only just pass their
+        test (the mark of one missing effect) from changes each far beyond it.
 
     Returns
     -------
     str
         The verdict's first line.
     """
+    said = (f"; the forward steps passed their tests {', '.join(f'{s:.3g}' for s in strengths)} times over"
+            if strengths else "")
     return (f"{UNEXPLAINED} with at most {most} changes; {len(places)} together reach the noise "
-            f"({', '.join(places)}): several changes that each buy a small improvement are the mark of one effect "
-            "the search lacks, not of several effects")
+            f"({', '.join(places)}){said}: changes that each only just pass their test are the mark of one effect "
+            f"the search lacks; changes each far beyond it may be as many effects at once, beyond what an "
+            f"explanation may hold (DiagnoseSettings(most_changes={len(places)}) takes them as one)")
 
 
 def bounded(hits: Sequence[str]) -> str:
