@@ -334,7 +334,7 @@ def quantity(value: Any, field: str, dimension: str) -> pint.Quantity:
         raise InvalidValueError(f"{field}: got {show_value(value)}; expected a real value")
     try:
         magnitude = float(q.magnitude)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InvalidValueError(f"{field}: got {show_value(value)}; expected a real number with its unit") from None
     except OverflowError:  # an integer beyond any float
         magnitude = math.inf

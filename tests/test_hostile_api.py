@@ -867,3 +867,53 @@ def test_finite_real_is_the_one_test_of_a_finite_number():
     from substructure.units import finite_real
     assert all(finite_real(v) for v in (0, -3, 2.5, np.float32(1.0), np.int64(7), Fraction(1, 3), 10 ** 300))
     assert not any(finite_real(v) for v in (True, np.bool_(False), math.nan, math.inf, 10 ** 400, "1", None, 1j))
+
+
+@pytest.fixture(scope="module")
+def lobes_of_the_built_in_tool():
+    from substructure.stability import MillingCut, fit_modes, spindle_speeds, zoa
+    frf = default_assembly().frf("tool.tip:y", frequency=np.arange(100.0, 5000.0, 10.0))
+    cut = MillingCut(teeth=4, diameter="12 mm", radial_depth="3 mm", kt="700 MPa", kn="200 MPa")
+    speeds = spindle_speeds("2000 rpm", "20000 rpm", "200 rpm")
+    return frf, cut, speeds, zoa(frf, cut, speeds), fit_modes(frf)
+
+
+def test_the_stability_settings_of_the_wrong_kind_are_refused_by_name(lobes_of_the_built_in_tool):
+    # each raised TypeError ('<' between int and str, not iterable), ValueError or OverflowError from inside
+    from substructure.stability import MillingCut, ModalFitter, TurningCut, flexible_band, lobes_band, recommend, sdm
+    frf, cut, speeds, lobes, modes = lobes_of_the_built_in_tool
+    refused = [
+        (lambda: recommend(lobes, cut, margin=10 ** 400), r"margin: got 10+; expected a number in \[0, 1\)"),
+        (lambda: recommend(lobes, cut, count="abc"), r"count: got 'abc'; expected a whole number of speeds"),
+        (lambda: lobes_band(math.nan, nominal=lobes), r"results: expected one or more Lobes"),
+        (lambda: flexible_band(math.nan), r"frf: got float; expected an FRF"),
+        (lambda: sdm(modes, cut, speeds, rtol="abc"), r"rtol: got 'abc'; expected a relative tolerance in \(0, 0\.5\)"),
+        (lambda: sdm(modes, cut, speeds, coarse_ratio=math.inf), r"coarse_ratio: got inf; expected a ratio > 1"),
+        (lambda: sdm(modes, cut, speeds, max_phase_step="abc"), r"max_phase_step: got 'abc'; expected a positive"),
+        (lambda: sdm(modes, cut, speeds, min_intervals=None), r"min_intervals: got None; expected a whole number"),
+        (lambda: sdm(modes, cut, speeds, min_intervals=10 ** 40), r"min_intervals: got 10+; expected a whole number "
+                                                                   r"from 1 to"),
+        (lambda: sdm(modes, cut, speeds, depth_range=math.nan), r"depth_range: got nan; expected \(low, high\)"),
+        (lambda: MillingCut(teeth=4, diameter="12 mm", radial_depth="3 mm", kt="700 MPa", kn="200 MPa",
+                            milling=[1, 2]), r"milling: got \[1, 2\]; expected 'down' \(climb\) or 'up'"),
+        (lambda: TurningCut(kf="1000 MPa", direction=np.array([])), r"direction: got array\(\[\], dtype=float64\); "
+                                                                    r"expected 'x' or 'y'"),
+        (lambda: ModalFitter(band=math.nan).fit(frf), r"band: got nan; expected \(lo, hi\) in Hz"),
+        (lambda: ModalFitter(band="abc").fit(frf), r"band: got 'abc'; expected \(lo, hi\) in Hz"),  # not ignored
+    ]
+    for call, message in refused:
+        with pytest.raises(InvalidValueError, match=message):
+            call()
+
+
+@pytest.mark.parametrize("settings, message", [
+    (dict(method=np.array([])), r"method: got array\(\[\], dtype=float64\); expected 'zoa' or 'sdm'"),
+    (dict(title=np.array([])), r"title: got array\(\[\], dtype=float64\); expected a text or None"),
+    (dict(notes=math.nan), r"notes: got nan; expected a list of texts"),
+    (dict(notes="one note"), r"notes: got 'one note'; expected a list of texts"),  # one letter a note, before
+    (dict(margin=10 ** 400), r"margin: got 10+; expected a number in \[0, 1\)"),
+])
+def test_report_settings_of_the_wrong_kind_are_refused_before_any_work(settings, message):
+    from substructure.report import report
+    with pytest.raises(InvalidValueError, match=message):
+        report(default_assembly(), **settings)

@@ -43,7 +43,7 @@ def _finite(value, field: str) -> float:
         raise InvalidValueError(f"{field}: got {value!r}; expected a number")
     try:
         x = float(value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InvalidValueError(f"{field}: got {value!r}; expected a number") from None
     if not math.isfinite(x):
         raise InvalidValueError(f"{field}: got {value!r}; expected a finite number")

@@ -400,7 +400,7 @@ def _scan_starts(cls: type, where: str, assembly: Assembly, limits: dict) -> tup
         for name, value in trial.items():
             try:
                 value = float(value)
-            except (TypeError, ValueError):
+            except (TypeError, ValueError, OverflowError):
                 value = float("nan")
             if not np.isfinite(value):
                 raise InvalidValueError(f"effect {cls.name!r} at {where}: scan_starts[{k}][{name!r}]: got "

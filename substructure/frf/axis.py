@@ -93,7 +93,7 @@ def _hz_array(value: Any) -> np.ndarray:
         raise InvalidValueError("hz: got complex values; expected real frequencies in Hz")
     try:
         return _readonly(np.array(value, dtype=np.float64, copy=True))
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InvalidValueError(
             f"hz: cannot read {value!r} as numbers; expected a 1-D array of frequencies in Hz"
         ) from None

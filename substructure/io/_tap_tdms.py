@@ -104,7 +104,7 @@ def _step(channel, where: str) -> float:
     value = channel.properties["wf_increment"]
     try:
         step = float(value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise FileFormatError(f"{where}: channel {channel.name!r}: wf_increment {value!r}; expected a time step in "
                               "s") from None
     if not (np.isfinite(step) and step > 0):

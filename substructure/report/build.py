@@ -498,8 +498,12 @@ def report(assembly: Any, measurements: Any = None, cut: Any = None, limits: Any
     elif measurements is not None and not isinstance(measurements, MeasurementSet):
         raise InvalidValueError(f"measurements: got {type(measurements).__name__}; expected a MeasurementSet or "
                                 "the path of a measurement file")
-    if method not in ("zoa", "sdm"):
+    if not isinstance(method, str) or method not in ("zoa", "sdm"):
         raise InvalidValueError(f"method: got {method!r}; expected 'zoa' or 'sdm'")
+    if title is not None and not isinstance(title, str):
+        raise InvalidValueError(f"title: got {title!r}; expected a text or None (the default title)")
+    if isinstance(notes, str) or not isinstance(notes, (list, tuple)) or not all(isinstance(n, str) for n in notes):
+        raise InvalidValueError(f"notes: got {notes!r}; expected a list of texts (each a note of the report)")
     if cut is not None and not isinstance(cut, (MillingCut, TurningCut)):
         raise InvalidValueError(f"cut: got {type(cut).__name__}; expected a MillingCut or a TurningCut")
     if intervals is not None and method != "sdm":

@@ -25,7 +25,7 @@ def _esc(value: Any) -> str:
 def _num(value: Any, fmt: str, scale: float = 1.0) -> str:
     try:
         v = float(value) * scale
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         return "–"
     return format(v, fmt) if math.isfinite(v) else "–"
 

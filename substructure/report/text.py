@@ -45,7 +45,7 @@ AS_GOOD_AS_DATA = 1.5
 def _number(value: Any) -> float | None:
     try:
         v = float(value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         return None
     return v if np.isfinite(v) else None
 

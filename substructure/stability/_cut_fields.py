@@ -64,6 +64,6 @@ def _edge(field: str):
 
 def _milling(value: Any) -> str:
     key = value.strip().lower() if isinstance(value, str) else value
-    if key not in MILLING_ALIASES:
+    if not isinstance(key, str) or key not in MILLING_ALIASES:
         raise InvalidValueError(f"milling: got {show_value(value)}; expected 'down' (climb) or 'up' (conventional)")
     return MILLING_ALIASES[key]

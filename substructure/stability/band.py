@@ -258,6 +258,8 @@ def flexible_band(frf: FRF) -> FlexibleBand:
     -----
     See the module documentation for the rules and their sources.
     """
+    if not isinstance(frf, FRF):
+        raise InvalidValueError(f"frf: got {type(frf).__name__}; expected an FRF")
     f = frf.frequency.hz
     results = [_one_entry(f, h) for h in _diagonals(frf)]
     if any(r["kind"] == "mass-line-only" for r in results):
@@ -317,7 +319,7 @@ def choose_band(structure: Any, band: Any = "auto") -> tuple[Any, FlexibleBand |
                                                "(rigid-body detection switched off)"), structure)
     try:
         lo, hi = (float(v) for v in band)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InvalidValueError(
             f"band: got {band!r}; expected 'auto', 'all', (lo_hz, hi_hz) or a FlexibleBand") from None
     cropped = structure.crop(lo, hi)

@@ -439,7 +439,13 @@ class ModalFitter:
         _direction(direction)
         frf = _one_entry(frf, "frf")
         if self.band is not None:
-            frf = frf.crop(*self.band)
+            try:  # (a scalar quantity says it is iterable and is not)
+                pair = None if isinstance(self.band, (str, bytes)) else tuple(self.band)
+            except TypeError:
+                pair = None
+            if pair is None or len(pair) != 2:
+                raise InvalidValueError(f"band: got {self.band!r}; expected (lo, hi) in Hz")
+            frf = frf.crop(*pair)
         f, h = frf.frequency.hz, frf.data[:, 0, 0]
         if f.size < 8:
             raise InvalidValueError(f"frf: {f.size} lines in the band; a modal fit needs at least 8")

@@ -35,6 +35,7 @@ import attrs
 import numpy as np
 
 from ..errors import InvalidValueError
+from ..units import whole_number
 from .machine import MachineLimits, cut_power, cut_torque, removal_rate
 
 __all__ = ["Recommendation", "recommend", "RECOMMENDATION_KEYS", "NoRecommendationError"]
@@ -205,7 +206,7 @@ class Recommendation:
 def _check(value: Any, field: str, lo: float, hi: float) -> float:
     try:
         v = float(value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         v = np.nan
     if not lo <= v < hi:
         raise InvalidValueError(f"{field}: got {value!r}; expected a number in [{lo:g}, {hi:g})")
@@ -277,6 +278,7 @@ def recommend(lobes: Any, cut: Any, limits: MachineLimits | None = None, *, marg
         raise InvalidValueError(f"lobes: got {type(lobes).__name__}; expected Lobes (zoa or sdm)")
     margin = _check(margin, "margin", 0.0, 1.0)
     x = _check(speed_tolerance, "speed_tolerance", 0.0, 0.5)
+    whole_number(count, "count", 1, "a whole number of speeds (the recommendation and its runners-up)")
     if not hasattr(cut, "radial_depth"):
         raise InvalidValueError(f"cut: got {type(cut).__name__}; a recommendation is for a milling cut (MillingCut)")
     if lobes.cut is not None and hasattr(lobes.cut, "radial_depth") and not _same_cut(lobes.cut, cut):

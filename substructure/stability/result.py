@@ -511,7 +511,10 @@ def lobes_band(results: Sequence[Lobes], nominal: Lobes | None = None, label: st
     LobesBand
         The lowest and highest depth limit (m) at each speed (rpm).
     """
-    results = list(results)
+    try:  # (a scalar quantity says it is iterable and is not)
+        results = [] if isinstance(results, Lobes) else list(results)
+    except TypeError:
+        results = []
     if not results or not all(isinstance(r, Lobes) for r in results):
         raise InvalidValueError("results: expected one or more Lobes")
     speeds = results[0].spindle_speed_rpm

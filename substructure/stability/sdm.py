@@ -50,7 +50,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..errors import InvalidValueError
-from ..units import Q_, to_si
+from ..units import Q_, finite_real, to_si, whole_number
 from . import _semidiscrete
 from ._semidiscrete import _chatter, _critical, _Plan, expm_batch, monodromy_order
 from .speeds import as_speed_rpm
@@ -403,10 +403,13 @@ def sdm(modes: ModalModel, cut: Any, speeds: Any, *, intervals: int | None = Non
     """
     model = _check_model(modes)
     speeds_rpm = as_speed_rpm(speeds)
-    if not 0 < rtol < 0.5:
-        raise InvalidValueError(f"rtol: got {rtol!r}; expected a relative tolerance in (0, 0.5)")
-    if not coarse_ratio > 1.0:
-        raise InvalidValueError(f"coarse_ratio: got {coarse_ratio!r}; expected a ratio > 1")
+    for name, value, inside, expected in (
+            ("rtol", rtol, lambda v: 0 < v < 0.5, "a relative tolerance in (0, 0.5)"),
+            ("coarse_ratio", coarse_ratio, lambda v: v > 1.0, "a ratio > 1"),
+            ("max_phase_step", max_phase_step, lambda v: v > 0, "a positive angle in rad")):
+        if not (finite_real(value) and inside(value)):
+            raise InvalidValueError(f"{name}: got {value!r}; expected {expected}")
+    whole_number(min_intervals, "min_intervals", 1, maximum=MAX_INTERVALS)
     check_intervals(model, cut, speeds, intervals)
     return _sdm(model, cut, speeds_rpm, intervals=intervals, min_intervals=min_intervals,
                 max_phase_step=max_phase_step, rtol=rtol, depth_range=depth_range, coarse_ratio=coarse_ratio,
@@ -435,7 +438,13 @@ def _sdm(model: ModalModel, cut: Any, speeds_rpm: np.ndarray, *, intervals: int 
         ladder = np.concatenate([[ref / 4.0], ref * coarse_ratio ** np.arange(
             np.floor(np.log(0.5) / np.log(coarse_ratio)), np.log(64.0) / np.log(coarse_ratio) + 1e-9)])
     else:
-        lo, hi = (to_si(v, f, "m") for v, f in zip(depth_range, ("depth_range[0]", "depth_range[1]")))
+        try:  # (a scalar quantity says it is iterable and is not)
+            pair = None if isinstance(depth_range, (str, bytes)) else tuple(depth_range)
+        except TypeError:
+            pair = None
+        if pair is None or len(pair) != 2:
+            raise InvalidValueError(f"depth_range: got {depth_range!r}; expected (low, high), two depths with units")
+        lo, hi = (to_si(v, f, "m") for v, f in zip(pair, ("depth_range[0]", "depth_range[1]")))
         if not 0 < lo < hi:
             raise InvalidValueError(f"depth_range: got {depth_range!r}; expected 0 < low < high")
         ladder = np.geomspace(lo, hi, int(np.ceil(np.log(hi / lo) / np.log(coarse_ratio))) + 1)

@@ -31,7 +31,7 @@ def _orientation(value: Any) -> float:
 
 
 def _direction(value: Any) -> str:
-    if value not in ("x", "y"):
+    if not isinstance(value, str) or value not in ("x", "y"):
         raise InvalidValueError(f"direction: got {value!r}; expected 'x' or 'y'")
     return value
 

@@ -45,7 +45,7 @@ def _fraction(field: str, lo: float, hi: float):
 def _quantiles(value: Any) -> tuple[float, ...]:
     try:
         q = tuple(float(v) for v in value if not isinstance(v, bool))
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         q = ()
     if len(q) < 2 or len(q) != len(value) or any(not 0 < v < 1 for v in q) or list(q) != sorted(set(q)):
         raise InvalidValueError(f"quantiles: got {value!r}; expected two or more increasing probabilities in (0, 1), "

@@ -184,7 +184,7 @@ def _array(value: Any, field: str) -> np.ndarray:
                                 "record (a spectrum is not a tap record)")
     try:
         array = np.array(raw, dtype=np.float64)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InvalidValueError(f"{field}: got {type(value).__name__}; expected a 1-D array of numbers") from None
     if array.ndim != 1:
         raise InvalidValueError(f"{field}: got shape {array.shape}; expected a 1-D array of samples")

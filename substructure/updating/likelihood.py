@@ -147,7 +147,7 @@ def measured_frfs(measurements, band=None) -> tuple[list[Measured], tuple[float,
         if any(isinstance(x, (str, bytes, bool, np.bool_)) for x in (lo, hi)):
             raise TypeError
         lo, hi = float(lo), float(hi)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InvalidValueError(f"band: got {band!r}; expected (lo, hi) in Hz") from None
     if not lo < hi:
         raise InvalidValueError(f"band: got {lo:g}-{hi:g} Hz; expected lo < hi")
