@@ -917,3 +917,18 @@ def test_report_settings_of_the_wrong_kind_are_refused_before_any_work(settings,
     from substructure.report import report
     with pytest.raises(InvalidValueError, match=message):
         report(default_assembly(), **settings)
+
+
+def test_names_kinds_and_band_ends_of_the_wrong_kind_are_refused_by_the_assembly_and_the_frf():
+    # the truth value of an array, an unhashable list, an integer beyond every float: raw errors before
+    frf = default_assembly().frf("tool.tip:y", frequency=np.arange(100.0, 3000.0, 20.0))
+    with pytest.raises(UnknownPointError, match=r"no component array\(\[\], dtype=float64\) in assembly"):
+        default_assembly().without(np.array([]))
+    with pytest.raises(UnknownPointError, match=r"sensor: got array\(\[\], dtype=float64\); expected a sensor's name"):
+        default_assembly().sensor(np.array([]))
+    with pytest.raises(InvalidValueError, match=r"hi: got 10+; expected a finite frequency in Hz"):
+        frf.crop(100.0, 10 ** 400)
+    with pytest.raises(InvalidValueError, match=r"kind: got \[1, 2\]; expected one of bode"):
+        frf.plot(kind=[1, 2])
+    with pytest.raises(InvalidValueError, match=r"unit: got \[1, 2\]; expected one of"):
+        frf.plot(unit=[1, 2])

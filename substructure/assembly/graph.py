@@ -155,6 +155,8 @@ class Assembly:
         raise UnknownPointError(f"no component {name!r} in assembly {self.name!r}")
 
     def _named(self, items: tuple, kind: str, plural: str, name: str):
+        if not isinstance(name, str):
+            raise UnknownPointError(f"{kind}: got {name!r}; expected a {kind}'s name")
         for item in items:
             if item.name == name:
                 return item
@@ -415,7 +417,7 @@ class Assembly:
             A new assembly; this one is unchanged.
         """
         for n in names:
-            if not any(c.name == n for c in self.components):
+            if not isinstance(n, str) or not any(c.name == n for c in self.components):
                 raise UnknownPointError(f"no component {n!r} in assembly {self.name!r}")
         removed = {m for c in self.components if c.name in names for m in c.component_names}
 

@@ -16,7 +16,7 @@ import attrs
 import numpy as np
 
 from ..errors import InvalidValueError, UnitError
-from ..units import cycles_per_second, frequency_hz, ureg
+from ..units import cycles_per_second, finite_real, frequency_hz, ureg
 
 __all__ = ["Frequency", "MAX_GRID_LINES"]
 
@@ -74,6 +74,8 @@ def _hz(value: Any, field: str) -> float:
     Angular units are converted explicitly (:func:`substructure.units.frequency_hz`).
     """
     if isinstance(value, numbers.Real) and not isinstance(value, bool):
+        if not finite_real(value):  # NaN, or an integer beyond every float
+            raise InvalidValueError(f"{field}: got {value!r}; expected a finite frequency in Hz")
         return float(value)
     return frequency_hz(value, field)
 

@@ -207,9 +207,9 @@ def draw_frf(
     **line_kw: Any,
 ) -> Figure:
     """Draw entries of an FRF (the options of :func:`substructure.plot.plot_frf`); returns the Figure."""
-    if kind not in KINDS:
+    if not isinstance(kind, str) or kind not in KINDS:
         raise InvalidValueError(f"kind: got {kind!r}; expected one of {', '.join(KINDS)}")
-    if unit not in FRF_UNITS:
+    if not isinstance(unit, str) or unit not in FRF_UNITS:
         raise InvalidValueError(f"unit: got {unit!r}; expected one of {', '.join(FRF_UNITS)}")
     if parts is None:
         parts = KINDS[kind]
