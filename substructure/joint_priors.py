@@ -40,6 +40,7 @@ import numpy as np
 
 from ._toml import loads_toml
 from .errors import InvalidValueError
+from .units import items_of, whole_number
 from .joints import DAMPING_UNITS, STIFFNESS_UNITS, Joint, JointProvenance
 from .points import parse_point
 
@@ -141,9 +142,9 @@ def prior_joint(role: str, kind: str, name: str, between: Any) -> Joint:
         ``"prior"`` with the row's source and uncertainty factor.
     """
     table = priors_table()
-    if role not in table:
+    if not isinstance(role, str) or role not in table:
         raise InvalidValueError(f"role: got {role!r}; expected one of {', '.join(ROLES)}")
-    if kind not in table[role]:
+    if not isinstance(kind, str) or kind not in table[role]:
         raise InvalidValueError(f"{role} prior: no row for {kind!r}; known: {', '.join(table[role])}")
     row = table[role][kind]
     source = f"{row['title']} ({row['basis']}): {row['source']}"
@@ -236,6 +237,8 @@ def with_joint_priors(assembly: Any, names: Any = None) -> Any:
     Assembly
         A new assembly (joints identified, predicted or already priors kept).
     """
+    if names is not None:
+        names = [names] if isinstance(names, str) else items_of(names, "names", "joint names")
     out = assembly
     for joint in assembly.joints:
         if joint.rigid or not (joint.name in names if names is not None
@@ -271,8 +274,7 @@ def joint_variants(assembly: Any, levels: int = 3) -> list:
     list of Assembly
         The variants; ``[assembly]`` when no joint states an uncertainty.
     """
-    if not 2 <= int(levels) <= 5:
-        raise InvalidValueError(f"levels: got {levels!r}; expected 2 to 5")
+    whole_number(levels, "levels", 2, "a whole number of levels", 5)  # (2.7 was taken as 2)
     uncertain = [j for j in assembly.joints if not j.rigid and j.provenance is not None
                  and j.provenance.uncertainty is not None and j.provenance.uncertainty > 1.0]
     if not uncertain:

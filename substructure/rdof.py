@@ -39,7 +39,7 @@ import pint
 from .errors import InvalidValueError, UnitError, UnknownPointError
 from .frf import FRF
 from .points import PointRef, parse_point
-from .units import Q_, to_si, whole_number
+from .units import Q_, items_of, to_si, whole_number
 
 __all__ = [
     "fd_weights",
@@ -58,7 +58,7 @@ def _coordinates(positions: Any, at: Any) -> tuple[np.ndarray, float]:
     """Plain floats, or lengths converted to metres; the two kinds are not mixed."""
     if isinstance(positions, (str, pint.Quantity)) and np.ndim(getattr(positions, "magnitude", 0)) == 0:
         raise InvalidValueError(f"positions: got {positions!r}; expected a sequence of at least 2 positions")
-    values = list(positions)
+    values = items_of(positions, "positions", "at least 2 positions")
     lengths = [_is_length(v) for v in values] + [_is_length(at)]
     if any(lengths) and not all(lengths):
         raise UnitError(
@@ -226,7 +226,8 @@ def _stencil(points: Any, positions: Any, at: Any, at_position: Any, suffix: str
     names = {"points": f"points{suffix}", "positions": f"positions{suffix}", "at": f"at{suffix}"}
     if isinstance(points, str) or isinstance(positions, str):
         raise InvalidValueError(f"{names['points']}, {names['positions']}: expected sequences, one entry per point")
-    points, positions = list(points), list(positions)
+    points = items_of(points, names["points"], "point names, one per position")
+    positions = items_of(positions, names["positions"], "positions, one per point")
     if len(points) < 2:
         raise InvalidValueError(
             f"{names['points']}: got {len(points)} point(s); finite differences need at least 2 "
@@ -401,8 +402,7 @@ def positions_from(assembly_or_component: Any, points: Sequence[str]) -> tuple[p
     UnknownPointError
         For a point that is not on the component.
     """
-    if isinstance(points, str):
-        points = [points]
+    points = [points] if isinstance(points, str) else items_of(points, "points", "point names")
     refs = [_point(p, f"points[{i}]") for i, p in enumerate(points)]
     if not refs:
         raise InvalidValueError("points: got none; expected point names on one component")

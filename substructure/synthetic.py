@@ -22,6 +22,7 @@ from .errors import InvalidValueError
 from .frf import FRF
 from .measurements import Measurement, MeasurementSet, model_of_measurement
 from .points import parse_point
+from .units import finite_real, items_of, whole_number
 
 __all__ = ["simulate", "write_measurement_set"]
 
@@ -60,8 +61,13 @@ def simulate(assembly: Assembly, points: Sequence[str], excitation: str | None =
     MeasurementSet
         One receptance (m/N) per point, recorded with the sensors and removed components.
     """
-    if noise < 0:
+    if not (finite_real(noise) and noise >= 0):
         raise InvalidValueError(f"noise: got {noise!r}; expected a level >= 0")
+    whole_number(seed, "seed", 0, "a seed, an integer")
+    points = [points] if isinstance(points, str) else items_of(points, "points", "point names")
+    if not points:
+        raise InvalidValueError("points: got none; expected at least one response point")
+    sensors, removed = (items_of(v, f, "names") for v, f in ((sensors, "sensors"), (removed, "removed")))
     model = model_of_measurement(assembly, _Configuration(tuple(sensors), tuple(removed)))
     excitation = excitation or points[0]
     rng = np.random.default_rng(seed)
@@ -112,7 +118,9 @@ def write_measurement_set(measurements: MeasurementSet | Sequence[Measurement], 
     from .io import write_text
     from .io.frf_files import write_csv
 
-    directory = Path(directory)
+    from ._files import file_name as _path_text
+
+    directory = Path(_path_text(directory, "directory"))
     directory.mkdir(parents=True, exist_ok=True)
     items = list(measurements)
     toml_path = directory / file_name

@@ -452,6 +452,32 @@ def finite_real(value: Any) -> bool:
         return False
 
 
+def items_of(value: Any, field: str, what: str) -> list:
+    """The items of a sequence given where one is expected, or an error naming ``field`` when ``value`` is a
+    text or no sequence at all (a number, None: a scalar quantity says it is iterable and is not).
+
+    Parameters
+    ----------
+    value : object
+        The value given.
+    field : str
+        Its name in the message.
+    what : str
+        What the items are, for the message (``"point names"``).
+
+    Returns
+    -------
+    list
+        Its items.
+    """
+    try:
+        if not isinstance(value, (str, bytes)):
+            return list(value)
+    except TypeError:
+        pass
+    raise InvalidValueError(f"{field}: got {value!r}; expected a sequence of {what}")
+
+
 MAX_REPEATS = 10_000
 """The most repetitions of a whole computation (bootstrap refits, samples of a prediction's distribution), in
 Python as on the command line: a count beyond every float ran for ever, or asked for gigabytes first."""

@@ -932,3 +932,31 @@ def test_names_kinds_and_band_ends_of_the_wrong_kind_are_refused_by_the_assembly
         frf.plot(kind=[1, 2])
     with pytest.raises(InvalidValueError, match=r"unit: got \[1, 2\]; expected one of"):
         frf.plot(unit=[1, 2])
+
+
+def test_finite_differences_simulations_and_priors_refuse_what_is_no_sequence_or_count(tmp_path):
+    # 'float' object is not iterable, '<' between str and int, SeedSequence's own error, NaN to integer
+    from substructure.joint_priors import joint_variants, prior_joint, with_joint_priors
+    from substructure.rdof import fd_weights, positions_from
+    from substructure.synthetic import simulate, write_measurement_set
+    model = default_assembly()
+    refused = [
+        (lambda: fd_weights(math.nan, "0 mm"), r"positions: got nan; expected a sequence of at least 2 positions"),
+        (lambda: positions_from(model, math.nan), r"points: got nan; expected a sequence of point names"),
+        (lambda: simulate(model, math.nan, frequency=GRID), r"points: got nan; expected a sequence of point names"),
+        (lambda: simulate(model, [], frequency=GRID), r"points: got none; expected at least one response point"),
+        (lambda: simulate(model, ["tool.tip"], frequency=GRID, noise="abc"), r"noise: got 'abc'; expected a level"),
+        (lambda: simulate(model, ["tool.tip"], frequency=GRID, seed=math.nan), r"seed: got nan; expected a seed"),
+        (lambda: simulate(model, ["tool.tip"], frequency=GRID, sensors=1.0), r"sensors: got 1\.0; expected a "
+                                                                               r"sequence of names"),
+        (lambda: joint_variants(model, 2.7), r"levels: got 2\.7; expected a whole number of levels >= 2"),
+        (lambda: joint_variants(model, 6), r"levels: got 6; expected a whole number of levels from 2 to 5"),
+        (lambda: prior_joint([1, 2], "collet", "j", ("holder.tip", "tool.base")), r"role: got \[1, 2\]"),
+        (lambda: with_joint_priors(model, math.nan), r"names: got nan; expected a sequence of joint names"),
+    ]
+    for call, message in refused:
+        with pytest.raises(InvalidValueError, match=message):
+            call()
+    from substructure.errors import FileFormatError
+    with pytest.raises(FileFormatError, match=r"got nan of type float; expected the name of a directory"):
+        write_measurement_set(simulate(model, ["tool.tip"], frequency=GRID), math.nan)
