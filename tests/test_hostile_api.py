@@ -960,3 +960,24 @@ def test_finite_differences_simulations_and_priors_refuse_what_is_no_sequence_or
     from substructure.errors import FileFormatError
     with pytest.raises(FileFormatError, match=r"got nan of type float; expected the name of a directory"):
         write_measurement_set(simulate(model, ["tool.tip"], frequency=GRID), math.nan)
+
+
+def test_result_methods_refuse_axes_points_assemblies_and_tolerances_of_the_wrong_kind():
+    # AttributeError ('float' object has no attribute 'figure'), not iterable, '>' between float and str
+    from substructure.diagnose import diagnose
+    from substructure.synthetic import simulate
+    grid = np.arange(100.0, 3000.0, 20.0)
+    data = simulate(default_assembly().attach(Sensor("acc", "tool.tip", "2 g")), ["tool.tip"], frequency=grid,
+                    noise=0.01)
+    d = diagnose(default_assembly(), data, progress=False)
+    with pytest.raises(InvalidValueError, match=r"ax: got 1 axes for the 1 panel\(s\) \('history',\)"):
+        d.plot_history(ax=math.nan)
+    with pytest.raises(InvalidValueError, match=r"ax: got 1 axes for the 3 panel\(s\) \('magnitude', 'phase', "
+                                                r"'residual'\)"):
+        d.plot_where(ax=math.nan)
+    with pytest.raises(InvalidValueError, match=r"points: got nan; expected a sequence of point names"):
+        data.matrix(math.nan)
+    with pytest.raises(InvalidValueError, match=r"assembly: got float; expected an Assembly"):
+        data.validate(math.nan)
+    with pytest.raises(InvalidValueError, match=r"rtol: got 'abc'; expected a relative tolerance >= 0"):
+        default_assembly().frf("tool.tip", frequency=GRID).check_reciprocity(rtol="abc")

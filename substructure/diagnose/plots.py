@@ -6,6 +6,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from .._text import plain_text
+from ..frf.plotting import given_axes
 
 __all__ = ["plot_comparison", "plot_history"]
 
@@ -32,7 +33,7 @@ def plot_comparison(comparison, ax=None):
         fig, axes = plt.subplots(3, 1, sharex=True, figsize=(8.0, 7.5), layout="constrained",
                                  gridspec_kw={"height_ratios": [3, 1.5, 1.5]})
     else:
-        axes = list(ax)
+        axes = given_axes(ax, ("magnitude", "phase", "residual"))
         fig = axes[0].figure
     meas, model = comparison.measured, comparison.model
     f = meas.frequency.hz
@@ -91,6 +92,7 @@ def plot_history(diagnosis, ax=None):
     if ax is None:
         fig, ax = plt.subplots(figsize=(6.5, 3.8), layout="constrained")
     else:
+        ax = given_axes(ax, ("history",))[0]
         fig = ax.figure
     steps = diagnosis.refinement
     x = [s.step for s in steps]

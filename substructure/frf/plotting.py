@@ -59,12 +59,31 @@ def _axes_for(ax: Any, parts: Sequence[str]) -> list[Axes]:
         _, grid = plt.subplots(len(parts), 1, sharex=True, squeeze=False,
                                figsize=(7.0, 2.2 + 1.8 * len(parts)), layout="constrained")
         return list(grid[:, 0])
+    return given_axes(ax, parts)
+
+
+def given_axes(ax: Any, panels: Sequence[str]) -> list[Axes]:
+    """The Axes a caller gave to draw ``panels`` on: one Axes, a Figure (its axes) or a sequence of Axes, one per
+    panel; anything else is refused naming ``ax`` (before any drawing).
+
+    Parameters
+    ----------
+    ax : matplotlib Axes, Figure or sequence of Axes
+        What was given.
+    panels : sequence of str
+        The panels to draw, for the count and the message.
+
+    Returns
+    -------
+    list of Axes
+        One per panel.
+    """
     if isinstance(ax, Figure):
         ax = ax.axes
     axes = [ax] if isinstance(ax, Axes) else list(np.ravel(np.asarray(ax, dtype=object)))
-    if len(axes) != len(parts) or not all(isinstance(a, Axes) for a in axes):
+    if len(axes) != len(panels) or not all(isinstance(a, Axes) for a in axes):
         raise InvalidValueError(
-            f"ax: got {len(axes)} axes for the {len(parts)} panel(s) {tuple(parts)}; pass one "
+            f"ax: got {len(axes)} axes for the {len(panels)} panel(s) {tuple(panels)}; pass one "
             "Axes per panel (e.g. fig.axes of an earlier plot) or choose parts to match"
         )
     return axes

@@ -18,6 +18,7 @@ import attrs
 import numpy as np
 
 from ..errors import FrequencyAxisMismatchError, InvalidValueError, NonReciprocalWarning, UnknownPointError
+from ..units import finite_real
 from ._fields import check_label, _check_frequency, _check_quantity, _complex_array, _labels, _scalar
 from .axis import _GRID_RTOL, Frequency
 from .files._common import register_frf_class
@@ -455,6 +456,8 @@ class FRF:
         float
             The relative asymmetry.
         """
+        if not (finite_real(rtol) and rtol >= 0):
+            raise InvalidValueError(f"rtol: got {rtol!r}; expected a relative tolerance >= 0")
         error = self.reciprocity_error()
         if error > rtol:
             message = f"FRF is not reciprocal: relative asymmetry {error:.3g} exceeds rtol={rtol:g}"

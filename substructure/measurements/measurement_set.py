@@ -13,6 +13,7 @@ import attrs
 import numpy as np
 
 from ..errors import FrequencyAxisMismatchError, InvalidValueError, SubstructureError
+from ..units import items_of
 from ..frf import FRF, Frequency
 from ..points import parse_point
 from .measurement import (
@@ -217,7 +218,7 @@ class MeasurementSet:
             Listing every entry that is not measured (with its reciprocal, when
             ``reciprocity`` is True), and the configurations the set holds.
         """
-        points = [points] if isinstance(points, str) else list(points)
+        points = [points] if isinstance(points, str) else items_of(points, "points", "point names")
         if not points:
             raise InvalidValueError("points: got none; expected at least one point name")
         labels = [dof_label(p, f"points[{i}]") for i, p in enumerate(points)]
@@ -275,6 +276,8 @@ class MeasurementSet:
             the field (``measurements[2].sensors``, or ``frf[2].sensors`` for
             a set read from a file).
         """
+        if not hasattr(assembly, "components"):
+            raise InvalidValueError(f"assembly: got {type(assembly).__name__}; expected an Assembly")
         problems: list[str] = []
         top_level = {c.name: c for c in assembly.components}
         table = "measurements" if self.source is None else "frf"  # the file's [[frf]] tables
