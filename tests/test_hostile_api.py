@@ -981,3 +981,15 @@ def test_result_methods_refuse_axes_points_assemblies_and_tolerances_of_the_wron
         data.validate(math.nan)
     with pytest.raises(InvalidValueError, match=r"rtol: got 'abc'; expected a relative tolerance >= 0"):
         default_assembly().frf("tool.tip", frequency=GRID).check_reciprocity(rtol="abc")
+
+
+def test_a_study_s_methods_and_joint_table_of_the_wrong_kind_are_refused_by_name():
+    # 'float' object is not iterable; TypeError from os.fspath
+    from substructure.errors import FileFormatError
+    from substructure.study import Compute, SurrogateSpec
+    with pytest.raises(InvalidValueError, match=r"lobes: got nan; expected a sequence of methods, zoa and/or sdm"):
+        Compute(lobes=math.nan)
+    with pytest.raises(InvalidValueError, match=r"lobes: got \[1, 2\]; expected zoa and/or sdm"):
+        Compute(lobes=[[1, 2]])
+    with pytest.raises(FileFormatError, match=r"got nan of type float; expected the name of a joint table"):
+        SurrogateSpec(table=math.nan)

@@ -15,6 +15,7 @@ from typing import Any
 import attrs
 
 from ..errors import InvalidValueError, SubstructureError
+from ..units import items_of
 from .spec import plain
 
 __all__ = ["Compute", "Grid", "METHODS"]
@@ -24,9 +25,9 @@ METHODS = ("zoa", "sdm")
 
 
 def _methods(value: Any) -> tuple[str, ...]:
-    value = (value,) if isinstance(value, str) else tuple(value)
+    value = (value,) if isinstance(value, str) else tuple(items_of(value, "lobes", "methods, zoa and/or sdm"))
     for m in value:
-        if m not in METHODS:
+        if not isinstance(m, str) or m not in METHODS:
             raise InvalidValueError(f"lobes: got {m!r}; expected zoa and/or sdm")
     if len(set(value)) != len(value):
         raise InvalidValueError(f"lobes: got {list(value)!r}; a method given twice")

@@ -473,7 +473,9 @@ class SurrogateSpec:
         if not isinstance(table, JointTable):
             from pathlib import Path
 
-            path = os.fspath(table)
+            from .._files import file_name
+
+            path = file_name(table, "joint table")
             table = JointTable.from_toml(path) if Path(path).suffix.lower() == ".toml" else JointTable.from_csv(path)
         table.check_not_empty(3, "a surrogate")
         object.__setattr__(self, "joint_table", table)
