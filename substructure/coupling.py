@@ -42,6 +42,7 @@ from ._engine import (
     interface_update,
 )
 from .errors import FrequencyAxisMismatchError, InvalidValueError, UnknownPointError
+from .units import items_of
 from .frf import FRF
 from .points import parse_point
 
@@ -268,13 +269,7 @@ def decouple(coupled: FRF, removed: FRF, interface: Sequence[tuple[str, str, Any
     joints with ``-K``; the same engine as coupling.
     """
     given = coupled
-    try:
-        items = None if isinstance(interface, (str, bytes)) else list(interface)
-    except TypeError:  # a number, None (a scalar quantity says it is iterable and is not)
-        items = None
-    if items is None:
-        raise InvalidValueError("interface: expected a sequence of (point_in_coupled, point_in_removed, joint or "
-                                "None)")
+    items = items_of(interface, "interface", "(point_in_coupled, point_in_removed, joint or None)")
     coupled, removed = _receptance(coupled, "coupled"), _receptance(removed, "removed")
     if coupled.frequency != removed.frequency:
         raise FrequencyAxisMismatchError(

@@ -23,8 +23,7 @@ import matplotlib.pyplot as plt
 from matplotlib.figure import Figure
 
 from ._text import plain_text
-from .errors import InvalidValueError
-from .frf import FRF
+from .frf import FRF, frf_checked
 from .frf.plotting import FRF_UNITS, KINDS, PARTS, draw_frf, rigid_body_cutoff  # noqa: F401 (their public place)
 from .identify.plotting import plot_identification  # noqa: F401 (its public place)
 
@@ -102,8 +101,7 @@ def plot_frf(
     axes are scaled on the data above it; the line is still drawn, in a
     shaded band.
     """
-    if not isinstance(frf, FRF):
-        raise InvalidValueError(f"frf: got {type(frf).__name__}; expected an FRF")
+    frf_checked(frf)
     return draw_frf(frf, ax, entries, parts, label, kind=kind, unit=unit, title=title, note=note, limits=limits,
                     **line_kw)
 

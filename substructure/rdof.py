@@ -37,7 +37,7 @@ import numpy as np
 import pint
 
 from .errors import InvalidValueError, UnitError, UnknownPointError
-from .frf import FRF
+from .frf import FRF, frf_checked
 from .points import PointRef, parse_point
 from .units import Q_, items_of, to_si, whole_number
 
@@ -333,8 +333,7 @@ def estimate_rotational(
     constant over frequency and growing as the spacing shrinks: another
     reason for a larger spacing for ``P``.
     """
-    if not isinstance(frf, FRF):
-        raise InvalidValueError(f"frf: got {type(frf).__name__}; expected an FRF")
+    frf_checked(frf)
     labels, t, name = _stencil(points, positions, at, at_position)
     h = frf.select(labels, labels).data
     data = t @ h @ t.T
@@ -368,8 +367,7 @@ def estimate_rotational_cross(
         Outputs ``("A:y", "A:theta")``, inputs ``("B:y", "B:theta")``:
         ``[[H_ab, L_ab], [N_ab, P_ab]]``.
     """
-    if not isinstance(frf, FRF):
-        raise InvalidValueError(f"frf: got {type(frf).__name__}; expected an FRF")
+    frf_checked(frf)
     labels_a, t_a, name_a = _stencil(points_a, positions_a, at_a, at_position_a, "_a")
     labels_b, t_b, name_b = _stencil(points_b, positions_b, at_b, at_position_b, "_b")
     h = frf.select(labels_a, labels_b).data

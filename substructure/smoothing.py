@@ -24,7 +24,7 @@ import numpy as np
 from scipy.signal import find_peaks, savgol_coeffs, savgol_filter
 
 from .errors import InvalidValueError, SubstructureWarning
-from .frf import FRF
+from .frf import FRF, frf_checked
 from .units import whole_number
 
 __all__ = ["smooth", "choose_window", "PEAK_BIAS", "CoarseDataWarning"]
@@ -40,8 +40,7 @@ class CoarseDataWarning(SubstructureWarning):
 
 
 def _check_frf(frf: FRF) -> None:
-    if not isinstance(frf, FRF):
-        raise InvalidValueError(f"frf: got {type(frf).__name__}; expected an FRF")
+    frf_checked(frf)
     hz = frf.frequency.hz
     if hz.size < 3:
         raise InvalidValueError(f"frf: has {hz.size} frequency line(s); smoothing needs at least 3")

@@ -36,7 +36,7 @@ from .coupling import Link, couple_substructures
 from .errors import InvalidValueError
 from .frf import FRF, Frequency
 from .joints import dynamic_stiffness
-from .units import whole_number
+from .units import items_of, whole_number
 
 # MAX_SWEEP_VALUES is not listed: the module shares the sweep function's name in the API pages
 __all__ = ["SweepResult", "sweep"]
@@ -148,14 +148,10 @@ def sweep(
         The receptances of every variant, shape ``(n_variants, n_freq, n_out, n_in)``
         (m/N, m/(N m), rad/N, rad/(N m)).
     """
-    try:  # (a scalar quantity says it is iterable and is not)
-        items = None if isinstance(assemblies, Assembly) else list(assemblies)
-    except TypeError:
-        items = None
-    if items is None:
+    if isinstance(assemblies, Assembly):
         raise InvalidValueError(f"sweep: got {_show(assemblies)}; expected a sequence of assemblies (a list: "
                                 "[assembly] for one)")
-    assemblies = items
+    assemblies = items_of(assemblies, "sweep", "assemblies (a list: [assembly] for one)")
     if not assemblies:
         raise InvalidValueError("sweep: got no assemblies")
     for i, a in enumerate(assemblies):

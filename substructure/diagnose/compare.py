@@ -21,13 +21,11 @@ deviations is the error a perfect model would still show (:func:`noise_floor`).
 
 from __future__ import annotations
 
-from typing import Any
-
 import attrs
 import numpy as np
 
 from ..errors import FrequencyAxisMismatchError, InvalidValueError
-from ..frf import FRF
+from ..frf import FRF, frf_checked
 from ..smoothing import choose_window, smooth
 from .settings import DEFAULT_SETTINGS, DiagnoseSettings
 
@@ -50,7 +48,7 @@ METRIC = "rms_log_ratio"
 
 def _check(model: FRF, measured: FRF) -> None:
     for name, value in (("model", model), ("measured", measured)):
-        _an_frf(value, name)
+        frf_checked(value, name)
     if model.frequency != measured.frequency:
         raise FrequencyAxisMismatchError(
             "model and measurement are on different frequency axes: compute the model on the "
@@ -58,11 +56,6 @@ def _check(model: FRF, measured: FRF) -> None:
         )
     if model.shape[1:] != measured.shape[1:]:
         raise InvalidValueError(f"model {model.shape[1:]} and measurement {measured.shape[1:]} differ in entries")
-
-
-def _an_frf(value: Any, name: str) -> None:
-    if not isinstance(value, FRF):
-        raise InvalidValueError(f"{name}: got {type(value).__name__}; expected an FRF")
 
 
 def log_ratio(model: FRF, measured: FRF) -> np.ndarray:
@@ -152,7 +145,7 @@ def noise_floor(measured: FRF, window: int | None = None, polyorder: int = 3) ->
     """
     from ..updating.noise import estimate_noise
 
-    _an_frf(measured, "measured")
+    frf_checked(measured, "measured")
     floors = [estimate_noise(measured.select([o], [i]), window, polyorder).floor ** 2
               for o in measured.outputs for i in measured.inputs]
     return float(np.sqrt(np.mean(floors)))

@@ -20,6 +20,7 @@ from ._fields import QUANTITIES
 from .axis import MAX_GRID_LINES, Frequency
 from .passivity import REVERSED_SHARE, reversed_share
 from .peaks import local_maxima
-from .response import FRF
+from .response import FRF, frf_checked
 
-__all__ = ["Frequency", "FRF", "QUANTITIES", "MAX_GRID_LINES", "local_maxima", "reversed_share", "REVERSED_SHARE"]
+__all__ = ["Frequency", "FRF", "frf_checked", "QUANTITIES", "MAX_GRID_LINES", "local_maxima", "reversed_share",
+           "REVERSED_SHARE"]

@@ -617,3 +617,23 @@ class FRF:
 
 # the class the files of frf.files are read into (they cannot import this module, which imports them)
 register_frf_class(FRF)
+
+
+def frf_checked(value: Any, field: str = "frf") -> FRF:
+    """``value`` when it is an :class:`FRF`, else an error naming ``field`` (the one check of an FRF argument).
+
+    Parameters
+    ----------
+    value : object
+        What was given.
+    field : str, default "frf"
+        Its name in the message.
+
+    Returns
+    -------
+    FRF
+        ``value``.
+    """
+    if not isinstance(value, FRF):
+        raise InvalidValueError(f"{field}: got {type(value).__name__}; expected an FRF")
+    return value

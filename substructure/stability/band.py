@@ -46,7 +46,7 @@ import attrs
 import numpy as np
 
 from ..errors import InvalidValueError
-from ..frf import FRF
+from ..frf import FRF, frf_checked
 
 __all__ = ["FlexibleBand", "flexible_band", "choose_band", "assembly_structure", "mode_above", "MASS_LINE_PHASE_DEG",
            "SUSPENSION_RATIO"]
@@ -174,8 +174,7 @@ class FlexibleBand:
 
 
 def _diagonals(frf: FRF) -> list[np.ndarray]:
-    if not isinstance(frf, FRF):
-        raise InvalidValueError(f"frf: got {type(frf).__name__}; expected an FRF")
+    frf_checked(frf)
     data = frf.to_receptance().data
     n = min(data.shape[1], data.shape[2])
     return [data[:, i, i] for i in range(n)]
@@ -258,10 +257,9 @@ def flexible_band(frf: FRF) -> FlexibleBand:
     -----
     See the module documentation for the rules and their sources.
     """
-    if not isinstance(frf, FRF):
-        raise InvalidValueError(f"frf: got {type(frf).__name__}; expected an FRF")
+    diagonals = _diagonals(frf)  # (an FRF, checked there)
     f = frf.frequency.hz
-    results = [_one_entry(f, h) for h in _diagonals(frf)]
+    results = [_one_entry(f, h) for h in diagonals]
     if any(r["kind"] == "mass-line-only" for r in results):
         raise InvalidValueError(
             f"frf: the FRF is a mass line (rigid-body motion, phase near -180 degrees, no resonance) over its "

@@ -30,7 +30,7 @@ import pint
 from .._files import decode_text, read_bytes
 from ..errors import FileFormatError, InvalidValueError, SubstructureWarning
 from ..frf import FRF, Frequency
-from ..units import Q_, dimensionless, quantity, show_value
+from ..units import Q_, dimensionless, items_of, quantity, show_value
 from .structure import XY_LABELS, _one_entry, xy_receptance
 
 __all__ = ["Mode", "ModalModel", "ModalFitter", "fit_modes", "MODES_CSV_HEADER", "MODE_FREQUENCY_RANGE_HZ",
@@ -439,11 +439,8 @@ class ModalFitter:
         _direction(direction)
         frf = _one_entry(frf, "frf")
         if self.band is not None:
-            try:  # (a scalar quantity says it is iterable and is not)
-                pair = None if isinstance(self.band, (str, bytes)) else tuple(self.band)
-            except TypeError:
-                pair = None
-            if pair is None or len(pair) != 2:
+            pair = items_of(self.band, "band", "two frequencies, (lo, hi) in Hz")
+            if len(pair) != 2:
                 raise InvalidValueError(f"band: got {self.band!r}; expected (lo, hi) in Hz")
             frf = frf.crop(*pair)
         f, h = frf.frequency.hz, frf.data[:, 0, 0]

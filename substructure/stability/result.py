@@ -18,6 +18,7 @@ import attrs
 import numpy as np
 
 from ..errors import InvalidValueError, SubstructureWarning
+from ..units import items_of
 from .speeds import rpm_values
 
 __all__ = ["Lobes", "LobesBand", "lobes_band", "StabilityWarning", "sampled_window_minimum"]
@@ -511,10 +512,7 @@ def lobes_band(results: Sequence[Lobes], nominal: Lobes | None = None, label: st
     LobesBand
         The lowest and highest depth limit (m) at each speed (rpm).
     """
-    try:  # (a scalar quantity says it is iterable and is not)
-        results = [] if isinstance(results, Lobes) else list(results)
-    except TypeError:
-        results = []
+    results = [] if isinstance(results, Lobes) else items_of(results, "results", "Lobes")
     if not results or not all(isinstance(r, Lobes) for r in results):
         raise InvalidValueError("results: expected one or more Lobes")
     speeds = results[0].spindle_speed_rpm

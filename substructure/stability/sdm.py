@@ -50,7 +50,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..errors import InvalidValueError
-from ..units import Q_, finite_real, to_si, whole_number
+from ..units import Q_, finite_real, items_of, to_si, whole_number
 from . import _semidiscrete
 from ._semidiscrete import _chatter, _critical, _Plan, expm_batch, monodromy_order
 from .speeds import as_speed_rpm
@@ -438,11 +438,8 @@ def _sdm(model: ModalModel, cut: Any, speeds_rpm: np.ndarray, *, intervals: int 
         ladder = np.concatenate([[ref / 4.0], ref * coarse_ratio ** np.arange(
             np.floor(np.log(0.5) / np.log(coarse_ratio)), np.log(64.0) / np.log(coarse_ratio) + 1e-9)])
     else:
-        try:  # (a scalar quantity says it is iterable and is not)
-            pair = None if isinstance(depth_range, (str, bytes)) else tuple(depth_range)
-        except TypeError:
-            pair = None
-        if pair is None or len(pair) != 2:
+        pair = items_of(depth_range, "depth_range", "two depths with units, (low, high)")
+        if len(pair) != 2:
             raise InvalidValueError(f"depth_range: got {depth_range!r}; expected (low, high), two depths with units")
         lo, hi = (to_si(v, f, "m") for v, f in zip(pair, ("depth_range[0]", "depth_range[1]")))
         if not 0 < lo < hi:
