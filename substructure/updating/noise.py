@@ -51,7 +51,11 @@ measured through an exponential window has its noise correlated over
 neighbouring lines (:func:`window_correlation`): the smoother then keeps
 more of it, the share ``h0`` is computed for that correlation, and
 ``NoiseModel.correlation`` tells the fits and tests how many times
-fewer lines the data count as.  See docs/diagnose.md, "The noise model".
+fewer lines the data count as.  An FRF that does not say its window (a
+file of another analyser) but whose smoothing residual is correlated
+between neighbouring lines beyond what independent lines give is treated
+as measured through the window that correlates it as much
+(``NoiseModel.seen_tau``).  See docs/diagnose.md, "The noise model".
 """
 
 from __future__ import annotations
@@ -84,6 +88,12 @@ LINEAR_LINES = 101
 """Width of the window of the linear-domain noise of lines drowned in additive noise [lines]."""
 NOISE_DOMINATED = 0.1
 """Variance of ``ln H`` from the additive noise above which a line is read linearly [-] (its log is biased)."""
+CORRELATION_Z = 4.0
+"""How many standard errors above that of independent lines the correlation of neighbouring lines' smoothing
+residuals must lie to be taken as the noise's own (:func:`estimate_noise`)."""
+WINDOW_X_MAX = 20.0
+"""The shortest exponential window the data's own correlation is read as, ``T / tau`` (1e-9 of the response
+left at the record's end); a residual more correlated than that is not noise (:func:`estimate_noise`)."""
 COHERENCE_MIN = 1e-3
 """Smallest coherence used in the variance of an H1 estimate (a line below it carries no information)."""
 
@@ -136,6 +146,11 @@ class NoiseModel:
         and the sum of all lags gives ``(T/tau) coth(T/tau)``
         (:func:`window_correlation`): a fit, a test or a comparison of
         ``chi^2`` counts the data as that many times fewer lines.
+    seen_tau : float or None
+        When the FRF does not say its window but its own scatter shows its
+        noise correlated over neighbouring lines: the time constant [s] of
+        the exponential window that would correlate it as much (its
+        ``correlation`` is that window's); None otherwise.
     """
 
     var_re: np.ndarray = attrs.field(eq=False, repr=False)
@@ -151,6 +166,7 @@ class NoiseModel:
     linear: tuple | None = attrs.field(default=None, eq=False, repr=False)
     dof: np.ndarray | None = attrs.field(default=None, eq=False, repr=False)
     correlation: float = 1.0
+    seen_tau: float | None = None
 
     @property
     def floor(self) -> float:
@@ -450,6 +466,22 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
         length, or a force noise without the window's length, a truncation
         of the wrong length or negative.
     """
+    model, seen = _estimate(measured, window, polyorder, coherence, averages, force_noise, force_window_s,
+                            estimator, truncation, window_tau)
+    if window_tau is not None or seen is None or force_noise is not None or truncation is not None:
+        return model  # a tap test processed here says its window, and counts the smooth errors its taps leave
+    tau = _equivalent_tau(*seen)
+    if tau is None:
+        return model
+    model, _ = _estimate(measured, model.window, polyorder, coherence, averages, force_noise, force_window_s,
+                         estimator, truncation, tau)
+    return attrs.evolve(model, seen_tau=tau)
+
+
+def _estimate(measured: FRF, window, polyorder: int, coherence, averages, force_noise, force_window_s,
+              estimator, truncation, window_tau) -> tuple[NoiseModel, tuple | None]:
+    """The noise model (:func:`estimate_noise`) for noise correlated as through ``window_tau`` (None: independent
+    lines), and what :func:`_equivalent_tau` reads of the correlation the data show."""
     if measured.shape[1:] != (1, 1):
         raise InvalidValueError(f"measured: got {measured.shape[1]}x{measured.shape[2]} entries; expected one")
     h = measured.data[:, 0, 0]
@@ -547,6 +579,8 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     with np.errstate(invalid="ignore"):
         spike = usable & np.isfinite(z) & (z / local > _TRIM / 2)
     own = np.abs(q_local) ** 2 / (1.0 - h0) ** 2
+    with np.errstate(divide="ignore", invalid="ignore"):  # the residual in units of its noise, for _equivalent_tau
+        whitened = (q_local.real / np.sqrt((1 - h0) * v_re), q_local.imag / np.sqrt((1 - h0) * v_im))
     v_re, v_im = (np.where(spike, np.maximum(v, own), v) for v in (v_re, v_im))
     # lines where the additive noise (the floor's, and the response's noise that the coherence term
     # carries) is as large as the signal: the log of the data is biased and heavy-tailed there, and
@@ -604,8 +638,55 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     if bias is not None:  # Hv's bias towards H2, in the magnitude only (H1, H2 and Hv share their phase)
         var_re = np.minimum(var_re + bias**2, VARIANCE_CAP)
         lin_re = lin_re + np.expm1(bias) ** 2
-    return NoiseModel(var_re, var_im, (float(coef[0]), float(coef[1])), float(coef[2]) / scale,
-                      max(spread, float(np.sqrt(1.0 / max(idx.size, 1)))), w, scatter,
-                      local_scale=local, outliers=int(spike.sum()), coherence_factor=coherence_factor,
-                      linear=(hs, lin_re, lin_im), dof=dof,
-                      correlation=window_correlation(window_tau, spacing))
+    model = NoiseModel(var_re, var_im, (float(coef[0]), float(coef[1])), float(coef[2]) / scale,
+                       max(spread, float(np.sqrt(1.0 / max(idx.size, 1)))), w, scatter,
+                       local_scale=local, outliers=int(spike.sum()), coherence_factor=coherence_factor,
+                       linear=(hs, lin_re, lin_im), dof=dof,
+                       correlation=window_correlation(window_tau, spacing))
+    return model, (whitened, usable & np.isfinite(z) & ~spike & ~linear, w, polyorder, spacing)
+
+
+def _residual_lag1(w: int, polyorder: int, u: float | None) -> float:
+    """The correlation of neighbouring lines' smoothing residuals for noise correlated as through an exponential
+    window with ``tau df = u`` (None: independent lines): ``r^T C_1 r / r^T C_0 r``, ``r`` the residual's filter."""
+    r = -savgol_coeffs(w, polyorder)
+    r[w // 2] += 1.0
+    lag = np.subtract.outer(np.arange(w), np.arange(w))
+
+    def c(k):
+        return (k == 0).astype(float) if u is None else 1.0 / (1.0 + (np.pi * k * u) ** 2)
+
+    return float(r @ c(lag - 1) @ r / (r @ c(lag) @ r))
+
+
+def _equivalent_tau(whitened, valid: np.ndarray, w: int, polyorder: int, spacing: float) -> float | None:
+    """The time constant [s] of the exponential window that would correlate the noise of neighbouring lines as
+    much as the data's own smoothing residual shows, or None where it shows no more than independent lines do.
+
+    Real tap-test noise is often correlated over neighbouring lines without a window the FRF records (the
+    analyser's exponential window in a file of another system); read as independent, it makes an exact model
+    fail the tests.  The residual's lag-1 correlation (both parts, their values clipped at 3.5 noise units
+    against heavy tails; the median over :data:`_BLOCKS` blocks of the band, at least 50 pairs of lines each)
+    is set against :func:`_residual_lag1` over the family of exponential windows; taken only beyond
+    :data:`CORRELATION_Z` standard errors (of the median) of independent lines' value.
+    """
+    pairs = np.flatnonzero(valid[:-1] & valid[1:])
+    if pairs.size < 50 * _BLOCKS or not spacing > 0:
+        return None
+    parts = [np.clip(np.where(valid, x, 0.0), -3.5, 3.5) for x in whitened]
+    num = sum(x[pairs] * x[pairs + 1] for x in parts)
+    den = sum(0.5 * (x[pairs] ** 2 + x[pairs + 1] ** 2) for x in parts)
+    # the median over blocks of the band: a misfit a few lines wide (a bump the smoother follows in part) is the
+    # data's own, not a correlation of the noise everywhere
+    blocks = [(float(np.sum(num[b])), float(np.sum(den[b]))) for b in np.array_split(np.arange(pairs.size), _BLOCKS)]
+    if not all(d > 0 for _, d in blocks):
+        return None
+    seen = float(np.median([n / d for n, d in blocks]))
+    if seen <= _residual_lag1(w, polyorder, None) + 1.25 * CORRELATION_Z / np.sqrt(pairs.size):
+        return None
+    us = np.geomspace(1.0 / WINDOW_X_MAX, 30.0, 120)
+    lags = np.array([_residual_lag1(w, polyorder, u) for u in us])  # falls as u grows
+    if seen > lags[0]:  # more than any window leaves noise: the smoother's own misfit of data without noise
+        return None
+    u = float(np.exp(np.interp(seen, lags[::-1], np.log(us[::-1]))))
+    return u / spacing
