@@ -135,3 +135,16 @@ def test_the_model_with_the_sensor_is_explained_as_it_is():
     model = hd.nominal_model().attach(Mass("accelerometer", "tool.tip", "4 g"))
     d = diagnose(model, _noisy(hd.measure(noise=0, phase_deg=0, floor=0, sensor_kg=0.004), 6, 5.0))
     assert d.explained and not d.effects, d.report
+
+
+def test_an_identification_under_such_noise_says_so_and_counts_it():
+    """The joint's values stand within their standard deviations of the truth, and the note names the key."""
+    from substructure.measurements import Measurement
+    from substructure.identify import identify_joint
+
+    truth = hd.measure(noise=0, phase_deg=0, floor=0, ht_scale=0.7)
+    (frf,) = _noisy(truth, 7, 5.0)
+    report = identify_joint(hd.nominal_model(), [Measurement.from_frf(frf, "tool.tip", "tool.tip")], "holder-tool",
+                            parameters=("k_yf",))
+    assert abs(report.k["yf"] - 0.7 * 1.43e7) < 3 * report.k_std["yf"]
+    assert any("correlated over neighbouring lines" in w and "window_tau_s" in w for w in report.warnings)
