@@ -102,7 +102,7 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
             tool_bore: float = 0.0, bearing_moved: tuple[int, float] | None = None,
             spindle_body: tuple[float, float, float] | None = None, sensor_below: float = 0.0, seed: int = 0,
             points=("tool.tip",), excitation: str = "tool.tip", noise: float = 0.015, phase_deg: float = 0.5,
-            floor: float = 1e-3) -> list[FRF]:
+            floor: float = 1e-3, decay: float = 0.0) -> list[FRF]:
     """FRFs of the rig with the hidden effects, noisy (response at each point, hammer at ``excitation``).
 
     flutes: (length m, diameter ratio) at the tip; springs: (k N/m, x1 m, x2 m) on the spindle;
@@ -119,7 +119,8 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
     through the whole tool [m] (the shank in the holder too); bearing_moved, (index, position m) of one
     bearing placed elsewhere than the model says (with ``bearings``); spindle_body, (mass kg, rotary inertia
     kg m^2, x m) of a body on the spindle (a pulley, a rotary union at its rear end); sensor_below, how far below the
-    tool's tip the sensor of ``sensor_kg`` sits [m] (a sensor cannot sit on the cutting edge).
+    tool's tip the sensor of ``sensor_kg`` sits [m] (a sensor cannot sit on the cutting edge); decay, ``1 / tau`` [1/s]
+    of an exponential window the rig is measured through (the FRF at the angular frequency ``omega - i / tau``).
     """
     cb = fe.Material(tool_E, tool_nu, tool_rho, 0.002)
     m = fe.Model()
@@ -192,7 +193,7 @@ def measure(sensor_kg: float = 0.0, flutes: tuple[float, float] | None = None,
     for p in points:
         comp, x = _offset(p, lengths[p.split(".")[0].split("@")[0]])
         outputs.append((beams[comp], x, "y"))
-    h_all = m.receptance(GRID.hz, outputs, [hammer])
+    h_all = m.receptance(GRID.hz, outputs, [hammer], decay=decay)
     out = []
     for i, p in enumerate(points):
         h_true = h_all[:, i : i + 1, :]

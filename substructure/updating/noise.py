@@ -91,6 +91,8 @@ NOISE_DOMINATED = 0.1
 CORRELATION_Z = 4.0
 """How many standard errors above that of independent lines the correlation of neighbouring lines' smoothing
 residuals must lie to be taken as the noise's own (:func:`estimate_noise`)."""
+DETECT_WINDOW = 13
+"""The narrowest smoothing window [lines] whose residual the noise's correlation is read from."""
 WINDOW_X_MAX = 20.0
 """The shortest exponential window the data's own correlation is read as, ``T / tau`` (1e-9 of the response
 left at the record's end); a residual more correlated than that is not noise (:func:`estimate_noise`)."""
@@ -473,7 +475,7 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     tau = _equivalent_tau(*seen)
     if tau is None:
         return model
-    model, _ = _estimate(measured, model.window, polyorder, coherence, averages, force_noise, force_window_s,
+    model, _ = _estimate(measured, window or seen[2], polyorder, coherence, averages, force_noise, force_window_s,
                          estimator, truncation, tau)
     return attrs.evolve(model, seen_tau=tau)
 
@@ -579,8 +581,13 @@ def _estimate(measured: FRF, window, polyorder: int, coherence, averages, force_
     with np.errstate(invalid="ignore"):
         spike = usable & np.isfinite(z) & (z / local > _TRIM / 2)
     own = np.abs(q_local) ** 2 / (1.0 - h0) ** 2
-    with np.errstate(divide="ignore", invalid="ignore"):  # the residual in units of its noise, for _equivalent_tau
-        whitened = (q_local.real / np.sqrt((1 - h0) * v_re), q_local.imag / np.sqrt((1 - h0) * v_im))
+    # the residual in units of its noise, for _equivalent_tau: about a smoother of at least DETECT_WINDOW lines (a
+    # narrower one follows a correlated noise nearly whole; its misfit of a sharp resonance stays in a few blocks)
+    w_seen = max(w, min(DETECT_WINDOW, n if n % 2 else n - 1))
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        q_seen = q_local if w_seen == w else _best_domain_residual(clean, h, np.log(
+            h / smooth(clean, window=w_seen, polyorder=polyorder).data[:, 0, 0]), usable, w_seen, polyorder)
+        whitened = (q_seen.real / np.sqrt(v_re), q_seen.imag / np.sqrt(v_im))
     v_re, v_im = (np.where(spike, np.maximum(v, own), v) for v in (v_re, v_im))
     # lines where the additive noise (the floor's, and the response's noise that the coherence term
     # carries) is as large as the signal: the log of the data is biased and heavy-tailed there, and
@@ -643,7 +650,9 @@ def _estimate(measured: FRF, window, polyorder: int, coherence, averages, force_
                        local_scale=local, outliers=int(spike.sum()), coherence_factor=coherence_factor,
                        linear=(hs, lin_re, lin_im), dof=dof,
                        correlation=window_correlation(window_tau, spacing))
-    return model, (whitened, usable & np.isfinite(z) & ~spike & ~linear, w, polyorder, spacing)
+    valid = usable & np.isfinite(z) & ~spike & ~linear
+    valid[: w_seen] = valid[n - w_seen:] = False
+    return model, (whitened, valid, w_seen, polyorder, spacing)
 
 
 def _residual_lag1(w: int, polyorder: int, u: float | None) -> float:
