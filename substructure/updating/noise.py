@@ -94,8 +94,8 @@ residuals must lie to be taken as the noise's own (:func:`estimate_noise`)."""
 DETECT_WINDOW = 13
 """The narrowest smoothing window [lines] whose residual the noise's correlation is read from."""
 WINDOW_X_MAX = 20.0
-"""The shortest exponential window the data's own correlation is read as, ``T / tau`` (1e-9 of the response
-left at the record's end); a residual more correlated than that is not noise (:func:`estimate_noise`)."""
+"""The shortest exponential window the data's own correlation is read as, ``T / tau`` (exp(-20) of the response
+left at the record's end, about 2e-9); a residual more correlated than that is not noise (:func:`estimate_noise`)."""
 COHERENCE_MIN = 1e-3
 """Smallest coherence used in the variance of an H1 estimate (a line below it carries no information)."""
 
