@@ -382,8 +382,7 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
             report = list(report) + [words.windowed(which, tau, float(hz[0]), float(hz[-1]), m.noise.correlation,
                                                     lacking)]
         elif m.noise.seen_tau is not None:
-            report = list(report) + [words.correlated(which, m.noise.seen_tau, float(hz[0]), float(hz[-1]),
-                                                      m.noise.correlation)]
+            report = list(report) + [words.correlated(which, m.noise, float(hz[0]), float(hz[-1]))]
         cut = getattr(m.measurement, "truncation", None)
         if cut is not None:  # on the measurement's own lines: those of the band
             full = m.measurement.frf.frequency.hz

@@ -381,32 +381,26 @@ def windowed(which: str, tau: float, lo_hz: float, hi_hz: float, lines: float, l
             "the taps' end counted as noise instead; taps long enough for the response to die out need no window)")
 
 
-def correlated(which: str, tau: float, lo_hz: float, hi_hz: float, lines: float) -> str:
+def correlated(which: str, noise, lo_hz: float, hi_hz: float) -> str:
     """The note that a measurement's noise is correlated over neighbouring lines though it says of no window.
 
     Parameters
     ----------
     which : str
         The measurement (``response / excitation``).
-    tau : float
-        The time constant [s] of the exponential window that would correlate the noise as much
-        (``NoiseModel.seen_tau``).
+    noise : NoiseModel
+        Its noise, with ``seen_tau`` set (:meth:`~substructure.updating.NoiseModel.seen_note`).
     lo_hz, hi_hz : float
-        The band's ends [Hz].
-    lines : float
-        How many times fewer lines the tests count (``NoiseModel.correlation``).
+        The band's ends, at which the window's damping ratio is quoted [Hz].
 
     Returns
     -------
     str
         One line.
     """
-    zeta = [f"{1.0 / (tau * 2.0 * math.pi * f):.2g} at {f:.4g} Hz" for f in (lo_hz, hi_hz)]
-    return (f"{which}: its noise is correlated over neighbouring lines (seen in its own scatter, as an exponential "
-            f"window of tau = {tau:.3g} s would correlate it), so the tests count its lines as {lines:.3g} times "
-            "fewer; if the analyser applied an exponential window, give its time constant (window_tau_s in the "
-            f"measurement set): it adds the damping ratio 1/(tau omega) to every mode ({zeta[0]} to {zeta[1]} for "
-            "this one), which the model lacks")
+    zeta = [f"{1.0 / (noise.seen_tau * 2.0 * math.pi * f):.2g} at {f:.4g} Hz" for f in (lo_hz, hi_hz)]
+    return (noise.seen_note(which) + f": it adds the damping ratio 1/(tau omega) to every mode ({zeta[0]} to "
+            f"{zeta[1]} for this one), which the model lacks")
 
 
 def truncated(which: str, error: float, at_hz: float) -> str:

@@ -393,10 +393,7 @@ class JointIdentifier:
                 self.std_[p] = float("nan")
         notes += [_bound_note(p, self.values_[p], side, self.search_[p], specs[p].log)
                   for p, side in self.at_bound_.items()]
-        notes += [f"{m.label}: its noise is correlated over neighbouring lines (seen in its own scatter, as an "
-                  f"exponential window of tau = {m.noise.seen_tau:.3g} s would correlate it), counted as "
-                  f"{m.noise.correlation:.3g} times fewer lines; if the analyser applied that window, give its time "
-                  "constant (window_tau_s): its damping 1/(tau omega) is otherwise taken for the joint's"
+        notes += [m.noise.seen_note(m.label) + ": its damping 1/(tau omega) is otherwise taken for the joint's"
                   for m in lik.measured if m.noise.seen_tau is not None]
         self.band_ = band
         self.cost_ = float(result.chi2)

@@ -170,6 +170,24 @@ class NoiseModel:
     correlation: float = 1.0
     seen_tau: float | None = None
 
+    def seen_note(self, which: str) -> str:
+        """The note that the data's own scatter shows the noise correlated (:attr:`seen_tau` set), and what to give.
+
+        Parameters
+        ----------
+        which : str
+            The measurement (``response / excitation``).
+
+        Returns
+        -------
+        str
+            One clause, which the diagnosis and the identification end with what the window does to them.
+        """
+        return (f"{which}: its noise is correlated over neighbouring lines (seen in its own scatter, as an exponential "
+                f"window of tau = {self.seen_tau:.3g} s would correlate it), counted as {self.correlation:.3g} times "
+                "fewer lines; if the analyser applied that window, give its time constant (window_tau_s in the "
+                "measurement set)")
+
     @property
     def floor(self) -> float:
         """The RMS log ratio a perfect model would show: ``sqrt(mean(v_re + v_im))``."""
