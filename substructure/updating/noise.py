@@ -171,7 +171,7 @@ class NoiseModel:
     seen_tau: float | None = None
 
     def seen_note(self, which: str) -> str:
-        """The note that the data's own scatter shows the noise correlated (:attr:`seen_tau` set), and what to give.
+        """The note that the data's own scatter shows the noise correlated (``seen_tau`` set), and what to give.
 
         Parameters
         ----------
