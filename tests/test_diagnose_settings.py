@@ -54,7 +54,8 @@ OUT_OF_RANGE = {
     "other_firsts": -1, "pair_seconds": 0, "confirm_firsts": -1,
     "confirm_screen_step": 0, "confirm_named": -1, "other_starts": -1,
     "other_apart": 0.0, "other_apart_std": -3.0, "rivals_checked": -1, "explained_error_factor": 0.9,
-    "partial_gain": -0.1, "calibration": 1.0, "point_reach": -0.001, "tip_share": 1.0, "calibration_hint": (0.01, 1.0),
+    "partial_gain": -0.1, "seen_window": "yes",
+    "calibration": 1.0, "point_reach": -0.001, "tip_share": 1.0, "calibration_hint": (0.01, 1.0),
     "signature_step": 1.0, "signature_window": 1.0, "signature_share": 1.0, "level_bands": 0,
     "level_floors": -2.0, "level_spread": 1.0, "level_in_place": 1.0, "report_bands": 0, "band_merge": 1.0,
     "separation_every": 0,
@@ -74,6 +75,8 @@ def test_a_value_out_of_range_is_refused_naming_the_field(name):
 @pytest.mark.parametrize("name", FIELDS)
 @pytest.mark.parametrize("bad", ["3", True, float("nan"), [object()]], ids=["text", "bool", "nan", "list"])
 def test_a_value_of_the_wrong_type_is_refused_naming_the_field(name, bad):
+    if isinstance(getattr(DEFAULT_SETTINGS, name), bool) and bad is True:
+        bad = 1  # a flag's (seen_window) wrong type is a number
     with pytest.raises(InvalidValueError, match=rf"^DiagnoseSettings\.{name}: "):
         DiagnoseSettings(**{name: bad})
 

@@ -32,12 +32,14 @@ from __future__ import annotations
 import sys
 from typing import Callable, Sequence
 
+import attrs
 import numpy as np
 
 from .._kernels import one_blas_thread
 from ..assembly import Assembly
 from ..errors import InvalidValueError, SubstructureError
 from ..frf import FRF
+from ..measurements.measurement import Measurement
 from ..measurements.measurement_set import measurements_given
 from ..updating.likelihood import Likelihood, measured_frfs
 from ..updating.structure import assembly_checked
@@ -192,9 +194,19 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     -------
     Diagnosis
         The verdict, the candidates, the refinement and the refined model.
-    """
-    from .report import Explanation, level_signature, separation, unexplained_report, values_text
 
+    Notes
+    -----
+    When the data are not explained and a measurement that declares no
+    window shows its noise correlated as through an exponential window
+    (``NoiseModel.seen_tau``), the data are diagnosed again with each such
+    measurement read as through that window (an analyser's window on the
+    response adds the damping ``1/(tau omega)`` to every mode).  If that
+    explains them, that diagnosis is returned, its report's first line says
+    so and ``Diagnosis.assumed_windows`` lists the windows; otherwise the
+    first, with a line that the window was tried
+    (``DiagnoseSettings.seen_window``).
+    """
     assembly_checked(assembly)
     if isinstance(measurements, FRF):  # one FRF is one measurement (iterated, it was read as FRF[0])
         measurements = [measurements]
@@ -212,7 +224,6 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     budget = settings.budget if isinstance(budget, _FromSettings) else budget
     time_limit = settings.time_limit if isinstance(time_limit, _FromSettings) else time_limit
     max_steps = settings.max_steps if isinstance(max_steps, _FromSettings) else max_steps
-    meter = Budget(budget, time_limit, settings.budget_lines)
     catalogue = _catalogue(effects)
     if progress is True:
         def progress(text):  # noqa: F811 - a printer when asked for
@@ -221,6 +232,35 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
     if hasattr(measurements, "validate"):
         measurements.validate(assembly)
     _refuse_rotations(measurements)
+    first, seen = _diagnose(assembly, measurements, catalogue, band, refine, max_steps, say, open_world,
+                            Budget(budget, time_limit, settings.budget_lines), settings)
+    left = None if time_limit is None else time_limit - first.search["seconds"]
+    if first.explained or not seen or not settings.seen_window or (left is not None and left <= 0):
+        return first
+    # noise correlated as through a window the data do not declare: the response through it too, as an analyser
+    # that windows it makes it (the damping 1/(tau omega) on every mode, which no change of the structure makes)
+    if say:
+        say("the noise reads as through an exponential window the data do not declare; diagnosing again through it")
+    entries = [(_one_entry(m), tau) for m, tau in seen]
+    through, _ = _diagnose(assembly, [m.through_window(tau) if tau else m for m, tau in entries], catalogue, band,
+                           refine, max_steps, say, open_world, Budget(budget, left, settings.budget_lines),
+                           settings)
+    windows = tuple((m.describe(), tau) for m, tau in entries if tau)
+    if not through.explained:
+        return attrs.evolve(first, verdict=attrs.evolve(first.verdict, report=first.report + (
+            words.window_not_enough(windows),)))
+    line = words.window_assumed(windows, first.final_error, first.noise_floor)
+    return attrs.evolve(through, verdict=attrs.evolve(through.verdict, report=(line,) + through.report,
+                                                      assumed_windows=windows),
+                        search={**through.search, "without_window": first.search})
+
+
+def _diagnose(assembly, measurements, catalogue, band, refine, max_steps, say, open_world, meter, settings
+              ) -> tuple[Diagnosis, list]:
+    """One diagnosis of :func:`diagnose`'s checked arguments, and the measured FRF entries (``Measured``), each
+    with the window its noise shows (``seen_tau``) where it declares none (an empty list where none shows one)."""
+    from .report import Explanation, level_signature, separation, unexplained_report, values_text
+
     measured, band = measured_frfs(measurements, band)
     lik = Likelihood(assembly, measured, calibration=settings.calibration)
     floor, floors = lik.floors()
@@ -358,8 +398,8 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
         report.append(words.partial("ambiguous", final_effects))
         sep = sep or rivals[0][1]
         names = tuple(dict.fromkeys(list(names) + [r.name for r, _ in rivals]))
-    search = {**outcome.search, "evaluations": round(meter.used(), 1), "budget": budget,
-              "time_limit_s": time_limit, "seconds": round(meter.elapsed(), 3)}
+    search = {**outcome.search, "evaluations": round(meter.used(), 1), "budget": meter.evaluations,
+              "time_limit_s": meter.seconds, "seconds": round(meter.elapsed(), 3)}
     if not explained:  # the changes the cross-validation dropped, said where the verdict is read
         report = list(report) + [words.held_back(r["effect"], r["where"], r["chi2_with"], r["chi2_without"])
                                  for r in search.get("held_back", []) if not r["predicts"]]
@@ -397,7 +437,8 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
             report = list(report) + [words.estimated_as_h2(which, corrected)]
     if missing is not None:  # where it acts as kept (a point's place at its final value, not its first step's)
         missing = next((f for f in final_effects if f.change.key == missing.change.key), missing)
-    return Diagnosis(
+    seen = [(m, m.noise.seen_tau if getattr(m.measurement, "window_tau", None) is None else None) for m in measured]
+    diagnosis = Diagnosis(
         verdict=Verdict(explained=explained, report=tuple(report),
                         missing_effect=None if missing is None else missing.name,
                         missing_where=None if missing is None else missing.where),
@@ -411,6 +452,17 @@ def diagnose(assembly: Assembly, measurements, effects: str | Sequence = "all", 
                                   rivals=tuple(rivals), equivalents=tuple(equivalents)),
         search=search, settings=settings,
     )
+    return diagnosis, seen if any(tau for _, tau in seen) else []
+
+
+def _one_entry(item) -> Measurement:
+    """The measurement of one FRF entry of the data (a plain FRF's entry, or one of what holds it as ``frf``,
+    made one, on all its lines)."""
+    if isinstance(item.measurement, Measurement):
+        return item.measurement
+    out, inp = item.frf.outputs[0], item.frf.inputs[0]
+    whole = item.measurement if isinstance(item.measurement, FRF) else getattr(item.measurement, "frf", item.frf)
+    return Measurement.from_frf(whole if whole.shape[1:] == (1, 1) else whole.select([out], [inp]), out, inp)
 
 
 def sites(assembly, change, values) -> frozenset:

@@ -223,12 +223,17 @@ class Verdict:
         The first change of the refinement.
     missing_where : str or None
         Where it acts.
+    assumed_windows : tuple of (str, float)
+        The measurements the explanation reads as through an exponential
+        window they do not declare, each with the time constant [s] its
+        noise shows (``DiagnoseSettings.seen_window``); empty when none.
     """
 
     explained: bool
     report: tuple[str, ...] = ()
     missing_effect: str | None = None
     missing_where: str | None = None
+    assumed_windows: tuple[tuple[str, float], ...] = ()
 
 
 @attrs.frozen
@@ -391,6 +396,7 @@ class Diagnosis:
     report = _read("verdict", "report")
     missing_effect = _read("verdict", "missing_effect")
     missing_where = _read("verdict", "missing_where")
+    assumed_windows = _read("verdict", "assumed_windows")
     metric = _read("measures", "metric")
     band = _read("measures", "band")
     noise_floor = _read("measures", "noise_floor")
@@ -440,6 +446,8 @@ class Diagnosis:
             "candidates": [c.to_json() for c in self.candidates],
             "refinement": [s.to_json() for s in self.refinement],
             "missing_where": self.missing_where,
+            "assumed_windows": [{"measurement": which, "window_tau_s": _finite(tau)}
+                                for which, tau in self.assumed_windows],
             "suggestion": self.suggestion,
             "band_hz": list(self.band),
             "final_error": _finite(self.final_error),

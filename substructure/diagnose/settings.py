@@ -82,6 +82,11 @@ def _numbers(lo: float = 0.0, hi: float = math.inf, lo_open: bool = True,
     return check
 
 
+def _flag(instance, attribute, value) -> None:
+    if not isinstance(value, bool):
+        _fail(attribute, value, "True or False")
+
+
 def _tuple(value):
     return tuple(value) if isinstance(value, list) else value
 
@@ -394,6 +399,15 @@ class DiagnoseSettings:
         data match in level only within this range of shares (default
         (0.01, 0.25): 1 % to 25 % above or below throughout) suggests giving
         it: a real test's scale is rarely better than a few per cent.
+    seen_window : bool
+        When a measurement that declares no window shows its noise correlated
+        as through an exponential window (``NoiseModel.seen_tau``) and the data
+        are not explained, diagnose again with each such measurement read as
+        through the window its noise shows (default True).  An analyser that
+        windows the response adds the damping ``1/(tau omega)`` to every mode,
+        which no change of the structure makes; if that explains the data,
+        the diagnosis through the window is returned and its report says so
+        first (``Verdict.assumed_windows``); otherwise the first one.
     partial_gain : float
         An unexplained verdict's partial explanation keeps a change only when
         the error, refitted without it, is higher by at least this share of
@@ -515,6 +529,7 @@ class DiagnoseSettings:
     calibration: float | None = attrs.field(default=None, validator=_number(0.0, 1.0, hi_open=True, optional=True))
     calibration_hint: tuple[float, ...] = attrs.field(default=CALIBRATION_HINT, converter=_tuple,
                                                       validator=_numbers(0.0, 1.0, hi_open=True))
+    seen_window: bool = attrs.field(default=True, validator=_flag)
     partial_gain: float = attrs.field(default=0.05, validator=_number(0.0, lo_open=False))
     signature_step: float = attrs.field(default=1.05, validator=_number(1.0, 2.0))
     signature_window: float = attrs.field(default=0.15, validator=_number(0.0, 1.0, hi_open=True))

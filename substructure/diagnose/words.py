@@ -18,7 +18,8 @@ from typing import Iterable, Sequence
 __all__ = [
     "UNEXPLAINED", "values_text", "left_out", "calibrated", "level_hint",
     "bound_text", "partial", "too_many_changes", "bounded", "on_bound",
-    "not_unique", "tell_apart", "budget_cut", "windowed", "correlated", "outlying", "unexplained", "error_lives",
+    "not_unique", "tell_apart", "budget_cut", "windowed", "correlated", "window_assumed",
+    "window_not_enough", "outlying", "unexplained", "error_lives",
     "error_spread",
     "best_partial", "nothing_improves", "mode_line", "signature_line", "level_line", "separation_text",
     "parameter_values", "summary",
@@ -403,6 +404,49 @@ def correlated(which: str, noise, lo_hz: float, hi_hz: float) -> str:
             f"{zeta[1]} for this one), which the model lacks")
 
 
+def _windows_text(windows: Sequence[tuple[str, float]]) -> str:
+    return "; ".join(f"{which} as through exp(-t/tau), tau = {tau:.3g} s" for which, tau in windows)
+
+
+def window_assumed(windows: Sequence[tuple[str, float]], error: float, floor: float) -> str:
+    """The first line of a verdict explained once the measurements were read through the window their noise shows.
+
+    Parameters
+    ----------
+    windows : sequence of (str, float)
+        Each measurement so read and the time constant [s] its noise's correlation gives (``NoiseModel.seen_tau``).
+    error, floor : float
+        The error the best model left without the window, and the noise floor then.
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    return (f"explained through an exponential window the data do not declare ({_windows_text(windows)}, read "
+            "from the noise's correlation over neighbouring lines): an analyser that windows the response adds the "
+            "damping ratio 1/(tau omega) to every mode, which no change of the structure makes; read without it, the "
+            f"data were not explained (error {error:.4g}, {error / floor:.2g} times the noise floor). Check "
+            "that the analyser applied such a window and give its time constant (window_tau_s in the measurement "
+            "set)")
+
+
+def window_not_enough(windows: Sequence[tuple[str, float]]) -> str:
+    """The note that reading the measurements through the window their noise shows explained them no better.
+
+    Parameters
+    ----------
+    windows : sequence of (str, float)
+        Each measurement so read and the time constant [s] its noise gives.
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    return f"read through the window its noise shows ({_windows_text(windows)}), the data are not explained either"
+
+
 def truncated(which: str, error: float, at_hz: float) -> str:
     """The note that a measurement's taps ended while the response still rang (an error counted as noise).
 
@@ -717,7 +761,8 @@ def parameter_values(found) -> str:
 
 
 def summary(result, model_name: str, measured: int) -> list[str]:
-    """The summary ``substructure diagnose`` prints: the verdict first when unexplained, then the numbers.
+    """The summary ``substructure diagnose`` prints: the verdict first when unexplained (or explained only through a
+    window the data do not declare), then the numbers.
 
     Parameters
     ----------
@@ -734,7 +779,9 @@ def summary(result, model_name: str, measured: int) -> list[str]:
         The lines.
     """
     floor = result.noise_floor
-    lines = [] if result.explained else list(result.report)
+    # an explanation through a window the data do not declare says so first
+    said = 1 if result.explained and result.assumed_windows else 0
+    lines = list(result.report[:said]) if result.explained else list(result.report)
     lines.append(f"model {model_name!r} against {measured} measured FRF(s), "
                  f"{result.band[0]:.0f}-{result.band[1]:.0f} Hz")
     lines.append(f"error ({result.metric}): {result.baseline_error:.4f}; noise floor of the data: {floor:.4f}")
@@ -774,7 +821,7 @@ def summary(result, model_name: str, measured: int) -> list[str]:
             what = "model as given" if step.added is None else f"+ {step.added.name} at {step.added.where}"
             lines.append(f"  step {step.step}: {what:50s} error {step.error:.4f}  chi^2/nu {step.chi2_reduced:.4g}")
     if result.explained:  # an explained verdict's report holds the facts of the data only (a window, an H2, ...)
-        lines.extend(f"note: {line}" for line in result.report)
+        lines.extend(f"note: {line}" for line in result.report[said:])
     cons = result.consistency
     verdict = "explained" if result.explained else "not explained"
     check = result.error_check

@@ -384,6 +384,36 @@ class Measurement:
                  for name in ("coherence", "force_noise", "truncation")}
         return attrs.evolve(self, frf=self.frf.crop(lo, hi), **lines)
 
+    def through_window(self, tau: Any) -> "Measurement":
+        """The same measurement read as through the exponential window ``exp(-t/tau)``, which it did not declare.
+
+        What :meth:`from_frf` would have made with ``window_tau=tau``: a
+        mobility or accelerance is divided again by the complex frequency
+        ``omega - i/tau`` the window saw (a receptance is the same lines).
+
+        Parameters
+        ----------
+        tau : float
+            The window's time constant [s].
+
+        Returns
+        -------
+        Measurement
+            The measurement with ``window_tau`` set.
+
+        Raises
+        ------
+        InvalidValueError
+            For a measurement that declares a window already (its own is kept) or a bad ``tau``.
+        """
+        if self.window_tau is not None:
+            raise InvalidValueError(f"window_tau: {self.describe()} was measured through a window of "
+                                    f"{self.window_tau!r} s already; expected a measurement that declares none")
+        tau = window_tau(tau)
+        unit = attrs.evolve(self.frf, data=np.ones_like(self.frf.data), quantity=self.quantity)
+        ratio = unit.to_receptance(1.0 / tau).data / unit.to_receptance().data  # 1 for a receptance
+        return attrs.evolve(self, frf=attrs.evolve(self.frf, data=self.frf.data * ratio), window_tau=tau)
+
     @property
     def configuration(self) -> Configuration:
         """``(sensors, removed)``, each sorted: what identifies the tested configuration."""

@@ -77,11 +77,16 @@ def diagnosis_verdict(data: dict) -> tuple[str, str]:
     effects = data.get("final_effects") or []
     named = "; ".join(f"{_effect_name(e.get('effect'))} at {e.get('where')} ({_values(e.get('parameters'))})"
                       for e in effects if isinstance(e, dict))
+    windows = [w for w in data.get("assumed_windows") or [] if isinstance(w, dict)]
+    through = "" if not explained or not windows else (
+        " That is with the tap test read through an exponential window (tau = " + ", ".join(
+            f"{w.get('window_tau_s'):.3g} s" if _number(w.get("window_tau_s")) is not None else "?"
+            for w in windows) + ") that its noise shows and its file does not declare: check the analyser's window.")
     if explained and not effects:
-        return "agrees", "The model agrees with the tap test as closely as the test's own scatter allows."
+        return "agrees", "The model agrees with the tap test as closely as the test's own scatter allows." + through
     if explained:
         return "explained", (f"The model misses {named}. With it, the model agrees with the tap test as closely "
-                             "as the test's own scatter allows.")
+                             "as the test's own scatter allows." + through)
     if effects:
         return "unexplained", (f"Not explained: the model does not agree with the tap test, and what the diagnosis "
                                f"found explains it only in part ({named}; partial). Something else is missing.")
