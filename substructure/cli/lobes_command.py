@@ -41,6 +41,27 @@ def _window(args: argparse.Namespace) -> dict | None:
     return taus if any(t is not None for t in taus.values()) else None
 
 
+def _unsaid_windows(args: argparse.Namespace) -> list[str]:
+    """Measured FRF files that declare no window but whose noise is correlated as through an exponential one
+    (``NoiseModel.seen_tau``): read as they are, every mode carries the window's damping."""
+    from ..updating.noise import estimate_noise
+
+    out = []
+    for path in dict.fromkeys(p for p in (args.frf, args.frf_y) if p is not None):
+        try:
+            with warnings.catch_warnings():  # the data's own checks were said when the file was read
+                warnings.simplefilter("ignore")
+                tau = estimate_noise(_read_frf(path).to_receptance()).seen_tau
+        except SubstructureError:  # too few lines to tell: nothing to say
+            continue
+        if tau is not None:
+            out.append(f"{path}: its noise is correlated over neighbouring lines as an exponential window of tau = "
+                       f"{tau:.3g} s would correlate it, and the file declares no window; if the analyser applied "
+                       "one, every mode carries its damping 1/(tau omega) and these lobes promise depths the tool "
+                       f"may not take: give --window-tau (the analyser's value, or {tau:.3g} as read)")
+    return out
+
+
 def _read_frf(path):
     """A measured tool point FRF by its suffix: CSV, a universal file of one type-58 record, or a MATLAB file of
     signal structures (a Testlab export) of one FRF."""
@@ -197,6 +218,10 @@ def run(args: argparse.Namespace) -> int:
     notes: list[str] = []
     if band is not None:
         notes.append(f"structure band: {band.lo_hz:g} to {band.hi_hz:g} Hz ({band.kind}); {band.reason}")
+    if window is None and args.frf is not None and args.window_tau is None:
+        for line in _unsaid_windows(args):
+            notes.append(f"warning: {line}")
+            warnings.warn(line, WindowedFRFWarning, stacklevel=2)
     if window is not None:
         said = ", ".join(f"{d} {t:.4g} s" for d, t in window.tau.items() if t is not None)
         notes.append(f"exponential window: tau {said}; its damping 1/(tau omega) taken out of the "
