@@ -430,8 +430,12 @@ def _diagnose(assembly, measurements, catalogue, band, refine, max_steps, say, o
             if inside.any() and cut[inside].max() > 0:
                 k = int(np.argmax(np.where(inside, cut, -1.0)))
                 report = list(report) + [words.truncated(which, float(np.sqrt(cut[k])), float(full[k]))]
-        if not alive.all():
-            report = list(report) + [words.empty_lines(which, hz[~alive])]
+        held = m.noise.held
+        if m.noise.interpolated is not None and held is not None:
+            report = list(report) + [words.interpolated(which, *m.noise.interpolated, int(held.sum()), held.size)]
+        empty = ~alive if held is None else held & ~alive
+        if empty.any():
+            report = list(report) + [words.empty_lines(which, hz[empty])]
         if getattr(m.measurement, "estimator", None) == "H2":
             corrected = getattr(m.measurement, "coherence", None) is not None
             report = list(report) + [words.estimated_as_h2(which, corrected)]

@@ -18,7 +18,7 @@ from typing import Iterable, Sequence
 __all__ = [
     "UNEXPLAINED", "values_text", "left_out", "calibrated", "level_hint",
     "bound_text", "partial", "too_many_changes", "bounded", "on_bound",
-    "not_unique", "tell_apart", "budget_cut", "windowed", "correlated", "window_assumed",
+    "not_unique", "tell_apart", "budget_cut", "windowed", "correlated", "window_assumed", "interpolated",
     "window_not_enough", "outlying", "unexplained", "error_lives",
     "error_spread",
     "best_partial", "nothing_improves", "mode_line", "signature_line", "level_line", "separation_text",
@@ -511,6 +511,31 @@ def empty_lines(which: str, hz) -> str:
     shown = ", ".join(f"{f:.6g}" for f in hz[:3]) + (", ..." if len(hz) > 3 else "")
     return (f"{which} holds no value on {len(hz)} line{'s' if len(hz) != 1 else ''} of the band ({shown} Hz: zero "
             "or not finite, a dropout or lines an analyser left empty): left out of every comparison")
+
+
+def interpolated(which: str, step: int, degree: int, measured: int, lines: int) -> str:
+    """The note that a measurement's lines are interpolated from every ``step``-th of them, compared on those alone.
+
+    Parameters
+    ----------
+    which : str
+        The measurement (``response / excitation``).
+    step : int
+        Lines from one measured line to the next.
+    degree : int
+        The interpolant's degree between them (0: a value held, 1: straight lines, 3: a cubic spline).
+    measured, lines : int
+        The measured lines in the band, and all its lines.
+
+    Returns
+    -------
+    str
+        One line.
+    """
+    how = {0: "each value held to the next", 1: "straight lines between them", 3: "a cubic spline through them"}
+    return (f"{which}: its lines are interpolated from every {step}th of them ({how.get(degree, f'degree {degree}')}, "
+            f"read from the data): the model is compared on the {measured} measured lines of the {lines} in the "
+            "band, and the noise estimated on them (the lines between hold no measurement of their own)")
 
 
 def estimated_as_h2(which: str, compared_as_h1: bool) -> str:

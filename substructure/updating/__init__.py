@@ -17,7 +17,8 @@ imports the other):
 * :mod:`~substructure.updating.elements`: bodies, springs to the ground and
   section changes at fitted positions;
 * :mod:`~substructure.updating.noise`: the per-line noise of a measured FRF,
-  estimated from the data;
+  estimated from the data (:mod:`~substructure.updating.interpolated`: on
+  the measured lines of an FRF interpolated between them);
 * :mod:`~substructure.updating.likelihood`: ``chi^2`` of whitened complex
   log ratios, each measurement in its configuration;
 * :mod:`~substructure.updating.fit`: weighted nonlinear least squares with
@@ -29,6 +30,7 @@ imports the other):
 from .changes import Change, ParamSpec
 from .elements import AddedMass, GroundSpring, SectionChange
 from .fit import Fit, fit
+from .interpolated import interpolated_from
 from .likelihood import Likelihood, Measured, measured_frfs
 from .noise import NoiseModel, estimate_noise, window_correlation
 from .parameters import (ModelParameter, ParameterChange, ParameterSet, get_parameter, model_parameters,
@@ -40,8 +42,8 @@ from .structure import Structure
 
 __all__ = [
     "Change", "ParamSpec", "AddedMass", "GroundSpring", "SectionChange", "Fit", "fit", "Likelihood", "Measured",
-    "measured_frfs", "NoiseModel", "estimate_noise", "window_correlation", "ModelParameter", "ParameterChange",
-    "ParameterSet",
+    "measured_frfs", "NoiseModel", "estimate_noise", "window_correlation", "interpolated_from", "ModelParameter",
+    "ParameterChange", "ParameterSet",
     "get_parameter", "model_parameters", "set_parameters", "apply_path_si", "Consistency", "ErrorCheck",
     "Significance", "consistency", "error_check", "indifferent", "significance", "Evaluator", "Structure",
 ]

@@ -342,7 +342,9 @@ class Likelihood:
     ----------
     alive : list of ndarray of bool
         Per measured FRF, on ``lines``: the lines it holds a value on (not
-        zero, finite).  The others are left out of every comparison.
+        zero, finite) that were measured (``NoiseModel.held``: not
+        interpolated between measured lines).  The others are left out of
+        every comparison.
     """
 
     def __init__(self, assembly, measured: Sequence[Measured], lines: np.ndarray | None = None,
@@ -362,7 +364,9 @@ class Likelihood:
         self.data = [m.frf.data[self.lines, 0, 0] for m in self.measured]
         # the lines each FRF holds: a line of zero or not finite (a dropout, a line an analyser left empty) says
         # nothing of the structure, and is left out (no weight, no degree of freedom, no share of an error)
-        self.alive = [np.isfinite(d) & (d != 0) for d in self.data]
+        # lines interpolated between measured ones (NoiseModel.held) are the interpolant's, not data
+        self.alive = [np.isfinite(d) & (d != 0) & (True if m.noise.held is None else m.noise.held[self.lines])
+                      for d, m in zip(self.data, self.measured)]
         # lines whose noise is correlated (through an exponential window, NoiseModel.correlation) weigh as that
         # many times fewer lines: a fit's uncertainty and a comparison of chi^2 count what the data hold
         self.w_re = [np.where(a, 1.0 / np.sqrt(m.noise.correlation * m.noise.var_re[self.lines]), 0.0)

@@ -68,9 +68,10 @@ from scipy.optimize import minimize
 from scipy.signal import savgol_coeffs
 
 from ..errors import InvalidValueError
-from ..frf import FRF
+from ..frf import FRF, Frequency
 from ..frf._fields import window_tau as window_tau_s
 from ..smoothing import choose_window, smooth
+from .interpolated import interpolated_from, on_every_line
 
 __all__ = ["NoiseModel", "estimate_noise", "window_correlation", "VARIANCE_CAP"]
 
@@ -153,6 +154,15 @@ class NoiseModel:
         noise correlated over neighbouring lines: the time constant [s] of
         the exponential window that would correlate it as much (its
         ``correlation`` is that window's); None otherwise.
+    held : ndarray of bool, optional
+        For an FRF interpolated from every ``step``-th of its lines
+        (:func:`~substructure.updating.interpolated_from`): the
+        lines measured, on which the noise was estimated and the model is
+        compared (the others carry their nearest measured line's noise);
+        None when every line is a measurement.
+    interpolated : (int, int) or None
+        ``(step, degree)`` of that interpolation (degree 0: a value held,
+        1: straight lines, 3: a cubic spline); None without one.
     """
 
     var_re: np.ndarray = attrs.field(eq=False, repr=False)
@@ -169,6 +179,8 @@ class NoiseModel:
     dof: np.ndarray | None = attrs.field(default=None, eq=False, repr=False)
     correlation: float = 1.0
     seen_tau: float | None = None
+    held: np.ndarray | None = attrs.field(default=None, eq=False, repr=False)
+    interpolated: tuple[int, int] | None = None
 
     def seen_note(self, which: str) -> str:
         """The note that the data's own scatter shows the noise correlated (``seen_tau`` set), and what to give.
@@ -209,8 +221,9 @@ class NoiseModel:
         local = None if self.local_scale is None else self.local_scale[mask]
         linear = None if self.linear is None else tuple(part[mask] for part in self.linear)
         dof = None if self.dof is None else self.dof[mask]
+        held = None if self.held is None else self.held[mask]
         return attrs.evolve(self, var_re=self.var_re[mask], var_im=self.var_im[mask], scatter=self.scatter[mask],
-                            local_scale=local, linear=linear, dof=dof)
+                            local_scale=local, linear=linear, dof=dof, held=held)
 
     def line_scores(self, ratios: np.ndarray, lines=None) -> np.ndarray:
         """Per line, half the squared whitened residual (exponential with mean 1 for noise).
@@ -485,7 +498,27 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
         underflows (below 1e-140), a coherence or force noise of the wrong
         length, or a force noise without the window's length, a truncation
         of the wrong length or negative.
+
+    Notes
+    -----
+    An FRF interpolated from every ``step``-th of its lines (straight lines,
+    a cubic spline or a value held between them, found in the data by
+    :func:`~substructure.updating.interpolated_from`) has its
+    noise estimated on those lines alone; ``NoiseModel.held`` marks them,
+    and the comparisons keep them.
     """
+    lines, n = (coherence, force_noise, truncation), measured.frequency.n
+    found = (interpolated_from(measured.data[:, 0, 0]) if measured.shape[1:] == (1, 1)
+             and all(a is None or np.size(a) == n for a in lines) else None)
+    knots = None if found is None else np.arange(found[1], n, found[0])
+    if knots is not None and knots.size >= polyorder + 8:  # the noise of the measured lines, which are compared
+        coherence, force_noise, truncation = (None if a is None else np.asarray(a)[knots] for a in lines)
+        sub = FRF(Frequency.from_hz(measured.frequency.hz[knots]), measured.data[knots], measured.outputs,
+                  measured.inputs, measured.quantity)
+        model = estimate_noise(sub, window, polyorder, coherence=coherence,
+                               averages=averages, force_noise=force_noise, force_window_s=force_window_s,
+                               estimator=estimator, truncation=truncation, window_tau=window_tau)
+        return on_every_line(model, knots, n, found[0], found[2])
     model, seen = _estimate(measured, window, polyorder, coherence, averages, force_noise, force_window_s,
                             estimator, truncation, window_tau)
     if window_tau is not None or seen is None or force_noise is not None or truncation is not None:
