@@ -20,7 +20,7 @@ import numpy as np
 from .._files import MAX_DATA_BYTES, file_name, read_text, relative_path
 from .._files import check_file as check_readable_file
 from .._toml import TomlDocument, loads_toml
-from ..errors import FileFormatError, InvalidValueError, SubstructureError, SubstructureWarning
+from ..errors import FileFormatError, InvalidValueError, SubstructureError, SubstructureWarning, WindowedFRFWarning
 from ..frf import FRF, QUANTITIES, Frequency
 from ..frf.axis import ROUNDED_STEP_SHARE, rounded_uniform
 from ..frf.files._common import _beyond_physical
@@ -311,7 +311,12 @@ class _Reader:
         estimator = self.choice(table, index, "estimator", ESTIMATORS)
         coherence_record = self.integer(table, index, "coherence_record", 0,
                                         "the 0-based index of the type-58 coherence record")
-        raw, columns, window = self.data(index, file, record, quantity, response, excitation)
+        with warnings.catch_warnings(record=True) as caught:  # a file's window the entry gives is said no more
+            warnings.simplefilter("always", WindowedFRFWarning)
+            raw, columns, window = self.data(index, file, record, quantity, response, excitation)
+        for item in caught:
+            if tau is None or not issubclass(item.category, WindowedFRFWarning):
+                warnings.warn_explicit(item.message, item.category, item.filename, item.lineno)
         if window is not None:  # the data file says it was measured through the window: it travels with the data
             if tau is None:
                 tau = window

@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import os
 import re
+import warnings
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ...errors import FileFormatError, InvalidValueError
+from ...errors import FileFormatError, InvalidValueError, WindowedFRFWarning
 from .._fields import QUANTITIES
 from ..axis import Frequency
 from ._common import _GRID_LINE, coherence_checked, frf_class
@@ -225,6 +226,14 @@ def read_uff(path: str | os.PathLike, record: int | None = None, quantity: str |
         0), a record that does not say its quantity (when ``quantity`` is not
         given) or contradicts itself.
 
+    Warns
+    -----
+    WindowedFRFWarning
+        For records whose qualifiers (a type-1858 record right before each)
+        say an exponential window (window type 4 or 6): the file does not
+        give its time constant, and the FRF is read as it is, every mode
+        with the window's damping.
+
     Notes
     -----
     The quantity and the units come from the record (UFF 58, records 8-10):
@@ -266,8 +275,10 @@ def read_uff(path: str | os.PathLike, record: int | None = None, quantity: str |
             )
     units = [k for k, t in enumerate(types) if t == 164]
     chosen = range(len(positions)) if record is None else [int(record)]
-    parsed = []
+    parsed, windowed = [], []
     for number in chosen:
+        if _exponential_window(uff, types, positions[number]):
+            windowed.append(number)
         system = None
         before = [k for k in units if k < positions[number]]
         try:
@@ -281,10 +292,31 @@ def read_uff(path: str | os.PathLike, record: int | None = None, quantity: str |
             raise FileFormatError(f"{name}, type-58 record {number}: cannot read it ({exc})") from None
         frfs = _frfs_beside(uff, positions, number, dset) if record is None else []
         parsed.append((number, *_parse_record(dset, name, number, quantity, system, frfs)))
+    if windowed:
+        warnings.warn(f"{name}: type-58 record(s) {', '.join(map(str, windowed))} measured through an exponential "
+                      "window (the 1858 record before each says so), whose time constant the file does not give: "
+                      "every mode carries the window's damping 1/(tau omega), which raises stability limits; give "
+                      "the analyser's value (window_tau_s in a measurement set, --window-tau for lobes); diagnose "
+                      "reads it from the noise where the noise shows it", WindowedFRFWarning, stacklevel=3)
     if len(parsed) == 1:
         _, frequency, data, output, input_, kind = parsed[0]
         return frf_class().single(frequency, data, output=output, input=input_, quantity=kind)
     return _assemble(parsed, name)
+
+
+_EXPONENTIAL = (4, 6)  # the window types of a type-1858 record that are exponential (alone, or with a force window)
+
+
+def _exponential_window(uff, types: list[int], position: int) -> bool:
+    """Whether the type-1858 record right before a type-58 one (its qualifiers, as some analysers write them) says
+    the function was measured through an exponential window; False without one, or one that cannot be read."""
+    if position == 0 or types[position - 1] != 1858:
+        return False
+    try:
+        qualifiers = uff.read_sets(position - 1)
+        return int(qualifiers.get("window_type", 0)) in _EXPONENTIAL
+    except Exception:  # pyuff raises bare Exception; the qualifiers are not needed to read the function
+        return False
 
 
 _RECORD_TYPES = {15: "nodes", 18: "coordinate systems", 55: "data at nodes (modes)", 58: "functions",
