@@ -110,3 +110,19 @@ def test_a_softer_joint_on_interpolated_data_is_found_alone():
     (found,) = d.effects
     assert (found.name, found.where) == ("joint-stiffness", "holder-tool")
     assert found.values["k_yf"] == pytest.approx(0.7 * 1.43e7, rel=0.03)
+
+
+@pytest.mark.parametrize("quantity", ["accelerance", "mobility"])
+@pytest.mark.parametrize("tau", [None, 0.1])
+def test_an_interpolated_accelerance_or_mobility_is_read_as_such_once_a_receptance(exact, quantity, tau):
+    """Analysers export accelerances: interpolated as such, then divided by ``-omega^2`` (or ``i omega``; at
+    ``omega - i/tau`` through a window) into the receptance compared, whose lines are no interpolant."""
+    from substructure.measurements import Measurement
+
+    coarse = _coarse(exact, 4, 6)
+    s = coarse.frequency.omega - (1j / tau if tau else 0.0)
+    factor = -(s**2) if quantity == "accelerance" else 1j * s
+    given = FRF(coarse.frequency, coarse.data * factor[:, None, None], coarse.outputs, coarse.inputs,
+                quantity=quantity)
+    m = Measurement.from_frf(_fine(given, 4, "cubic"), "tool.tip", "tool.tip", window_tau=tau)
+    assert estimate_noise(m.frf, window_tau=tau).interpolated == (4, 3)

@@ -508,7 +508,7 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     and the comparisons keep them.
     """
     lines, n = (coherence, force_noise, truncation), measured.frequency.n
-    found = (interpolated_from(measured.data[:, 0, 0]) if measured.shape[1:] == (1, 1)
+    found = (_interpolated(measured, window_tau) if measured.shape[1:] == (1, 1)
              and all(a is None or np.size(a) == n for a in lines) else None)
     knots = None if found is None else np.arange(found[1], n, found[0])
     if knots is not None and knots.size >= polyorder + 8:  # the noise of the measured lines, which are compared
@@ -529,6 +529,22 @@ def estimate_noise(measured: FRF, window: int | None = None, polyorder: int = 3,
     model, _ = _estimate(measured, window or seen[2], polyorder, coherence, averages, force_noise, force_window_s,
                          estimator, truncation, tau)
     return attrs.evolve(model, seen_tau=tau)
+
+
+def _interpolated(measured: FRF, window_tau) -> tuple[int, int, int] | None:
+    """:func:`interpolated_from` of the FRF as given, or as the mobility or accelerance a receptance was read from
+    (interpolated before it was divided by ``i omega`` or ``-omega^2``, at ``omega - i/tau`` through a window)."""
+    try:
+        decay = 0.0 if window_tau is None else 1.0 / window_tau_s(window_tau)
+    except InvalidValueError:  # said where the window is used
+        decay = 0.0
+    s = measured.frequency.omega - 1j * decay
+    h = measured.data[:, 0, 0]
+    for factor in (None, 1j * s, -(s**2)):
+        found = interpolated_from(h if factor is None else h * factor)
+        if found is not None:
+            return found
+    return None
 
 
 def _estimate(measured: FRF, window, polyorder: int, coherence, averages, force_noise, force_window_s,
