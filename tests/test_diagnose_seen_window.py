@@ -148,3 +148,11 @@ def test_lobes_from_a_file_whose_noise_shows_an_undeclared_window_warn_and_name_
     assert main(["lobes", "--frf", str(tmp_path / "windowed.csv"), "--window-tau", "0.1", *LOBES]) == 0
     out, err = capsys.readouterr()
     assert "declares no window" not in out + err and "exponential window: tau" in out
+
+
+@pytest.mark.parametrize("hostile", [5, "abc", [1, None], {"window_tau_s": 0.1}, [{"window_tau_s": "x"}], None])
+def test_the_report_page_reads_a_hostile_assumed_windows_key_without_error(hostile):
+    """A diagnosis JSON edited by hand: the page's sentence says what it can and never fails."""
+    word, sentence = diagnosis_verdict({"explained": True, "noise_floor": 0.02, "final_error": 0.02,
+                                        "assumed_windows": hostile})
+    assert word == "agrees" and ("tau = ?" in sentence) == (hostile == [{"window_tau_s": "x"}])

@@ -77,11 +77,12 @@ def diagnosis_verdict(data: dict) -> tuple[str, str]:
     effects = data.get("final_effects") or []
     named = "; ".join(f"{_effect_name(e.get('effect'))} at {e.get('where')} ({_values(e.get('parameters'))})"
                       for e in effects if isinstance(e, dict))
-    windows = [w for w in data.get("assumed_windows") or [] if isinstance(w, dict)]
-    through = "" if not explained or not windows else (
-        " That is with the tap test read through an exponential window (tau = " + ", ".join(
-            f"{w.get('window_tau_s'):.3g} s" if _number(w.get("window_tau_s")) is not None else "?"
-            for w in windows) + ") that its noise shows and its file does not declare: check the analyser's window.")
+    assumed = data.get("assumed_windows")
+    taus = [_number(w.get("window_tau_s")) for w in assumed if isinstance(w, dict)] if isinstance(assumed, list) else []
+    through = "" if not explained or not taus else (
+        " That is with the tap test read through an exponential window (tau = "
+        + ", ".join("?" if t is None else f"{t:.3g} s" for t in taus)
+        + ") that its noise shows and its file does not declare: check the analyser's window.")
     if explained and not effects:
         return "agrees", "The model agrees with the tap test as closely as the test's own scatter allows." + through
     if explained:
