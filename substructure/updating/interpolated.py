@@ -58,11 +58,12 @@ def interpolated_from(values: np.ndarray) -> tuple[int, int, int] | None:
     h = np.asarray(values, dtype=complex).ravel()
     if h.size < 3 or not np.all(np.isfinite(h)):
         return None
-    size = np.abs(h)
-    for exact in (ROUNDING, EXACT):  # values as computed (a smooth spline's knots show only there), then as written
-        found = _interpolant(h, size, exact)
-        if found is not None:
-            return found
+    with np.errstate(over="ignore", invalid="ignore"):  # values beyond any structure: no interpolant read
+        size = np.abs(h)
+        for exact in (ROUNDING, EXACT):  # values as computed (a smooth spline's knots show only there), as written
+            found = _interpolant(h, size, exact)
+            if found is not None:
+                return found
     return None
 
 

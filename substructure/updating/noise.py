@@ -541,7 +541,8 @@ def _interpolated(measured: FRF, window_tau) -> tuple[int, int, int] | None:
     s = measured.frequency.omega - 1j * decay
     h = measured.data[:, 0, 0]
     for factor in (None, 1j * s, -(s**2)):
-        found = interpolated_from(h if factor is None else h * factor)
+        with np.errstate(over="ignore", invalid="ignore"):  # beyond any structure: refused with its range after
+            found = interpolated_from(h if factor is None else h * factor)
         if found is not None:
             return found
     return None
