@@ -126,3 +126,13 @@ def test_an_interpolated_accelerance_or_mobility_is_read_as_such_once_a_receptan
                 quantity=quantity)
     m = Measurement.from_frf(_fine(given, 4, "cubic"), "tool.tip", "tool.tip", window_tau=tau)
     assert estimate_noise(m.frf, window_tau=tau).interpolated == (4, 3)
+
+
+@pytest.mark.parametrize("values", [np.full(200, 1e-6 + 0j), np.linspace(1.0, 2.0, 200) + 0j, np.zeros(200, complex),
+                                    np.array([1.0, np.nan, 2.0] * 60, complex), np.ones(2, complex),
+                                    np.full(200, 1e300 - 1e300j), np.array([], complex)],
+                         ids=["constant", "a straight line", "zeros", "not finite", "two lines", "huge", "empty"])
+def test_values_that_say_nothing_of_measured_lines_read_as_none(values):
+    """A constant or one straight line is no interpolant between knots (every difference vanishes, across too);
+    values that are not finite, too few or beyond any structure say nothing, without error."""
+    assert interpolated_from(values) is None
